@@ -1,0 +1,350 @@
+//! The typed contact specification: what a deck means, independent of how it was spelled.
+//!
+//! Both front ends produce it: the Sierra-syntax parser ([`super::parse_sierra`]) and the
+//! TOML reader ([`super::parse_toml`]). TOML keys are the canonical snake_case names of
+//! the deck phrases (`Skin All Blocks` → `skin_all_blocks`). Names of blocks, side sets,
+//! node sets and surfaces are stored lower-case (Sierra names are case-insensitive);
+//! file names keep their case. `at` fields carry the deck location for later messages
+//! and are not part of the TOML form.
+
+use serde::{Deserialize, Serialize};
+
+use crate::diag::Loc;
+
+/// Everything in one deck file.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Deck {
+    #[serde(default, rename = "contact_definition")]
+    pub contact_definitions: Vec<ContactDefinition>,
+}
+
+/// `begin Contact Definition [name]` … `end`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactDefinition {
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Surface-making commands in deck order: order decides ownership.
+    #[serde(default, rename = "surface")]
+    pub surfaces: Vec<SurfaceDef>,
+    #[serde(default)]
+    pub restrict_contact_to_subdomain: Option<Subdomain>,
+    #[serde(default)]
+    pub visualize_contact: bool,
+    #[serde(default)]
+    pub output_rule: Option<OutputRule>,
+    #[serde(default)]
+    pub update_search_every_n_steps: Option<u32>,
+    #[serde(default)]
+    pub opposed_normal_threshold_angle: Option<f64>,
+    #[serde(default)]
+    pub disable_opposed_normal_interaction_culling: bool,
+    #[serde(default)]
+    pub periodicity: Vec<Periodicity>,
+    #[serde(default, rename = "enforcement")]
+    pub enforcements: Vec<Enforcement>,
+    #[serde(default, rename = "interaction")]
+    pub interactions: Vec<Interaction>,
+    #[serde(default)]
+    pub interaction_defaults: Option<InteractionDefaults>,
+    #[serde(default)]
+    pub search_options: Option<SearchOptions>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// One surface-making command. Commands are applied in this order; the first one that
+/// includes a face (or node) owns it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SurfaceDef {
+    /// `Contact Surface S Contains a b …`: blocks (skinned), side sets or assemblies by name.
+    Contains {
+        name: String,
+        contains: Vec<String>,
+        #[serde(skip)]
+        at: Loc,
+    },
+    /// `Contact Node Set S Contains ns …`.
+    NodeSet {
+        name: String,
+        contains: Vec<String>,
+        #[serde(skip)]
+        at: Loc,
+    },
+    /// `Skin All Blocks = On [Exclude b …]`: one surface per block, named after it.
+    SkinAllBlocks {
+        #[serde(default)]
+        exclude: Vec<String>,
+        #[serde(skip)]
+        at: Loc,
+    },
+    /// `begin Contact Surface S` … `end`.
+    Block(SurfaceBlock),
+}
+
+impl SurfaceDef {
+    pub fn at(&self) -> &Loc {
+        match self {
+            SurfaceDef::Contains { at, .. }
+            | SurfaceDef::NodeSet { at, .. }
+            | SurfaceDef::SkinAllBlocks { at, .. } => at,
+            SurfaceDef::Block(b) => &b.at,
+        }
+    }
+}
+
+/// `begin Contact Surface S` with its line commands.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceBlock {
+    pub name: String,
+    #[serde(default)]
+    pub include_all_blocks: bool,
+    /// `Block = …` (skinned).
+    #[serde(default, rename = "block")]
+    pub blocks: Vec<String>,
+    /// `Element = ids…`: the exterior faces of these elements (user element numbers).
+    #[serde(default, rename = "element")]
+    pub elements: Vec<i64>,
+    /// `Surface = …`: side sets.
+    #[serde(default, rename = "surface")]
+    pub side_sets: Vec<String>,
+    #[serde(default, rename = "assembly")]
+    pub assemblies: Vec<String>,
+    #[serde(default, rename = "remove_block")]
+    pub remove_blocks: Vec<String>,
+    #[serde(default, rename = "remove_surface")]
+    pub remove_surfaces: Vec<String>,
+    #[serde(default, rename = "subset")]
+    pub subsets: Vec<Subset>,
+    #[serde(default)]
+    pub auto_subset: Option<AutoSubset>,
+    #[serde(default)]
+    pub contact_type: ContactType,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// `Subset name With Normal nx ny nz`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Subset {
+    pub name: String,
+    pub normal: [f64; 3],
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// `Auto Subset name [Number Of Subsets n] [Angle a]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AutoSubset {
+    pub name: String,
+    #[serde(default)]
+    pub number_of_subsets: Option<u32>,
+    /// Degrees; default 60.
+    #[serde(default)]
+    pub angle: Option<f64>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// `Contact Type = Face | Node`: whether the surface is made of faces or of their nodes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContactType {
+    #[default]
+    Face,
+    Node,
+}
+
+/// `Restrict Contact To Subdomain Defined By Radius r And Point x y z`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Subdomain {
+    pub radius: f64,
+    pub point: [f64; 3],
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OutputRule {
+    None,
+    Summary,
+    Verbose,
+    MoreVerbose,
+}
+
+/// `Periodicity For S = …`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Periodicity {
+    pub surface: String,
+    pub transform: PeriodicTransform,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum PeriodicTransform {
+    Rectangular {
+        offset: Vec<f64>,
+    },
+    Cylindrical {
+        axis: Vec<f64>,
+        center: Vec<f64>,
+        /// Degrees.
+        angle: f64,
+    },
+    AlignSurface {
+        destination: String,
+        #[serde(default = "default_true")]
+        invert_normals: bool,
+    },
+    /// Each map is a Lua expression in x, y, z or the name of a function in a Lua file.
+    Mapped {
+        x_map: String,
+        y_map: String,
+        #[serde(default)]
+        z_map: Option<String>,
+    },
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// `begin Enforcement [name]` … `end`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Enforcement {
+    #[serde(default)]
+    pub name: Option<String>,
+    /// `Enforcement for EQ = MODEL args…`, one per equation.
+    #[serde(default, rename = "model")]
+    pub models: Vec<EnforcementModel>,
+    /// `[Material Property] = [Model] [args…]` lines, e.g. `Gap Conductance Coefficient = Constant H = 10`.
+    #[serde(default, rename = "property")]
+    pub properties: Vec<PropertyModel>,
+    #[serde(default)]
+    pub integer_data: Vec<i64>,
+    #[serde(default)]
+    pub real_data: Vec<f64>,
+    /// `Side B Variable b To a` (deprecated alias `Slave Variable`).
+    #[serde(default)]
+    pub side_b_variable: Option<VariableMap>,
+    #[serde(default)]
+    pub dash_penalty_factor: Option<f64>,
+    #[serde(default)]
+    pub offset_temperature: Option<f64>,
+    #[serde(default)]
+    pub use_toggle_block: Option<String>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnforcementModel {
+    /// Equation, lower case (`energy`, `current`, …).
+    pub equation: String,
+    /// Model, lower case (`gap_conductance`, `tied_temperature`, `plugin`, …).
+    pub model: String,
+    /// The remaining words of the line, as `key = value` pairs where the deck wrote them
+    /// so and as bare words (key without value) otherwise.
+    #[serde(default)]
+    pub args: Vec<Arg>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PropertyModel {
+    /// Property, snake_case (`gap_conductance_coefficient`).
+    pub property: String,
+    /// Model, snake_case (`constant`).
+    pub model: String,
+    #[serde(default)]
+    pub args: Vec<Arg>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// One argument of a model line: `key = value`, or a bare value (`key` empty).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Arg {
+    #[serde(default)]
+    pub key: String,
+    pub value: String,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VariableMap {
+    pub side_b: String,
+    pub side_a: String,
+}
+
+/// `begin Interaction [name]` … `end`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Interaction {
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub side_a: Vec<String>,
+    #[serde(default)]
+    pub side_b: Vec<String>,
+    #[serde(default)]
+    pub surfaces: Vec<String>,
+    #[serde(default)]
+    pub normal_tolerance: Option<f64>,
+    #[serde(default)]
+    pub enforcement: Option<String>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// `begin Interaction Defaults` … `end`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InteractionDefaults {
+    #[serde(default)]
+    pub general_contact: Option<bool>,
+    #[serde(default)]
+    pub self_contact: Option<bool>,
+    #[serde(default)]
+    pub surfaces: Vec<String>,
+    #[serde(default)]
+    pub enforcement: Option<String>,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+/// `begin Search Options` … `end`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SearchOptions {
+    #[serde(default)]
+    pub normal_tolerance: Option<f64>,
+    #[serde(default)]
+    pub tangential_tolerance: Option<f64>,
+    #[serde(default)]
+    pub buffer_factor: Option<f64>,
+    #[serde(default)]
+    pub field_factor: Option<f64>,
+    /// Degrees.
+    #[serde(default)]
+    pub normal_check_angle: Option<f64>,
+    #[serde(default)]
+    pub self_contact: Option<bool>,
+    #[serde(default)]
+    pub search_update_frequency: Option<u32>,
+    #[serde(skip)]
+    pub at: Loc,
+}

@@ -1,0 +1,10 @@
+//! seam: interface enforcement for implicit finite-element multiphysics codes.
+//!
+//! The data flow, one module per arrow: [`deck`] (Sierra syntax or TOML → typed spec),
+//! [`mesh`] (Exodus II, Gmsh, generators), [`surface`] (contact surfaces by the Sierra
+//! rules). Diagnostics shared by all of them live in [`diag`].
+
+pub mod deck;
+pub mod diag;
+pub mod mesh;
+pub mod surface;

@@ -1,0 +1,1 @@
+//! Mesh generators for tests, examples and benchmarks.

@@ -1,0 +1,1 @@
+//! Contact surfaces built from the mesh by the Sierra rules.
