@@ -1,1 +1,313 @@
-fn main() {}
+//! The `seam` command line.
+//!
+//! Exit codes: 0 ok; 1 ran but failed; 2 bad input or usage; 3 plugin fault.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use serde::Serialize;
+
+use seam::deck::{self, LoadedDeck};
+use seam::diag::{Diagnostic, Diagnostics, Loc};
+use seam::mesh::{self, ElemId, Mesh};
+use seam::surface::{self, SurfaceKind};
+
+const EXIT_BAD_INPUT: u8 = 2;
+
+#[derive(Parser)]
+#[command(name = "seam", version, about = "Interface enforcement for implicit finite-element codes")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Build the contact surfaces of a deck on a mesh and print them.
+    Surfaces {
+        /// Contact definition: Sierra syntax (.i or any) or TOML (.toml).
+        deck: PathBuf,
+        /// Mesh: Exodus II (.e .exo .g .gen) or Gmsh 4.1 (.msh).
+        #[arg(long)]
+        mesh: PathBuf,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Dead elements, by element number: `3,7,10-20`.
+        #[arg(long)]
+        dead: Option<String>,
+    },
+    /// Validate a deck (and, with --mesh, its surfaces) and print every diagnostic.
+    Check {
+        deck: PathBuf,
+        #[arg(long)]
+        mesh: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Surfaces {
+            deck,
+            mesh,
+            json,
+            dead,
+        } => surfaces(&deck, &mesh, json, dead.as_deref()),
+        Command::Check { deck, mesh } => check(&deck, mesh.as_deref()),
+    }
+}
+
+/// Load the deck, then the mesh; stop with exit code 2 on the first stage that fails.
+fn load(deck_path: &Path, mesh_path: Option<&Path>) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
+    let loaded = deck::load(deck_path);
+    if loaded.diagnostics.has_errors() {
+        eprint!("{}", loaded.diagnostics.render(&loaded.sources));
+        return Err(ExitCode::from(EXIT_BAD_INPUT));
+    }
+    let mesh = match mesh_path {
+        None => None,
+        Some(p) => match mesh::read(p) {
+            Ok(m) => Some(m),
+            Err(e) => {
+                eprint!("{}", loaded.diagnostics.render(&loaded.sources));
+                eprintln!("error[E0400]: {e}");
+                return Err(ExitCode::from(EXIT_BAD_INPUT));
+            }
+        },
+    };
+    Ok((loaded, mesh))
+}
+
+#[derive(Serialize)]
+struct SurfaceRow {
+    name: String,
+    kind: SurfaceKind,
+    faces: usize,
+    nodes: usize,
+    area: f64,
+    definition: Option<String>,
+    parent: Option<String>,
+    origins: Vec<Origin>,
+}
+
+#[derive(Serialize)]
+struct Origin {
+    source: String,
+    count: usize,
+}
+
+#[derive(Serialize)]
+struct Warning {
+    code: &'static str,
+    message: String,
+}
+
+#[derive(Serialize)]
+struct SurfacesReport {
+    surfaces: Vec<SurfaceRow>,
+    warnings: Vec<Warning>,
+}
+
+fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) -> ExitCode {
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path)) {
+        Ok(x) => x,
+        Err(code) => return code,
+    };
+    let mesh = mesh.expect("a mesh path was given");
+    let dead = match dead.map(|d| parse_dead(d, &mesh)).transpose() {
+        Ok(d) => d.unwrap_or_default(),
+        Err(e) => {
+            eprintln!("error[E0002]: --dead {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let mut diags = loaded.diagnostics.clone();
+    diags.extend(not_yet_carried_out(&loaded, false));
+    let mut rows = Vec::new();
+    for def in &loaded.deck.contact_definitions {
+        let set = surface::build_with_dead(&mesh, def, &loaded.sources, &dead);
+        diags.extend(set.diagnostics);
+        for s in set.surfaces {
+            rows.push(SurfaceRow {
+                area: s.area(&mesh),
+                faces: s.faces.len(),
+                nodes: s.nodes.len(),
+                kind: s.kind,
+                definition: def.name.clone(),
+                parent: s.parent,
+                origins: s
+                    .origins
+                    .into_iter()
+                    .map(|(source, count)| Origin { source, count })
+                    .collect(),
+                name: s.name,
+            });
+        }
+    }
+    if diags.has_errors() {
+        eprint!("{}", diags.render(&loaded.sources));
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    if json {
+        let report = SurfacesReport {
+            surfaces: rows,
+            warnings: diags
+                .warnings()
+                .map(|d| Warning {
+                    code: d.code,
+                    message: d.message.clone(),
+                })
+                .collect(),
+        };
+        println!("{}", serde_json::to_string(&report).expect("plain data serialises"));
+    } else {
+        print_table(&rows);
+        eprint!("{}", diags.render(&loaded.sources));
+    }
+    ExitCode::SUCCESS
+}
+
+fn print_table(rows: &[SurfaceRow]) {
+    let width = rows.iter().map(|r| r.name.len()).max().unwrap_or(7).max(7);
+    println!(
+        "{:<width$}  {:<5}  {:>9}  {:>9}  {:>13}  from",
+        "surface", "kind", "faces", "nodes", "area"
+    );
+    for r in rows {
+        let kind = match r.kind {
+            SurfaceKind::Faces => "faces",
+            SurfaceKind::Nodes => "nodes",
+        };
+        let from = r
+            .origins
+            .iter()
+            .map(|o| format!("{} ({})", o.source, o.count))
+            .collect::<Vec<_>>()
+            .join(", ");
+        println!(
+            "{:<width$}  {:<5}  {:>9}  {:>9}  {:>13.6e}  {}",
+            r.name, kind, r.faces, r.nodes, r.area, from
+        );
+    }
+}
+
+fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
+    let (loaded, mesh) = match load(deck_path, mesh_path) {
+        Ok(x) => x,
+        Err(code) => return code,
+    };
+    let mut diags = loaded.diagnostics.clone();
+    diags.extend(not_yet_carried_out(&loaded, true));
+    let mut count = 0;
+    if let Some(mesh) = &mesh {
+        for def in &loaded.deck.contact_definitions {
+            let set = surface::build(mesh, def, &loaded.sources);
+            count += set.surfaces.len();
+            diags.extend(set.diagnostics);
+        }
+    }
+    eprint!("{}", diags.render(&loaded.sources));
+    if diags.has_errors() {
+        let n = diags.errors().count();
+        eprintln!("{}: {n} error{}", deck_path.display(), if n == 1 { "" } else { "s" });
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    let defs = loaded.deck.contact_definitions.len();
+    match mesh {
+        Some(_) => println!("ok: {defs} contact definition(s), {count} contact surface(s)"),
+        None => println!("ok: {defs} contact definition(s)"),
+    }
+    ExitCode::SUCCESS
+}
+
+/// Commands the deck recognises whose meaning this version does not carry out yet.
+/// `seam check` reports them as errors; `seam surfaces`, which does not need them,
+/// as warnings — never silently.
+fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
+    let mut out = Diagnostics::default();
+    let mut report = |what: &str, at: &Loc| {
+        let message = format!("`{what}` is recognised but not carried out by this version of seam");
+        let d = if as_errors {
+            Diagnostic::error("E0900", message)
+        } else {
+            Diagnostic::warning("W0900", message)
+        };
+        out.push(d.at(Some(at.clone())).help(
+            "contact surfaces are built now; search, enforcement and periodicity arrive in later versions",
+        ));
+    };
+    for def in &loaded.deck.contact_definitions {
+        for e in &def.enforcements {
+            report("begin Enforcement", &e.at);
+        }
+        for i in &def.interactions {
+            report("begin Interaction", &i.at);
+        }
+        if let Some(d) = &def.interaction_defaults {
+            report("begin Interaction Defaults", &d.at);
+        }
+        if let Some(s) = &def.search_options {
+            report("begin Search Options", &s.at);
+        }
+        for p in &def.periodicity {
+            report("Periodicity For", &p.at);
+        }
+        let flags = [
+            (def.output_rule.is_some(), "Output Rule"),
+            (def.visualize_contact, "Visualize Contact"),
+            (def.update_search_every_n_steps.is_some(), "Update Search Every n Steps"),
+            (def.opposed_normal_threshold_angle.is_some(), "Opposed Normal Threshold Angle"),
+            (
+                def.disable_opposed_normal_interaction_culling,
+                "Disable Opposed Normal Interaction Culling",
+            ),
+        ];
+        for (set, what) in flags {
+            if set {
+                report(what, &def.at);
+            }
+        }
+    }
+    out
+}
+
+/// Parse `3,7,10-20` into dense element ids, checking every number exists.
+fn parse_dead(text: &str, mesh: &Mesh) -> Result<HashSet<ElemId>, String> {
+    let index: std::collections::HashMap<i64, u32> = mesh
+        .elem_numbers
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| (n, i as u32))
+        .collect();
+    let mut out = HashSet::new();
+    for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let (lo, hi) = match part.split_once('-') {
+            Some((a, b)) => (a.trim(), b.trim()),
+            None => (part, part),
+        };
+        let parse = |s: &str| {
+            s.parse::<i64>()
+                .map_err(|_| format!("`{part}` is not an element number or a range like 10-20"))
+        };
+        let (lo, hi) = (parse(lo)?, parse(hi)?);
+        if lo > hi {
+            return Err(format!("range `{part}` runs backwards"));
+        }
+        if hi - lo >= mesh.num_elems() as i64 {
+            return Err(format!("range `{part}` is longer than the mesh has elements"));
+        }
+        for n in lo..=hi {
+            match index.get(&n) {
+                Some(&e) => {
+                    out.insert(ElemId(e));
+                }
+                None => return Err(format!("element {n} does not exist in the mesh")),
+            }
+        }
+    }
+    Ok(out)
+}
+
