@@ -234,6 +234,31 @@ pub fn did_you_mean<'a>(
         .map(|(_, c)| c)
 }
 
+impl SourceMap {
+    /// Narrow `loc` to the first case-insensitive occurrence of `word` on its line at or
+    /// after its column, so a caret can point at one name in a list. Returns `loc`
+    /// unchanged when the line or the word is not found.
+    pub fn narrow(&self, loc: &Loc, word: &str) -> Loc {
+        let Some(line) = self.line(&loc.file, loc.line) else {
+            return loc.clone();
+        };
+        let lower = line.to_ascii_lowercase();
+        let word = word.to_ascii_lowercase();
+        let start = line
+            .char_indices()
+            .nth(loc.col.saturating_sub(1) as usize)
+            .map_or(0, |(i, _)| i);
+        match lower.get(start..).and_then(|rest| rest.find(&word)) {
+            Some(off) => Loc {
+                col: lower[..start + off].chars().count() as u32 + 1,
+                len: word.chars().count() as u32,
+                ..loc.clone()
+            },
+            None => loc.clone(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -261,30 +286,5 @@ mod tests {
         let c = ["contact surface", "skin all blocks"];
         assert_eq!(did_you_mean("contact surfce", c), Some("contact surface"));
         assert_eq!(did_you_mean("gravity", c), None);
-    }
-}
-
-impl SourceMap {
-    /// Narrow `loc` to the first case-insensitive occurrence of `word` on its line at or
-    /// after its column, so a caret can point at one name in a list. Returns `loc`
-    /// unchanged when the line or the word is not found.
-    pub fn narrow(&self, loc: &Loc, word: &str) -> Loc {
-        let Some(line) = self.line(&loc.file, loc.line) else {
-            return loc.clone();
-        };
-        let lower = line.to_ascii_lowercase();
-        let word = word.to_ascii_lowercase();
-        let start = line
-            .char_indices()
-            .nth(loc.col.saturating_sub(1) as usize)
-            .map_or(0, |(i, _)| i);
-        match lower.get(start..).and_then(|rest| rest.find(&word)) {
-            Some(off) => Loc {
-                col: lower[..start + off].chars().count() as u32 + 1,
-                len: word.chars().count() as u32,
-                ..loc.clone()
-            },
-            None => loc.clone(),
-        }
     }
 }

@@ -17,7 +17,11 @@ use seam::surface::{self, SurfaceKind};
 const EXIT_BAD_INPUT: u8 = 2;
 
 #[derive(Parser)]
-#[command(name = "seam", version, about = "Interface enforcement for implicit finite-element codes")]
+#[command(
+    name = "seam",
+    version,
+    about = "Interface enforcement for implicit finite-element codes"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -61,7 +65,10 @@ fn main() -> ExitCode {
 }
 
 /// Load the deck, then the mesh; stop with exit code 2 on the first stage that fails.
-fn load(deck_path: &Path, mesh_path: Option<&Path>) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
+fn load(
+    deck_path: &Path,
+    mesh_path: Option<&Path>,
+) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
     let loaded = deck::load(deck_path);
     if loaded.diagnostics.has_errors() {
         eprint!("{}", loaded.diagnostics.render(&loaded.sources));
@@ -162,7 +169,10 @@ fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) 
                 })
                 .collect(),
         };
-        println!("{}", serde_json::to_string(&report).expect("plain data serialises"));
+        println!(
+            "{}",
+            serde_json::to_string(&report).expect("plain data serialises")
+        );
     } else {
         print_table(&rows);
         eprint!("{}", diags.render(&loaded.sources));
@@ -212,7 +222,11 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
     eprint!("{}", diags.render(&loaded.sources));
     if diags.has_errors() {
         let n = diags.errors().count();
-        eprintln!("{}: {n} error{}", deck_path.display(), if n == 1 { "" } else { "s" });
+        eprintln!(
+            "{}: {n} error{}",
+            deck_path.display(),
+            if n == 1 { "" } else { "s" }
+        );
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     let defs = loaded.deck.contact_definitions.len();
@@ -258,8 +272,14 @@ fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
         let flags = [
             (def.output_rule.is_some(), "Output Rule"),
             (def.visualize_contact, "Visualize Contact"),
-            (def.update_search_every_n_steps.is_some(), "Update Search Every n Steps"),
-            (def.opposed_normal_threshold_angle.is_some(), "Opposed Normal Threshold Angle"),
+            (
+                def.update_search_every_n_steps.is_some(),
+                "Update Search Every n Steps",
+            ),
+            (
+                def.opposed_normal_threshold_angle.is_some(),
+                "Opposed Normal Threshold Angle",
+            ),
             (
                 def.disable_opposed_normal_interaction_culling,
                 "Disable Opposed Normal Interaction Culling",
@@ -297,7 +317,9 @@ fn parse_dead(text: &str, mesh: &Mesh) -> Result<HashSet<ElemId>, String> {
             return Err(format!("range `{part}` runs backwards"));
         }
         if hi - lo >= mesh.num_elems() as i64 {
-            return Err(format!("range `{part}` is longer than the mesh has elements"));
+            return Err(format!(
+                "range `{part}` is longer than the mesh has elements"
+            ));
         }
         for n in lo..=hi {
             match index.get(&n) {
@@ -310,4 +332,3 @@ fn parse_dead(text: &str, mesh: &Mesh) -> Result<HashSet<ElemId>, String> {
     }
     Ok(out)
 }
-

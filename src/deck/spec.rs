@@ -56,6 +56,8 @@ pub struct ContactDefinition {
 
 /// One surface-making command. Commands are applied in this order; the first one that
 /// includes a face (or node) owns it.
+// A deck holds a handful of these; boxing the block variant would buy nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SurfaceDef {

@@ -129,7 +129,11 @@ impl Builder {
     fn node(&mut self, p: [f64; 3]) -> NodeId {
         // Merging compares exact bit patterns after adding 0.0 (which turns -0.0 into
         // +0.0): generated grid points that coincide are computed by the same formula.
-        let key = [(p[0] + 0.0).to_bits(), (p[1] + 0.0).to_bits(), (p[2] + 0.0).to_bits()];
+        let key = [
+            (p[0] + 0.0).to_bits(),
+            (p[1] + 0.0).to_bits(),
+            (p[2] + 0.0).to_bits(),
+        ];
         if self.merge {
             if let Some(&n) = self.positions.get(&key) {
                 return n;
@@ -203,7 +207,14 @@ impl Builder {
                         at(i, j + 1, k + 1),
                     ];
                     let conn = &mut self.blocks[block].2;
-                    let on = [i == 0, i == nx - 1, j == 0, j == ny - 1, k == 0, k == nz - 1];
+                    let on = [
+                        i == 0,
+                        i == nx - 1,
+                        j == 0,
+                        j == ny - 1,
+                        k == 0,
+                        k == nz - 1,
+                    ];
                     match kind {
                         SolidKind::Hex8 => {
                             let e = conn.len() / 8;
@@ -274,7 +285,11 @@ impl Builder {
 
 fn lerp(a: f64, b: f64, i: usize, n: usize) -> f64 {
     // Exact at both ends, so boxes that share a face produce bit-identical coordinates.
-    if i == n { b } else { a + (b - a) * i as f64 / n as f64 }
+    if i == n {
+        b
+    } else {
+        a + (b - a) * i as f64 / n as f64
+    }
 }
 
 /// Kuhn subdivision of a hex cell (local corners as in Exodus Hex8) into six tets that

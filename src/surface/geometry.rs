@@ -38,7 +38,11 @@ pub(crate) fn measure_and_normal(mesh: &Mesh, nodes: &[NodeId]) -> (f64, Vec3) {
         2 => {
             let d = sub(x(1), x(0));
             let len = norm(d);
-            let n = if len > 0.0 { [d[1] / len, -d[0] / len, 0.0] } else { [0.0; 3] };
+            let n = if len > 0.0 {
+                [d[1] / len, -d[0] / len, 0.0]
+            } else {
+                [0.0; 3]
+            };
             (len, n)
         }
         3 => {
@@ -58,13 +62,17 @@ pub(crate) fn measure_and_normal(mesh: &Mesh, nodes: &[NodeId]) -> (f64, Vec3) {
                         - (1.0 + eta) * p3[d]
                 });
                 let t_eta: Vec3 = std::array::from_fn(|d| {
-                    -(1.0 - xi) * p0[d] - (1.0 + xi) * p1[d] + (1.0 + xi) * p2[d]
+                    -(1.0 - xi) * p0[d] - (1.0 + xi) * p1[d]
+                        + (1.0 + xi) * p2[d]
                         + (1.0 - xi) * p3[d]
                 });
                 area += norm(cross(t_xi, t_eta)) / 16.0;
             }
             let m = norm(vector_area);
-            (area, scale(vector_area, if m > 0.0 { 1.0 / m } else { 0.0 }))
+            (
+                area,
+                scale(vector_area, if m > 0.0 { 1.0 / m } else { 0.0 }),
+            )
         }
     }
 }

@@ -180,7 +180,14 @@ impl<'a> Builder<'a> {
                         }
                         let mut g = Gathered::default();
                         self.skin_block(b, &mut g);
-                        self.claim(&block.sierra_name(), SurfaceKind::Faces, g, at, &mut names, None);
+                        self.claim(
+                            &block.sierra_name(),
+                            SurfaceKind::Faces,
+                            g,
+                            at,
+                            &mut names,
+                            None,
+                        );
                     }
                 }
                 SurfaceDef::Block(sb) => {
@@ -188,7 +195,7 @@ impl<'a> Builder<'a> {
                     let first = self.surfaces.len();
                     self.claim(&sb.name, SurfaceKind::Faces, g, &sb.at, &mut names, None);
                     if sb.contact_type == ContactType::Node {
-                        self.to_node_surface(first);
+                        self.make_node_surface(first);
                     }
                     if let Some(parent) = self.surfaces.get(first).cloned() {
                         subset::apply(self, parent, first, sb, &mut names);
@@ -318,7 +325,13 @@ impl<'a> Builder<'a> {
             }
             for s in 0..8u8 {
                 if mask & (1 << s) != 0 {
-                    g.faces.push((Side { elem: e, side: s + 1 }, origin.clone()));
+                    g.faces.push((
+                        Side {
+                            elem: e,
+                            side: s + 1,
+                        },
+                        origin.clone(),
+                    ));
                 }
             }
         }
@@ -395,7 +408,8 @@ impl<'a> Builder<'a> {
                 Some(ns) => {
                     let set = &self.mesh.node_sets[ns];
                     let origin = format!("node set {}", set.sierra_name());
-                    g.nodes.extend(set.nodes.iter().map(|&n| (n, origin.clone())));
+                    g.nodes
+                        .extend(set.nodes.iter().map(|&n| (n, origin.clone())));
                 }
                 None => self.unknown_name(name, "node set", at, Names::NodeSets),
             }
@@ -419,7 +433,13 @@ impl<'a> Builder<'a> {
             let origin = format!("element {}", self.mesh.elem_number(e));
             for s in 0..8u8 {
                 if mask & (1 << s) != 0 {
-                    g.faces.push((Side { elem: e, side: s + 1 }, origin.clone()));
+                    g.faces.push((
+                        Side {
+                            elem: e,
+                            side: s + 1,
+                        },
+                        origin.clone(),
+                    ));
                 }
             }
         }
@@ -442,8 +462,10 @@ impl<'a> Builder<'a> {
                 None => self.unknown_name(name, "assembly", at, Names::Assemblies),
             }
         }
-        let removed_blocks: HashSet<usize> =
-            self.resolve_blocks(&sb.remove_blocks, at).into_iter().collect();
+        let removed_blocks: HashSet<usize> = self
+            .resolve_blocks(&sb.remove_blocks, at)
+            .into_iter()
+            .collect();
         let mut removed_sides = HashSet::new();
         for name in &sb.remove_surfaces {
             match self.mesh.find_side_set(name) {
@@ -452,7 +474,8 @@ impl<'a> Builder<'a> {
             }
         }
         g.faces.retain(|(side, _)| {
-            !removed_sides.contains(side) && !removed_blocks.contains(&self.mesh.block_of(side.elem))
+            !removed_sides.contains(side)
+                && !removed_blocks.contains(&self.mesh.block_of(side.elem))
         });
         g
     }
@@ -547,7 +570,11 @@ impl<'a> Builder<'a> {
     ) {
         let name = name.to_ascii_lowercase();
         if let Some(first) = names.get(&name) {
-            let where_first = if first.is_unknown() { String::new() } else { format!(" (first at {first})") };
+            let where_first = if first.is_unknown() {
+                String::new()
+            } else {
+                format!(" (first at {first})")
+            };
             self.diags.push(
                 Diagnostic::error("E0304", format!("contact surface `{name}` is defined twice{where_first}"))
                     .at(Some(at.clone()))
@@ -563,7 +590,10 @@ impl<'a> Builder<'a> {
         let mut faces = Vec::new();
         let mut nodes = Vec::new();
         let mut seen = HashSet::new();
-        let bump = |origins: &mut Vec<(String, usize)>, o: String| match origins.iter_mut().find(|x| x.0 == o) {
+        let bump = |origins: &mut Vec<(String, usize)>, o: String| match origins
+            .iter_mut()
+            .find(|x| x.0 == o)
+        {
             Some(x) => x.1 += 1,
             None => origins.push((o, 1)),
         };
@@ -596,7 +626,11 @@ impl<'a> Builder<'a> {
         }
         faces.sort_by_key(|f| f.side);
         nodes.sort_unstable();
-        let unit = if kind == SurfaceKind::Faces { "faces" } else { "nodes" };
+        let unit = if kind == SurfaceKind::Faces {
+            "faces"
+        } else {
+            "nodes"
+        };
         for (&owner, &count) in &skipped {
             let owner_name = &self.surfaces[owner as usize].name;
             self.diags.push(
@@ -641,12 +675,16 @@ impl<'a> Builder<'a> {
         }
     }
 
-    fn to_node_surface(&mut self, i: usize) {
+    fn make_node_surface(&mut self, i: usize) {
         let s = &mut self.surfaces[i];
         if s.kind == SurfaceKind::Nodes {
             return;
         }
-        let mut nodes: Vec<NodeId> = s.faces.iter().flat_map(|f| self.mesh.side_nodes(f.side)).collect();
+        let mut nodes: Vec<NodeId> = s
+            .faces
+            .iter()
+            .flat_map(|f| self.mesh.side_nodes(f.side))
+            .collect();
         nodes.sort_unstable();
         nodes.dedup();
         for f in s.faces.drain(..) {
@@ -700,7 +738,11 @@ impl<'a> Builder<'a> {
             if s.kind != SurfaceKind::Faces {
                 continue;
             }
-            let mut nodes: Vec<NodeId> = s.faces.iter().flat_map(|f| self.mesh.side_nodes(f.side)).collect();
+            let mut nodes: Vec<NodeId> = s
+                .faces
+                .iter()
+                .flat_map(|f| self.mesh.side_nodes(f.side))
+                .collect();
             nodes.sort_unstable();
             nodes.dedup();
             let index = i as u32;
@@ -727,7 +769,12 @@ enum Names {
 
 fn list_names(names: &[String]) -> String {
     const SHOWN: usize = 12;
-    let mut s = names.iter().take(SHOWN).map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ");
+    let mut s = names
+        .iter()
+        .take(SHOWN)
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(", ");
     if names.len() > SHOWN {
         s.push_str(&format!(" and {} more", names.len() - SHOWN));
     }

@@ -131,7 +131,9 @@ pub(super) fn apply(
                     format!("contact surface `{name}` is defined twice (first at {first})"),
                 )
                 .at(Some(at))
-                .help("subset names are `<surface>_<subset>`: rename the subset or the other surface"),
+                .help(
+                    "subset names are `<surface>_<subset>`: rename the subset or the other surface",
+                ),
             );
             continue;
         }
@@ -153,7 +155,11 @@ pub(super) fn apply(
 }
 
 /// Groups of edge-connected faces whose normals lie within `angle_deg` of their seed's.
-fn group_by_normal(b: &Builder<'_>, faces: &[SurfaceFace], angle_deg: f64) -> Vec<Vec<SurfaceFace>> {
+fn group_by_normal(
+    b: &Builder<'_>,
+    faces: &[SurfaceFace],
+    angle_deg: f64,
+) -> Vec<Vec<SurfaceFace>> {
     let mesh = b.mesh;
     let cos_limit = angle_deg.to_radians().cos();
     let normals: Vec<[f64; 3]> = faces.iter().map(|f| face_normal(mesh, f.side)).collect();

@@ -63,7 +63,8 @@ fn codes(set: &SurfaceSet) -> Vec<&'static str> {
 fn stack(merge: bool) -> Mesh {
     generate::boxes(
         &[
-            BoxSpec::hex([0.0; 3], [1.0, 1.0, 1.0], [2, 2, 2], 1).with_side_sets([0, 0, 0, 0, 1, 2]),
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, 1.0], [2, 2, 2], 1)
+                .with_side_sets([0, 0, 0, 0, 1, 2]),
             BoxSpec::hex([0.0, 0.0, 1.0], [1.0, 1.0, 2.0], [2, 2, 2], 2),
         ],
         merge,
@@ -87,7 +88,10 @@ fn skinning_one_block_gives_its_boundary() {
 #[test]
 fn faces_between_two_included_blocks_are_interior() {
     let mesh = stack(true);
-    let set = build(&mesh, vec![contains("a", &["block_1"]), contains("b", &["block_2"])]);
+    let set = build(
+        &mesh,
+        vec![contains("a", &["block_1"]), contains("b", &["block_2"])],
+    );
     assert_eq!(faces(&set, "a"), CUBE_FACES - 4);
     assert_eq!(faces(&set, "b"), CUBE_FACES - 4);
 }
@@ -102,7 +106,10 @@ fn faces_against_an_excluded_block_are_exterior() {
 #[test]
 fn parts_meshed_apart_keep_their_whole_skins() {
     let mesh = stack(false);
-    let set = build(&mesh, vec![contains("a", &["block_1"]), contains("b", &["block_2"])]);
+    let set = build(
+        &mesh,
+        vec![contains("a", &["block_1"]), contains("b", &["block_2"])],
+    );
     assert_eq!(faces(&set, "a"), CUBE_FACES);
     assert_eq!(faces(&set, "b"), CUBE_FACES);
 }
@@ -110,7 +117,10 @@ fn parts_meshed_apart_keep_their_whole_skins() {
 #[test]
 fn side_sets_may_hold_interior_faces() {
     let mesh = stack(true);
-    let set = build(&mesh, vec![skin_all(&[]), contains("iface", &["surface_2"])]);
+    let set = build(
+        &mesh,
+        vec![skin_all(&[]), contains("iface", &["surface_2"])],
+    );
     assert_eq!(faces(&set, "iface"), 4);
     assert_eq!(faces(&set, "block_1"), CUBE_FACES - 4);
     assert!(set.diagnostics.is_empty(), "{:?}", set.diagnostics);
@@ -119,13 +129,23 @@ fn side_sets_may_hold_interior_faces() {
 #[test]
 fn first_definition_owns_a_face_and_later_ones_are_warned() {
     let mesh = stack(false);
-    let set = build(&mesh, vec![contains("bottom", &["surface_1"]), contains("rest", &["block_1"])]);
+    let set = build(
+        &mesh,
+        vec![
+            contains("bottom", &["surface_1"]),
+            contains("rest", &["block_1"]),
+        ],
+    );
     assert_eq!(faces(&set, "bottom"), 4);
     assert_eq!(faces(&set, "rest"), CUBE_FACES - 4);
     let w = &set.diagnostics.0;
     assert_eq!(w.len(), 1);
     assert_eq!(w[0].code, "W0301");
-    assert!(w[0].message.contains("4 faces") && w[0].message.contains("`bottom`"), "{}", w[0].message);
+    assert!(
+        w[0].message.contains("4 faces") && w[0].message.contains("`bottom`"),
+        "{}",
+        w[0].message
+    );
 }
 
 /// Skin All Blocks first: it owns every skin face, so a later surface over the same
@@ -133,7 +153,10 @@ fn first_definition_owns_a_face_and_later_ones_are_warned() {
 #[test]
 fn skin_all_blocks_first_leaves_a_later_surface_empty() {
     let mesh = stack(false);
-    let set = build(&mesh, vec![skin_all(&[]), contains("bottom", &["surface_1"])]);
+    let set = build(
+        &mesh,
+        vec![skin_all(&[]), contains("bottom", &["surface_1"])],
+    );
     assert_eq!(faces(&set, "block_1"), CUBE_FACES);
     assert_eq!(faces(&set, "bottom"), 0);
     assert_eq!(codes(&set), ["W0301", "W0302"]);
@@ -144,7 +167,10 @@ fn skin_all_blocks_first_leaves_a_later_surface_empty() {
 #[test]
 fn surface_before_skin_all_blocks_keeps_its_faces() {
     let mesh = stack(false);
-    let set = build(&mesh, vec![contains("bottom", &["surface_1"]), skin_all(&[])]);
+    let set = build(
+        &mesh,
+        vec![contains("bottom", &["surface_1"]), skin_all(&[])],
+    );
     assert_eq!(faces(&set, "bottom"), 4);
     assert_eq!(faces(&set, "block_1"), CUBE_FACES - 4);
     assert_eq!(faces(&set, "block_2"), CUBE_FACES);
@@ -249,7 +275,10 @@ fn contact_type_node_turns_faces_into_nodes() {
     sb.contact_type = ContactType::Node;
     let set = build(&mesh, vec![SurfaceDef::Block(sb)]);
     let s = set.get("n").unwrap();
-    assert_eq!((s.kind, s.faces.len(), s.nodes.len()), (SurfaceKind::Nodes, 0, 8));
+    assert_eq!(
+        (s.kind, s.faces.len(), s.nodes.len()),
+        (SurfaceKind::Nodes, 0, 8)
+    );
 }
 
 /// A hex with a shell on its top face sharing its nodes, and the shell block defined
@@ -277,7 +306,10 @@ fn shell_on_solid_face_is_sandwiched_whatever_the_order() {
         }
         let solid_cmd = || contains("solid", &["block_1"]);
         let shell_cmd = || contains("shell", &["block_2"]);
-        for cmds in [vec![solid_cmd(), shell_cmd()], vec![shell_cmd(), solid_cmd()]] {
+        for cmds in [
+            vec![solid_cmd(), shell_cmd()],
+            vec![shell_cmd(), solid_cmd()],
+        ] {
             let set = build(&mesh, cmds);
             let solid = set.get("solid").unwrap();
             let shell = set.get("shell").unwrap();
@@ -290,10 +322,17 @@ fn shell_on_solid_face_is_sandwiched_whatever_the_order() {
 }
 
 fn surface_normal(mesh: &Mesh, side: Side) -> [f64; 3] {
-    let p: Vec<[f64; 3]> = mesh.side_nodes(side).map(|n| mesh.coords[n.index()]).collect();
+    let p: Vec<[f64; 3]> = mesh
+        .side_nodes(side)
+        .map(|n| mesh.coords[n.index()])
+        .collect();
     let a = [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]];
     let b = [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]];
-    let n = [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    let n = [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ];
     let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     n.map(|c| c / l)
 }
@@ -349,7 +388,10 @@ fn auto_subset_of_a_unit_hex_gives_six_single_faces() {
     for k in 1..=6 {
         let s = set.get(&format!("cube_side_auto_{k}")).unwrap();
         assert_eq!(s.faces.len(), 1);
-        assert_eq!(s.faces[0].side.side, k as u8, "groups ordered by lowest face");
+        assert_eq!(
+            s.faces[0].side.side, k as u8,
+            "groups ordered by lowest face"
+        );
     }
     assert_eq!(faces(&set, "cube"), 0);
     // Side 1 (nodes 1 2 6 5) takes four nodes; side 2 (2 3 7 6) only the two new ones.
@@ -382,7 +424,15 @@ fn auto_subset_groups_beyond_the_count_stay_in_the_parent() {
 /// (Chaining neighbour to neighbour would have made one group of twelve.)
 #[test]
 fn auto_subset_on_a_faceted_curve_bounds_each_group_by_the_angle() {
-    let mesh = generate::annulus(1.0, 2.0, 180.0, [0.0, 1.0], [1, 12, 1], 1, [1, 0, 0, 0, 0, 0]);
+    let mesh = generate::annulus(
+        1.0,
+        2.0,
+        180.0,
+        [0.0, 1.0],
+        [1, 12, 1],
+        1,
+        [1, 0, 0, 0, 0, 0],
+    );
     let mut sb = surface_block("c");
     sb.side_sets = vec!["surface_1".into()];
     sb.auto_subset = Some(AutoSubset {
@@ -418,7 +468,10 @@ fn element_death_exposes_faces_of_skins_and_shrinks_side_sets() {
     let mesh = generate::single_box(
         BoxSpec::hex([0.0; 3], [3.0, 1.0, 1.0], [3, 1, 1], 1).with_side_sets([0, 0, 0, 0, 5, 0]),
     );
-    let d = def(vec![contains("bottom", &["surface_5"]), contains("skin", &["block_1"])]);
+    let d = def(vec![
+        contains("bottom", &["surface_5"]),
+        contains("skin", &["block_1"]),
+    ]);
     let alive = surface::build(&mesh, &d, &SourceMap::default());
     assert_eq!(faces(&alive, "skin"), 14 - 3);
     // Kill the middle element: the two end cubes have 6 faces each, 2 of them in the side set.
@@ -432,12 +485,25 @@ fn element_death_exposes_faces_of_skins_and_shrinks_side_sets() {
 fn two_dimensional_skins_are_edges() {
     let mut mesh = Mesh {
         dim: 2,
-        coords: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [2.0, 1.0, 0.0]],
+        coords: vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ],
         node_numbers: (1..=6).collect(),
         ..Mesh::default()
     };
     let q = |a: u32, b: u32, c: u32, d: u32| [NodeId(a), NodeId(b), NodeId(c), NodeId(d)];
-    mesh.push_block(1, "", Topology::Quad4, [q(0, 1, 4, 3), q(1, 2, 5, 4)].concat(), None);
+    mesh.push_block(
+        1,
+        "",
+        Topology::Quad4,
+        [q(0, 1, 4, 3), q(1, 2, 5, 4)].concat(),
+        None,
+    );
     let set = build(&mesh, vec![contains("edge", &["block_1"])]);
     let s = set.get("edge").unwrap();
     assert_eq!(s.faces.len(), 6);
