@@ -6,5 +6,7 @@
 
 pub mod deck;
 pub mod diag;
+pub mod interaction;
 pub mod mesh;
+pub mod script;
 pub mod surface;
