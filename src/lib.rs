@@ -8,5 +8,6 @@ pub mod deck;
 pub mod diag;
 pub mod interaction;
 pub mod mesh;
+pub mod periodic;
 pub mod script;
 pub mod surface;
