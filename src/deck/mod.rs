@@ -74,6 +74,7 @@ pub fn parse_sierra(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
     let (deck, locs, lower_diags) = sierra::lower(file, &items);
     diags.extend(lower_diags);
     diags.extend(check::check(&deck, &locs));
+    sort_by_place(&mut diags);
     (deck, diags)
 }
 
@@ -97,6 +98,16 @@ pub fn parse_toml(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
             (Deck::default(), diags)
         }
     }
+}
+
+/// Order diagnostics as an analyst reads the file: by line and column, unlocated last;
+/// the sort is stable, so diagnostics at one place keep the order they were found in.
+fn sort_by_place(diags: &mut Diagnostics) {
+    diags.0.sort_by_key(|d| {
+        d.loc
+            .as_ref()
+            .map_or((u32::MAX, u32::MAX), |l| (l.line, l.col))
+    });
 }
 
 /// The 1-based line and character column of a byte range (clamped to its first line).

@@ -426,13 +426,24 @@ pub fn match_block(words: &[&str]) -> Option<&'static BlockSpec> {
 
 /// The command phrases allowed in block `key`.
 pub fn phrases_in(key: &str) -> Vec<&'static str> {
-    let mut v: Vec<&'static str> = COMMANDS
+    COMMANDS
         .iter()
         .filter(|c| c.blocks.contains(&key))
         .map(|c| c.phrase)
-        .collect();
-    v.extend(BLOCKS.iter().filter(|b| b.parent == key).map(|b| b.phrase));
-    v
+        .collect()
+}
+
+/// What block `key` accepts, for help lines: its commands, then `begin …` for its
+/// sub-blocks, each in backquotes.
+pub fn accepted_in(key: &str) -> String {
+    let mut v: Vec<String> = phrases_in(key).iter().map(|p| format!("`{p}`")).collect();
+    v.extend(
+        BLOCKS
+            .iter()
+            .filter(|b| b.parent == key)
+            .map(|b| format!("`begin {}`", b.phrase)),
+    );
+    v.join(", ")
 }
 
 /// The closest phrase to the start of `words` among `candidates`, with the number of

@@ -284,7 +284,6 @@ impl Lower {
         } else {
             written.join(" ")
         };
-        let list: Vec<String> = allowed.iter().map(|p| format!("`{p}`")).collect();
         let mut help = match suggestion {
             Some((p, _)) => format!("did you mean `{p}`? "),
             None => String::new(),
@@ -292,7 +291,7 @@ impl Lower {
         help.push_str(&format!(
             "{} accepts {}",
             registry::describe_block(block),
-            list.join(", ")
+            registry::accepted_in(block)
         ));
         if block == ENF {
             help.push_str(", and `<material property> = <model> [args]` lines");
