@@ -20,6 +20,9 @@ mod sierra;
 pub mod spec;
 mod tree;
 
+#[cfg(test)]
+mod tests;
+
 pub use registry::reference_markdown;
 
 use std::path::Path;
