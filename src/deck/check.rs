@@ -258,7 +258,7 @@ fn check_surface_block(
         }
     }
     if let Some(auto) = &b.auto_subset {
-        if let (Some(sub), false) = (b.subsets.first(), false) {
+        if let Some(sub) = b.subsets.first() {
             // Point at whichever of the two came second in the deck.
             let second = if !sub.at.is_unknown() && sub.at.line > auto.at.line {
                 &sub.at

@@ -479,8 +479,16 @@ pub fn reference_markdown() -> String {
     let _ = writeln!(
         out,
         "Keywords are case-insensitive; `=`, `is` and `are` are interchangeable; `#` and `$` \
-         start comments; commas and tabs are whitespace. The TOML key of each command is given \
-         in the `key` column. Generated from the keyword registry (`src/deck/registry.rs`).\n"
+         start comments; commas and tabs are whitespace; names are stored lower case, quoted \
+         strings keep their case. The `key` column is the canonical snake_case name, which is \
+         the TOML field name. In TOML the surface-making commands (`contact surface`, \
+         `contact node set`, `skin all blocks`, `begin contact surface`) are entries of \
+         `[[contact_definition.surface]]` with `kind = \"contains\" | \"node_set\" | \
+         \"skin_all_blocks\" | \"block\"`; `periodicity for` is an entry of \
+         `[[contact_definition.periodicity]]` with a `transform` table tagged by `kind`; \
+         `enforcement for` lines are `model` entries and material property lines `property` \
+         entries of an enforcement. Generated from the keyword registry \
+         (`src/deck/registry.rs`).\n"
     );
     for b in BLOCKS {
         let name = match b.naming {
@@ -489,13 +497,11 @@ pub fn reference_markdown() -> String {
             Naming::Forbidden => "",
         };
         let _ = writeln!(out, "## `begin {}{name}` … `end`\n", b.phrase);
-        let _ = writeln!(
-            out,
-            "{} Key `{}`; appears in {}.\n",
-            b.description,
-            b.key,
-            describe_block(b.parent)
-        );
+        let place = match block(b.parent) {
+            Some(p) => format!("inside `begin {}`", p.phrase),
+            None => "at the top level".to_string(),
+        };
+        let _ = writeln!(out, "{} Key `{}`; appears {place}.\n", b.description, b.key);
         let _ = writeln!(
             out,
             "| command | key | arguments | description | implemented |"
@@ -509,10 +515,14 @@ pub fn reference_markdown() -> String {
             );
         }
         for c in COMMANDS.iter().filter(|c| c.blocks.contains(&b.key)) {
-            let args = c.args.replace('|', "\\|");
+            let args = if c.args.is_empty() {
+                "—".to_string()
+            } else {
+                format!("`{}`", c.args.replace('|', "\\|"))
+            };
             let _ = writeln!(
                 out,
-                "| `{}` | `{}` | `{}` | {} | {} |",
+                "| `{}` | `{}` | {} | {} | {} |",
                 c.phrase,
                 c.key,
                 args,

@@ -757,6 +757,15 @@ impl Lower {
         };
         c.pos += 1;
         let kind = kind_tok.lower.as_str();
+        let usage = match kind {
+            "rectangular" => "rectangular offset = <dx> <dy> [<dz>]",
+            "cylindrical" => {
+                "cylindrical axis = <a1> <a2> [<a3>] center = <c1> <c2> [<c3>] angle = <degrees>"
+            }
+            "align_surface" => "align_surface destination = <surface> [invert_normals = 0|1]",
+            _ => "mapped x_map = <f> y_map = <g> [z_map = <h>]",
+        };
+        let usage = format!("write `periodicity for {surface} = {usage}`");
         let allowed: &[&str] = match kind {
             "rectangular" => &["offset"],
             "cylindrical" => &["axis", "center", "angle"],
@@ -798,10 +807,10 @@ impl Lower {
                 self.push(
                     Diagnostic::error(
                         codes::PERIODICITY,
-                        format!("unexpected `{}` in a `{kind}` periodicity", t.text),
+                        format!("unexpected `{}` in the `{kind}` periodicity", t.text),
                     )
                     .at(Some(t.loc(&self.file)))
-                    .help(format!("write `{} {}`", c.phrase(), c.cmd.args)),
+                    .help(usage.clone()),
                 );
                 ok = false;
                 i += 1;
@@ -843,11 +852,11 @@ impl Lower {
                 self.push(
                     Diagnostic::error(
                         codes::PERIODICITY,
-                        format!("`{}` is not a part of a `{kind}` periodicity", k.text),
+                        format!("`{}` is not a part of the `{kind}` periodicity", k.text),
                     )
                     .at(Some(k.loc(&self.file)))
                     .help(format!(
-                        "{hint}a `{kind}` periodicity takes {}",
+                        "{hint}the `{kind}` periodicity takes {}",
                         list.join(", ")
                     )),
                 );
@@ -859,10 +868,10 @@ impl Lower {
                 l.push(
                     Diagnostic::error(
                         codes::PERIODICITY,
-                        format!("a `{kind}` periodicity needs `{key} = …`"),
+                        format!("the `{kind}` periodicity needs `{key} = …`"),
                     )
-                    .at(l.span(&c.line.tokens))
-                    .help(format!("write `{} {}`", c.phrase(), c.cmd.args)),
+                    .at(Some(kind_tok.loc(&l.file)))
+                    .help(usage.clone()),
                 );
             }
             present

@@ -120,14 +120,19 @@ fn open(file: &Arc<str>, head: Line, diags: &mut Diagnostics) -> Block {
             .to_vec(),
         None => {
             let all: Vec<&str> = registry::BLOCKS.iter().map(|b| b.phrase).collect();
-            let written = words.join(" ");
-            let hint = registry::suggest(&words, &all)
-                .map(|(p, _)| format!("did you mean `begin {p}`? "))
-                .or_else(|| {
-                    did_you_mean(&written, all.iter().copied())
-                        .map(|p| format!("did you mean `begin {p}`? "))
-                })
+            // With a suggestion, blame only the words it replaces (the rest is the name).
+            let suggestion = registry::suggest(&words, &all);
+            let n = suggestion.map_or(words.len(), |(_, k)| k);
+            let written = words.get(..n).unwrap_or_default().join(" ");
+            let hint = suggestion
+                .map(|(p, _)| p)
+                .or_else(|| did_you_mean(&written, all.iter().copied()))
+                .map(|p| format!("did you mean `begin {p}`? "))
                 .unwrap_or_default();
+            let blamed = match n {
+                0 => rest,
+                _ => rest.get(..n).unwrap_or(rest),
+            };
             let list: Vec<String> = all.iter().map(|p| format!("`{p}`")).collect();
             let message = if rest.is_empty() {
                 "`begin` without a block type".to_string()
@@ -138,7 +143,11 @@ fn open(file: &Arc<str>, head: Line, diags: &mut Diagnostics) -> Block {
                 Diagnostic::error(codes::UNKNOWN_BLOCK, message)
                     .at(span(
                         file,
-                        if rest.is_empty() { &head.tokens } else { rest },
+                        if rest.is_empty() {
+                            &head.tokens
+                        } else {
+                            blamed
+                        },
                     ))
                     .help(format!("{hint}block types are {}", list.join(", "))),
             );
