@@ -60,7 +60,7 @@ pub struct Line {
 pub fn span(file: &Arc<str>, tokens: &[Token]) -> Option<Loc> {
     let first = tokens.first()?;
     let last = tokens.last()?;
-    let end = last.col + last.len;
+    let end = last.col.saturating_add(last.len);
     Some(Loc::new(
         file,
         first.line,

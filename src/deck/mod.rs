@@ -70,6 +70,14 @@ pub fn load(path: &Path) -> LoadedDeck {
 }
 
 /// Parse Sierra-syntax text. `file` is the name used in diagnostics.
+///
+/// ```
+/// use std::sync::Arc;
+/// let text = "begin contact definition\n  contact surface top contains block_1\nend\n";
+/// let (deck, diags) = seam::deck::parse_sierra(&Arc::from("deck.i"), text);
+/// assert!(diags.is_empty());
+/// assert_eq!(deck.contact_definitions.len(), 1);
+/// ```
 pub fn parse_sierra(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
     let (lines, mut diags) = lexer::lex(file, text);
     let (items, tree_diags) = tree::build(file, lines);
@@ -79,6 +87,12 @@ pub fn parse_sierra(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
     diags.extend(check::check(&deck, &locs));
     sort_by_place(&mut diags);
     (deck, diags)
+}
+
+/// The semantic checks alone, for a [`Deck`] built in code or edited after parsing;
+/// diagnostics carry no location but name the definition and item.
+pub fn check_deck(deck: &Deck) -> Diagnostics {
+    check::check(deck, &check::Locs::default())
 }
 
 /// Parse the TOML form: the same spec through serde, then the same semantic checks.

@@ -140,7 +140,12 @@ impl Lower {
     /// Just past the last token of the line, for "missing …" messages.
     fn end_of(&self, line: &Line) -> Option<Loc> {
         let last = line.tokens.last()?;
-        Some(Loc::new(&self.file, last.line, last.col + last.len + 1, 1))
+        Some(Loc::new(
+            &self.file,
+            last.line,
+            last.col.saturating_add(last.len).saturating_add(1),
+            1,
+        ))
     }
 
     fn push(&mut self, d: Diagnostic) {
@@ -502,7 +507,13 @@ impl Lower {
 
     /// Warn when a single-valued command repeats.
     fn once(&mut self, seen: &mut HashSet<&'static str>, c: &Cur) {
-        if !seen.insert(c.cmd.key) {
+        self.once_as(seen, c.cmd.key, c);
+    }
+
+    /// As [`Self::once`], counting `c` under `key` (so an alias and its canonical phrase
+    /// count as the same command).
+    fn once_as(&mut self, seen: &mut HashSet<&'static str>, key: &'static str, c: &Cur) {
+        if !seen.insert(key) {
             let n = registry::word_count(c.cmd.phrase);
             self.push(
                 Diagnostic::warning(
@@ -1026,10 +1037,7 @@ impl Lower {
                             .help("write `side b variable <side B variable> to <side A variable>`"),
                         );
                     }
-                    if seen.contains("side_b_variable") {
-                        self.once(&mut seen, &c);
-                    }
-                    seen.insert("side_b_variable");
+                    self.once_as(&mut seen, "side_b_variable", &c);
                     c.skip_sep();
                     let Some((side_b, _)) = self.name(&mut c, "a side B variable") else {
                         continue;

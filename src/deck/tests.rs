@@ -636,3 +636,23 @@ proptest! {
         let _ = sierra(&text);
     }
 }
+
+#[test]
+fn alias_and_canonical_phrase_count_as_one_command() {
+    let (_, d) = sierra(
+        "begin contact definition\n begin enforcement\n  side b variable a to b\n  slave variable a to b\n end\nend\n",
+    );
+    assert_eq!(
+        codes_of(&d),
+        [codes::DEPRECATED_ALIAS, codes::REPEATED_COMMAND]
+    );
+}
+
+#[test]
+fn check_deck_works_on_a_spec_built_in_code() {
+    let mut deck = clean(FULL);
+    deck.contact_definitions[0].opposed_normal_threshold_angle = Some(10.0);
+    let d = super::check_deck(&deck);
+    assert_eq!(codes_of(&d), [codes::OPPOSED_ANGLE]);
+    assert!(d.0[0].loc.is_none());
+}
