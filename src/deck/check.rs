@@ -48,24 +48,27 @@ pub fn check(deck: &Deck, locs: &Locs) -> Diagnostics {
             Some(n) => format!("contact definition `{n}`"),
             None => format!("contact definition #{}", d + 1),
         };
-        check_definition(d, def, &label, locs, &mut out);
+        let mut found = Diagnostics::default();
+        check_definition(d, def, locs, &mut found);
+        // A located message shows its line; an unlocated one (TOML, or a spec built in
+        // code) must say which definition it is about.
+        for mut diag in found.0 {
+            if diag.loc.is_none() {
+                diag.message = format!("{label}: {}", diag.message);
+            }
+            out.push(diag);
+        }
     }
     out
 }
 
-fn check_definition(
-    d: usize,
-    def: &ContactDefinition,
-    label: &str,
-    locs: &Locs,
-    out: &mut Diagnostics,
-) {
+fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Diagnostics) {
     if let Some(a) = def.opposed_normal_threshold_angle {
         if !(90.0..=180.0).contains(&a) {
             out.push(
                 Diagnostic::error(
                     codes::OPPOSED_ANGLE,
-                    format!("{label}: opposed normal threshold angle is {a} degrees; it must be between 90 and 180"),
+                    format!("opposed normal threshold angle is {a} degrees; it must be between 90 and 180"),
                 )
                 .at(locs.or(&format!("{d}.opposed_normal_threshold_angle"), &def.at))
                 .help("it is the smallest angle between two face normals for the faces to interact; 180 means exactly opposed, 90 the most permissive"),
@@ -92,7 +95,7 @@ fn check_definition(
             out.push(
                 Diagnostic::error(
                     codes::DUPLICATE_SURFACE,
-                    format!("{label}: contact surface `{name}` is defined twice"),
+                    format!("contact surface `{name}` is defined twice"),
                 )
                 .at(locs.or(&format!("{d}.surface.{s}.name"), surf.at()))
                 .help(format!(
@@ -103,7 +106,7 @@ fn check_definition(
             first.insert(name, s);
         }
         if let SurfaceDef::Block(b) = surf {
-            check_surface_block(d, s, b, label, locs, out);
+            check_surface_block(d, s, b, locs, out);
         }
     }
 
@@ -115,7 +118,7 @@ fn check_definition(
                     Diagnostic::error(
                         codes::VALUE_COUNT,
                         format!(
-                            "{label}: periodicity for `{}`: `{what}` needs 2 (2-D) or 3 (3-D) values, found {}",
+                            "periodicity for `{}`: `{what}` needs 2 (2-D) or 3 (3-D) values, found {}",
                             per.surface,
                             v.len()
                         ),
@@ -135,7 +138,7 @@ fn check_definition(
                         Diagnostic::error(
                             codes::ZERO_NORMAL,
                             format!(
-                                "{label}: periodicity for `{}`: the axis is the zero vector",
+                                "periodicity for `{}`: the axis is the zero vector",
                                 per.surface
                             ),
                         )
@@ -170,7 +173,7 @@ fn check_definition(
         out.push(
             Diagnostic::error(
                 codes::UNKNOWN_ENFORCEMENT,
-                format!("{label}: {who} uses enforcement `{name}`, which is not defined"),
+                format!("{who} uses enforcement `{name}`, which is not defined"),
             )
             .at(locs.or(&key, at))
             .help(format!("{hint}{known}")),
@@ -202,7 +205,7 @@ fn check_definition(
             out.push(
                 Diagnostic::error(
                     codes::NORMAL_TOLERANCE,
-                    format!("{label}: {who}: normal tolerance is {t}; it must be positive"),
+                    format!("{who}: normal tolerance is {t}; it must be positive"),
                 )
                 .at(locs.or(&key, at))
                 .help("the normal tolerance is the largest gap (a length) at which faces are paired; use a small positive distance"),
@@ -233,14 +236,7 @@ fn check_definition(
     }
 }
 
-fn check_surface_block(
-    d: usize,
-    s: usize,
-    b: &SurfaceBlock,
-    label: &str,
-    locs: &Locs,
-    out: &mut Diagnostics,
-) {
+fn check_surface_block(d: usize, s: usize, b: &SurfaceBlock, locs: &Locs, out: &mut Diagnostics) {
     let name = &b.name;
     for (k, sub) in b.subsets.iter().enumerate() {
         if sub.normal.iter().all(|&c| c == 0.0) {
@@ -248,7 +244,7 @@ fn check_surface_block(
                 Diagnostic::error(
                     codes::ZERO_NORMAL,
                     format!(
-                        "{label}: subset `{}` of contact surface `{name}` has a zero normal",
+                        "subset `{}` of contact surface `{name}` has a zero normal",
                         sub.name
                     ),
                 )
@@ -268,7 +264,7 @@ fn check_surface_block(
             out.push(
                 Diagnostic::error(
                     codes::SUBSET_AND_AUTO,
-                    format!("{label}: contact surface `{name}` has both `subset` and `auto subset`"),
+                    format!("contact surface `{name}` has both `subset` and `auto subset`"),
                 )
                 .at((!second.is_unknown()).then(|| second.clone()))
                 .help("split the surface either by explicit normals (`subset`) or automatically (`auto subset`), not both"),
@@ -278,7 +274,7 @@ fn check_surface_block(
             out.push(
                 Diagnostic::error(
                     codes::NONPOSITIVE_ANGLE,
-                    format!("{label}: auto subset `{}` of contact surface `{name}` has angle {a}; it must be positive", auto.name),
+                    format!("auto subset `{}` of contact surface `{name}` has angle {a}; it must be positive", auto.name),
                 )
                 .at(locs.or(&format!("{d}.surface.{s}.auto_subset.angle"), &auto.at))
                 .help("the angle (degrees) is how far face normals may turn within one subset; the default is 60"),
@@ -289,7 +285,7 @@ fn check_surface_block(
                 Diagnostic::error(
                     codes::NONPOSITIVE_SUBSETS,
                     format!(
-                        "{label}: auto subset `{}` of contact surface `{name}` asks for 0 subsets",
+                        "auto subset `{}` of contact surface `{name}` asks for 0 subsets",
                         auto.name
                     ),
                 )

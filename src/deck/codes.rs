@@ -65,3 +65,62 @@ pub const PERIODICITY: &str = "E0214";
 pub const UNKNOWN_ENFORCEMENT: &str = "E0215";
 pub const DEPRECATED_ALIAS: &str = "W0101";
 pub const REPEATED_COMMAND: &str = "W0102";
+
+/// Every code above, for tests and tools that list them.
+pub const ALL: &[&str] = &[
+    UNCLOSED_BLOCK,
+    MISMATCHED_END,
+    UNKNOWN_KEYWORD,
+    WRONG_BLOCK,
+    UNKNOWN_BLOCK,
+    MISPLACED_BLOCK,
+    STRAY_END,
+    UNTERMINATED_STRING,
+    OUTSIDE_BLOCK,
+    MISSING_ARGUMENT,
+    BLOCK_NAME,
+    EXTRA_WORDS,
+    DUPLICATE_BLOCK,
+    TOML_ERROR,
+    NOT_A_NUMBER,
+    NONPOSITIVE_ANGLE,
+    NONPOSITIVE_SUBSETS,
+    SUBSET_AND_AUTO,
+    SECOND_AUTO_SUBSET,
+    ZERO_NORMAL,
+    OPPOSED_ANGLE,
+    NORMAL_TOLERANCE,
+    DUPLICATE_SURFACE,
+    OUTPUT_RULE,
+    VALUE_COUNT,
+    ON_OFF,
+    CONTACT_TYPE,
+    PERIODICITY,
+    UNKNOWN_ENFORCEMENT,
+    DEPRECATED_ALIAS,
+    REPEATED_COMMAND,
+];
+
+#[cfg(test)]
+mod tests {
+    use super::ALL;
+
+    #[test]
+    fn codes_are_unique_and_documented_in_the_table() {
+        let source = include_str!("codes.rs");
+        for (i, code) in ALL.iter().enumerate() {
+            assert!(!ALL[i + 1..].contains(code), "{code} is used twice");
+            assert!(
+                source.contains(&format!("//! | {code} |")),
+                "{code} is missing from the table"
+            );
+            let consts = source.matches(&format!("&str = \"{code}\";")).count();
+            assert_eq!(consts, 1, "{code} should have exactly one constant");
+        }
+        let rows = source
+            .lines()
+            .filter(|l| l.starts_with("//! | E") || l.starts_with("//! | W"))
+            .count();
+        assert_eq!(rows, ALL.len(), "the table and ALL list different codes");
+    }
+}

@@ -656,3 +656,24 @@ fn check_deck_works_on_a_spec_built_in_code() {
     assert_eq!(codes_of(&d), [codes::OPPOSED_ANGLE]);
     assert!(d.0[0].loc.is_none());
 }
+
+#[test]
+fn block_naming_and_duplicate_blocks() {
+    let (_, d) = sierra(
+        "begin contact definition\n begin contact surface\n end\n begin search options\n end\n begin search options again\n end\nend\n",
+    );
+    assert_eq!(codes_of(&d), [codes::BLOCK_NAME, codes::DUPLICATE_BLOCK]);
+    let lines: Vec<u32> =
+        d.0.iter()
+            .filter_map(|x| x.loc.as_ref().map(|l| l.line))
+            .collect();
+    assert_eq!(lines, [2, 6]);
+}
+
+#[test]
+fn unterminated_string_surfaces_through_parse_sierra() {
+    let (_, d) = sierra(
+        "begin contact definition\n begin enforcement\n  enforcement for energy = plugin library = \"lib.so\n end\nend\n",
+    );
+    assert_eq!(codes_of(&d), [codes::UNTERMINATED_STRING]);
+}
