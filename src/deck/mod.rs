@@ -2,7 +2,7 @@
 //! twin, both lowered to the typed [`spec::Deck`].
 //!
 //! Entry points: [`load`] (by extension), [`parse_sierra`], [`parse_toml`]. Every
-//! problem found is collected as a [`Diagnostic`](crate::diag::Diagnostic) with a code,
+//! problem found is collected as a [`Diagnostic`] with a code,
 //! file:line:column and a help line; parsing never stops at the first error and never
 //! panics.
 //!
