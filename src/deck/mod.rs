@@ -18,6 +18,7 @@ pub mod lexer;
 pub mod registry;
 mod sierra;
 pub mod spec;
+mod toml_locs;
 mod tree;
 
 #[cfg(test)]
@@ -100,8 +101,10 @@ pub fn check_deck(deck: &Deck) -> Diagnostics {
 pub fn parse_toml(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
     let mut diags = Diagnostics::default();
     match ::toml::from_str::<Deck>(text) {
-        Ok(deck) => {
-            diags.extend(check::check(&deck, &check::Locs::default()));
+        Ok(mut deck) => {
+            let locs = toml_locs::locate(file, text, &mut deck);
+            diags.extend(check::check(&deck, &locs));
+            sort_by_place(&mut diags);
             (deck, diags)
         }
         Err(e) => {
