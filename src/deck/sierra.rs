@@ -828,6 +828,9 @@ impl Lower {
             }
         }
         let mut nums = |l: &mut Lower, key: &str| -> Option<Vec<f64>> {
+            if !allowed.contains(&key) {
+                return None; // reported below as not a part of this transform
+            }
             let (_, vals) = groups.iter().find(|(k, _)| k.lower == key)?;
             let mut v = Vec::new();
             for t in vals {
@@ -931,7 +934,11 @@ impl Lower {
                                     codes::ON_OFF,
                                     format!("`invert_normals` is 0 or 1, not `{v}`"),
                                 )
-                                .at(self.span(&c.line.tokens))
+                                .at(groups
+                                    .iter()
+                                    .find(|(k, _)| k.lower == "invert_normals")
+                                    .and_then(|(k, vals)| vals.first().copied().or(Some(*k)))
+                                    .map(|t| t.loc(&self.file)))
                                 .help("write `invert_normals = 0` to keep the normals as they are"),
                             );
                             return None;

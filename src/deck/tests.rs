@@ -697,3 +697,13 @@ fn unterminated_string_surfaces_through_parse_sierra() {
     );
     assert_eq!(codes_of(&d), [codes::UNTERMINATED_STRING]);
 }
+
+#[test]
+fn invert_normals_takes_zero_or_one_and_points_at_the_value() {
+    let (_, d) = sierra(
+        "begin contact definition\n periodicity for a = align_surface destination = b invert_normals = maybe\nend\n",
+    );
+    assert_eq!(codes_of(&d), [codes::ON_OFF]);
+    let loc = d.0[0].loc.clone().unwrap_or_default();
+    assert_eq!((loc.line, loc.col, loc.len), (2, 69, 5));
+}
