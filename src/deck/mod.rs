@@ -2,16 +2,34 @@
 //! twin, both lowered to the typed [`spec::Deck`].
 //!
 //! Entry points: [`load`] (by extension), [`parse_sierra`], [`parse_toml`]. Every
-//! problem found is collected as a [`Diagnostic`](crate::diag::Diagnostic) with a code,
+//! problem found is collected as a [`Diagnostic`] with a code,
 //! file:line:column and a help line; parsing never stops at the first error and never
 //! panics.
+//!
+//! The Sierra front end runs in stages: [`lexer`] (tokens with line and column), a
+//! `begin … end` tree (`tree`), lowering to the spec (`sierra`), then the semantic
+//! checks of [`check`], which the TOML front end shares. Every keyword comes from the
+//! [`registry`]; [`reference_markdown`] generates the deck reference from it. The
+//! diagnostic codes are listed in [`codes`].
 
+pub mod check;
+pub mod codes;
+pub mod lexer;
+pub mod registry;
+mod sierra;
 pub mod spec;
+mod toml_locs;
+mod tree;
+
+#[cfg(test)]
+mod tests;
+
+pub use registry::reference_markdown;
 
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::diag::{Diagnostic, Diagnostics, SourceMap, file_label};
+use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap, file_label};
 
 pub use spec::Deck;
 
@@ -52,12 +70,83 @@ pub fn load(path: &Path) -> LoadedDeck {
     out
 }
 
-/// Parse Sierra-syntax text.
-pub fn parse_sierra(_file: &Arc<str>, _text: &str) -> (Deck, Diagnostics) {
-    (Deck::default(), Diagnostics::default())
+/// Parse Sierra-syntax text. `file` is the name used in diagnostics.
+///
+/// ```
+/// use std::sync::Arc;
+/// let text = "begin contact definition\n  contact surface top contains block_1\nend\n";
+/// let (deck, diags) = seam::deck::parse_sierra(&Arc::from("deck.i"), text);
+/// assert!(diags.is_empty());
+/// assert_eq!(deck.contact_definitions.len(), 1);
+/// ```
+pub fn parse_sierra(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
+    let (lines, mut diags) = lexer::lex(file, text);
+    let (items, tree_diags) = tree::build(file, lines);
+    diags.extend(tree_diags);
+    let (deck, locs, lower_diags) = sierra::lower(file, &items);
+    diags.extend(lower_diags);
+    diags.extend(check::check(&deck, &locs));
+    sort_by_place(&mut diags);
+    (deck, diags)
 }
 
-/// Parse the TOML form.
-pub fn parse_toml(_file: &Arc<str>, _text: &str) -> (Deck, Diagnostics) {
-    (Deck::default(), Diagnostics::default())
+/// The semantic checks alone, for a [`Deck`] built in code or edited after parsing;
+/// diagnostics carry no location but name the definition and item.
+pub fn check_deck(deck: &Deck) -> Diagnostics {
+    check::check(deck, &check::Locs::default())
+}
+
+/// Parse the TOML form: the same spec through serde, then the same semantic checks.
+/// On a TOML error the deck is empty and the one diagnostic points at the error.
+pub fn parse_toml(file: &Arc<str>, text: &str) -> (Deck, Diagnostics) {
+    let mut diags = Diagnostics::default();
+    match ::toml::from_str::<Deck>(text) {
+        Ok(mut deck) => {
+            let locs = toml_locs::locate(file, text, &mut deck);
+            diags.extend(check::check(&deck, &locs));
+            sort_by_place(&mut diags);
+            (deck, diags)
+        }
+        Err(e) => {
+            let at = e.span().map(|r| byte_span_loc(file, text, r));
+            let message = e.message().trim().replace('\n', "; ");
+            diags.push(
+                Diagnostic::error(codes::TOML_ERROR, format!("TOML: {message}"))
+                    .at(at)
+                    .help("TOML keys are the snake_case forms of the deck phrases; see the deck reference"),
+            );
+            (Deck::default(), diags)
+        }
+    }
+}
+
+/// Order diagnostics as an analyst reads the file: by line and column, unlocated last;
+/// the sort is stable, so diagnostics at one place keep the order they were found in.
+fn sort_by_place(diags: &mut Diagnostics) {
+    diags.0.sort_by_key(|d| {
+        d.loc
+            .as_ref()
+            .map_or((u32::MAX, u32::MAX), |l| (l.line, l.col))
+    });
+}
+
+/// The 1-based line and character column of a byte range (clamped to its first line).
+fn byte_span_loc(file: &Arc<str>, text: &str, r: std::ops::Range<usize>) -> Loc {
+    let start = floor_char_boundary(text, r.start.min(text.len()));
+    let end = floor_char_boundary(text, r.end.min(text.len()).max(start));
+    let before = text.get(..start).unwrap_or_default();
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before.get(line_start..).unwrap_or_default().chars().count() + 1;
+    let span = text.get(start..end).unwrap_or_default();
+    let len = span.split('\n').next().unwrap_or_default().chars().count();
+    let n = |x: usize| u32::try_from(x).unwrap_or(u32::MAX);
+    Loc::new(file, n(line), n(col), n(len.max(1)))
+}
+
+fn floor_char_boundary(text: &str, mut i: usize) -> usize {
+    while i > 0 && !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
 }

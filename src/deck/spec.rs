@@ -333,6 +333,8 @@ pub struct InteractionDefaults {
 #[serde(deny_unknown_fields)]
 pub struct SearchOptions {
     #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
     pub normal_tolerance: Option<f64>,
     #[serde(default)]
     pub tangential_tolerance: Option<f64>,
@@ -349,4 +351,53 @@ pub struct SearchOptions {
     pub search_update_frequency: Option<u32>,
     #[serde(skip)]
     pub at: Loc,
+}
+
+impl Deck {
+    /// The same deck with every `at` reset to the unknown location: for comparing decks
+    /// read from different files or front ends.
+    pub fn without_locations(&self) -> Deck {
+        let mut d = self.clone();
+        for cd in &mut d.contact_definitions {
+            cd.at = Loc::default();
+            for s in &mut cd.surfaces {
+                match s {
+                    SurfaceDef::Contains { at, .. }
+                    | SurfaceDef::NodeSet { at, .. }
+                    | SurfaceDef::SkinAllBlocks { at, .. } => *at = Loc::default(),
+                    SurfaceDef::Block(b) => {
+                        b.at = Loc::default();
+                        for sub in &mut b.subsets {
+                            sub.at = Loc::default();
+                        }
+                        if let Some(a) = &mut b.auto_subset {
+                            a.at = Loc::default();
+                        }
+                    }
+                }
+            }
+            for p in &mut cd.periodicity {
+                p.at = Loc::default();
+            }
+            for e in &mut cd.enforcements {
+                e.at = Loc::default();
+                for m in &mut e.models {
+                    m.at = Loc::default();
+                }
+                for p in &mut e.properties {
+                    p.at = Loc::default();
+                }
+            }
+            for i in &mut cd.interactions {
+                i.at = Loc::default();
+            }
+            if let Some(x) = &mut cd.interaction_defaults {
+                x.at = Loc::default();
+            }
+            if let Some(x) = &mut cd.search_options {
+                x.at = Loc::default();
+            }
+        }
+        d
+    }
 }

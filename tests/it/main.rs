@@ -1,4 +1,5 @@
-//! The integration-test binary: one binary, one module per area.
+//! The one integration-test binary; each module is one area.
 
 mod bad_cli;
+mod bad_decks;
 mod surfaces;

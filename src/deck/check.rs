@@ -1,0 +1,300 @@
+//! Semantic checks on a typed [`Deck`], shared by both front ends.
+//!
+//! Entry point: [`check`]. The Sierra front end passes a [`Locs`] table with the exact
+//! location of each value it read, so messages point at the token; the TOML front end
+//! passes an empty table and messages fall back to the item's `at` (or no location) —
+//! the message itself always names the definition and item.
+//!
+//! Location keys: `"{d}.opposed_normal_threshold_angle"`,
+//! `"{d}.interaction.{i}.normal_tolerance"`, `"{d}.interaction.{i}.enforcement"`,
+//! `"{d}.interaction_defaults.enforcement"`, `"{d}.search_options.{key}"`,
+//! `"{d}.surface.{s}.name"`, `"{d}.surface.{s}.subset.{k}.normal"`,
+//! `"{d}.surface.{s}.auto_subset.{angle|number_of_subsets}"`,
+//! `"{d}.periodicity.{p}.{offset|axis|center|angle}"`, with `d`, `i`, `s`, `k`, `p`
+//! 0-based indices into the spec's vectors.
+
+use std::collections::HashMap;
+
+use crate::diag::{Diagnostic, Diagnostics, Loc, did_you_mean};
+
+use super::codes;
+use super::spec::*;
+
+/// Locations of individual values, by the keys listed in the module docs.
+#[derive(Clone, Debug, Default)]
+pub struct Locs(HashMap<String, Loc>);
+
+impl Locs {
+    pub fn set(&mut self, key: String, loc: Loc) {
+        self.0.insert(key, loc);
+    }
+
+    pub fn get(&self, key: &str) -> Option<Loc> {
+        self.0.get(key).cloned()
+    }
+
+    /// The location for `key`, else `fallback` (if known).
+    fn or(&self, key: &str, fallback: &Loc) -> Option<Loc> {
+        self.get(key)
+            .or_else(|| (!fallback.is_unknown()).then(|| fallback.clone()))
+    }
+}
+
+/// Every semantic problem in `deck`.
+pub fn check(deck: &Deck, locs: &Locs) -> Diagnostics {
+    let mut out = Diagnostics::default();
+    for (d, def) in deck.contact_definitions.iter().enumerate() {
+        let label = match &def.name {
+            Some(n) => format!("contact definition `{n}`"),
+            None => format!("contact definition #{}", d + 1),
+        };
+        let mut found = Diagnostics::default();
+        check_definition(d, def, locs, &mut found);
+        // A located message shows its line; an unlocated one (TOML, or a spec built in
+        // code) must say which definition it is about.
+        for mut diag in found.0 {
+            if diag.loc.is_none() {
+                diag.message = format!("{label}: {}", diag.message);
+            }
+            out.push(diag);
+        }
+    }
+    out
+}
+
+fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Diagnostics) {
+    if let Some(a) = def.opposed_normal_threshold_angle {
+        if !(90.0..=180.0).contains(&a) {
+            out.push(
+                Diagnostic::error(
+                    codes::OPPOSED_ANGLE,
+                    format!("opposed normal threshold angle is {a} degrees; it must be between 90 and 180"),
+                )
+                .at(locs.or(&format!("{d}.opposed_normal_threshold_angle"), &def.at))
+                .help("it is the smallest angle between two face normals for the faces to interact; 180 means exactly opposed, 90 the most permissive"),
+            );
+        }
+    }
+
+    // Surface names: each defined once.
+    let mut first: HashMap<&str, usize> = HashMap::new();
+    for (s, surf) in def.surfaces.iter().enumerate() {
+        let name = match surf {
+            SurfaceDef::Contains { name, .. } | SurfaceDef::NodeSet { name, .. } => name,
+            SurfaceDef::Block(b) => &b.name,
+            SurfaceDef::SkinAllBlocks { .. } => continue,
+        };
+        if let Some(&prev) = first.get(name.as_str()) {
+            let where_prev = def
+                .surfaces
+                .get(prev)
+                .map(|p| p.at())
+                .filter(|l| !l.is_unknown())
+                .map(|l| format!(" on line {}", l.line))
+                .unwrap_or_default();
+            out.push(
+                Diagnostic::error(
+                    codes::DUPLICATE_SURFACE,
+                    format!("contact surface `{name}` is defined twice"),
+                )
+                .at(locs.or(&format!("{d}.surface.{s}.name"), surf.at()))
+                .help(format!(
+                    "it was first defined{where_prev}; give this one another name or merge the two"
+                )),
+            );
+        } else {
+            first.insert(name, s);
+        }
+        if let SurfaceDef::Block(b) = surf {
+            check_surface_block(d, s, b, locs, out);
+        }
+    }
+
+    for (p, per) in def.periodicity.iter().enumerate() {
+        let key = |k: &str| format!("{d}.periodicity.{p}.{k}");
+        let mut count = |what: &str, v: &[f64]| {
+            if !(2..=3).contains(&v.len()) {
+                out.push(
+                    Diagnostic::error(
+                        codes::VALUE_COUNT,
+                        format!(
+                            "periodicity for `{}`: `{what}` needs 2 (2-D) or 3 (3-D) values, found {}",
+                            per.surface,
+                            v.len()
+                        ),
+                    )
+                    .at(locs.or(&key(what), &per.at))
+                    .help(format!("write `{what} = x y` or `{what} = x y z`")),
+                );
+            }
+        };
+        match &per.transform {
+            PeriodicTransform::Rectangular { offset } => count("offset", offset),
+            PeriodicTransform::Cylindrical { axis, center, .. } => {
+                count("axis", axis);
+                count("center", center);
+                if axis.iter().all(|&a| a == 0.0) && !axis.is_empty() {
+                    out.push(
+                        Diagnostic::error(
+                            codes::ZERO_NORMAL,
+                            format!(
+                                "periodicity for `{}`: the axis is the zero vector",
+                                per.surface
+                            ),
+                        )
+                        .at(locs.or(&key("axis"), &per.at))
+                        .help("give the direction of the rotation axis, e.g. `axis = 0 0 1`"),
+                    );
+                }
+            }
+            PeriodicTransform::AlignSurface { .. } | PeriodicTransform::Mapped { .. } => {}
+        }
+    }
+
+    let enforcements: Vec<&str> = def
+        .enforcements
+        .iter()
+        .filter_map(|e| e.name.as_deref())
+        .collect();
+    let mut refers = |name: &Option<String>, key: String, at: &Loc, who: &str| {
+        let Some(name) = name else { return };
+        if enforcements.contains(&name.as_str()) {
+            return;
+        }
+        let hint = did_you_mean(name, enforcements.iter().copied())
+            .map(|s| format!("did you mean `{s}`? "))
+            .unwrap_or_default();
+        let known = if enforcements.is_empty() {
+            "no named `begin enforcement` block is defined".to_string()
+        } else {
+            let v: Vec<String> = enforcements.iter().map(|e| format!("`{e}`")).collect();
+            format!("the enforcements are {}", v.join(", "))
+        };
+        out.push(
+            Diagnostic::error(
+                codes::UNKNOWN_ENFORCEMENT,
+                format!("{who} uses enforcement `{name}`, which is not defined"),
+            )
+            .at(locs.or(&key, at))
+            .help(format!("{hint}{known}")),
+        );
+    };
+    for (i, x) in def.interactions.iter().enumerate() {
+        let who = match &x.name {
+            Some(n) => format!("interaction `{n}`"),
+            None => format!("interaction #{}", i + 1),
+        };
+        refers(
+            &x.enforcement,
+            format!("{d}.interaction.{i}.enforcement"),
+            &x.at,
+            &who,
+        );
+    }
+    if let Some(x) = &def.interaction_defaults {
+        refers(
+            &x.enforcement,
+            format!("{d}.interaction_defaults.enforcement"),
+            &x.at,
+            "interaction defaults",
+        );
+    }
+
+    let tolerance = |v: Option<f64>, key: String, at: &Loc, who: &str, out: &mut Diagnostics| {
+        if let Some(t) = v.filter(|t| t.is_nan() || *t <= 0.0) {
+            out.push(
+                Diagnostic::error(
+                    codes::NORMAL_TOLERANCE,
+                    format!("{who}: normal tolerance is {t}; it must be positive"),
+                )
+                .at(locs.or(&key, at))
+                .help("the normal tolerance is the largest gap (a length) at which faces are paired; use a small positive distance"),
+            );
+        }
+    };
+    for (i, x) in def.interactions.iter().enumerate() {
+        let who = match &x.name {
+            Some(n) => format!("interaction `{n}`"),
+            None => format!("interaction #{}", i + 1),
+        };
+        tolerance(
+            x.normal_tolerance,
+            format!("{d}.interaction.{i}.normal_tolerance"),
+            &x.at,
+            &who,
+            out,
+        );
+    }
+    if let Some(so) = &def.search_options {
+        tolerance(
+            so.normal_tolerance,
+            format!("{d}.search_options.normal_tolerance"),
+            &so.at,
+            "search options",
+            out,
+        );
+    }
+}
+
+fn check_surface_block(d: usize, s: usize, b: &SurfaceBlock, locs: &Locs, out: &mut Diagnostics) {
+    let name = &b.name;
+    for (k, sub) in b.subsets.iter().enumerate() {
+        if sub.normal.iter().all(|&c| c == 0.0) {
+            out.push(
+                Diagnostic::error(
+                    codes::ZERO_NORMAL,
+                    format!(
+                        "subset `{}` of contact surface `{name}` has a zero normal",
+                        sub.name
+                    ),
+                )
+                .at(locs.or(&format!("{d}.surface.{s}.subset.{k}.normal"), &sub.at))
+                .help("give the outward direction of the faces to pick, e.g. `with normal 0 0 1`"),
+            );
+        }
+    }
+    if let Some(auto) = &b.auto_subset {
+        if let Some(sub) = b.subsets.first() {
+            // Point at whichever of the two came second in the deck.
+            let second = if !sub.at.is_unknown() && sub.at.line > auto.at.line {
+                &sub.at
+            } else {
+                &auto.at
+            };
+            out.push(
+                Diagnostic::error(
+                    codes::SUBSET_AND_AUTO,
+                    format!("contact surface `{name}` has both `subset` and `auto subset`"),
+                )
+                .at((!second.is_unknown()).then(|| second.clone()))
+                .help("split the surface either by explicit normals (`subset`) or automatically (`auto subset`), not both"),
+            );
+        }
+        if let Some(a) = auto.angle.filter(|a| a.is_nan() || *a <= 0.0) {
+            out.push(
+                Diagnostic::error(
+                    codes::NONPOSITIVE_ANGLE,
+                    format!("auto subset `{}` of contact surface `{name}` has angle {a}; it must be positive", auto.name),
+                )
+                .at(locs.or(&format!("{d}.surface.{s}.auto_subset.angle"), &auto.at))
+                .help("the angle (degrees) is how far face normals may turn within one subset; the default is 60"),
+            );
+        }
+        if auto.number_of_subsets == Some(0) {
+            out.push(
+                Diagnostic::error(
+                    codes::NONPOSITIVE_SUBSETS,
+                    format!(
+                        "auto subset `{}` of contact surface `{name}` asks for 0 subsets",
+                        auto.name
+                    ),
+                )
+                .at(locs.or(
+                    &format!("{d}.surface.{s}.auto_subset.number_of_subsets"),
+                    &auto.at,
+                ))
+                .help("ask for at least one subset, or leave `number of subsets` out"),
+            );
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! The deck's diagnostic codes: one constant per meaning, never reused.
+//!
+//! | code  | severity | meaning |
+//! |-------|----------|---------|
+//! | E0101 | error    | `begin` block not closed before the end of the file |
+//! | E0102 | error    | `end` line names a block type or name other than the open block |
+//! | E0103 | error    | unknown line command in this block (with did-you-mean) |
+//! | E0104 | error    | known line command used in a block where it is not allowed |
+//! | E0105 | error    | unknown block type after `begin` (with did-you-mean) |
+//! | E0106 | error    | block opened somewhere it may not appear |
+//! | E0107 | error    | `end` with no open block |
+//! | E0108 | error    | quoted string not closed on its line |
+//! | E0109 | error    | line outside every block |
+//! | E0110 | error    | command is missing a word or value it needs |
+//! | E0111 | error    | block needs a name, or has a name it may not have |
+//! | E0112 | error    | unexpected extra words at the end of a command |
+//! | E0113 | error    | a block that may appear once per definition appears twice |
+//! | E0150 | error    | TOML syntax or type error |
+//! | E0201 | error    | value should be a (finite) number or integer but is not |
+//! | E0202 | error    | `Auto Subset … Angle` not positive |
+//! | E0203 | error    | `Auto Subset … Number Of Subsets` not positive |
+//! | E0204 | error    | `Subset` and `Auto Subset` in the same `Contact Surface` block |
+//! | E0205 | error    | more than one `Auto Subset` in one `Contact Surface` block |
+//! | E0206 | error    | zero normal vector in `Subset … With Normal` |
+//! | E0207 | error    | `Opposed Normal Threshold Angle` below 90 degrees (or above 180) |
+//! | E0208 | error    | `Normal Tolerance` not positive |
+//! | E0209 | error    | the same surface name defined twice in one contact definition |
+//! | E0210 | error    | unknown `Output Rule` value |
+//! | E0211 | error    | wrong number of values (point, offset, axis, center) |
+//! | E0212 | error    | on/off switch with another value |
+//! | E0213 | error    | unknown `Contact Type` value |
+//! | E0214 | error    | unknown periodicity transform, or a transform missing a part |
+//! | E0215 | error    | interaction names an enforcement that is not defined |
+//! | W0101 | warning  | deprecated alias (`Slave Variable`) |
+//! | W0102 | warning  | single-valued command given twice; the last one wins |
+
+pub const UNCLOSED_BLOCK: &str = "E0101";
+pub const MISMATCHED_END: &str = "E0102";
+pub const UNKNOWN_KEYWORD: &str = "E0103";
+pub const WRONG_BLOCK: &str = "E0104";
+pub const UNKNOWN_BLOCK: &str = "E0105";
+pub const MISPLACED_BLOCK: &str = "E0106";
+pub const STRAY_END: &str = "E0107";
+pub const UNTERMINATED_STRING: &str = "E0108";
+pub const OUTSIDE_BLOCK: &str = "E0109";
+pub const MISSING_ARGUMENT: &str = "E0110";
+pub const BLOCK_NAME: &str = "E0111";
+pub const EXTRA_WORDS: &str = "E0112";
+pub const DUPLICATE_BLOCK: &str = "E0113";
+pub const TOML_ERROR: &str = "E0150";
+pub const NOT_A_NUMBER: &str = "E0201";
+pub const NONPOSITIVE_ANGLE: &str = "E0202";
+pub const NONPOSITIVE_SUBSETS: &str = "E0203";
+pub const SUBSET_AND_AUTO: &str = "E0204";
+pub const SECOND_AUTO_SUBSET: &str = "E0205";
+pub const ZERO_NORMAL: &str = "E0206";
+pub const OPPOSED_ANGLE: &str = "E0207";
+pub const NORMAL_TOLERANCE: &str = "E0208";
+pub const DUPLICATE_SURFACE: &str = "E0209";
+pub const OUTPUT_RULE: &str = "E0210";
+pub const VALUE_COUNT: &str = "E0211";
+pub const ON_OFF: &str = "E0212";
+pub const CONTACT_TYPE: &str = "E0213";
+pub const PERIODICITY: &str = "E0214";
+pub const UNKNOWN_ENFORCEMENT: &str = "E0215";
+pub const DEPRECATED_ALIAS: &str = "W0101";
+pub const REPEATED_COMMAND: &str = "W0102";
+
+/// Every code above, for tests and tools that list them.
+pub const ALL: &[&str] = &[
+    UNCLOSED_BLOCK,
+    MISMATCHED_END,
+    UNKNOWN_KEYWORD,
+    WRONG_BLOCK,
+    UNKNOWN_BLOCK,
+    MISPLACED_BLOCK,
+    STRAY_END,
+    UNTERMINATED_STRING,
+    OUTSIDE_BLOCK,
+    MISSING_ARGUMENT,
+    BLOCK_NAME,
+    EXTRA_WORDS,
+    DUPLICATE_BLOCK,
+    TOML_ERROR,
+    NOT_A_NUMBER,
+    NONPOSITIVE_ANGLE,
+    NONPOSITIVE_SUBSETS,
+    SUBSET_AND_AUTO,
+    SECOND_AUTO_SUBSET,
+    ZERO_NORMAL,
+    OPPOSED_ANGLE,
+    NORMAL_TOLERANCE,
+    DUPLICATE_SURFACE,
+    OUTPUT_RULE,
+    VALUE_COUNT,
+    ON_OFF,
+    CONTACT_TYPE,
+    PERIODICITY,
+    UNKNOWN_ENFORCEMENT,
+    DEPRECATED_ALIAS,
+    REPEATED_COMMAND,
+];
+
+#[cfg(test)]
+mod tests {
+    use super::ALL;
+
+    #[test]
+    fn codes_are_unique_and_documented_in_the_table() {
+        let source = include_str!("codes.rs");
+        for (i, code) in ALL.iter().enumerate() {
+            assert!(!ALL[i + 1..].contains(code), "{code} is used twice");
+            assert!(
+                source.contains(&format!("//! | {code} |")),
+                "{code} is missing from the table"
+            );
+            let consts = source.matches(&format!("&str = \"{code}\";")).count();
+            assert_eq!(consts, 1, "{code} should have exactly one constant");
+        }
+        let rows = source
+            .lines()
+            .filter(|l| l.starts_with("//! | E") || l.starts_with("//! | W"))
+            .count();
+        assert_eq!(rows, ALL.len(), "the table and ALL list different codes");
+    }
+}
