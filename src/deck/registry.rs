@@ -138,42 +138,48 @@ pub static COMMANDS: &[CommandSpec] = &[
         "visualize_contact",
         [CD],
         "[= on|off]",
-        "Write contact variables (gap, status, flux) to the results."
+        "Write contact variables (gap, status, flux) to the results.",
+        planned
     ),
     cmd!(
         "output rule",
         "output_rule",
         [CD],
         "= none|summary|verbose|more verbose",
-        "How much the contact search reports in the log."
+        "How much the contact search reports in the log.",
+        planned
     ),
     cmd!(
         "update search every",
         "update_search_every_n_steps",
         [CD],
         "<n> steps",
-        "Redo the search every n steps (1: every step)."
+        "Redo the search every n steps (1: every step).",
+        planned
     ),
     cmd!(
         "opposed normal threshold angle",
         "opposed_normal_threshold_angle",
         [CD],
         "= <degrees>",
-        "Faces interact only if their normals are at least this far apart (>= 90)."
+        "Faces interact only if their normals are at least this far apart (>= 90).",
+        planned
     ),
     cmd!(
         "disable opposed normal interaction culling",
         "disable_opposed_normal_interaction_culling",
         [CD],
         "",
-        "Keep pairs whatever the angle between their normals."
+        "Keep pairs whatever the angle between their normals.",
+        planned
     ),
     cmd!(
         "periodicity for",
         "periodicity",
         [CD],
         "<surface> = rectangular offset = <dx> <dy> [<dz>] | cylindrical axis = <a>... center = <c>... angle = <deg> | align_surface destination = <surface> [invert_normals = 0|1] | mapped x_map = <f> y_map = <g> [z_map = <h>]",
-        "Tie a surface to the image of another under a periodic transform."
+        "Tie a surface to the image of another under a periodic transform.",
+        planned
     ),
     // Enforcement.
     cmd!(
@@ -181,49 +187,56 @@ pub static COMMANDS: &[CommandSpec] = &[
         "model",
         [ENF],
         "<equation> = <model> [<key> = <value> | <word>]...",
-        "The enforcement model for one equation, with its arguments."
+        "The enforcement model for one equation, with its arguments.",
+        planned
     ),
     cmd!(
         "integer data",
         "integer_data",
         [ENF],
         "[=] <i>...",
-        "Integers handed to a plugin model."
+        "Integers handed to a plugin model.",
+        planned
     ),
     cmd!(
         "real data",
         "real_data",
         [ENF],
         "[=] <r>...",
-        "Reals handed to a plugin model."
+        "Reals handed to a plugin model.",
+        planned
     ),
     cmd!(
         "side b variable",
         "side_b_variable",
         [ENF],
         "<side B variable> to <side A variable>",
-        "Tie a variable on side B to another on side A (Lagrange multipliers)."
+        "Tie a variable on side B to another on side A (Lagrange multipliers).",
+        planned
     ),
     cmd!(
         "slave variable",
         "slave_variable",
         [ENF],
         "<side B variable> to <side A variable>",
-        "Deprecated alias of `side b variable`."
+        "Deprecated alias of `side b variable`.",
+        planned
     ),
     cmd!(
         "dash penalty factor",
         "dash_penalty_factor",
         [ENF],
         "= <f>",
-        "Penalty factor of the Dash (mortar penalty) model."
+        "Penalty factor of the Dash (mortar penalty) model.",
+        planned
     ),
     cmd!(
         "offset temperature",
         "offset_temperature",
         [ENF],
         "= <t>",
-        "Temperature offset added across the interface."
+        "Temperature offset added across the interface.",
+        planned
     ),
     cmd!(
         "use toggle block",
@@ -239,49 +252,56 @@ pub static COMMANDS: &[CommandSpec] = &[
         "side_a",
         [INT],
         "[=] <surface>...",
-        "Surfaces that carry the integration points."
+        "Surfaces that carry the integration points.",
+        planned
     ),
     cmd!(
         "side b",
         "side_b",
         [INT],
         "[=] <surface>...",
-        "Surfaces projected onto."
+        "Surfaces projected onto.",
+        planned
     ),
     cmd!(
         "surfaces",
         "surfaces",
         [INT, DEF],
         "[=] <surface>...",
-        "Surfaces that interact with each other (both sides)."
+        "Surfaces that interact with each other (both sides).",
+        planned
     ),
     cmd!(
         "normal tolerance",
         "normal_tolerance",
         [INT, SO],
         "[=] <distance>",
-        "Largest normal gap at which a pair is found (> 0)."
+        "Largest normal gap at which a pair is found (> 0).",
+        planned
     ),
     cmd!(
         "enforcement",
         "enforcement",
         [INT, DEF],
         "= <enforcement name>",
-        "Which `begin enforcement` block applies."
+        "Which `begin enforcement` block applies.",
+        planned
     ),
     cmd!(
         "general contact",
         "general_contact",
         [DEF],
         "= on|off",
-        "Every listed surface interacts with every other."
+        "Every listed surface interacts with every other.",
+        planned
     ),
     cmd!(
         "self contact",
         "self_contact",
         [DEF, SO],
         "= on|off",
-        "A surface may interact with itself."
+        "A surface may interact with itself.",
+        planned
     ),
     // Search Options.
     cmd!(
@@ -289,35 +309,40 @@ pub static COMMANDS: &[CommandSpec] = &[
         "tangential_tolerance",
         [SO],
         "[=] <distance>",
-        "How far outside a face a projection still counts."
+        "How far outside a face a projection still counts.",
+        planned
     ),
     cmd!(
         "buffer factor",
         "buffer_factor",
         [SO],
         "[=] <f>",
-        "Growth of the search boxes, relative to the face size."
+        "Growth of the search boxes, relative to the face size.",
+        planned
     ),
     cmd!(
         "field factor",
         "field_factor",
         [SO],
         "[=] <f>",
-        "Scale of the search field around each face."
+        "Scale of the search field around each face.",
+        planned
     ),
     cmd!(
         "normal check angle",
         "normal_check_angle",
         [SO],
         "[=] <degrees>",
-        "Largest angle between normals of a pair."
+        "Largest angle between normals of a pair.",
+        planned
     ),
     cmd!(
         "search update frequency",
         "search_update_frequency",
         [SO],
         "[=] <n>",
-        "Redo the search every n steps."
+        "Redo the search every n steps.",
+        planned
     ),
     // Contact Surface block (Sierra/SM).
     cmd!(
@@ -508,10 +533,17 @@ pub fn reference_markdown() -> String {
         );
         let _ = writeln!(out, "|---|---|---|---|---|");
         for sub in BLOCKS.iter().filter(|s| s.parent == b.key) {
+            // A block is carried out when any of its commands is.
+            let done = COMMANDS
+                .iter()
+                .any(|c| c.implemented && c.blocks.contains(&sub.key));
             let _ = writeln!(
                 out,
-                "| `begin {}` | `{}` | block | {} | yes |",
-                sub.phrase, sub.key, sub.description
+                "| `begin {}` | `{}` | block | {} | {} |",
+                sub.phrase,
+                sub.key,
+                sub.description,
+                if done { "yes" } else { "parsed only" }
             );
         }
         for c in COMMANDS.iter().filter(|c| c.blocks.contains(&b.key)) {
@@ -533,7 +565,7 @@ pub fn reference_markdown() -> String {
         if b.key == ENF {
             let _ = writeln!(
                 out,
-                "| `<material property>` | `property` | `= <model> [<key> = <value> \\| <word>]...` | Any other `words = model args` line, e.g. `gap conductance coefficient = constant h = 10`. | yes |"
+                "| `<material property>` | `property` | `= <model> [<key> = <value> \\| <word>]...` | Any other `words = model args` line, e.g. `gap conductance coefficient = constant h = 10`. | parsed only |"
             );
         }
         let _ = writeln!(out);

@@ -2,4 +2,5 @@
 
 mod bad_cli;
 mod bad_decks;
+mod docs;
 mod surfaces;
