@@ -1,0 +1,1 @@
+mod mesh_io;
