@@ -29,11 +29,15 @@ pub fn read(path: &Path) -> Result<Mesh, MeshError> {
             path: path.to_path_buf(),
             source,
         },
+        other if looks_truncated(&other) => MeshError::format(
+            path,
+            format!("the file is truncated: {other}"),
+            "the file is shorter than its header says; re-export it or check that the copy finished",
+        ),
         other => MeshError::format(
             path,
             format!("not a readable netCDF/Exodus II file: {other}"),
-            "the file may be truncated or not an Exodus file; re-export it from Cubit/SEACAS \
-             (or check that the copy finished)",
+            "the file may be corrupt or not an Exodus file; re-export it from Cubit/SEACAS",
         ),
     })?;
     let ex = ExoFile { path, file };
@@ -57,9 +61,7 @@ impl ExoFile<'_> {
 
     /// Wrap a netCDF error raised while reading `what`.
     fn nc_err(&self, what: &str, e: netcdf_reader::Error) -> MeshError {
-        let truncated = matches!(e, netcdf_reader::Error::UnexpectedEof { .. })
-            || matches!(&e, netcdf_reader::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof);
-        if truncated {
+        if looks_truncated(&e) {
             self.err(
                 format!("cannot read `{what}`: the file is truncated ({e})"),
                 "the file is shorter than its header says; re-export it or check that the copy finished",
@@ -134,12 +136,14 @@ impl ExoFile<'_> {
     }
 
     /// 1-based positions in `1..=count` → dense 0-based indices, checked.
+    /// `describe(k)` names entry `k` (0-based) for messages.
     fn positions(
         &self,
         name: &str,
         expect: usize,
         count: usize,
         what: &str,
+        describe: &dyn Fn(usize) -> String,
     ) -> Result<Vec<u32>, MeshError> {
         let var = self
             .file
@@ -149,7 +153,9 @@ impl ExoFile<'_> {
             if v < 1 || v as u64 > count as u64 {
                 Err(self.err(
                     format!(
-                        "`{name}` entry {} refers to {what} {v}, but the file has {count} {what}s (1-based)",
+                        "{} refers to {what} position {v}, but the file has {count} {what}s \
+                         (`{name}` entry {}; positions are 1-based)",
+                        describe(k),
                         k + 1
                     ),
                     "the file is corrupt or was written with 0-based indices; re-export it",
@@ -276,7 +282,7 @@ impl ExoFile<'_> {
             None
         };
 
-        self.read_blocks(&mut mesh, dim, num_nodes)?;
+        self.read_blocks(&mut mesh, dim, num_nodes, elem_numbers.as_deref())?;
         if mesh.elem_numbers.len() != num_elem {
             return Err(self.err(
                 format!(
@@ -324,7 +330,14 @@ impl ExoFile<'_> {
         Ok(())
     }
 
-    fn read_blocks(&self, mesh: &mut Mesh, dim: usize, num_nodes: usize) -> Result<(), MeshError> {
+    /// `map` is `elem_num_map`, used to name elements in messages.
+    fn read_blocks(
+        &self,
+        mesh: &mut Mesh,
+        dim: usize,
+        num_nodes: usize,
+        map: Option<&[i64]>,
+    ) -> Result<(), MeshError> {
         let nblk = self.dim_opt("num_el_blk").unwrap_or(0);
         let ids = self.ids("eb_prop1", nblk)?;
         let names = self.names("eb_names", nblk)?;
@@ -378,9 +391,16 @@ impl ExoFile<'_> {
                      (e.g. Cubit `block N element type hex8`)",
                 ));
             };
-            let idx = self.positions(&conn_name, count * npe, num_nodes, "node")?;
-            let connectivity: Vec<NodeId> = idx.into_iter().map(NodeId).collect();
             let first = mesh.elem_numbers.len() as i64;
+            let describe = |k: usize| {
+                let pos = first as usize + k / npe;
+                let number = map
+                    .and_then(|m| m.get(pos).copied())
+                    .unwrap_or(pos as i64 + 1);
+                format!("element {number} in {label}, local node {}", k % npe + 1)
+            };
+            let idx = self.positions(&conn_name, count * npe, num_nodes, "node", &describe)?;
+            let connectivity: Vec<NodeId> = idx.into_iter().map(NodeId).collect();
             mesh.push_block(
                 id,
                 name,
@@ -429,7 +449,15 @@ impl ExoFile<'_> {
             let count = self.dim_opt(&format!("num_side_ss{i}")).unwrap_or(0);
             let mut sides = Vec::with_capacity(count);
             if count > 0 {
-                let elems = self.positions(&format!("ss_elem{i}"), count, num_elem, "element")?;
+                let label = set_label("side set", ids[i - 1], &names[i - 1]);
+                let describe = |k: usize| format!("{label}, entry {}", k + 1);
+                let elems = self.positions(
+                    &format!("ss_elem{i}"),
+                    count,
+                    num_elem,
+                    "element",
+                    &describe,
+                )?;
                 let side_name = format!("ss_side{i}");
                 let nums = self.ints(&side_name, count)?;
                 for (k, (&e, &s)) in elems.iter().zip(&nums).enumerate() {
@@ -464,7 +492,9 @@ impl ExoFile<'_> {
         for i in 1..=nns {
             let count = self.dim_opt(&format!("num_nod_ns{i}")).unwrap_or(0);
             let nodes = if count > 0 {
-                self.positions(&format!("node_ns{i}"), count, num_nodes, "node")?
+                let label = set_label("node set", ids[i - 1], &names[i - 1]);
+                let describe = |k: usize| format!("{label}, entry {}", k + 1);
+                self.positions(&format!("node_ns{i}"), count, num_nodes, "node", &describe)?
                     .into_iter()
                     .map(NodeId)
                     .collect()
@@ -524,6 +554,25 @@ impl ExoFile<'_> {
             });
         }
         Ok(())
+    }
+}
+
+/// netcdf-reader reports a short file as an EOF, or (classic header check) as invalid
+/// data saying the file "has only" so many bytes.
+fn looks_truncated(e: &netcdf_reader::Error) -> bool {
+    match e {
+        netcdf_reader::Error::UnexpectedEof { .. } => true,
+        netcdf_reader::Error::Io(io) => io.kind() == std::io::ErrorKind::UnexpectedEof,
+        netcdf_reader::Error::InvalidData(m) => m.contains("file has only"),
+        _ => false,
+    }
+}
+
+fn set_label(kind: &str, id: i64, name: &str) -> String {
+    if name.is_empty() {
+        format!("{kind} {id}")
+    } else {
+        format!("{kind} {id} (`{name}`)")
     }
 }
 
