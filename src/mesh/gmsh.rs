@@ -688,6 +688,20 @@ fn lower(raw: Raw) -> Result<Mesh, LowerError> {
             sources.push((tag as i64, String::new(), groups));
         }
     }
+    if sources.is_empty() {
+        let (what, group) = if top == 3 {
+            ("volume", "Physical Volume")
+        } else {
+            ("surface", "Physical Surface")
+        };
+        return Err((
+            format!("the file has physical groups but no physical {what}, so no element block"),
+            format!(
+                "add the {what}s to a physical group (`{group}(\"name\") = {{...}};`), or remove \
+                 all physical groups so that every {what} becomes a block"
+            ),
+        ));
+    }
     for (id, name, groups) in sources {
         let what = if name.is_empty() {
             format!("physical group {id}")
@@ -908,4 +922,77 @@ fn same_orientation(side: impl Iterator<Item = u32>, face: &[u32]) -> bool {
         return false;
     };
     (0..n).all(|i| buf[(start + i) % n] == face[i])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read_str(text: &str) -> Result<Mesh, String> {
+        let raw = parse(text.as_bytes()).map_err(|e| format!("line {}: {}", e.line, e.message))?;
+        lower(raw).map_err(|(m, _)| m)
+    }
+
+    /// One tet with sparse node tags, its four faces, and a physical surface on one face.
+    const ONE_TET: &str = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n\
+$PhysicalNames\n2\n2 7 \"base\"\n3 3 \"solid\"\n$EndPhysicalNames\n\
+$Entities\n0 0 1 1\n\
+4 0 0 0 1 1 0 1 7 0\n\
+9 0 0 0 1 1 1 1 3 0\n$EndEntities\n\
+$Nodes\n1 4 10 40\n3 9 0 4\n10\n20\n30\n40\n\
+0 0 0\n1 0 0\n0 1 0\n0 0 1\n$EndNodes\n\
+$Elements\n2 2 5 6\n3 9 4 1\n5 10 20 30 40\n2 4 2 1\n6 10 30 20\n$EndElements\n";
+
+    #[test]
+    fn one_tet_with_sparse_tags_and_a_base_side_set() {
+        let m = read_str(ONE_TET).unwrap();
+        assert_eq!(m.dim, 3);
+        assert_eq!(m.node_numbers, vec![10, 20, 30, 40]);
+        assert_eq!(m.elem_numbers, vec![5]);
+        assert_eq!(m.blocks.len(), 1);
+        assert_eq!((m.blocks[0].id, m.blocks[0].name.as_str()), (3, "solid"));
+        assert_eq!(m.blocks[0].topology, Topology::Tet4);
+        assert_eq!(m.side_sets.len(), 1);
+        let s = &m.side_sets[0];
+        assert_eq!((s.id, s.name.as_str()), (7, "base"));
+        // Nodes 10, 30, 20 are the Exodus tet side 4 (local 0, 2, 1).
+        assert_eq!(
+            s.sides,
+            vec![Side {
+                elem: ElemId(0),
+                side: 4
+            }]
+        );
+        assert_eq!(m.validate(), Ok(()));
+    }
+
+    #[test]
+    fn surface_groups_without_volume_groups_are_refused() {
+        let text = ONE_TET.replace("9 0 0 0 1 1 1 1 3 0", "9 0 0 0 1 1 1 0 0");
+        let err = read_str(&text).unwrap_err();
+        assert!(err.contains("no physical volume"), "{err}");
+    }
+
+    #[test]
+    fn a_bad_number_gives_its_line() {
+        let text = ONE_TET.replace("0 1 0\n", "0 one 0\n");
+        let err = read_str(&text).unwrap_err();
+        // The coordinate lines start at line 21 (1-based); `0 1 0` is the third.
+        assert!(err.starts_with("line 23:"), "{err}");
+        assert!(err.contains("`one`"), "{err}");
+    }
+
+    #[test]
+    fn element_referring_to_a_missing_node_is_an_error() {
+        let text = ONE_TET.replace("5 10 20 30 40", "5 10 20 30 41");
+        let err = read_str(&text).unwrap_err();
+        assert!(err.contains("element 5 refers to node 41"), "{err}");
+    }
+
+    #[test]
+    fn orientation_of_cycles() {
+        assert!(same_orientation([1, 2, 3].into_iter(), &[2, 3, 1]));
+        assert!(!same_orientation([1, 2, 3].into_iter(), &[1, 3, 2]));
+        assert!(same_orientation([1, 2, 3, 4].into_iter(), &[3, 4, 1, 2]));
+    }
 }
