@@ -40,13 +40,28 @@ pub fn read(path: &Path) -> Result<Mesh, MeshError> {
             "the file may be corrupt or not an Exodus file; re-export it from Cubit/SEACAS",
         ),
     })?;
-    let ex = ExoFile { path, file };
+    let file_len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(u64::MAX);
+    // Classic data is stored uncompressed; netCDF-4 data may be deflated, which shrinks
+    // data at most ~1032:1 (zlib's limit), so allow 1100x.
+    let max_bytes = if file.as_classic().is_some() {
+        file_len
+    } else {
+        file_len.saturating_mul(1100).saturating_add(1 << 20)
+    };
+    let ex = ExoFile {
+        path,
+        file,
+        max_bytes,
+    };
     ex.read_mesh()
 }
 
 struct ExoFile<'a> {
     path: &'a Path,
     file: NcFile,
+    /// Most bytes of data the file can hold; counts beyond it are corruption, refused
+    /// before allocating.
+    max_bytes: u64,
 }
 
 /// Exodus `ex_entity_type` codes used in assemblies.
@@ -72,6 +87,17 @@ impl ExoFile<'_> {
                 "the file may be corrupt; re-export it from Cubit/SEACAS",
             )
         }
+    }
+
+    /// Refuse `n` entries of `size` bytes when the file cannot hold them.
+    fn bound(&self, what: &str, n: usize, size: usize) -> Result<(), MeshError> {
+        if (n as u64).saturating_mul(size as u64) > self.max_bytes {
+            return Err(self.err(
+                format!("`{what}` claims {n} entries, more than the file can hold"),
+                "the file is corrupt; re-export it from Cubit/SEACAS",
+            ));
+        }
+        Ok(())
     }
 
     fn dim_opt(&self, name: &str) -> Option<usize> {
@@ -102,6 +128,8 @@ impl ExoFile<'_> {
                 "the file's dimensions disagree with its data; re-export it",
             ));
         }
+        let size = var.dtype().size().unwrap_or(8);
+        self.bound(name, n, size)?;
         macro_rules! via {
             ($t:ty) => {{
                 let mut buf = vec![<$t>::default(); n];
@@ -175,6 +203,7 @@ impl ExoFile<'_> {
                     "the file's dimensions disagree with its data; re-export it",
                 ));
             }
+            self.bound(name, n, 4)?;
             let mut buf = vec![0i32; n];
             self.file
                 .read_variable_into::<i32>(name, &mut buf)
@@ -203,6 +232,7 @@ impl ExoFile<'_> {
                 "the file's dimensions disagree with its data; re-export it",
             ));
         }
+        self.bound(name, n, var.dtype().size().unwrap_or(4))?;
         if *var.dtype() == NcType::Double {
             let mut buf = vec![0.0; n];
             self.file
@@ -222,6 +252,10 @@ impl ExoFile<'_> {
     fn names(&self, name: &str, count: usize) -> Result<Vec<String>, MeshError> {
         if !self.has_var(name) {
             return Ok(vec![String::new(); count]);
+        }
+        if let Ok(var) = self.file.variable(name) {
+            let n = var.num_elements().unwrap_or(u64::MAX);
+            self.bound(name, usize::try_from(n).unwrap_or(usize::MAX), 1)?;
         }
         let mut v = self
             .file
@@ -258,6 +292,13 @@ impl ExoFile<'_> {
         }
         let num_nodes = self.dim_opt("num_nodes").unwrap_or(0);
         let num_elem = self.dim_opt("num_elem").unwrap_or(0);
+        // Every node has `dim` coordinates of at least 4 bytes, every element at least
+        // one 4-byte connectivity entry, every block or set at least a 4-byte id.
+        self.bound("num_nodes", num_nodes, 4 * dim)?;
+        self.bound("num_elem", num_elem, 4)?;
+        for d in ["num_el_blk", "num_side_sets", "num_node_sets"] {
+            self.bound(d, self.dim_opt(d).unwrap_or(0), 4)?;
+        }
         if num_nodes > u32::MAX as usize || num_elem > u32::MAX as usize {
             return Err(self.err(
                 "more than 2^32 nodes or elements",
@@ -447,7 +488,7 @@ impl ExoFile<'_> {
         let names = self.names("ss_names", nss)?;
         for i in 1..=nss {
             let count = self.dim_opt(&format!("num_side_ss{i}")).unwrap_or(0);
-            let mut sides = Vec::with_capacity(count);
+            let mut sides = Vec::new();
             if count > 0 {
                 let label = set_label("side set", ids[i - 1], &names[i - 1]);
                 let describe = |k: usize| format!("{label}, entry {}", k + 1);
@@ -460,6 +501,7 @@ impl ExoFile<'_> {
                 )?;
                 let side_name = format!("ss_side{i}");
                 let nums = self.ints(&side_name, count)?;
+                sides.reserve_exact(count);
                 for (k, (&e, &s)) in elems.iter().zip(&nums).enumerate() {
                     if !(1..=u8::MAX as i64).contains(&s) {
                         return Err(self.err(

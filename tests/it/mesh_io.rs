@@ -527,3 +527,72 @@ fn large_mesh_read_and_validate_timing() {
         validate.as_secs_f64()
     );
 }
+
+/// Every prefix of a fixture (at a stride) is an error, never a panic and never a mesh
+/// that fails later: short files are the most common corruption (interrupted copies).
+#[test]
+fn truncated_copies_never_panic() {
+    let dir = std::env::temp_dir().join(format!("seam-mesh-trunc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in [
+        "two_hex_classic.exo",
+        "two_hex_offset64.exo",
+        "two_hex_nc4.exo",
+        "box_hex_ascii.msh",
+        "box_hex_binary.msh",
+    ] {
+        let bytes = std::fs::read(fixture(name)).unwrap();
+        let path = dir.join(name);
+        let stride = (bytes.len() / 60).max(1);
+        for len in (0..bytes.len()).step_by(stride) {
+            std::fs::write(&path, &bytes[..len]).unwrap();
+            let result = std::panic::catch_unwind(|| mesh::read(&path));
+            match result {
+                Ok(Ok(_)) => panic!(
+                    "{name} cut to {len} of {} bytes: read as a mesh",
+                    bytes.len()
+                ),
+                Ok(Err(_)) => {}
+                Err(_) => panic!("{name} cut to {len} of {} bytes: panic", bytes.len()),
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Random byte corruption (3 bytes per copy, a fixed xorshift seed so failures
+/// reproduce) gives errors, never panics or aborts. Run with more copies by hand after
+/// reader changes: 12 000 copies passed when this was written.
+#[test]
+fn corrupted_copies_never_panic() {
+    let dir = std::env::temp_dir().join(format!("seam-mesh-flip-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut state: u64 = 0x1234_5678_9abc_def0;
+    let mut rand = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    for name in [
+        "two_hex_classic.exo",
+        "two_hex_nc4.exo",
+        "box_hex_binary.msh",
+        "box_hex_ascii.msh",
+    ] {
+        let bytes = std::fs::read(fixture(name)).unwrap();
+        let path = dir.join(name);
+        for copy in 0..150 {
+            let mut b = bytes.clone();
+            for _ in 0..3 {
+                let i = rand() as usize % b.len();
+                b[i] = rand() as u8;
+            }
+            std::fs::write(&path, &b).unwrap();
+            let p = path.clone();
+            let outcome = std::panic::catch_unwind(move || mesh::read(&p).map(|_| ()));
+            assert!(outcome.is_ok(), "{name}, corrupted copy {copy}: panic");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
