@@ -370,6 +370,32 @@ fn gmsh_ascii_errors_give_the_line() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+#[test]
+fn exodus_from_meshio_matches_the_gmsh_file_it_was_converted_from() {
+    // meshio writes netCDF-4 with int64 connectivity, a combined `coord` array and no
+    // ids or names; blocks are numbered 1.. in the order of the Gmsh element blocks.
+    let exo = read("meshio_box.exo");
+    let msh = read("box_hex_ascii.msh");
+    assert_eq!(exo.coords.len(), msh.coords.len());
+    for (p, q) in exo.coords.iter().zip(&msh.coords) {
+        for d in 0..3 {
+            assert!((p[d] - q[d]).abs() < 1e-15, "{p:?} vs {q:?}");
+        }
+    }
+    let exo_conn: Vec<_> = exo
+        .blocks
+        .iter()
+        .flat_map(|b| b.connectivity.clone())
+        .collect();
+    let msh_conn: Vec<_> = msh
+        .blocks
+        .iter()
+        .flat_map(|b| b.connectivity.clone())
+        .collect();
+    assert_eq!(exo_conn, msh_conn);
+    assert!(exo.blocks.iter().all(|b| b.topology == Topology::Hex8));
+}
+
 // ------------------------------------------------------------------------------------
 // Every fixture, every element
 
@@ -387,6 +413,7 @@ fn every_fixture_element_has_positive_volume() {
         "box_tet_ascii.msh",
         "box_tet_binary.msh",
         "plate2d.msh",
+        "meshio_box.exo",
     ] {
         let m = read(name);
         let measures = element_measures(&m);
@@ -401,7 +428,7 @@ fn every_fixture_element_has_positive_volume() {
             "tet_wedge.exo" => 2.0,
             "quad2d.exo" => 6.0,
             "shell.exo" => 1.0,
-            n if n.starts_with("box_") => 2.0,
+            n if n.starts_with("box_") || n == "meshio_box.exo" => 2.0,
             "plate2d.msh" => 2.0,
             _ => unreachable!(),
         };
