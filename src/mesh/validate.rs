@@ -197,11 +197,13 @@ impl Mesh {
                 second,
             });
         }
-        let ids = |it: &mut dyn Iterator<Item = i64>| -> Vec<i64> { it.collect() };
         for (kind, list) in [
-            ("block", ids(&mut self.blocks.iter().map(|b| b.id))),
-            ("side set", ids(&mut self.side_sets.iter().map(|s| s.id))),
-            ("node set", ids(&mut self.node_sets.iter().map(|s| s.id))),
+            (
+                "block",
+                self.blocks.iter().map(|b| b.id).collect::<Vec<_>>(),
+            ),
+            ("side set", self.side_sets.iter().map(|s| s.id).collect()),
+            ("node set", self.node_sets.iter().map(|s| s.id).collect()),
         ] {
             if let Some((id, _, _)) = first_duplicate(&list) {
                 p.push(ValidationError::DuplicateId { kind, id });
@@ -639,6 +641,24 @@ mod tests {
             m.validate(),
             Err(ValidationError::Inverted { .. })
         ));
+    }
+
+    #[test]
+    fn duplicate_block_ids_and_element_numbers() {
+        let mut m = one_element(Topology::Hex8, &UNIT_HEX, &[0, 1, 2, 3, 4, 5, 6, 7]);
+        m.push_block(
+            2,
+            "again",
+            Topology::Hex8,
+            (0..8).map(NodeId).collect(),
+            Some(vec![17]),
+        );
+        let msg = m.validate().unwrap_err().to_string();
+        assert!(msg.contains("block id 2 is used twice"), "{msg}");
+        assert!(
+            msg.contains("element number 17 is used by more than one element"),
+            "{msg}"
+        );
     }
 
     #[test]
