@@ -3,4 +3,5 @@
 mod bad_cli;
 mod bad_decks;
 mod docs;
+mod mesh_io;
 mod surfaces;
