@@ -175,6 +175,8 @@ fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) 
         );
     } else {
         print_table(&rows);
+        use std::io::Write as _;
+        let _ = std::io::stdout().flush();
         eprint!("{}", diags.render(&loaded.sources));
     }
     ExitCode::SUCCESS
@@ -198,9 +200,24 @@ fn print_table(rows: &[SurfaceRow]) {
             .collect::<Vec<_>>()
             .join(", ");
         println!(
-            "{:<width$}  {:<5}  {:>9}  {:>9}  {:>13.6e}  {}",
-            r.name, kind, r.faces, r.nodes, r.area, from
+            "{:<width$}  {:<5}  {:>9}  {:>9}  {:>13}  {}",
+            r.name,
+            kind,
+            r.faces,
+            r.nodes,
+            format_number(r.area),
+            from
         );
+    }
+}
+
+/// Fixed-point with six decimals in the everyday range, scientific outside it.
+fn format_number(x: f64) -> String {
+    let x = x + 0.0; // no "-0"
+    if x == 0.0 || (1e-3..1e7).contains(&x.abs()) {
+        format!("{x:.6}")
+    } else {
+        format!("{x:.6e}")
     }
 }
 

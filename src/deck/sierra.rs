@@ -1347,7 +1347,13 @@ impl Lower {
                     } else {
                         "side set names"
                     };
+                    let first = c.pos;
                     let v = self.names(&mut c, what);
+                    for t in c.line.tokens.get(first..c.pos).unwrap_or_default() {
+                        if !t.is_sep() {
+                            x.name_locs.push((value_text(t), t.loc(&self.file)));
+                        }
+                    }
                     let list = match c.cmd.key {
                         "block" => &mut x.blocks,
                         "surface" => &mut x.side_sets,
@@ -1363,8 +1369,9 @@ impl Lower {
                         self.missing(&c, "element numbers");
                     }
                     while c.peek().is_some() {
-                        if let Some((v, _)) = self.integer(&mut c, "element numbers (integers)") {
+                        if let Some((v, l)) = self.integer(&mut c, "element numbers (integers)") {
                             x.elements.push(v);
+                            x.name_locs.push((v.to_string(), l));
                         }
                     }
                 }

@@ -127,6 +127,20 @@ pub struct SurfaceBlock {
     pub contact_type: ContactType,
     #[serde(skip)]
     pub at: Loc,
+    /// Where each name (or element number) of the line commands was written, for
+    /// messages about one of them.
+    #[serde(skip)]
+    pub name_locs: Vec<(String, Loc)>,
+}
+
+impl SurfaceBlock {
+    /// The location of a name written in one of the block's commands, else the block's.
+    pub fn loc_of(&self, name: &str) -> &Loc {
+        self.name_locs
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map_or(&self.at, |(_, l)| l)
+    }
 }
 
 /// `Subset name With Normal nx ny nz`.
@@ -367,6 +381,7 @@ impl Deck {
                     | SurfaceDef::SkinAllBlocks { at, .. } => *at = Loc::default(),
                     SurfaceDef::Block(b) => {
                         b.at = Loc::default();
+                        b.name_locs.clear();
                         for sub in &mut b.subsets {
                             sub.at = Loc::default();
                         }

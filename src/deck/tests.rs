@@ -141,6 +141,7 @@ fn full_expected() -> Deck {
                 auto_subset: None,
                 contact_type: ContactType::Node,
                 at: Default::default(),
+                name_locs: Vec::new(),
             }),
             SurfaceDef::Block(SurfaceBlock {
                 name: "side".into(),

@@ -162,7 +162,7 @@ pub struct Mesh {
 #[non_exhaustive]
 pub enum MeshError {
     #[error(
-        "cannot open mesh file {path}: {source}\n  help: check the path (relative paths are taken from the deck's directory)"
+        "cannot open mesh file {path}: {source}\n  help: check the path and that the file is readable"
     )]
     Open {
         path: PathBuf,

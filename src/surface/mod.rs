@@ -52,6 +52,8 @@ pub struct SurfaceFace {
     pub side: Side,
     /// Offset along the face normal (shell faces: half the thickness), else 0.
     pub loft: f64,
+    /// Index into the surface's `origins`.
+    pub origin: u32,
 }
 
 /// A named contact surface.
@@ -161,12 +163,16 @@ impl<'a> Builder<'a> {
         for cmd in &def.surfaces {
             match cmd {
                 SurfaceDef::Contains { name, contains, at } => {
+                    let before = self.error_count();
                     let g = self.gather_contains(name, contains, at);
-                    self.claim(name, SurfaceKind::Faces, g, at, &mut names, None);
+                    let named_wrong = self.error_count() > before;
+                    self.claim(name, SurfaceKind::Faces, g, at, &mut names, named_wrong);
                 }
                 SurfaceDef::NodeSet { name, contains, at } => {
+                    let before = self.error_count();
                     let g = self.gather_node_sets(contains, at);
-                    self.claim(name, SurfaceKind::Nodes, g, at, &mut names, None);
+                    let named_wrong = self.error_count() > before;
+                    self.claim(name, SurfaceKind::Nodes, g, at, &mut names, named_wrong);
                 }
                 SurfaceDef::SkinAllBlocks { exclude, at } => {
                     let excluded = self.resolve_blocks(exclude, at);
@@ -186,14 +192,23 @@ impl<'a> Builder<'a> {
                             g,
                             at,
                             &mut names,
-                            None,
+                            false,
                         );
                     }
                 }
                 SurfaceDef::Block(sb) => {
+                    let before = self.error_count();
                     let g = self.gather_block(sb);
+                    let named_wrong = self.error_count() > before;
                     let first = self.surfaces.len();
-                    self.claim(&sb.name, SurfaceKind::Faces, g, &sb.at, &mut names, None);
+                    self.claim(
+                        &sb.name,
+                        SurfaceKind::Faces,
+                        g,
+                        &sb.at,
+                        &mut names,
+                        named_wrong,
+                    );
                     if sb.contact_type == ContactType::Node {
                         self.make_node_surface(first);
                     }
@@ -254,7 +269,7 @@ impl<'a> Builder<'a> {
                             }
                         }
                     }
-                    for e in self.resolve_elements(&sb.elements, &quiet, false) {
+                    for e in self.resolve_elements(&sb.elements, &|_| quiet.clone(), false) {
                         included[e.index()] = true;
                     }
                 }
@@ -425,10 +440,10 @@ impl<'a> Builder<'a> {
                 self.skin_block(b, &mut g);
             }
         }
-        for b in self.resolve_blocks(&sb.blocks, at) {
+        for b in self.resolve_blocks_in(sb, &sb.blocks) {
             self.skin_block(b, &mut g);
         }
-        for e in self.resolve_elements(&sb.elements, at, true) {
+        for e in self.resolve_elements_in(sb) {
             let mask = self.exterior_by_elem[e.index()];
             let origin = format!("element {}", self.mesh.elem_number(e));
             for s in 0..8u8 {
@@ -446,7 +461,7 @@ impl<'a> Builder<'a> {
         for name in &sb.side_sets {
             match self.mesh.find_side_set(name) {
                 Some(ss) => self.add_side_set(ss, at, &mut g),
-                None => self.unknown_name(name, "side set", at, Names::SideSets),
+                None => self.unknown_name(name, "side set", sb.loc_of(name), Names::SideSets),
             }
         }
         for name in &sb.assemblies {
@@ -459,18 +474,18 @@ impl<'a> Builder<'a> {
                         self.add_side_set(ss, at, &mut g);
                     }
                 }
-                None => self.unknown_name(name, "assembly", at, Names::Assemblies),
+                None => self.unknown_name(name, "assembly", sb.loc_of(name), Names::Assemblies),
             }
         }
         let removed_blocks: HashSet<usize> = self
-            .resolve_blocks(&sb.remove_blocks, at)
+            .resolve_blocks_in(sb, &sb.remove_blocks)
             .into_iter()
             .collect();
         let mut removed_sides = HashSet::new();
         for name in &sb.remove_surfaces {
             match self.mesh.find_side_set(name) {
                 Some(ss) => removed_sides.extend(self.mesh.side_sets[ss].sides.iter().copied()),
-                None => self.unknown_name(name, "side set", at, Names::SideSets),
+                None => self.unknown_name(name, "side set", sb.loc_of(name), Names::SideSets),
             }
         }
         g.faces.retain(|(side, _)| {
@@ -478,6 +493,22 @@ impl<'a> Builder<'a> {
                 && !removed_blocks.contains(&self.mesh.block_of(side.elem))
         });
         g
+    }
+
+    /// Blocks named in a surface block, each error pointing at the name.
+    fn resolve_blocks_in(&mut self, sb: &SurfaceBlock, names: &[String]) -> Vec<usize> {
+        let mut out = Vec::new();
+        for name in names {
+            match self.mesh.find_block(name) {
+                Some(b) => out.push(b),
+                None => self.unknown_name(name, "block", sb.loc_of(name), Names::Blocks),
+            }
+        }
+        out
+    }
+
+    fn resolve_elements_in(&mut self, sb: &SurfaceBlock) -> Vec<ElemId> {
+        self.resolve_elements(&sb.elements, &|n| sb.loc_of(&n.to_string()).clone(), true)
     }
 
     fn resolve_blocks(&mut self, names: &[String], at: &Loc) -> Vec<usize> {
@@ -491,7 +522,12 @@ impl<'a> Builder<'a> {
         out
     }
 
-    fn resolve_elements(&mut self, numbers: &[i64], at: &Loc, report: bool) -> Vec<ElemId> {
+    fn resolve_elements(
+        &mut self,
+        numbers: &[i64],
+        at: &dyn Fn(i64) -> Loc,
+        report: bool,
+    ) -> Vec<ElemId> {
         if numbers.is_empty() {
             return Vec::new();
         }
@@ -509,13 +545,17 @@ impl<'a> Builder<'a> {
                 Some(_) => {}
                 None if report => self.diags.push(
                     Diagnostic::error("E0305", format!("element {n} does not exist in the mesh"))
-                        .at(Some(self.sources.narrow(at, &n.to_string())))
+                        .at(Some(at(n)))
                         .help("`Element =` takes element numbers as in the mesh file (its element number map)"),
                 ),
                 None => {}
             }
         }
         out
+    }
+
+    fn error_count(&self) -> usize {
+        self.diags.errors().count()
     }
 
     fn warn_beam(&mut self, b: usize, at: &Loc) {
@@ -566,7 +606,7 @@ impl<'a> Builder<'a> {
         g: Gathered,
         at: &Loc,
         names: &mut HashMap<String, Loc>,
-        parent: Option<String>,
+        named_wrong: bool,
     ) {
         let name = name.to_ascii_lowercase();
         if let Some(first) = names.get(&name) {
@@ -590,12 +630,17 @@ impl<'a> Builder<'a> {
         let mut faces = Vec::new();
         let mut nodes = Vec::new();
         let mut seen = HashSet::new();
-        let bump = |origins: &mut Vec<(String, usize)>, o: String| match origins
-            .iter_mut()
-            .find(|x| x.0 == o)
-        {
-            Some(x) => x.1 += 1,
-            None => origins.push((o, 1)),
+        let bump = |origins: &mut Vec<(String, usize)>, o: String| -> u32 {
+            match origins.iter().position(|x| x.0 == o) {
+                Some(i) => {
+                    origins[i].1 += 1;
+                    i as u32
+                }
+                None => {
+                    origins.push((o, 1));
+                    origins.len() as u32 - 1
+                }
+            }
         };
         for (side, origin) in g.faces {
             if !seen.insert(side) {
@@ -606,8 +651,8 @@ impl<'a> Builder<'a> {
                 None => {
                     self.face_owner.insert(side, index);
                     let loft = self.loft(side);
-                    faces.push(SurfaceFace { side, loft });
-                    bump(&mut origins, origin);
+                    let origin = bump(&mut origins, origin);
+                    faces.push(SurfaceFace { side, loft, origin });
                 }
             }
         }
@@ -649,7 +694,8 @@ impl<'a> Builder<'a> {
                     .at(Some(at.clone()))
                     .help("this is the ownership rule at work; drop the definition or move it earlier"),
             );
-        } else if empty && parent.is_none() {
+        } else if empty && !named_wrong {
+            // (When a name in the command was wrong, that error already explains it.)
             self.diags.push(
                 Diagnostic::error("E0303", format!("contact surface `{name}` is empty"))
                     .at(Some(at.clone()))
@@ -662,7 +708,7 @@ impl<'a> Builder<'a> {
             faces,
             nodes,
             origins,
-            parent,
+            parent: None,
         });
     }
 

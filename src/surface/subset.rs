@@ -122,7 +122,7 @@ pub(super) fn apply(
             .help("refer to the subsets by name in interactions"),
         );
     }
-    b.surfaces[index].faces = remaining;
+    recount_origins(&mut b.surfaces[index], remaining);
     for (name, faces, origin, at) in made {
         if let Some(first) = names.get(&name) {
             b.diags.push(
@@ -139,8 +139,10 @@ pub(super) fn apply(
         }
         names.insert(name.clone(), at);
         let new_index = b.surfaces.len() as u32;
-        for f in &faces {
+        let mut faces = faces;
+        for f in &mut faces {
             b.face_owner.insert(f.side, new_index);
+            f.origin = 0;
         }
         let count = faces.len();
         b.surfaces.push(ContactSurface {
@@ -152,6 +154,27 @@ pub(super) fn apply(
             parent: Some(parent.name.clone()),
         });
     }
+}
+
+/// Give `surface` the faces it keeps, and count its origins again over them.
+fn recount_origins(surface: &mut ContactSurface, mut faces: Vec<SurfaceFace>) {
+    let mut counts = vec![0usize; surface.origins.len()];
+    for f in &faces {
+        counts[f.origin as usize] += 1;
+    }
+    let mut remap = vec![0u32; counts.len()];
+    let mut origins = Vec::new();
+    for (i, (name, _)) in surface.origins.drain(..).enumerate() {
+        if counts[i] > 0 {
+            remap[i] = origins.len() as u32;
+            origins.push((name, counts[i]));
+        }
+    }
+    for f in &mut faces {
+        f.origin = remap[f.origin as usize];
+    }
+    surface.origins = origins;
+    surface.faces = faces;
 }
 
 /// Groups of edge-connected faces whose normals lie within `angle_deg` of their seed's.

@@ -2,6 +2,7 @@
 
 mod bad_cli;
 mod bad_decks;
+mod cli;
 mod docs;
 mod mesh_io;
 mod surfaces;

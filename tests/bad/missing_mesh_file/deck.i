@@ -1,0 +1,3 @@
+begin contact definition
+  skin all blocks = on
+end

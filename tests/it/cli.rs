@@ -1,0 +1,222 @@
+//! The `seam` command line on the bundled example and on fixtures: output formats,
+//! exit codes, the TOML twin, element death.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn seam(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_seam"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("seam runs")
+}
+
+fn json(out: &Output) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "exit {:?}: {}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")
+}
+
+const EXAMPLE_MESH: &str = "examples/two_blocks/two_blocks.exo";
+
+fn surface<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    report["surfaces"]
+        .as_array()
+        .expect("surfaces is an array")
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("no surface {name} in {report}"))
+}
+
+/// The example's mesh: base is 6×6×6 hexes on the unit cube, lid 4×4×3 on
+/// [0,1]²×[1,1.5] (see examples/two_blocks/make_mesh.py), so every count below follows
+/// from the grid sizes.
+#[test]
+fn example_surfaces_as_json() {
+    let r = json(&seam(&[
+        "surfaces",
+        "examples/two_blocks/contact.i",
+        "--mesh",
+        EXAMPLE_MESH,
+        "--json",
+    ]));
+    let expect = [
+        ("interface_base", 36, 1.0),
+        ("interface_lid", 16, 1.0),
+        ("lid_outside", 4 * 4 * 3, 2.0),
+        ("lid_outside_top", 16, 1.0),
+        ("base", 6 * 36 - 36, 5.0),
+    ];
+    assert_eq!(r["surfaces"].as_array().unwrap().len(), expect.len());
+    for (name, faces, area) in expect {
+        let s = surface(&r, name);
+        assert_eq!(s["kind"], "faces");
+        assert_eq!(s["faces"], faces, "{name}");
+        let a = s["area"].as_f64().unwrap();
+        assert!((a - area).abs() < 1e-12, "{name}: area {a}");
+    }
+    // Nodes: 7×7 on the base's top; the lid's top 5×5 less its rim, owned by lid_outside.
+    assert_eq!(surface(&r, "interface_base")["nodes"], 49);
+    assert_eq!(surface(&r, "lid_outside_top")["nodes"], 9);
+    let codes: Vec<&str> = r["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w["code"].as_str().unwrap())
+        .collect();
+    assert_eq!(codes, ["W0301"]);
+}
+
+#[test]
+fn toml_twin_gives_the_same_surfaces() {
+    let a = json(&seam(&[
+        "surfaces",
+        "examples/two_blocks/contact.i",
+        "--mesh",
+        EXAMPLE_MESH,
+        "--json",
+    ]));
+    let b = json(&seam(&[
+        "surfaces",
+        "examples/two_blocks/contact.toml",
+        "--mesh",
+        EXAMPLE_MESH,
+        "--json",
+    ]));
+    assert_eq!(a, b);
+}
+
+#[test]
+fn table_lists_every_surface() {
+    let out = seam(&[
+        "surfaces",
+        "examples/two_blocks/contact.i",
+        "--mesh",
+        EXAMPLE_MESH,
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].starts_with("surface"), "{text}");
+    assert_eq!(lines.len(), 6, "{text}");
+    assert!(
+        lines[5].starts_with("base ") && lines[5].contains("180"),
+        "{text}"
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("warning[W0301]"));
+}
+
+/// Element 8 is the base's cell (i, j, k) = (1, 1, 0): on the bottom plane, not on an
+/// edge. Dead, it takes its one bottom face away and exposes five neighbours' sides.
+#[test]
+fn dead_elements_expose_faces() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "surfaces",
+            "examples/two_blocks/contact.i",
+            "--mesh",
+            EXAMPLE_MESH,
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        json(&seam(&args))
+    };
+    let (alive, dead) = (run(&[]), run(&["--dead", "8"]));
+    assert_eq!(surface(&alive, "base")["faces"], 180);
+    assert_eq!(surface(&dead, "base")["faces"], 180 - 1 + 5);
+    let area = surface(&dead, "base")["area"].as_f64().unwrap();
+    assert!((area - (5.0 + 4.0 / 36.0)).abs() < 1e-12, "{area}");
+}
+
+#[test]
+fn bad_dead_list_is_a_usage_error() {
+    let out = seam(&[
+        "surfaces",
+        "examples/two_blocks/contact.i",
+        "--mesh",
+        EXAMPLE_MESH,
+        "--dead",
+        "5-x",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`5-x`"));
+}
+
+#[test]
+fn check_passes_the_example_and_fails_unimplemented_commands() {
+    let out = seam(&[
+        "check",
+        "examples/two_blocks/contact.i",
+        "--mesh",
+        EXAMPLE_MESH,
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("5 contact surface(s)"));
+
+    let dir = std::env::temp_dir().join(format!("seam-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let deck = dir.join("deck.i");
+    std::fs::write(
+        &deck,
+        "begin contact definition\n  skin all blocks = on\n  begin enforcement\n    enforcement for energy = tied_temperature\n  end\nend\n",
+    )
+    .unwrap();
+    let out = seam(&["check", deck.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("error[E0900]"));
+    // `seam surfaces` does not need the enforcement: it warns and goes on.
+    let out = seam(&["surfaces", deck.to_str().unwrap(), "--mesh", EXAMPLE_MESH]);
+    assert_eq!(out.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("warning[W0900]"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The Gmsh fixture is two unit cubes stacked and meshed conformingly (blocks `lower`
+/// and `upper`, side set `interface` at z = 1): with both skinned, the shared square is
+/// interior, so each skin has area 5, and the side set still gives the interface.
+#[test]
+fn gmsh_meshes_work_end_to_end() {
+    let dir = std::env::temp_dir().join(format!("seam-gmsh-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let deck = dir.join("deck.i");
+    std::fs::write(
+        &deck,
+        "begin contact definition\n  contact surface iface contains interface\n  skin all blocks = on\nend\n",
+    )
+    .unwrap();
+    let mut reports = Vec::new();
+    for mesh in ["box_hex_ascii.msh", "box_hex_binary.msh"] {
+        let mesh = root().join("tests/fixtures").join(mesh);
+        let r = json(&seam(&[
+            "surfaces",
+            deck.to_str().unwrap(),
+            "--mesh",
+            mesh.to_str().unwrap(),
+            "--json",
+        ]));
+        for (name, area) in [("iface", 1.0), ("lower", 5.0), ("upper", 5.0)] {
+            let a = surface(&r, name)["area"].as_f64().unwrap();
+            assert!((a - area).abs() < 1e-12, "{name}: {a}");
+        }
+        reports.push(r);
+    }
+    assert_eq!(
+        reports[0], reports[1],
+        "ASCII and binary give the same surfaces"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
