@@ -16,7 +16,9 @@
 
 use serde::Serialize;
 
-use crate::deck::spec::{ContactDefinition, Interaction as InteractionSpec};
+use crate::deck::spec::{
+    ContactDefinition, Control, ControlAssignment, Interaction as InteractionSpec, Overclosure,
+};
 use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap, did_you_mean};
 use crate::surface::{SurfaceKind, SurfaceSet};
 
@@ -66,6 +68,11 @@ pub struct Interaction {
     /// The enforcement this interaction uses, by name, if the deck says.
     pub enforcement: Option<String>,
     pub settings: SearchSettings,
+    /// Penalty scale factor from the control assignments (1 when none applies).
+    pub penalty_scale: f64,
+    /// Initial-overclosure treatment from the control assignments (store offsets when
+    /// none applies: a thermal analysis keeps its geometry).
+    pub overclosure: Overclosure,
     /// Where the interaction was defined (unknown for defaults).
     #[serde(skip)]
     pub at: Loc,
@@ -132,6 +139,8 @@ pub fn resolve(
             side_b_name: surfaces.surfaces[b].name.clone(),
             enforcement,
             settings,
+            penalty_scale: 1.0,
+            overclosure: Overclosure::StoreOffsets,
             at,
         };
         match out.iter_mut().find(|x| x.side_a == a && x.side_b == b) {
@@ -208,7 +217,49 @@ pub fn resolve(
             }
         }
     }
+    apply_controls(&def.control_assignments, &mut out, &mut resolver);
     (out, diags)
+}
+
+/// Abaqus-style control assignments, in deck order: an assignment with no surface
+/// covers every interaction; one surface (or the same surface twice) covers its
+/// self-interaction; two surfaces cover the interaction between them, in either role.
+/// Where assignments overlap, the last one applies.
+fn apply_controls(
+    controls: &[ControlAssignment],
+    out: &mut [Interaction],
+    r: &mut Resolver<'_, '_>,
+) {
+    for c in controls {
+        let s1 = c
+            .surface_1
+            .as_ref()
+            .map(|n| r.names(std::slice::from_ref(n), &c.at));
+        let s2 = c
+            .surface_2
+            .as_ref()
+            .map(|n| r.names(std::slice::from_ref(n), &c.at));
+        let target = match (s1.as_deref(), s2.as_deref()) {
+            (None, _) => None,
+            (Some([a]), None) => Some((*a, *a)),
+            (Some([a]), Some([b])) => Some((*a, *b)),
+            _ => continue, // an unknown name, reported above
+        };
+        for i in out.iter_mut() {
+            let applies = match target {
+                None => true,
+                Some((a, b)) => {
+                    (i.side_a == a && i.side_b == b) || (i.side_a == b && i.side_b == a)
+                }
+            };
+            if applies {
+                match c.control {
+                    Control::ScalePenalty { factor } => i.penalty_scale = factor,
+                    Control::InitialOverclosure { treatment } => i.overclosure = treatment,
+                }
+            }
+        }
+    }
 }
 
 fn settings_for(spec: &InteractionSpec, base: &SearchSettings) -> SearchSettings {

@@ -10,7 +10,8 @@
 //! `"{d}.interaction_defaults.enforcement"`, `"{d}.search_options.{key}"`,
 //! `"{d}.surface.{s}.name"`, `"{d}.surface.{s}.subset.{k}.normal"`,
 //! `"{d}.surface.{s}.auto_subset.{angle|number_of_subsets}"`,
-//! `"{d}.periodicity.{p}.{offset|axis|center|angle}"`, with `d`, `i`, `s`, `k`, `p`
+//! `"{d}.periodicity.{p}.{offset|axis|center|angle}"`,
+//! `"{d}.control_assignment.{k}.factor"`, with `d`, `i`, `s`, `k`, `p`
 //! 0-based indices into the spec's vectors.
 
 use std::collections::HashMap;
@@ -233,6 +234,20 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
             "search options",
             out,
         );
+    }
+    for (k, c) in def.control_assignments.iter().enumerate() {
+        if let Control::ScalePenalty { factor } = c.control {
+            if !(factor > 0.0 && factor.is_finite()) {
+                out.push(
+                    Diagnostic::error(
+                        codes::NOT_POSITIVE,
+                        format!("the penalty scale factor must be positive, found {factor}"),
+                    )
+                    .at(locs.or(&format!("{d}.control_assignment.{k}.factor"), &c.at))
+                    .help("a factor of 1 keeps the enforcement's own penalty"),
+                );
+            }
+        }
     }
 }
 

@@ -31,6 +31,8 @@
 //! | E0213 | error    | unknown `Contact Type` value |
 //! | E0214 | error    | unknown periodicity transform, or a transform missing a part |
 //! | E0215 | error    | interaction names an enforcement that is not defined |
+//! | E0216 | error    | a value that must be positive is not (penalty scale factor) |
+//! | E0217 | error    | a word outside the command's list of choices (overclosure treatment) |
 //! | W0101 | warning  | deprecated alias (`Slave Variable`) |
 //! | W0102 | warning  | single-valued command given twice; the last one wins |
 
@@ -63,6 +65,8 @@ pub const ON_OFF: &str = "E0212";
 pub const CONTACT_TYPE: &str = "E0213";
 pub const PERIODICITY: &str = "E0214";
 pub const UNKNOWN_ENFORCEMENT: &str = "E0215";
+pub const NOT_POSITIVE: &str = "E0216";
+pub const BAD_CHOICE: &str = "E0217";
 pub const DEPRECATED_ALIAS: &str = "W0101";
 pub const REPEATED_COMMAND: &str = "W0102";
 
@@ -97,6 +101,8 @@ pub const ALL: &[&str] = &[
     CONTACT_TYPE,
     PERIODICITY,
     UNKNOWN_ENFORCEMENT,
+    NOT_POSITIVE,
+    BAD_CHOICE,
     DEPRECATED_ALIAS,
     REPEATED_COMMAND,
 ];

@@ -174,6 +174,22 @@ pub static COMMANDS: &[CommandSpec] = &[
         planned
     ),
     cmd!(
+        "scale penalty",
+        "scale_penalty",
+        [CD],
+        "[for <surface> [with <surface>]] = <factor>",
+        "Penalty scale factor for the whole domain, one surface's self-contact, or one pair (Abaqus control assignment; the last that applies wins).",
+        planned
+    ),
+    cmd!(
+        "initial overclosure",
+        "initial_overclosure",
+        [CD],
+        "[for <surface> [with <surface>]] = adjust nodes|store offsets",
+        "Treatment of gaps that are negative at the start, for the whole domain, one surface or one pair (the last that applies wins).",
+        planned
+    ),
+    cmd!(
         "periodicity for",
         "periodicity",
         [CD],

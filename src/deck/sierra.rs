@@ -740,6 +740,16 @@ impl Lower {
                 self.once(seen, c);
                 cd.disable_opposed_normal_interaction_culling = true;
             }
+            "scale_penalty" | "initial_overclosure" => {
+                let k = cd.control_assignments.len();
+                if let Some((x, value_at)) = self.control_assignment(c, at) {
+                    if let Some(l) = value_at {
+                        self.locs
+                            .set(format!("{d}.control_assignment.{k}.factor"), l);
+                    }
+                    cd.control_assignments.push(x);
+                }
+            }
             "periodicity" => {
                 let p = cd.periodicity.len();
                 if let Some(x) = self.periodicity(d, p, c) {
@@ -748,6 +758,69 @@ impl Lower {
             }
             _ => {}
         }
+    }
+
+    /// `<phrase> [for s1 [with s2]] = value`.
+    fn control_assignment(
+        &mut self,
+        c: &mut Cur,
+        at: Loc,
+    ) -> Option<(ControlAssignment, Option<Loc>)> {
+        let mut surface_1 = None;
+        let mut surface_2 = None;
+        if c.peek().is_some_and(|t| t.is_word() && t.lower == "for") {
+            c.pos += 1;
+            surface_1 = Some(self.name(c, "a surface name")?.0);
+            if c.peek().is_some_and(|t| t.is_word() && t.lower == "with") {
+                c.pos += 1;
+                surface_2 = Some(self.name(c, "a second surface name")?.0);
+            }
+        }
+        if !c.peek().is_some_and(Token::is_sep) {
+            self.missing(c, "`=` and a value");
+            return None;
+        }
+        c.skip_sep();
+        let mut value_at = None;
+        let control = if c.cmd.key == "scale_penalty" {
+            let (factor, f_at) = self.number(c, "a penalty scale factor")?;
+            value_at = Some(f_at);
+            Control::ScalePenalty { factor }
+        } else {
+            let rest: Vec<String> = c.rest().iter().map(|t| t.lower.clone()).collect();
+            let treatment = match rest.join(" ").as_str() {
+                "adjust nodes" | "adjust" => Overclosure::AdjustNodes,
+                "store offsets" | "store offset" | "offsets" => Overclosure::StoreOffsets,
+                other => {
+                    let hint = did_you_mean(other, ["adjust nodes", "store offsets"])
+                        .map(|s| format!("did you mean `{s}`? "))
+                        .unwrap_or_default();
+                    self.push(
+                        Diagnostic::error(
+                            codes::BAD_CHOICE,
+                            format!("unknown overclosure treatment `{other}`"),
+                        )
+                        .at(self.span(c.rest()))
+                        .help(format!(
+                            "{hint}the choices are `adjust nodes` and `store offsets`"
+                        )),
+                    );
+                    c.pos = c.line.tokens.len();
+                    return None;
+                }
+            };
+            c.pos = c.line.tokens.len();
+            Control::InitialOverclosure { treatment }
+        };
+        Some((
+            ControlAssignment {
+                surface_1,
+                surface_2,
+                control,
+                at,
+            },
+            value_at,
+        ))
     }
 
     fn periodicity(&mut self, d: usize, p: usize, c: &mut Cur) -> Option<Periodicity> {

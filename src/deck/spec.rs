@@ -50,8 +50,46 @@ pub struct ContactDefinition {
     pub interaction_defaults: Option<InteractionDefaults>,
     #[serde(default)]
     pub search_options: Option<SearchOptions>,
+    /// Per-pair control assignments (Abaqus style), in deck order: where they overlap,
+    /// the last one applies.
+    #[serde(default, rename = "control_assignment")]
+    pub control_assignments: Vec<ControlAssignment>,
     #[serde(skip)]
     pub at: Loc,
+}
+
+/// `Scale Penalty [For s1 [With s2]] = f` or `Initial Overclosure [For s1 [With s2]] = …`.
+/// No `surface_1`: the whole contact domain; no `surface_2` (or the same name twice):
+/// the self-interaction of `surface_1`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlAssignment {
+    #[serde(default)]
+    pub surface_1: Option<String>,
+    #[serde(default)]
+    pub surface_2: Option<String>,
+    pub control: Control,
+    #[serde(skip)]
+    pub at: Loc,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Control {
+    /// Multiplies the penalty of penalty-type enforcements.
+    ScalePenalty { factor: f64 },
+    /// What to do with a gap that is negative at the start.
+    InitialOverclosure { treatment: Overclosure },
+}
+
+/// Treatment of an initial overclosure (a negative gap in the undeformed geometry).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Overclosure {
+    /// Move side-A points onto side B: the enforcement then starts from gap 0.
+    AdjustNodes,
+    /// Keep the geometry and record the initial gap as an offset (the thermal default).
+    StoreOffsets,
 }
 
 /// One surface-making command. Commands are applied in this order; the first one that
@@ -393,6 +431,9 @@ impl Deck {
             }
             for p in &mut cd.periodicity {
                 p.at = Loc::default();
+            }
+            for c in &mut cd.control_assignments {
+                c.at = Loc::default();
             }
             for e in &mut cd.enforcements {
                 e.at = Loc::default();

@@ -4,5 +4,6 @@ mod bad_cli;
 mod bad_decks;
 mod cli;
 mod docs;
+mod interactions;
 mod mesh_io;
 mod surfaces;
