@@ -58,6 +58,9 @@ Begin Contact Definition Lid   $ the only one
   Periodicity For cyl = Cylindrical Axis = 0 0 1 Center = 0 0 0 Angle = 90
   Periodicity For a = Align_Surface Destination = B Invert_Normals = 0
   Periodicity For m = Mapped X_Map = "x + 1" Y_Map = "Shift(y)"
+  Scale Penalty = 2
+  Scale Penalty For Top With Bottom is 0.5
+  Initial Overclosure For Top = Adjust Nodes
   Begin Enforcement Gap
     Enforcement For Energy = Plugin Library = "path/libModel.so" Model = Name
     Integer Data 1 2 3
@@ -250,6 +253,28 @@ fn full_expected() -> Deck {
             search_update_frequency: Some(3),
             at: Default::default(),
         }),
+        control_assignments: vec![
+            ControlAssignment {
+                surface_1: None,
+                surface_2: None,
+                control: Control::ScalePenalty { factor: 2.0 },
+                at: Default::default(),
+            },
+            ControlAssignment {
+                surface_1: Some("top".into()),
+                surface_2: Some("bottom".into()),
+                control: Control::ScalePenalty { factor: 0.5 },
+                at: Default::default(),
+            },
+            ControlAssignment {
+                surface_1: Some("top".into()),
+                surface_2: None,
+                control: Control::InitialOverclosure {
+                    treatment: Overclosure::AdjustNodes,
+                },
+                at: Default::default(),
+            },
+        ],
         at: Default::default(),
     };
     Deck {
@@ -354,6 +379,18 @@ field_factor = 2
 normal_check_angle = 30
 self_contact = true
 search_update_frequency = 3
+
+[[contact_definition.control_assignment]]
+control = { kind = "scale_penalty", factor = 2.0 }
+
+[[contact_definition.control_assignment]]
+surface_1 = "top"
+surface_2 = "bottom"
+control = { kind = "scale_penalty", factor = 0.5 }
+
+[[contact_definition.control_assignment]]
+surface_1 = "top"
+control = { kind = "initial_overclosure", treatment = "adjust_nodes" }
 "#;
 
 #[test]
