@@ -7,4 +7,5 @@
 pub mod deck;
 pub mod diag;
 pub mod mesh;
+pub mod search;
 pub mod surface;
