@@ -207,7 +207,10 @@ pub fn project_point_tri3(p: [f64; 3], x: &[[f64; 3]; 3]) -> Projection {
     let eta = (a11 * b2 - a12 * b1) / det;
     let inside = xi >= -INSIDE_TOL && eta >= -INSIDE_TOL && xi + eta <= 1.0 + INSIDE_TOL;
     if xi >= 0.0 && eta >= 0.0 && xi + eta <= 1.0 {
-        let q = map_tri3(x, [xi, eta]);
+        // The foot of the perpendicular, `p − ((p − x₀)·n) n`, rather than `x(ξ, η)`: it
+        // is the same point, but a `p` lying in the plane of an axis-aligned face comes
+        // back exactly (distance 0, not the round-off of re-mapping ξ).
+        let q = axpy(p, -dot(d, normal), normal);
         return finish(p, [xi, eta], q, normal, true, false);
     }
     let (edge, t, _) = closest_on_boundary(p, x);
@@ -295,7 +298,12 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
             let w = sub(add(x[0], x[2]), add(x[1], x[3]));
             dot(w, area_normal).abs() > 1e-12 * l2.sqrt()
         };
-        if warped {
+        if !warped {
+            // Foot of the perpendicular on the plane, as in `project_point_tri3`.
+            let q = axpy(p, -dot(sub(p, x[0]), area_normal), area_normal);
+            return finish(p, xi_c, q, area_normal, true, false);
+        }
+        {
             let (edge, t, d2) = closest_on_boundary(p, x);
             if d2 < norm2(sub(p, q)) {
                 let xi_b = quad4_edge_xi(edge, t);
@@ -392,13 +400,17 @@ fn newton_quad4(p: V3, x: &[[f64; 3]; 4], mut xi: [f64; 2]) -> ([f64; 2], bool) 
         if s_max > 2.0 {
             step = [step[0] * 2.0 / s_max, step[1] * 2.0 / s_max];
         }
-        // Backtracking: halve until f does not increase (at most 2⁻³⁰).
+        // Backtracking: halve until f does not increase (at most 2⁻³⁰). Near the solution
+        // (steps below 1e-4, inside the region of quadratic convergence) the full step is
+        // taken: f is flat to round-off there (δf ≈ |x_ξ|² δξ² is below ε |x|² for δξ
+        // below ~1e-8), so comparing f would stall ξ at ~1e-8 instead of ~1e-15.
         let mut accepted = false;
+        let near = step[0].abs().max(step[1].abs()) < 1e-4;
         for _ in 0..30 {
             let trial = [xi[0] + step[0], xi[1] + step[1]];
             let r_t = sub(map_quad4(x, trial), p);
             let f_t = norm2(r_t);
-            if f_t <= f {
+            if near || f_t <= f {
                 xi = trial;
                 r = r_t;
                 f = f_t;
