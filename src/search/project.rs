@@ -283,6 +283,15 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
         return project_degenerate(p, x, quad4_edge_xi);
     }
     let area_normal = scale(va, 1.0 / norm(va));
+    // `w = x₀ − x₁ + x₂ − x₃` measures the twist out of the plane; 1e-12 of the size is
+    // round-off of coordinates that were meant to be coplanar.
+    let warped = {
+        let w = sub(add(x[0], x[2]), add(x[1], x[3]));
+        dot(w, area_normal).abs() > 1e-12 * l2.sqrt()
+    };
+    if !warped && let Some(pr) = project_planar_quad4(p, x, area_normal, l2) {
+        return pr;
+    }
 
     let xi0 = start_quad4(p, x);
     let (xi, converged) = newton_quad4(p, x, xi0);
@@ -291,13 +300,8 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
         let xi_c = [xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)];
         let q = map_quad4(x, xi_c);
         // On a warped face the interior stationary point need not be the global minimum;
-        // compare with the boundary only when the face is warped (cheap test first).
-        // A planar face has its stationary point as the global minimum (Pythagoras in
-        // the plane); `w = x₀ − x₁ + x₂ − x₃` measures the twist out of the plane.
-        let warped = {
-            let w = sub(add(x[0], x[2]), add(x[1], x[3]));
-            dot(w, area_normal).abs() > 1e-12 * l2.sqrt()
-        };
+        // compare with the boundary. A planar face has its stationary point as the global
+        // minimum (Pythagoras in the plane).
         if !warped {
             // Foot of the perpendicular on the plane, as in `project_point_tri3`.
             let q = axpy(p, -dot(sub(p, x[0]), area_normal), area_normal);
@@ -331,6 +335,111 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
         false,
         false,
     )
+}
+
+/// Iterations of the planar inverse map: from the centre of a convex quad Newton
+/// converges quadratically in ≤ 5 steps; more means the point is far outside.
+const PLANAR_MAX_ITER: usize = 12;
+
+/// The fast path of [`project_point_quad4`] for a planar, strictly convex quad: the
+/// closest point is the in-plane closest point of the foot `q = p − ((p − x₀)·n) n`
+/// (Pythagoras).
+///
+/// - If `p` lies clearly outside one of the edge lines (by more than
+///   [`PLANAR_OUTSIDE`] × the edge × the longest edge, far beyond the parametric
+///   [`INSIDE_TOL`] band), it is outside the face and its closest point is on an edge whose
+///   line it lies outside of (for a convex polygon the normal cone at the closest
+///   boundary point contains `p − y`, and at a corner `p` is outside at least one of the
+///   two adjacent edge lines), so only those edges are searched.
+/// - Otherwise `x(ξ) = q` is inverted by Newton from the centre (`J Δ = −r` through
+///   `JᵀJ Δ = −Jᵀr`, exact as `r` lies in the plane of `J`'s columns); convexity makes the
+///   inverse unique. Outside the square (beyond [`INSIDE_TOL`]) the boundary is searched.
+///
+/// `None` for a non-convex quad or no convergence: the general path then runs.
+fn project_planar_quad4(p: V3, x: &[[f64; 3]; 4], n: V3, l2: f64) -> Option<Projection> {
+    let mut side = [0.0; 4];
+    let mut len = [0.0; 4];
+    for k in 0..4 {
+        let e = sub(x[(k + 1) % 4], x[k]);
+        let e_prev = sub(x[k], x[(k + 3) % 4]);
+        // Strictly convex and oriented with n: every corner turns left about n.
+        if dot(cross(e_prev, e), n) <= 0.0 {
+            return None;
+        }
+        // |e| × signed distance of p to the left of edge k (positive inside).
+        side[k] = dot(cross(e, sub(p, x[k])), n);
+        len[k] = norm(e);
+    }
+    let l = l2.sqrt();
+    let clearly_outside = (0..4).any(|k| side[k] < -PLANAR_OUTSIDE * len[k] * l);
+    if !clearly_outside {
+        let h = dot(sub(p, x[0]), n);
+        let q = axpy(p, -h, n);
+        if let Some(xi) = invert_planar_quad4(x, q) {
+            if xi[0].abs() <= 1.0 + INSIDE_TOL && xi[1].abs() <= 1.0 + INSIDE_TOL {
+                let xi_c = [xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)];
+                return Some(finish(p, xi_c, q, n, true, false));
+            }
+        } else {
+            return None;
+        }
+    }
+    // Closest point on the edges p lies outside of (all four if round-off left none).
+    let any_facing = side.iter().any(|&s| s <= 0.0);
+    let mut best = (0, 0.0, f64::INFINITY);
+    for k in 0..4 {
+        if any_facing && side[k] > 0.0 {
+            continue;
+        }
+        let (t, d2) = closest_on_segment(p, x[k], x[(k + 1) % 4]);
+        if d2 < best.2 {
+            best = (k, t, d2);
+        }
+    }
+    let (edge, t, _) = best;
+    let xi_b = quad4_edge_xi(edge, t);
+    let q_b = axpy(x[edge], t, sub(x[(edge + 1) % 4], x[edge]));
+    Some(finish(p, xi_b, q_b, n, false, false))
+}
+
+/// Relative distance beyond an edge line above which a point is surely outside a planar
+/// quad (see [`project_planar_quad4`]): 1e-8 is far above round-off, and as a parametric
+/// distance (≥ 1e-8 / 2 for any shape) far above [`INSIDE_TOL`].
+const PLANAR_OUTSIDE: f64 = 1e-8;
+
+/// Inverts the bilinear map of a planar convex quad at the in-plane point `q` by Newton
+/// from the centre; `None` when the Jacobian is singular or Newton does not converge.
+fn invert_planar_quad4(x: &[[f64; 3]; 4], q: V3) -> Option<[f64; 2]> {
+    // Monomial form x(ξ, η) = c₀ + c₁ ξ + c₂ η + c₃ ξη (the shape functions expanded),
+    // so an iteration costs a few dozen flops; q folded into c₀.
+    let c0 = sub(scale(add(add(x[0], x[1]), add(x[2], x[3])), 0.25), q);
+    let c1 = scale(sub(add(x[1], x[2]), add(x[0], x[3])), 0.25);
+    let c2 = scale(sub(add(x[2], x[3]), add(x[0], x[1])), 0.25);
+    let c3 = scale(sub(add(x[0], x[2]), add(x[1], x[3])), 0.25);
+    let mut xi = [0.0f64, 0.0];
+    for _ in 0..PLANAR_MAX_ITER {
+        let ta = axpy(c1, xi[1], c3);
+        let tb = axpy(c2, xi[0], c3);
+        let r = axpy(axpy(c0, xi[0], ta), xi[1], c2);
+        let (a11, a12, a22) = (dot(ta, ta), dot(ta, tb), dot(tb, tb));
+        let (g1, g2) = (dot(ta, r), dot(tb, r));
+        let det = a11 * a22 - a12 * a12;
+        if det.is_nan() || det <= 0.0 {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let mut step = [-(a22 * g1 - a12 * g2) * inv, -(a11 * g2 - a12 * g1) * inv];
+        let s = step[0].abs().max(step[1].abs());
+        if s > 1.0 {
+            step = [step[0] / s, step[1] / s];
+        }
+        xi = [xi[0] + step[0], xi[1] + step[1]];
+        // The step that follows one of 1e-13 is ~1e-26: xi is at round-off.
+        if s < 1e-13 {
+            return Some(xi);
+        }
+    }
+    None
 }
 
 /// Starting guess for the Quad4 Newton: (ξ, η) at the plane projection on the better of
@@ -508,6 +617,39 @@ mod tests {
             for (got, want) in pr.normal.iter().zip(&n) {
                 assert!(close(*got, *want, 1e-12));
             }
+        }
+    }
+
+    #[test]
+    fn planar_quad_outside_acute_corner() {
+        // A convex quad with an acute corner at node 1 (interior angle ≈ 18°). Points
+        // around that corner are compared with a fine sampling of the closed face.
+        let x = [
+            [0.0, 0.0, 0.0],
+            [3.0, 0.5, 0.0],
+            [0.0, 1.0, 0.0],
+            [-0.5, 0.5, 0.0],
+        ];
+        for p in [
+            [4.0, 0.5, 0.3],
+            [3.5, 0.0, -0.2],
+            [3.2, 1.5, 0.0],
+            [2.0, -1.0, 0.1],
+        ] {
+            let pr = project_point_quad4(p, &x);
+            assert!(!pr.inside && !pr.degenerate);
+            let mut best = f64::INFINITY;
+            for i in 0..=400 {
+                for j in 0..=400 {
+                    let xi = [-1.0 + i as f64 / 200.0, -1.0 + j as f64 / 200.0];
+                    best = best.min(norm(sub(p, map_quad4(&x, xi))));
+                }
+            }
+            assert!(
+                pr.distance <= best + 1e-14 && pr.distance >= best - 1e-3,
+                "{p:?}"
+            );
+            assert!(norm(sub(pr.point, map_quad4(&x, pr.xi))) < 1e-14);
         }
     }
 
