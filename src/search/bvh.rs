@@ -74,12 +74,14 @@ impl Aabb {
     /// Whether the two closed boxes share at least one point.
     #[inline]
     pub fn intersects(&self, other: &Aabb) -> bool {
-        self.min[0] <= other.max[0]
-            && other.min[0] <= self.max[0]
-            && self.min[1] <= other.max[1]
-            && other.min[1] <= self.max[1]
-            && self.min[2] <= other.max[2]
-            && other.min[2] <= self.max[2]
+        // Non-short-circuit `&`: one branch for the caller instead of six
+        // hard-to-predict ones in the tree traversal.
+        (self.min[0] <= other.max[0])
+            & (other.min[0] <= self.max[0])
+            & (self.min[1] <= other.max[1])
+            & (other.min[1] <= self.max[1])
+            & (self.min[2] <= other.max[2])
+            & (other.min[2] <= self.max[2])
     }
 
     /// The smallest box holding both.
@@ -233,6 +235,21 @@ impl Bvh {
             |slot| {
                 if self.boxes[slot].intersects(query) {
                     visit(self.order[slot] as usize);
+                }
+            },
+        );
+    }
+
+    /// Like [`Bvh::query`], handing the item's box to `visit` too (read from the tree's
+    /// own copy, already in cache), so a narrow phase can skip candidates whose box is
+    /// farther than the best found so far.
+    pub fn query_with_box(&self, query: &Aabb, mut visit: impl FnMut(usize, &Aabb)) {
+        self.traverse(
+            |b| b.intersects(query),
+            |slot| {
+                let b = &self.boxes[slot];
+                if b.intersects(query) {
+                    visit(self.order[slot] as usize, b);
                 }
             },
         );
