@@ -634,6 +634,20 @@ mod tests {
     }
 
     #[test]
+    fn degenerate_and_unsupported_faces_give_nothing() {
+        let a = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        let line = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        let pentagon = [[0.0; 3]; 5];
+        let nan = [[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert_eq!(overlap_area_face_face(&line, &a), 0.0);
+        assert!(segments_face_face(&line, &a, 2).is_empty());
+        assert!(segments_face_face(&a, &pentagon, 2).is_empty());
+        assert!(segments_face_face(&a, &nan, 2).is_empty());
+        // A degenerate B (a segment) overlaps nothing.
+        assert_eq!(overlap_area_face_face(&a, &line), 0.0);
+    }
+
+    #[test]
     fn non_convex_b_is_split() {
         // A dart-shaped B (reflex corner at node 2) against a big square A.
         let a = [

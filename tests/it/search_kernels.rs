@@ -49,9 +49,25 @@ fn boxes_strategy() -> impl Strategy<Value = Vec<Aabb>> {
     })
 }
 
+/// Closed boxes overlap iff their intervals overlap on every axis (written out here, not
+/// `Aabb::intersects`, so the test does not trust the code under test).
+fn overlaps(a: &Aabb, b: &Aabb) -> bool {
+    (0..3).all(|k| a.min[k] <= b.max[k] && b.min[k] <= a.max[k])
+}
+
+/// Squared distance from a point to a box, clamping per axis.
+fn box_distance2(b: &Aabb, p: V3) -> f64 {
+    (0..3)
+        .map(|k| {
+            let c = p[k].clamp(b.min[k], b.max[k]);
+            (p[k] - c) * (p[k] - c)
+        })
+        .sum()
+}
+
 fn brute(items: &[Aabb], q: &Aabb) -> Vec<usize> {
     (0..items.len())
-        .filter(|&i| items[i].intersects(q))
+        .filter(|&i| overlaps(&items[i], q))
         .collect()
 }
 
@@ -79,14 +95,32 @@ proptest! {
         perm.sort_unstable();
         prop_assert_eq!(perm, (0..items.len()).collect::<Vec<_>>());
         let check = |bvh: &Bvh, items: &[Aabb]| -> Result<(), TestCaseError> {
+            // Boxes that touch items exactly at a corner (closed boxes must report them),
+            // besides the random ones.
+            let touching = items.iter().take(8).flat_map(|b| {
+                [
+                    Aabb { min: [b.min[0] - 1.0, b.min[1] - 1.0, b.min[2] - 1.0], max: b.min },
+                    Aabb { min: b.max, max: [b.max[0] + 1.0, b.max[1] + 1.0, b.max[2] + 1.0] },
+                ]
+            });
+            for q in touching {
+                prop_assert_eq!(queried(bvh, &q), brute(items, &q));
+            }
             for (c, e) in &queries {
                 let q = Aabb { min: *c, max: [c[0] + e[0], c[1] + e[1], c[2] + e[2]] };
                 prop_assert_eq!(queried(bvh, &q), brute(items, &q));
+                let mut with_box = Vec::new();
+                bvh.query_with_box(&q, |i, b| with_box.push((i, *b)));
+                with_box.sort_unstable_by_key(|x| x.0);
+                prop_assert_eq!(
+                    with_box,
+                    brute(items, &q).into_iter().map(|i| (i, items[i])).collect::<Vec<_>>()
+                );
                 let mut near = Vec::new();
                 bvh.query_point_within(*c, radius, |i| near.push(i));
                 near.sort_unstable();
                 let want: Vec<usize> = (0..items.len())
-                    .filter(|&i| items[i].distance2_to_point(*c) <= radius * radius)
+                    .filter(|&i| box_distance2(&items[i], *c) <= radius * radius)
                     .collect();
                 prop_assert_eq!(near, want);
             }
