@@ -358,7 +358,7 @@ const PLANAR_MAX_ITER: usize = 12;
 /// `None` for a non-convex quad or no convergence: the general path then runs.
 fn project_planar_quad4(p: V3, x: &[[f64; 3]; 4], n: V3, l2: f64) -> Option<Projection> {
     let mut side = [0.0; 4];
-    let mut len = [0.0; 4];
+    let mut len2 = [0.0; 4];
     for k in 0..4 {
         let e = sub(x[(k + 1) % 4], x[k]);
         let e_prev = sub(x[k], x[(k + 3) % 4]);
@@ -368,10 +368,11 @@ fn project_planar_quad4(p: V3, x: &[[f64; 3]; 4], n: V3, l2: f64) -> Option<Proj
         }
         // |e| × signed distance of p to the left of edge k (positive inside).
         side[k] = dot(cross(e, sub(p, x[k])), n);
-        len[k] = norm(e);
+        len2[k] = norm2(e);
     }
-    let l = l2.sqrt();
-    let clearly_outside = (0..4).any(|k| side[k] < -PLANAR_OUTSIDE * len[k] * l);
+    // side < −PLANAR_OUTSIDE |e| l, squared to spare four square roots.
+    let tol2 = PLANAR_OUTSIDE * PLANAR_OUTSIDE * l2;
+    let clearly_outside = (0..4).any(|k| side[k] < 0.0 && side[k] * side[k] > tol2 * len2[k]);
     if !clearly_outside {
         let h = dot(sub(p, x[0]), n);
         let q = axpy(p, -h, n);
