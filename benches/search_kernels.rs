@@ -8,9 +8,10 @@
 //! For m² = 1e4, 1e5, 1e6 faces it reports the BVH build time (median of runs), then the
 //! search time per side-A point — query the BVH with the point's box inflated by a
 //! search radius, project onto every candidate whose box is nearer than the best point
-//! found so far, keep the closest — with the points in
-//! three orders: random (shuffled), as generated (row-major) and sorted by a Morton
-//! (Z-order) code, whose sort time is reported apart. Speed comes with error: the
+//! found so far, keep the closest — with the points in three orders: random
+//! (shuffled), as generated (row-major) and sorted by a Morton (Z-order) code, whose
+//! sort time is reported apart; `+h` marks queries that start from the previous
+//! query's leaf (`Bvh::query_with_hint`) instead of the root. Speed comes with error: the
 //! largest |gap − z| over all points (the exact gap of a point above the plane z = 0 is
 //! its z), the number of points with no face found and the number whose closest face
 //! does not hold their foot (`outside`; both must be 0, as B tiles the square).
@@ -23,7 +24,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use seam::search::bvh::{Aabb, Bvh};
+use seam::search::bvh::{Aabb, Bvh, QueryHint};
 use seam::search::project::project_point_quad4;
 
 /// SplitMix64: a small deterministic generator, so every run meshes the same interface.
@@ -139,7 +140,7 @@ struct SearchStats {
 
 /// For every point: query the inflated box, project onto each candidate, keep the
 /// closest.
-fn search(bvh: &Bvh, b: &Interface, pts: &[[f64; 3]], radius: f64) -> SearchStats {
+fn search(bvh: &Bvh, b: &Interface, pts: &[[f64; 3]], radius: f64, hinted: bool) -> SearchStats {
     let t = Instant::now();
     let mut candidates = 0;
     let mut projections = 0;
@@ -147,10 +148,11 @@ fn search(bvh: &Bvh, b: &Interface, pts: &[[f64; 3]], radius: f64) -> SearchStat
     let mut outside = 0;
     let mut max_gap_error = 0.0f64;
     let mut checksum = 0.0;
+    let mut hint = QueryHint::default();
     for p in pts {
         let q = Aabb::from_point(*p).inflate(radius);
         let mut best: Option<(usize, f64, f64, bool)> = None;
-        bvh.query_with_box(&q, |f, bx| {
+        let narrow = |f: usize, bx: &Aabb| {
             candidates += 1;
             // A face whose box is no nearer than the best point found cannot win
             // (ties keep the first, as the strict `<` below does).
@@ -164,7 +166,12 @@ fn search(bvh: &Bvh, b: &Interface, pts: &[[f64; 3]], radius: f64) -> SearchStat
             if best.is_none_or(|(_, d, _, _)| pr.distance < d) {
                 best = Some((f, pr.distance, pr.gap, pr.inside));
             }
-        });
+        };
+        if hinted {
+            bvh.query_with_hint(&mut hint, &q, narrow);
+        } else {
+            bvh.query_with_box(&q, narrow);
+        }
         match best {
             Some((f, _, gap, inside)) => {
                 max_gap_error = max_gap_error.max((gap - p[2]).abs());
@@ -255,17 +262,19 @@ fn main() {
 
         for radius_h in [0.1, 0.25] {
             let radius = radius_h * b.h;
-            let orders: [(&str, &[[f64; 3]], f64); 3] = [
-                ("random", &shuffled, 0.0),
-                ("generated", &generated, 0.0),
-                ("morton", &sorted, sort_s),
+            let orders: [(&str, &[[f64; 3]], f64, bool); 5] = [
+                ("random", &shuffled, 0.0, false),
+                ("random+h", &shuffled, 0.0, true),
+                ("generated+h", &generated, 0.0, true),
+                ("morton", &sorted, sort_s, false),
+                ("morton+h", &sorted, sort_s, true),
             ];
             let mut checks = Vec::new();
-            for (name, pts, sort) in orders {
+            for (name, pts, sort, hinted) in orders {
                 let mut times = Vec::new();
                 let mut last = None;
                 for _ in 0..5 {
-                    let s = search(&bvh, &b, pts, radius);
+                    let s = search(&bvh, &b, pts, radius, hinted);
                     times.push(s.seconds);
                     last = Some(s);
                 }

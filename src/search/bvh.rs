@@ -127,6 +127,13 @@ impl Aabb {
     }
 }
 
+/// Where [`Bvh::query_with_hint`] starts: the leaf of the previous query's first hit.
+/// The default starts at the root. A hint from another tree is harmless (only slower).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QueryHint {
+    node: u32,
+}
+
 /// One node of the flat tree. A leaf holds items `start .. start + count` of the
 /// permutation; an interior node (`count == 0`) has its left child right after it and its
 /// right child at `start`.
@@ -141,6 +148,8 @@ struct Node {
 #[derive(Debug, Clone)]
 pub struct Bvh {
     nodes: Vec<Node>,
+    /// Parent of each node (the root's entry is unused).
+    parent: Vec<u32>,
     /// Item index at each leaf slot.
     order: Vec<u32>,
     /// Item boxes in leaf-slot order.
@@ -168,8 +177,16 @@ impl Bvh {
             build_range(items, &centers, &mut order, 0, &mut nodes);
         }
         let boxes = order.iter().map(|&i| items[i as usize]).collect();
+        let mut parent = vec![0u32; nodes.len()];
+        for (k, node) in nodes.iter().enumerate() {
+            if node.count == 0 {
+                parent[k + 1] = k as u32;
+                parent[node.start as usize] = k as u32;
+            }
+        }
         Bvh {
             nodes,
+            parent,
             order,
             boxes,
         }
@@ -230,29 +247,72 @@ impl Bvh {
     /// Calls `visit(i)` for every item `i` whose box intersects `query`, in leaf order.
     /// Allocates nothing.
     pub fn query(&self, query: &Aabb, mut visit: impl FnMut(usize)) {
-        self.traverse(
-            |b| b.intersects(query),
-            |slot| {
-                if self.boxes[slot].intersects(query) {
-                    visit(self.order[slot] as usize);
-                }
-            },
-        );
+        self.query_with_box(query, |i, _| visit(i));
     }
 
     /// Like [`Bvh::query`], handing the item's box to `visit` too (read from the tree's
     /// own copy, already in cache), so a narrow phase can skip candidates whose box is
     /// farther than the best found so far.
     pub fn query_with_box(&self, query: &Aabb, mut visit: impl FnMut(usize, &Aabb)) {
-        self.traverse(
+        self.traverse_from(
+            0,
             |b| b.intersects(query),
-            |slot| {
-                let b = &self.boxes[slot];
-                if b.intersects(query) {
-                    visit(self.order[slot] as usize, b);
+            |_, boxes, items| {
+                for (b, &i) in boxes.iter().zip(items) {
+                    if b.intersects(query) {
+                        visit(i as usize, b);
+                    }
                 }
             },
         );
+    }
+
+    /// Like [`Bvh::query_with_box`], for a stream of nearby queries: the search starts
+    /// at the leaf where the previous query found its first item (kept in `hint`) and
+    /// climbs to the root, testing at each level the sibling of the subtree already
+    /// searched. Every item is still found (the siblings along the path to the root
+    /// cover the whole tree), whatever the hint; a good hint only makes the tests cheap,
+    /// since for a small query most siblings miss, which the branch predictor learns,
+    /// where a descent from the root takes a coin-flip branch per level. Issue queries
+    /// in a spatially coherent order (e.g. Morton order of the points) to profit.
+    ///
+    /// The report order depends on the hint (it is deterministic for a deterministic
+    /// sequence of queries); the set reported equals that of [`Bvh::query`].
+    pub fn query_with_hint(
+        &self,
+        hint: &mut QueryHint,
+        query: &Aabb,
+        mut visit: impl FnMut(usize, &Aabb),
+    ) {
+        let start = hint.node as usize;
+        let start = if start < self.nodes.len() { start } else { 0 };
+        let mut first_hit: Option<usize> = None;
+        let mut leaf = |k: usize, boxes: &[Aabb], items: &[u32]| {
+            for (b, &i) in boxes.iter().zip(items) {
+                if b.intersects(query) {
+                    first_hit.get_or_insert(k);
+                    visit(i as usize, b);
+                }
+            }
+        };
+        self.traverse_from(start, |b| b.intersects(query), &mut leaf);
+        let mut c = start;
+        while c != 0 {
+            let p = self.parent[c] as usize;
+            let sibling = if c == p + 1 {
+                self.nodes[p].start as usize
+            } else {
+                p + 1
+            };
+            // Test here first: most siblings miss, and a miss then costs one box test.
+            if self.nodes[sibling].bounds.intersects(query) {
+                self.traverse_from(sibling, |b| b.intersects(query), &mut leaf);
+            }
+            c = p;
+        }
+        if let Some(k) = first_hit {
+            hint.node = k as u32;
+        }
     }
 
     /// Calls `visit(i)` for every item `i` whose box lies within distance `radius` of `p`
@@ -262,35 +322,43 @@ impl Bvh {
         if radius.is_nan() || radius < 0.0 {
             return;
         }
-        self.traverse(
+        self.traverse_from(
+            0,
             |b| b.distance2_to_point(p) <= r2,
-            |slot| {
-                if self.boxes[slot].distance2_to_point(p) <= r2 {
-                    visit(self.order[slot] as usize);
+            |_, boxes, items| {
+                for (b, &i) in boxes.iter().zip(items) {
+                    if b.distance2_to_point(p) <= r2 {
+                        visit(i as usize);
+                    }
                 }
             },
         );
     }
 
-    /// Depth-first traversal, left before right, descending into nodes accepted by
-    /// `enter` and handing every leaf slot of an accepted leaf to `leaf`.
+    /// Depth-first traversal of the subtree at node `start` (left before right),
+    /// descending into nodes accepted by `enter` and handing the node index, boxes and
+    /// items of every accepted leaf to `leaf`. Does nothing for an empty tree.
     #[inline]
-    fn traverse(&self, enter: impl Fn(&Aabb) -> bool, mut leaf: impl FnMut(usize)) {
-        if self.nodes.is_empty() {
+    fn traverse_from(
+        &self,
+        start: usize,
+        enter: impl Fn(&Aabb) -> bool,
+        mut leaf: impl FnMut(usize, &[Aabb], &[u32]),
+    ) {
+        if start >= self.nodes.len() {
             return;
         }
         let mut stack = [0u32; STACK];
         let mut top = 0usize;
-        let mut k = 0usize;
+        let mut k = start;
         loop {
             let node = &self.nodes[k];
             let mut next = None;
             if enter(&node.bounds) {
                 if node.count > 0 {
                     let s = node.start as usize;
-                    for slot in s..s + node.count as usize {
-                        leaf(slot);
-                    }
+                    let e = s + node.count as usize;
+                    leaf(k, &self.boxes[s..e], &self.order[s..e]);
                 } else {
                     stack[top] = node.start;
                     top += 1;
@@ -436,6 +504,31 @@ mod tests {
         bvh.query_point_within([6.5, 8.5, 0.5], 0.5, |i| within.push(i));
         within.sort_unstable();
         assert_eq!(within, vec![24, 34]);
+    }
+
+    #[test]
+    fn hints_from_anywhere_give_the_same_set() {
+        let big: Vec<Aabb> = (0..500)
+            .map(|i| unit_box((i % 25) as f64 * 1.5, (i / 25) as f64 * 1.5, 0.0))
+            .collect();
+        let small: Vec<Aabb> = big[..40].to_vec();
+        let (tb, ts) = (Bvh::build(&big), Bvh::build(&small));
+        // A hint left at a deep leaf of the big tree is out of range for the small one.
+        let mut hint = QueryHint::default();
+        let far = Aabb::from_point([30.0, 28.0, 0.5]);
+        tb.query_with_hint(&mut hint, &far, |_, _| {});
+        assert_ne!(hint, QueryHint::default());
+        for q in [unit_box(0.2, 0.2, 0.0), unit_box(3.0, 1.0, -0.5), far] {
+            for tree in [&tb, &ts] {
+                let mut got = Vec::new();
+                let mut h = hint;
+                tree.query_with_hint(&mut h, &q, |i, _| got.push(i));
+                got.sort_unstable();
+                let mut want = collect(tree, &q);
+                want.sort_unstable();
+                assert_eq!(got, want);
+            }
+        }
     }
 
     #[test]

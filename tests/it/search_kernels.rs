@@ -4,7 +4,7 @@
 //! mortar clipping and quadrature, and non-matching tilings of a square.
 
 use proptest::prelude::*;
-use seam::search::bvh::{Aabb, Bvh};
+use seam::search::bvh::{Aabb, Bvh, QueryHint};
 use seam::search::mortar::{
     clip_polygon_polygon, overlap_area_face_face, segments_face_face, signed_area_polygon,
 };
@@ -103,12 +103,22 @@ proptest! {
                     Aabb { min: b.max, max: [b.max[0] + 1.0, b.max[1] + 1.0, b.max[2] + 1.0] },
                 ]
             });
+            // One hint carried across all queries, as a search loop would.
+            let mut hint = QueryHint::default();
+            let mut hinted = |q: &Aabb| {
+                let mut v = Vec::new();
+                bvh.query_with_hint(&mut hint, q, |i, _| v.push(i));
+                v.sort_unstable();
+                v
+            };
             for q in touching {
                 prop_assert_eq!(queried(bvh, &q), brute(items, &q));
+                prop_assert_eq!(hinted(&q), brute(items, &q));
             }
             for (c, e) in &queries {
                 let q = Aabb { min: *c, max: [c[0] + e[0], c[1] + e[1], c[2] + e[2]] };
                 prop_assert_eq!(queried(bvh, &q), brute(items, &q));
+                prop_assert_eq!(hinted(&q), brute(items, &q));
                 let mut with_box = Vec::new();
                 bvh.query_with_box(&q, |i, b| with_box.push((i, *b)));
                 with_box.sort_unstable_by_key(|x| x.0);
