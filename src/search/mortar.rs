@@ -2,7 +2,8 @@
 //! and a side-B face.
 //!
 //! Entry points: [`clip_polygon_polygon`] (2-D convex clipping), [`segments_face_face`]
-//! (quadrature points on the overlap of two faces, as [`MortarPoint`]s),
+//! and [`segments_face_face_into`] (quadrature points on the overlap of two faces, as
+//! [`MortarPoint`]s),
 //! [`overlap_area_face_face`] and [`rule_triangle`] (the triangle quadrature rules).
 //!
 //! Conventions:
@@ -506,14 +507,27 @@ pub fn overlap_area_face_face(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
 /// degenerate or unsupported.
 pub fn segments_face_face(a: &[[f64; 3]], b: &[[f64; 3]], order: usize) -> Vec<MortarPoint> {
     let mut out = Vec::new();
+    segments_face_face_into(a, b, &rule_triangle(order), &mut out);
+    out
+}
+
+/// [`segments_face_face`] with a rule built once by the caller ([`rule_triangle`]),
+/// appending to `out` (so a loop over face pairs reuses one buffer); returns the number
+/// of points appended.
+pub fn segments_face_face_into(
+    a: &[[f64; 3]],
+    b: &[[f64; 3]],
+    rule: &TriangleRule,
+    out: &mut Vec<MortarPoint>,
+) -> usize {
+    let before = out.len();
     if !valid_face(a) || !valid_face(b) {
-        return out;
+        return 0;
     }
     let Some(plane) = plane_of(a) else {
-        return out;
+        return 0;
     };
     let (fa, fb) = (Flat::new(a, &plane), Flat::new(b, &plane));
-    let rule = rule_triangle(order);
     for_each_overlap(&fa, &fb, |poly| {
         let n = poly.len() as f64;
         let c = poly
@@ -547,7 +561,7 @@ pub fn segments_face_face(a: &[[f64; 3]], b: &[[f64; 3]], order: usize) -> Vec<M
             }
         }
     });
-    out
+    out.len() - before
 }
 
 #[cfg(test)]

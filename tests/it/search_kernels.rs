@@ -6,7 +6,8 @@
 use proptest::prelude::*;
 use seam::search::bvh::{Aabb, Bvh, QueryHint};
 use seam::search::mortar::{
-    clip_polygon_polygon, overlap_area_face_face, segments_face_face, signed_area_polygon,
+    clip_polygon_polygon, overlap_area_face_face, rule_triangle, segments_face_face,
+    segments_face_face_into, signed_area_polygon,
 };
 use seam::search::project::{map_quad4, project_point_quad4, project_point_tri3};
 
@@ -494,6 +495,46 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn warped_face_against_its_offset_copy(
+        x in quad_strategy(),
+        s in -0.3..0.3f64,
+        q in quaternion(),
+        t in prop::array::uniform3(-10.0..10.0f64),
+        order in 1usize..6,
+    ) {
+        // B is A moved by s along A's unit vector-area normal n (same node order, so B
+        // faces the same way). Exact: the overlap is A's projected area |½ d₁ × d₂|, and
+        // every line along n meets B exactly s beyond A, so each gap is s.
+        let r = rotation(q);
+        let a = x.map(|v| apply(&r, t, 1.0, v));
+        let d1 = sub(a[2], a[0]);
+        let d2 = sub(a[3], a[1]);
+        let va = [
+            0.5 * (d1[1] * d2[2] - d1[2] * d2[1]),
+            0.5 * (d1[2] * d2[0] - d1[0] * d2[2]),
+            0.5 * (d1[0] * d2[1] - d1[1] * d2[0]),
+        ];
+        let area = norm(va);
+        let n = va.map(|c| c / area);
+        let b = a.map(|v| [v[0] + s * n[0], v[1] + s * n[1], v[2] + s * n[2]]);
+        prop_assert!((overlap_area_face_face(&a, &b) - area).abs() < 1e-13);
+        let pts = segments_face_face(&a, &b, order);
+        let w: f64 = pts.iter().map(|p| p.weight).sum();
+        prop_assert!((w - area).abs() < 1e-13);
+        for p in &pts {
+            prop_assert!((p.gap - s).abs() < 1e-12, "{p:?}");
+            // Same shape: the same parametric point on both faces.
+            prop_assert!((p.xi_a[0] - p.xi_b[0]).abs() < 1e-11 && (p.xi_a[1] - p.xi_b[1]).abs() < 1e-11);
+            prop_assert!(norm(sub(p.x_a, map_quad4(&a, p.xi_a))) < 1e-12);
+            prop_assert!(p.xi_a.iter().all(|v| v.abs() <= 1.0 + 1e-12));
+        }
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // (d) and (e): non-matching tilings of the unit square
 // ---------------------------------------------------------------------------------------
@@ -539,6 +580,10 @@ fn grid_3x2_against_grid_7x3_sums_to_one_with_exact_moments() {
     let b = grid(&uniform_lines(7), &uniform_lines(3), 0.0);
     let mut area = 0.0;
     let mut m = [0.0; 8];
+    // The buffer-reusing variant over all pairs gives the same points as per-pair calls.
+    let rule = rule_triangle(3);
+    let mut all = Vec::new();
+    let mut per_pair = Vec::new();
     for fa in &a {
         for fb in &b {
             area += overlap_area_face_face(fa, fb);
@@ -546,8 +591,13 @@ fn grid_3x2_against_grid_7x3_sums_to_one_with_exact_moments() {
             for k in 0..8 {
                 m[k] += q[k];
             }
+            let n = segments_face_face_into(fa, fb, &rule, &mut all);
+            let pts = segments_face_face(fa, fb, 3);
+            assert_eq!(n, pts.len());
+            per_pair.extend(pts);
         }
     }
+    assert_eq!(all, per_pair);
     assert!((area - 1.0).abs() <= 1e-14, "{area}");
     // Moments of the unit square: ∫x = ½, ∫x² = ⅓, ∫xy = ¼, ∫x³ = ¼, ∫x²y = ⅙.
     let want = [1.0, 0.5, 0.5, 1.0 / 3.0, 0.25, 1.0 / 3.0, 0.25, 1.0 / 6.0];
