@@ -376,7 +376,7 @@ fn project_planar_quad4(p: V3, x: &[[f64; 3]; 4], n: V3, l2: f64) -> Option<Proj
     if !clearly_outside {
         let h = dot(sub(p, x[0]), n);
         let q = axpy(p, -h, n);
-        if let Some(xi) = invert_planar_quad4(x, q) {
+        if let Some(xi) = invert_planar_quad4(x, q, n) {
             if xi[0].abs() <= 1.0 + INSIDE_TOL && xi[1].abs() <= 1.0 + INSIDE_TOL {
                 let xi_c = [xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)];
                 return Some(finish(p, xi_c, q, n, true, false));
@@ -410,26 +410,38 @@ const PLANAR_OUTSIDE: f64 = 1e-8;
 
 /// Inverts the bilinear map of a planar convex quad at the in-plane point `q` by Newton
 /// from the centre; `None` when the Jacobian is singular or Newton does not converge.
-fn invert_planar_quad4(x: &[[f64; 3]; 4], q: V3) -> Option<[f64; 2]> {
-    // Monomial form x(ξ, η) = c₀ + c₁ ξ + c₂ η + c₃ ξη (the shape functions expanded),
-    // so an iteration costs a few dozen flops; q folded into c₀.
+///
+/// Monomial form `x(ξ, η) = c₀ + c₁ ξ + c₂ η + c₃ ξη` (the shape functions expanded),
+/// written in the in-plane basis `t₁ = c₁/|c₁|`, `t₂ = n × t₁`: all `cₖ` lie in the
+/// plane, so the 2-D system `C₀ + C₁ ξ + C₂ η + C₃ ξη = Q` is equivalent and each Newton
+/// step is a 2×2 solve of a dozen flops.
+fn invert_planar_quad4(x: &[[f64; 3]; 4], q: V3, n: V3) -> Option<[f64; 2]> {
     let c0 = sub(scale(add(add(x[0], x[1]), add(x[2], x[3])), 0.25), q);
     let c1 = scale(sub(add(x[1], x[2]), add(x[0], x[3])), 0.25);
     let c2 = scale(sub(add(x[2], x[3]), add(x[0], x[1])), 0.25);
     let c3 = scale(sub(add(x[0], x[2]), add(x[1], x[3])), 0.25);
+    let t1 = scale(c1, 1.0 / norm(c1));
+    let t2 = cross(n, t1);
+    let to2 = |c: V3| [dot(c, t1), dot(c, t2)];
+    let (r0, a, b, w) = (to2(c0), to2(c1), to2(c2), to2(c3));
     let mut xi = [0.0f64, 0.0];
     for _ in 0..PLANAR_MAX_ITER {
-        let ta = axpy(c1, xi[1], c3);
-        let tb = axpy(c2, xi[0], c3);
-        let r = axpy(axpy(c0, xi[0], ta), xi[1], c2);
-        let (a11, a12, a22) = (dot(ta, ta), dot(ta, tb), dot(tb, tb));
-        let (g1, g2) = (dot(ta, r), dot(tb, r));
-        let det = a11 * a22 - a12 * a12;
+        // J = [a + w η | b + w ξ], r = r₀ + a ξ + b η + w ξη.
+        let ja = [a[0] + w[0] * xi[1], a[1] + w[1] * xi[1]];
+        let jb = [b[0] + w[0] * xi[0], b[1] + w[1] * xi[0]];
+        let r = [
+            r0[0] + ja[0] * xi[0] + b[0] * xi[1],
+            r0[1] + ja[1] * xi[0] + b[1] * xi[1],
+        ];
+        let det = ja[0] * jb[1] - jb[0] * ja[1];
         if det.is_nan() || det <= 0.0 {
             return None;
         }
         let inv = 1.0 / det;
-        let mut step = [-(a22 * g1 - a12 * g2) * inv, -(a11 * g2 - a12 * g1) * inv];
+        let mut step = [
+            -(jb[1] * r[0] - jb[0] * r[1]) * inv,
+            -(ja[0] * r[1] - ja[1] * r[0]) * inv,
+        ];
         let s = step[0].abs().max(step[1].abs());
         if s > 1.0 {
             step = [step[0] / s, step[1] / s];
