@@ -97,7 +97,13 @@ fn clip_into(subject: &[P2], clip: &[P2], out: &mut Vec<P2>, scratch: &mut Vec<P
         let e = sub2(clip[(i + 1) % clip.len()], clip[i]);
         scale2 = scale2.max(e[0] * e[0] + e[1] * e[1]);
     }
-    let ccw = area2(clip) >= 0.0;
+    let clip_area2 = area2(clip);
+    // A clip polygon without area (all points on a line or one point) holds nothing;
+    // without this a point-like clip, whose edges have no direction, would keep all.
+    if clip_area2.abs() <= 8.0 * f64::EPSILON * scale2 {
+        return;
+    }
+    let ccw = clip_area2 > 0.0;
     out.extend_from_slice(subject);
     let m = clip.len();
     for k in 0..m {
@@ -252,10 +258,9 @@ fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
                 p0 = p1;
                 p1 = p2;
             }
-            let pn = if n == 1 { x } else { p1 };
-            let pm = if n == 1 { 1.0 } else { p0 };
-            dp = n as f64 * (x * pn - pm) / (x * x - 1.0);
-            let dx = pn / dp;
+            // Pₙ' = n (x Pₙ − Pₙ₋₁) / (x² − 1); for n = 1 the loop leaves P₁ = x, P₀ = 1.
+            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
+            let dx = p1 / dp;
             x -= dx;
             if dx.abs() < 1e-16 {
                 break;
@@ -594,6 +599,9 @@ mod tests {
         assert!((signed_area_polygon(&e) - 4.0).abs() < 1e-15);
         // Disjoint.
         assert!(clip_polygon_polygon(&square(5.0, 5.0, 6.0, 6.0), &a).is_empty());
+        // A clip without area (one point, or a segment) holds nothing.
+        assert!(clip_polygon_polygon(&a, &[[1.0, 1.0]; 4]).is_empty());
+        assert!(clip_polygon_polygon(&a, &[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]).is_empty());
     }
 
     #[test]
