@@ -10,4 +10,5 @@ pub mod interaction;
 pub mod mesh;
 pub mod periodic;
 pub mod script;
+pub mod search;
 pub mod surface;

@@ -1,0 +1,548 @@
+//! A bounding-volume hierarchy over axis-aligned boxes, for the broad phase of the
+//! contact search.
+//!
+//! Entry points: [`Aabb`] (a box, with [`Aabb::from_points`], [`Aabb::inflate`],
+//! [`Aabb::intersects`], [`Aabb::union`]), [`Bvh::build`], [`Bvh::refit`],
+//! [`Bvh::query`], [`Bvh::query_with_box`] (hands the candidate's box to the narrow
+//! phase), [`Bvh::query_with_hint`] (for coherent streams of queries, starts at the
+//! previous query's leaf) and [`Bvh::query_point_within`].
+//!
+//! Construction: a top-down median split on the longest axis of the item centroids'
+//! bounds, down to leaves of at most [`LEAF_SIZE`] items. Splitting at the median of the
+//! *count* keeps the tree balanced whatever the geometry (depth ≤ ⌈log₂ n⌉), so the
+//! build is O(n log n) (a linear-time selection per level) and the query stack has a
+//! fixed size. Ties between equal centroids are broken by item index, so the same input
+//! always gives the same tree.
+//!
+//! Layout: one flat node array in depth-first pre-order (the left child of node `i` is
+//! `i + 1`, the right child is stored), plus the item permutation and a copy of the item
+//! boxes in leaf order, so that a query reads memory mostly forwards and never touches the
+//! caller's array. [`Bvh::item_order`] exposes the leaf order, a spatially coherent order
+//! in which to issue many queries for cache locality.
+//!
+//! Boxes are closed: boxes that only touch intersect. A box with `min > max` on some axis
+//! is empty and intersects nothing. Queries report items in a deterministic order (the
+//! leaf order of the tree; for [`Bvh::query_with_hint`], an order fixed by the hint).
+//! The parent links add 4 bytes per node; a node is 56 bytes.
+
+use super::vec3::V3;
+
+/// Maximum number of items in a leaf.
+pub const LEAF_SIZE: usize = 4;
+
+/// An axis-aligned box `[min, max]` (closed). Empty when `min[k] > max[k]` on some axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+impl Aabb {
+    /// The empty box: the identity of [`Aabb::union`].
+    pub const EMPTY: Aabb = Aabb {
+        min: [f64::INFINITY; 3],
+        max: [f64::NEG_INFINITY; 3],
+    };
+
+    /// The box of a single point.
+    pub fn from_point(p: [f64; 3]) -> Aabb {
+        Aabb { min: p, max: p }
+    }
+
+    /// The smallest box holding all `points` ([`Aabb::EMPTY`] for none).
+    pub fn from_points(points: &[[f64; 3]]) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for p in points {
+            b = b.union(&Aabb::from_point(*p));
+        }
+        b
+    }
+
+    /// The box grown by `margin` on every side (shrunk for a negative margin).
+    pub fn inflate(&self, margin: f64) -> Aabb {
+        Aabb {
+            min: [
+                self.min[0] - margin,
+                self.min[1] - margin,
+                self.min[2] - margin,
+            ],
+            max: [
+                self.max[0] + margin,
+                self.max[1] + margin,
+                self.max[2] + margin,
+            ],
+        }
+    }
+
+    /// Whether the two closed boxes share at least one point.
+    #[inline]
+    pub fn intersects(&self, other: &Aabb) -> bool {
+        // Non-short-circuit `&`: one branch for the caller instead of six
+        // hard-to-predict ones in the tree traversal.
+        (self.min[0] <= other.max[0])
+            & (other.min[0] <= self.max[0])
+            & (self.min[1] <= other.max[1])
+            & (other.min[1] <= self.max[1])
+            & (self.min[2] <= other.max[2])
+            & (other.min[2] <= self.max[2])
+    }
+
+    /// The smallest box holding both.
+    #[inline]
+    pub fn union(&self, other: &Aabb) -> Aabb {
+        Aabb {
+            min: [
+                self.min[0].min(other.min[0]),
+                self.min[1].min(other.min[1]),
+                self.min[2].min(other.min[2]),
+            ],
+            max: [
+                self.max[0].max(other.max[0]),
+                self.max[1].max(other.max[1]),
+                self.max[2].max(other.max[2]),
+            ],
+        }
+    }
+
+    /// Whether the box holds no point.
+    pub fn is_empty(&self) -> bool {
+        (0..3).any(|k| self.min[k] > self.max[k] || self.min[k].is_nan() || self.max[k].is_nan())
+    }
+
+    /// The centre `(min + max) / 2`.
+    pub fn center(&self) -> [f64; 3] {
+        [
+            0.5 * (self.min[0] + self.max[0]),
+            0.5 * (self.min[1] + self.max[1]),
+            0.5 * (self.min[2] + self.max[2]),
+        ]
+    }
+
+    /// Squared Euclidean distance from `p` to the box (0 inside).
+    #[inline]
+    pub fn distance2_to_point(&self, p: [f64; 3]) -> f64 {
+        let mut d2 = 0.0;
+        for ((lo, hi), x) in self.min.iter().zip(&self.max).zip(&p) {
+            let d = (lo - x).max(x - hi).max(0.0);
+            d2 += d * d;
+        }
+        d2
+    }
+}
+
+/// Where [`Bvh::query_with_hint`] starts: the leaf of the previous query's first hit.
+/// The default starts at the root. A hint from another tree is harmless (only slower).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QueryHint {
+    node: u32,
+}
+
+/// One node of the flat tree. A leaf holds items `start .. start + count` of the
+/// permutation; an interior node (`count == 0`) has its left child right after it and its
+/// right child at `start`.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    bounds: Aabb,
+    start: u32,
+    count: u32,
+}
+
+/// A bounding-volume hierarchy over a fixed list of boxes (items `0 .. n`).
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    /// Parent of each node (the root's entry is unused).
+    parent: Vec<u32>,
+    /// Item index at each leaf slot.
+    order: Vec<u32>,
+    /// Item boxes in leaf-slot order.
+    boxes: Vec<Aabb>,
+}
+
+/// Depth bound of the stack in the queries: the median split gives depth ≤ ⌈log₂ n⌉ < 64.
+const STACK: usize = 64;
+
+impl Bvh {
+    /// Builds the tree over `items` (item `i` is `items[i]`).
+    ///
+    /// # Panics
+    /// If there are `u32::MAX` items or more (the node layout stores 32-bit indices).
+    pub fn build(items: &[Aabb]) -> Bvh {
+        let n = items.len();
+        assert!(
+            n < u32::MAX as usize,
+            "Bvh::build: {n} items exceed the 32-bit index range"
+        );
+        let centers: Vec<V3> = items.iter().map(Aabb::center).collect();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut nodes = Vec::with_capacity(if n == 0 { 0 } else { 2 * n.div_ceil(LEAF_SIZE) });
+        if n > 0 {
+            build_range(items, &centers, &mut order, 0, &mut nodes);
+        }
+        let boxes = order.iter().map(|&i| items[i as usize]).collect();
+        let mut parent = vec![0u32; nodes.len()];
+        for (k, node) in nodes.iter().enumerate() {
+            if node.count == 0 {
+                parent[k + 1] = k as u32;
+                parent[node.start as usize] = k as u32;
+            }
+        }
+        Bvh {
+            nodes,
+            parent,
+            order,
+            boxes,
+        }
+    }
+
+    /// Number of items.
+    pub fn len(&self) -> usize {
+        self.order.len()
+    }
+
+    /// Whether the tree has no items.
+    pub fn is_empty(&self) -> bool {
+        self.order.is_empty()
+    }
+
+    /// The items in leaf order: a spatially coherent permutation of `0 .. n`.
+    pub fn item_order(&self) -> impl ExactSizeIterator<Item = usize> + '_ {
+        self.order.iter().map(|&i| i as usize)
+    }
+
+    /// The box of the whole tree ([`Aabb::EMPTY`] when empty).
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, |n| n.bounds)
+    }
+
+    /// Recomputes every node box bottom-up for moved `items`, keeping the topology. The
+    /// tree stays correct (queries exact) whatever the motion, but it may lose quality
+    /// after large motions; rebuild then.
+    ///
+    /// # Panics
+    /// If `items.len()` differs from the number the tree was built with.
+    pub fn refit(&mut self, items: &[Aabb]) {
+        assert_eq!(
+            items.len(),
+            self.order.len(),
+            "Bvh::refit: item count differs from the built tree"
+        );
+        for (slot, &i) in self.boxes.iter_mut().zip(&self.order) {
+            *slot = items[i as usize];
+        }
+        // Pre-order: children have larger indices than their parent.
+        for k in (0..self.nodes.len()).rev() {
+            let node = self.nodes[k];
+            let bounds = if node.count > 0 {
+                let s = node.start as usize;
+                self.boxes[s..s + node.count as usize]
+                    .iter()
+                    .fold(Aabb::EMPTY, |b, x| b.union(x))
+            } else {
+                self.nodes[k + 1]
+                    .bounds
+                    .union(&self.nodes[node.start as usize].bounds)
+            };
+            self.nodes[k].bounds = bounds;
+        }
+    }
+
+    /// Calls `visit(i)` for every item `i` whose box intersects `query`, in leaf order.
+    /// Allocates nothing.
+    pub fn query(&self, query: &Aabb, mut visit: impl FnMut(usize)) {
+        self.query_with_box(query, |i, _| visit(i));
+    }
+
+    /// Like [`Bvh::query`], handing the item's box to `visit` too (read from the tree's
+    /// own copy, already in cache), so a narrow phase can skip candidates whose box is
+    /// farther than the best found so far.
+    pub fn query_with_box(&self, query: &Aabb, mut visit: impl FnMut(usize, &Aabb)) {
+        self.traverse_from(
+            0,
+            |b| b.intersects(query),
+            |_, boxes, items| {
+                for (b, &i) in boxes.iter().zip(items) {
+                    if b.intersects(query) {
+                        visit(i as usize, b);
+                    }
+                }
+            },
+        );
+    }
+
+    /// Like [`Bvh::query_with_box`], for a stream of nearby queries: the search starts
+    /// at the leaf where the previous query found its first item (kept in `hint`) and
+    /// climbs to the root, testing at each level the sibling of the subtree already
+    /// searched. Every item is still found (the siblings along the path to the root
+    /// cover the whole tree), whatever the hint; a good hint only makes the tests cheap,
+    /// since for a small query most siblings miss, which the branch predictor learns,
+    /// where a descent from the root takes a coin-flip branch per level. Issue queries
+    /// in a spatially coherent order (e.g. Morton order of the points) to profit.
+    ///
+    /// The report order depends on the hint (it is deterministic for a deterministic
+    /// sequence of queries); the set reported equals that of [`Bvh::query`].
+    pub fn query_with_hint(
+        &self,
+        hint: &mut QueryHint,
+        query: &Aabb,
+        mut visit: impl FnMut(usize, &Aabb),
+    ) {
+        let start = hint.node as usize;
+        let start = if start < self.nodes.len() { start } else { 0 };
+        let mut first_hit: Option<usize> = None;
+        let mut leaf = |k: usize, boxes: &[Aabb], items: &[u32]| {
+            for (b, &i) in boxes.iter().zip(items) {
+                if b.intersects(query) {
+                    first_hit.get_or_insert(k);
+                    visit(i as usize, b);
+                }
+            }
+        };
+        self.traverse_from(start, |b| b.intersects(query), &mut leaf);
+        let mut c = start;
+        while c != 0 {
+            let p = self.parent[c] as usize;
+            let sibling = if c == p + 1 {
+                self.nodes[p].start as usize
+            } else {
+                p + 1
+            };
+            // Test here first: most siblings miss, and a miss then costs one box test.
+            if self.nodes[sibling].bounds.intersects(query) {
+                self.traverse_from(sibling, |b| b.intersects(query), &mut leaf);
+            }
+            c = p;
+        }
+        if let Some(k) = first_hit {
+            hint.node = k as u32;
+        }
+    }
+
+    /// Calls `visit(i)` for every item `i` whose box lies within distance `radius` of `p`
+    /// (closed: distance ≤ radius), in leaf order. Allocates nothing.
+    pub fn query_point_within(&self, p: [f64; 3], radius: f64, mut visit: impl FnMut(usize)) {
+        let r2 = radius * radius;
+        if radius.is_nan() || radius < 0.0 {
+            return;
+        }
+        self.traverse_from(
+            0,
+            |b| b.distance2_to_point(p) <= r2,
+            |_, boxes, items| {
+                for (b, &i) in boxes.iter().zip(items) {
+                    if b.distance2_to_point(p) <= r2 {
+                        visit(i as usize);
+                    }
+                }
+            },
+        );
+    }
+
+    /// Depth-first traversal of the subtree at node `start` (left before right),
+    /// descending into nodes accepted by `enter` and handing the node index, boxes and
+    /// items of every accepted leaf to `leaf`. Does nothing for an empty tree.
+    #[inline]
+    fn traverse_from(
+        &self,
+        start: usize,
+        enter: impl Fn(&Aabb) -> bool,
+        mut leaf: impl FnMut(usize, &[Aabb], &[u32]),
+    ) {
+        if start >= self.nodes.len() {
+            return;
+        }
+        let mut stack = [0u32; STACK];
+        let mut top = 0usize;
+        let mut k = start;
+        loop {
+            let node = &self.nodes[k];
+            let mut next = None;
+            if enter(&node.bounds) {
+                if node.count > 0 {
+                    let s = node.start as usize;
+                    let e = s + node.count as usize;
+                    leaf(k, &self.boxes[s..e], &self.order[s..e]);
+                } else {
+                    stack[top] = node.start;
+                    top += 1;
+                    next = Some(k + 1);
+                }
+            }
+            match next {
+                Some(c) => k = c,
+                None if top > 0 => {
+                    top -= 1;
+                    k = stack[top] as usize;
+                }
+                None => return,
+            }
+        }
+    }
+}
+
+/// Builds the subtree over `order[..]` (which starts at leaf slot `offset`), pushing its
+/// nodes in pre-order; returns nothing, the subtree root is the first node pushed.
+fn build_range(
+    items: &[Aabb],
+    centers: &[V3],
+    order: &mut [u32],
+    offset: usize,
+    nodes: &mut Vec<Node>,
+) {
+    let me = nodes.len();
+    let bounds = order
+        .iter()
+        .fold(Aabb::EMPTY, |b, &i| b.union(&items[i as usize]));
+    let n = order.len();
+    if n <= LEAF_SIZE {
+        nodes.push(Node {
+            bounds,
+            start: offset as u32,
+            count: n as u32,
+        });
+        return;
+    }
+    nodes.push(Node {
+        bounds,
+        start: 0,
+        count: 0,
+    });
+    // Longest axis of the centroids' bounds; NaN extents never win.
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &i in order.iter() {
+        let c = centers[i as usize];
+        for k in 0..3 {
+            lo[k] = lo[k].min(c[k]);
+            hi[k] = hi[k].max(c[k]);
+        }
+    }
+    let mut axis = 0;
+    for k in 1..3 {
+        if hi[k] - lo[k] > hi[axis] - lo[axis] {
+            axis = k;
+        }
+    }
+    let mid = n / 2;
+    // Total order (coordinate, then index): the split sets do not depend on the
+    // selection algorithm, so equal inputs give equal trees.
+    order.select_nth_unstable_by(mid, |&a, &b| {
+        centers[a as usize][axis]
+            .total_cmp(&centers[b as usize][axis])
+            .then(a.cmp(&b))
+    });
+    let (left, right) = order.split_at_mut(mid);
+    build_range(items, centers, left, offset, nodes);
+    let right_index = nodes.len();
+    build_range(items, centers, right, offset + mid, nodes);
+    nodes[me].start = right_index as u32;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_box(x: f64, y: f64, z: f64) -> Aabb {
+        Aabb {
+            min: [x, y, z],
+            max: [x + 1.0, y + 1.0, z + 1.0],
+        }
+    }
+
+    fn collect(bvh: &Bvh, q: &Aabb) -> Vec<usize> {
+        let mut v = Vec::new();
+        bvh.query(q, |i| v.push(i));
+        v
+    }
+
+    #[test]
+    fn empty_and_single() {
+        let bvh = Bvh::build(&[]);
+        assert!(bvh.is_empty());
+        assert!(collect(&bvh, &unit_box(0.0, 0.0, 0.0)).is_empty());
+        let bvh = Bvh::build(&[unit_box(0.0, 0.0, 0.0)]);
+        assert_eq!(collect(&bvh, &unit_box(0.5, 0.5, 0.5)), vec![0]);
+        assert!(collect(&bvh, &unit_box(2.0, 0.0, 0.0)).is_empty());
+        // Touching boxes intersect (closed boxes).
+        assert_eq!(collect(&bvh, &unit_box(1.0, 0.0, 0.0)), vec![0]);
+    }
+
+    #[test]
+    fn duplicates_and_flat_boxes() {
+        // 100 identical flat boxes: all centroids equal, the split must still terminate
+        // with small leaves and report every item once.
+        let flat = Aabb {
+            min: [0.0, 0.0, 0.0],
+            max: [1.0, 1.0, 0.0],
+        };
+        let items = vec![flat; 100];
+        let bvh = Bvh::build(&items);
+        let mut got = collect(&bvh, &Aabb::from_point([0.5, 0.5, 0.0]));
+        got.sort_unstable();
+        assert_eq!(got, (0..100).collect::<Vec<_>>());
+        assert!(collect(&bvh, &Aabb::from_point([0.5, 0.5, 1e-12])).is_empty());
+    }
+
+    #[test]
+    fn grid_query_and_refit() {
+        let mut items = Vec::new();
+        for i in 0..10 {
+            for j in 0..10 {
+                items.push(unit_box(2.0 * i as f64, 2.0 * j as f64, 0.0));
+            }
+        }
+        let mut bvh = Bvh::build(&items);
+        // A point inside box (3, 4) only.
+        let q = Aabb::from_point([6.5, 8.5, 0.5]);
+        assert_eq!(collect(&bvh, &q), vec![34]);
+        // Move every box by +1 in x; refit; the point now sits in the gap between boxes.
+        for b in &mut items {
+            b.min[0] += 1.0;
+            b.max[0] += 1.0;
+        }
+        bvh.refit(&items);
+        assert!(collect(&bvh, &q).is_empty());
+        assert_eq!(collect(&bvh, &Aabb::from_point([7.5, 8.5, 0.5])), vec![34]);
+        let mut within = Vec::new();
+        bvh.query_point_within([6.5, 8.5, 0.5], 0.5, |i| within.push(i));
+        within.sort_unstable();
+        assert_eq!(within, vec![24, 34]);
+    }
+
+    #[test]
+    fn hints_from_anywhere_give_the_same_set() {
+        let big: Vec<Aabb> = (0..500)
+            .map(|i| unit_box((i % 25) as f64 * 1.5, (i / 25) as f64 * 1.5, 0.0))
+            .collect();
+        let small: Vec<Aabb> = big[..40].to_vec();
+        let (tb, ts) = (Bvh::build(&big), Bvh::build(&small));
+        // A hint left at a deep leaf of the big tree is out of range for the small one.
+        let mut hint = QueryHint::default();
+        let far = Aabb::from_point([30.0, 28.0, 0.5]);
+        tb.query_with_hint(&mut hint, &far, |_, _| {});
+        assert_ne!(hint, QueryHint::default());
+        for q in [unit_box(0.2, 0.2, 0.0), unit_box(3.0, 1.0, -0.5), far] {
+            for tree in [&tb, &ts] {
+                let mut got = Vec::new();
+                let mut h = hint;
+                tree.query_with_hint(&mut h, &q, |i, _| got.push(i));
+                got.sort_unstable();
+                let mut want = collect(tree, &q);
+                want.sort_unstable();
+                assert_eq!(got, want);
+            }
+        }
+    }
+
+    #[test]
+    fn same_input_same_tree() {
+        let items: Vec<Aabb> = (0..257)
+            .map(|i| unit_box(((i * 37) % 101) as f64, ((i * 53) % 7) as f64, 0.0))
+            .collect();
+        let a = Bvh::build(&items);
+        let b = Bvh::build(&items);
+        assert_eq!(a.order, b.order);
+        let q = unit_box(10.0, 2.0, 0.0).inflate(5.0);
+        assert_eq!(collect(&a, &q), collect(&b, &q));
+    }
+}
