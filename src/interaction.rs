@@ -6,7 +6,8 @@
 //! - `begin Interaction Defaults`: `General Contact = on` pairs every two distinct
 //!   surfaces (of its `Surfaces` list, if given); `Self Contact = on` pairs each surface
 //!   with itself.
-//! - With neither block, every pair of distinct contact surfaces interacts.
+//! - With neither block, every pair of distinct contact surfaces interacts, except that a
+//!   surface with a `Periodicity For` pairs only through its periodic image.
 //! - Node surfaces interact only with face surfaces, and only as side A; pairs of two
 //!   node surfaces are dropped, and a node surface named as side B is an error.
 //! - A pair named twice keeps one interaction: the later definition's options apply.
@@ -204,6 +205,20 @@ pub fn resolve(
         }
     }
     if def.interactions.is_empty() && def.interaction_defaults.is_none() {
+        // Surfaces tied by a periodicity pair through their image, not directly.
+        let periodic: Vec<usize> = def
+            .periodicity
+            .iter()
+            .filter_map(|p| {
+                let name = p.surface.to_ascii_lowercase();
+                surfaces.surfaces.iter().position(|s| s.name == name)
+            })
+            .collect();
+        let all: Vec<usize> = all
+            .iter()
+            .copied()
+            .filter(|i| !periodic.contains(i))
+            .collect();
         for (i, &a) in all.iter().enumerate() {
             for &b in &all[i + 1..] {
                 if let Some((a, b)) = orient(surfaces, a, b) {

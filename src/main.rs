@@ -43,6 +43,22 @@ enum Command {
         #[arg(long)]
         dead: Option<String>,
     },
+    /// Build surfaces, pair them by the deck's interactions and periodicity, and report
+    /// the coverage of each pair.
+    Search {
+        deck: PathBuf,
+        #[arg(long)]
+        mesh: PathBuf,
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+        /// Integrate on mortar segments (exact overlap) instead of side-A Gauss points.
+        #[arg(long)]
+        segments: bool,
+        /// Quadrature order (Gauss points per face direction, or segment rule degree).
+        #[arg(long, default_value_t = 2)]
+        order: usize,
+    },
     /// Validate a deck (and, with --mesh, its surfaces) and print every diagnostic.
     Check {
         deck: PathBuf,
@@ -60,6 +76,13 @@ fn main() -> ExitCode {
             json,
             dead,
         } => surfaces(&deck, &mesh, json, dead.as_deref()),
+        Command::Search {
+            deck,
+            mesh,
+            json,
+            segments,
+            order,
+        } => search(&deck, &mesh, json, segments, order),
         Command::Check { deck, mesh } => check(&deck, mesh.as_deref()),
     }
 }
@@ -211,6 +234,188 @@ fn print_table(rows: &[SurfaceRow]) {
     }
 }
 
+#[derive(Serialize)]
+struct SearchReport {
+    interactions: Vec<seam::search::scene::PairingSummary>,
+    timing: seam::search::scene::Timing,
+    warnings: Vec<Warning>,
+}
+
+fn search(
+    deck_path: &Path,
+    mesh_path: &Path,
+    json: bool,
+    segments: bool,
+    order: usize,
+) -> ExitCode {
+    use seam::deck::spec::OutputRule;
+    use seam::search::pairing::Integration;
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path)) {
+        Ok(x) => x,
+        Err(code) => return code,
+    };
+    let mesh = mesh.expect("a mesh path was given");
+    let deck_dir = deck_path.parent().unwrap_or(Path::new("."));
+    let integration = if segments {
+        Integration::Segments { order }
+    } else {
+        Integration::Quadrature { order }
+    };
+    let mut diags = loaded.diagnostics.clone();
+    let mut summaries = Vec::new();
+    let mut timing = seam::search::scene::Timing::default();
+    let mut details = Vec::new();
+    let mut rule = OutputRule::Summary;
+    for def in &loaded.deck.contact_definitions {
+        let set = surface::build(&mesh, def, &loaded.sources);
+        diags.extend(set.diagnostics.clone());
+        let (interactions, d) = seam::interaction::resolve(def, &set, mesh.dim, &loaded.sources);
+        diags.extend(d);
+        if diags.has_errors() {
+            continue;
+        }
+        let scene = seam::search::scene::search_definition(
+            &mesh,
+            def,
+            &set,
+            &interactions,
+            deck_dir,
+            &loaded.sources,
+            integration,
+        );
+        diags.extend(scene.diagnostics);
+        timing.build_s += scene.timing.build_s;
+        timing.search_s += scene.timing.search_s;
+        rule = def.output_rule.unwrap_or(OutputRule::Summary);
+        for p in &scene.pairings {
+            summaries.push(p.summary(def.visualize_contact));
+            if matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose) {
+                details.push(point_details(p, rule == OutputRule::MoreVerbose));
+            }
+        }
+    }
+    if diags.has_errors() {
+        eprint!("{}", diags.render(&loaded.sources));
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    if json {
+        let report = SearchReport {
+            interactions: summaries,
+            timing,
+            warnings: diags
+                .warnings()
+                .map(|d| Warning {
+                    code: d.code,
+                    message: d.message.clone(),
+                })
+                .collect(),
+        };
+        println!(
+            "{}",
+            serde_json::to_string(&report).expect("plain data serialises")
+        );
+        return ExitCode::SUCCESS;
+    }
+    if rule != OutputRule::None {
+        print_search_table(&summaries);
+        println!(
+            "search: build {:.3} s, search {:.3} s",
+            timing.build_s, timing.search_s
+        );
+        for d in details {
+            print!("{d}");
+        }
+    }
+    use std::io::Write as _;
+    let _ = std::io::stdout().flush();
+    eprint!("{}", diags.render(&loaded.sources));
+    ExitCode::SUCCESS
+}
+
+fn print_search_table(rows: &[seam::search::scene::PairingSummary]) {
+    let width = rows
+        .iter()
+        .map(|r| r.side_a.len() + r.side_b.len() + 3)
+        .max()
+        .unwrap_or(11)
+        .max(11);
+    println!(
+        "{:<width$}  {:>8}  {:>8}  {:>9}  {:>8}  {:>8}  {:>13}  {:>13}  {:>11}  {:>11}",
+        "interaction",
+        "points",
+        "matched",
+        "unmatched",
+        "rej.dist",
+        "rej.angle",
+        "overlap area",
+        "side-A area",
+        "gap min",
+        "gap max"
+    );
+    for r in rows {
+        let name = format!(
+            "{} / {}{}",
+            r.side_a,
+            r.side_b,
+            if r.periodic { " (periodic)" } else { "" }
+        );
+        let gap = |g: Option<f64>| g.map_or("-".to_string(), |g| format!("{g:.3e}"));
+        println!(
+            "{:<width$}  {:>8}  {:>8}  {:>9}  {:>8}  {:>8}  {:>13}  {:>13}  {:>11}  {:>11}",
+            name,
+            r.stats.points,
+            r.stats.matched,
+            r.stats.unmatched,
+            r.stats.rejected_distance,
+            r.stats.rejected_angle,
+            format_number(r.stats.overlap_area),
+            format_number(r.stats.side_a_area),
+            gap(r.stats.gap_min),
+            gap(r.stats.gap_max)
+        );
+    }
+}
+
+/// The points that did not pair (verbose: the first 10 per interaction; more verbose:
+/// all), with where they are and why.
+fn point_details(p: &seam::search::scene::Pairing, all: bool) -> String {
+    use seam::search::pairing::PointStatus;
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let bad: Vec<_> = p
+        .result
+        .points
+        .iter()
+        .filter(|q| q.status != PointStatus::Matched)
+        .collect();
+    if bad.is_empty() {
+        return out;
+    }
+    let _ = writeln!(
+        out,
+        "{} / {}: {} point(s) not paired",
+        p.side_a,
+        p.side_b,
+        bad.len()
+    );
+    let shown = if all { bad.len() } else { bad.len().min(10) };
+    for q in &bad[..shown] {
+        let _ = writeln!(
+            out,
+            "  {:?} at ({:.6}, {:.6}, {:.6})",
+            q.status, q.x[0], q.x[1], q.x[2]
+        );
+    }
+    if shown < bad.len() {
+        let _ = writeln!(
+            out,
+            "  … {} more (Output Rule = more verbose lists all)",
+            bad.len() - shown
+        );
+    }
+    out
+}
+
 /// Fixed-point with six decimals in the everyday range, scientific outside it.
 fn format_number(x: f64) -> String {
     let x = x + 0.0; // no "-0"
@@ -230,10 +435,28 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
     diags.extend(not_yet_carried_out(&loaded, true));
     let mut count = 0;
     if let Some(mesh) = &mesh {
+        let deck_dir = deck_path.parent().unwrap_or(Path::new("."));
         for def in &loaded.deck.contact_definitions {
             let set = surface::build(mesh, def, &loaded.sources);
             count += set.surfaces.len();
-            diags.extend(set.diagnostics);
+            diags.extend(set.diagnostics.clone());
+            let (interactions, d) =
+                seam::interaction::resolve(def, &set, mesh.dim, &loaded.sources);
+            diags.extend(d);
+            if !diags.has_errors() {
+                // The search checks what only geometry can tell: periodic maps that land
+                // nowhere, rotations that do not close, Lua maps that do not run.
+                let scene = seam::search::scene::search_definition(
+                    mesh,
+                    def,
+                    &set,
+                    &interactions,
+                    deck_dir,
+                    &loaded.sources,
+                    seam::search::pairing::Integration::Quadrature { order: 1 },
+                );
+                diags.extend(scene.diagnostics);
+            }
         }
     }
     eprint!("{}", diags.render(&loaded.sources));
@@ -267,7 +490,7 @@ fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
             Diagnostic::warning("W0900", message)
         };
         out.push(d.at(Some(at.clone())).help(
-            "contact surfaces are built now; search, enforcement and periodicity arrive in later versions",
+            "surfaces and the search (`seam search`) are carried out now; enforcement and time stepping arrive in later versions",
         ));
     };
     for def in &loaded.deck.contact_definitions {

@@ -138,16 +138,14 @@ pub static COMMANDS: &[CommandSpec] = &[
         "visualize_contact",
         [CD],
         "[= on|off]",
-        "Write contact variables (gap, status, flux) to the results.",
-        planned
+        "Write contact variables (gap, status, flux) to the results."
     ),
     cmd!(
         "output rule",
         "output_rule",
         [CD],
         "= none|summary|verbose|more verbose",
-        "How much the contact search reports in the log.",
-        planned
+        "How much the contact search reports in the log."
     ),
     cmd!(
         "update search every",
@@ -162,40 +160,35 @@ pub static COMMANDS: &[CommandSpec] = &[
         "opposed_normal_threshold_angle",
         [CD],
         "= <degrees>",
-        "Faces interact only if their normals are at least this far apart (>= 90).",
-        planned
+        "Faces interact only if their normals are at least this far apart (>= 90)."
     ),
     cmd!(
         "disable opposed normal interaction culling",
         "disable_opposed_normal_interaction_culling",
         [CD],
         "",
-        "Keep pairs whatever the angle between their normals.",
-        planned
+        "Keep pairs whatever the angle between their normals."
     ),
     cmd!(
         "scale penalty",
         "scale_penalty",
         [CD],
         "[for <surface> [with <surface>]] = <factor>",
-        "Penalty scale factor for the whole domain, one surface's self-contact, or one pair (Abaqus control assignment; the last that applies wins).",
-        planned
+        "Penalty scale factor for the whole domain, one surface's self-contact, or one pair (Abaqus control assignment; the last that applies wins)."
     ),
     cmd!(
         "initial overclosure",
         "initial_overclosure",
         [CD],
         "[for <surface> [with <surface>]] = adjust nodes|store offsets",
-        "Treatment of gaps that are negative at the start, for the whole domain, one surface or one pair (the last that applies wins).",
-        planned
+        "Treatment of gaps that are negative at the start, for the whole domain, one surface or one pair (the last that applies wins)."
     ),
     cmd!(
         "periodicity for",
         "periodicity",
         [CD],
         "<surface> = rectangular offset = <dx> <dy> [<dz>] | cylindrical axis = <a>... center = <c>... angle = <deg> | align_surface destination = <surface> [invert_normals = 0|1] | mapped x_map = <f> y_map = <g> [z_map = <h>]",
-        "Tie a surface to the image of another under a periodic transform.",
-        planned
+        "Tie a surface to the image of another under a periodic transform."
     ),
     // Enforcement.
     cmd!(
@@ -268,56 +261,49 @@ pub static COMMANDS: &[CommandSpec] = &[
         "side_a",
         [INT],
         "[=] <surface>...",
-        "Surfaces that carry the integration points.",
-        planned
+        "Surfaces that carry the integration points."
     ),
     cmd!(
         "side b",
         "side_b",
         [INT],
         "[=] <surface>...",
-        "Surfaces projected onto.",
-        planned
+        "Surfaces projected onto."
     ),
     cmd!(
         "surfaces",
         "surfaces",
         [INT, DEF],
         "[=] <surface>...",
-        "Surfaces that interact with each other (both sides).",
-        planned
+        "Surfaces that interact with each other (both sides)."
     ),
     cmd!(
         "normal tolerance",
         "normal_tolerance",
         [INT, SO],
         "[=] <distance>",
-        "Largest normal gap at which a pair is found (> 0).",
-        planned
+        "Largest normal gap at which a pair is found (> 0)."
     ),
     cmd!(
         "enforcement",
         "enforcement",
         [INT, DEF],
         "= <enforcement name>",
-        "Which `begin enforcement` block applies.",
-        planned
+        "Which `begin enforcement` block applies."
     ),
     cmd!(
         "general contact",
         "general_contact",
         [DEF],
         "= on|off",
-        "Every listed surface interacts with every other.",
-        planned
+        "Every listed surface interacts with every other."
     ),
     cmd!(
         "self contact",
         "self_contact",
         [DEF, SO],
         "= on|off",
-        "A surface may interact with itself.",
-        planned
+        "A surface may interact with itself."
     ),
     // Search Options.
     cmd!(
@@ -325,40 +311,35 @@ pub static COMMANDS: &[CommandSpec] = &[
         "tangential_tolerance",
         [SO],
         "[=] <distance>",
-        "How far outside a face a projection still counts.",
-        planned
+        "How far outside a face a projection still counts."
     ),
     cmd!(
         "buffer factor",
         "buffer_factor",
         [SO],
         "[=] <f>",
-        "Growth of the search boxes, relative to the face size.",
-        planned
+        "Growth of the search boxes, relative to the face size."
     ),
     cmd!(
         "field factor",
         "field_factor",
         [SO],
         "[=] <f>",
-        "Scale of the search field around each face.",
-        planned
+        "Scale of the search field around each face."
     ),
     cmd!(
         "normal check angle",
         "normal_check_angle",
         [SO],
         "[=] <degrees>",
-        "Largest angle between normals of a pair.",
-        planned
+        "Largest angle between normals of a pair."
     ),
     cmd!(
         "search update frequency",
         "search_update_frequency",
         [SO],
         "[=] <n>",
-        "Redo the search every n steps.",
-        planned
+        "Redo the search every n steps."
     ),
     // Contact Surface block (Sierra/SM).
     cmd!(

@@ -19,4 +19,6 @@ pub mod bvh;
 pub mod mortar;
 pub mod project;
 
+pub mod pairing;
+pub mod scene;
 mod vec3;

@@ -6,5 +6,6 @@ mod cli;
 mod docs;
 mod interactions;
 mod mesh_io;
+mod search;
 mod search_kernels;
 mod surfaces;
