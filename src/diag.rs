@@ -235,28 +235,54 @@ pub fn did_you_mean<'a>(
 }
 
 impl SourceMap {
-    /// Narrow `loc` to the first case-insensitive occurrence of `word` on its line at or
-    /// after its column, so a caret can point at one name in a list. Returns `loc`
-    /// unchanged when the line or the word is not found.
+    /// Narrow `loc` to the first case-insensitive occurrence of `word` as a whole word,
+    /// on its line at or after its column, or else on the lines below it up to the
+    /// `end` of the block it opens — so a caret can point at one name in a list. Returns
+    /// `loc` unchanged when the word is not found.
     pub fn narrow(&self, loc: &Loc, word: &str) -> Loc {
-        let Some(line) = self.line(&loc.file, loc.line) else {
-            return loc.clone();
-        };
-        let lower = line.to_ascii_lowercase();
         let word = word.to_ascii_lowercase();
-        let start = line
-            .char_indices()
-            .nth(loc.col.saturating_sub(1) as usize)
-            .map_or(0, |(i, _)| i);
-        match lower.get(start..).and_then(|rest| rest.find(&word)) {
-            Some(off) => Loc {
-                col: lower[..start + off].chars().count() as u32 + 1,
-                len: word.chars().count() as u32,
-                ..loc.clone()
-            },
-            None => loc.clone(),
+        for (k, line_no) in (loc.line..loc.line.saturating_add(200)).enumerate() {
+            let Some(line) = self.line(&loc.file, line_no) else {
+                break;
+            };
+            let lower = line.to_ascii_lowercase();
+            if k > 0 && lower.trim_start().starts_with("end") {
+                break;
+            }
+            let start = if k == 0 {
+                line.char_indices()
+                    .nth(loc.col.saturating_sub(1) as usize)
+                    .map_or(0, |(i, _)| i)
+            } else {
+                0
+            };
+            if let Some(at) = find_word(&lower, &word, start) {
+                return Loc {
+                    line: line_no,
+                    col: lower[..at].chars().count() as u32 + 1,
+                    len: word.chars().count() as u32,
+                    ..loc.clone()
+                };
+            }
         }
+        loc.clone()
     }
+}
+
+/// Byte offset of `word` in `text` at or after `from`, not inside a longer name.
+fn find_word(text: &str, word: &str, from: usize) -> Option<usize> {
+    let is_name = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
+    let mut pos = from;
+    while let Some(off) = text.get(pos..)?.find(word) {
+        let at = pos + off;
+        let before = text[..at].chars().next_back();
+        let after = text[at + word.len()..].chars().next();
+        if !before.is_some_and(is_name) && !after.is_some_and(is_name) {
+            return Some(at);
+        }
+        pos = at + word.len().max(1);
+    }
+    None
 }
 
 #[cfg(test)]

@@ -497,38 +497,8 @@ fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
         for e in &def.enforcements {
             report("begin Enforcement", &e.at);
         }
-        for i in &def.interactions {
-            report("begin Interaction", &i.at);
-        }
-        if let Some(d) = &def.interaction_defaults {
-            report("begin Interaction Defaults", &d.at);
-        }
-        if let Some(s) = &def.search_options {
-            report("begin Search Options", &s.at);
-        }
-        for p in &def.periodicity {
-            report("Periodicity For", &p.at);
-        }
-        let flags = [
-            (def.output_rule.is_some(), "Output Rule"),
-            (def.visualize_contact, "Visualize Contact"),
-            (
-                def.update_search_every_n_steps.is_some(),
-                "Update Search Every n Steps",
-            ),
-            (
-                def.opposed_normal_threshold_angle.is_some(),
-                "Opposed Normal Threshold Angle",
-            ),
-            (
-                def.disable_opposed_normal_interaction_culling,
-                "Disable Opposed Normal Interaction Culling",
-            ),
-        ];
-        for (set, what) in flags {
-            if set {
-                report(what, &def.at);
-            }
+        if def.update_search_every_n_steps.is_some() {
+            report("Update Search Every n Steps", &def.at);
         }
     }
     out

@@ -182,7 +182,7 @@ impl Sandbox {
         match self.lua.globals().get::<Value>(name) {
             Ok(Value::Function(f)) => Ok(ScriptFn {
                 f,
-                name: name.into(),
+                name: format!("{name} ({chunk})"),
             }),
             _ => Err(ScriptError::NotAFunction {
                 chunk: chunk.into(),

@@ -1,0 +1,3 @@
+function fx(x, y, z)
+  while true do end
+end
