@@ -295,8 +295,12 @@ pub struct Sphere {
 /// The side-B half of a search: a BVH over the faces, kept between searches.
 pub struct Searcher {
     bvh: Bvh,
-    /// Box inflation: the largest distance a point may be from a face and still pair.
+    /// Box inflation: the search buffer (mean face size × buffer factor, or more).
     margin: f64,
+    /// The farthest a point may be from a face's own box and still pair with it (the
+    /// largest distance acceptance plus the tangential tolerance): candidates beyond it
+    /// are skipped before the (much dearer) projection.
+    reach: f64,
 }
 
 /// One chunk's points and, per face, (matched weight, total weight, overlap area).
@@ -311,9 +315,16 @@ impl Searcher {
     pub fn new(b: &SurfaceGeometry, settings: &SearchSettings) -> Searcher {
         let margin = margin_for(b, settings);
         let boxes: Vec<Aabb> = b.faces.iter().map(|f| f.aabb().inflate(margin)).collect();
+        let largest = max_face_size(b);
+        let reach = settings
+            .normal_tolerance
+            .unwrap_or(0.0)
+            .max(settings.field_factor * largest)
+            + settings.tangential_tolerance * largest;
         Searcher {
             bvh: Bvh::build(&boxes),
             margin,
+            reach: reach.min(margin),
         }
     }
 
@@ -336,8 +347,35 @@ impl Searcher {
         integration: Integration,
         subdomain: Option<Sphere>,
     ) -> SearchResult {
+        self.run(a, b, settings, integration, subdomain, true)
+    }
+
+    /// [`Self::search`] without the overlap-area diagnostic (`stats.overlap_area` stays
+    /// 0 in quadrature mode): the pairing alone, for callers that redo it every step.
+    pub fn search_points(
+        &self,
+        a: &SurfaceGeometry,
+        b: &SurfaceGeometry,
+        settings: &SearchSettings,
+        integration: Integration,
+        subdomain: Option<Sphere>,
+    ) -> SearchResult {
+        self.run(a, b, settings, integration, subdomain, false)
+    }
+
+    fn run(
+        &self,
+        a: &SurfaceGeometry,
+        b: &SurfaceGeometry,
+        settings: &SearchSettings,
+        integration: Integration,
+        subdomain: Option<Sphere>,
+        overlap: bool,
+    ) -> SearchResult {
         let ctx = Ctx {
             bvh: &self.bvh,
+            margin: self.margin,
+            reach2: self.reach * self.reach,
             b,
             settings,
             subdomain,
@@ -375,8 +413,12 @@ impl Searcher {
                             hit += p.weight;
                         }
                     }
-                    let overlap = ctx.overlap_of(a, fa, &points[before..], integration);
-                    per_face.push((hit, total, overlap));
+                    let area = if overlap || matches!(integration, Integration::Segments { .. }) {
+                        ctx.overlap_of(a, fa, &points[before..], integration)
+                    } else {
+                        0.0
+                    };
+                    per_face.push((hit, total, area));
                 }
                 (points, per_face)
             })
@@ -463,6 +505,8 @@ fn tally(r: &mut SearchResult) {
 
 struct Ctx<'a> {
     bvh: &'a Bvh,
+    margin: f64,
+    reach2: f64,
     b: &'a SurfaceGeometry,
     settings: &'a SearchSettings,
     subdomain: Option<Sphere>,
@@ -483,6 +527,24 @@ struct Best {
 type Candidate = ((bool, f64, u32), [f64; 2], f64, V3);
 
 impl Ctx<'_> {
+    /// Side-B faces whose own box comes within the reach of `face`'s box, ascending.
+    fn face_candidates(&self, face: &FaceGeom, out: &mut Vec<usize>) {
+        out.clear();
+        let reach = self.reach2.sqrt();
+        let near = face.aabb().inflate(reach);
+        let m = self.margin;
+        self.bvh.query_with_box(&face.aabb(), |j, inflated| {
+            let own = Aabb {
+                min: inflated.min.map(|v| v + m),
+                max: inflated.max.map(|v| v - m),
+            };
+            if own.intersects(&near) {
+                out.push(j);
+            }
+        });
+        out.sort_unstable();
+    }
+
     fn distance_limit(&self, face: &FaceGeom) -> f64 {
         self.settings
             .normal_tolerance
@@ -517,7 +579,16 @@ impl Ctx<'_> {
             rejected: PointStatus::Unmatched,
         };
         let query = Aabb::from_point(x);
-        self.bvh.query(&query, |j| {
+        let m = self.margin;
+        self.bvh.query_with_box(&query, |j, inflated| {
+            // The face's own box is the tree's box less the margin.
+            let own = Aabb {
+                min: inflated.min.map(|v| v + m),
+                max: inflated.max.map(|v| v - m),
+            };
+            if own.distance2_to_point(x) > self.reach2 {
+                return;
+            }
             let face = &self.b.faces[j];
             let pr = match face.len {
                 3 => project_point_tri3(x, &[face.x[0], face.x[1], face.x[2]]),
@@ -630,8 +701,7 @@ impl Ctx<'_> {
         let n_a = face.normal();
         let rule = rule_triangle(order);
         let mut candidates = Vec::new();
-        self.bvh.query(&face.aabb(), |j| candidates.push(j));
-        candidates.sort_unstable();
+        self.face_candidates(face, &mut candidates);
         let outside = self.outside(face.centroid());
         for j in candidates {
             let fb = &self.b.faces[j];
@@ -696,8 +766,7 @@ impl Ctx<'_> {
         let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
         let mut candidates = Vec::new();
-        self.bvh.query(&face.aabb(), |j| candidates.push(j));
-        candidates.sort_unstable();
+        self.face_candidates(face, &mut candidates);
         for j in candidates {
             let fb = &self.b.faces[j];
             if !self.normals_ok(n_a, fb.normal())

@@ -1,0 +1,173 @@
+//! Benchmark: the contact search of one interaction at 1e4, 1e5 and 1e6 side-A points
+//! against about as many side-B faces, on a planar and on a curved non-matching
+//! interface, with 1 and 2 threads.
+//!
+//! Side A has one Gauss point per face (`Quadrature { order: 1 }`), so points = faces.
+//! Reported per case: tree build time, pairing time (points/s), and the full search with
+//! the overlap-area diagnostic. Run: `cargo bench --bench search` (`-- quick` stops at
+//! 1e5). Medians of 3 runs.
+
+use std::time::Instant;
+
+use seam::interaction::SearchSettings;
+use seam::mesh::generate::{self, BoxSpec};
+use seam::mesh::{ElemId, Mesh, NodeId, Side};
+use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
+use seam::surface::{ContactSurface, SurfaceFace, SurfaceKind};
+
+fn surface_of(mesh: &Mesh, set: usize) -> ContactSurface {
+    ContactSurface {
+        name: format!("s{set}"),
+        kind: SurfaceKind::Faces,
+        faces: mesh.side_sets[set]
+            .sides
+            .iter()
+            .map(|&side| SurfaceFace {
+                side,
+                loft: 0.0,
+                origin: 0,
+            })
+            .collect(),
+        nodes: Vec::<NodeId>::new(),
+        origins: vec![],
+        parent: None,
+    }
+}
+
+/// Planar: side A is the top of an n×n-cell slab, side B the bottom of an m×m slab
+/// above it, m ≈ 0.9 n (non-matching).
+fn planar(n: usize) -> (Mesh, usize, usize) {
+    let m = (n as f64 * 0.9).round() as usize;
+    let mesh = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.1], [n, n, 1], 1)
+                .with_side_sets([0, 0, 0, 0, 0, 1]),
+            BoxSpec::hex([0.0, 0.0, 0.1], [1.0, 1.0, 0.2], [m, m, 1], 2)
+                .with_side_sets([0, 0, 0, 0, 2, 0]),
+        ],
+        false,
+    );
+    (mesh, 0, 1)
+}
+
+/// Curved: the outer face of a thin ring (side A, n_θ × n_z faces) inside a second ring
+/// with different n_θ and n_z (side B).
+fn curved(faces: usize) -> (Mesh, usize, usize) {
+    let nz = ((faces as f64 / 8.0).sqrt()).round().max(1.0) as usize;
+    let nt = faces / nz;
+    let a = generate::annulus(
+        0.9,
+        1.0,
+        360.0,
+        [0.0, 1.0],
+        [1, nt, nz],
+        1,
+        [0, 1, 0, 0, 0, 0],
+    );
+    let b = generate::annulus(
+        1.0,
+        1.1,
+        360.0,
+        [0.0, 1.0],
+        [1, nt * 9 / 10, nz * 10 / 9 + 1],
+        2,
+        [2, 0, 0, 0, 0, 0],
+    );
+    let mut mesh = a.clone();
+    let shift = mesh.num_nodes() as u32;
+    let eshift = mesh.num_elems() as u32;
+    mesh.coords.extend_from_slice(&b.coords);
+    mesh.node_numbers
+        .extend(b.node_numbers.iter().map(|n| n + shift as i64));
+    let conn = b.blocks[0]
+        .connectivity
+        .iter()
+        .map(|n| NodeId(n.0 + shift))
+        .collect();
+    mesh.push_block(2, "", b.blocks[0].topology, conn, None);
+    let mut ss = b.side_sets[0].clone();
+    for s in &mut ss.sides {
+        *s = Side {
+            elem: ElemId(s.elem.0 + eshift),
+            side: s.side,
+        };
+    }
+    mesh.side_sets.push(ss);
+    (mesh, 0, 1)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "quick");
+    let sizes: &[usize] = if quick {
+        &[10_000, 100_000]
+    } else {
+        &[10_000, 100_000, 1_000_000]
+    };
+    println!(
+        "{:<8} {:>9} {:>9} {:>7} {:>10} {:>12} {:>12} {:>10}",
+        "case", "points", "B faces", "threads", "build s", "pair s", "points/s", "full s"
+    );
+    for &size in sizes {
+        let n = (size as f64).sqrt().round() as usize;
+        for (label, (mesh, ia, ib)) in [("planar", planar(n)), ("curved", curved(size))] {
+            let a =
+                SurfaceGeometry::from_surface(&mesh, &surface_of(&mesh, ia), &mesh.coords).unwrap();
+            let b =
+                SurfaceGeometry::from_surface(&mesh, &surface_of(&mesh, ib), &mesh.coords).unwrap();
+            let settings = SearchSettings::defaults(3);
+            for threads in [1, 2] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let (mut build, mut pair, mut full) = (vec![], vec![], vec![]);
+                let mut matched = 0;
+                for _ in 0..3 {
+                    pool.install(|| {
+                        let t = Instant::now();
+                        let searcher = Searcher::new(&b, &settings);
+                        build.push(t.elapsed().as_secs_f64());
+                        let t = Instant::now();
+                        let r = searcher.search_points(
+                            &a,
+                            &b,
+                            &settings,
+                            Integration::Quadrature { order: 1 },
+                            None,
+                        );
+                        pair.push(t.elapsed().as_secs_f64());
+                        matched = r.stats.matched;
+                        let t = Instant::now();
+                        let r = searcher.search(
+                            &a,
+                            &b,
+                            &settings,
+                            Integration::Quadrature { order: 1 },
+                            None,
+                        );
+                        full.push(t.elapsed().as_secs_f64());
+                        std::hint::black_box(r);
+                    });
+                }
+                let p = median(pair);
+                println!(
+                    "{:<8} {:>9} {:>9} {:>7} {:>10.4} {:>12.4} {:>12.3e} {:>10.4}   ({} matched)",
+                    label,
+                    a.faces.len(),
+                    b.faces.len(),
+                    threads,
+                    median(build),
+                    p,
+                    a.faces.len() as f64 / p,
+                    median(full),
+                    matched
+                );
+            }
+        }
+    }
+}
