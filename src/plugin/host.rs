@@ -450,15 +450,24 @@ impl Plugin {
         let fd = self.uses_finite_differences();
         let mut ins: Vec<SeamPointIn> = Vec::with_capacity(CHUNK);
         let mut outs: Vec<SeamPointOut> = Vec::with_capacity(CHUNK);
-        let mut integer = self.data.integer_data.clone();
-        let mut real = self.data.real_data.clone();
+        // Every point of a call gets its own copy of the data: a plugin's writes are not
+        // kept, nor seen by other points.
+        let (ni, nr) = (self.data.integer_data.len(), self.data.real_data.len());
+        let mut integer: Vec<i64> = Vec::with_capacity(CHUNK * ni);
+        let mut real: Vec<f64> = Vec::with_capacity(CHUNK * nr);
         let mut fd_state = vec![0.0; ns];
         let mut start = 0;
         while start < n {
             let end = (start + CHUNK).min(n);
-            // Fresh copies of the data for every call: a plugin's writes are not kept.
-            integer.copy_from_slice(&self.data.integer_data);
-            real.copy_from_slice(&self.data.real_data);
+            let fill = |integer: &mut Vec<i64>, real: &mut Vec<f64>| {
+                integer.clear();
+                real.clear();
+                for _ in start..end {
+                    integer.extend_from_slice(&self.data.integer_data);
+                    real.extend_from_slice(&self.data.real_data);
+                }
+            };
+            fill(&mut integer, &mut real);
             ins.clear();
             let (old, new) = (&states.old, &mut states.new);
             for (i, p) in points.iter().enumerate().take(end).skip(start) {
@@ -481,10 +490,10 @@ impl Plugin {
                     s.fields = ctx.fields[i * ctx.n_fields..].as_ptr();
                     s.n_fields = ctx.n_fields;
                 }
-                s.integer_data = integer.as_ptr();
-                s.n_integer = integer.len();
-                s.real_data = real.as_ptr();
-                s.n_real = real.len();
+                s.integer_data = integer[(i - start) * ni..].as_ptr();
+                s.n_integer = ni;
+                s.real_data = real[(i - start) * nr..].as_ptr();
+                s.n_real = nr;
                 if ns > 0 {
                     s.state_old = old[i * ns..].as_ptr();
                     s.state_new = new[i * ns..].as_mut_ptr();
@@ -507,8 +516,7 @@ impl Plugin {
                 };
             }
             if fd {
-                integer.copy_from_slice(&self.data.integer_data);
-                real.copy_from_slice(&self.data.real_data);
+                fill(&mut integer, &mut real);
                 for (k, &input) in ins.iter().enumerate() {
                     let point = start + k;
                     let mut base = input;

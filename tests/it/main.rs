@@ -6,4 +6,5 @@ mod cli;
 mod docs;
 mod interactions;
 mod mesh_io;
+mod plugin;
 mod surfaces;

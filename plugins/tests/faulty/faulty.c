@@ -20,6 +20,11 @@ void fault_point(void *instance, const SeamPointIn *in, SeamPointOut *out) {
     out->d_temp_b = 0.0;
     out->d_gap = 0.0;
     out->d_pressure = 0.0;
+#if defined(FAULT_WRONG_DERIVATIVE)
+    /* h = 1 + 1e-6 p, but the slope is reported twice too large. */
+    out->value = 1.0 + 1e-6 * in->pressure;
+    out->d_pressure = 2e-6;
+#endif
     if (in->pressure < 100.0) {
         return;
     }
