@@ -25,6 +25,9 @@ pub const FD_FLOOR_GAP: f64 = 1e-9;
 /// bytes) while keeping per-call overhead negligible.
 const CHUNK: usize = 256;
 
+/// An output before the call.
+const RESET: SeamPointOut = SeamPointOut::new();
+
 /// Libraries loaded so far, by canonical path. Never unloaded: function pointers copied
 /// out of a library, thread-locals and plugin threads all outlive any safe unload point.
 static LIBRARIES: Mutex<Vec<(PathBuf, &'static libloading::Library)>> = Mutex::new(Vec::new());
@@ -501,8 +504,18 @@ impl Plugin {
                 }
                 ins.push(s);
             }
-            outs.clear();
+            // Reset what a plugin reads or may leave unwritten; the rest of the 256-byte
+            // message buffer only matters after the plugin writes a message.
             outs.resize(end - start, SeamPointOut::new());
+            outs.truncate(end - start);
+            for o in outs.iter_mut() {
+                o.struct_size = RESET.struct_size;
+                o.status = SEAM_STATUS_OK;
+                (o.value, o.d_temp_a, o.d_temp_b, o.d_gap, o.d_pressure) =
+                    (0.0, 0.0, 0.0, 0.0, 0.0);
+                o.cutback_factor = 0.0;
+                o.message[0] = 0;
+            }
             self.call(&ins, &mut outs, batch);
             for (k, o) in outs.iter().enumerate() {
                 let point = start + k;
@@ -590,16 +603,20 @@ impl Plugin {
                 });
             }
         }
-        let mut checks = vec![(what, o.value)];
-        if self.info.provides_derivatives() {
-            checks.extend([
-                ("dvalue/dT_A", o.d_temp_a),
-                ("dvalue/dT_B", o.d_temp_b),
-                ("dvalue/dgap", o.d_gap),
-                ("dvalue/dpressure", o.d_pressure),
-            ]);
-        }
-        for (what, value) in checks {
+        // Without derivatives only the value is the plugin's; the rest is seam's.
+        let checks = [
+            (what, o.value),
+            ("dvalue/dT_A", o.d_temp_a),
+            ("dvalue/dT_B", o.d_temp_b),
+            ("dvalue/dgap", o.d_gap),
+            ("dvalue/dpressure", o.d_pressure),
+        ];
+        let checked = if self.info.provides_derivatives() {
+            5
+        } else {
+            1
+        };
+        for &(what, value) in &checks[..checked] {
             if !value.is_finite() {
                 return Err(PluginFault::NotFinite {
                     plugin: plugin(),
