@@ -319,8 +319,11 @@ impl Plugin {
                 ),
             });
         }
-        if let Some(asked) = &data.model
-            && !asked.eq_ignore_ascii_case(&name)
+        // (No let-chain: the crate promises Rust 1.85.)
+        if let Some(asked) = data
+            .model
+            .as_ref()
+            .filter(|a| !a.eq_ignore_ascii_case(&name))
         {
             return Err(PluginError::ModelMismatch {
                 path: path.to_owned(),
