@@ -39,6 +39,9 @@ fn cc_shared(source: &str, defines: &[&str], stem: &str) -> PathBuf {
     let dir = tmp().join("plugins-c");
     std::fs::create_dir_all(&dir).expect("create plugins-c");
     let out = dll(&dir, stem);
+    // Compile to a private name and rename: a test process that already mapped the old
+    // library (another process of a parallel runner) keeps its inode intact.
+    let partial = dir.join(format!("{stem}.{}.partial", std::process::id()));
     let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let status = Command::new(&compiler)
         .args([
@@ -49,11 +52,12 @@ fn cc_shared(source: &str, defines: &[&str], stem: &str) -> PathBuf {
         .args(defines)
         .arg(root().join(source))
         .arg("-o")
-        .arg(&out)
+        .arg(&partial)
         .arg("-lm")
         .status()
         .unwrap_or_else(|e| panic!("cannot run the C compiler `{compiler}`: {e}"));
     assert!(status.success(), "compiling {source} {defines:?} failed");
+    std::fs::rename(&partial, &out).expect("move the compiled plugin into place");
     out
 }
 
@@ -323,8 +327,8 @@ fn c_header_matches_the_rust_abi() {
     expected.push(format!("SEAM_PLUGIN_ENTRY_SYMBOL {entry}"));
     let dir = tmp().join("plugins-c");
     std::fs::create_dir_all(&dir).unwrap();
-    let src = dir.join("layout.c");
-    let exe = dir.join("layout");
+    let src = dir.join(format!("layout.{}.c", std::process::id()));
+    let exe = dir.join(format!("layout.{}", std::process::id()));
     std::fs::write(&src, c).unwrap();
     let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let status = Command::new(compiler)
