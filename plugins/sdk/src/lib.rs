@@ -420,4 +420,111 @@ mod tests {
         let s = unsafe { CStr::from_ptr(buf.as_ptr()) }.to_str().unwrap();
         assert_eq!(s, "short");
     }
+
+    /// Counts calls in its state, errors at gap < 0, asks for a cutback at gap > 1 and
+    /// panics at gap > 2.
+    struct Probe;
+
+    impl EnforcementModel for Probe {
+        const STATE_SIZE: u32 = 1;
+        fn new(data: &InstanceData<'_>) -> Result<Self, ModelError> {
+            if data.real_data.is_empty() {
+                return Err(ModelError::new("need one real"));
+            }
+            Ok(Probe)
+        }
+        fn evaluate(&self, p: &PointIn<'_>, state: &mut [f64]) -> Result<Output, ModelError> {
+            state[0] = p.state_old[0] + 1.0;
+            if p.gap > 2.0 {
+                panic!("boom {}", p.surface_a);
+            } else if p.gap > 1.0 {
+                return Err(ModelError::cutback(0.5, "too far"));
+            } else if p.gap < 0.0 {
+                return Err(ModelError::new("negative gap"));
+            }
+            Ok(Output {
+                value: p.real_data[0],
+                ..Output::default()
+            })
+        }
+    }
+
+    fn message(out: &SeamPointOut) -> String {
+        // SAFETY: the trampolines always NUL-terminate the message they write, and
+        // SeamPointOut::new() starts all-zero.
+        unsafe { CStr::from_ptr(out.message.as_ptr()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    #[test]
+    fn trampolines_map_results_errors_cutbacks_and_panics_to_statuses() {
+        let d = descriptor::<Probe>(c"probe", c"1", caps::THREAD_SAFE);
+        assert_eq!(d.state_size, 1);
+        assert_eq!(d.capabilities, caps::THREAD_SAFE | SEAM_CAP_HAS_STATE);
+        let real = [4.5];
+        let mut instance = std::ptr::null_mut();
+        let mut msg = [0 as c_char; SEAM_MESSAGE_LEN];
+        let bad = SeamInstanceIn {
+            struct_size: size_of::<SeamInstanceIn>() as u32,
+            reserved: 0,
+            model: c"probe".as_ptr(),
+            integer_data: std::ptr::null(),
+            n_integer: 0,
+            real_data: std::ptr::null(),
+            n_real: 0,
+        };
+        // SAFETY: valid input, slot and 256-byte buffer.
+        let status = unsafe { d.init.unwrap()(&bad, &mut instance, msg.as_mut_ptr()) };
+        assert_eq!(status, SEAM_STATUS_ERROR);
+        // SAFETY: NUL-terminated by init.
+        assert_eq!(
+            unsafe { CStr::from_ptr(msg.as_ptr()) }.to_str().unwrap(),
+            "need one real"
+        );
+        let good = SeamInstanceIn {
+            real_data: real.as_ptr(),
+            n_real: 1,
+            ..bad
+        };
+        // SAFETY: as above.
+        let status = unsafe { d.init.unwrap()(&good, &mut instance, msg.as_mut_ptr()) };
+        assert_eq!(status, SEAM_STATUS_OK);
+        let old = [[2.0], [0.0], [0.0], [0.0]];
+        let mut new = [[0.0]; 4];
+        let gaps = [0.5, 1.5, -1.0, 3.0];
+        let ins: Vec<SeamPointIn> = (0..4)
+            .map(|i| {
+                let mut p = SeamPointIn::new();
+                p.gap = gaps[i];
+                p.surface_a = c"top".as_ptr();
+                p.real_data = real.as_ptr();
+                p.n_real = 1;
+                p.state_old = old[i].as_ptr();
+                p.state_new = new[i].as_mut_ptr();
+                p.n_state = 1;
+                p
+            })
+            .collect();
+        let mut outs = vec![SeamPointOut::new(); 4];
+        // SAFETY: 4 valid inputs (their arrays outlive the call) and 4 outputs.
+        unsafe { d.evaluate_batch.unwrap()(instance, ins.as_ptr(), outs.as_mut_ptr(), 4) };
+        assert_eq!((outs[0].status, outs[0].value), (SEAM_STATUS_OK, 4.5));
+        assert_eq!(new[0], [3.0], "state_new = state_old + 1");
+        assert_eq!(
+            (outs[1].status, outs[1].cutback_factor),
+            (SEAM_STATUS_CUTBACK, 0.5)
+        );
+        assert_eq!(message(&outs[1]), "too far");
+        assert_eq!(
+            (outs[2].status, message(&outs[2]).as_str()),
+            (SEAM_STATUS_ERROR, "negative gap")
+        );
+        assert_eq!(
+            (outs[3].status, message(&outs[3]).as_str()),
+            (SEAM_STATUS_ERROR, "panic: boom top")
+        );
+        // SAFETY: the instance from init, released once.
+        unsafe { d.finalize.unwrap()(instance) };
+    }
 }
