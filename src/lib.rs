@@ -2,13 +2,14 @@
 //!
 //! The data flow, one module per arrow: [`deck`] (Sierra syntax or TOML → typed spec),
 //! [`mesh`] (Exodus II, Gmsh, generators), [`surface`] (contact surfaces by the Sierra
-//! rules). Diagnostics shared by all of them live in [`diag`].
+//! rules), [`plugin`] (user enforcement models loaded as shared libraries). Diagnostics shared by all of them live in [`diag`].
 
 pub mod deck;
 pub mod diag;
 pub mod interaction;
 pub mod mesh;
 pub mod periodic;
+pub mod plugin;
 pub mod script;
 pub mod search;
 pub mod surface;

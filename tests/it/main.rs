@@ -8,4 +8,5 @@ mod interactions;
 mod mesh_io;
 mod search;
 mod search_kernels;
+mod plugin;
 mod surfaces;

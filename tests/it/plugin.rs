@@ -1,0 +1,921 @@
+//! Enforcement plugins: the ABI header, data passing, the two examples, every fault the
+//! host must survive, and the conformance kit.
+//!
+//! The plugins are built by the tests themselves, once per test process:
+//! - C plugins with `$CC` (default `cc`) `-std=c99 -Wall -Wextra -Werror -shared -fPIC`
+//!   into `$CARGO_TARGET_TMPDIR/plugins-c/`;
+//! - Rust plugins with `cargo build --manifest-path plugins/Cargo.toml --locked -p …`
+//!   into their own target directory `$CARGO_TARGET_TMPDIR/plugins-target` (a separate
+//!   directory, so the inner cargo never waits for the lock the outer `cargo test` holds).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use seam::plugin::{
+    ContactPoint, Plugin, PluginData, PluginError, PluginFault, PointResult, StateStore,
+    StepContext, check_plugin,
+};
+use seam_plugin_testkit::{Config, Grid};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn tmp() -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+}
+
+fn dll(dir: &Path, stem: &str) -> PathBuf {
+    dir.join(format!(
+        "{}{stem}{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ))
+}
+
+/// Compile one C file into a shared library with the CI flags; returns its path.
+fn cc_shared(source: &str, defines: &[&str], stem: &str) -> PathBuf {
+    let dir = tmp().join("plugins-c");
+    std::fs::create_dir_all(&dir).expect("create plugins-c");
+    let out = dll(&dir, stem);
+    // Compile to a private name and rename: a test process that already mapped the old
+    // library (another process of a parallel runner) keeps its inode intact.
+    let partial = dir.join(format!("{stem}.{}.partial", std::process::id()));
+    let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let status = Command::new(&compiler)
+        .args([
+            "-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-shared", "-fPIC",
+        ])
+        .arg("-I")
+        .arg(root().join("plugins/include"))
+        .args(defines)
+        .arg(root().join(source))
+        .arg("-o")
+        .arg(&partial)
+        .arg("-lm")
+        .status()
+        .unwrap_or_else(|e| panic!("cannot run the C compiler `{compiler}`: {e}"));
+    assert!(status.success(), "compiling {source} {defines:?} failed");
+    std::fs::rename(&partial, &out).expect("move the compiled plugin into place");
+    out
+}
+
+/// The faulty C plugins, by FAULT_* name.
+const FAULTS: [&str; 13] = [
+    "WRONG_DERIVATIVE",
+    "NAN",
+    "NAN_DERIVATIVE",
+    "NEGATIVE",
+    "ERROR",
+    "CUTBACK",
+    "BAD_STATUS",
+    "MAJOR",
+    "MINOR",
+    "SMALL",
+    "NULL_EVALUATE",
+    "NO_ENTRY",
+    "V2_ONLY",
+];
+
+struct CPlugins {
+    table: PathBuf,
+    echo: PathBuf,
+    smooth: PathBuf,
+}
+
+fn c_plugins() -> &'static CPlugins {
+    static BUILT: OnceLock<CPlugins> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        for f in FAULTS {
+            cc_shared(
+                "plugins/tests/faulty/faulty.c",
+                &[&format!("-DFAULT_{f}")],
+                &format!("faulty_{}", f.to_lowercase()),
+            );
+        }
+        CPlugins {
+            table: cc_shared("plugins/examples/c_table/c_table.c", &[], "seam_c_table"),
+            echo: cc_shared("plugins/tests/c/echo.c", &[], "echo"),
+            smooth: cc_shared("plugins/tests/c/smooth.c", &[], "smooth"),
+        }
+    })
+}
+
+fn faulty(name: &str) -> PathBuf {
+    c_plugins();
+    dll(
+        &tmp().join("plugins-c"),
+        &format!("faulty_{}", name.to_lowercase()),
+    )
+}
+
+struct RustPlugins {
+    cmy: PathBuf,
+    panicky: PathBuf,
+}
+
+fn rust_plugins() -> &'static RustPlugins {
+    static BUILT: OnceLock<RustPlugins> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        let target = tmp().join("plugins-target");
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+        let status = Command::new(cargo)
+            .args(["build", "--quiet", "--locked", "--manifest-path"])
+            .arg(root().join("plugins/Cargo.toml"))
+            .args([
+                "-p",
+                "seam-example-rust-cmy",
+                "-p",
+                "seam-faulty-rust-panic",
+            ])
+            .arg("--target-dir")
+            .arg(&target)
+            .env_remove("CARGO_TARGET_DIR")
+            .status()
+            .expect("run cargo for the plugins workspace");
+        assert!(status.success(), "building the Rust plugins failed");
+        let dir = target.join("debug");
+        RustPlugins {
+            cmy: dll(&dir, "seam_rust_cmy"),
+            panicky: dll(&dir, "seam_faulty_rust_panic"),
+        }
+    })
+}
+
+fn data(real: &[f64], integer: &[i64]) -> PluginData {
+    PluginData {
+        model: None,
+        integer_data: integer.to_vec(),
+        real_data: real.to_vec(),
+    }
+}
+
+fn ctx() -> StepContext<'static> {
+    StepContext {
+        surface_a: "block_1_top",
+        surface_b: "block_2_bottom",
+        time: 1.0,
+        dt: 0.5,
+        step: 2,
+        iteration: 1,
+        ..StepContext::default()
+    }
+}
+
+fn point(gap: f64, pressure: f64, temp_a: f64, temp_b: f64) -> ContactPoint {
+    ContactPoint {
+        gap,
+        pressure,
+        temp_a,
+        temp_b,
+        normal_a: [0.0, 0.0, 1.0],
+        normal_b: [0.0, 0.0, -1.0],
+        weight: 1.0,
+        ..ContactPoint::default()
+    }
+}
+
+fn eval(plugin: &Plugin, points: &[ContactPoint]) -> Result<Vec<PointResult>, PluginFault> {
+    let mut r = vec![PointResult::default(); points.len()];
+    plugin.evaluate(&ctx(), points, &mut r, None)?;
+    Ok(r)
+}
+
+fn close(a: f64, b: f64, rtol: f64) -> bool {
+    (a - b).abs() <= rtol * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+}
+
+// --- the header ------------------------------------------------------------------------
+
+/// Every struct's size, every field's offset and every constant in seam_plugin.h equals
+/// the Rust definition in seam-plugin-abi.
+#[test]
+fn c_header_matches_the_rust_abi() {
+    use seam_plugin_abi::*;
+    use std::mem::{offset_of, size_of};
+    /// (struct, [(field, offset, size)], size)
+    type Layout<'a> = (&'a str, &'a [(&'a str, usize, usize)], usize);
+    fn size_of_field<T, F>(_field: impl Fn(&T) -> &F) -> usize {
+        size_of::<F>()
+    }
+    macro_rules! f {
+        ($t:ty, $f:ident) => {
+            (
+                stringify!($f),
+                offset_of!($t, $f),
+                size_of_field(|s: &$t| &s.$f),
+            )
+        };
+    }
+    let fields: &[Layout<'_>] = &[
+        (
+            "SeamInstanceIn",
+            &[
+                f!(SeamInstanceIn, struct_size),
+                f!(SeamInstanceIn, reserved),
+                f!(SeamInstanceIn, model),
+                f!(SeamInstanceIn, integer_data),
+                f!(SeamInstanceIn, n_integer),
+                f!(SeamInstanceIn, real_data),
+                f!(SeamInstanceIn, n_real),
+            ],
+            size_of::<SeamInstanceIn>(),
+        ),
+        (
+            "SeamPointIn",
+            &[
+                f!(SeamPointIn, struct_size),
+                f!(SeamPointIn, reserved),
+                f!(SeamPointIn, gap),
+                f!(SeamPointIn, pressure),
+                f!(SeamPointIn, temp_a),
+                f!(SeamPointIn, temp_b),
+                f!(SeamPointIn, x),
+                f!(SeamPointIn, normal_a),
+                f!(SeamPointIn, normal_b),
+                f!(SeamPointIn, weight),
+                f!(SeamPointIn, time),
+                f!(SeamPointIn, dt),
+                f!(SeamPointIn, step),
+                f!(SeamPointIn, iteration),
+                f!(SeamPointIn, surface_a),
+                f!(SeamPointIn, surface_b),
+                f!(SeamPointIn, fields),
+                f!(SeamPointIn, n_fields),
+                f!(SeamPointIn, integer_data),
+                f!(SeamPointIn, n_integer),
+                f!(SeamPointIn, real_data),
+                f!(SeamPointIn, n_real),
+                f!(SeamPointIn, state_old),
+                f!(SeamPointIn, state_new),
+                f!(SeamPointIn, n_state),
+            ],
+            size_of::<SeamPointIn>(),
+        ),
+        (
+            "SeamPointOut",
+            &[
+                f!(SeamPointOut, struct_size),
+                f!(SeamPointOut, status),
+                f!(SeamPointOut, value),
+                f!(SeamPointOut, d_temp_a),
+                f!(SeamPointOut, d_temp_b),
+                f!(SeamPointOut, d_gap),
+                f!(SeamPointOut, d_pressure),
+                f!(SeamPointOut, cutback_factor),
+                f!(SeamPointOut, message),
+            ],
+            size_of::<SeamPointOut>(),
+        ),
+        (
+            "SeamPluginDescriptor",
+            &[
+                f!(SeamPluginDescriptor, abi_major),
+                f!(SeamPluginDescriptor, abi_minor),
+                f!(SeamPluginDescriptor, struct_size),
+                f!(SeamPluginDescriptor, state_size),
+                f!(SeamPluginDescriptor, name),
+                f!(SeamPluginDescriptor, model_version),
+                f!(SeamPluginDescriptor, capabilities),
+                f!(SeamPluginDescriptor, init),
+                f!(SeamPluginDescriptor, finalize),
+                f!(SeamPluginDescriptor, evaluate_point),
+                f!(SeamPluginDescriptor, evaluate_batch),
+            ],
+            size_of::<SeamPluginDescriptor>(),
+        ),
+    ];
+    let constants: &[(&str, i128)] = &[
+        ("SEAM_PLUGIN_ABI_MAJOR", SEAM_PLUGIN_ABI_MAJOR.into()),
+        ("SEAM_PLUGIN_ABI_MINOR", SEAM_PLUGIN_ABI_MINOR.into()),
+        ("SEAM_MESSAGE_LEN", SEAM_MESSAGE_LEN as i128),
+        ("SEAM_STATUS_OK", SEAM_STATUS_OK.into()),
+        ("SEAM_STATUS_ERROR", SEAM_STATUS_ERROR.into()),
+        ("SEAM_STATUS_CUTBACK", SEAM_STATUS_CUTBACK.into()),
+        ("SEAM_CAP_THREAD_SAFE", SEAM_CAP_THREAD_SAFE.into()),
+        (
+            "SEAM_CAP_PROVIDES_DERIVATIVES",
+            SEAM_CAP_PROVIDES_DERIVATIVES.into(),
+        ),
+        ("SEAM_CAP_RETURNS_FLUX", SEAM_CAP_RETURNS_FLUX.into()),
+        ("SEAM_CAP_HAS_STATE", SEAM_CAP_HAS_STATE.into()),
+        ("SEAM_CAP_ALL", SEAM_CAP_ALL.into()),
+    ];
+    // A C program printing what the C compiler makes of the header, one `key value` a line.
+    let mut c = String::from(
+        "#include <stdio.h>\n#include <stddef.h>\n#include \"seam_plugin.h\"\nint main(void) {\n",
+    );
+    let mut expected = Vec::new();
+    for (ty, fs, size) in fields {
+        c += &format!("  printf(\"sizeof {ty} %lu\\n\", (unsigned long)sizeof({ty}));\n");
+        expected.push(format!("sizeof {ty} {size}"));
+        for (f, off, size) in *fs {
+            c += &format!(
+                "  printf(\"field {ty}.{f} offset %lu size %lu\\n\", (unsigned long)offsetof({ty}, {f}), (unsigned long)sizeof((({ty} *)0)->{f}));\n"
+            );
+            expected.push(format!("field {ty}.{f} offset {off} size {size}"));
+        }
+    }
+    for (name, value) in constants {
+        c += &format!("  printf(\"{name} %lld\\n\", (long long)({name}));\n");
+        expected.push(format!("{name} {value}"));
+    }
+    c +=
+        "  printf(\"SEAM_PLUGIN_ENTRY_SYMBOL %s\\n\", SEAM_PLUGIN_ENTRY_SYMBOL);\n  return 0;\n}\n";
+    let entry = std::str::from_utf8(&ENTRY_SYMBOL[..ENTRY_SYMBOL.len() - 1]).unwrap();
+    expected.push(format!("SEAM_PLUGIN_ENTRY_SYMBOL {entry}"));
+    let dir = tmp().join("plugins-c");
+    std::fs::create_dir_all(&dir).unwrap();
+    let src = dir.join(format!("layout.{}.c", std::process::id()));
+    let exe = dir.join(format!("layout.{}", std::process::id()));
+    std::fs::write(&src, c).unwrap();
+    let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let status = Command::new(compiler)
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-I"])
+        .arg(root().join("plugins/include"))
+        .arg(&src)
+        .arg("-o")
+        .arg(&exe)
+        .status()
+        .unwrap();
+    assert!(status.success(), "the header does not compile cleanly");
+    let out = Command::new(&exe).output().unwrap();
+    let got: Vec<String> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    let differ: Vec<String> = expected
+        .iter()
+        .zip(&got)
+        .filter(|(e, g)| e != g)
+        .map(|(e, g)| format!("Rust `{e}` vs C `{g}`"))
+        .collect();
+    assert!(
+        differ.is_empty() && got.len() == expected.len(),
+        "seam_plugin.h and seam-plugin-abi disagree ({} vs {} lines):\n{}",
+        got.len(),
+        expected.len(),
+        differ.join("\n")
+    );
+}
+
+// --- data passing --------------------------------------------------------------------
+
+/// The echo plugin folds every input into its outputs; the test computes the same sums.
+#[test]
+fn every_input_arrives_exactly_as_written() {
+    let path = &c_plugins().echo;
+    let real = [1.5, -0.25, 1e3];
+    let integer = [7, -2];
+    let plugin = Plugin::load_with(path, &data(&real, &integer)).unwrap();
+    assert_eq!(plugin.info().state_size, 2);
+    assert!(!plugin.info().thread_safe());
+    let points = [
+        ContactPoint {
+            gap: 1e-5,
+            pressure: 2e6,
+            temp_a: 301.0,
+            temp_b: 299.5,
+            x: [0.1, 0.2, 0.3],
+            normal_a: [0.0, 0.6, 0.8],
+            normal_b: [0.0, -0.6, -0.8],
+            weight: 0.125,
+        },
+        ContactPoint {
+            gap: -3e-7,
+            pressure: 0.0,
+            temp_a: 500.0,
+            temp_b: 250.0,
+            x: [-1.0, 2.0, -3.0],
+            normal_a: [1.0, 0.0, 0.0],
+            normal_b: [-1.0, 0.0, 0.0],
+            weight: 2.0,
+        },
+    ];
+    let fields = [10.0, 20.0, 30.0, -1.0, -2.0, -3.0];
+    let ctx = StepContext {
+        surface_a: "side_A_surf",
+        surface_b: "Ω_b",
+        time: 12.5,
+        dt: 0.25,
+        step: 9,
+        iteration: 3,
+        fields: &fields,
+        n_fields: 3,
+    };
+    let mut states = StateStore::new(2, 2);
+    let mut r = vec![PointResult::default(); 2];
+    let bytes = |s: &str| s.bytes().map(f64::from).sum::<f64>();
+    for round in 0..3 {
+        plugin
+            .evaluate(&ctx, &points, &mut r, Some(&mut states))
+            .unwrap();
+        for (i, (p, out)) in points.iter().zip(&r).enumerate() {
+            let f: f64 = fields[3 * i..3 * i + 3].iter().sum();
+            let mix = p.gap
+                + 2.0 * p.pressure
+                + 3.0 * p.temp_a
+                + 5.0 * p.temp_b
+                + 7.0 * p.x[0]
+                + 11.0 * p.x[1]
+                + 13.0 * p.x[2]
+                + 17.0 * p.normal_a[0]
+                + 19.0 * p.normal_a[1]
+                + 23.0 * p.normal_a[2]
+                + 29.0 * p.normal_b[0]
+                + 31.0 * p.normal_b[1]
+                + 37.0 * p.normal_b[2]
+                + 41.0 * p.weight
+                + 43.0 * ctx.time
+                + 47.0 * ctx.dt
+                + 53.0 * ctx.step as f64
+                + 59.0 * ctx.iteration as f64
+                + 61.0 * f;
+            // The plugin overwrites its copies of the data each call: the sums stay.
+            assert_eq!(
+                out.value,
+                1.5 - 0.25 + 1e3 + 7.0 - 2.0,
+                "round {round} point {i}"
+            );
+            assert_eq!(out.d_temp_a, 3.0 + 2e3 + 3e6 + 2e9, "lengths, point {i}");
+            assert!(
+                close(out.d_temp_b, mix, 1e-14),
+                "scalars, point {i}: {} vs {mix}",
+                out.d_temp_b
+            );
+            assert_eq!(
+                out.d_gap,
+                bytes("side_A_surf") + 1e3 * bytes("Ω_b"),
+                "surface names"
+            );
+            // Old state is the committed one: 0 until the first commit, then 1.
+            let expected_old = if round < 2 { 0.0 } else { 1.0 };
+            assert_eq!(out.d_pressure, expected_old, "state_old, round {round}");
+            assert_eq!(states.new_state(i), &[expected_old + 1.0, out.value]);
+        }
+        if round == 1 {
+            states.commit();
+        }
+    }
+    assert_eq!(states.old(0), &[1.0, 1006.25]);
+}
+
+/// A plugin that does not declare THREAD_SAFE is serialised: calling the (stateful,
+/// data-scribbling) echo plugin from 4 threads still gives exact results.
+#[test]
+fn calls_to_a_plugin_that_is_not_thread_safe_are_serialised() {
+    let plugin = Plugin::load_with(&c_plugins().echo, &data(&[2.0, 3.0], &[1])).unwrap();
+    let points = vec![point(1e-5, 1e6, 300.0, 310.0); 600];
+    std::thread::scope(|s| {
+        for _ in 0..4 {
+            s.spawn(|| {
+                for _ in 0..20 {
+                    let r = eval(&plugin, &points).unwrap();
+                    assert!(
+                        r.iter().all(|o| o.value == 6.0),
+                        "a call saw another's scribbles"
+                    );
+                }
+            });
+        }
+    });
+}
+
+// --- the examples ----------------------------------------------------------------------
+
+/// Table used in the c_table tests: (pressure, conductance) pairs.
+const TABLE: [(f64, f64); 4] = [(0.0, 1e3), (1e6, 5e3), (4e6, 6.5e3), (1e7, 6.5e3)];
+
+fn table_real() -> Vec<f64> {
+    TABLE.iter().flat_map(|&(p, h)| [p, h]).collect()
+}
+
+/// h(p) by linear interpolation, flat outside, written independently of the plugin.
+fn table_h(p: f64) -> f64 {
+    if p <= TABLE[0].0 {
+        return TABLE[0].1;
+    }
+    for w in TABLE.windows(2) {
+        let ((p0, h0), (p1, h1)) = (w[0], w[1]);
+        if p <= p1 {
+            return h0 + (h1 - h0) * (p - p0) / (p1 - p0);
+        }
+    }
+    TABLE[TABLE.len() - 1].1
+}
+
+#[test]
+fn c_table_reproduces_its_table_with_exact_derivatives() {
+    let plugin = Plugin::load_with(&c_plugins().table, &data(&table_real(), &[])).unwrap();
+    assert_eq!(plugin.info().name, "c_table");
+    let pressures = [-5.0, 0.0, 2.5e5, 1e6, 2e6, 3.999e6, 4e6, 7e6, 1e7, 2e7];
+    let points: Vec<_> = pressures
+        .iter()
+        .map(|&p| point(1e-6, p, 300.0, 400.0))
+        .collect();
+    let r = eval(&plugin, &points).unwrap();
+    for (p, o) in pressures.iter().zip(&r) {
+        assert!(
+            close(o.value, table_h(*p), 1e-14),
+            "h({p}) = {} vs {}",
+            o.value,
+            table_h(*p)
+        );
+        // Finite differences of the independent table, away from breakpoints one-sided
+        // differences of a linear segment are exact; step 1 Pa.
+        let fd = (table_h(p + 1.0) - table_h(*p)) / 1.0;
+        assert!(
+            (o.d_pressure - fd).abs() <= 1e-9 * fd.abs().max(1e-3),
+            "dh/dp({p}) = {} vs FD {fd}",
+            o.d_pressure
+        );
+        assert_eq!((o.d_temp_a, o.d_temp_b, o.d_gap), (0.0, 0.0, 0.0));
+    }
+    // Bad tables are refused at set-up with the plugin's message.
+    let err = Plugin::load_with(&c_plugins().table, &data(&[0.0, 1.0, 5.0], &[])).unwrap_err();
+    assert!(err.to_string().contains("pairs p0 h0 p1 h1"), "{err}");
+    assert!(matches!(err, PluginError::Init { .. }));
+    let err = Plugin::load_with(&c_plugins().table, &data(&[1.0, 1.0, 0.5, 2.0], &[])).unwrap_err();
+    assert!(err.to_string().contains("increase strictly"), "{err}");
+}
+
+/// CMY parameters (Real Data order): k_s m sigma H_c k_g M eps_A eps_B.
+const CMY: [f64; 8] = [20.0, 0.1, 1e-6, 1e9, 0.026, 1e-5, 0.8, 0.6];
+
+#[test]
+fn rust_cmy_matches_the_formula() {
+    let plugin = Plugin::load_with(&rust_plugins().cmy, &data(&CMY, &[])).unwrap();
+    assert_eq!(plugin.info().name, "cmy");
+    let [k_s, m, sigma, h_c, k_g, gm, ea, eb] = CMY;
+    let sb = 5.670374419e-8;
+    let states = [
+        (1e-6, 1e5, 300.0, 350.0),
+        (1e-4, 3e7, 900.0, 310.0),
+        (0.0, 1.0, 1000.0, 1000.0),
+        (5e-5, 0.0, 400.0, 200.0),
+    ];
+    let points: Vec<_> = states
+        .iter()
+        .map(|&(g, p, a, b)| point(g, p, a, b))
+        .collect();
+    let r = eval(&plugin, &points).unwrap();
+    for (&(g, p, ta, tb), o) in states.iter().zip(&r) {
+        let e = 1.0 / ea + 1.0 / eb - 1.0;
+        let hc = if p > 0.0 {
+            1.25 * k_s * m / sigma * (p / h_c).powf(0.95)
+        } else {
+            0.0
+        };
+        let h = hc + k_g / (g + gm) + sb * (ta * ta + tb * tb) * (ta + tb) / e;
+        let dta = sb * (3.0 * ta * ta + 2.0 * ta * tb + tb * tb) / e;
+        let dtb = sb * (ta * ta + 2.0 * ta * tb + 3.0 * tb * tb) / e;
+        let dg = if g > 0.0 {
+            -k_g / ((g + gm) * (g + gm))
+        } else {
+            0.0
+        };
+        let dp = if p > 0.0 { 0.95 * hc / p } else { 0.0 };
+        for (name, got, want) in [
+            ("h", o.value, h),
+            ("dT_A", o.d_temp_a, dta),
+            ("dT_B", o.d_temp_b, dtb),
+            ("dgap", o.d_gap, dg),
+            ("dp", o.d_pressure, dp),
+        ] {
+            assert!(
+                close(got, want, 1e-12),
+                "{name} at {g} {p} {ta} {tb}: {got} vs {want}"
+            );
+        }
+    }
+    // Wrong Real Data: the SDK turns the model's error into a set-up error.
+    let err = Plugin::load_with(&rust_plugins().cmy, &data(&[1.0], &[])).unwrap_err();
+    assert!(
+        err.to_string().contains("needs 8 Real Data values"),
+        "{err}"
+    );
+}
+
+#[test]
+fn batch_and_per_point_calls_agree() {
+    let table = Plugin::load_with(&c_plugins().table, &data(&table_real(), &[])).unwrap();
+    let cmy = Plugin::load_with(&rust_plugins().cmy, &data(&CMY, &[])).unwrap();
+    let points: Vec<_> = (0..1000)
+        .map(|i| point(1e-7 * i as f64, 1.2e4 * i as f64, 300.0 + i as f64, 400.0))
+        .collect();
+    for plugin in [&table, &cmy] {
+        assert!(plugin.info().has_batch);
+        let batch = eval(plugin, &points).unwrap();
+        let mut single = vec![PointResult::default(); points.len()];
+        plugin
+            .evaluate_per_point(&ctx(), &points, &mut single, None)
+            .unwrap();
+        assert_eq!(batch, single, "{}", plugin.info().name);
+    }
+}
+
+/// The smooth plugin gives no derivatives: seam forms them by central differences.
+#[test]
+fn derivatives_are_formed_by_finite_differences_when_missing() {
+    let plugin = Plugin::load(&c_plugins().smooth).unwrap();
+    assert!(plugin.uses_finite_differences());
+    let notice = plugin.derivative_notice().expect("a notice the first time");
+    assert!(notice.contains("finite differences"), "{notice}");
+    assert!(
+        plugin.derivative_notice().is_none(),
+        "the notice is given once"
+    );
+    let (g, p, ta, tb) = (2e-3, 3.0, 310.0, 290.0);
+    let r = eval(&plugin, &[point(g, p, ta, tb)]).unwrap()[0];
+    assert!(close(r.value, 1.0 + p * p + ta * tb + (-g).exp(), 1e-15));
+    // Central differences: error O(δ²) with δ = ε^{1/3}·max(|x|, floor); 1e-7 relative
+    // leaves a wide margin for round-off on a value of ~9e4.
+    assert!(close(r.d_pressure, 2.0 * p, 1e-6), "{}", r.d_pressure);
+    assert!(close(r.d_temp_a, tb, 1e-7), "{}", r.d_temp_a);
+    assert!(close(r.d_temp_b, ta, 1e-7), "{}", r.d_temp_b);
+    // In the gap the step is δ = ε^{1/3}·2e-3 ≈ 1.2e-8 while h ≈ 9e4, so round-off
+    // bounds the error by about 2ε|h|/(2δ) ≈ 1.6e-3: allow twice that.
+    let delta = f64::EPSILON.cbrt() * g;
+    let bound = 2.0 * f64::EPSILON * r.value / delta;
+    assert!(
+        (r.d_gap + (-g).exp()).abs() < bound,
+        "{} vs {} (bound {bound:e})",
+        r.d_gap,
+        -(-g).exp()
+    );
+}
+
+// --- faults ----------------------------------------------------------------------------
+
+fn load_err(path: &Path) -> String {
+    match Plugin::load(path) {
+        Ok(_) => panic!("{} loaded", path.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn load_faults_are_clear_errors_naming_the_plugin() {
+    let missing = tmp().join("no/such/libplugin.so");
+    let msg = load_err(&missing);
+    assert!(
+        msg.contains("does not exist") && msg.contains("libplugin.so"),
+        "{msg}"
+    );
+
+    let text = tmp().join("plugins-c/not_a_library.so");
+    std::fs::create_dir_all(text.parent().unwrap()).unwrap();
+    std::fs::write(&text, "this is a text file, not ELF\n").unwrap();
+    let msg = load_err(&text);
+    assert!(
+        msg.contains("could not be loaded as a shared library") && msg.contains("not_a_library.so"),
+        "{msg}"
+    );
+
+    for (fault, needles) in [
+        (
+            "NO_ENTRY",
+            &[
+                "does not export the entry symbol `seam_plugin_v1`",
+                "faulty_no_entry",
+            ][..],
+        ),
+        (
+            "V2_ONLY",
+            &[
+                "built for plugin ABI 2.0",
+                "seam speaks ABI 1.0",
+                "major versions must be equal",
+            ],
+        ),
+        (
+            "MAJOR",
+            &["built for plugin ABI 2.0", "seam speaks ABI 1.0"],
+        ),
+        (
+            "MINOR",
+            &[
+                "built for plugin ABI 1.99",
+                "newer than this seam's ABI 1.0",
+            ],
+        ),
+        ("SMALL", &["struct_size 16 bytes", "needs at least 72"]),
+        ("NULL_EVALUATE", &["`evaluate_point` is NULL"]),
+    ] {
+        let path = faulty(fault);
+        let msg = load_err(&path);
+        assert!(
+            msg.contains(&*path.display().to_string()),
+            "{fault}: path missing in {msg}"
+        );
+        for n in needles {
+            assert!(msg.contains(n), "{fault}: `{n}` missing in: {msg}");
+        }
+    }
+    let err = Plugin::load_with(
+        &c_plugins().table,
+        &PluginData {
+            model: Some("cmy".into()),
+            ..data(&table_real(), &[])
+        },
+    )
+    .unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("provides model `c_table`, but the deck asks for model `cmy`"),
+        "{err}"
+    );
+}
+
+#[test]
+fn evaluation_faults_name_the_plugin_and_the_point_and_the_host_carries_on() {
+    // Points 0..3 fine, point 3 triggers the fault (pressure >= 100).
+    let points = [
+        point(0.0, 1.0, 300.0, 300.0),
+        point(0.0, 2.0, 300.0, 300.0),
+        point(0.0, 3.0, 300.0, 300.0),
+        point(0.0, 150.0, 300.0, 300.0),
+    ];
+    let cases: [(&str, &[&str]); 6] = [
+        ("NAN", &["point 3", "value is NaN"]),
+        ("NAN_DERIVATIVE", &["point 3", "dvalue/dgap is NaN"]),
+        ("NEGATIVE", &["point 3", "conductance -2.5 is negative"]),
+        (
+            "ERROR",
+            &[
+                "point 3",
+                "reported an error",
+                "pressure 150 is beyond the measured range",
+            ],
+        ),
+        (
+            "CUTBACK",
+            &[
+                "point 3",
+                "smaller time step (factor 0.25)",
+                "coating creep increment too large",
+            ],
+        ),
+        ("BAD_STATUS", &["point 3", "unknown status code 42"]),
+    ];
+    for (fault, needles) in cases {
+        let plugin = Plugin::load(&faulty(fault)).unwrap();
+        let err = eval(&plugin, &points).unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains("`faulty`") && msg.contains(&format!("faulty_{}", fault.to_lowercase())),
+            "{msg}"
+        );
+        for n in needles {
+            assert!(msg.contains(n), "{fault}: `{n}` missing in: {msg}");
+        }
+        assert_eq!(err.point(), Some(3));
+        assert_eq!(err.is_cutback(), fault == "CUTBACK", "{fault}");
+        // The host is alive and the plugin still answers for good points.
+        assert_eq!(eval(&plugin, &points[..3]).unwrap()[2].value, 1.0);
+    }
+    // The fault's exact content for the cutback request.
+    let plugin = Plugin::load(&faulty("CUTBACK")).unwrap();
+    match eval(&plugin, &points).unwrap_err() {
+        PluginFault::Cutback { factor, point, .. } => assert_eq!((factor, point), (0.25, 3)),
+        other => panic!("expected a cutback, got {other:?}"),
+    }
+}
+
+#[test]
+fn a_panic_in_a_rust_plugin_is_caught_and_reported() {
+    let plugin = Plugin::load(&rust_plugins().panicky).unwrap();
+    let err = eval(
+        &plugin,
+        &[point(0.0, 0.5, 300.0, 300.0), point(0.0, 5.0, 300.0, 300.0)],
+    )
+    .unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.contains("point 1") && msg.contains("panic: deliberate panic at pressure 5"),
+        "{msg}"
+    );
+    // Still alive, still usable.
+    assert_eq!(
+        eval(&plugin, &[point(0.0, 0.5, 300.0, 300.0)]).unwrap()[0].value,
+        1.0
+    );
+}
+
+// --- conformance kit and check-plugin --------------------------------------------------
+
+#[test]
+fn conformance_kit_passes_the_examples_and_fails_every_faulty_plugin() {
+    let table = Config {
+        real_data: table_real(),
+        ..Config::default()
+    };
+    let report = seam_plugin_testkit::run(
+        &seam_plugin_testkit::load(&c_plugins().table).unwrap(),
+        &table,
+    );
+    assert!(report.passed(), "{report}");
+    assert!(report.batch_checked && report.threads_checked && report.derivatives_checked == 216);
+    let cmy = Config {
+        real_data: CMY.to_vec(),
+        ..Config::default()
+    };
+    let report = seam_plugin_testkit::run(
+        &seam_plugin_testkit::load(&rust_plugins().cmy).unwrap(),
+        &cmy,
+    );
+    assert!(report.passed(), "{report}");
+    assert!(report.max_derivative_error < 1e-8, "{report}");
+    for fault in [
+        "NAN",
+        "NAN_DERIVATIVE",
+        "NEGATIVE",
+        "ERROR",
+        "CUTBACK",
+        "BAD_STATUS",
+    ] {
+        let report = seam_plugin_testkit::run(
+            &seam_plugin_testkit::load(&faulty(fault)).unwrap(),
+            &Config::default(),
+        );
+        assert!(!report.passed(), "{fault} passed the kit:\n{report}");
+    }
+    let report = seam_plugin_testkit::run(
+        &seam_plugin_testkit::load(&rust_plugins().panicky).unwrap(),
+        &Config::default(),
+    );
+    assert!(
+        !report.passed() && report.to_string().contains("deliberate panic"),
+        "{report}"
+    );
+    for fault in ["MAJOR", "MINOR", "SMALL", "NULL_EVALUATE", "NO_ENTRY"] {
+        assert!(
+            seam_plugin_testkit::load(&faulty(fault)).is_err(),
+            "{fault} loaded in the kit"
+        );
+    }
+    // A derivative off by a factor 2 is caught (the host cannot see it; the kit must).
+    let report = seam_plugin_testkit::run(
+        &seam_plugin_testkit::load(&faulty("WRONG_DERIVATIVE")).unwrap(),
+        &Config::default(),
+    );
+    assert!(
+        !report.passed() && report.to_string().contains("d/dpressure = 2e-6"),
+        "{report}"
+    );
+    // And the comparison's tolerance is real: at rtol 1e-14 round-off alone fails CMY.
+    let strict = Config {
+        rtol: 1e-14,
+        grid: Grid {
+            gaps: vec![1e-5],
+            pressures: vec![3e6],
+            temps_a: vec![500.0],
+            temps_b: vec![400.0],
+        },
+        ..cmy
+    };
+    let report = seam_plugin_testkit::run(
+        &seam_plugin_testkit::load(&rust_plugins().cmy).unwrap(),
+        &strict,
+    );
+    assert!(
+        !report.passed() && report.to_string().contains("finite differences give"),
+        "{report}"
+    );
+}
+
+#[test]
+fn check_plugin_reports_pass_and_fault_with_exit_codes() {
+    let mut out = Vec::new();
+    let report = check_plugin(&rust_plugins().cmy, &CMY, &[], &mut out).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert_eq!(report.exit_code(), 0, "{text}");
+    for n in [
+        "model         cmy 1.0.0",
+        "ABI           1.0",
+        "THREAD_SAFE | PROVIDES_DERIVATIVES",
+        "PASS",
+    ] {
+        assert!(text.contains(n), "`{n}` missing in:\n{text}");
+    }
+    let mut out = Vec::new();
+    let report = check_plugin(&faulty("NEGATIVE"), &[], &[], &mut out).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    assert_eq!(report.exit_code(), 3, "{text}");
+    assert!(
+        text.contains("conductance -2.5 is negative") && text.contains("FAIL"),
+        "{text}"
+    );
+    let mut out = Vec::new();
+    let report = check_plugin(&c_plugins().smooth, &[], &[], &mut out).unwrap();
+    assert!(report.finite_difference_derivatives && report.passed());
+    assert!(
+        String::from_utf8(out)
+            .unwrap()
+            .contains("does not provide derivatives")
+    );
+    let err = check_plugin(&faulty("MAJOR"), &[], &[], &mut Vec::new()).unwrap_err();
+    assert!(err.to_string().contains("ABI 2.0"), "{err}");
+}
