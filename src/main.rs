@@ -15,6 +15,7 @@ use seam::mesh::{self, ElemId, Mesh};
 use seam::surface::{self, SurfaceKind};
 
 const EXIT_BAD_INPUT: u8 = 2;
+const EXIT_PLUGIN_FAULT: u8 = 3;
 
 #[derive(Parser)]
 #[command(
@@ -59,6 +60,19 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         order: usize,
     },
+    /// Load an enforcement plugin, print its descriptor, and probe it on a grid of
+    /// states: outputs finite and non-negative, derivatives against finite differences.
+    /// Exit 0 when it passes, 3 on any fault.
+    CheckPlugin {
+        /// The shared library.
+        path: PathBuf,
+        /// Real Data handed to the plugin, as the deck would (`--real 1.5 2e3`).
+        #[arg(long, num_args = 1.., allow_negative_numbers = true)]
+        real: Vec<f64>,
+        /// Integer Data handed to the plugin (`--integer 1 2 3`).
+        #[arg(long, num_args = 1.., allow_negative_numbers = true)]
+        integer: Vec<i64>,
+    },
     /// Validate a deck (and, with --mesh, its surfaces) and print every diagnostic.
     Check {
         deck: PathBuf,
@@ -83,6 +97,11 @@ fn main() -> ExitCode {
             segments,
             order,
         } => search(&deck, &mesh, json, segments, order),
+        Command::CheckPlugin {
+            path,
+            real,
+            integer,
+        } => check_plugin(&path, &real, &integer),
         Command::Check { deck, mesh } => check(&deck, mesh.as_deref()),
     }
 }
@@ -423,6 +442,18 @@ fn format_number(x: f64) -> String {
         format!("{x:.6}")
     } else {
         format!("{x:.6e}")
+    }
+}
+
+fn check_plugin(path: &Path, real: &[f64], integer: &[i64]) -> ExitCode {
+    let mut stdout = std::io::stdout();
+    match seam::plugin::check_plugin(path, real, integer, &mut stdout) {
+        Ok(report) if report.exit_code() == 0 => ExitCode::SUCCESS,
+        Ok(_) => ExitCode::from(EXIT_PLUGIN_FAULT),
+        Err(e) => {
+            eprintln!("error[E0500]: {e}");
+            ExitCode::from(EXIT_PLUGIN_FAULT)
+        }
     }
 }
 

@@ -6,7 +6,7 @@ mod cli;
 mod docs;
 mod interactions;
 mod mesh_io;
+mod plugin;
 mod search;
 mod search_kernels;
-mod plugin;
 mod surfaces;

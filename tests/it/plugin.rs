@@ -919,3 +919,37 @@ fn check_plugin_reports_pass_and_fault_with_exit_codes() {
     let err = check_plugin(&faulty("MAJOR"), &[], &[], &mut Vec::new()).unwrap_err();
     assert!(err.to_string().contains("ABI 2.0"), "{err}");
 }
+
+/// `seam check-plugin`: exit 0 and PASS for a good plugin with its data, 3 for a plugin
+/// whose outputs are wrong and for one that cannot be loaded.
+#[test]
+fn check_plugin_command_exit_codes() {
+    let seam = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(args)
+            .output()
+            .expect("seam runs")
+    };
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    let real: Vec<String> = table_real().iter().map(|v| v.to_string()).collect();
+    let mut args = vec!["check-plugin", table.as_str(), "--real"];
+    args.extend(real.iter().map(String::as_str));
+    let out = seam(&args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("PASS") && text.contains("c_table"), "{text}");
+
+    let out = seam(&["check-plugin", faulty("NAN").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("NaN"));
+
+    let out = seam(&["check-plugin", faulty("MAJOR").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("ABI 2.0") && err.contains("ABI 1.0"), "{err}");
+}
