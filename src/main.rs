@@ -528,9 +528,6 @@ fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
         for e in &def.enforcements {
             report("begin Enforcement", &e.at);
         }
-        if def.update_search_every_n_steps.is_some() {
-            report("Update Search Every n Steps", &def.at);
-        }
     }
     out
 }

@@ -152,8 +152,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "update_search_every_n_steps",
         [CD],
         "<n> steps",
-        "Redo the search every n steps (1: every step).",
-        planned
+        "Redo the search every n steps (1: every step)."
     ),
     cmd!(
         "opposed normal threshold angle",

@@ -456,7 +456,59 @@ fn max_face_size(b: &SurfaceGeometry) -> f64 {
     b.faces.iter().map(|f| f.area().sqrt()).fold(0.0, f64::max)
 }
 
+/// `Update Search Every n Steps`: a full search on the first step and every n-th step
+/// after it; on the steps between, the pairing is kept and only the geometry is
+/// refreshed ([`SearchResult::update_geometry`], [`Searcher::refit`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SearchSchedule {
+    every: u32,
+}
+
+impl SearchSchedule {
+    /// `None` (no such line) searches every step.
+    pub fn new(every: Option<u32>) -> Self {
+        SearchSchedule {
+            every: every.unwrap_or(1).max(1),
+        }
+    }
+
+    /// Whether step `step` (0-based) does a full search.
+    pub fn full_search(&self, step: u64) -> bool {
+        step.is_multiple_of(u64::from(self.every))
+    }
+}
+
 impl SearchResult {
+    /// Keep the pairing, refresh the geometry: every matched point is placed again at
+    /// its parametric coordinates on its side-A face and side-B face of the moved
+    /// surfaces, and its gap and normals are measured anew (quadrature points: along
+    /// side B's normal; node points likewise). Statistics follow.
+    pub fn update_geometry(&mut self, a: &SurfaceGeometry, b: &SurfaceGeometry) {
+        for p in &mut self.points {
+            if p.a_face != u32::MAX {
+                let fa = &a.faces[p.a_face as usize];
+                p.x = fa.map(p.xi_a);
+                p.normal_a = fa.normal();
+            } else if let Some((_, x)) = a.nodes.get(p.a_node as usize) {
+                p.x = *x;
+            }
+            if p.status != PointStatus::Matched {
+                continue;
+            }
+            let fb = &b.faces[p.b_face as usize];
+            let on_b = fb.map(p.xi_b);
+            p.normal_b = fb.normal();
+            p.gap = dot(sub(p.x, on_b), p.normal_b);
+        }
+        let (overlap, area) = (self.stats.overlap_area, self.stats.side_a_area);
+        self.stats = SearchStats {
+            overlap_area: overlap,
+            side_a_area: area,
+            ..SearchStats::default()
+        };
+        tally(self);
+    }
+
     /// Apply the initial-overclosure treatment to matched points with a negative gap:
     /// `AdjustNodes` moves the side-A point onto side B along side B's normal (gap 0);
     /// `StoreOffsets` keeps the geometry and records the gap as the point's offset.

@@ -503,3 +503,62 @@ fn overclosure_offsets_or_adjustments() {
         assert!((q.x[2] - 1.0).abs() < 1e-14, "moved onto side B: {:?}", q.x);
     }
 }
+
+/// `Update Search Every 3 Steps`: steps 0, 3, 6 search; between them the pairing is kept
+/// and the geometry refreshed, so a side B lowered by 0.003 opens every gap by 0.003
+/// with the same faces, and a later full search agrees while the motion is small.
+#[test]
+fn pairing_is_reused_between_search_updates() {
+    use seam::search::pairing::SearchSchedule;
+    let schedule = SearchSchedule::new(Some(3));
+    let full: Vec<bool> = (0..7).map(|s| schedule.full_search(s)).collect();
+    assert_eq!(full, [true, false, false, true, false, false, true]);
+    assert!(SearchSchedule::new(None).full_search(5));
+
+    let mesh = two_boxes(5, 4);
+    let def = parse_sierra(&Arc::from("d"), PAIR)
+        .0
+        .contact_definitions
+        .remove(0);
+    let set = surface::build(&mesh, &def, &SourceMap::default());
+    let settings = interaction::SearchSettings::defaults(3);
+    let geo = |coords: &[[f64; 3]], name: &str| {
+        SurfaceGeometry::from_surface(&mesh, set.get(name).unwrap(), coords).unwrap()
+    };
+    let (a, b0) = (geo(&mesh.coords, "bottom"), geo(&mesh.coords, "top"));
+    let mut r = Searcher::new(&b0, &settings).search(
+        &a,
+        &b0,
+        &settings,
+        Integration::Quadrature { order: 2 },
+        None,
+    );
+    let before = r.points.clone();
+    let lowered: Vec<[f64; 3]> = mesh
+        .coords
+        .iter()
+        .map(|p| [p[0], p[1], p[2] - 0.003])
+        .collect();
+    let b1 = geo(&lowered, "top");
+    r.update_geometry(&a, &b1);
+    for (p, q) in r.points.iter().zip(&before) {
+        assert_eq!(p.b_face, q.b_face);
+        assert!(
+            (p.gap - (q.gap + 0.003)).abs() < 1e-15,
+            "{} vs {}",
+            p.gap,
+            q.gap
+        );
+    }
+    let fresh = Searcher::new(&b1, &settings).search(
+        &a,
+        &b1,
+        &settings,
+        Integration::Quadrature { order: 2 },
+        None,
+    );
+    assert_eq!(
+        fresh.points.iter().map(|p| p.b_face).collect::<Vec<_>>(),
+        r.points.iter().map(|p| p.b_face).collect::<Vec<_>>()
+    );
+}
