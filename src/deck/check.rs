@@ -64,9 +64,10 @@ pub fn check(deck: &Deck, locs: &Locs) -> Diagnostics {
 }
 
 fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Diagnostics) {
-    if let Some(a) = def.opposed_normal_threshold_angle {
-        if !(90.0..=180.0).contains(&a) {
-            out.push(
+    if let Some(a) = def.opposed_normal_threshold_angle
+        && !(90.0..=180.0).contains(&a)
+    {
+        out.push(
                 Diagnostic::error(
                     codes::OPPOSED_ANGLE,
                     format!("opposed normal threshold angle is {a} degrees; it must be between 90 and 180"),
@@ -74,7 +75,6 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
                 .at(locs.or(&format!("{d}.opposed_normal_threshold_angle"), &def.at))
                 .help("it is the smallest angle between two face normals for the faces to interact; 180 means exactly opposed, 90 the most permissive"),
             );
-        }
     }
 
     // Surface names: each defined once.
@@ -236,17 +236,17 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
         );
     }
     for (k, c) in def.control_assignments.iter().enumerate() {
-        if let Control::ScalePenalty { factor } = c.control {
-            if !(factor > 0.0 && factor.is_finite()) {
-                out.push(
-                    Diagnostic::error(
-                        codes::NOT_POSITIVE,
-                        format!("the penalty scale factor must be positive, found {factor}"),
-                    )
-                    .at(locs.or(&format!("{d}.control_assignment.{k}.factor"), &c.at))
-                    .help("a factor of 1 keeps the enforcement's own penalty"),
-                );
-            }
+        if let Control::ScalePenalty { factor } = c.control
+            && !(factor > 0.0 && factor.is_finite())
+        {
+            out.push(
+                Diagnostic::error(
+                    codes::NOT_POSITIVE,
+                    format!("the penalty scale factor must be positive, found {factor}"),
+                )
+                .at(locs.or(&format!("{d}.control_assignment.{k}.factor"), &c.at))
+                .help("a factor of 1 keeps the enforcement's own penalty"),
+            );
         }
     }
 }

@@ -134,10 +134,10 @@ impl Builder {
             (p[1] + 0.0).to_bits(),
             (p[2] + 0.0).to_bits(),
         ];
-        if self.merge {
-            if let Some(&n) = self.positions.get(&key) {
-                return n;
-            }
+        if self.merge
+            && let Some(&n) = self.positions.get(&key)
+        {
+            return n;
         }
         let n = NodeId(self.mesh.coords.len() as u32);
         self.mesh.coords.push(p);
