@@ -4,10 +4,13 @@
 //! [`mesh`] (Exodus II, Gmsh, generators), [`surface`] (contact surfaces by the Sierra
 //! rules). Diagnostics shared by all of them live in [`diag`].
 
+pub mod assembly;
 pub mod deck;
 pub mod diag;
+pub mod heat;
 pub mod interaction;
 pub mod mesh;
 pub mod periodic;
 pub mod script;
+pub mod solve;
 pub mod surface;
