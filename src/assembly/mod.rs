@@ -16,16 +16,21 @@
 //! - Every element owns a fixed slot of `ne × ne` values (`ne` = element dofs, fields
 //!   of the block one after the other, nodes in connectivity order, row-major), every
 //!   coupling a slot of two values `(i, j)` and `(j, i)`, every dof a diagonal slot.
-//!   The symbolic CSC matrix and the faer argsort are built once from the index
-//!   sequence of those slots ([`SymbolicSparseColMat::try_new_from_indices`]); each
-//!   assembly only writes values and calls [`SparseColMat::new_from_argsort`].
-//! - Determinism: element kernels run in parallel (rayon) but write only their own
-//!   slot, and duplicates are summed by faer in the fixed slot order, so the matrix is
-//!   bit-identical whatever the number of threads.
+//!   The symbolic CSC matrix is built once from the index sequence of those slots
+//!   ([`SymbolicSparseColMat::try_new_from_indices`]), together with each slot's
+//!   position in the CSC value array; each assembly only writes slot values and adds
+//!   them into a fresh value array, slot after slot.
+//! - Determinism and symmetry: element kernels run in parallel (rayon) but write only
+//!   their own slot, and slots are summed in slot order, so the matrix is
+//!   bit-identical whatever the number of threads, and entries `(i, j)` and `(j, i)`
+//!   receive the same terms in the same order (exactly symmetric when the element
+//!   matrices are). faer's own `new_from_argsort` is not used because it sums
+//!   duplicates in the order of an unstable sort, which leaves `a_ij` and `a_ji`
+//!   differing in the last bit.
 
 use std::ops::Range;
 
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 
 use crate::mesh::{ElemId, Mesh, NodeId};
@@ -234,8 +239,8 @@ impl DofMap {
 }
 
 /// The sparse pattern of the global matrix: element connectivity, extra couplings and
-/// the diagonal, with the faer symbolic structure and argsort once [`Pattern::build`]
-/// has run.
+/// the diagonal, with the faer symbolic structure and slot positions once
+/// [`Pattern::build`] has run.
 #[derive(Clone, Debug)]
 pub struct Pattern {
     n: usize,
@@ -246,7 +251,8 @@ pub struct Pattern {
     /// Global dofs of each element slot row, concatenated block after block.
     elem_dofs: Vec<u32>,
     couplings: Vec<(u32, u32)>,
-    built: Option<(SymbolicSparseColMat<usize>, Argsort<usize>)>,
+    /// The CSC structure and, for every slot, its position in the value array.
+    built: Option<(SymbolicSparseColMat<usize>, Vec<u32>)>,
 }
 
 impl Pattern {
@@ -318,7 +324,8 @@ impl Pattern {
         self.elem_values + 2 * self.couplings.len() + self.n
     }
 
-    /// Build the faer symbolic matrix and the argsort from the slot index sequence.
+    /// Build the faer symbolic matrix and the slot positions from the slot index
+    /// sequence.
     pub fn build(&mut self) -> Result<(), AssemblyError> {
         if self.built.is_some() {
             return Ok(());
@@ -350,9 +357,25 @@ impl Pattern {
             });
         }
         idx.extend((0..self.n).map(|i| Pair { row: i, col: i }));
-        let built = SymbolicSparseColMat::try_new_from_indices(self.n, self.n, &idx)
+        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(self.n, self.n, &idx)
             .map_err(|e| AssemblyError::Faer(format!("{e:?}")))?;
-        self.built = Some(built);
+        if sym.row_idx().len() > u32::MAX as usize {
+            return Err(AssemblyError::Faer(format!(
+                "{} stored entries exceed the 32-bit slot positions",
+                sym.row_idx().len()
+            )));
+        }
+        // Position of each slot's (row, col) inside its sorted column.
+        let positions = idx
+            .par_iter()
+            .with_min_len(4096)
+            .map(|p| {
+                let range = sym.col_range(p.col);
+                let rows = &sym.row_idx()[range.clone()];
+                (range.start + rows.partition_point(|&r| r < p.row)) as u32
+            })
+            .collect();
+        self.built = Some((sym, positions));
         Ok(())
     }
 
@@ -459,15 +482,19 @@ impl<'p> Assembler<'p> {
         Ok(())
     }
 
-    /// The assembled matrix (values only: the pattern's symbolic structure is cloned).
+    /// The assembled matrix (values only: the pattern's symbolic structure is cloned
+    /// and the slots are added into their positions in slot order).
     pub fn matrix(&self) -> Result<SparseColMat<usize, f64>, AssemblyError> {
-        let (sym, argsort) = self
+        let (sym, positions) = self
             .pattern
             .built
             .as_ref()
             .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))?;
-        SparseColMat::new_from_argsort(sym.clone(), argsort, &self.values)
-            .map_err(|e| AssemblyError::Faer(format!("{e:?}")))
+        let mut vals = vec![0.0; sym.row_idx().len()];
+        for (&p, &v) in positions.iter().zip(&self.values) {
+            vals[p as usize] += v;
+        }
+        Ok(SparseColMat::new(sym.clone(), vals))
     }
 
     /// The assembled right-hand side: the direct loads, then the element vectors added

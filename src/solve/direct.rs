@@ -10,8 +10,8 @@ use faer::linalg::cholesky::llt::factor::LltError;
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymmetricOrdering,
-    factorize_symbolic_cholesky,
+    CholeskySymbolicParams, LdltRef, LltRef, SymbolicCholesky, SymbolicCholeskyRaw,
+    SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Lu as FaerLu, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -161,8 +161,15 @@ impl Analysis {
         })
     }
 
-    /// Original row of pivot `k` of the permuted factorisation.
+    /// Original row of the failed pivot that faer reports as `k`.
     fn original_row(&self, k: usize) -> usize {
+        // faer 0.24's simplicial kernels report the failed pivot one past its 0-based
+        // position (`index: k + 1`), the supernodal ones 0-based; observed on a matrix
+        // with one negative diagonal entry (tests/it/fem.rs).
+        let k = match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(_) => k.saturating_sub(1),
+            SymbolicCholeskyRaw::Supernodal(_) => k,
+        };
         match self.symbolic.perm() {
             Some(p) => p.arrays().0[k],
             None => k,
@@ -215,6 +222,13 @@ impl Cholesky {
     /// Stored values of L (faer's `len_val`), the fill measure; 0 before `factor`.
     pub fn factor_nnz(&self) -> usize {
         self.analysis.as_ref().map_or(0, |a| a.symbolic.len_val())
+    }
+
+    /// Whether faer chose its supernodal (blocked) kernels rather than simplicial ones.
+    pub fn is_supernodal(&self) -> bool {
+        self.analysis
+            .as_ref()
+            .is_some_and(|a| matches!(a.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_)))
     }
 
     /// Whether the current analysis uses METIS (false: AMD).

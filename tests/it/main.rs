@@ -4,5 +4,6 @@ mod bad_cli;
 mod bad_decks;
 mod cli;
 mod docs;
+mod fem;
 mod mesh_io;
 mod surfaces;
