@@ -3,7 +3,10 @@
 //!
 //! Set-up, level by level until at most [`AmgOptions::coarse_size`] unknowns remain:
 //! 1. strength of connection: `j` is a strong neighbour of `i` when
-//!    `|a_ij| ≥ θ_l √(|a_ii a_jj|)`, `θ_l = θ₀ · 2^{−l}` (Vaněk et al.'s ε = 0.08·(½)^l);
+//!    `|a_ij| ≥ θ_l √(|a_ii a_jj|)`, `θ_l = θ₀ · 2^{−l}` (Vaněk et al.'s ε·(½)^l, with
+//!    θ₀ = 0.02 rather than their 0.08: the Q1 hex stiffness couples a node to its
+//!    edge and corner neighbours with 1/16 and 1/32 of its diagonal and to its face
+//!    neighbours with 0, so 0.08 would leave no strong connection at all);
 //! 2. aggregation (the paper's three passes): seed aggregates from nodes whose strong
 //!    neighbourhood is still free, attach leftovers to a neighbouring aggregate, group
 //!    the rest; nodes with no strong neighbour (e.g. rows eliminated by Dirichlet
@@ -205,7 +208,7 @@ pub struct AmgOptions {
 impl Default for AmgOptions {
     fn default() -> Self {
         AmgOptions {
-            strength: 0.08,
+            strength: 0.02,
             coarse_size: 500,
             max_levels: 12,
             smoother: Smoother::SymmetricGaussSeidel,
