@@ -210,13 +210,17 @@ fn main() {
         rayon::current_num_threads(),
         faer::get_global_parallelism()
     );
+    // `SEAM_BENCH_ONLY=assembly` skips the Laplacian cases (for profiling assembly).
+    let only_assembly = std::env::var("SEAM_BENCH_ONLY").is_ok_and(|s| s == "assembly");
     let mut rows = Vec::new();
-    cholesky_rows(&mut rows, small, reps);
-    cholesky_rows(&mut rows, mid, reps_env.unwrap_or(1));
-    for n in [mid, big] {
-        let a = laplacian_7pt(n);
-        let b = rhs(a.nrows());
-        amg_rows(&mut rows, &format!("7-pt {n}³ AMG-CG"), &a, &b, reps);
+    if !only_assembly {
+        cholesky_rows(&mut rows, small, reps);
+        cholesky_rows(&mut rows, mid, reps_env.unwrap_or(1));
+        for n in [mid, big] {
+            let a = laplacian_7pt(n);
+            let b = rhs(a.nrows());
+            amg_rows(&mut rows, &format!("7-pt {n}³ AMG-CG"), &a, &b, reps);
+        }
     }
     let (mut a, mut f) = assembly_rows(&mut rows, cells, reps);
     // Dirichlet T = 0 on the boundary of the cube, then AMG-CG on the Q1 matrix.

@@ -525,6 +525,50 @@ mod tests {
         }
     }
 
+    /// Capacity: the consistent matrix sums to ρc·V (partition of unity, twice), the
+    /// lumped one is its row sums on the diagonal, and both are symmetric positive.
+    /// Checked on a distorted element of every topology (1e-13 relative).
+    #[test]
+    fn capacity_matrices_are_consistent() {
+        use crate::mesh::Topology::*;
+        for t in [Hex8, Tet4, Wedge6, Pyramid5, Quad4, Tri3] {
+            let nn = t.node_count();
+            let x: Vec<[f64; 3]> = shape::reference_nodes(t)
+                .unwrap()
+                .iter()
+                .enumerate()
+                .map(|(a, p)| {
+                    let w = 0.05 * ((a * 37 % 11) as f64 / 11.0 - 0.5);
+                    let z = if t.parametric_dim() == 3 {
+                        p[2] - w
+                    } else {
+                        0.0
+                    };
+                    [1.3 * p[0] + w, 0.7 * p[1] + 0.2 * p[0], z]
+                })
+                .collect();
+            let rule = QuadratureRule::standard(t).unwrap();
+            let v = kernel::measure(t, &x, &rule).unwrap();
+            let (mut mc, mut ml) = (vec![0.0; nn * nn], vec![0.0; nn * nn]);
+            kernel::capacity_consistent(t, &x, &rule, 2.0, &mut mc).unwrap();
+            kernel::capacity_lumped(t, &x, &rule, 2.0, &mut ml).unwrap();
+            let total: f64 = mc.iter().sum();
+            assert!(
+                (total - 2.0 * v).abs() < 1e-13 * v,
+                "{t:?}: {total} vs {}",
+                2.0 * v
+            );
+            for a in 0..nn {
+                let row: f64 = mc[a * nn..(a + 1) * nn].iter().sum();
+                assert!((ml[a * nn + a] - row).abs() < 1e-14, "{t:?} row {a}");
+                assert!(ml[a * nn + a] > 0.0, "{t:?}: lumped mass {a} not positive");
+                for b in 0..nn {
+                    assert_eq!(mc[a * nn + b], mc[b * nn + a]);
+                }
+            }
+        }
+    }
+
     /// An inverted element is an error naming the element, not a panic or a NaN.
     #[test]
     fn inverted_element_is_reported() {

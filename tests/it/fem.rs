@@ -74,6 +74,70 @@ fn wedge_box(lo: [f64; 3], hi: [f64; 3], cells: [usize; 3]) -> Mesh {
     mesh
 }
 
+/// A box of Pyramid5 elements: every hex cell split into six pyramids, one per face,
+/// with a new node at the cell centre as their common apex. Hex sides are listed
+/// counter-clockwise from outside, pyramid bases counter-clockwise seen from the apex
+/// (inside), so each base is the hex side reversed.
+fn pyramid_box(lo: [f64; 3], hi: [f64; 3], cells: [usize; 3]) -> Mesh {
+    let hex = single_box(BoxSpec::hex(lo, hi, cells, 1));
+    let mut mesh = Mesh {
+        dim: 3,
+        coords: hex.coords.clone(),
+        node_numbers: hex.node_numbers.clone(),
+        ..Mesh::default()
+    };
+    let mut conn = Vec::new();
+    let block = &hex.blocks[0];
+    for k in 0..block.len() {
+        let c = block.elem_nodes(k);
+        let mut centre = [0.0; 3];
+        for n in c {
+            for d in 0..3 {
+                centre[d] += mesh.coords[n.index()][d] / 8.0;
+            }
+        }
+        let apex = NodeId(mesh.coords.len() as u32);
+        mesh.coords.push(centre);
+        mesh.node_numbers.push(apex.0 as i64 + 1);
+        for side in Topology::Hex8.sides() {
+            let q: Vec<NodeId> = side.iter().map(|&l| c[l as usize]).collect();
+            conn.extend_from_slice(&[q[0], q[3], q[2], q[1], apex]);
+        }
+    }
+    mesh.push_block(1, "", Topology::Pyramid5, conn, None);
+    mesh
+}
+
+/// A 2-D mesh of `[0,1]²` with `n × n` Quad4 cells, or each cell split into two Tri3.
+fn plane_mesh(n: usize, tri: bool) -> Mesh {
+    let mut mesh = Mesh {
+        dim: 2,
+        ..Mesh::default()
+    };
+    for j in 0..=n {
+        for i in 0..=n {
+            mesh.coords
+                .push([i as f64 / n as f64, j as f64 / n as f64, 0.0]);
+            mesh.node_numbers.push(mesh.coords.len() as i64);
+        }
+    }
+    let id = |i: usize, j: usize| NodeId((i + (n + 1) * j) as u32);
+    let mut conn = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+            if tri {
+                conn.extend_from_slice(&[q[0], q[1], q[2], q[0], q[2], q[3]]);
+            } else {
+                conn.extend_from_slice(&q);
+            }
+        }
+    }
+    let topo = if tri { Topology::Tri3 } else { Topology::Quad4 };
+    mesh.push_block(1, "", topo, conn, None);
+    mesh
+}
+
 fn unit_material(blocks: usize, k: f64) -> Vec<Material> {
     vec![
         Material {
@@ -128,6 +192,7 @@ fn patch_test_reproduces_linear_field_on_distorted_meshes() {
         ("hex8", single_box(BoxSpec::hex(lo, hi, cells, 1)), 0.2),
         ("tet4", single_box(BoxSpec::tet(lo, hi, cells, 1)), 0.1),
         ("wedge6", wedge_box(lo, hi, cells), 0.15),
+        ("pyramid5", pyramid_box(lo, hi, cells), 0.1),
     ];
     for (name, mut mesh, amount) in meshes {
         let before = mesh.coords.clone();
@@ -144,6 +209,37 @@ fn patch_test_reproduces_linear_field_on_distorted_meshes() {
         let scale = max_abs(mesh.coords.iter().map(|&p| exact(p)));
         let err = max_abs(t.iter().zip(&mesh.coords).map(|(t, &p)| t - exact(p)));
         assert!(err <= 1e-12 * scale, "{name}: max nodal error {err:.3e}");
+    }
+}
+
+/// The 2-D patch test: T = 1 + x + 2y on distorted Quad4 and Tri3 meshes of the unit
+/// square (per unit depth), Dirichlet data on the boundary; same tolerance and reason
+/// as in 3-D.
+#[test]
+fn patch_test_in_two_dimensions() {
+    let exact = |p: [f64; 3]| 1.0 + p[0] + 2.0 * p[1];
+    for tri in [false, true] {
+        let mut mesh = plane_mesh(6, tri);
+        let on_boundary = |p: [f64; 3]| p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 1.0;
+        let mut rng = Rng(11);
+        for p in mesh.coords.iter_mut() {
+            if !on_boundary(*p) {
+                p[0] += 0.25 / 6.0 * (2.0 * rng.next() - 1.0);
+                p[1] += 0.25 / 6.0 * (2.0 * rng.next() - 1.0);
+            }
+        }
+        let bc: Vec<(NodeId, f64)> = (0..mesh.num_nodes())
+            .filter(|&i| on_boundary(mesh.coords[i]))
+            .map(|i| (NodeId(i as u32), exact(mesh.coords[i])))
+            .collect();
+        let t = solve_steady(&mesh, 1.3, None, &bc, &[]);
+        let err = max_abs(t.iter().zip(&mesh.coords).map(|(t, &p)| t - exact(p)));
+        assert!(err <= 1e-12 * 4.0, "tri = {tri}: max nodal error {err:.3e}");
+        // A source term breaks linearity: the test can fail.
+        let q = |_: [f64; 3]| 1.0;
+        let t = solve_steady(&mesh, 1.3, Some(&q), &bc, &[]);
+        let err = max_abs(t.iter().zip(&mesh.coords).map(|(t, &p)| t - exact(p)));
+        assert!(err > 1e-4, "tri = {tri}: a source must change the field");
     }
 }
 
@@ -244,6 +340,7 @@ fn nonlinear_jacobian_matches_finite_differences() {
         ("hex8", single_box(BoxSpec::hex(lo, hi, [3, 3, 3], 1))),
         ("tet4", single_box(BoxSpec::tet(lo, hi, [2, 2, 2], 1))),
         ("wedge6", wedge_box(lo, hi, [2, 2, 2])),
+        ("pyramid5", pyramid_box(lo, hi, [2, 2, 2])),
     ] {
         distort(&mut mesh, lo, hi, 1.0 / 3.0, 0.1, 7);
         let dofs = DofMap::new(&mesh, &[(TEMPERATURE, &[0])]).unwrap();
