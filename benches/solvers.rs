@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use faer::sparse::SparseColMat;
 use seam::assembly::{Assembler, DofMap, Pattern};
-use seam::heat::{QuadratureRule, TEMPERATURE, kernel};
+use seam::heat::{Basis, TEMPERATURE, kernel};
 use seam::mesh::Topology;
 use seam::mesh::generate::{BoxSpec, single_box};
 use seam::solve::{
@@ -126,14 +126,14 @@ fn assembly_rows(
 ) -> (SparseColMat<usize, f64>, Vec<f64>) {
     let (mesh, t_mesh) = time(|| single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [c, c, c], 1)));
     let dofs = DofMap::new(&mesh, &[(TEMPERATURE, &[0])]).unwrap();
-    let rule = QuadratureRule::standard(Topology::Hex8).unwrap();
+    let rule = Basis::standard(Topology::Hex8).unwrap();
     let kernel = |e: seam::mesh::ElemId, ke: &mut [f64], fe: &mut [f64]| {
         let mut x = [[0.0; 3]; 8];
         for (k, n) in mesh.elem_nodes(e).iter().enumerate() {
             x[k] = mesh.coords[n.index()];
         }
-        kernel::conductivity(Topology::Hex8, &x, &rule, |_| 1.0, ke).unwrap();
-        kernel::source(Topology::Hex8, &x, &rule, |_| 1.0, fe).unwrap();
+        kernel::conductivity(&rule, &x, |_| 1.0, ke).unwrap();
+        kernel::source(&rule, &x, |_| 1.0, fe).unwrap();
     };
     let mut first = Vec::new();
     let mut pattern_t = Vec::new();

@@ -16,8 +16,8 @@
 //! - Every element owns a fixed slot of `ne × ne` values (`ne` = element dofs, fields
 //!   of the block one after the other, nodes in connectivity order, row-major), every
 //!   coupling a slot of two values `(i, j)` and `(j, i)`, every dof a diagonal slot.
-//!   The symbolic CSC matrix is built once from the index sequence of those slots
-//!   ([`SymbolicSparseColMat::try_new_from_indices`]), together with each slot's
+//!   The symbolic CSC matrix ([`SymbolicSparseColMat`]) is built once from the
+//!   element connectivity, couplings and diagonal, together with each slot's
 //!   position in the CSC value array; each assembly only writes slot values and adds
 //!   them into a fresh value array, slot after slot.
 //! - Determinism and symmetry: element kernels run in parallel (rayon) but write only
@@ -30,7 +30,7 @@
 
 use std::ops::Range;
 
-use faer::sparse::{Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 
 use crate::mesh::{ElemId, Mesh, NodeId};
@@ -324,57 +324,137 @@ impl Pattern {
         self.elem_values + 2 * self.couplings.len() + self.n
     }
 
-    /// Build the faer symbolic matrix and the slot positions from the slot index
-    /// sequence.
+    /// Build the faer symbolic matrix and the slot positions. Column `j` holds `j`
+    /// itself, every dof of every element that has `j`, and the coupling partners of
+    /// `j`; columns are built in parallel from a dof → element map (no global sort of
+    /// all slots), then each slot finds its position by binary search in its column.
     pub fn build(&mut self) -> Result<(), AssemblyError> {
         if self.built.is_some() {
             return Ok(());
         }
-        let mut idx = Vec::with_capacity(self.value_count());
-        let mut pos = 0;
+        let n = self.n;
+        // Every element's range in `elem_dofs`, in slot order.
+        let mut elems: Vec<(usize, usize)> = Vec::new();
+        let mut off = 0;
         for &(_, ne, count) in &self.block_slots {
-            for e in 0..count {
-                let d = &self.elem_dofs[pos + e * ne..pos + (e + 1) * ne];
-                for &r in d {
-                    for &c in d {
-                        idx.push(Pair {
-                            row: r as usize,
-                            col: c as usize,
-                        });
-                    }
+            for _ in 0..count {
+                elems.push((off, ne));
+                off += ne;
+            }
+        }
+        // dof → elements holding it (CSR by counting).
+        let mut d2e_ptr = vec![0usize; n + 1];
+        for &d in &self.elem_dofs {
+            if d != NONE {
+                d2e_ptr[d as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            d2e_ptr[i + 1] += d2e_ptr[i];
+        }
+        let mut d2e = vec![0u32; d2e_ptr[n]];
+        let mut next = d2e_ptr.clone();
+        for (e, &(o, ne)) in elems.iter().enumerate() {
+            for &d in &self.elem_dofs[o..o + ne] {
+                if d != NONE {
+                    d2e[next[d as usize]] = e as u32;
+                    next[d as usize] += 1;
                 }
             }
-            pos += count * ne;
         }
+        // Coupling partners per column (both directions).
+        let mut c_ptr = vec![0usize; n + 1];
         for &(i, j) in &self.couplings {
-            idx.push(Pair {
-                row: i as usize,
-                col: j as usize,
-            });
-            idx.push(Pair {
-                row: j as usize,
-                col: i as usize,
-            });
+            c_ptr[j as usize + 1] += 1;
+            c_ptr[i as usize + 1] += 1;
         }
-        idx.extend((0..self.n).map(|i| Pair { row: i, col: i }));
-        let (sym, _) = SymbolicSparseColMat::try_new_from_indices(self.n, self.n, &idx)
-            .map_err(|e| AssemblyError::Faer(format!("{e:?}")))?;
-        if sym.row_idx().len() > u32::MAX as usize {
-            return Err(AssemblyError::Faer(format!(
-                "{} stored entries exceed the 32-bit slot positions",
-                sym.row_idx().len()
-            )));
+        for i in 0..n {
+            c_ptr[i + 1] += c_ptr[i];
         }
-        // Position of each slot's (row, col) inside its sorted column.
-        let positions = idx
-            .par_iter()
-            .with_min_len(4096)
-            .map(|p| {
-                let range = sym.col_range(p.col);
-                let rows = &sym.row_idx()[range.clone()];
-                (range.start + rows.partition_point(|&r| r < p.row)) as u32
+        let mut partners = vec![0u32; c_ptr[n]];
+        let mut next = c_ptr.clone();
+        for &(i, j) in &self.couplings {
+            partners[next[j as usize]] = i;
+            next[j as usize] += 1;
+            partners[next[i as usize]] = j;
+            next[i as usize] += 1;
+        }
+        const CHUNK: usize = 4096;
+        let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (mut lens, mut rows) = (Vec::new(), Vec::new());
+                let mut col = Vec::new();
+                for j in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                    col.clear();
+                    col.push(j);
+                    for &e in &d2e[d2e_ptr[j]..d2e_ptr[j + 1]] {
+                        let (o, ne) = elems[e as usize];
+                        col.extend(
+                            self.elem_dofs[o..o + ne]
+                                .iter()
+                                .filter(|&&d| d != NONE)
+                                .map(|&d| d as usize),
+                        );
+                    }
+                    col.extend(partners[c_ptr[j]..c_ptr[j + 1]].iter().map(|&i| i as usize));
+                    col.sort_unstable();
+                    col.dedup();
+                    lens.push(col.len());
+                    rows.extend_from_slice(&col);
+                }
+                (lens, rows)
             })
             .collect();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0usize);
+        let mut row_idx = Vec::new();
+        for (lens, rows) in chunks {
+            for l in lens {
+                col_ptr.push(col_ptr.last().unwrap() + l);
+            }
+            row_idx.extend(rows);
+        }
+        if row_idx.len() > u32::MAX as usize {
+            return Err(AssemblyError::Faer(format!(
+                "{} stored entries exceed the 32-bit slot positions",
+                row_idx.len()
+            )));
+        }
+        let pos = |row: usize, col: usize| -> u32 {
+            let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+            (col_ptr[col] + rows.partition_point(|&r| r < row)) as u32
+        };
+        let mut positions = vec![0u32; self.value_count()];
+        let (elem_part, rest) = positions.split_at_mut(self.elem_values);
+        let mut elem_part = elem_part;
+        let mut dof_off = 0;
+        for &(_, ne, count) in &self.block_slots {
+            let (block_part, tail) = elem_part.split_at_mut(count * ne * ne);
+            elem_part = tail;
+            let dofs = &self.elem_dofs[dof_off..dof_off + count * ne];
+            block_part
+                .par_chunks_mut((ne * ne).max(1))
+                .zip(dofs.par_chunks(ne.max(1)))
+                .with_min_len(256)
+                .for_each(|(slots, d)| {
+                    for (a, &r) in d.iter().enumerate() {
+                        for (b, &c) in d.iter().enumerate() {
+                            slots[a * ne + b] = pos(r as usize, c as usize);
+                        }
+                    }
+                });
+            dof_off += count * ne;
+        }
+        let (coupling_part, diag_part) = rest.split_at_mut(2 * self.couplings.len());
+        for (k, &(i, j)) in self.couplings.iter().enumerate() {
+            coupling_part[2 * k] = pos(i as usize, j as usize);
+            coupling_part[2 * k + 1] = pos(j as usize, i as usize);
+        }
+        for (i, p) in diag_part.iter_mut().enumerate() {
+            *p = pos(i, i);
+        }
+        let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         self.built = Some((sym, positions));
         Ok(())
     }

@@ -45,68 +45,139 @@ pub struct PointValues {
     pub jxw: f64,
 }
 
-/// Evaluate shape functions, physical gradients and det J·w at reference point `xi`.
+/// Shape functions of one topology tabulated at the points of a quadrature rule, so
+/// element loops map them to physical space without re-evaluating them.
+#[derive(Clone, Debug)]
+pub struct Basis {
+    pub topology: Topology,
+    pub rule: QuadratureRule,
+    n: Vec<[f64; MAX_NODES]>,
+    dn: Vec<[[f64; 3]; MAX_NODES]>,
+}
+
+impl Basis {
+    /// Tabulate `topology`'s shape functions at the points of `rule`. Panics for
+    /// topologies without shape functions (see [`super::shape::reference_nodes`]).
+    pub fn new(topology: Topology, rule: QuadratureRule) -> Self {
+        let mut n = Vec::with_capacity(rule.len());
+        let mut dn = Vec::with_capacity(rule.len());
+        for p in &rule.points {
+            let (mut v, mut g) = ([0.0; MAX_NODES], [[0.0; 3]; MAX_NODES]);
+            shape(topology, *p, &mut v, &mut g);
+            n.push(v);
+            dn.push(g);
+        }
+        Basis {
+            topology,
+            rule,
+            n,
+            dn,
+        }
+    }
+
+    /// The element's standard rule ([`QuadratureRule::standard`]); `None` for shells
+    /// and beams.
+    pub fn standard(topology: Topology) -> Option<Self> {
+        QuadratureRule::standard(topology).map(|r| Self::new(topology, r))
+    }
+
+    /// Number of quadrature points.
+    pub fn len(&self) -> usize {
+        self.rule.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rule.is_empty()
+    }
+
+    /// Values at quadrature point `q` of the element with nodes at `coords`.
+    pub fn eval(&self, q: usize, coords: &[[f64; 3]]) -> Result<PointValues, BadJacobian> {
+        map_point(
+            self.topology,
+            coords,
+            &self.n[q],
+            &self.dn[q],
+            self.rule.points[q],
+            self.rule.weights[q],
+        )
+    }
+}
+
+/// Evaluate shape functions, physical gradients and det J·w at reference point `xi`
+/// (untabulated; [`Basis::eval`] is the fast path).
 pub fn eval_point(
     topology: Topology,
     coords: &[[f64; 3]],
     xi: [f64; 3],
     weight: f64,
 ) -> Result<PointValues, BadJacobian> {
+    let (mut n, mut dn) = ([0.0; MAX_NODES], [[0.0; 3]; MAX_NODES]);
+    shape(topology, xi, &mut n, &mut dn);
+    map_point(topology, coords, &n, &dn, xi, weight)
+}
+
+/// Map reference values to physical space: `J_ij = Σ_a x_a,i ∂N_a/∂ξ_j`,
+/// `∇_x N = J⁻ᵀ ∇_ξ N`, `jxw = det J · w`.
+fn map_point(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    n: &[f64; MAX_NODES],
+    dn: &[[f64; 3]; MAX_NODES],
+    xi: [f64; 3],
+    weight: f64,
+) -> Result<PointValues, BadJacobian> {
     let nn = topology.node_count();
     let mut pv = PointValues {
-        n: [0.0; MAX_NODES],
+        n: *n,
         grad: [[0.0; 3]; MAX_NODES],
         x: [0.0; 3],
         jxw: 0.0,
     };
-    let mut dn = [[0.0; 3]; MAX_NODES];
-    shape(topology, xi, &mut pv.n, &mut dn);
     let dim = topology.parametric_dim();
-    // J_ij = ∂x_i/∂ξ_j = Σ_a x_a,i ∂N_a/∂ξ_j
     let mut j = [[0.0; 3]; 3];
     for a in 0..nn {
+        let (c, d) = (coords[a], dn[a]);
         for i in 0..3 {
-            pv.x[i] += pv.n[a] * coords[a][i];
-        }
-        for i in 0..dim {
-            for k in 0..dim {
-                j[i][k] += coords[a][i] * dn[a][k];
+            pv.x[i] += n[a] * c[i];
+            for k in 0..3 {
+                j[i][k] += c[i] * d[k];
             }
         }
     }
-    let (det, inv) = if dim == 3 {
-        let det = j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
-            - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
-            + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0]);
-        let c = |r: usize, s: usize| {
-            // cofactor-based inverse: inv[s][r] = cof(r, s) / det
-            let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-            let (s1, s2) = ((s + 1) % 3, (s + 2) % 3);
-            j[r1][s1] * j[r2][s2] - j[r1][s2] * j[r2][s1]
-        };
-        let mut inv = [[0.0; 3]; 3];
-        for r in 0..3 {
-            for s in 0..3 {
-                inv[s][r] = c(r, s) / det;
-            }
-        }
-        (det, inv)
+    // inv = J⁻¹ by cofactors.
+    let mut inv = [[0.0; 3]; 3];
+    let det = if dim == 3 {
+        let c00 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+        let c01 = j[1][2] * j[2][0] - j[1][0] * j[2][2];
+        let c02 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+        let det = j[0][0] * c00 + j[0][1] * c01 + j[0][2] * c02;
+        let r = 1.0 / det;
+        inv[0][0] = c00 * r;
+        inv[1][0] = c01 * r;
+        inv[2][0] = c02 * r;
+        inv[0][1] = (j[0][2] * j[2][1] - j[0][1] * j[2][2]) * r;
+        inv[1][1] = (j[0][0] * j[2][2] - j[0][2] * j[2][0]) * r;
+        inv[2][1] = (j[0][1] * j[2][0] - j[0][0] * j[2][1]) * r;
+        inv[0][2] = (j[0][1] * j[1][2] - j[0][2] * j[1][1]) * r;
+        inv[1][2] = (j[0][2] * j[1][0] - j[0][0] * j[1][2]) * r;
+        inv[2][2] = (j[0][0] * j[1][1] - j[0][1] * j[1][0]) * r;
+        det
     } else {
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
-        let mut inv = [[0.0; 3]; 3];
         inv[0][0] = j[1][1] / det;
         inv[0][1] = -j[0][1] / det;
         inv[1][0] = -j[1][0] / det;
         inv[1][1] = j[0][0] / det;
-        (det, inv)
+        det
     };
     if det.is_nan() || det <= 0.0 {
         return Err(BadJacobian { det, point: xi });
     }
-    // ∇_x N = J⁻ᵀ ∇_ξ N: (∇_x N)_i = Σ_k inv[k][i] ∂N/∂ξ_k
+    // (∇_x N)_i = Σ_k inv[k][i] ∂N/∂ξ_k
     for a in 0..nn {
+        let d = dn[a];
         for i in 0..dim {
-            pv.grad[a][i] = (0..dim).map(|k| inv[k][i] * dn[a][k]).sum();
+            pv.grad[a][i] = inv[0][i] * d[0] + inv[1][i] * d[1] + inv[2][i] * d[2];
         }
     }
     pv.jxw = det * weight;
@@ -115,22 +186,25 @@ pub fn eval_point(
 
 /// `K_ab += ∫ k(x) ∇N_a·∇N_b dV`.
 pub fn conductivity(
-    topology: Topology,
+    basis: &Basis,
     coords: &[[f64; 3]],
-    rule: &QuadratureRule,
     k: impl Fn([f64; 3]) -> f64,
     ke: &mut [f64],
 ) -> Result<(), BadJacobian> {
-    let nn = topology.node_count();
-    for (p, w) in rule.points.iter().zip(&rule.weights) {
-        let pv = eval_point(topology, coords, *p, *w)?;
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
         let kw = k(pv.x) * pv.jxw;
+        // Upper triangle, mirrored: exactly symmetric and half the work.
         for a in 0..nn {
-            for b in 0..nn {
-                let g = pv.grad[a][0] * pv.grad[b][0]
-                    + pv.grad[a][1] * pv.grad[b][1]
-                    + pv.grad[a][2] * pv.grad[b][2];
-                ke[a * nn + b] += kw * g;
+            let ga = pv.grad[a];
+            for b in a..nn {
+                let gb = pv.grad[b];
+                let v = kw * (ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2]);
+                ke[a * nn + b] += v;
+                if b != a {
+                    ke[b * nn + a] += v;
+                }
             }
         }
     }
@@ -139,15 +213,14 @@ pub fn conductivity(
 
 /// Consistent capacity `M_ab += ∫ ρc N_a N_b dV`.
 pub fn capacity_consistent(
-    topology: Topology,
+    basis: &Basis,
     coords: &[[f64; 3]],
-    rule: &QuadratureRule,
     rho_c: f64,
     me: &mut [f64],
 ) -> Result<(), BadJacobian> {
-    let nn = topology.node_count();
-    for (p, w) in rule.points.iter().zip(&rule.weights) {
-        let pv = eval_point(topology, coords, *p, *w)?;
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
         for a in 0..nn {
             for b in 0..nn {
                 me[a * nn + b] += rho_c * pv.n[a] * pv.n[b] * pv.jxw;
@@ -160,15 +233,14 @@ pub fn capacity_consistent(
 /// Lumped capacity: the row sums of the consistent matrix on the diagonal,
 /// `M_aa += ∫ ρc N_a dV` (positive for every element here, since ∫N_a > 0).
 pub fn capacity_lumped(
-    topology: Topology,
+    basis: &Basis,
     coords: &[[f64; 3]],
-    rule: &QuadratureRule,
     rho_c: f64,
     me: &mut [f64],
 ) -> Result<(), BadJacobian> {
-    let nn = topology.node_count();
-    for (p, w) in rule.points.iter().zip(&rule.weights) {
-        let pv = eval_point(topology, coords, *p, *w)?;
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
         for a in 0..nn {
             me[a * nn + a] += rho_c * pv.n[a] * pv.jxw;
         }
@@ -178,15 +250,14 @@ pub fn capacity_lumped(
 
 /// `f_a += ∫ Q(x) N_a dV`.
 pub fn source(
-    topology: Topology,
+    basis: &Basis,
     coords: &[[f64; 3]],
-    rule: &QuadratureRule,
     q: impl Fn([f64; 3]) -> f64,
     fe: &mut [f64],
 ) -> Result<(), BadJacobian> {
-    let nn = topology.node_count();
-    for (p, w) in rule.points.iter().zip(&rule.weights) {
-        let pv = eval_point(topology, coords, *p, *w)?;
+    let nn = basis.topology.node_count();
+    for i in 0..basis.len() {
+        let pv = basis.eval(i, coords)?;
         let qw = q(pv.x) * pv.jxw;
         for a in 0..nn {
             fe[a] += qw * pv.n[a];
@@ -196,14 +267,10 @@ pub fn source(
 }
 
 /// Element volume (area for 2-D elements): ∫ 1 dV.
-pub fn measure(
-    topology: Topology,
-    coords: &[[f64; 3]],
-    rule: &QuadratureRule,
-) -> Result<f64, BadJacobian> {
+pub fn measure(basis: &Basis, coords: &[[f64; 3]]) -> Result<f64, BadJacobian> {
     let mut v = 0.0;
-    for (p, w) in rule.points.iter().zip(&rule.weights) {
-        v += eval_point(topology, coords, *p, *w)?.jxw;
+    for q in 0..basis.len() {
+        v += basis.eval(q, coords)?.jxw;
     }
     Ok(v)
 }
@@ -313,17 +380,16 @@ pub fn face_convection(
 /// Nonlinear conduction: `R_a += ∫ k(T) ∇N_a·∇T dV` and its exact Jacobian
 /// `J_ab += ∫ [k ∇N_a·∇N_b + (dk/dT) N_b ∇N_a·∇T] dV`; `k(T, x)` returns `(k, dk/dT)`.
 pub fn conduction_residual_jacobian(
-    topology: Topology,
+    basis: &Basis,
     coords: &[[f64; 3]],
-    rule: &QuadratureRule,
     t: &[f64],
     k: impl Fn(f64, [f64; 3]) -> (f64, f64),
     re: &mut [f64],
     je: &mut [f64],
 ) -> Result<(), BadJacobian> {
-    let nn = topology.node_count();
-    for (p, w) in rule.points.iter().zip(&rule.weights) {
-        let pv = eval_point(topology, coords, *p, *w)?;
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
         let mut tq = 0.0;
         let mut gt = [0.0; 3];
         for a in 0..nn {

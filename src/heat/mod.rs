@@ -29,6 +29,7 @@ use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId, Pattern};
 use crate::mesh::{ElemId, Mesh, NodeId, Side};
 use crate::solve::{LinearSolver, Lu, SolveError, apply_dirichlet};
 
+pub use kernel::Basis;
 pub use quadrature::QuadratureRule;
 
 /// Name of the temperature field in a [`DofMap`].
@@ -147,21 +148,21 @@ fn bad_jacobian(mesh: &Mesh, elem: ElemId, b: kernel::BadJacobian) -> HeatError 
     }
 }
 
-/// Standard rules of the temperature blocks, checking every block is a solid.
+/// Standard bases of the temperature blocks, checking every block is a solid.
 fn block_rules(
     mesh: &Mesh,
     dofs: &DofMap,
     field: FieldId,
-) -> Result<Vec<Option<QuadratureRule>>, HeatError> {
+) -> Result<Vec<Option<Basis>>, HeatError> {
     let mut rules = vec![None; mesh.blocks.len()];
     for &b in dofs.field_blocks(field) {
         let block = &mesh.blocks[b];
-        rules[b] = Some(QuadratureRule::standard(block.topology).ok_or(
-            HeatError::UnsupportedTopology {
+        rules[b] = Some(
+            Basis::standard(block.topology).ok_or(HeatError::UnsupportedTopology {
                 block: block.id,
                 topology: block.topology,
-            },
-        )?);
+            })?,
+        );
     }
     Ok(rules)
 }
@@ -216,12 +217,12 @@ pub fn steady_conduction(
         let nn = elem_coords(mesh, e, &mut x);
         let x = &x[..nn];
         let k = materials[b].conductivity;
-        if let Err(bad) = kernel::conductivity(topo, x, rule, |_| k, ke) {
+        if let Err(bad) = kernel::conductivity(rule, x, |_| k, ke) {
             errors.record(e, bad_jacobian(mesh, e, bad));
             return;
         }
         if let Some(q) = source {
-            if let Err(bad) = kernel::source(topo, x, rule, q, fe) {
+            if let Err(bad) = kernel::source(rule, x, q, fe) {
                 errors.record(e, bad_jacobian(mesh, e, bad));
                 return;
             }
@@ -299,6 +300,7 @@ pub fn error_norms(
                 topology: block.topology,
             },
         )?;
+        let basis = Basis::new(block.topology, rule);
         let per: Vec<Result<(f64, f64), HeatError>> = (0..block.len())
             .into_par_iter()
             .with_min_len(256)
@@ -310,8 +312,9 @@ pub fn error_norms(
                     x[i] = mesh.coords[n.index()];
                 }
                 let (mut l2, mut h1) = (0.0, 0.0);
-                for (p, w) in rule.points.iter().zip(&rule.weights) {
-                    let pv = kernel::eval_point(block.topology, &x[..nodes.len()], *p, *w)
+                for q in 0..basis.len() {
+                    let pv = basis
+                        .eval(q, &x[..nodes.len()])
                         .map_err(|bad| bad_jacobian(mesh, e, bad))?;
                     let mut th = 0.0;
                     let mut gh = [0.0; 3];
@@ -364,7 +367,6 @@ pub fn nonlinear_residual_jacobian(
     let errors = FirstError::new();
     asm.elements(mesh, Some(dofs.field_blocks(field)), |e, je, re| {
         let b = mesh.block_of(e);
-        let topo = mesh.blocks[b].topology;
         let rule = rules[b].as_ref().expect("rule of a temperature block");
         let mut x = [[0.0; 3]; kernel::MAX_NODES];
         let nn = elem_coords(mesh, e, &mut x);
@@ -372,24 +374,17 @@ pub fn nonlinear_residual_jacobian(
         for (k, n) in mesh.elem_nodes(e).iter().enumerate() {
             te[k] = t[dofs.dof(field, *n).expect("temperature dof").index()];
         }
-        let r = kernel::conduction_residual_jacobian(
-            topo,
-            &x[..nn],
-            rule,
-            &te[..nn],
-            conductivity,
-            re,
-            je,
-        )
-        .and_then(|_| match source {
-            Some(q) => {
-                let mut f = [0.0; kernel::MAX_NODES];
-                kernel::source(topo, &x[..nn], rule, q, &mut f)?;
-                re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
-                Ok(())
-            }
-            None => Ok(()),
-        });
+        let r =
+            kernel::conduction_residual_jacobian(rule, &x[..nn], &te[..nn], conductivity, re, je)
+                .and_then(|_| match source {
+                    Some(q) => {
+                        let mut f = [0.0; kernel::MAX_NODES];
+                        kernel::source(rule, &x[..nn], q, &mut f)?;
+                        re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
+                        Ok(())
+                    }
+                    None => Ok(()),
+                });
         if let Err(bad) = r {
             errors.record(e, bad_jacobian(mesh, e, bad));
         }
@@ -492,7 +487,7 @@ mod tests {
         ] {
             let mesh = single_box(spec);
             let block = &mesh.blocks[0];
-            let rule = QuadratureRule::standard(block.topology).unwrap();
+            let basis = Basis::standard(block.topology).unwrap();
             let mut v = 0.0;
             for k in 0..block.len() {
                 let x: Vec<[f64; 3]> = block
@@ -500,7 +495,7 @@ mod tests {
                     .iter()
                     .map(|n| mesh.coords[n.index()])
                     .collect();
-                v += kernel::measure(block.topology, &x, &rule).unwrap();
+                v += kernel::measure(&basis, &x).unwrap();
             }
             assert!((v - 3.0).abs() < 1e-13 * 3.0, "{:?}: {v}", block.topology);
         }
@@ -520,7 +515,7 @@ mod tests {
             (Tri3, 0.5),
         ] {
             let x = shape::reference_nodes(t).unwrap();
-            let m = kernel::measure(t, x, &QuadratureRule::standard(t).unwrap()).unwrap();
+            let m = kernel::measure(&Basis::standard(t).unwrap(), x).unwrap();
             assert!((m - v).abs() < 1e-14, "{t:?}: {m}");
         }
     }
@@ -547,11 +542,11 @@ mod tests {
                     [1.3 * p[0] + w, 0.7 * p[1] + 0.2 * p[0], z]
                 })
                 .collect();
-            let rule = QuadratureRule::standard(t).unwrap();
-            let v = kernel::measure(t, &x, &rule).unwrap();
+            let basis = Basis::standard(t).unwrap();
+            let v = kernel::measure(&basis, &x).unwrap();
             let (mut mc, mut ml) = (vec![0.0; nn * nn], vec![0.0; nn * nn]);
-            kernel::capacity_consistent(t, &x, &rule, 2.0, &mut mc).unwrap();
-            kernel::capacity_lumped(t, &x, &rule, 2.0, &mut ml).unwrap();
+            kernel::capacity_consistent(&basis, &x, 2.0, &mut mc).unwrap();
+            kernel::capacity_lumped(&basis, &x, 2.0, &mut ml).unwrap();
             let total: f64 = mc.iter().sum();
             assert!(
                 (total - 2.0 * v).abs() < 1e-13 * v,

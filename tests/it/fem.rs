@@ -8,7 +8,7 @@
 
 use faer::sparse::SparseColMat;
 use seam::assembly::{Assembler, DofMap, Pattern};
-use seam::heat::{self, FaceBc, Material, QuadratureRule, TEMPERATURE, kernel};
+use seam::heat::{self, Basis, FaceBc, Material, TEMPERATURE, kernel};
 use seam::mesh::generate::{BoxSpec, single_box};
 use seam::mesh::{Mesh, NodeId, Side, Topology};
 use seam::solve::{
@@ -665,7 +665,7 @@ fn saddle_ldlt_matches_eliminated_solution() {
     pattern.add_couplings(&pairs).unwrap();
     pattern.build().unwrap();
     let mut asm = Assembler::new(&pattern);
-    let rule = QuadratureRule::standard(Topology::Hex8).unwrap();
+    let rule = Basis::standard(Topology::Hex8).unwrap();
     let kcond = [1.0, 4.0];
     asm.elements(&mesh, None, |e, ke, fe| {
         let x: Vec<[f64; 3]> = mesh
@@ -674,8 +674,8 @@ fn saddle_ldlt_matches_eliminated_solution() {
             .map(|n| mesh.coords[n.index()])
             .collect();
         let b = mesh.block_of(e);
-        kernel::conductivity(Topology::Hex8, &x, &rule, |_| kcond[b], ke).unwrap();
-        kernel::source(Topology::Hex8, &x, &rule, |p| 10.0 * p[0], fe).unwrap();
+        kernel::conductivity(&rule, &x, |_| kcond[b], ke).unwrap();
+        kernel::source(&rule, &x, |p| 10.0 * p[0], fe).unwrap();
     });
     for (k, (_, m)) in ties.iter().enumerate() {
         // Row λ_k: u_s − 0.6 u_m0 − 0.4 u_m1 = 0 (and the symmetric column).
@@ -884,7 +884,7 @@ fn values_only_reassembly_matches_fresh_assembly() {
     let dofs = DofMap::new(&mesh, &[(TEMPERATURE, &[0])]).unwrap();
     let mut pattern = Pattern::new(&mesh, &dofs);
     pattern.build().unwrap();
-    let rule = QuadratureRule::standard(Topology::Hex8).unwrap();
+    let rule = Basis::standard(Topology::Hex8).unwrap();
     let (mesh_ref, rule_ref) = (&mesh, &rule);
     let kernel_k = move |k: f64| {
         move |e: seam::mesh::ElemId, ke: &mut [f64], _fe: &mut [f64]| {
@@ -893,7 +893,7 @@ fn values_only_reassembly_matches_fresh_assembly() {
                 .iter()
                 .map(|n| mesh_ref.coords[n.index()])
                 .collect();
-            kernel::conductivity(Topology::Hex8, &x, rule_ref, |_| k, ke).unwrap();
+            kernel::conductivity(rule_ref, &x, |_| k, ke).unwrap();
         }
     };
     let mut asm = Assembler::new(&pattern);
@@ -910,4 +910,75 @@ fn values_only_reassembly_matches_fresh_assembly() {
     seam::solve::spmv(&second, &vec![1.0; dofs.len()], &mut y);
     assert!(max_abs(y.into_iter()) < 1e-13);
     assert_eq!(pattern.nnz(), second.val().len());
+}
+
+/// The pattern and slot sums agree with faer's own triplet assembly of the same
+/// entries (structure exactly, values to round-off: only the summation order
+/// differs), on a two-field, two-block mesh with extra dofs and couplings.
+#[test]
+fn assembly_matches_faer_triplets() {
+    use faer::sparse::Triplet;
+    let mesh = seam::mesh::generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0; 3], [3, 2, 2], 1),
+            BoxSpec::tet([1.0, 0.0, 0.0], [2.0, 1.0, 1.0], [2, 2, 2], 2),
+        ],
+        true,
+    );
+    let mut dofs = DofMap::new(&mesh, &[(TEMPERATURE, &[0, 1]), ("voltage", &[1])]).unwrap();
+    let extra = dofs.add_extra(3);
+    let mut pattern = Pattern::new(&mesh, &dofs);
+    let couplings = [
+        (extra.start, 0),
+        (extra.start + 1, 5),
+        (extra.start + 2, 40),
+        (3, 60),
+    ];
+    pattern.add_couplings(&couplings).unwrap();
+    pattern.build().unwrap();
+    let mut asm = Assembler::new(&pattern);
+    // Element "matrices" with distinct, non-symmetric values that depend on the element.
+    asm.elements(&mesh, None, |e, ke, fe| {
+        for (k, v) in ke.iter_mut().enumerate() {
+            *v = 1.0 + e.0 as f64 * 0.01 + k as f64 * 1e-3;
+        }
+        fe.iter_mut().for_each(|f| *f = 1.0);
+    });
+    for k in 0..couplings.len() {
+        asm.add_coupling(k, 2.0 + k as f64, -1.0 - k as f64);
+    }
+    for d in extra.clone() {
+        asm.add_diagonal(d, -0.5);
+    }
+    let a = asm.matrix().unwrap();
+    let mut triplets = Vec::new();
+    let mut buf = Vec::new();
+    for e in 0..mesh.num_elems() {
+        let e = seam::mesh::ElemId(e as u32);
+        dofs.elem_dofs(&mesh, e, &mut buf);
+        let ne = buf.len();
+        for (a, &r) in buf.iter().enumerate() {
+            for (b, &c) in buf.iter().enumerate() {
+                let v = 1.0 + e.0 as f64 * 0.01 + (a * ne + b) as f64 * 1e-3;
+                triplets.push(Triplet::new(r as usize, c as usize, v));
+            }
+        }
+    }
+    for (k, &(i, j)) in couplings.iter().enumerate() {
+        triplets.push(Triplet::new(i, j, 2.0 + k as f64));
+        triplets.push(Triplet::new(j, i, -1.0 - k as f64));
+    }
+    for d in 0..dofs.len() {
+        let v = if extra.contains(&d) { -0.5 } else { 0.0 };
+        triplets.push(Triplet::new(d, d, v));
+    }
+    let b = SparseColMat::try_new_from_triplets(dofs.len(), dofs.len(), &triplets).unwrap();
+    assert_eq!(a.symbolic().col_ptr(), b.symbolic().col_ptr());
+    assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx());
+    for (x, y) in a.val().iter().zip(b.val()) {
+        assert!((x - y).abs() <= 1e-14 * y.abs().max(1.0), "{x} vs {y}");
+    }
+    // Hex block elements carry one field (8 dofs), tet block elements two (8 dofs).
+    assert_eq!(dofs.elem_dof_count(&mesh, 0), 8);
+    assert_eq!(dofs.elem_dof_count(&mesh, 1), 8);
 }
