@@ -4,12 +4,15 @@
 //! [`mesh`] (Exodus II, Gmsh, generators), [`surface`] (contact surfaces by the Sierra
 //! rules), [`plugin`] (user enforcement models loaded as shared libraries). Diagnostics shared by all of them live in [`diag`].
 
+pub mod assembly;
 pub mod deck;
 pub mod diag;
+pub mod heat;
 pub mod interaction;
 pub mod mesh;
 pub mod periodic;
 pub mod plugin;
 pub mod script;
 pub mod search;
+pub mod solve;
 pub mod surface;

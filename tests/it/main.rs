@@ -5,6 +5,7 @@ mod bad_decks;
 mod cli;
 mod docs;
 mod interactions;
+mod fem;
 mod mesh_io;
 mod plugin;
 mod search;

@@ -1,0 +1,596 @@
+//! The host's global system: which unknown (degree of freedom, dof) belongs to which
+//! node and field, the sparse pattern those unknowns couple through, and the assembly
+//! of element matrices and vectors into a faer [`SparseColMat`].
+//!
+//! Entry points: [`DofMap::new`] (named scalar fields on sets of blocks, plus
+//! [`DofMap::add_extra`] for Lagrange multipliers), [`Pattern::new`] with
+//! [`Pattern::add_couplings`] (node–node couplings across an interface) and
+//! [`Pattern::build`], then an [`Assembler`] per assembly.
+//!
+//! Conventions:
+//! - Dofs are numbered field after field; inside a field, by increasing [`NodeId`] over
+//!   the nodes of the field's blocks. Extra dofs follow all field dofs.
+//! - The matrix is stored in full (both triangles), columns sorted, and its pattern
+//!   always holds the diagonal, so Dirichlet elimination and multiplier rows never
+//!   change the pattern.
+//! - Every element owns a fixed slot of `ne × ne` values (`ne` = element dofs, fields
+//!   of the block one after the other, nodes in connectivity order, row-major), every
+//!   coupling a slot of two values `(i, j)` and `(j, i)`, every dof a diagonal slot.
+//!   The symbolic CSC matrix ([`SymbolicSparseColMat`]) is built once from the
+//!   element connectivity, couplings and diagonal, together with each slot's
+//!   position in the CSC value array; each assembly only writes slot values and adds
+//!   them into a fresh value array, slot after slot.
+//! - Determinism and symmetry: element kernels run in parallel (rayon) but write only
+//!   their own slot, and slots are summed in slot order, so the matrix is
+//!   bit-identical whatever the number of threads, and entries `(i, j)` and `(j, i)`
+//!   receive the same terms in the same order (exactly symmetric when the element
+//!   matrices are). faer's own `new_from_argsort` is not used because it sums
+//!   duplicates in the order of an unstable sort, which leaves `a_ij` and `a_ji`
+//!   differing in the last bit.
+
+use std::ops::Range;
+
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use rayon::prelude::*;
+
+use crate::mesh::{ElemId, Mesh, NodeId};
+
+/// A named field of a [`DofMap`], by position.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FieldId(pub u32);
+
+/// A global unknown: a row (and column) of the assembled system.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Dof(pub u32);
+
+impl Dof {
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// Errors of DOF numbering, pattern building and assembly.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum AssemblyError {
+    #[error("field `{field}`: block index {block} does not exist (the mesh has {count} blocks)")]
+    NoSuchBlock {
+        field: String,
+        block: usize,
+        count: usize,
+    },
+    #[error("field `{0}` is defined twice")]
+    DuplicateField(String),
+    #[error("coupling ({row}, {col}) names a dof outside 0..{n}")]
+    CouplingOutOfRange { row: usize, col: usize, n: usize },
+    #[error(
+        "element {elem} (number {number}) produced a non-finite matrix entry {value} at local ({row}, {col})"
+    )]
+    NonFiniteElement {
+        elem: u32,
+        number: i64,
+        row: usize,
+        col: usize,
+        value: f64,
+    },
+    #[error("the sparse matrix could not be created: {0}")]
+    Faer(String),
+}
+
+const NONE: u32 = u32::MAX;
+
+#[derive(Clone, Debug)]
+struct Field {
+    name: String,
+    blocks: Vec<usize>,
+    /// Node index → dof, `NONE` where the field has no dof.
+    node_dof: Vec<u32>,
+    range: Range<usize>,
+}
+
+/// Node → dof numbering for named scalar fields, plus extra (multiplier) dofs.
+#[derive(Clone, Debug)]
+pub struct DofMap {
+    fields: Vec<Field>,
+    /// For each block: the fields defined on it, in field order.
+    block_fields: Vec<Vec<FieldId>>,
+    extra: Vec<Range<usize>>,
+    len: usize,
+}
+
+impl DofMap {
+    /// Number the dofs of `fields`, each a name and the indices (into `mesh.blocks`) of
+    /// the blocks it lives on.
+    pub fn new(mesh: &Mesh, fields: &[(&str, &[usize])]) -> Result<Self, AssemblyError> {
+        let mut out = DofMap {
+            fields: Vec::new(),
+            block_fields: vec![Vec::new(); mesh.blocks.len()],
+            extra: Vec::new(),
+            len: 0,
+        };
+        for (name, blocks) in fields {
+            if out.fields.iter().any(|f| f.name == *name) {
+                return Err(AssemblyError::DuplicateField(name.to_string()));
+            }
+            let mut on = vec![false; mesh.num_nodes()];
+            for &b in *blocks {
+                let block = mesh.blocks.get(b).ok_or(AssemblyError::NoSuchBlock {
+                    field: name.to_string(),
+                    block: b,
+                    count: mesh.blocks.len(),
+                })?;
+                for n in &block.connectivity {
+                    on[n.index()] = true;
+                }
+            }
+            let start = out.len;
+            let mut next = start as u32;
+            let node_dof = on
+                .iter()
+                .map(|&o| {
+                    if o {
+                        next += 1;
+                        next - 1
+                    } else {
+                        NONE
+                    }
+                })
+                .collect();
+            out.len = next as usize;
+            let id = FieldId(out.fields.len() as u32);
+            let mut blocks = blocks.to_vec();
+            blocks.sort_unstable();
+            blocks.dedup();
+            for &b in &blocks {
+                out.block_fields[b].push(id);
+            }
+            out.fields.push(Field {
+                name: name.to_string(),
+                blocks,
+                node_dof,
+                range: start..out.len,
+            });
+        }
+        Ok(out)
+    }
+
+    /// Total number of dofs (fields and extra).
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Append `n` extra dofs (Lagrange multipliers) after everything numbered so far.
+    /// A [`Pattern`] built before this call does not know them: build a new one.
+    pub fn add_extra(&mut self, n: usize) -> Range<usize> {
+        let r = self.len..self.len + n;
+        self.len += n;
+        self.extra.push(r.clone());
+        r
+    }
+
+    /// The ranges handed out by [`DofMap::add_extra`], in order.
+    pub fn extra_ranges(&self) -> &[Range<usize>] {
+        &self.extra
+    }
+
+    pub fn field(&self, name: &str) -> Option<FieldId> {
+        self.fields
+            .iter()
+            .position(|f| f.name == name)
+            .map(|i| FieldId(i as u32))
+    }
+
+    pub fn field_name(&self, field: FieldId) -> &str {
+        &self.fields[field.0 as usize].name
+    }
+
+    /// The contiguous dof range of a field.
+    pub fn field_range(&self, field: FieldId) -> Range<usize> {
+        self.fields[field.0 as usize].range.clone()
+    }
+
+    /// Block indices a field lives on (sorted).
+    pub fn field_blocks(&self, field: FieldId) -> &[usize] {
+        &self.fields[field.0 as usize].blocks
+    }
+
+    /// The dof of `field` at `node`, if the field lives there.
+    pub fn dof(&self, field: FieldId, node: NodeId) -> Option<Dof> {
+        match self.fields[field.0 as usize].node_dof.get(node.index()) {
+            Some(&d) if d != NONE => Some(Dof(d)),
+            _ => None,
+        }
+    }
+
+    /// Fields defined on a block, in field order.
+    pub fn block_fields(&self, block: usize) -> &[FieldId] {
+        &self.block_fields[block]
+    }
+
+    /// Number of dofs of one element of `block`.
+    pub fn elem_dof_count(&self, mesh: &Mesh, block: usize) -> usize {
+        self.block_fields[block].len() * mesh.blocks[block].topology.node_count()
+    }
+
+    /// Dofs of an element: for each field of its block, its nodes' dofs in
+    /// connectivity order. `out` is cleared first.
+    pub fn elem_dofs(&self, mesh: &Mesh, elem: ElemId, out: &mut Vec<u32>) {
+        out.clear();
+        let b = mesh.block_of(elem);
+        let nodes = mesh.elem_nodes(elem);
+        for f in &self.block_fields[b] {
+            let map = &self.fields[f.0 as usize].node_dof;
+            out.extend(nodes.iter().map(|n| map[n.index()]));
+        }
+    }
+
+    /// Nodal values of `field` from a dof vector (`NaN` where the field has no dof).
+    pub fn nodal_values(&self, field: FieldId, x: &[f64]) -> Vec<f64> {
+        self.fields[field.0 as usize]
+            .node_dof
+            .iter()
+            .map(|&d| if d == NONE { f64::NAN } else { x[d as usize] })
+            .collect()
+    }
+}
+
+/// The sparse pattern of the global matrix: element connectivity, extra couplings and
+/// the diagonal, with the faer symbolic structure and slot positions once
+/// [`Pattern::build`] has run.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    n: usize,
+    /// Per block: (first slot offset, element dof count, element count); elements of a
+    /// block are contiguous in the slot array.
+    block_slots: Vec<(usize, usize, usize)>,
+    elem_values: usize,
+    /// Global dofs of each element slot row, concatenated block after block.
+    elem_dofs: Vec<u32>,
+    couplings: Vec<(u32, u32)>,
+    /// The CSC structure and, for every slot, its position in the value array.
+    built: Option<(SymbolicSparseColMat<usize>, Vec<u32>)>,
+}
+
+impl Pattern {
+    /// The element part of the pattern for every element of every block that carries a
+    /// field of `dofs`.
+    pub fn new(mesh: &Mesh, dofs: &DofMap) -> Self {
+        let mut block_slots = Vec::with_capacity(mesh.blocks.len());
+        let mut elem_values = 0;
+        let mut elem_dofs = Vec::new();
+        let mut buf = Vec::new();
+        for (b, block) in mesh.blocks.iter().enumerate() {
+            let ne = dofs.elem_dof_count(mesh, b);
+            let count = if ne == 0 { 0 } else { block.len() };
+            block_slots.push((elem_values, ne, count));
+            elem_values += count * ne * ne;
+            for e in block.elems().take(count) {
+                dofs.elem_dofs(mesh, e, &mut buf);
+                elem_dofs.extend_from_slice(&buf);
+            }
+        }
+        Pattern {
+            n: dofs.len(),
+            block_slots,
+            elem_values,
+            elem_dofs,
+            couplings: Vec::new(),
+            built: None,
+        }
+    }
+
+    /// Add couplings `(i, j)`; each makes entries `(i, j)` and `(j, i)`. Coupling `k`
+    /// (counting all calls) is filled by [`Assembler::add_coupling`]`(k, ..)`. Returns
+    /// the index range of the added couplings. Invalidates a built pattern.
+    pub fn add_couplings(
+        &mut self,
+        pairs: &[(usize, usize)],
+    ) -> Result<Range<usize>, AssemblyError> {
+        let start = self.couplings.len();
+        for &(row, col) in pairs {
+            if row >= self.n || col >= self.n {
+                return Err(AssemblyError::CouplingOutOfRange {
+                    row,
+                    col,
+                    n: self.n,
+                });
+            }
+            self.couplings.push((row as u32, col as u32));
+        }
+        self.built = None;
+        Ok(start..self.couplings.len())
+    }
+
+    /// Number of rows (= columns).
+    pub fn len(&self) -> usize {
+        self.n
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.n == 0
+    }
+
+    pub fn coupling_count(&self) -> usize {
+        self.couplings.len()
+    }
+
+    /// Length of the value array an [`Assembler`] fills: element slots, two per
+    /// coupling, one per diagonal entry.
+    pub fn value_count(&self) -> usize {
+        self.elem_values + 2 * self.couplings.len() + self.n
+    }
+
+    /// Build the faer symbolic matrix and the slot positions. Column `j` holds `j`
+    /// itself, every dof of every element that has `j`, and the coupling partners of
+    /// `j`; columns are built in parallel from a dof → element map (no global sort of
+    /// all slots), then each slot finds its position by binary search in its column.
+    pub fn build(&mut self) -> Result<(), AssemblyError> {
+        if self.built.is_some() {
+            return Ok(());
+        }
+        let n = self.n;
+        // Every element's range in `elem_dofs`, in slot order.
+        let mut elems: Vec<(usize, usize)> = Vec::new();
+        let mut off = 0;
+        for &(_, ne, count) in &self.block_slots {
+            for _ in 0..count {
+                elems.push((off, ne));
+                off += ne;
+            }
+        }
+        // dof → elements holding it (CSR by counting).
+        let mut d2e_ptr = vec![0usize; n + 1];
+        for &d in &self.elem_dofs {
+            if d != NONE {
+                d2e_ptr[d as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            d2e_ptr[i + 1] += d2e_ptr[i];
+        }
+        let mut d2e = vec![0u32; d2e_ptr[n]];
+        let mut next = d2e_ptr.clone();
+        for (e, &(o, ne)) in elems.iter().enumerate() {
+            for &d in &self.elem_dofs[o..o + ne] {
+                if d != NONE {
+                    d2e[next[d as usize]] = e as u32;
+                    next[d as usize] += 1;
+                }
+            }
+        }
+        // Coupling partners per column (both directions).
+        let mut c_ptr = vec![0usize; n + 1];
+        for &(i, j) in &self.couplings {
+            c_ptr[j as usize + 1] += 1;
+            c_ptr[i as usize + 1] += 1;
+        }
+        for i in 0..n {
+            c_ptr[i + 1] += c_ptr[i];
+        }
+        let mut partners = vec![0u32; c_ptr[n]];
+        let mut next = c_ptr.clone();
+        for &(i, j) in &self.couplings {
+            partners[next[j as usize]] = i;
+            next[j as usize] += 1;
+            partners[next[i as usize]] = j;
+            next[i as usize] += 1;
+        }
+        const CHUNK: usize = 4096;
+        let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let (mut lens, mut rows) = (Vec::new(), Vec::new());
+                let mut col = Vec::new();
+                for j in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                    col.clear();
+                    col.push(j);
+                    for &e in &d2e[d2e_ptr[j]..d2e_ptr[j + 1]] {
+                        let (o, ne) = elems[e as usize];
+                        col.extend(
+                            self.elem_dofs[o..o + ne]
+                                .iter()
+                                .filter(|&&d| d != NONE)
+                                .map(|&d| d as usize),
+                        );
+                    }
+                    col.extend(partners[c_ptr[j]..c_ptr[j + 1]].iter().map(|&i| i as usize));
+                    col.sort_unstable();
+                    col.dedup();
+                    lens.push(col.len());
+                    rows.extend_from_slice(&col);
+                }
+                (lens, rows)
+            })
+            .collect();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0usize);
+        let mut row_idx = Vec::new();
+        for (lens, rows) in chunks {
+            for l in lens {
+                col_ptr.push(col_ptr.last().unwrap() + l);
+            }
+            row_idx.extend(rows);
+        }
+        if row_idx.len() > u32::MAX as usize {
+            return Err(AssemblyError::Faer(format!(
+                "{} stored entries exceed the 32-bit slot positions",
+                row_idx.len()
+            )));
+        }
+        let pos = |row: usize, col: usize| -> u32 {
+            let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
+            (col_ptr[col] + rows.partition_point(|&r| r < row)) as u32
+        };
+        let mut positions = vec![0u32; self.value_count()];
+        let (elem_part, rest) = positions.split_at_mut(self.elem_values);
+        let mut elem_part = elem_part;
+        let mut dof_off = 0;
+        for &(_, ne, count) in &self.block_slots {
+            let (block_part, tail) = elem_part.split_at_mut(count * ne * ne);
+            elem_part = tail;
+            let dofs = &self.elem_dofs[dof_off..dof_off + count * ne];
+            block_part
+                .par_chunks_mut((ne * ne).max(1))
+                .zip(dofs.par_chunks(ne.max(1)))
+                .with_min_len(256)
+                .for_each(|(slots, d)| {
+                    for (a, &r) in d.iter().enumerate() {
+                        for (b, &c) in d.iter().enumerate() {
+                            slots[a * ne + b] = pos(r as usize, c as usize);
+                        }
+                    }
+                });
+            dof_off += count * ne;
+        }
+        let (coupling_part, diag_part) = rest.split_at_mut(2 * self.couplings.len());
+        for (k, &(i, j)) in self.couplings.iter().enumerate() {
+            coupling_part[2 * k] = pos(i as usize, j as usize);
+            coupling_part[2 * k + 1] = pos(j as usize, i as usize);
+        }
+        for (i, p) in diag_part.iter_mut().enumerate() {
+            *p = pos(i, i);
+        }
+        let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        self.built = Some((sym, positions));
+        Ok(())
+    }
+
+    /// The symbolic CSC structure (after [`Pattern::build`]).
+    pub fn symbolic(&self) -> Option<&SymbolicSparseColMat<usize>> {
+        self.built.as_ref().map(|b| &b.0)
+    }
+
+    /// Stored entries of the matrix (after [`Pattern::build`]).
+    pub fn nnz(&self) -> usize {
+        self.symbolic().map_or(0, |s| s.row_idx().len())
+    }
+}
+
+/// Collects element matrices and vectors, couplings and diagonal terms into the slot
+/// arrays of a [`Pattern`], then makes the sparse matrix by values only.
+pub struct Assembler<'p> {
+    pattern: &'p Pattern,
+    values: Vec<f64>,
+    /// Element vector slots (`ne` per element), then one per dof for direct loads.
+    vector: Vec<f64>,
+    vec_elem_len: usize,
+}
+
+impl<'p> Assembler<'p> {
+    pub fn new(pattern: &'p Pattern) -> Self {
+        let vec_elem_len = pattern.block_slots.iter().map(|s| s.1 * s.2).sum();
+        Assembler {
+            pattern,
+            values: vec![0.0; pattern.value_count()],
+            vector: vec![0.0; vec_elem_len + pattern.n],
+            vec_elem_len,
+        }
+    }
+
+    /// Run `kernel(elem, ke, fe)` for every element of the blocks listed (all blocks
+    /// carrying a field when `blocks` is `None`), in parallel. `ke` (`ne × ne`,
+    /// row-major, zeroed) and `fe` (`ne`, zeroed) are that element's slots; the kernel
+    /// overwrites them, so calling twice replaces, not adds.
+    pub fn elements<F>(&mut self, mesh: &Mesh, blocks: Option<&[usize]>, kernel: F)
+    where
+        F: Fn(ElemId, &mut [f64], &mut [f64]) + Sync,
+    {
+        let pattern = self.pattern;
+        let mut vec_off = 0;
+        for (b, block) in mesh.blocks.iter().enumerate() {
+            let (off, ne, count) = pattern.block_slots[b];
+            let run = blocks.is_none_or(|l| l.contains(&b));
+            if run && count > 0 {
+                let mat = &mut self.values[off..off + count * ne * ne];
+                let vec = &mut self.vector[vec_off..vec_off + count * ne];
+                let first = block.first_elem.0;
+                // Fixed-size chunks of elements: the result does not depend on how rayon
+                // splits the work because each element writes only its own slot.
+                mat.par_chunks_mut(ne * ne)
+                    .zip(vec.par_chunks_mut(ne))
+                    .enumerate()
+                    .with_min_len(256)
+                    .for_each(|(k, (ke, fe))| {
+                        ke.fill(0.0);
+                        fe.fill(0.0);
+                        kernel(ElemId(first + k as u32), ke, fe);
+                    });
+            }
+            vec_off += count * ne;
+        }
+    }
+
+    /// Add values to coupling `k`: `v_ij` at `(i, j)` and `v_ji` at `(j, i)`.
+    pub fn add_coupling(&mut self, k: usize, v_ij: f64, v_ji: f64) {
+        let base = self.pattern.elem_values + 2 * k;
+        self.values[base] += v_ij;
+        self.values[base + 1] += v_ji;
+    }
+
+    /// Add `v` to the diagonal entry of `dof`.
+    pub fn add_diagonal(&mut self, dof: usize, v: f64) {
+        let base = self.pattern.elem_values + 2 * self.pattern.couplings.len();
+        self.values[base + dof] += v;
+    }
+
+    /// Add `v` to the right-hand side at `dof`.
+    pub fn add_rhs(&mut self, dof: usize, v: f64) {
+        self.vector[self.vec_elem_len + dof] += v;
+    }
+
+    /// Check every element slot for non-finite values and name the first bad one.
+    pub fn check_finite(&self, mesh: &Mesh) -> Result<(), AssemblyError> {
+        for (b, block) in mesh.blocks.iter().enumerate() {
+            let (off, ne, count) = self.pattern.block_slots[b];
+            let vals = &self.values[off..off + count * ne * ne];
+            if let Some(p) = vals.iter().position(|v| !v.is_finite()) {
+                let k = p / (ne * ne);
+                let e = ElemId(block.first_elem.0 + k as u32);
+                return Err(AssemblyError::NonFiniteElement {
+                    elem: e.0,
+                    number: mesh.elem_number(e),
+                    row: (p % (ne * ne)) / ne,
+                    col: p % ne,
+                    value: vals[p],
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The assembled matrix (values only: the pattern's symbolic structure is cloned
+    /// and the slots are added into their positions in slot order).
+    pub fn matrix(&self) -> Result<SparseColMat<usize, f64>, AssemblyError> {
+        let (sym, positions) = self
+            .pattern
+            .built
+            .as_ref()
+            .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))?;
+        let mut vals = vec![0.0; sym.row_idx().len()];
+        for (&p, &v) in positions.iter().zip(&self.values) {
+            vals[p as usize] += v;
+        }
+        Ok(SparseColMat::new(sym.clone(), vals))
+    }
+
+    /// The assembled right-hand side: the direct loads, then the element vectors added
+    /// in element order.
+    pub fn rhs(&self) -> Vec<f64> {
+        let mut f = self.vector[self.vec_elem_len..].to_vec();
+        for (d, v) in self
+            .pattern
+            .elem_dofs
+            .iter()
+            .zip(&self.vector[..self.vec_elem_len])
+        {
+            if *d != NONE {
+                f[*d as usize] += v;
+            }
+        }
+        f
+    }
+}

@@ -1,0 +1,414 @@
+//! Element and face kernels of heat conduction. Every kernel *adds* into its output
+//! (`ke` row-major `nn × nn`, `fe` length `nn`, `nn` the element's node count), so
+//! several terms can share one element slot.
+//!
+//! Formulas (N_a shape functions, J the isoparametric Jacobian, w_q weights):
+//! - conductivity `K_ab = ∫ k ∇N_a·∇N_b dV`,
+//! - capacity `M_ab = ∫ ρc N_a N_b dV` (consistent) or its row sums on the diagonal
+//!   (lumped),
+//! - source `f_a = ∫ Q N_a dV`,
+//! - face flux `f_a = ∫_Γ q N_a dA` (q into the body), convection `K_ab = ∫_Γ h N_a N_b`
+//!   and `f_a = ∫_Γ h T∞ N_a`,
+//! - nonlinear conduction `R_a = ∫ k(T) ∇N_a·∇T dV` with the exact Jacobian
+//!   `∂R_a/∂T_b = ∫ [k ∇N_a·∇N_b + (dk/dT) N_b ∇N_a·∇T] dV`.
+//!
+//! 2-D elements (`Quad4`, `Tri3`) use x and y and integrate per unit depth.
+
+// Index loops mirror the subscripts of the formulas they implement.
+#![allow(clippy::needless_range_loop)]
+
+use crate::mesh::{FaceShape, Topology};
+
+use super::quadrature::QuadratureRule;
+use super::shape::{face_shape, shape};
+
+/// Largest element node count handled (Hex8).
+pub const MAX_NODES: usize = 8;
+
+/// A non-positive Jacobian determinant at a quadrature point: the element is inverted
+/// or degenerate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BadJacobian {
+    pub det: f64,
+    pub point: [f64; 3],
+}
+
+/// Shape functions mapped to physical space at one quadrature point.
+#[derive(Clone, Copy, Debug)]
+pub struct PointValues {
+    pub n: [f64; MAX_NODES],
+    /// ∇N_a in physical coordinates.
+    pub grad: [[f64; 3]; MAX_NODES],
+    /// Physical position of the point.
+    pub x: [f64; 3],
+    /// det J · w.
+    pub jxw: f64,
+}
+
+/// Shape functions of one topology tabulated at the points of a quadrature rule, so
+/// element loops map them to physical space without re-evaluating them.
+#[derive(Clone, Debug)]
+pub struct Basis {
+    pub topology: Topology,
+    pub rule: QuadratureRule,
+    n: Vec<[f64; MAX_NODES]>,
+    dn: Vec<[[f64; 3]; MAX_NODES]>,
+}
+
+impl Basis {
+    /// Tabulate `topology`'s shape functions at the points of `rule`. Panics for
+    /// topologies without shape functions (see [`super::shape::reference_nodes`]).
+    pub fn new(topology: Topology, rule: QuadratureRule) -> Self {
+        let mut n = Vec::with_capacity(rule.len());
+        let mut dn = Vec::with_capacity(rule.len());
+        for p in &rule.points {
+            let (mut v, mut g) = ([0.0; MAX_NODES], [[0.0; 3]; MAX_NODES]);
+            shape(topology, *p, &mut v, &mut g);
+            n.push(v);
+            dn.push(g);
+        }
+        Basis {
+            topology,
+            rule,
+            n,
+            dn,
+        }
+    }
+
+    /// The element's standard rule ([`QuadratureRule::standard`]); `None` for shells
+    /// and beams.
+    pub fn standard(topology: Topology) -> Option<Self> {
+        QuadratureRule::standard(topology).map(|r| Self::new(topology, r))
+    }
+
+    /// Number of quadrature points.
+    pub fn len(&self) -> usize {
+        self.rule.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rule.is_empty()
+    }
+
+    /// Values at quadrature point `q` of the element with nodes at `coords`.
+    pub fn eval(&self, q: usize, coords: &[[f64; 3]]) -> Result<PointValues, BadJacobian> {
+        map_point(
+            self.topology,
+            coords,
+            &self.n[q],
+            &self.dn[q],
+            self.rule.points[q],
+            self.rule.weights[q],
+        )
+    }
+}
+
+/// Evaluate shape functions, physical gradients and det J·w at reference point `xi`
+/// (untabulated; [`Basis::eval`] is the fast path).
+pub fn eval_point(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    xi: [f64; 3],
+    weight: f64,
+) -> Result<PointValues, BadJacobian> {
+    let (mut n, mut dn) = ([0.0; MAX_NODES], [[0.0; 3]; MAX_NODES]);
+    shape(topology, xi, &mut n, &mut dn);
+    map_point(topology, coords, &n, &dn, xi, weight)
+}
+
+/// Map reference values to physical space: `J_ij = Σ_a x_a,i ∂N_a/∂ξ_j`,
+/// `∇_x N = J⁻ᵀ ∇_ξ N`, `jxw = det J · w`.
+fn map_point(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    n: &[f64; MAX_NODES],
+    dn: &[[f64; 3]; MAX_NODES],
+    xi: [f64; 3],
+    weight: f64,
+) -> Result<PointValues, BadJacobian> {
+    let nn = topology.node_count();
+    let mut pv = PointValues {
+        n: *n,
+        grad: [[0.0; 3]; MAX_NODES],
+        x: [0.0; 3],
+        jxw: 0.0,
+    };
+    let dim = topology.parametric_dim();
+    let mut j = [[0.0; 3]; 3];
+    for a in 0..nn {
+        let (c, d) = (coords[a], dn[a]);
+        for i in 0..3 {
+            pv.x[i] += n[a] * c[i];
+            for k in 0..3 {
+                j[i][k] += c[i] * d[k];
+            }
+        }
+    }
+    // inv = J⁻¹ by cofactors.
+    let mut inv = [[0.0; 3]; 3];
+    let det = if dim == 3 {
+        let c00 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+        let c01 = j[1][2] * j[2][0] - j[1][0] * j[2][2];
+        let c02 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+        let det = j[0][0] * c00 + j[0][1] * c01 + j[0][2] * c02;
+        let r = 1.0 / det;
+        inv[0][0] = c00 * r;
+        inv[1][0] = c01 * r;
+        inv[2][0] = c02 * r;
+        inv[0][1] = (j[0][2] * j[2][1] - j[0][1] * j[2][2]) * r;
+        inv[1][1] = (j[0][0] * j[2][2] - j[0][2] * j[2][0]) * r;
+        inv[2][1] = (j[0][1] * j[2][0] - j[0][0] * j[2][1]) * r;
+        inv[0][2] = (j[0][1] * j[1][2] - j[0][2] * j[1][1]) * r;
+        inv[1][2] = (j[0][2] * j[1][0] - j[0][0] * j[1][2]) * r;
+        inv[2][2] = (j[0][0] * j[1][1] - j[0][1] * j[1][0]) * r;
+        det
+    } else {
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        inv[0][0] = j[1][1] / det;
+        inv[0][1] = -j[0][1] / det;
+        inv[1][0] = -j[1][0] / det;
+        inv[1][1] = j[0][0] / det;
+        det
+    };
+    if det.is_nan() || det <= 0.0 {
+        return Err(BadJacobian { det, point: xi });
+    }
+    // (∇_x N)_i = Σ_k inv[k][i] ∂N/∂ξ_k
+    for a in 0..nn {
+        let d = dn[a];
+        for i in 0..dim {
+            pv.grad[a][i] = inv[0][i] * d[0] + inv[1][i] * d[1] + inv[2][i] * d[2];
+        }
+    }
+    pv.jxw = det * weight;
+    Ok(pv)
+}
+
+/// `K_ab += ∫ k(x) ∇N_a·∇N_b dV`.
+pub fn conductivity(
+    basis: &Basis,
+    coords: &[[f64; 3]],
+    k: impl Fn([f64; 3]) -> f64,
+    ke: &mut [f64],
+) -> Result<(), BadJacobian> {
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
+        let kw = k(pv.x) * pv.jxw;
+        // Upper triangle, mirrored: exactly symmetric and half the work.
+        for a in 0..nn {
+            let ga = pv.grad[a];
+            for b in a..nn {
+                let gb = pv.grad[b];
+                let v = kw * (ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2]);
+                ke[a * nn + b] += v;
+                if b != a {
+                    ke[b * nn + a] += v;
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Consistent capacity `M_ab += ∫ ρc N_a N_b dV`.
+pub fn capacity_consistent(
+    basis: &Basis,
+    coords: &[[f64; 3]],
+    rho_c: f64,
+    me: &mut [f64],
+) -> Result<(), BadJacobian> {
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
+        for a in 0..nn {
+            for b in 0..nn {
+                me[a * nn + b] += rho_c * pv.n[a] * pv.n[b] * pv.jxw;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Lumped capacity: the row sums of the consistent matrix on the diagonal,
+/// `M_aa += ∫ ρc N_a dV` (positive for every element here, since ∫N_a > 0).
+pub fn capacity_lumped(
+    basis: &Basis,
+    coords: &[[f64; 3]],
+    rho_c: f64,
+    me: &mut [f64],
+) -> Result<(), BadJacobian> {
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
+        for a in 0..nn {
+            me[a * nn + a] += rho_c * pv.n[a] * pv.jxw;
+        }
+    }
+    Ok(())
+}
+
+/// `f_a += ∫ Q(x) N_a dV`.
+pub fn source(
+    basis: &Basis,
+    coords: &[[f64; 3]],
+    q: impl Fn([f64; 3]) -> f64,
+    fe: &mut [f64],
+) -> Result<(), BadJacobian> {
+    let nn = basis.topology.node_count();
+    for i in 0..basis.len() {
+        let pv = basis.eval(i, coords)?;
+        let qw = q(pv.x) * pv.jxw;
+        for a in 0..nn {
+            fe[a] += qw * pv.n[a];
+        }
+    }
+    Ok(())
+}
+
+/// Element volume (area for 2-D elements): ∫ 1 dV.
+pub fn measure(basis: &Basis, coords: &[[f64; 3]]) -> Result<f64, BadJacobian> {
+    let mut v = 0.0;
+    for q in 0..basis.len() {
+        v += basis.eval(q, coords)?.jxw;
+    }
+    Ok(v)
+}
+
+/// One quadrature point on a face: face shape values, position, dA·w.
+struct FacePoint {
+    n: [f64; 4],
+    x: [f64; 3],
+    jxw: f64,
+}
+
+fn face_points<'a>(
+    face: FaceShape,
+    fcoords: &'a [[f64; 3]],
+    rule: &'a QuadratureRule,
+) -> impl Iterator<Item = FacePoint> + 'a {
+    rule.points.iter().zip(&rule.weights).map(move |(p, w)| {
+        let mut n = [0.0; 4];
+        let mut dn = [[0.0; 2]; 4];
+        face_shape(face, [p[0], p[1]], &mut n, &mut dn);
+        let mut x = [0.0; 3];
+        let mut t = [[0.0; 3]; 2];
+        for a in 0..face.node_count() {
+            for i in 0..3 {
+                x[i] += n[a] * fcoords[a][i];
+                t[0][i] += dn[a][0] * fcoords[a][i];
+                t[1][i] += dn[a][1] * fcoords[a][i];
+            }
+        }
+        // dA = |∂x/∂s × ∂x/∂t| for surfaces, |∂x/∂s| for edges.
+        let da = match face {
+            FaceShape::Line2 => (t[0][0].powi(2) + t[0][1].powi(2) + t[0][2].powi(2)).sqrt(),
+            _ => {
+                let c = [
+                    t[0][1] * t[1][2] - t[0][2] * t[1][1],
+                    t[0][2] * t[1][0] - t[0][0] * t[1][2],
+                    t[0][0] * t[1][1] - t[0][1] * t[1][0],
+                ];
+                (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+            }
+        };
+        FacePoint { n, x, jxw: da * w }
+    })
+}
+
+/// The face shape, its local element nodes and its coordinates, for 1-based `side`.
+fn side_geometry(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+) -> (FaceShape, &'static [u8], [[f64; 3]; 4]) {
+    let s = side as usize - 1;
+    let local = topology.sides()[s];
+    let mut fc = [[0.0; 3]; 4];
+    for (k, &l) in local.iter().enumerate() {
+        fc[k] = coords[l as usize];
+    }
+    (topology.side_shape(s), local, fc)
+}
+
+/// Rule degree for face integrals: exact for N_a N_b h on flat faces (degree 2 per
+/// direction; bilinear faces need degree 4 for the N N term times the area factor —
+/// we take 4 so warped quads are still integrated accurately).
+const FACE_DEGREE: usize = 4;
+
+/// `f_a += ∫_side q(x) N_a dA` (q: flux into the body). `side` is 1-based (Exodus).
+pub fn face_flux(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+    q: impl Fn([f64; 3]) -> f64,
+    fe: &mut [f64],
+) {
+    let (face, local, fc) = side_geometry(topology, coords, side);
+    let rule = QuadratureRule::face(face, FACE_DEGREE);
+    for fp in face_points(face, &fc, &rule) {
+        let qw = q(fp.x) * fp.jxw;
+        for (k, &l) in local.iter().enumerate() {
+            fe[l as usize] += qw * fp.n[k];
+        }
+    }
+}
+
+/// Convection on a side: `K_ab += ∫ h N_a N_b dA`, `f_a += ∫ h T∞ N_a dA`.
+pub fn face_convection(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+    h: f64,
+    t_inf: f64,
+    ke: &mut [f64],
+    fe: &mut [f64],
+) {
+    let nn = topology.node_count();
+    let (face, local, fc) = side_geometry(topology, coords, side);
+    let rule = QuadratureRule::face(face, FACE_DEGREE);
+    for fp in face_points(face, &fc, &rule) {
+        for (k, &a) in local.iter().enumerate() {
+            fe[a as usize] += h * t_inf * fp.n[k] * fp.jxw;
+            for (m, &b) in local.iter().enumerate() {
+                ke[a as usize * nn + b as usize] += h * fp.n[k] * fp.n[m] * fp.jxw;
+            }
+        }
+    }
+}
+
+/// Nonlinear conduction: `R_a += ∫ k(T) ∇N_a·∇T dV` and its exact Jacobian
+/// `J_ab += ∫ [k ∇N_a·∇N_b + (dk/dT) N_b ∇N_a·∇T] dV`; `k(T, x)` returns `(k, dk/dT)`.
+pub fn conduction_residual_jacobian(
+    basis: &Basis,
+    coords: &[[f64; 3]],
+    t: &[f64],
+    k: impl Fn(f64, [f64; 3]) -> (f64, f64),
+    re: &mut [f64],
+    je: &mut [f64],
+) -> Result<(), BadJacobian> {
+    let nn = basis.topology.node_count();
+    for q in 0..basis.len() {
+        let pv = basis.eval(q, coords)?;
+        let mut tq = 0.0;
+        let mut gt = [0.0; 3];
+        for a in 0..nn {
+            tq += pv.n[a] * t[a];
+            for i in 0..3 {
+                gt[i] += pv.grad[a][i] * t[a];
+            }
+        }
+        let (kq, dk) = k(tq, pv.x);
+        for a in 0..nn {
+            let ga = pv.grad[a];
+            let ga_gt = ga[0] * gt[0] + ga[1] * gt[1] + ga[2] * gt[2];
+            re[a] += kq * ga_gt * pv.jxw;
+            for b in 0..nn {
+                let gb = pv.grad[b];
+                let gg = ga[0] * gb[0] + ga[1] * gb[1] + ga[2] * gb[2];
+                je[a * nn + b] += (kq * gg + dk * pv.n[b] * ga_gt) * pv.jxw;
+            }
+        }
+    }
+    Ok(())
+}
