@@ -264,18 +264,22 @@ fn normal_quad4(x: &[[f64; 3]; 4], xi: [f64; 2], area_normal: V3) -> V3 {
 
 /// Closest point of the bilinear Quad4 face `x` (possibly warped) to `p`.
 ///
-/// Minimises `f(ξ) = ½ |x(ξ) − p|²` over `[-1, 1]²`. Interior stationary points solve
+/// A planar, convex face (the common case) takes a fast exact path: see
+/// `project_planar_quad4` (edge-line tests, then the inverse bilinear map of the foot of
+/// the perpendicular). Otherwise the general path below runs.
+///
+/// General path: minimises `f(ξ) = ½ |x(ξ) − p|²` over `[-1, 1]²`. Interior stationary points solve
 /// `g = (x_ξ · r, x_η · r) = 0`, `r = x(ξ) − p`, by Newton with the Hessian
 /// `H = [x_ξ·x_ξ, x_ξ·x_η + x_ξη·r; ·, x_η·x_η]` (`x_ξξ = x_ηη = 0` for a bilinear map,
 /// `x_ξη = ¼ (x₀ − x₁ + x₂ − x₃)`), switching to the Gauss–Newton matrix `JᵀJ` where `H`
 /// is not positive definite, with the step limited to the square's size and halved until
 /// `f` does not increase. The start is the better of the projections on the two
-/// triangles `(0, 1, 2)` and `(0, 2, 3)`, so a planar face converges in 1–3 steps.
+/// triangles `(0, 1, 2)` and `(0, 2, 3)`.
 ///
 /// The edges of a bilinear face are straight segments, so the minimum on the boundary is
 /// found exactly; it is taken when Newton fails or converges outside the square, and
-/// compared with the interior point otherwise (a warped face can have several local
-/// minima). Never NaN for finite input.
+/// compared with the interior point on a warped face (which can have several local
+/// minima; when the boundary wins, `inside` is false). Never NaN for finite input.
 pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
     let va = vector_area_quad4(x);
     let l2 = longest_edge2(x);
@@ -296,45 +300,27 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
     let xi0 = start_quad4(p, x);
     let (xi, converged) = newton_quad4(p, x, xi0);
     let inside = converged && xi[0].abs() <= 1.0 + INSIDE_TOL && xi[1].abs() <= 1.0 + INSIDE_TOL;
+    let (edge, t, d2_edge) = closest_on_boundary(p, x);
     if inside {
         let xi_c = [xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)];
-        let q = map_quad4(x, xi_c);
-        // On a warped face the interior stationary point need not be the global minimum;
-        // compare with the boundary. A planar face has its stationary point as the global
-        // minimum (Pythagoras in the plane).
         if !warped {
-            // Foot of the perpendicular on the plane, as in `project_point_tri3`.
+            // Planar (non-convex, off the fast path): the stationary point is the global
+            // minimum (Pythagoras in the plane); the foot of the perpendicular, as in
+            // `project_point_tri3`.
             let q = axpy(p, -dot(sub(p, x[0]), area_normal), area_normal);
             return finish(p, xi_c, q, area_normal, true, false);
         }
-        {
-            let (edge, t, d2) = closest_on_boundary(p, x);
-            if d2 < norm2(sub(p, q)) {
-                let xi_b = quad4_edge_xi(edge, t);
-                let q_b = axpy(x[edge], t, sub(x[(edge + 1) % 4], x[edge]));
-                return finish(
-                    p,
-                    xi_b,
-                    q_b,
-                    normal_quad4(x, xi_b, area_normal),
-                    false,
-                    false,
-                );
-            }
+        // Warped: the interior stationary point need not be the global minimum, so it
+        // competes with the closest boundary point (then reported as not inside).
+        let q = map_quad4(x, xi_c);
+        if norm2(sub(p, q)) <= d2_edge {
+            return finish(p, xi_c, q, normal_quad4(x, xi_c, area_normal), true, false);
         }
-        return finish(p, xi_c, q, normal_quad4(x, xi_c, area_normal), true, false);
     }
-    let (edge, t, _) = closest_on_boundary(p, x);
     let xi_b = quad4_edge_xi(edge, t);
     let q_b = axpy(x[edge], t, sub(x[(edge + 1) % 4], x[edge]));
-    finish(
-        p,
-        xi_b,
-        q_b,
-        normal_quad4(x, xi_b, area_normal),
-        false,
-        false,
-    )
+    let normal = normal_quad4(x, xi_b, area_normal);
+    finish(p, xi_b, q_b, normal, false, false)
 }
 
 /// Iterations of the planar inverse map: from the centre of a convex quad Newton
