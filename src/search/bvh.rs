@@ -177,7 +177,7 @@ impl Bvh {
         let mut order: Vec<u32> = (0..n as u32).collect();
         let mut nodes = Vec::with_capacity(if n == 0 { 0 } else { 2 * n.div_ceil(LEAF_SIZE) });
         if n > 0 {
-            build_range(items, &centers, &mut order, 0, &mut nodes);
+            build_range(&centers, &mut order, 0, &mut nodes);
         }
         let boxes = order.iter().map(|&i| items[i as usize]).collect();
         let mut parent = vec![0u32; nodes.len()];
@@ -187,12 +187,14 @@ impl Bvh {
                 parent[node.start as usize] = k as u32;
             }
         }
-        Bvh {
+        let mut bvh = Bvh {
             nodes,
             parent,
             order,
             boxes,
-        }
+        };
+        bvh.fit_bounds();
+        bvh
     }
 
     /// Number of items.
@@ -230,6 +232,11 @@ impl Bvh {
         for (slot, &i) in self.boxes.iter_mut().zip(&self.order) {
             *slot = items[i as usize];
         }
+        self.fit_bounds();
+    }
+
+    /// Node boxes bottom-up from the leaf boxes.
+    fn fit_bounds(&mut self) {
         // Pre-order: children have larger indices than their parent.
         for k in (0..self.nodes.len()).rev() {
             let node = self.nodes[k];
@@ -382,28 +389,21 @@ impl Bvh {
 
 /// Builds the subtree over `order[..]` (which starts at leaf slot `offset`), pushing its
 /// nodes in pre-order; returns nothing, the subtree root is the first node pushed.
-fn build_range(
-    items: &[Aabb],
-    centers: &[V3],
-    order: &mut [u32],
-    offset: usize,
-    nodes: &mut Vec<Node>,
-) {
+fn build_range(centers: &[V3], order: &mut [u32], offset: usize, nodes: &mut Vec<Node>) {
     let me = nodes.len();
-    let bounds = order
-        .iter()
-        .fold(Aabb::EMPTY, |b, &i| b.union(&items[i as usize]));
     let n = order.len();
+    // Bounds are filled in afterwards, bottom-up (`fit_bounds`): one pass in all instead
+    // of one union over the items at every level.
     if n <= LEAF_SIZE {
         nodes.push(Node {
-            bounds,
+            bounds: Aabb::EMPTY,
             start: offset as u32,
             count: n as u32,
         });
         return;
     }
     nodes.push(Node {
-        bounds,
+        bounds: Aabb::EMPTY,
         start: 0,
         count: 0,
     });
@@ -432,9 +432,9 @@ fn build_range(
             .then(a.cmp(&b))
     });
     let (left, right) = order.split_at_mut(mid);
-    build_range(items, centers, left, offset, nodes);
+    build_range(centers, left, offset, nodes);
     let right_index = nodes.len();
-    build_range(items, centers, right, offset + mid, nodes);
+    build_range(centers, right, offset + mid, nodes);
     nodes[me].start = right_index as u32;
 }
 

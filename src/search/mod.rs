@@ -14,6 +14,37 @@
 //!   (-1,1)`.
 //! - Gaps are signed, positive on the side the normal points to; see each module for the
 //!   exact definition.
+//!
+//! A closest-face search for one side-A point against side-B quads:
+//!
+//! ```
+//! use seam::search::bvh::{Aabb, Bvh};
+//! use seam::search::project::project_point_quad4;
+//!
+//! // Side B: two unit squares side by side at z = 0, normals +z.
+//! let faces = [
+//!     [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+//!     [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [1.0, 1.0, 0.0]],
+//! ];
+//! let boxes: Vec<Aabb> = faces.iter().map(|f| Aabb::from_points(f)).collect();
+//! let bvh = Bvh::build(&boxes);
+//!
+//! // A side-A point 0.01 above the second face: query a box around it, project onto
+//! // each candidate, keep the closest.
+//! let p = [1.25, 0.5, 0.01];
+//! let mut best = None;
+//! bvh.query(&Aabb::from_point(p).inflate(0.1), |f| {
+//!     let pr = project_point_quad4(p, &faces[f]);
+//!     if best.is_none_or(|(_, d)| pr.distance < d) {
+//!         best = Some((f, pr.distance));
+//!     }
+//! });
+//! let (face, _) = best.unwrap();
+//! let pr = project_point_quad4(p, &faces[face]);
+//! assert_eq!(face, 1);
+//! assert!(pr.inside && (pr.gap - 0.01).abs() < 1e-15);
+//! assert!((pr.xi[0] + 0.5).abs() < 1e-15 && pr.xi[1].abs() < 1e-15);
+//! ```
 
 pub mod bvh;
 pub mod mortar;

@@ -264,18 +264,22 @@ fn normal_quad4(x: &[[f64; 3]; 4], xi: [f64; 2], area_normal: V3) -> V3 {
 
 /// Closest point of the bilinear Quad4 face `x` (possibly warped) to `p`.
 ///
-/// Minimises `f(ξ) = ½ |x(ξ) − p|²` over `[-1, 1]²`. Interior stationary points solve
+/// A planar, convex face (the common case) takes a fast exact path: see
+/// `project_planar_quad4` (edge-line tests, then the inverse bilinear map of the foot of
+/// the perpendicular). Otherwise the general path below runs.
+///
+/// General path: minimises `f(ξ) = ½ |x(ξ) − p|²` over `[-1, 1]²`. Interior stationary points solve
 /// `g = (x_ξ · r, x_η · r) = 0`, `r = x(ξ) − p`, by Newton with the Hessian
 /// `H = [x_ξ·x_ξ, x_ξ·x_η + x_ξη·r; ·, x_η·x_η]` (`x_ξξ = x_ηη = 0` for a bilinear map,
 /// `x_ξη = ¼ (x₀ − x₁ + x₂ − x₃)`), switching to the Gauss–Newton matrix `JᵀJ` where `H`
 /// is not positive definite, with the step limited to the square's size and halved until
 /// `f` does not increase. The start is the better of the projections on the two
-/// triangles `(0, 1, 2)` and `(0, 2, 3)`, so a planar face converges in 1–3 steps.
+/// triangles `(0, 1, 2)` and `(0, 2, 3)`.
 ///
 /// The edges of a bilinear face are straight segments, so the minimum on the boundary is
 /// found exactly; it is taken when Newton fails or converges outside the square, and
-/// compared with the interior point otherwise (a warped face can have several local
-/// minima). Never NaN for finite input.
+/// compared with the interior point on a warped face (which can have several local
+/// minima; when the boundary wins, `inside` is false). Never NaN for finite input.
 pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
     let va = vector_area_quad4(x);
     let l2 = longest_edge2(x);
@@ -285,56 +289,68 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
     let area_normal = scale(va, 1.0 / norm(va));
     // `w = x₀ − x₁ + x₂ − x₃` measures the twist out of the plane; 1e-12 of the size is
     // round-off of coordinates that were meant to be coplanar.
-    let warped = {
-        let w = sub(add(x[0], x[2]), add(x[1], x[3]));
-        dot(w, area_normal).abs() > 1e-12 * l2.sqrt()
-    };
+    let w_n = dot(sub(add(x[0], x[2]), add(x[1], x[3])), area_normal).abs();
+    let warped = w_n > 1e-12 * l2.sqrt();
     if !warped && let Some(pr) = project_planar_quad4(p, x, area_normal, l2) {
         return pr;
     }
 
-    let xi0 = start_quad4(p, x);
-    let (xi, converged) = newton_quad4(p, x, xi0);
-    let inside = converged && xi[0].abs() <= 1.0 + INSIDE_TOL && xi[1].abs() <= 1.0 + INSIDE_TOL;
-    if inside {
-        let xi_c = [xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)];
-        let q = map_quad4(x, xi_c);
-        // On a warped face the interior stationary point need not be the global minimum;
-        // compare with the boundary. A planar face has its stationary point as the global
-        // minimum (Pythagoras in the plane).
-        if !warped {
-            // Foot of the perpendicular on the plane, as in `project_point_tri3`.
-            let q = axpy(p, -dot(sub(p, x[0]), area_normal), area_normal);
-            return finish(p, xi_c, q, area_normal, true, false);
+    // Interior stationary points from Newton; the closest one found competes with the
+    // closest boundary point (exact: the edges are straight).
+    let (edge, t, d2_edge) = closest_on_boundary(p, x);
+    type Stationary = Option<([f64; 2], V3, f64)>;
+    let stationary = |xi0: [f64; 2]| -> Stationary {
+        let (xi, converged) = newton_quad4(p, x, xi0);
+        if !(converged && xi[0].abs() <= 1.0 + INSIDE_TOL && xi[1].abs() <= 1.0 + INSIDE_TOL) {
+            return None;
         }
-        {
-            let (edge, t, d2) = closest_on_boundary(p, x);
-            if d2 < norm2(sub(p, q)) {
-                let xi_b = quad4_edge_xi(edge, t);
-                let q_b = axpy(x[edge], t, sub(x[(edge + 1) % 4], x[edge]));
-                return finish(
-                    p,
-                    xi_b,
-                    q_b,
-                    normal_quad4(x, xi_b, area_normal),
-                    false,
-                    false,
-                );
+        let xi_c = [xi[0].clamp(-1.0, 1.0), xi[1].clamp(-1.0, 1.0)];
+        let q = if warped {
+            map_quad4(x, xi_c)
+        } else {
+            // Planar: the foot of the perpendicular, as in `project_point_tri3`.
+            axpy(p, -dot(sub(p, x[0]), area_normal), area_normal)
+        };
+        Some((xi_c, q, norm2(sub(p, q))))
+    };
+    let closer = |a: Stationary, b: Stationary| match (a, b) {
+        (Some(u), Some(v)) => Some(if v.2 < u.2 { v } else { u }),
+        (u, v) => u.or(v),
+    };
+    let mut best = stationary(start_quad4(p, x));
+    // One start finds the global minimum when p is well inside the face's tubular
+    // neighbourhood: the curvature of a bilinear patch is about κ = |x_ξη·n| / (|x_ξ||x_η|)
+    // ≈ |w·n| / A (twist over area), and within a quarter of 1/κ the stationary point is
+    // unique. Farther out, and for folded faces (the Jacobian turns against the normal
+    // at a corner, as for a non-convex or bow-tie quad), several local minima can exist:
+    // restart from a 3 × 3 grid of the square and keep the closest.
+    let folded = (0..4).any(|k| {
+        let e_prev = sub(x[k], x[(k + 3) % 4]);
+        let e = sub(x[(k + 1) % 4], x[k]);
+        dot(cross(e_prev, e), area_normal) <= 0.0
+    });
+    let d_now = best.map_or(d2_edge, |b| b.2.min(d2_edge)).sqrt();
+    if !warped || folded || d_now * w_n > 0.25 * norm(va) {
+        for a in [-0.5, 0.0, 0.5] {
+            for b in [-0.5, 0.0, 0.5] {
+                best = closer(best, stationary([a, b]));
             }
         }
-        return finish(p, xi_c, q, normal_quad4(x, xi_c, area_normal), true, false);
     }
-    let (edge, t, _) = closest_on_boundary(p, x);
+    if let Some((xi_c, q, d2)) = best
+        && d2 <= d2_edge
+    {
+        let normal = if warped {
+            normal_quad4(x, xi_c, area_normal)
+        } else {
+            area_normal
+        };
+        return finish(p, xi_c, q, normal, true, false);
+    }
     let xi_b = quad4_edge_xi(edge, t);
     let q_b = axpy(x[edge], t, sub(x[(edge + 1) % 4], x[edge]));
-    finish(
-        p,
-        xi_b,
-        q_b,
-        normal_quad4(x, xi_b, area_normal),
-        false,
-        false,
-    )
+    let normal = normal_quad4(x, xi_b, area_normal);
+    finish(p, xi_b, q_b, normal, false, false)
 }
 
 /// Iterations of the planar inverse map: from the centre of a convex quad Newton
@@ -664,6 +680,34 @@ mod tests {
             );
             assert!(norm(sub(pr.point, map_quad4(&x, pr.xi))) < 1e-14);
         }
+    }
+
+    #[test]
+    fn folded_quad_finds_the_interior_minimum() {
+        // Found by the property test on arbitrary quads: a strongly warped, folded face
+        // whose closest point (ξ ≈ (−0.265, −0.106), by sampling) a single Newton start
+        // misses, returning a boundary point 0.0048 farther away.
+        let x = [
+            [-0.567847524576703, 0.825426595631995, -0.21438333220437528],
+            [
+                0.5108355663097093,
+                -0.7206922048406489,
+                -0.22020777530687866,
+            ],
+            [0.2274357683533758, -0.3331669944504791, -0.362425769411658],
+            [
+                -0.13779206830358143,
+                0.7565022146436776,
+                -0.4241812587545802,
+            ],
+        ];
+        let p = [-0.6079691828968687, 0.0, -0.9242297518048601];
+        let pr = project_point_quad4(p, &x);
+        assert!(pr.inside && pr.distance < 0.86210, "{pr:?}");
+        assert!(close(pr.xi[0], -0.2645, 1e-3) && close(pr.xi[1], -0.1061, 1e-3));
+        // Stationary: p − point is along the normal.
+        let d = sub(p, pr.point);
+        assert!(norm(cross(d, pr.normal)) < 1e-12);
     }
 
     #[test]

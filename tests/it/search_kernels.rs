@@ -270,6 +270,28 @@ proptest! {
     }
 
     #[test]
+    fn quad4_projection_on_arbitrary_quads_is_finite_and_closest(
+        x in prop::array::uniform4(prop::array::uniform3(-1.0..1.0f64)),
+        p in prop::array::uniform3(-1.5..1.5f64),
+    ) {
+        // Any four points: warped, non-convex, bow-tie or nearly degenerate faces.
+        let pr = project_point_quad4(p, &x);
+        let all = pr.xi.iter().chain(&pr.point).chain(&pr.normal).chain([&pr.gap, &pr.distance]);
+        prop_assert!(all.into_iter().all(|v| v.is_finite()), "{pr:?}");
+        prop_assert!(pr.xi.iter().all(|v| v.abs() <= 1.0), "{pr:?}");
+        prop_assert!(norm(sub(map_quad4(&x, pr.xi), pr.point)) < 1e-12, "{pr:?}");
+        let m = 60;
+        let mut best = f64::INFINITY;
+        for i in 0..=m {
+            for j in 0..=m {
+                let xi = [-1.0 + 2.0 * i as f64 / m as f64, -1.0 + 2.0 * j as f64 / m as f64];
+                best = best.min(norm(sub(p, map_quad4(&x, xi))));
+            }
+        }
+        prop_assert!(pr.distance <= best + 1e-12, "{pr:?} vs sampled {best}");
+    }
+
+    #[test]
     fn tri3_projection_is_rigid_and_scale_invariant(
         x in prop::array::uniform3(prop::array::uniform3(-1.0..1.0f64)),
         p in prop::array::uniform3(-1.5..1.5f64),
