@@ -1,0 +1,1 @@
+//! Conductance-coefficient models.
