@@ -181,6 +181,34 @@ pub fn steady_conduction(
     flux_bcs: &[FaceBc],
 ) -> Result<LinearSystem, HeatError> {
     let field = temperature(dofs)?;
+    let mut pattern = Pattern::new(mesh, dofs);
+    pattern.build()?;
+    let mut asm = Assembler::new(&pattern);
+    assemble_conduction(&mut asm, mesh, dofs, materials, source, flux_bcs)?;
+    let mut matrix = asm.matrix()?;
+    let mut rhs = asm.rhs();
+    let bcs = dirichlet_dofs(mesh, dofs, field, dirichlet)?;
+    apply_dirichlet(&mut matrix, &mut rhs, &bcs)?;
+    drop(asm);
+    Ok(LinearSystem {
+        pattern,
+        matrix,
+        rhs,
+    })
+}
+
+/// Fill the element slots of `asm` with the linear conduction terms (conductivity,
+/// source, face flux and convection) of every temperature block; Dirichlet conditions
+/// are left to the caller, so other terms (contact) can be added first.
+pub fn assemble_conduction(
+    asm: &mut Assembler<'_>,
+    mesh: &Mesh,
+    dofs: &DofMap,
+    materials: &[Material],
+    source: Option<SourceFn<'_>>,
+    flux_bcs: &[FaceBc],
+) -> Result<(), HeatError> {
+    let field = temperature(dofs)?;
     if materials.len() != mesh.blocks.len() {
         return Err(HeatError::MaterialCount {
             count: materials.len(),
@@ -204,9 +232,6 @@ pub fn steady_conduction(
         faces.push((s.elem.0, k));
     }
     faces.sort_unstable();
-    let mut pattern = Pattern::new(mesh, dofs);
-    pattern.build()?;
-    let mut asm = Assembler::new(&pattern);
     let errors = FirstError::new();
     asm.elements(mesh, Some(dofs.field_blocks(field)), |e, ke, fe| {
         let (block, _) = mesh.locate(e);
@@ -221,11 +246,11 @@ pub fn steady_conduction(
             errors.record(e, bad_jacobian(mesh, e, bad));
             return;
         }
-        if let Some(q) = source {
-            if let Err(bad) = kernel::source(rule, x, q, fe) {
-                errors.record(e, bad_jacobian(mesh, e, bad));
-                return;
-            }
+        if let Some(q) = source
+            && let Err(bad) = kernel::source(rule, x, q, fe)
+        {
+            errors.record(e, bad_jacobian(mesh, e, bad));
+            return;
         }
         let first = faces.partition_point(|f| f.0 < e.0);
         for &(_, k) in faces[first..].iter().take_while(|f| f.0 == e.0) {
@@ -239,16 +264,7 @@ pub fn steady_conduction(
     });
     errors.into_result()?;
     asm.check_finite(mesh)?;
-    let mut matrix = asm.matrix()?;
-    let mut rhs = asm.rhs();
-    let bcs = dirichlet_dofs(mesh, dofs, field, dirichlet)?;
-    apply_dirichlet(&mut matrix, &mut rhs, &bcs)?;
-    drop(asm);
-    Ok(LinearSystem {
-        pattern,
-        matrix,
-        rhs,
-    })
+    Ok(())
 }
 
 /// `(dof, value)` pairs of nodal Dirichlet data on the temperature field.
