@@ -19,6 +19,7 @@
 pub mod kernel;
 pub mod quadrature;
 pub mod shape;
+pub mod steady;
 
 use std::sync::Mutex;
 
@@ -61,6 +62,8 @@ pub enum HeatError {
     DirichletOffField(i64),
     #[error("side {side} of element {number} is not a side of that element")]
     BadSide { number: i64, side: u8 },
+    #[error("contact: {0}")]
+    Contact(String),
     #[error(transparent)]
     Assembly(#[from] AssemblyError),
     #[error(transparent)]
@@ -101,7 +104,7 @@ pub struct LinearSystem {
     pub rhs: Vec<f64>,
 }
 
-type SourceFn<'a> = &'a (dyn Fn([f64; 3]) -> f64 + Sync);
+pub type SourceFn<'a> = &'a (dyn Fn([f64; 3]) -> f64 + Sync);
 
 fn temperature(dofs: &DofMap) -> Result<FieldId, HeatError> {
     dofs.field(TEMPERATURE).ok_or(HeatError::NoTemperatureField)

@@ -1,0 +1,500 @@
+//! Interface forms of the flux-type enforcements, evaluated at contact points and
+//! assembled into the host's system.
+//!
+//! Model problem (DESIGN.md): side A (Ω_A) and side B (Ω_B) meet on Γ; `[u] = u_A − u_B`,
+//! the flux from A to B is `q = −k ∇u·n`. With `{k∂u} = w_A k_A ∇u_A·n_A − w_B k_B
+//! ∇u_B·n_B` (each side's own outward normal, so periodic images need no special
+//! case; `w_A + w_B = 1`), every model here is one bilinear form
+//!
+//! ```text
+//! B_Γ(u, v) = ∫ P [u][v] − θ ({k∂u}[v] + [u]{k∂v}) − S {k∂u}{k∂v}
+//! ```
+//!
+//! with coefficients per model:
+//!
+//! | model | P | θ | S |
+//! |---|---|---|---|
+//! | `Contact_Resistance`, `Conductance`, `Dash` (penalty ρ) | h (or ρ) | 0 | 0 |
+//! | `Gap_Conductance` (Robin–Nitsche) | hα/(h+α) | h/(h+α) | 1/(h+α) |
+//! | `Tied_<field>` (weighted Nitsche) | α | 1 | 0 |
+//! | `Tied_Ip_<field>` (interior penalty) | α_ip | 1 | 0 |
+//!
+//! The Robin–Nitsche row is the interface form of Juntunen & Stenberg (2009): it follows
+//! from the consistent identity `q = ([u] + γ{q})/(ε + γ)` with `ε = 1/h`, `γ = 1/α`,
+//! symmetrised by the consistent term `(γ/(ε+γ))([u] − ε{q}){q(v)}`. It is the resistance
+//! form as h → 0 and tied Nitsche as h → ∞, and stable for every h in between.
+//! Weights and penalty (Annavarapu et al. 2012): `w_A = k_B/(k_A+k_B)`, `w_B =
+//! k_A/(k_A+k_B)` and `α = β k_eff / h_e` with `k_eff = 2k_A k_B/(k_A+k_B)` and `h_e` the
+//! smaller of the two elements' volume-to-face-area ratios, so high conductivity
+//! contrast stays robust; `Tied_Ip` uses `w = ½` and `α_ip = β (k_A+k_B)/2 / h_e`.
+//!
+//! An `Offset Temperature` ΔT replaces `[u]` by `[u] − ΔT` (a prescribed jump).
+//!
+//! Heat accounting: with `v = 1` on all of side A (0 on B), the form gives the heat
+//! leaving side A, `∫ P([u] − ΔT) − θ{k∂u}`; with `v = 1` on side B, minus the same. So
+//! the heat through each side is read off the assembled interface residual, and their
+//! sum is zero to round-off for every model here.
+
+use std::collections::HashMap;
+
+use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId, Pattern};
+use crate::heat::kernel::{MAX_NODES, eval_point};
+use crate::heat::shape::reference_nodes;
+use crate::mesh::{ElemId, Mesh, Side, Topology};
+use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
+
+/// Default Nitsche penalty factor β in `α = β k_eff / h_e`: well above the inverse-
+/// estimate constant of trilinear and linear elements with `h_e` = volume / face area
+/// (coercivity needs β > 2 C_I with C_I ≲ 4 for these elements).
+pub const DEFAULT_BETA: f64 = 20.0;
+
+/// Which interface form.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Form {
+    /// `P = h`: contact resistance, conductance, and mortar penalty ties (Dash).
+    Conductance,
+    /// Robin–Nitsche gap conductance.
+    GapConductance,
+    /// Weighted symmetric Nitsche tie.
+    TiedNitsche,
+    /// Symmetric interior-penalty tie (arithmetic weights).
+    TiedInteriorPenalty,
+}
+
+/// The conductance at one point and its derivatives (for Newton).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HValue {
+    pub h: f64,
+    pub dh_dtemp_a: f64,
+    pub dh_dtemp_b: f64,
+}
+
+/// What the conductance may depend on at a point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HInput {
+    pub gap: f64,
+    pub temp_a: f64,
+    pub temp_b: f64,
+    pub x: [f64; 3],
+}
+
+/// One interaction's enforcement, ready to assemble.
+pub struct InterfaceForm<'a> {
+    pub form: Form,
+    /// The conductance (for `Conductance`/`GapConductance`); a penalty for Dash goes here
+    /// too, as a constant.
+    pub h: &'a (dyn Fn(&HInput) -> Result<HValue, String> + Sync),
+    /// Prescribed jump ΔT (`Offset Temperature`).
+    pub offset: f64,
+    /// β of the Nitsche penalty, times the interaction's penalty scale.
+    pub beta: f64,
+    /// Conductivity of each block (by block index).
+    pub conductivity: &'a [f64],
+}
+
+/// Everything one contact point needs from one side: the element, its dofs, shape
+/// values and physical gradients at the point, the outward normal, k and h_e.
+#[derive(Clone, Copy, Debug)]
+pub struct SideEval {
+    pub elem: ElemId,
+    pub len: usize,
+    pub dofs: [u32; MAX_NODES],
+    pub n: [f64; MAX_NODES],
+    pub grad: [[f64; 3]; MAX_NODES],
+    pub normal: [f64; 3],
+    pub k: f64,
+    /// Element volume / face area: the length of the Nitsche penalty.
+    pub h_e: f64,
+}
+
+/// Why an interface could not be set up.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum InterfaceError {
+    #[error("element {number}: a contact point could not be placed in it (Jacobian {det:.3e})")]
+    BadElement { number: i64, det: f64 },
+    #[error("element {number} has topology {topology:?}, which carries no shape functions")]
+    NoShapes { number: i64, topology: Topology },
+    #[error("node {number} of element {elem} has no `{field}` dof")]
+    NoDof {
+        number: i64,
+        elem: i64,
+        field: String,
+    },
+    #[error("conductance at ({x:.6}, {y:.6}, {z:.6}): {message}", x = at[0], y = at[1], z = at[2])]
+    Conductance { at: [f64; 3], message: String },
+    #[error(transparent)]
+    Assembly(#[from] AssemblyError),
+}
+
+/// Reference coordinates, in element `elem`, of the point with face coordinates `xi` on
+/// local side `side`: the face's own shape functions interpolate the reference
+/// coordinates of its nodes.
+fn reference_point(topology: Topology, side: u8, xi: [f64; 2]) -> Option<[f64; 3]> {
+    let nodes = reference_nodes(topology)?;
+    let local = topology.sides().get(side as usize - 1)?;
+    let w: Vec<f64> = match local.len() {
+        3 => vec![1.0 - xi[0] - xi[1], xi[0], xi[1]],
+        4 => {
+            let (s, t) = (xi[0], xi[1]);
+            vec![
+                0.25 * (1.0 - s) * (1.0 - t),
+                0.25 * (1.0 + s) * (1.0 - t),
+                0.25 * (1.0 + s) * (1.0 + t),
+                0.25 * (1.0 - s) * (1.0 + t),
+            ]
+        }
+        _ => return None,
+    };
+    let mut p = [0.0; 3];
+    for (k, &l) in local.iter().enumerate() {
+        for d in 0..3 {
+            p[d] += w[k] * nodes[l as usize][d];
+        }
+    }
+    Some(p)
+}
+
+/// Evaluate one side at a point of face `side`, face coordinates `xi`.
+pub fn side_eval(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    field: FieldId,
+    side: Side,
+    xi: [f64; 2],
+    conductivity: &[f64],
+) -> Result<SideEval, InterfaceError> {
+    let elem = side.elem;
+    let topology = mesh.topology(elem);
+    let number = mesh.elem_number(elem);
+    let xi3 = reference_point(topology, side.side, xi)
+        .ok_or(InterfaceError::NoShapes { number, topology })?;
+    let nodes = mesh.elem_nodes(elem);
+    let mut coords = [[0.0; 3]; MAX_NODES];
+    for (k, n) in nodes.iter().enumerate() {
+        coords[k] = mesh.coords[n.index()];
+    }
+    let pv = eval_point(topology, &coords[..nodes.len()], xi3, 1.0)
+        .map_err(|b| InterfaceError::BadElement { number, det: b.det })?;
+    let mut out = SideEval {
+        elem,
+        len: nodes.len(),
+        dofs: [0; MAX_NODES],
+        n: pv.n,
+        grad: pv.grad,
+        normal: outward_normal(mesh, side),
+        k: conductivity[mesh.block_of(elem)],
+        h_e: element_length(mesh, elem, side),
+    };
+    for (k, &node) in nodes.iter().enumerate() {
+        out.dofs[k] = dofs
+            .dof(field, node)
+            .ok_or_else(|| InterfaceError::NoDof {
+                number: mesh.node_number(node),
+                elem: number,
+                field: dofs.field_name(field).to_string(),
+            })?
+            .0;
+    }
+    Ok(out)
+}
+
+/// Outward unit normal of a (planar or nearly planar) side: its vector area.
+fn outward_normal(mesh: &Mesh, side: Side) -> [f64; 3] {
+    let p: Vec<[f64; 3]> = mesh
+        .side_nodes(side)
+        .map(|n| mesh.coords[n.index()])
+        .collect();
+    let v = match p.len() {
+        3 => cross(sub(p[1], p[0]), sub(p[2], p[0])),
+        4 => cross(sub(p[2], p[0]), sub(p[3], p[1])),
+        _ => [0.0; 3],
+    };
+    let l = norm(v);
+    if l > 0.0 { v.map(|c| c / l) } else { v }
+}
+
+/// Volume of the element over the area of the side: the element's thickness normal to
+/// the interface (exact for a box cell; within a factor ~3 for tets).
+fn element_length(mesh: &Mesh, elem: ElemId, side: Side) -> f64 {
+    let topology = mesh.topology(elem);
+    let nodes = mesh.elem_nodes(elem);
+    let mut coords = [[0.0; 3]; MAX_NODES];
+    for (k, n) in nodes.iter().enumerate() {
+        coords[k] = mesh.coords[n.index()];
+    }
+    let volume = crate::heat::Basis::standard(topology)
+        .and_then(|b| crate::heat::kernel::measure(&b, &coords[..nodes.len()]).ok())
+        .unwrap_or(0.0);
+    let p: Vec<[f64; 3]> = mesh
+        .side_nodes(side)
+        .map(|n| mesh.coords[n.index()])
+        .collect();
+    let area = match p.len() {
+        3 => 0.5 * norm(cross(sub(p[1], p[0]), sub(p[2], p[0]))),
+        4 => 0.5 * norm(cross(sub(p[2], p[0]), sub(p[3], p[1]))),
+        _ => 0.0,
+    };
+    if area > 0.0 { volume / area } else { 0.0 }
+}
+
+/// The coefficients (P, θ, S) and their derivatives with respect to h.
+fn coefficients(form: Form, h: f64, alpha: f64) -> ([f64; 3], [f64; 3]) {
+    match form {
+        Form::Conductance => ([h, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        Form::TiedNitsche | Form::TiedInteriorPenalty => ([alpha, 1.0, 0.0], [0.0; 3]),
+        Form::GapConductance => {
+            if !h.is_finite() {
+                return ([alpha, 1.0, 0.0], [0.0; 3]);
+            }
+            let d = h + alpha;
+            (
+                [h * alpha / d, h / d, 1.0 / d],
+                [alpha * alpha / (d * d), alpha / (d * d), -1.0 / (d * d)],
+            )
+        }
+    }
+}
+
+/// Per-point local vectors: jump and flux-average of each local basis function (side
+/// A's dofs first, then side B's), and their values for the current field.
+struct Local {
+    dofs: Vec<u32>,
+    /// `J_i`: the jump of basis function i (`N_A,i` or `−N_B,i`).
+    jump: Vec<f64>,
+    /// `F_i`: the weighted flux average `{k∂N_i}`.
+    flux: Vec<f64>,
+    /// Indices of side A's dofs in `dofs` are `0..na`.
+    na: usize,
+    alpha: f64,
+}
+
+fn local(a: &SideEval, b: &SideEval, form: Form, beta: f64) -> Local {
+    let (ka, kb) = (a.k, b.k);
+    let (wa, wb) = match form {
+        Form::TiedInteriorPenalty => (0.5, 0.5),
+        _ => (kb / (ka + kb), ka / (ka + kb)),
+    };
+    let h_e = a.h_e.min(b.h_e).max(f64::MIN_POSITIVE);
+    let k_eff = match form {
+        Form::TiedInteriorPenalty => 0.5 * (ka + kb),
+        _ => 2.0 * ka * kb / (ka + kb),
+    };
+    let mut l = Local {
+        dofs: Vec::with_capacity(a.len + b.len),
+        jump: Vec::with_capacity(a.len + b.len),
+        flux: Vec::with_capacity(a.len + b.len),
+        na: a.len,
+        alpha: beta * k_eff / h_e,
+    };
+    for i in 0..a.len {
+        l.dofs.push(a.dofs[i]);
+        l.jump.push(a.n[i]);
+        l.flux.push(wa * ka * dot(a.grad[i], a.normal));
+    }
+    for i in 0..b.len {
+        l.dofs.push(b.dofs[i]);
+        l.jump.push(-b.n[i]);
+        l.flux.push(-wb * kb * dot(b.grad[i], b.normal));
+    }
+    l
+}
+
+/// The assembled interface terms of one interaction: for each pair of elements
+/// (A, B) met by some point, a dense block over their dofs, and a right-hand side.
+#[derive(Clone, Debug, Default)]
+pub struct InterfaceSystem {
+    /// Dense blocks keyed by (element A, element B): (dofs, row-major matrix).
+    pub blocks: Vec<(Vec<u32>, Vec<f64>)>,
+    /// (dof, value) right-hand-side contributions.
+    pub rhs: Vec<(u32, f64)>,
+    /// The interface residual `B_Γ(u, ·) − ℓ_Γ(·)` at the given field, by dof.
+    pub residual: Vec<(u32, f64)>,
+    /// Dofs of side A (for heat accounting).
+    pub side_a_dofs: Vec<u32>,
+    pub side_b_dofs: Vec<u32>,
+}
+
+/// Evaluate the interface form of one interaction at the field `u` (global dof vector):
+/// the Jacobian blocks (exact, including dh/dT), the residual and, for linear models,
+/// the right-hand side of `K u = f`.
+#[allow(clippy::too_many_arguments)]
+pub fn interface_terms(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    field: FieldId,
+    a: &SurfaceGeometry,
+    b: &SurfaceGeometry,
+    points: &[ContactPoint],
+    form: &InterfaceForm<'_>,
+    u: &[f64],
+) -> Result<InterfaceSystem, InterfaceError> {
+    let mut blocks: HashMap<(u32, u32), (Vec<u32>, Vec<f64>)> = HashMap::new();
+    let mut rhs: HashMap<u32, f64> = HashMap::new();
+    let mut residual: HashMap<u32, f64> = HashMap::new();
+    let mut side_a = Vec::new();
+    let mut side_b = Vec::new();
+    for p in points.iter().filter(|p| p.status == PointStatus::Matched) {
+        if p.a_face == u32::MAX {
+            continue; // node points carry no face to integrate over
+        }
+        let fa = &a.faces[p.a_face as usize];
+        let fb = &b.faces[p.b_face as usize];
+        let ea = side_eval(mesh, dofs, field, fa.side, p.xi_a, form.conductivity)?;
+        let eb = side_eval(mesh, dofs, field, fb.side, p.xi_b, form.conductivity)?;
+        let l = local(&ea, &eb, form.form, form.beta);
+        let nl = l.dofs.len();
+        let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[l.dofs[i] as usize]).sum() };
+        let jump_u = value(&l.jump) - form.offset;
+        let flux_u = value(&l.flux);
+        let temp_a: f64 = (0..l.na).map(|i| l.jump[i] * u[l.dofs[i] as usize]).sum();
+        let temp_b = temp_a - (jump_u + form.offset);
+        let hv = match form.form {
+            Form::Conductance | Form::GapConductance => (form.h)(&HInput {
+                gap: p.gap - p.offset,
+                temp_a,
+                temp_b,
+                x: p.x,
+            })
+            .map_err(|message| InterfaceError::Conductance { at: p.x, message })?,
+            _ => HValue::default(),
+        };
+        let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, l.alpha);
+        let w = p.weight;
+        // dh/du_j: T_A = Σ_A N u, T_B = Σ_B N u (jump entries of B are −N).
+        let dh: Vec<f64> = (0..nl)
+            .map(|j| {
+                if j < l.na {
+                    hv.dh_dtemp_a * l.jump[j]
+                } else {
+                    -hv.dh_dtemp_b * l.jump[j]
+                }
+            })
+            .collect();
+        let key = (ea.elem.0, eb.elem.0);
+        let entry = blocks
+            .entry(key)
+            .or_insert_with(|| (l.dofs.clone(), vec![0.0; nl * nl]));
+        for i in 0..nl {
+            let (ji, fi) = (l.jump[i], l.flux[i]);
+            // Residual r_i = w [P J_i [u]' − θ (F_i [u]' + J_i F(u)) − S F_i F(u)].
+            let r_p = ji * jump_u;
+            let r_t = -(fi * jump_u + ji * flux_u);
+            let r_s = -fi * flux_u;
+            *residual.entry(l.dofs[i]).or_default() += w * (cp * r_p + ct * r_t + cs * r_s);
+            // Right-hand side of the linear form (the offset terms).
+            *rhs.entry(l.dofs[i]).or_default() += w * form.offset * (cp * ji - ct * fi);
+            let dr_dh = dp * r_p + dt * r_t + ds * r_s;
+            for j in 0..nl {
+                let (jj, fj) = (l.jump[j], l.flux[j]);
+                let lin = cp * ji * jj - ct * (fi * jj + ji * fj) - cs * fi * fj;
+                entry.1[i * nl + j] += w * (lin + dr_dh * dh[j]);
+            }
+        }
+        side_a.extend_from_slice(&l.dofs[..l.na]);
+        side_b.extend_from_slice(&l.dofs[l.na..]);
+    }
+    side_a.sort_unstable();
+    side_a.dedup();
+    side_b.sort_unstable();
+    side_b.dedup();
+    let mut blocks: Vec<_> = blocks.into_iter().collect();
+    blocks.sort_by_key(|(k, _)| *k);
+    let mut rhs: Vec<_> = rhs.into_iter().collect();
+    rhs.sort_unstable_by_key(|x| x.0);
+    let mut residual: Vec<_> = residual.into_iter().collect();
+    residual.sort_unstable_by_key(|x| x.0);
+    Ok(InterfaceSystem {
+        blocks: blocks.into_iter().map(|(_, v)| v).collect(),
+        rhs,
+        residual,
+        side_a_dofs: side_a,
+        side_b_dofs: side_b,
+    })
+}
+
+impl InterfaceSystem {
+    /// The dof pairs (i < j) the blocks couple, for [`Pattern::add_couplings`].
+    pub fn couplings(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for (dofs, _) in &self.blocks {
+            for (a, &i) in dofs.iter().enumerate() {
+                for &j in &dofs[a + 1..] {
+                    if i != j {
+                        out.push((i.min(j) as usize, i.max(j) as usize));
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Add the blocks into `asm`, whose pattern holds `couplings` (as returned by
+    /// [`Self::couplings`], registered at `first` onwards).
+    pub fn add_to(&self, asm: &mut Assembler<'_>, couplings: &[(usize, usize)], first: usize) {
+        for (dofs, m) in &self.blocks {
+            let n = dofs.len();
+            for a in 0..n {
+                for c in 0..n {
+                    let (i, j) = (dofs[a] as usize, dofs[c] as usize);
+                    let v = m[a * n + c];
+                    if v == 0.0 {
+                        continue;
+                    }
+                    if i == j {
+                        asm.add_diagonal(i, v);
+                    } else {
+                        let key = (i.min(j), i.max(j));
+                        let k = couplings
+                            .binary_search(&key)
+                            .expect("coupling registered from the same blocks");
+                        if i < j {
+                            asm.add_coupling(first + k, v, 0.0);
+                        } else {
+                            asm.add_coupling(first + k, 0.0, v);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Heat leaving side A and side B through Γ, read off the interface residual.
+    pub fn heat(&self) -> (f64, f64) {
+        let sum = |set: &[u32]| -> f64 {
+            self.residual
+                .iter()
+                .filter(|(d, _)| set.binary_search(d).is_ok())
+                .map(|(_, v)| v)
+                .sum()
+        };
+        (sum(&self.side_a_dofs), sum(&self.side_b_dofs))
+    }
+}
+
+/// Make sure a pattern knows a set of couplings; returns their first index.
+pub fn register(
+    pattern: &mut Pattern,
+    couplings: &[(usize, usize)],
+) -> Result<usize, AssemblyError> {
+    Ok(pattern.add_couplings(couplings)?.start)
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
