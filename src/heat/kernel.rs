@@ -336,6 +336,19 @@ fn side_geometry(
 /// we take 4 so warped quads are still integrated accurately).
 const FACE_DEGREE: usize = 4;
 
+/// The face rule of each face shape, made once.
+fn face_rule(face: FaceShape) -> &'static QuadratureRule {
+    use std::sync::OnceLock;
+    static RULES: [OnceLock<QuadratureRule>; 3] =
+        [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    let k = match face {
+        FaceShape::Line2 => 0,
+        FaceShape::Tri3 => 1,
+        FaceShape::Quad4 => 2,
+    };
+    RULES[k].get_or_init(|| QuadratureRule::face(face, FACE_DEGREE))
+}
+
 /// `f_a += ∫_side q(x) N_a dA` (q: flux into the body). `side` is 1-based (Exodus).
 pub fn face_flux(
     topology: Topology,
@@ -345,8 +358,7 @@ pub fn face_flux(
     fe: &mut [f64],
 ) {
     let (face, local, fc) = side_geometry(topology, coords, side);
-    let rule = QuadratureRule::face(face, FACE_DEGREE);
-    for fp in face_points(face, &fc, &rule) {
+    for fp in face_points(face, &fc, face_rule(face)) {
         let qw = q(fp.x) * fp.jxw;
         for (k, &l) in local.iter().enumerate() {
             fe[l as usize] += qw * fp.n[k];
@@ -366,8 +378,7 @@ pub fn face_convection(
 ) {
     let nn = topology.node_count();
     let (face, local, fc) = side_geometry(topology, coords, side);
-    let rule = QuadratureRule::face(face, FACE_DEGREE);
-    for fp in face_points(face, &fc, &rule) {
+    for fp in face_points(face, &fc, face_rule(face)) {
         for (k, &a) in local.iter().enumerate() {
             fe[a as usize] += h * t_inf * fp.n[k] * fp.jxw;
             for (m, &b) in local.iter().enumerate() {

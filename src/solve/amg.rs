@@ -18,7 +18,9 @@
 //!
 //! The V-cycle smooths with symmetric Gauss–Seidel (forward before, backward after the
 //! coarse correction) or damped Jacobi `ω = 4/(3ρ)`, so the preconditioner is symmetric
-//! positive definite and CG applies. The coarsest level is solved by dense Cholesky.
+//! positive definite and CG applies. The coarsest level is solved by dense Cholesky
+//! (or, when coarsening stalls above 2000 unknowns, by 20 symmetric Gauss–Seidel
+//! sweeps — the iteration count then grows with the mesh).
 
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
@@ -325,7 +327,10 @@ impl AmgCg {
         }
         let last = self.levels.last().unwrap();
         self.coarse_n = last.a.nrows;
-        if self.coarse_n <= 4 * self.options.coarse_size.max(1000) {
+        // Dense Cholesky costs n³/3 flops: fine to ~2000 unknowns (≈ 3e9 flops). A
+        // larger coarsest level (coarsening stalled or `max_levels` reached) is
+        // smoothed instead: 20 symmetric Gauss–Seidel sweeps.
+        if self.coarse_n <= self.options.coarse_size.max(2000) {
             self.coarse = dense_cholesky(&last.a)?;
         } else {
             self.coarse.clear();

@@ -982,3 +982,36 @@ fn assembly_matches_faer_triplets() {
     assert_eq!(dofs.elem_dof_count(&mesh, 0), 8);
     assert_eq!(dofs.elem_dof_count(&mesh, 1), 8);
 }
+
+/// Convection (Robin) faces against the exact 1-D solution: T(0) = T₀, −kT′(1) =
+/// h(T(1) − T∞), insulated elsewhere, gives the linear T = T₀ + s·x with
+/// s = h(T∞ − T₀)/(k + h). Linear fields are reproduced exactly, so the nodal values
+/// match to round-off, on Hex8 and Tet4 (whose x = 1 sides are triangles).
+#[test]
+fn convection_faces_reproduce_exact_robin_solution() {
+    let (k, h, t0, t_inf) = (2.0, 5.0, 400.0, 300.0);
+    let s = h * (t_inf - t0) / (k + h);
+    for spec in [
+        BoxSpec::hex([0.0; 3], [1.0, 0.5, 0.5], [4, 2, 2], 1),
+        BoxSpec::tet([0.0; 3], [1.0, 0.5, 0.5], [4, 2, 2], 1),
+    ] {
+        let mesh = single_box(spec.with_side_sets([0, 2, 0, 0, 0, 0]));
+        let right = mesh.side_sets.iter().find(|s| s.id == 2).unwrap();
+        let faces: Vec<FaceBc> = right
+            .sides
+            .iter()
+            .map(|&side| FaceBc::Convection { side, h, t_inf })
+            .collect();
+        let bc: Vec<(NodeId, f64)> = (0..mesh.num_nodes())
+            .filter(|&i| mesh.coords[i][0] == 0.0)
+            .map(|i| (NodeId(i as u32), t0))
+            .collect();
+        let t = solve_steady(&mesh, k, None, &bc, &faces);
+        let err = max_abs(t.iter().zip(&mesh.coords).map(|(t, p)| t - (t0 + s * p[0])));
+        assert!(
+            err <= 1e-12 * t0,
+            "{:?}: {err:.3e}",
+            mesh.blocks[0].topology
+        );
+    }
+}
