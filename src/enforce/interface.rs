@@ -35,6 +35,8 @@
 //! the heat through each side is read off the assembled interface residual, and their
 //! sum is zero to round-off for every model here.
 
+#![allow(clippy::needless_range_loop)] // index loops mirror the formulas' subscripts
+
 use std::collections::HashMap;
 
 use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId, Pattern};

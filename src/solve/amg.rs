@@ -567,10 +567,10 @@ fn aggregate(a: &Csr, theta: f64) -> (Vec<usize>, usize) {
     // Pass 2: a free node joins the aggregate of a strong neighbour from pass 1.
     let after_pass1 = agg.clone();
     for i in 0..n {
-        if agg[i] == FREE {
-            if let Some(j) = strong(i).find(|&j| after_pass1[j] < ISOLATED) {
-                agg[i] = after_pass1[j];
-            }
+        if agg[i] == FREE
+            && let Some(j) = strong(i).find(|&j| after_pass1[j] < ISOLATED)
+        {
+            agg[i] = after_pass1[j];
         }
     }
     // Pass 3: what is left groups with its free strong neighbours.
@@ -625,10 +625,10 @@ fn smoothed_prolongator(a: &Csr, inv_diag: &[f64], agg: &[usize], nagg: usize, o
         sp.val[sp.ptr[i]..sp.ptr[i + 1]]
             .iter_mut()
             .for_each(|v| *v = -*v);
-        if agg[i] != usize::MAX {
-            if let Some(p) = (sp.ptr[i]..sp.ptr[i + 1]).find(|&p| sp.idx[p] == agg[i]) {
-                sp.val[p] += 1.0;
-            }
+        if agg[i] != usize::MAX
+            && let Some(p) = (sp.ptr[i]..sp.ptr[i + 1]).find(|&p| sp.idx[p] == agg[i])
+        {
+            sp.val[p] += 1.0;
         }
     }
     sp
