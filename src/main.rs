@@ -60,6 +60,15 @@ enum Command {
         #[arg(long, default_value_t = 2)]
         order: usize,
     },
+    /// Solve a heat-transfer problem with contact (a TOML problem file) and write the
+    /// temperature as VTK XML. Exit 1 if Newton does not converge.
+    Run {
+        /// The problem file (see docs/run.md).
+        problem: PathBuf,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
     /// Load an enforcement plugin, print its descriptor, and probe it on a grid of
     /// states: outputs finite and non-negative, derivatives against finite differences.
     /// Exit 0 when it passes, 3 on any fault.
@@ -97,6 +106,7 @@ fn main() -> ExitCode {
             segments,
             order,
         } => search(&deck, &mesh, json, segments, order),
+        Command::Run { problem, json } => run(&problem, json),
         Command::CheckPlugin {
             path,
             real,
@@ -442,6 +452,65 @@ fn format_number(x: f64) -> String {
         format!("{x:.6}")
     } else {
         format!("{x:.6e}")
+    }
+}
+
+fn run(path: &Path, json: bool) -> ExitCode {
+    match seam::run::run(path) {
+        Ok(r) => {
+            let s = &r.summary;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string(s).expect("plain data serialises")
+                );
+            } else {
+                println!(
+                    "{} dofs, {} Newton iteration(s), {}",
+                    s.dofs,
+                    s.newton_iterations,
+                    if s.converged {
+                        "converged"
+                    } else {
+                        "NOT converged"
+                    }
+                );
+                for i in &s.interactions {
+                    println!(
+                        "  {} / {} ({}): heat out of A {:.6e}, out of B {:.6e}, imbalance {:.3e}",
+                        i.side_a, i.side_b, i.model, i.heat_side_a, i.heat_side_b, i.imbalance
+                    );
+                }
+                if let Some(o) = &s.output {
+                    println!("  wrote {}", o.display());
+                }
+                println!(
+                    "  time: surfaces {:.3} s, search {:.3} s, assembly {:.3} s, factor {:.3} s, solve {:.3} s, total {:.3} s",
+                    s.timing.surfaces_s,
+                    s.timing.search_s,
+                    s.timing.assembly_s,
+                    s.timing.factor_s,
+                    s.timing.solve_s,
+                    s.timing.total_s
+                );
+            }
+            use std::io::Write as _;
+            let _ = std::io::stdout().flush();
+            eprint!("{}", r.warnings.render(&r.sources));
+            if s.converged {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }
+        Err(seam::run::RunError::Input(d, sources)) => {
+            eprint!("{}", d.render(&sources));
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+        Err(seam::run::RunError::Solve(e)) => {
+            eprintln!("error[E0800]: {e}");
+            ExitCode::from(1)
+        }
     }
 }
 

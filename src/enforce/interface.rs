@@ -14,7 +14,8 @@
 //!
 //! | model | P | θ | S |
 //! |---|---|---|---|
-//! | `Contact_Resistance`, `Conductance`, `Dash` (penalty ρ) | h (or ρ) | 0 | 0 |
+//! | `Contact_Resistance`, `Conductance` | h | 0 | 0 |
+//! | `Dash` (mortar penalty) | β_D k_eff / h_e | 0 | 0 |
 //! | `Gap_Conductance` (Robin–Nitsche) | hα/(h+α) | h/(h+α) | 1/(h+α) |
 //! | `Tied_<field>` (weighted Nitsche) | α | 1 | 0 |
 //! | `Tied_Ip_<field>` (interior penalty) | α_ip | 1 | 0 |
@@ -61,6 +62,8 @@ pub enum Form {
     TiedNitsche,
     /// Symmetric interior-penalty tie (arithmetic weights).
     TiedInteriorPenalty,
+    /// Penalty tie `P = β k_eff / h_e` (Dash: β is the Dash Penalty Factor).
+    Penalty,
 }
 
 /// The conductance at one point and its derivatives (for Newton).
@@ -80,12 +83,15 @@ pub struct HInput {
     pub x: [f64; 3],
 }
 
+/// A conductance law at a point: h and its derivatives, or why it failed.
+pub type HFn = dyn Fn(&HInput) -> Result<HValue, String> + Sync;
+
 /// One interaction's enforcement, ready to assemble.
 pub struct InterfaceForm<'a> {
     pub form: Form,
     /// The conductance (for `Conductance`/`GapConductance`); a penalty for Dash goes here
     /// too, as a constant.
-    pub h: &'a (dyn Fn(&HInput) -> Result<HValue, String> + Sync),
+    pub h: &'a HFn,
     /// Prescribed jump ΔT (`Offset Temperature`).
     pub offset: f64,
     /// β of the Nitsche penalty, times the interaction's penalty scale.
@@ -245,6 +251,7 @@ fn coefficients(form: Form, h: f64, alpha: f64) -> ([f64; 3], [f64; 3]) {
     match form {
         Form::Conductance => ([h, 0.0, 0.0], [1.0, 0.0, 0.0]),
         Form::TiedNitsche | Form::TiedInteriorPenalty => ([alpha, 1.0, 0.0], [0.0; 3]),
+        Form::Penalty => ([alpha, 0.0, 0.0], [0.0; 3]),
         Form::GapConductance => {
             if !h.is_finite() {
                 return ([alpha, 1.0, 0.0], [0.0; 3]);

@@ -6,3 +6,4 @@
 
 pub mod conductance;
 pub mod interface;
+pub mod model;

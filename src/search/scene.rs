@@ -46,6 +46,7 @@ pub struct Pairing {
     pub periodic: bool,
     /// Side A's geometry as searched (for a periodic pair: the image).
     pub side_a_geometry: SurfaceGeometry,
+    pub side_b_geometry: SurfaceGeometry,
     pub result: SearchResult,
     /// For periodic pairs: the largest distance from an image node to the destination.
     pub worst_image_distance: Option<f64>,
@@ -118,6 +119,7 @@ pub fn search_definition(
             side_b_surface: i.side_b,
             periodic: false,
             side_a_geometry: a.clone(),
+            side_b_geometry: b.clone(),
             result,
             worst_image_distance: None,
         });
@@ -366,6 +368,7 @@ fn periodic_pair(
         side_b_surface: d,
         periodic: true,
         side_a_geometry: image,
+        side_b_geometry: dg.clone(),
         result,
         worst_image_distance: Some(worst),
     });

@@ -2,6 +2,7 @@
 
 mod bad_cli;
 mod bad_decks;
+mod cases;
 mod cli;
 mod docs;
 mod enforce;

@@ -1,0 +1,184 @@
+//! From the deck's `begin Enforcement` blocks to an interface form per interaction.
+//!
+//! Entry point: [`resolve`]. `Enforcement for Energy = MODEL [args]` names the model:
+//!
+//! | deck model | form |
+//! |---|---|
+//! | `Contact_Resistance`, `Conductance` | resistance, `h` from `H = …` or the conductance coefficient |
+//! | `Gap_Conductance` | Robin–Nitsche, needs a `Gap Conductance Coefficient = …` line |
+//! | `Tied_<field>`, `Nitche_Tied` | weighted symmetric Nitsche |
+//! | `Tied_Ip_<field>` | symmetric interior penalty |
+//! | `Dash` | mortar-integrated penalty `Dash Penalty Factor × k_eff / h_e` |
+//! | `Tied` with `Side B Variable b To a` | Lagrange multipliers (not carried out yet: an error says so) |
+//!
+//! `Offset Temperature = ΔT` prescribes the jump; `Integer Data`/`Real Data` are kept for
+//! plugin models.
+
+use crate::deck::spec::{Enforcement, EnforcementModel};
+use crate::diag::{Diagnostic, did_you_mean};
+
+use super::interface::Form;
+
+/// What one enforcement block asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelChoice {
+    /// The deck's model name, lower case (reported in summaries).
+    pub name: String,
+    pub form: Form,
+    /// The conductance law, for `Conductance`/`GapConductance`; for `Dash`, the penalty
+    /// factor as a constant.
+    pub conductance: Option<ConductanceLaw>,
+    pub offset: f64,
+    /// For Dash: the penalty factor multiplying k_eff / h_e.
+    pub penalty_factor: Option<f64>,
+}
+
+/// A conductance law as the deck gives it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ConductanceLaw {
+    Constant(f64),
+}
+
+const MODELS: [&str; 7] = [
+    "contact_resistance",
+    "conductance",
+    "gap_conductance",
+    "tied_temperature",
+    "tied_ip_temperature",
+    "nitche_tied",
+    "dash",
+];
+
+/// The energy model of an enforcement block, or the diagnostics that say why not.
+pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
+    let Some(m) = e.models.iter().find(|m| m.equation == "energy") else {
+        let d = Diagnostic::error(
+            "E0420",
+            "this enforcement block has no `Enforcement for Energy = …` line",
+        )
+        .at(Some(e.at.clone()))
+        .help("add e.g. `Enforcement for Energy = Gap_Conductance`");
+        return Err(vec![d]);
+    };
+    let name = m.model.to_ascii_lowercase();
+    let offset = e.offset_temperature.unwrap_or(0.0);
+    let base = |form| ModelChoice {
+        name: name.clone(),
+        form,
+        conductance: None,
+        offset,
+        penalty_factor: None,
+    };
+    if e.side_b_variable.is_some() || name == "tied" {
+        return Err(vec![
+            Diagnostic::error(
+                "E0900",
+                "`Tied` with `Side B Variable` (Lagrange multipliers) is recognised but not carried out by this version of seam",
+            )
+            .at(Some(m.at.clone()))
+            .help("use `Tied_Temperature` (Nitsche) meanwhile: it ties the same field without multipliers"),
+        ]);
+    }
+    match name.as_str() {
+        "contact_resistance" | "conductance" => {
+            let h = conductance(e, m)?;
+            Ok(ModelChoice {
+                conductance: Some(h),
+                ..base(Form::Conductance)
+            })
+        }
+        "gap_conductance" => {
+            let h = conductance(e, m)?;
+            Ok(ModelChoice {
+                conductance: Some(h),
+                ..base(Form::GapConductance)
+            })
+        }
+        "dash" => {
+            let f = e.dash_penalty_factor.unwrap_or(1.0);
+            Ok(ModelChoice {
+                penalty_factor: Some(f),
+                ..base(Form::Penalty)
+            })
+        }
+        n if n == "nitche_tied" || (n.starts_with("tied_") && !n.starts_with("tied_ip_")) => {
+            Ok(base(Form::TiedNitsche))
+        }
+        n if n.starts_with("tied_ip_") => Ok(base(Form::TiedInteriorPenalty)),
+        other => {
+            let hint = did_you_mean(other, MODELS)
+                .map(|s| format!("did you mean `{s}`? "))
+                .unwrap_or_default();
+            Err(vec![
+                Diagnostic::error("E0421", format!("unknown enforcement model `{}`", m.model))
+                    .at(Some(m.at.clone()))
+                    .help(format!(
+                        "{hint}the energy models are Contact_Resistance, Conductance, Gap_Conductance, Tied_Temperature, Tied_Ip_Temperature, Dash"
+                    )),
+            ])
+        }
+    }
+}
+
+/// The conductance: `H = …` on the model line, or a `Gap Conductance Coefficient =
+/// Constant H = …` line.
+fn conductance(e: &Enforcement, m: &EnforcementModel) -> Result<ConductanceLaw, Vec<Diagnostic>> {
+    let from_args = m
+        .args
+        .iter()
+        .find(|a| a.key.eq_ignore_ascii_case("h"))
+        .map(|a| (a.value.clone(), m.at.clone()));
+    let from_property = e
+        .properties
+        .iter()
+        .find(|p| p.property == "gap_conductance_coefficient")
+        .map(|p| {
+            if p.model != "constant" {
+                return Err(vec![
+                    Diagnostic::error(
+                        "E0900",
+                        format!("conductance model `{}` is recognised but not carried out by this version of seam", p.model),
+                    )
+                    .at(Some(p.at.clone()))
+                    .help("use `Gap Conductance Coefficient = Constant H = <value>`"),
+                ]);
+            }
+            match p.args.iter().find(|a| a.key.eq_ignore_ascii_case("h")) {
+                Some(a) => Ok((a.value.clone(), p.at.clone())),
+                None => Err(vec![
+                    Diagnostic::error("E0422", "`Constant` needs `H = <value>`")
+                        .at(Some(p.at.clone()))
+                        .help("write `Gap Conductance Coefficient = Constant H = 10`"),
+                ]),
+            }
+        })
+        .transpose()?;
+    let Some((text, at)) = from_args.or(from_property) else {
+        return Err(vec![
+            Diagnostic::error(
+                "E0423",
+                format!("`{}` needs a conductance and none is given", m.model),
+            )
+            .at(Some(m.at.clone()))
+            .help(
+                "add `Gap Conductance Coefficient = Constant H = <value>` to the enforcement block",
+            ),
+        ]);
+    };
+    match text.parse::<f64>() {
+        Ok(h) if h >= 0.0 && h.is_finite() => Ok(ConductanceLaw::Constant(h)),
+        Ok(h) => Err(vec![
+            Diagnostic::error(
+                "E0424",
+                format!("conductance must be non-negative and finite, found {h}"),
+            )
+            .at(Some(at))
+            .help("a conductance h ≥ 0 (W/m²K); h = 0 means no heat crosses"),
+        ]),
+        Err(_) => Err(vec![
+            Diagnostic::error("E0425", format!("`{text}` is not a number"))
+                .at(Some(at))
+                .help("give the conductance as a number (W/m²K)"),
+        ]),
+    }
+}
