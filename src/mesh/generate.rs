@@ -327,3 +327,44 @@ fn tet_cell_faces(tet: &[usize; 4]) -> impl Iterator<Item = (usize, u8)> + '_ {
             Some((face, s as u8 + 1))
         })
 }
+
+/// Two meshes side by side in one, each keeping its own nodes (parts meshed apart):
+/// `b`'s nodes, elements, blocks and side sets follow `a`'s, with node and element
+/// numbers continued after `a`'s largest.
+pub fn disjoint_union(a: &Mesh, b: &Mesh) -> Mesh {
+    let mut m = a.clone();
+    let shift = m.coords.len() as u32;
+    let eshift = m.num_elems() as u32;
+    m.coords.extend_from_slice(&b.coords);
+    let nmax = m.node_numbers.iter().copied().max().unwrap_or(0);
+    m.node_numbers
+        .extend(b.node_numbers.iter().map(|n| n + nmax));
+    let emax = m.elem_numbers.iter().copied().max().unwrap_or(0);
+    for blk in &b.blocks {
+        let conn = blk
+            .connectivity
+            .iter()
+            .map(|n| NodeId(n.0 + shift))
+            .collect();
+        let numbers = blk.elems().map(|e| b.elem_number(e) + emax).collect();
+        m.push_block(blk.id, blk.name.clone(), blk.topology, conn, Some(numbers));
+        if let Some(last) = m.blocks.last_mut() {
+            last.thickness = blk.thickness;
+        }
+    }
+    for ss in &b.side_sets {
+        let mut ss = ss.clone();
+        for s in &mut ss.sides {
+            s.elem = ElemId(s.elem.0 + eshift);
+        }
+        m.side_sets.push(ss);
+    }
+    for ns in &b.node_sets {
+        let mut ns = ns.clone();
+        for n in &mut ns.nodes {
+            *n = NodeId(n.0 + shift);
+        }
+        m.node_sets.push(ns);
+    }
+    m
+}

@@ -223,3 +223,235 @@ fn two_slab_jump_is_exact_for_every_conductance() {
         }
     }
 }
+
+/// Two concentric rings meshed apart, 3:2 around (inner 16m facets, outer 24m), 2m cells
+/// through each wall, one layer of height 0.2: inner ring r ∈ [0.5, 1] (side A, its
+/// outer face is side set 1), outer ring r ∈ [1, 1.5] (side B, inner face side set 2).
+fn rings(m: usize) -> Setup {
+    let a = generate::annulus(
+        0.5,
+        1.0,
+        360.0,
+        [0.0, 0.2],
+        [2 * m, 16 * m, 1],
+        1,
+        [0, 1, 0, 0, 0, 0],
+    );
+    let b = generate::annulus(
+        1.0,
+        1.5,
+        360.0,
+        [0.0, 0.2],
+        [2 * m, 24 * m, 1],
+        2,
+        [2, 0, 0, 0, 0, 0],
+    );
+    let mesh = generate::disjoint_union(&a, &b);
+    let (ga, gb) = (geometry(&mesh, 0), geometry(&mesh, 1));
+    let settings = SearchSettings::defaults(3);
+    let r = Searcher::new(&gb, &settings).search(
+        &ga,
+        &gb,
+        &settings,
+        Integration::Segments { order: 5 },
+        None,
+    );
+    assert_eq!(r.stats.matched, r.stats.points, "{:?}", r.stats);
+    Setup {
+        mesh,
+        a: ga,
+        b: gb,
+        points: r.points,
+    }
+}
+
+/// The exact radial solution: T(0.5) = 0, T(1.5) = 1, T = c + d ln r in each ring with
+/// k_A d_A = k_B d_B = q and a jump q/h at r = 1 (h = ∞ for ties).
+fn ring_exact(k: [f64; 2], h: f64) -> impl Fn([f64; 3], bool) -> (f64, [f64; 3]) {
+    let (l2, l15) = (2f64.ln(), 1.5f64.ln());
+    let q = 1.0 / (l2 / k[0] + l15 / k[1] + 1.0 / h);
+    move |p: [f64; 3], inner: bool| {
+        let r2 = p[0] * p[0] + p[1] * p[1];
+        let r = r2.sqrt();
+        let d = if inner { q / k[0] } else { q / k[1] };
+        let t = if inner {
+            d * (r / 0.5).ln()
+        } else {
+            1.0 - d * (1.5 / r).ln()
+        };
+        (t, [d * p[0] / r2, d * p[1] / r2, 0.0])
+    }
+}
+
+/// Convergence across a curved non-matching interface: L2 rate 2 ± 0.1 and H1 rate
+/// 1 ± 0.1 over three meshes, for every flux-type model.
+#[test]
+fn curved_interface_converges_at_optimal_rates() {
+    let k = [1.0, 3.0];
+    for (form, h) in [
+        (Form::TiedNitsche, f64::INFINITY),
+        (Form::TiedInteriorPenalty, f64::INFINITY),
+        (Form::GapConductance, 10.0),
+        (Form::Conductance, 10.0),
+    ] {
+        let exact = ring_exact(k, h);
+        let mut errors = Vec::new();
+        for m in [1, 2, 4] {
+            let s = rings(m);
+            let first_b = s.mesh.blocks[1].first_elem;
+            let n_a = s.mesh.elem_nodes(first_b)[0].index(); // nodes of ring B start here
+            let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+                .filter_map(|i| {
+                    let p = s.mesh.coords[i];
+                    let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+                    ((r - 0.5).abs() < 1e-12 || (r - 1.5).abs() < 1e-12)
+                        .then(|| (NodeId(i as u32), exact(p, i < n_a).0))
+                })
+                .collect();
+            let hh = if h.is_finite() { h } else { 0.0 };
+            let sol = solve(&s, form, hh, k, &dirichlet);
+            let mut e = (0.0, 0.0);
+            for (blk, inner) in [(0usize, true), (1usize, false)] {
+                let f = |p: [f64; 3]| exact(p, inner).0;
+                let g = |p: [f64; 3]| exact(p, inner).1;
+                let n =
+                    seam::heat::error_norms(&s.mesh, &[blk], &sol.temperature, &f, &g, 4).unwrap();
+                e.0 += n.l2 * n.l2;
+                e.1 += n.h1 * n.h1;
+            }
+            errors.push((e.0.sqrt(), e.1.sqrt()));
+        }
+        for w in errors.windows(2) {
+            let (l2, h1) = ((w[0].0 / w[1].0).log2(), (w[0].1 / w[1].1).log2());
+            eprintln!("{form:?}: L2 rate {l2:.3}, H1 rate {h1:.3}");
+            assert!(
+                (l2 - 2.0).abs() <= 0.1,
+                "{form:?}: L2 rate {l2:.3} ({errors:?})"
+            );
+            assert!(
+                (h1 - 1.0).abs() <= 0.1,
+                "{form:?}: H1 rate {h1:.3} ({errors:?})"
+            );
+        }
+    }
+}
+
+/// Robustness: on the two slabs, h from 1e-8 to 1e12 and k_B/k_A from 1 to 1e8. The
+/// exact solution is piecewise linear, so any error is round-off amplified by the
+/// conditioning: it must stay finite and below 1e-6 of the temperature scale (1).
+#[test]
+fn gap_conductance_is_robust_over_h_and_conductivity_contrast() {
+    let s = setup(3, 2, SolidKind::Hex8);
+    let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+        .filter_map(|i| {
+            let z = s.mesh.coords[i][2];
+            (z == 0.0 || z == 2.0).then(|| (NodeId(i as u32), z / 2.0))
+        })
+        .collect();
+    let first_b = 4 * 4 * 4;
+    let mut worst_all: f64 = 0.0;
+    for h in [1e-8, 1e-4, 1.0, 1e4, 1e8, 1e12] {
+        for ratio in [1.0, 1e2, 1e4, 1e8] {
+            let k = [1.0, ratio];
+            let sol = solve(&s, Form::GapConductance, h, k, &dirichlet);
+            let q = 1.0 / (1.0 / k[0] + 1.0 / h + 1.0 / k[1]);
+            for i in 0..s.mesh.num_nodes() {
+                let z = s.mesh.coords[i][2];
+                let exact = if i < first_b {
+                    q * z / k[0]
+                } else {
+                    1.0 - q * (2.0 - z) / k[1]
+                };
+                let e = (sol.temperature[i] - exact).abs();
+                assert!(
+                    e.is_finite() && e < 1e-6,
+                    "h={h} k_B/k_A={ratio}: error {e:e} at node {i}"
+                );
+                worst_all = worst_all.max(e);
+            }
+            let (qa, qb) = sol.heat[0];
+            assert!(
+                (qa + qb).abs() <= 1e-12 * qa.abs().max(f64::MIN_POSITIVE) + 1e-300,
+                "h={h} ratio={ratio}"
+            );
+        }
+    }
+    eprintln!("worst nodal error over the sweep: {worst_all:e}");
+}
+
+/// The interface Jacobian, with a temperature-dependent conductance h = h₀(1 + γ T̄),
+/// agrees with central differences of the interface residual to 1e-6 relative.
+#[test]
+fn interface_jacobian_matches_finite_differences() {
+    use seam::assembly::DofMap;
+    use seam::enforce::interface::interface_terms;
+    let s = setup(3, 2, SolidKind::Hex8);
+    let dofs = DofMap::new(&s.mesh, &[("temperature", &[0, 1])]).unwrap();
+    let field = dofs.field("temperature").unwrap();
+    let (h0, gamma) = (5.0, 0.3);
+    let hf = move |p: &HInput| {
+        let tm = 0.5 * (p.temp_a + p.temp_b);
+        Ok(HValue {
+            h: h0 * (1.0 + gamma * tm),
+            dh_dtemp_a: 0.5 * h0 * gamma,
+            dh_dtemp_b: 0.5 * h0 * gamma,
+        })
+    };
+    let k = [2.0, 0.7];
+    // A smooth, non-trivial field.
+    let u: Vec<f64> = (0..dofs.len())
+        .map(|i| {
+            let p = s.mesh.coords[i];
+            1.0 + 0.3 * p[0] - 0.2 * p[1] * p[1] + 0.5 * p[2] + 0.1 * (3.0 * p[0]).sin()
+        })
+        .collect();
+    for form in [Form::Conductance, Form::GapConductance] {
+        let f = InterfaceForm {
+            form,
+            h: &hf,
+            offset: 0.1,
+            beta: DEFAULT_BETA,
+            conductivity: &k,
+        };
+        let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, &u).unwrap();
+        let residual = |u: &[f64]| {
+            let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, u).unwrap();
+            let mut r = vec![0.0; u.len()];
+            for (d, v) in t.residual {
+                r[d as usize] += v;
+            }
+            r
+        };
+        // The assembled Jacobian, dense (small problem).
+        let n = dofs.len();
+        let mut jac = vec![0.0; n * n];
+        for (ds, m) in &t.blocks {
+            let l = ds.len();
+            for a in 0..l {
+                for c in 0..l {
+                    jac[ds[a] as usize * n + ds[c] as usize] += m[a * l + c];
+                }
+            }
+        }
+        let mut checked = 0;
+        for j in t.side_a_dofs.iter().chain(&t.side_b_dofs).step_by(3) {
+            let j = *j as usize;
+            let eps = 1e-6;
+            let (mut up, mut dn) = (u.clone(), u.clone());
+            up[j] += eps;
+            dn[j] -= eps;
+            let (rp, rm) = (residual(&up), residual(&dn));
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * eps);
+                let an = jac[i * n + j];
+                let scale = an.abs().max(fd.abs()).max(1e-3);
+                assert!(
+                    (fd - an).abs() <= 1e-6 * scale,
+                    "{form:?} J[{i}][{j}]: analytic {an} vs FD {fd}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked > 10);
+    }
+}

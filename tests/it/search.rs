@@ -244,32 +244,7 @@ fn concentric_cylinders_overlap_and_gap_statistics() {
     }
 }
 
-/// Two meshes side by side with their own nodes (and blocks, side sets).
-fn merge_apart(a: &Mesh, b: &Mesh) -> Mesh {
-    let mut m = a.clone();
-    let shift = m.coords.len() as u32;
-    let eshift = m.num_elems() as u32;
-    m.coords.extend_from_slice(&b.coords);
-    let nmax = m.node_numbers.iter().copied().max().unwrap_or(0);
-    m.node_numbers
-        .extend(b.node_numbers.iter().map(|n| n + nmax));
-    for blk in &b.blocks {
-        let conn = blk
-            .connectivity
-            .iter()
-            .map(|n| seam::mesh::NodeId(n.0 + shift))
-            .collect();
-        m.push_block(blk.id, blk.name.clone(), blk.topology, conn, None);
-    }
-    for ss in &b.side_sets {
-        let mut ss = ss.clone();
-        for s in &mut ss.sides {
-            s.elem = seam::mesh::ElemId(s.elem.0 + eshift);
-        }
-        m.side_sets.push(ss);
-    }
-    m
-}
+use generate::disjoint_union as merge_apart;
 
 #[test]
 fn rectangular_periodicity_ties_opposite_faces() {
