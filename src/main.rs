@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand};
 use serde::Serialize;
 
 use seam::deck::{self, LoadedDeck};
-use seam::diag::{Diagnostic, Diagnostics, Loc};
+use seam::diag::{Diagnostic, Diagnostics};
 use seam::mesh::{self, ElemId, Mesh};
 use seam::surface::{self, SurfaceKind};
 
@@ -534,6 +534,13 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
     let mut diags = loaded.diagnostics.clone();
     diags.extend(not_yet_carried_out(&loaded, true));
     let mut count = 0;
+    for def in &loaded.deck.contact_definitions {
+        for e in &def.enforcements {
+            if let Err(ds) = seam::enforce::model::resolve(e) {
+                ds.into_iter().for_each(|d| diags.push(d));
+            }
+        }
+    }
     if let Some(mesh) = &mesh {
         let deck_dir = deck_path.parent().unwrap_or(Path::new("."));
         for def in &loaded.deck.contact_definitions {
@@ -582,20 +589,22 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
 /// as warnings — never silently.
 fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
     let mut out = Diagnostics::default();
-    let mut report = |what: &str, at: &Loc| {
-        let message = format!("`{what}` is recognised but not carried out by this version of seam");
-        let d = if as_errors {
-            Diagnostic::error("E0900", message)
-        } else {
-            Diagnostic::warning("W0900", message)
-        };
-        out.push(d.at(Some(at.clone())).help(
-            "surfaces and the search (`seam search`) are carried out now; enforcement and time stepping arrive in later versions",
-        ));
-    };
     for def in &loaded.deck.contact_definitions {
-        for e in &def.enforcements {
-            report("begin Enforcement", &e.at);
+        for e in def
+            .enforcements
+            .iter()
+            .filter(|e| e.use_toggle_block.is_some())
+        {
+            let message =
+                "`Use Toggle Block` is recognised but not carried out by this version of seam";
+            let d = if as_errors {
+                Diagnostic::error("E0900", message)
+            } else {
+                Diagnostic::warning("W0900", message)
+            };
+            out.push(d.at(Some(e.at.clone())).help(
+                "toggling an enforcement on and off in time arrives with transient runs; remove the line meanwhile",
+            ));
         }
     }
     out

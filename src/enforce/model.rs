@@ -69,6 +69,28 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         offset,
         penalty_factor: None,
     };
+    if let Some(map) = &e.side_b_variable {
+        let known = ["temperature"];
+        let mut ds = Vec::new();
+        for (role, field) in [("side B", &map.side_b), ("side A", &map.side_a)] {
+            if !known.contains(&field.to_ascii_lowercase().as_str()) {
+                let hint = did_you_mean(field, known)
+                    .map(|s| format!("did you mean `{s}`? "))
+                    .unwrap_or_default();
+                ds.push(
+                    Diagnostic::error(
+                        "E0428",
+                        format!("unknown {role} field `{field}` in `Side B Variable`"),
+                    )
+                    .at(Some(e.at.clone()))
+                    .help(format!("{hint}the fields of this problem are: temperature")),
+                );
+            }
+        }
+        if !ds.is_empty() {
+            return Err(ds);
+        }
+    }
     if e.side_b_variable.is_some() || name == "tied" {
         return Err(vec![
             Diagnostic::error(
@@ -105,6 +127,14 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
             Ok(base(Form::TiedNitsche))
         }
         n if n.starts_with("tied_ip_") => Ok(base(Form::TiedInteriorPenalty)),
+        "plugin" => Err(vec![
+            Diagnostic::error(
+                "E0900",
+                "`Enforcement for Energy = Plugin …` is recognised but not carried out by `seam run` in this version",
+            )
+            .at(Some(m.at.clone()))
+            .help("plugins load and pass `seam check-plugin`; their use in a run arrives with the conductance models"),
+        ]),
         other => {
             let hint = did_you_mean(other, MODELS)
                 .map(|s| format!("did you mean `{s}`? "))

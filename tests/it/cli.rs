@@ -172,13 +172,13 @@ fn check_passes_the_example_and_fails_unimplemented_commands() {
     let deck = dir.join("deck.i");
     std::fs::write(
         &deck,
-        "begin contact definition\n  skin all blocks = on\n  begin enforcement\n    enforcement for energy = tied_temperature\n  end\nend\n",
+        "begin contact definition\n  skin all blocks = on\n  begin enforcement\n    enforcement for energy = tied_temperature\n    use toggle block = warm_up\n  end\nend\n",
     )
     .unwrap();
     let out = seam(&["check", deck.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("error[E0900]"));
-    // `seam surfaces` does not need the enforcement: it warns and goes on.
+    // `seam surfaces` does not need the toggle: it warns and goes on.
     let out = seam(&["surfaces", deck.to_str().unwrap(), "--mesh", EXAMPLE_MESH]);
     assert_eq!(out.status.code(), Some(0));
     assert!(String::from_utf8_lossy(&out.stderr).contains("warning[W0900]"));

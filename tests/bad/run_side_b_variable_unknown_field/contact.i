@@ -1,0 +1,8 @@
+begin contact definition
+  contact surface lid_face contains lid_bottom
+  contact surface base_face contains base_top
+  begin enforcement
+    enforcement for energy = tied
+    side b variable temprature to temperature
+  end
+end

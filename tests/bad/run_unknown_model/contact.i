@@ -1,0 +1,7 @@
+begin contact definition
+  contact surface lid_face contains lid_bottom
+  contact surface base_face contains base_top
+  begin enforcement
+    enforcement for energy = gap_conductanse
+  end
+end
