@@ -472,6 +472,17 @@ impl SearchSchedule {
         }
     }
 
+    /// The schedule of a contact definition: `Update Search Every n Steps`, else the
+    /// search options' `Search Update Frequency` (ELFEN's name for the same), else 1.
+    pub fn for_definition(def: &crate::deck::spec::ContactDefinition) -> Self {
+        SearchSchedule::new(
+            def.update_search_every_n_steps.or(def
+                .search_options
+                .as_ref()
+                .and_then(|o| o.search_update_frequency)),
+        )
+    }
+
     /// Whether step `step` (0-based) does a full search.
     pub fn full_search(&self, step: u64) -> bool {
         step.is_multiple_of(u64::from(self.every))
