@@ -3,9 +3,10 @@
 mod bad_cli;
 mod bad_decks;
 mod cli;
+mod conductance;
 mod docs;
-mod interactions;
 mod fem;
+mod interactions;
 mod mesh_io;
 mod plugin;
 mod search;
