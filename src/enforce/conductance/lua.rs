@@ -175,6 +175,14 @@ impl ConductanceModel for LuaConductance {
         self.label.clone()
     }
 
+    fn value(&self, s: &PointState) -> Result<f64, ConductanceError> {
+        let c = Conductance {
+            h: self.call(s)?,
+            ..Conductance::default()
+        };
+        check(self, s, c).map(|c| c.h)
+    }
+
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let mut c = Conductance {
             h: self.call(s)?,

@@ -141,6 +141,13 @@ pub trait ConductanceModel {
     /// h and its derivatives at `state`; an error if h is negative or anything is not
     /// finite.
     fn evaluate(&self, state: &PointState) -> Result<Conductance, ConductanceError>;
+
+    /// h alone (residual-only passes, line searches), checked like
+    /// [`ConductanceModel::evaluate`]. Models whose derivatives cost extra calls (Lua)
+    /// override it.
+    fn value(&self, state: &PointState) -> Result<f64, ConductanceError> {
+        self.evaluate(state).map(|c| c.h)
+    }
 }
 
 /// The result check every model applies: finite values, h ≥ 0.
