@@ -22,7 +22,7 @@ use super::{
 use crate::deck::spec::{Enforcement, PropertyModel};
 use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap, did_you_mean};
 use crate::plugin::{Plugin, PluginData};
-use crate::script::Limits;
+use crate::script::{Limits, ScriptError};
 
 /// The diagnostic codes of conductance lines (stable: never reused).
 pub mod codes {
@@ -520,10 +520,17 @@ impl Cx<'_> {
             return match LuaConductance::expression(&chunk, &a.value) {
                 Ok(m) => Some(Box::new(m)),
                 Err(e) => {
+                    // Lua's own message already starts with the chunk (`deck.i:4:1:`).
+                    let message = match e {
+                        ScriptError::Syntax { message, .. } => {
+                            format!("Lua syntax error: {message}")
+                        }
+                        other => other.to_string(),
+                    };
                     self.error(
                         codes::LUA,
                         self.sources.narrow(&l.model_loc, "lua"),
-                        format!("gap conductance: {e}"),
+                        format!("gap conductance: {message}"),
                         "write a Lua expression in gap, temp_a, temp_b (or T_A, T_B), pressure, x, y, z, t".into(),
                     );
                     None

@@ -584,6 +584,17 @@ mod tests {
     }
 
     #[test]
+    fn built_in_models_and_the_plugin_adapter_are_send_and_sync() {
+        fn send_sync<T: Send + Sync>() {}
+        send_sync::<Constant>();
+        send_sync::<GasGap>();
+        send_sync::<Radiation>();
+        send_sync::<Cmy>();
+        send_sync::<Table>();
+        send_sync::<PluginConductance>();
+    }
+
+    #[test]
     fn bad_parameters_are_refused() {
         assert!(Constant::new(-1.0).is_err());
         assert!(Constant::new(f64::NAN).is_err());
