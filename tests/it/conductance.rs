@@ -623,6 +623,34 @@ fn deck_lua_file_is_taken_from_the_deck_directory() {
     );
 }
 
+#[test]
+fn toml_properties_build_the_same_models() {
+    let text = r#"
+[[contact_definition]]
+[[contact_definition.enforcement]]
+[[contact_definition.enforcement.property]]
+property = "gap_conductance_coefficient"
+model = "table"
+args = [{ value = "of" }, { key = "pressure", value = "0" }, { value = "10" }, { value = "1e7" }, { value = "5000" }]
+[[contact_definition.enforcement.property]]
+property = "gap_conductance_coefficient"
+model = "lua"
+args = [{ value = "T_A - T_B" }]
+"#;
+    let file: Arc<str> = Arc::from("deck.toml");
+    let (deck, diags) = seam::deck::parse_toml(&file, text);
+    let sources = SourceMap::default();
+    assert!(!diags.has_errors(), "{}", diags.render(&sources));
+    let e = &deck.contact_definitions[0].enforcements[0];
+    let (m, d) = from_properties(e, Path::new("."), &sources);
+    assert!(d.is_empty(), "{}", d.render(&sources));
+    let c = m.unwrap().evaluate(&state(0.0, 5e6, 400.0, 300.0)).unwrap();
+    let want = 10.0 + 4990.0 * 0.5 + 100.0;
+    assert!(rel_close(c.h, want, 1e-14), "{} vs {want}", c.h);
+    assert!(rel_close(c.dh_dtemp_a, 1.0, 1e-9) && rel_close(c.dh_dtemp_b, -1.0, 1e-9));
+    assert!(rel_close(c.dh_dpressure, 4990.0 / 1e7, 1e-12));
+}
+
 // ---- bad deck lines: snapshots ----
 
 /// Each `tests/bad/conductance_*/` directory holds `conductance.i` (an enforcement

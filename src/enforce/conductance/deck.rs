@@ -520,13 +520,7 @@ impl Cx<'_> {
             return match LuaConductance::expression(&chunk, &a.value) {
                 Ok(m) => Some(Box::new(m)),
                 Err(e) => {
-                    // Lua's own message already starts with the chunk (`deck.i:4:1:`).
-                    let message = match e {
-                        ScriptError::Syntax { message, .. } => {
-                            format!("Lua syntax error: {message}")
-                        }
-                        other => other.to_string(),
-                    };
+                    let message = script_message(e);
                     self.error(
                         codes::LUA,
                         self.sources.narrow(&l.model_loc, "lua"),
@@ -568,7 +562,7 @@ impl Cx<'_> {
                 self.error(
                     codes::LUA,
                     self.value_loc(l, "file", file),
-                    format!("gap conductance: {e}"),
+                    format!("gap conductance: {}", script_message(e)),
                     format!("fix {file}; it must define a global function `{function}(gap, temp_a, temp_b, pressure, x, y, z, t)`"),
                 );
                 None
@@ -611,6 +605,15 @@ impl Cx<'_> {
                 None
             }
         }
+    }
+}
+
+/// A script error for a diagnostic: Lua's own syntax message already starts with the
+/// chunk and line (`deck.i:4:1:`, `h.lua:3:`), so the sandbox's `in <chunk>` is dropped.
+fn script_message(e: ScriptError) -> String {
+    match e {
+        ScriptError::Syntax { message, .. } => format!("Lua syntax error: {message}"),
+        other => other.to_string(),
     }
 }
 
