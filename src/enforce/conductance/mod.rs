@@ -220,8 +220,8 @@ impl ConductanceModel for Constant {
     fn name(&self) -> String {
         "constant".into()
     }
-    fn evaluate(&self, state: &PointState) -> Result<Conductance, ConductanceError> {
-        let _ = state;
+    fn evaluate(&self, _state: &PointState) -> Result<Conductance, ConductanceError> {
+        // h was checked (finite, ≥ 0) at construction.
         Ok(Conductance {
             h: self.h,
             ..Conductance::default()
