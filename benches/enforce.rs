@@ -25,16 +25,36 @@ fn exact(p: [f64; 3]) -> f64 {
 }
 
 fn grad(p: [f64; 3]) -> [f64; 3] {
-    let (sx, sy, sz) = ((PI * p[0]).sin(), (PI * p[1]).sin(), (0.5 * PI * p[2]).sin());
-    let (cx, cy, cz) = ((PI * p[0]).cos(), (PI * p[1]).cos(), (0.5 * PI * p[2]).cos());
-    [PI * cx * sy * sz, PI * sx * cy * sz, 0.5 * PI * sx * sy * cz]
+    let (sx, sy, sz) = (
+        (PI * p[0]).sin(),
+        (PI * p[1]).sin(),
+        (0.5 * PI * p[2]).sin(),
+    );
+    let (cx, cy, cz) = (
+        (PI * p[0]).cos(),
+        (PI * p[1]).cos(),
+        (0.5 * PI * p[2]).cos(),
+    );
+    [
+        PI * cx * sy * sz,
+        PI * sx * cy * sz,
+        0.5 * PI * sx * sy * cz,
+    ]
 }
 
 fn geometry(mesh: &Mesh, set: usize) -> SurfaceGeometry {
     let s = ContactSurface {
         name: format!("s{set}"),
         kind: SurfaceKind::Faces,
-        faces: mesh.side_sets[set].sides.iter().map(|&side| SurfaceFace { side, loft: 0.0, origin: 0 }).collect(),
+        faces: mesh.side_sets[set]
+            .sides
+            .iter()
+            .map(|&side| SurfaceFace {
+                side,
+                loft: 0.0,
+                origin: 0,
+            })
+            .collect(),
         nodes: vec![],
         origins: vec![],
         parent: None,
@@ -74,7 +94,9 @@ fn print(r: &Row) {
 fn errors(mesh: &Mesh, t: &[f64]) -> (f64, f64) {
     let blocks: Vec<usize> = (0..mesh.blocks.len()).collect();
     let n = error_norms(mesh, &blocks, t, &exact, &grad, 4).unwrap();
-    let max = (0..mesh.num_nodes()).map(|i| (t[i] - exact(mesh.coords[i])).abs()).fold(0.0, f64::max);
+    let max = (0..mesh.num_nodes())
+        .map(|i| (t[i] - exact(mesh.coords[i])).abs())
+        .fold(0.0, f64::max);
     (n.l2, max)
 }
 
@@ -83,10 +105,21 @@ fn main() {
     let sizes: &[usize] = if large { &[18, 40, 88] } else { &[18, 40] };
     println!(
         "{:<34} {:>9} {:>11} {:>11} {:>9} {:>9} {:>9} {:>9} {:>9}",
-        "case", "unknowns", "L2 error", "max error", "search s", "assemb s", "factor s", "solve s", "total s"
+        "case",
+        "unknowns",
+        "L2 error",
+        "max error",
+        "search s",
+        "assemb s",
+        "factor s",
+        "solve s",
+        "total s"
     );
     let source = |p: [f64; 3]| 2.25 * PI * PI * exact(p);
-    let mat = [Material { conductivity: 1.0, rho_c: 1.0 }; 2];
+    let mat = [Material {
+        conductivity: 1.0,
+        rho_c: 1.0,
+    }; 2];
     for &n in sizes {
         let m = 2 * n / 3;
         // Conforming baseline: both blocks with n cells across, sharing the z = 1 nodes.
@@ -126,7 +159,8 @@ fn main() {
         let mesh = generate::boxes(
             &[
                 BoxSpec::hex([0.0; 3], [1.0; 3], [n, n, n], 1).with_side_sets([0, 0, 0, 0, 0, 1]),
-                BoxSpec::hex([0.0, 0.0, 1.0], [1.0, 1.0, 2.0], [m, m, m], 2).with_side_sets([0, 0, 0, 0, 2, 0]),
+                BoxSpec::hex([0.0, 0.0, 1.0], [1.0, 1.0, 2.0], [m, m, m], 2)
+                    .with_side_sets([0, 0, 0, 0, 2, 0]),
             ],
             false,
         );
@@ -139,14 +173,20 @@ fn main() {
             (Integration::Segments { order: 4 }, "segments"),
         ] {
             let t = Instant::now();
-            let r = Searcher::new(&b, &settings).search_points(&a, &b, &settings, integration, None);
+            let r =
+                Searcher::new(&b, &settings).search_points(&a, &b, &settings, integration, None);
             let search = t.elapsed().as_secs_f64();
             for (form, name, h) in [
                 (Form::TiedNitsche, "tied nitsche", 0.0),
                 (Form::TiedInteriorPenalty, "tied ip", 0.0),
                 (Form::GapConductance, "gap conductance h=1e8", 1e8),
             ] {
-                let hf = move |_: &HInput| Ok(HValue { h, ..HValue::default() });
+                let hf = move |_: &HInput| {
+                    Ok(HValue {
+                        h,
+                        ..HValue::default()
+                    })
+                };
                 let sol = solve_steady(&SteadyProblem {
                     mesh: &mesh,
                     materials: &mat,
@@ -157,7 +197,13 @@ fn main() {
                         side_a: &a,
                         side_b: &b,
                         points: &r.points,
-                        form: InterfaceForm { form, h: &hf, offset: 0.0, beta: DEFAULT_BETA, conductivity: &k },
+                        form: InterfaceForm {
+                            form,
+                            h: &hf,
+                            offset: 0.0,
+                            beta: DEFAULT_BETA,
+                            conductivity: &k,
+                        },
                         linear: true,
                     }],
                     tolerance: 1e-10,

@@ -42,6 +42,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::deck::{self, LoadedDeck};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap, did_you_mean};
+use crate::enforce::conductance::{self, ConductanceModel, PointState};
 use crate::enforce::interface::{DEFAULT_BETA, Form, HFn, HInput, HValue, InterfaceForm};
 use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
 use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, solve_steady};
@@ -367,7 +368,22 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
                             .iter()
                             .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b)
                             .map_or(1.0, |i| i.penalty_scale);
-                        choices.push((choice, scale));
+                        let model: Option<Box<dyn ConductanceModel>> = match choice.conductance {
+                            Some(ConductanceLaw::Constant(h)) => Some(Box::new(
+                                conductance::Constant::new(h).expect("h checked non-negative"),
+                            )),
+                            Some(ConductanceLaw::Coefficient) => {
+                                let (m, d) =
+                                    conductance::from_properties(enf, &deck_dir, &loaded.sources);
+                                diags.extend(d);
+                                if m.is_none() {
+                                    continue;
+                                }
+                                m
+                            }
+                            None => None,
+                        };
+                        choices.push((choice, scale, model));
                         pairings.push(p);
                     }
                     Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
@@ -380,26 +396,38 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
     }
 
     let conductivity: Vec<f64> = materials.iter().map(|m| m.conductivity).collect();
-    let h_fns: Vec<Box<HFn>> = choices
+    // Each conductance model seen by the interface forms: the point's gap and
+    // temperatures in, h and dh/dT out (pressure is 0 until a pressure field is given).
+    let h_fns: Vec<Box<HFn<'_>>> = choices
         .iter()
-        .map(|(c, _)| {
-            let h = match c.conductance {
-                Some(ConductanceLaw::Constant(h)) => h,
-                None => 0.0,
-            };
-            Box::new(move |_: &HInput| {
+        .map(|(_, _, model)| {
+            let f = move |p: &HInput| -> Result<HValue, String> {
+                let Some(m) = model else {
+                    return Ok(HValue::default());
+                };
+                let state = PointState {
+                    gap: p.gap,
+                    pressure: 0.0,
+                    temp_a: p.temp_a,
+                    temp_b: p.temp_b,
+                    x: p.x,
+                    time: 0.0,
+                };
+                let c = m.evaluate(&state).map_err(|e| e.to_string())?;
                 Ok(HValue {
-                    h,
-                    ..HValue::default()
+                    h: c.h,
+                    dh_dtemp_a: c.dh_dtemp_a,
+                    dh_dtemp_b: c.dh_dtemp_b,
                 })
-            }) as Box<dyn Fn(&HInput) -> Result<HValue, String> + Sync>
+            };
+            Box::new(f) as Box<HFn<'_>>
         })
         .collect();
     let contact: Vec<ContactTerm<'_>> = pairings
         .iter()
         .zip(&choices)
         .zip(&h_fns)
-        .map(|((p, (c, scale)), h)| ContactTerm {
+        .map(|((p, (c, scale, model)), h)| ContactTerm {
             side_a: &p.side_a_geometry,
             side_b: &p.side_b_geometry,
             points: &p.result.points,
@@ -410,7 +438,8 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
                 beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
                 conductivity: &conductivity,
             },
-            linear: true,
+            // A constant conductance keeps the system linear and symmetric.
+            linear: model.as_ref().is_none_or(|m| m.name() == "constant"),
         })
         .collect();
     let source_fn = source
@@ -448,7 +477,7 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         .iter()
         .zip(&choices)
         .zip(&solution.heat)
-        .map(|((p, (c, _)), &(a, b))| InteractionHeat {
+        .map(|((p, (c, _, _)), &(a, b))| InteractionHeat {
             side_a: p.side_a.clone(),
             side_b: p.side_b.clone(),
             model: c.name.clone(),

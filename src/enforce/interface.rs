@@ -84,14 +84,16 @@ pub struct HInput {
 }
 
 /// A conductance law at a point: h and its derivatives, or why it failed.
-pub type HFn = dyn Fn(&HInput) -> Result<HValue, String> + Sync;
+/// Called serially (interface terms are assembled on one thread), so a Lua model may
+/// back it.
+pub type HFn<'a> = dyn Fn(&HInput) -> Result<HValue, String> + 'a;
 
 /// One interaction's enforcement, ready to assemble.
 pub struct InterfaceForm<'a> {
     pub form: Form,
     /// The conductance (for `Conductance`/`GapConductance`); a penalty for Dash goes here
     /// too, as a constant.
-    pub h: &'a HFn,
+    pub h: &'a HFn<'a>,
     /// Prescribed jump ΔT (`Offset Temperature`).
     pub offset: f64,
     /// β of the Nitsche penalty, times the interaction's penalty scale.

@@ -36,7 +36,11 @@ pub struct ModelChoice {
 /// A conductance law as the deck gives it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ConductanceLaw {
+    /// `H = …` on the `Enforcement for Energy` line.
     Constant(f64),
+    /// The block's `Gap Conductance Coefficient = …` lines (see
+    /// [`super::conductance::from_properties`]).
+    Coefficient,
 }
 
 const MODELS: [&str; 7] = [
@@ -150,65 +154,39 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
     }
 }
 
-/// The conductance: `H = …` on the model line, or a `Gap Conductance Coefficient =
-/// Constant H = …` line.
+/// The conductance: `H = …` on the model line, or the block's `Gap Conductance
+/// Coefficient = …` lines (read by [`super::conductance::from_properties`]).
 fn conductance(e: &Enforcement, m: &EnforcementModel) -> Result<ConductanceLaw, Vec<Diagnostic>> {
-    let from_args = m
-        .args
-        .iter()
-        .find(|a| a.key.eq_ignore_ascii_case("h"))
-        .map(|a| (a.value.clone(), m.at.clone()));
-    let from_property = e
-        .properties
-        .iter()
-        .find(|p| p.property == "gap_conductance_coefficient")
-        .map(|p| {
-            if p.model != "constant" {
-                return Err(vec![
-                    Diagnostic::error(
-                        "E0900",
-                        format!("conductance model `{}` is recognised but not carried out by this version of seam", p.model),
-                    )
-                    .at(Some(p.at.clone()))
-                    .help("use `Gap Conductance Coefficient = Constant H = <value>`"),
-                ]);
-            }
-            match p.args.iter().find(|a| a.key.eq_ignore_ascii_case("h")) {
-                Some(a) => Ok((a.value.clone(), p.at.clone())),
-                None => Err(vec![
-                    Diagnostic::error("E0422", "`Constant` needs `H = <value>`")
-                        .at(Some(p.at.clone()))
-                        .help("write `Gap Conductance Coefficient = Constant H = 10`"),
-                ]),
-            }
-        })
-        .transpose()?;
-    let Some((text, at)) = from_args.or(from_property) else {
-        return Err(vec![
-            Diagnostic::error(
-                "E0423",
-                format!("`{}` needs a conductance and none is given", m.model),
-            )
-            .at(Some(m.at.clone()))
-            .help(
-                "add `Gap Conductance Coefficient = Constant H = <value>` to the enforcement block",
-            ),
-        ]);
-    };
-    match text.parse::<f64>() {
-        Ok(h) if h >= 0.0 && h.is_finite() => Ok(ConductanceLaw::Constant(h)),
-        Ok(h) => Err(vec![
-            Diagnostic::error(
-                "E0424",
-                format!("conductance must be non-negative and finite, found {h}"),
-            )
-            .at(Some(at))
-            .help("a conductance h ≥ 0 (W/m²K); h = 0 means no heat crosses"),
-        ]),
-        Err(_) => Err(vec![
-            Diagnostic::error("E0425", format!("`{text}` is not a number"))
-                .at(Some(at))
-                .help("give the conductance as a number (W/m²K)"),
-        ]),
+    if let Some(a) = m.args.iter().find(|a| a.key.eq_ignore_ascii_case("h")) {
+        return match a.value.parse::<f64>() {
+            Ok(h) if h >= 0.0 && h.is_finite() => Ok(ConductanceLaw::Constant(h)),
+            Ok(h) => Err(vec![
+                Diagnostic::error(
+                    "E0424",
+                    format!("conductance must be non-negative and finite, found {h}"),
+                )
+                .at(Some(m.at.clone()))
+                .help("a conductance h ≥ 0 (W/m²K); h = 0 means no heat crosses"),
+            ]),
+            Err(_) => Err(vec![
+                Diagnostic::error("E0425", format!("`{}` is not a number", a.value))
+                    .at(Some(m.at.clone()))
+                    .help("give the conductance as a number (W/m²K)"),
+            ]),
+        };
     }
+    if e.properties
+        .iter()
+        .any(|p| p.property == "gap_conductance_coefficient")
+    {
+        return Ok(ConductanceLaw::Coefficient);
+    }
+    Err(vec![
+        Diagnostic::error(
+            "E0423",
+            format!("`{}` needs a conductance and none is given", m.model),
+        )
+        .at(Some(m.at.clone()))
+        .help("add `Gap Conductance Coefficient = Constant H = <value>` (or another model) to the enforcement block"),
+    ])
 }

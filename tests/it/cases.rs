@@ -16,6 +16,9 @@ struct Case {
     expect_field: Option<String>,
     tolerance: f64,
     conservation: Option<f64>,
+    /// The heat leaving side A of the (single) interaction, checked to `tolerance`
+    /// relative.
+    expect_heat_side_a: Option<f64>,
 }
 
 /// Coefficients (c0, cx, cy, cz) of an affine expression like `1 + x + 2*y - 3*z`.
@@ -90,6 +93,15 @@ fn verification_cases_meet_their_requirements() {
                 case.tolerance
             );
         }
+        if let Some(q) = case.expect_heat_side_a {
+            let got = r.summary.interactions[0].heat_side_a;
+            assert!(
+                (got - q).abs() <= case.tolerance * q.abs(),
+                "{}: {}\n  heat {got} vs {q}",
+                dir.display(),
+                case.requirement
+            );
+        }
         if let Some(tol) = case.conservation {
             for i in &r.summary.interactions {
                 let heat = i.heat_side_a.abs().max(i.heat_side_b.abs());
@@ -103,5 +115,5 @@ fn verification_cases_meet_their_requirements() {
         }
         ran += 1;
     }
-    assert!(ran >= 3, "only {ran} cases found");
+    assert!(ran >= 4, "only {ran} cases found");
 }

@@ -4,6 +4,7 @@ mod bad_cli;
 mod bad_decks;
 mod cases;
 mod cli;
+mod conductance;
 mod docs;
 mod enforce;
 mod fem;

@@ -489,11 +489,26 @@ fn pairing_is_reused_between_search_updates() {
     let full: Vec<bool> = (0..7).map(|s| schedule.full_search(s)).collect();
     assert_eq!(full, [true, false, false, true, false, false, true]);
     assert!(SearchSchedule::new(None).full_search(5));
-    let deck = |text: &str| parse_sierra(&Arc::from("d"), text).0.contact_definitions.remove(0);
-    let elfen = deck("begin contact definition\n begin search options\n search update frequency 4\n end\nend\n");
-    assert_eq!(SearchSchedule::for_definition(&elfen), SearchSchedule::new(Some(4)));
-    let aria = deck("begin contact definition\n update search every 2 steps\n begin search options\n search update frequency 4\n end\nend\n");
-    assert_eq!(SearchSchedule::for_definition(&aria), SearchSchedule::new(Some(2)));
+    let deck = |text: &str| {
+        parse_sierra(&Arc::from("d"), text)
+            .0
+            .contact_definitions
+            .remove(0)
+    };
+    let elfen = deck(
+        "begin contact definition\n begin search options\n search update frequency 4\n end\nend\n",
+    );
+    assert_eq!(
+        SearchSchedule::for_definition(&elfen),
+        SearchSchedule::new(Some(4))
+    );
+    let aria = deck(
+        "begin contact definition\n update search every 2 steps\n begin search options\n search update frequency 4\n end\nend\n",
+    );
+    assert_eq!(
+        SearchSchedule::for_definition(&aria),
+        SearchSchedule::new(Some(2))
+    );
 
     let mesh = two_boxes(5, 4);
     let def = parse_sierra(&Arc::from("d"), PAIR)

@@ -1,1 +1,0 @@
-//! Conductance-coefficient models.

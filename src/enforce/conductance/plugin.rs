@@ -1,0 +1,103 @@
+//! The plugin adapter: a loaded enforcement plugin that returns conductance, used as a
+//! conductance model.
+
+use super::{Conductance, ConductanceError, ConductanceModel, PointState, check};
+use crate::plugin::{ContactPoint, Plugin, PointResult, StepContext};
+
+/// A [`Plugin`] without `RETURNS_FLUX` and without per-point state, called one point at
+/// a time. The host validates the plugin's output (finite, h ≥ 0) and forms finite
+/// differences when the plugin does not provide derivatives; faults become
+/// [`ConductanceError::Evaluation`] naming the plugin and the point. `Send + Sync`
+/// (the host serialises calls to plugins that are not thread-safe).
+///
+/// The point has no normals or weight (a conductance does not depend on them): normals
+/// are 0 and the weight 1. `surface_a` / `surface_b` are passed in the step context.
+pub struct PluginConductance {
+    plugin: Plugin,
+    surface_a: String,
+    surface_b: String,
+}
+
+impl PluginConductance {
+    /// Refuses plugins that return flux or keep state (a coefficient model has
+    /// neither).
+    pub fn new(plugin: Plugin) -> Result<PluginConductance, ConductanceError> {
+        let info = plugin.info();
+        let model = format!("plugin {} ({})", info.name, info.path.display());
+        if info.returns_flux() {
+            return Err(ConductanceError::Parameter {
+                model,
+                message: "returns flux (RETURNS_FLUX), not a conductance coefficient".into(),
+            });
+        }
+        if info.state_size > 0 {
+            return Err(ConductanceError::Parameter {
+                model,
+                message: format!(
+                    "keeps {} doubles of state per point; a conductance coefficient must be stateless",
+                    info.state_size
+                ),
+            });
+        }
+        Ok(PluginConductance {
+            plugin,
+            surface_a: String::new(),
+            surface_b: String::new(),
+        })
+    }
+
+    /// The surfaces the plugin is told about.
+    pub fn on_surfaces(mut self, surface_a: &str, surface_b: &str) -> Self {
+        self.surface_a = surface_a.into();
+        self.surface_b = surface_b.into();
+        self
+    }
+
+    pub fn plugin(&self) -> &Plugin {
+        &self.plugin
+    }
+}
+
+impl ConductanceModel for PluginConductance {
+    fn name(&self) -> String {
+        format!("plugin {}", self.plugin.info().name)
+    }
+
+    fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
+        let ctx = StepContext {
+            surface_a: &self.surface_a,
+            surface_b: &self.surface_b,
+            time: s.time,
+            ..StepContext::default()
+        };
+        let point = ContactPoint {
+            gap: s.gap,
+            pressure: s.pressure,
+            temp_a: s.temp_a,
+            temp_b: s.temp_b,
+            x: s.x,
+            weight: 1.0,
+            ..ContactPoint::default()
+        };
+        let mut out = [PointResult::default()];
+        self.plugin
+            .evaluate(&ctx, &[point], &mut out, None)
+            .map_err(|e| ConductanceError::Evaluation {
+                model: self.name(),
+                state: *s,
+                message: e.to_string(),
+            })?;
+        let r = out[0];
+        check(
+            self,
+            s,
+            Conductance {
+                h: r.value,
+                dh_dgap: r.d_gap,
+                dh_dpressure: r.d_pressure,
+                dh_dtemp_a: r.d_temp_a,
+                dh_dtemp_b: r.d_temp_b,
+            },
+        )
+    }
+}

@@ -1,0 +1,4 @@
+-- conductance in W/m2K
+function h(gap, temp_a, temp_b)
+  return 10 +
+end
