@@ -381,6 +381,27 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
                                 }
                                 m
                             }
+                            Some(ConductanceLaw::Plugin) => {
+                                let loaded_plugin = crate::plugin::PluginSpec::from_enforcement(enf, &deck_dir)
+                                    .and_then(|spec| spec.load())
+                                    .map_err(|e| e.to_string())
+                                    .and_then(|pl| {
+                                        conductance::PluginConductance::new(pl)
+                                            .map(|c| c.on_surfaces(&p.side_a, &p.side_b))
+                                            .map_err(|e| e.to_string())
+                                    });
+                                match loaded_plugin {
+                                    Ok(c) => Some(Box::new(c) as Box<dyn ConductanceModel>),
+                                    Err(e) => {
+                                        diags.push(
+                                            Diagnostic::error("E0500", e)
+                                                .at(Some(enf.at.clone()))
+                                                .help("`seam check-plugin LIB` loads and probes a plugin on its own"),
+                                        );
+                                        continue;
+                                    }
+                                }
+                            }
                             None => None,
                         };
                         choices.push((choice, scale, model));

@@ -9,6 +9,7 @@
 //! | `Tied_<field>`, `Nitche_Tied` | weighted symmetric Nitsche |
 //! | `Tied_Ip_<field>` | symmetric interior penalty |
 //! | `Dash` | mortar-integrated penalty `Dash Penalty Factor × k_eff / h_e` |
+//! | `Plugin Library = "lib.so" [Model = m]` | resistance with the conductance the plugin returns |
 //! | `Tied` with `Side B Variable b To a` | Lagrange multipliers (not carried out yet: an error says so) |
 //!
 //! `Offset Temperature = ΔT` prescribes the jump; `Integer Data`/`Real Data` are kept for
@@ -41,6 +42,9 @@ pub enum ConductanceLaw {
     /// The block's `Gap Conductance Coefficient = …` lines (see
     /// [`super::conductance::from_properties`]).
     Coefficient,
+    /// `Enforcement for Energy = Plugin Library = "…" [Model = …]`: the plugin returns the
+    /// conductance, with the block's Integer Data and Real Data.
+    Plugin,
 }
 
 const MODELS: [&str; 7] = [
@@ -131,14 +135,10 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
             Ok(base(Form::TiedNitsche))
         }
         n if n.starts_with("tied_ip_") => Ok(base(Form::TiedInteriorPenalty)),
-        "plugin" => Err(vec![
-            Diagnostic::error(
-                "E0900",
-                "`Enforcement for Energy = Plugin …` is recognised but not carried out by `seam run` in this version",
-            )
-            .at(Some(m.at.clone()))
-            .help("plugins load and pass `seam check-plugin`; their use in a run arrives with the conductance models"),
-        ]),
+        "plugin" => Ok(ModelChoice {
+            conductance: Some(ConductanceLaw::Plugin),
+            ..base(Form::Conductance)
+        }),
         other => {
             let hint = did_you_mean(other, MODELS)
                 .map(|s| format!("did you mean `{s}`? "))

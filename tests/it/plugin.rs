@@ -953,3 +953,85 @@ fn check_plugin_command_exit_codes() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("ABI 2.0") && err.contains("ABI 1.0"), "{err}");
 }
+
+/// Run a two-block problem whose interface enforcement is `enforcement` (the lines
+/// inside `begin enforcement`), with the bottom at `t_low` and the top at `t_high`.
+fn run_with(enforcement: &str, t_low: f64, t_high: f64, tag: &str) -> Vec<f64> {
+    let dir = tmp().join(format!("run-{tag}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = root().join("examples/two_blocks/two_blocks.exo");
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = {mesh:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = {t_low}\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = {t_high}\n\
+             [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n",
+            mesh = mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
+             begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n{enforcement}\n end\nend\n"
+        ),
+    )
+    .unwrap();
+    match seam::run::run(&dir.join("problem.toml")) {
+        Ok(r) => {
+            assert!(r.summary.converged);
+            r.solution.temperature
+        }
+        Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+        Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
+    }
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+}
+
+/// A plugin returning a constant h (the C table plugin with a flat table), and a Lua
+/// expression `10`, give the temperatures of the built-in Contact_Resistance with h = 10
+/// to round-off; the Rust example plugin reduced to its radiation part (no gas, no
+/// contact pressure) gives those of the built-in radiation model, a nonlinear case.
+#[test]
+fn plugin_and_lua_models_match_the_built_in_ones_in_a_run() {
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    let builtin = run_with("  enforcement for energy = contact_resistance h = 10", 0.0, 1.0, "builtin");
+    let plugin = run_with(
+        &format!("  enforcement for energy = plugin library = \"{table}\"\n  real data 0 10 1e6 10"),
+        0.0,
+        1.0,
+        "plugin",
+    );
+    let lua = run_with(
+        "  enforcement for energy = contact_resistance\n  gap conductance coefficient = lua \"10\"",
+        0.0,
+        1.0,
+        "lua",
+    );
+    assert!(max_diff(&builtin, &plugin) <= 1e-14, "{}", max_diff(&builtin, &plugin));
+    assert!(max_diff(&builtin, &lua) <= 1e-14, "{}", max_diff(&builtin, &lua));
+
+    let cmy = rust_plugins().cmy.to_str().unwrap().to_string();
+    let radiation = run_with(
+        "  enforcement for energy = contact_resistance\n  gap conductance coefficient = radiation emissivity_a = 0.8 emissivity_b = 0.6",
+        300.0,
+        1300.0,
+        "radiation",
+    );
+    let plugin = run_with(
+        &format!("  enforcement for energy = plugin library = \"{cmy}\"\n  real data 16 0.1 1e-6 3e9 0 1e-6 0.8 0.6"),
+        300.0,
+        1300.0,
+        "cmy",
+    );
+    // Both solve the same nonlinear problem with exact derivatives to a 1e-13 residual.
+    assert!(max_diff(&radiation, &plugin) <= 1e-9, "{}", max_diff(&radiation, &plugin));
+    // And the radiation conductance is not trivial: the interface jump is large.
+    let spread = radiation.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - radiation.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert!(spread > 900.0);
+}
