@@ -382,14 +382,15 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
                                 m
                             }
                             Some(ConductanceLaw::Plugin) => {
-                                let loaded_plugin = crate::plugin::PluginSpec::from_enforcement(enf, &deck_dir)
-                                    .and_then(|spec| spec.load())
-                                    .map_err(|e| e.to_string())
-                                    .and_then(|pl| {
-                                        conductance::PluginConductance::new(pl)
-                                            .map(|c| c.on_surfaces(&p.side_a, &p.side_b))
-                                            .map_err(|e| e.to_string())
-                                    });
+                                let loaded_plugin =
+                                    crate::plugin::PluginSpec::from_enforcement(enf, &deck_dir)
+                                        .and_then(|spec| spec.load())
+                                        .map_err(|e| e.to_string())
+                                        .and_then(|pl| {
+                                            conductance::PluginConductance::new(pl)
+                                                .map(|c| c.on_surfaces(&p.side_a, &p.side_b))
+                                                .map_err(|e| e.to_string())
+                                        });
                                 match loaded_plugin {
                                     Ok(c) => Some(Box::new(c) as Box<dyn ConductanceModel>),
                                     Err(e) => {

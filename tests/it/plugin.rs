@@ -990,7 +990,10 @@ fn run_with(enforcement: &str, t_low: f64, t_high: f64, tag: &str) -> Vec<f64> {
 }
 
 fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// A plugin returning a constant h (the C table plugin with a flat table), and a Lua
@@ -1000,9 +1003,16 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 #[test]
 fn plugin_and_lua_models_match_the_built_in_ones_in_a_run() {
     let table = c_plugins().table.to_str().unwrap().to_string();
-    let builtin = run_with("  enforcement for energy = contact_resistance h = 10", 0.0, 1.0, "builtin");
+    let builtin = run_with(
+        "  enforcement for energy = contact_resistance h = 10",
+        0.0,
+        1.0,
+        "builtin",
+    );
     let plugin = run_with(
-        &format!("  enforcement for energy = plugin library = \"{table}\"\n  real data 0 10 1e6 10"),
+        &format!(
+            "  enforcement for energy = plugin library = \"{table}\"\n  real data 0 10 1e6 10"
+        ),
         0.0,
         1.0,
         "plugin",
@@ -1013,8 +1023,16 @@ fn plugin_and_lua_models_match_the_built_in_ones_in_a_run() {
         1.0,
         "lua",
     );
-    assert!(max_diff(&builtin, &plugin) <= 1e-14, "{}", max_diff(&builtin, &plugin));
-    assert!(max_diff(&builtin, &lua) <= 1e-14, "{}", max_diff(&builtin, &lua));
+    assert!(
+        max_diff(&builtin, &plugin) <= 1e-14,
+        "{}",
+        max_diff(&builtin, &plugin)
+    );
+    assert!(
+        max_diff(&builtin, &lua) <= 1e-14,
+        "{}",
+        max_diff(&builtin, &lua)
+    );
 
     let cmy = rust_plugins().cmy.to_str().unwrap().to_string();
     let radiation = run_with(
@@ -1024,14 +1042,52 @@ fn plugin_and_lua_models_match_the_built_in_ones_in_a_run() {
         "radiation",
     );
     let plugin = run_with(
-        &format!("  enforcement for energy = plugin library = \"{cmy}\"\n  real data 16 0.1 1e-6 3e9 0 1e-6 0.8 0.6"),
+        &format!(
+            "  enforcement for energy = plugin library = \"{cmy}\"\n  real data 16 0.1 1e-6 3e9 0 1e-6 0.8 0.6"
+        ),
         300.0,
         1300.0,
         "cmy",
     );
     // Both solve the same nonlinear problem with exact derivatives to a 1e-13 residual.
-    assert!(max_diff(&radiation, &plugin) <= 1e-9, "{}", max_diff(&radiation, &plugin));
+    assert!(
+        max_diff(&radiation, &plugin) <= 1e-9,
+        "{}",
+        max_diff(&radiation, &plugin)
+    );
     // And the radiation conductance is not trivial: the interface jump is large.
-    let spread = radiation.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - radiation.iter().cloned().fold(f64::INFINITY, f64::min);
+    let spread = radiation.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+        - radiation.iter().cloned().fold(f64::INFINITY, f64::min);
     assert!(spread > 900.0);
+}
+
+/// Integer Data and Real Data written in a deck (with commas, `=`, and a Fortran
+/// exponent) reach the plugin exactly: the echo plugin returns Σ real + Σ integer and
+/// encodes the counts in dT_A (n_real + 1e3 n_integer).
+#[test]
+fn deck_data_arrives_at_the_plugin_as_written() {
+    let echo = c_plugins().echo.clone();
+    let deck = format!(
+        "begin contact definition\n begin enforcement\n  enforcement for energy = plugin library = \"{}\"\n  integer data 1 2, 3\n  real data = 1.5, 2e3 1d2 -0.25\n end\nend\n",
+        echo.file_name().unwrap().to_str().unwrap()
+    );
+    let (d, diags) = seam::deck::parse_sierra(&std::sync::Arc::from("deck.i"), &deck);
+    assert!(!diags.has_errors(), "{diags:?}");
+    let enf = &d.contact_definitions[0].enforcements[0];
+    let spec = seam::plugin::PluginSpec::from_enforcement(enf, echo.parent().unwrap()).unwrap();
+    assert_eq!(spec.data.integer_data, [1, 2, 3]);
+    assert_eq!(spec.data.real_data, [1.5, 2000.0, 100.0, -0.25]);
+    let plugin = spec.load().unwrap();
+    let mut state = seam::plugin::StateStore::new(1, plugin.info().state_size as usize);
+    let mut r = vec![PointResult::default(); 1];
+    plugin
+        .evaluate(
+            &ctx(),
+            &[point(0.0, 0.0, 1.0, 2.0)],
+            &mut r,
+            Some(&mut state),
+        )
+        .unwrap();
+    assert_eq!(r[0].value, 1.5 + 2000.0 + 100.0 - 0.25 + 6.0);
+    assert_eq!(r[0].d_temp_a.rem_euclid(1e6), 4.0 + 3.0e3);
 }
