@@ -1078,7 +1078,7 @@ fn deck_data_arrives_at_the_plugin_as_written() {
     assert_eq!(spec.data.integer_data, [1, 2, 3]);
     assert_eq!(spec.data.real_data, [1.5, 2000.0, 100.0, -0.25]);
     let plugin = spec.load().unwrap();
-    let mut state = seam::plugin::StateStore::new(1, plugin.info().state_size as usize);
+    let mut state = seam::plugin::StateStore::new(1, plugin.info().state_size);
     let mut r = vec![PointResult::default(); 1];
     plugin
         .evaluate(
