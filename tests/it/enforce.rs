@@ -455,3 +455,106 @@ fn interface_jacobian_matches_finite_differences() {
         assert!(checked > 10);
     }
 }
+
+/// A gas-gap conductance k_g / max(g, g_min) across gaps of 1e-12, 0 and −1e-9 (a slight
+/// overlap): the results are finite and approach the tied solution, differing from it by
+/// the jump q/h with h = k_g / g_min.
+#[test]
+fn tiny_zero_and_negative_gaps_approach_the_tie() {
+    use seam::enforce::conductance::{ConductanceModel, GasGap, PointState};
+    let gas = GasGap::new(0.025).unwrap();
+    for gap in [1e-12, 0.0, -1e-9] {
+        let mut mesh = slabs(3, 2, SolidKind::Hex8);
+        let first_b = 4 * 4 * 4;
+        for p in &mut mesh.coords[first_b..] {
+            p[2] += gap;
+        }
+        let (a, b) = (geometry(&mesh, 0), geometry(&mesh, 1));
+        let settings = SearchSettings::defaults(3);
+        let r = Searcher::new(&b, &settings).search(
+            &a,
+            &b,
+            &settings,
+            Integration::Segments { order: 5 },
+            None,
+        );
+        assert_eq!(r.stats.matched, r.stats.points, "gap {gap}");
+        let s = Setup {
+            mesh,
+            a,
+            b,
+            points: r.points,
+        };
+        let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+            .filter_map(|i| {
+                let z = s.mesh.coords[i][2];
+                (z == 0.0 || (z - 2.0 - gap).abs() < 1e-15)
+                    .then(|| (NodeId(i as u32), if z == 0.0 { 0.0 } else { 1.0 }))
+            })
+            .collect();
+        let materials = [Material {
+            conductivity: 1.0,
+            rho_c: 1.0,
+        }; 2];
+        let hf = |p: &HInput| {
+            let c = gas
+                .evaluate(&PointState {
+                    gap: p.gap,
+                    pressure: 0.0,
+                    temp_a: p.temp_a,
+                    temp_b: p.temp_b,
+                    x: p.x,
+                    time: 0.0,
+                })
+                .map_err(|e| e.to_string())?;
+            Ok(HValue {
+                h: c.h,
+                dh_dtemp_a: c.dh_dtemp_a,
+                dh_dtemp_b: c.dh_dtemp_b,
+            })
+        };
+        let k = [1.0, 1.0];
+        let sol = solve_steady(&SteadyProblem {
+            mesh: &s.mesh,
+            materials: &materials,
+            source: None,
+            dirichlet: &dirichlet,
+            face_bcs: &[],
+            contact: vec![ContactTerm {
+                side_a: &s.a,
+                side_b: &s.b,
+                points: &s.points,
+                form: InterfaceForm {
+                    form: Form::GapConductance,
+                    h: &hf,
+                    offset: 0.0,
+                    beta: DEFAULT_BETA,
+                    conductivity: &k,
+                },
+                linear: false,
+            }],
+            tolerance: 1e-12,
+            max_iterations: 10,
+        })
+        .unwrap();
+        assert!(
+            sol.converged && sol.temperature.iter().all(|t| t.is_finite()),
+            "gap {gap}"
+        );
+        // Tied: T = z/2 (up to the tiny shift of block B); the jump q/h is 0.5 / 25000.
+        let h = 0.025 / 1e-6;
+        let q = 1.0 / (1.0 + 1.0 / h + 1.0);
+        for (i, t) in sol.temperature.iter().enumerate() {
+            let z = s.mesh.coords[i][2];
+            let tied = if i < first_b {
+                z / 2.0
+            } else {
+                (z - gap) / 2.0
+            };
+            assert!(
+                (t - tied).abs() <= q / h + 1e-9,
+                "gap {gap}: node {i} T {t} vs tied {tied}"
+            );
+        }
+    }
+}
