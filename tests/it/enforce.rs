@@ -489,7 +489,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
             .filter_map(|i| {
                 let z = s.mesh.coords[i][2];
                 (z == 0.0 || (z - 2.0 - gap).abs() < 1e-15)
-                    .then(|| (NodeId(i as u32), if z == 0.0 { 0.0 } else { 1.0 }))
+                    .then_some((NodeId(i as u32), if z == 0.0 { 0.0 } else { 1.0 }))
             })
             .collect();
         let materials = [Material {
