@@ -18,7 +18,6 @@ use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{Mesh, NodeId};
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
-use seam::surface::{ContactSurface, SurfaceFace, SurfaceKind};
 
 fn exact(p: [f64; 3]) -> f64 {
     (PI * p[0]).sin() * (PI * p[1]).sin() * (0.5 * PI * p[2]).sin()
@@ -43,23 +42,7 @@ fn grad(p: [f64; 3]) -> [f64; 3] {
 }
 
 fn geometry(mesh: &Mesh, set: usize) -> SurfaceGeometry {
-    let s = ContactSurface {
-        name: format!("s{set}"),
-        kind: SurfaceKind::Faces,
-        faces: mesh.side_sets[set]
-            .sides
-            .iter()
-            .map(|&side| SurfaceFace {
-                side,
-                loft: 0.0,
-                origin: 0,
-            })
-            .collect(),
-        nodes: vec![],
-        origins: vec![],
-        parent: None,
-    };
-    SurfaceGeometry::from_surface(mesh, &s, &mesh.coords).unwrap()
+    SurfaceGeometry::from_side_set(mesh, set).unwrap()
 }
 
 fn boundary(mesh: &Mesh) -> Vec<(NodeId, f64)> {

@@ -13,26 +13,6 @@ use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{ElemId, Mesh, NodeId, Side};
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
-use seam::surface::{ContactSurface, SurfaceFace, SurfaceKind};
-
-fn surface_of(mesh: &Mesh, set: usize) -> ContactSurface {
-    ContactSurface {
-        name: format!("s{set}"),
-        kind: SurfaceKind::Faces,
-        faces: mesh.side_sets[set]
-            .sides
-            .iter()
-            .map(|&side| SurfaceFace {
-                side,
-                loft: 0.0,
-                origin: 0,
-            })
-            .collect(),
-        nodes: Vec::<NodeId>::new(),
-        origins: vec![],
-        parent: None,
-    }
-}
 
 /// Planar: side A is the top of an n×n-cell slab, side B the bottom of an m×m slab
 /// above it, m ≈ 0.9 n (non-matching).
@@ -115,10 +95,8 @@ fn main() {
     for &size in sizes {
         let n = (size as f64).sqrt().round() as usize;
         for (label, (mesh, ia, ib)) in [("planar", planar(n)), ("curved", curved(size))] {
-            let a =
-                SurfaceGeometry::from_surface(&mesh, &surface_of(&mesh, ia), &mesh.coords).unwrap();
-            let b =
-                SurfaceGeometry::from_surface(&mesh, &surface_of(&mesh, ib), &mesh.coords).unwrap();
+            let a = SurfaceGeometry::from_side_set(&mesh, ia).unwrap();
+            let b = SurfaceGeometry::from_side_set(&mesh, ib).unwrap();
             let settings = SearchSettings::defaults(3);
             for threads in [1, 2] {
                 let pool = rayon::ThreadPoolBuilder::new()

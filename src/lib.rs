@@ -19,3 +19,4 @@ pub mod script;
 pub mod search;
 pub mod solve;
 pub mod surface;
+pub(crate) mod vec3;

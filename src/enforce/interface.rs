@@ -40,11 +40,12 @@
 
 use std::collections::HashMap;
 
-use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId, Pattern};
+use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId};
 use crate::heat::kernel::{MAX_NODES, eval_point};
 use crate::heat::shape::reference_nodes;
 use crate::mesh::{ElemId, Mesh, Side, Topology};
 use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
+use crate::vec3::{cross, dot, norm, sub};
 
 /// Default Nitsche penalty factor β in `α = β k_eff / h_e`: well above the inverse-
 /// estimate constant of trilinear and linear elements with `h_e` = volume / face area
@@ -483,29 +484,4 @@ impl InterfaceSystem {
         };
         (sum(&self.side_a_dofs), sum(&self.side_b_dofs))
     }
-}
-
-/// Make sure a pattern knows a set of couplings; returns their first index.
-pub fn register(
-    pattern: &mut Pattern,
-    couplings: &[(usize, usize)],
-) -> Result<usize, AssemblyError> {
-    Ok(pattern.add_couplings(couplings)?.start)
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

@@ -13,6 +13,7 @@
 use std::path::{Component, Path, PathBuf};
 
 use crate::script::{Limits, Sandbox, ScriptError, ScriptFn};
+use crate::vec3::{cross, dot, norm, normalize as unit, sub};
 
 pub type Vec3 = [f64; 3];
 
@@ -280,26 +281,6 @@ pub fn fold_count(angle_deg: f64) -> Option<usize> {
     (r >= 1.0 && (n - r).abs() < 1e-9 * n).then_some(r as usize)
 }
 
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn unit(a: Vec3) -> Option<Vec3> {
-    let n = norm(a);
-    (n > 0.0 && n.is_finite()).then(|| a.map(|x| x / n))
-}
 fn mat_vec(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
     std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
 }

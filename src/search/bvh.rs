@@ -25,7 +25,7 @@
 //! leaf order of the tree; for [`Bvh::query_with_hint`], an order fixed by the hint).
 //! The parent links add 4 bytes per node; a node is 56 bytes.
 
-use super::vec3::V3;
+use crate::vec3::V3;
 
 /// Maximum number of items in a leaf.
 pub const LEAF_SIZE: usize = 4;

@@ -52,4 +52,3 @@ pub mod project;
 
 pub mod pairing;
 pub mod scene;
-mod vec3;

@@ -24,7 +24,7 @@
 //!   origin, Quad4 `(ξ, η) ∈ [-1, 1]²` in Exodus node order.
 
 use super::project::{map_quad4, map_tri3};
-use super::vec3::{V3, axpy, cross, dot, norm, normalize, sub};
+use crate::vec3::{V3, axpy, cross, dot, norm, normalize, sub};
 
 type P2 = [f64; 2];
 

@@ -42,7 +42,7 @@ use crate::periodic::PeriodicMap;
 use crate::script::ScriptError;
 use crate::surface::{ContactSurface, SurfaceKind};
 
-type V3 = [f64; 3];
+use crate::vec3::{V3, add, cross, dot, norm, scale, sub};
 
 /// One face as coordinates.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -172,6 +172,29 @@ impl SurfaceGeometry {
             out.faces.push(g);
         }
         Ok(out)
+    }
+
+    /// The geometry of side set `set` of the mesh taken whole as a surface, on the
+    /// mesh's coordinates (for hosts and tests that name their interface faces directly).
+    pub fn from_side_set(mesh: &Mesh, set: usize) -> Result<Self, SearchError> {
+        let ss = &mesh.side_sets[set];
+        let surface = ContactSurface {
+            name: ss.sierra_name(),
+            kind: SurfaceKind::Faces,
+            faces: ss
+                .sides
+                .iter()
+                .map(|&side| crate::surface::SurfaceFace {
+                    side,
+                    loft: 0.0,
+                    origin: 0,
+                })
+                .collect(),
+            nodes: Vec::new(),
+            origins: Vec::new(),
+            parent: None,
+        };
+        Self::from_surface(mesh, &surface, &mesh.coords)
     }
 
     /// The image of this surface under a periodic map, named `name`.
@@ -894,27 +917,4 @@ fn face_jacobian(face: &FaceGeom, xi: [f64; 2]) -> f64 {
             norm(cross(d_xi, d_eta))
         }
     }
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: V3, s: f64) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn norm(a: V3) -> f64 {
-    dot(a, a).sqrt()
-}
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

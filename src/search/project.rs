@@ -22,7 +22,7 @@
 //! (orthogonal) projection fell within the face. Degenerate faces (zero area) never give
 //! NaN: they are flagged and projected onto their edges.
 
-use super::vec3::{V3, add, axpy, closest_on_segment, cross, dot, norm, norm2, scale, sub};
+use crate::vec3::{V3, add, axpy, closest_on_segment, cross, dot, norm, norm2, scale, sub};
 
 /// Tolerance on parametric coordinates for [`Projection::inside`]. Parametric
 /// coordinates are relative to the face size, so this is a relative tolerance: 1e-10 sits

@@ -7,27 +7,7 @@
 
 use crate::mesh::{Mesh, NodeId};
 
-pub(crate) type Vec3 = [f64; 3];
-
-pub(crate) fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn dot(a: Vec3, b: Vec3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn norm(a: Vec3) -> f64 {
-    dot(a, a).sqrt()
-}
+pub(crate) use crate::vec3::{V3 as Vec3, cross, dot, norm, scale, sub};
 
 /// Measure (length, area) and unit normal of a face given by its nodes in order.
 /// Quadrilaterals use 2×2 Gauss integration of the bilinear map, exact for planar
@@ -86,8 +66,4 @@ pub(crate) fn centroid(mesh: &Mesh, nodes: &[NodeId]) -> Vec3 {
         }
     }
     scale(c, 1.0 / nodes.len().max(1) as f64)
-}
-
-pub(crate) fn scale(a: Vec3, s: f64) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
 }

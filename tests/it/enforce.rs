@@ -8,7 +8,6 @@ use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec, SolidKind};
 use seam::mesh::{Mesh, NodeId};
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
-use seam::surface::{ContactSurface, SurfaceFace, SurfaceKind};
 
 /// Block 1 on [0,1]²×[0,1] (n1 cells a side), block 2 on [0,1]²×[1,2] (n2), meshed
 /// apart; side set 1 = top of block 1, 2 = bottom of block 2.
@@ -27,23 +26,7 @@ fn slabs(n1: usize, n2: usize, kind: SolidKind) -> Mesh {
 }
 
 fn geometry(mesh: &Mesh, set: usize) -> SurfaceGeometry {
-    let s = ContactSurface {
-        name: format!("s{set}"),
-        kind: SurfaceKind::Faces,
-        faces: mesh.side_sets[set]
-            .sides
-            .iter()
-            .map(|&side| SurfaceFace {
-                side,
-                loft: 0.0,
-                origin: 0,
-            })
-            .collect(),
-        nodes: vec![],
-        origins: vec![],
-        parent: None,
-    };
-    SurfaceGeometry::from_surface(mesh, &s, &mesh.coords).unwrap()
+    SurfaceGeometry::from_side_set(mesh, set).unwrap()
 }
 
 struct Setup {

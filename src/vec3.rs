@@ -1,4 +1,5 @@
-//! Small fixed-size vector helpers for the search kernels (private).
+//! Small fixed-size vector helpers (3-vectors as `[f64; 3]`), shared by the geometric
+//! code of every module (crate-private).
 
 pub(crate) type V3 = [f64; 3];
 
