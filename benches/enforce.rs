@@ -121,6 +121,7 @@ fn main() {
             source: Some(&source),
             dirichlet: &bc,
             face_bcs: &[],
+            ties: vec![],
             contact: vec![],
             tolerance: 1e-10,
             max_iterations: 3,
@@ -176,6 +177,7 @@ fn main() {
                     source: Some(&source),
                     dirichlet: &bc,
                     face_bcs: &[],
+                    ties: vec![],
                     contact: vec![ContactTerm {
                         side_a: &a,
                         side_b: &b,

@@ -45,7 +45,7 @@ use crate::diag::{Diagnostic, Diagnostics, SourceMap, did_you_mean};
 use crate::enforce::conductance::{self, ConductanceModel, PointState};
 use crate::enforce::interface::{DEFAULT_BETA, Form, HFn, HInput, HValue, InterfaceForm};
 use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
-use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, solve_steady};
+use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use crate::heat::{FaceBc, Material};
 use crate::interaction;
 use crate::mesh::{self, Mesh, NodeId};
@@ -449,6 +449,7 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         .iter()
         .zip(&choices)
         .zip(&h_fns)
+        .filter(|((_, (c, _, _)), _)| !c.mortar)
         .map(|((p, (c, scale, model)), h)| ContactTerm {
             side_a: &p.side_a_geometry,
             side_b: &p.side_b_geometry,
@@ -464,6 +465,17 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
             linear: model.as_ref().is_none_or(|m| m.name() == "constant"),
         })
         .collect();
+    let ties: Vec<TieTerm<'_>> = pairings
+        .iter()
+        .zip(&choices)
+        .filter(|(_, (c, _, _))| c.mortar)
+        .map(|(p, (c, _, _))| TieTerm {
+            side_a: &p.side_a_geometry,
+            side_b: &p.side_b_geometry,
+            points: &p.result.points,
+            offset: c.offset,
+        })
+        .collect();
     let source_fn = source
         .as_ref()
         .map(|s| s as &(dyn Fn([f64; 3]) -> f64 + Sync));
@@ -474,6 +486,7 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         dirichlet: &dirichlet,
         face_bcs: &face_bcs,
         contact,
+        ties,
         tolerance: problem.solve.tolerance,
         max_iterations: problem.solve.max_iterations,
     };
@@ -495,10 +508,45 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         }
         None => None,
     };
+    // Heat per pairing, in pairing order: flux-type terms and ties were solved apart.
+    let (mut flux_heat, mut tie_heat) = (solution.heat.iter(), solution.tie_heat.iter());
+    let heats: Vec<(f64, f64)> = choices
+        .iter()
+        .map(|(c, _, _)| {
+            let next = if c.mortar {
+                tie_heat.next()
+            } else {
+                flux_heat.next()
+            };
+            next.copied().unwrap_or((0.0, 0.0))
+        })
+        .collect();
+    for (t, cps) in solution.crosspoints.iter().enumerate() {
+        if !cps.is_empty() {
+            let numbers: Vec<String> = cps
+                .iter()
+                .take(10)
+                .map(|n| mesh.node_number(*n).to_string())
+                .collect();
+            diags.push(
+                Diagnostic::warning(
+                    "W0430",
+                    format!(
+                        "tie #{}: {} side-A node(s) already constrained (Dirichlet data or an earlier tie) get no multiplier: {}{}",
+                        t + 1,
+                        cps.len(),
+                        numbers.join(", "),
+                        if cps.len() > 10 { ", …" } else { "" }
+                    ),
+                )
+                .help("a crosspoint keeps its Dirichlet value (or its first tie); this keeps the system non-singular"),
+            );
+        }
+    }
     let interactions = pairings
         .iter()
         .zip(&choices)
-        .zip(&solution.heat)
+        .zip(&heats)
         .map(|((p, (c, _, _)), &(a, b))| InteractionHeat {
             side_a: p.side_a.clone(),
             side_b: p.side_b.clone(),

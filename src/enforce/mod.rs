@@ -7,3 +7,4 @@
 pub mod conductance;
 pub mod interface;
 pub mod model;
+pub mod mortar;

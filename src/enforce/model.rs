@@ -10,7 +10,7 @@
 //! | `Tied_Ip_<field>` | symmetric interior penalty |
 //! | `Dash` | mortar-integrated penalty `Dash Penalty Factor × k_eff / h_e` |
 //! | `Plugin Library = "lib.so" [Model = m]` | resistance with the conductance the plugin returns |
-//! | `Tied` with `Side B Variable b To a` | Lagrange multipliers (not carried out yet: an error says so) |
+//! | `Tied` with `Side B Variable b To a` | Lagrange multipliers on side A, mortar-integrated |
 //!
 //! `Offset Temperature = ΔT` prescribes the jump; `Integer Data`/`Real Data` are kept for
 //! plugin models.
@@ -32,6 +32,8 @@ pub struct ModelChoice {
     pub offset: f64,
     /// For Dash: the penalty factor multiplying k_eff / h_e.
     pub penalty_factor: Option<f64>,
+    /// `Tied` with `Side B Variable`: a Lagrange-multiplier mortar tie (`form` unused).
+    pub mortar: bool,
 }
 
 /// A conductance law as the deck gives it.
@@ -76,6 +78,7 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         conductance: None,
         offset,
         penalty_factor: None,
+        mortar: false,
     };
     if let Some(map) = &e.side_b_variable {
         let known = ["temperature"];
@@ -100,14 +103,10 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         }
     }
     if e.side_b_variable.is_some() || name == "tied" {
-        return Err(vec![
-            Diagnostic::error(
-                "E0900",
-                "`Tied` with `Side B Variable` (Lagrange multipliers) is recognised but not carried out by this version of seam",
-            )
-            .at(Some(m.at.clone()))
-            .help("use `Tied_Temperature` (Nitsche) meanwhile: it ties the same field without multipliers"),
-        ]);
+        return Ok(ModelChoice {
+            mortar: true,
+            ..base(Form::TiedNitsche)
+        });
     }
     match name.as_str() {
         "contact_resistance" | "conductance" => {

@@ -13,9 +13,11 @@ use std::time::Instant;
 
 use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::enforce::interface::{InterfaceForm, InterfaceSystem, interface_terms};
+use crate::enforce::mortar::mortar_tie;
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, SurfaceGeometry};
-use crate::solve::{Cholesky, LinearSolver, Lu, Ordering, apply_dirichlet, spmv};
+use crate::solve::{Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv};
+use std::collections::HashSet;
 
 use super::{
     FaceBc, HeatError, Material, SourceFn, TEMPERATURE, assemble_conduction, dirichlet_dofs,
@@ -32,6 +34,15 @@ pub struct ContactTerm<'a> {
     pub linear: bool,
 }
 
+/// One Lagrange-multiplier mortar tie (`Tied` with `Side B Variable`).
+pub struct TieTerm<'a> {
+    pub side_a: &'a SurfaceGeometry,
+    pub side_b: &'a SurfaceGeometry,
+    pub points: &'a [ContactPoint],
+    /// Prescribed jump `a − b` (`Offset Temperature`).
+    pub offset: f64,
+}
+
 /// A steady problem on a mesh.
 pub struct SteadyProblem<'a> {
     pub mesh: &'a Mesh,
@@ -40,6 +51,8 @@ pub struct SteadyProblem<'a> {
     pub dirichlet: &'a [(NodeId, f64)],
     pub face_bcs: &'a [FaceBc],
     pub contact: Vec<ContactTerm<'a>>,
+    /// Mortar ties with multipliers (solved as a saddle-point system).
+    pub ties: Vec<TieTerm<'a>>,
     /// Relative tolerance on the residual norm.
     pub tolerance: f64,
     pub max_iterations: usize,
@@ -66,6 +79,11 @@ pub struct SteadySolution {
     pub residual_history: Vec<f64>,
     /// Per contact term: heat leaving side A and heat leaving side B through Γ.
     pub heat: Vec<(f64, f64)>,
+    /// Per tie: the same.
+    pub tie_heat: Vec<(f64, f64)>,
+    /// Per tie: side-A nodes left without a multiplier because they were already
+    /// constrained (Dirichlet data or an earlier tie).
+    pub crosspoints: Vec<Vec<NodeId>>,
     pub timing: SolveTiming,
 }
 
@@ -75,12 +93,35 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let blocks: Vec<usize> = (0..mesh.blocks.len())
         .filter(|&b| mesh.blocks[b].topology.is_solid())
         .collect();
-    let dofs = DofMap::new(mesh, &[(TEMPERATURE, &blocks)])?;
+    let mut dofs = DofMap::new(mesh, &[(TEMPERATURE, &blocks)])?;
     let field = dofs
         .field(TEMPERATURE)
         .ok_or(HeatError::NoTemperatureField)?;
-    let n = dofs.len();
+    let n_primal = dofs.len();
     let bcs = dirichlet_dofs(mesh, &dofs, field, p.dirichlet)?;
+    // Mortar ties: multipliers on side-A nodes not constrained already.
+    let conductivity: Vec<f64> = p.materials.iter().map(|m| m.conductivity).collect();
+    let mut constrained: HashSet<NodeId> = p.dirichlet.iter().map(|&(node, _)| node).collect();
+    let mut ties = Vec::with_capacity(p.ties.len());
+    for t in &p.ties {
+        let tie = mortar_tie(
+            mesh,
+            &dofs,
+            field,
+            t.side_a,
+            t.side_b,
+            t.points,
+            &conductivity,
+            &mut constrained,
+        )
+        .map_err(|e| HeatError::Contact(e.to_string()))?;
+        ties.push(tie);
+    }
+    let mut lambda_first = Vec::with_capacity(ties.len());
+    for tie in &ties {
+        lambda_first.push(dofs.add_extra(tie.nodes.len()).start);
+    }
+    let n = dofs.len();
     let mut u = vec![0.0; n];
     for &(d, g) in &bcs {
         u[d] = g;
@@ -103,6 +144,16 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         couplings.push(cp);
         terms.push(s);
     }
+    // Tie couplings (primal dof, multiplier dof), one per entry of C.
+    let mut tie_coupling_first = Vec::with_capacity(ties.len());
+    for (t, tie) in ties.iter().enumerate() {
+        let pairs: Vec<(usize, usize)> = tie
+            .entries
+            .iter()
+            .map(|&(k, d, _)| (d as usize, lambda_first[t] + k as usize))
+            .collect();
+        tie_coupling_first.push(pattern.add_couplings(&pairs)?.start);
+    }
     pattern.build()?;
     // The conduction part is linear: assemble it once, keep K and F.
     let mut vol = Assembler::new(&pattern);
@@ -114,6 +165,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
 
     let symmetric = p.contact.iter().all(|c| c.linear);
     let mut chol = Cholesky::new(Ordering::Metis);
+    let mut saddle = SaddleLdlt::with_primal(n_primal, n, Ordering::Metis);
     let mut lu = Lu::new();
     let mut history = Vec::new();
     let mut converged = false;
@@ -139,6 +191,18 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         for s in &terms {
             for &(d, v) in &s.residual {
                 r[d as usize] += v;
+            }
+        }
+        // Ties: Cᵀλ on the primal rows, C u − ΔT ∫ψ on the multiplier rows.
+        for (t, tie) in ties.iter().enumerate() {
+            let l0 = lambda_first[t];
+            for &(k, d, c) in &tie.entries {
+                let l = l0 + k as usize;
+                r[d as usize] += c * u[l];
+                r[l] += c * u[d as usize];
+            }
+            for (k, w) in tie.psi_integral.iter().enumerate() {
+                r[l0 + k] -= p.ties[t].offset * w;
             }
         }
         for &(d, _) in &bcs {
@@ -181,6 +245,11 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         for (k, s) in terms.iter().enumerate() {
             s.add_to(&mut asm, &couplings[k], first[k]);
         }
+        for (t, tie) in ties.iter().enumerate() {
+            for (e, &(_, _, c)) in tie.entries.iter().enumerate() {
+                asm.add_coupling(tie_coupling_first[t] + e, c, c);
+            }
+        }
         let mut jac = asm.matrix()?;
         drop(asm);
         let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
@@ -188,13 +257,16 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         apply_dirichlet(&mut jac, &mut rhs, &zero)?;
         timing.assembly_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let use_chol = symmetric && chol.factor(&jac).is_ok();
-        if !use_chol {
+        let saddle_ok = !ties.is_empty() && symmetric && saddle.factor(&jac).is_ok();
+        let use_chol = !saddle_ok && ties.is_empty() && symmetric && chol.factor(&jac).is_ok();
+        if !saddle_ok && !use_chol {
             lu.factor(&jac)?;
         }
         timing.factor_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        if use_chol {
+        if saddle_ok {
+            saddle.solve(&mut rhs)?;
+        } else if use_chol {
             chol.solve(&mut rhs)?;
         } else {
             lu.solve(&mut rhs)?;
@@ -206,6 +278,24 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         }
     }
     let heat = terms.iter().map(InterfaceSystem::heat).collect();
+    let tie_heat = ties
+        .iter()
+        .enumerate()
+        .map(|(t, tie)| {
+            // Σ over each side's dofs of Cᵀλ.
+            let mut ct = std::collections::HashMap::<u32, f64>::new();
+            for &(k, d, c) in &tie.entries {
+                *ct.entry(d).or_default() += c * u[lambda_first[t] + k as usize];
+            }
+            let sum = |set: &[u32]| {
+                set.iter()
+                    .map(|d| ct.get(d).copied().unwrap_or(0.0))
+                    .sum::<f64>()
+            };
+            (sum(&tie.side_a_dofs), sum(&tie.side_b_dofs))
+        })
+        .collect();
+    let crosspoints = ties.iter().map(|t| t.crosspoints.clone()).collect();
     let temperature = dofs.nodal_values(field, &u);
     Ok(SteadySolution {
         dofs,
@@ -215,6 +305,8 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         converged,
         residual_history: history,
         heat,
+        tie_heat,
+        crosspoints,
         timing,
     })
 }

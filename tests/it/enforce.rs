@@ -86,6 +86,7 @@ fn solve(
         source: None,
         dirichlet,
         face_bcs: &[],
+        ties: vec![],
         contact: vec![ContactTerm {
             side_a: &s.a,
             side_b: &s.b,
@@ -503,6 +504,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
             source: None,
             dirichlet: &dirichlet,
             face_bcs: &[],
+            ties: vec![],
             contact: vec![ContactTerm {
                 side_a: &s.a,
                 side_b: &s.b,

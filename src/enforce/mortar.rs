@@ -1,0 +1,159 @@
+//! Mortar ties with Lagrange multipliers: `Tied` with `Side B Variable b To a`.
+//!
+//! The constraint `a = b` on Γ is imposed weakly with multipliers λ on side A: one per
+//! side-A interface node, with the side-A trace shape functions as their basis
+//! (standard mortar), integrated over the mortar segments:
+//!
+//! ```text
+//! C_kj = Σ_points w ψ_k(x) J_j(x),   J_j = N_A,j on side A, −N_B,j on side B,
+//! [K  Cᵀ] [u]   [F]
+//! [C  0 ] [λ] = [ΔT ∫ψ]
+//! ```
+//!
+//! λ is the flux from side A to side B; the heat leaving side A, `Σ_A (Cᵀλ)_i = ∫ λ`, is
+//! read off the assembled residual like every other model, and the heat leaving side B
+//! is minus the same, to round-off.
+//!
+//! **Crosspoints.** A side-A node that also carries a Dirichlet condition is already
+//! constrained: a multiplier there would constrain it twice and make the system
+//! singular (the LBB failure MOOSE users meet). Such nodes get no multiplier — the
+//! Dirichlet value wins — and are reported. The same holds for a side-A node tied by two
+//! mortar interfaces: the first interface in the deck keeps it. The dropped node's
+//! basis function is shared equally among the kept nodes of each face it touches, so
+//! the multiplier space still holds the constants (Wohlmuth's crosspoint modification)
+//! and the patch test stays exact.
+
+use std::collections::{BTreeMap, HashSet};
+
+use crate::assembly::{DofMap, FieldId};
+use crate::mesh::{Mesh, NodeId};
+use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
+
+use super::interface::{InterfaceError, side_eval};
+
+/// The constraint rows of one mortar tie.
+#[derive(Clone, Debug, Default)]
+pub struct MortarTie {
+    /// The side-A node of each multiplier, in multiplier order.
+    pub nodes: Vec<NodeId>,
+    /// Side-A interface nodes that got no multiplier because they are already
+    /// constrained (Dirichlet data or an earlier tie): the crosspoints.
+    pub crosspoints: Vec<NodeId>,
+    /// (multiplier, dof, value) entries of C.
+    pub entries: Vec<(u32, u32, f64)>,
+    /// ∫ ψ_k, for a prescribed jump.
+    pub psi_integral: Vec<f64>,
+    pub side_a_dofs: Vec<u32>,
+    pub side_b_dofs: Vec<u32>,
+}
+
+/// Build the constraint rows. `constrained` holds nodes that must not get a multiplier
+/// (Dirichlet nodes and nodes tied by earlier interfaces); the tie's own nodes are added
+/// to it.
+#[allow(clippy::too_many_arguments)]
+pub fn mortar_tie(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    field: FieldId,
+    a: &SurfaceGeometry,
+    b: &SurfaceGeometry,
+    points: &[ContactPoint],
+    conductivity: &[f64],
+    constrained: &mut HashSet<NodeId>,
+) -> Result<MortarTie, InterfaceError> {
+    let mut index: BTreeMap<NodeId, u32> = BTreeMap::new();
+    let mut crosspoints = Vec::new();
+    // Multipliers on the side-A faces' nodes, in node order (deterministic).
+    let mut face_nodes: Vec<NodeId> = a
+        .faces
+        .iter()
+        .flat_map(|f| f.nodes[..f.len as usize].to_vec())
+        .collect();
+    face_nodes.sort_unstable();
+    face_nodes.dedup();
+    for n in face_nodes {
+        if constrained.contains(&n) {
+            crosspoints.push(n);
+        } else {
+            let k = index.len() as u32;
+            index.insert(n, k);
+        }
+    }
+    let mut entries: BTreeMap<(u32, u32), f64> = BTreeMap::new();
+    let mut psi_integral = vec![0.0; index.len()];
+    let mut side_a = Vec::new();
+    let mut side_b = Vec::new();
+    for p in points
+        .iter()
+        .filter(|p| p.status == PointStatus::Matched && p.a_face != u32::MAX)
+    {
+        let fa = &a.faces[p.a_face as usize];
+        let fb = &b.faces[p.b_face as usize];
+        let ea = side_eval(mesh, dofs, field, fa.side, p.xi_a, conductivity)?;
+        let eb = side_eval(mesh, dofs, field, fb.side, p.xi_b, conductivity)?;
+        let nodes_a = mesh.elem_nodes(ea.elem);
+        // ψ on this face: each kept node's trace shape function, plus an equal share of
+        // the dropped (crosspoint) nodes' — so the multipliers still sum to one and can
+        // carry a constant flux up to the rim (the crosspoint modification of the
+        // mortar basis; without it the patch test fails near Dirichlet rims).
+        let shape_of = |node: NodeId| {
+            nodes_a
+                .iter()
+                .position(|&n| n == node)
+                .map_or(0.0, |i| ea.n[i])
+        };
+        let face = &fa.nodes[..fa.len as usize];
+        let kept: Vec<(u32, f64)> = face
+            .iter()
+            .filter_map(|n| index.get(n).map(|&k| (k, shape_of(*n))))
+            .collect();
+        if kept.is_empty() {
+            continue;
+        }
+        let dropped: f64 = face
+            .iter()
+            .filter(|n| !index.contains_key(n))
+            .map(|&n| shape_of(n))
+            .sum();
+        let share = dropped / kept.len() as f64;
+        for &(k, n_k) in &kept {
+            let psi = n_k + share;
+            if psi == 0.0 {
+                continue;
+            }
+            psi_integral[k as usize] += p.weight * psi;
+            for j in 0..ea.len {
+                *entries.entry((k, ea.dofs[j])).or_default() += p.weight * psi * ea.n[j];
+            }
+            for j in 0..eb.len {
+                *entries.entry((k, eb.dofs[j])).or_default() -= p.weight * psi * eb.n[j];
+            }
+        }
+        side_a.extend_from_slice(&ea.dofs[..ea.len]);
+        side_b.extend_from_slice(&eb.dofs[..eb.len]);
+    }
+    side_a.sort_unstable();
+    side_a.dedup();
+    side_b.sort_unstable();
+    side_b.dedup();
+    let nodes: Vec<NodeId> = {
+        let mut v = vec![NodeId(0); index.len()];
+        for (&n, &k) in &index {
+            v[k as usize] = n;
+        }
+        v
+    };
+    constrained.extend(nodes.iter().copied());
+    Ok(MortarTie {
+        nodes,
+        crosspoints,
+        entries: entries
+            .into_iter()
+            .filter(|(_, v)| *v != 0.0)
+            .map(|((k, d), v)| (k, d, v))
+            .collect(),
+        psi_integral,
+        side_a_dofs: side_a,
+        side_b_dofs: side_b,
+    })
+}
