@@ -543,3 +543,117 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
         }
     }
 }
+
+/// The mortar tie with Lagrange multipliers passes the linear patch test on hex 3:2,
+/// hex 7:3 and tet 3:2 non-matching meshes, with every outer node Dirichlet (so the
+/// interface rim is all crosspoints).
+#[test]
+fn mortar_lagrange_tie_passes_the_patch_test() {
+    use seam::heat::steady::TieTerm;
+    for (n1, n2, kind) in [
+        (3, 2, SolidKind::Hex8),
+        (7, 3, SolidKind::Hex8),
+        (3, 2, SolidKind::Tet4),
+    ] {
+        let s = setup(n1, n2, kind);
+        let on_boundary = |p: [f64; 3]| {
+            p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 1.0 || p[2] == 0.0 || p[2] == 2.0
+        };
+        let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+            .filter(|&i| on_boundary(s.mesh.coords[i]))
+            .map(|i| (NodeId(i as u32), linear_field(s.mesh.coords[i])))
+            .collect();
+        let materials = [Material {
+            conductivity: 1.0,
+            rho_c: 1.0,
+        }; 2];
+        let sol = solve_steady(&SteadyProblem {
+            mesh: &s.mesh,
+            materials: &materials,
+            source: None,
+            dirichlet: &dirichlet,
+            face_bcs: &[],
+            contact: vec![],
+            ties: vec![TieTerm {
+                side_a: &s.a,
+                side_b: &s.b,
+                points: &s.points,
+                offset: 0.0,
+            }],
+            tolerance: 1e-13,
+            max_iterations: 3,
+        })
+        .unwrap();
+        assert!(
+            !sol.crosspoints[0].is_empty(),
+            "the rim nodes are crosspoints"
+        );
+        let worst = (0..s.mesh.num_nodes())
+            .map(|i| (sol.temperature[i] - linear_field(s.mesh.coords[i])).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-12 * 6.0, "{n1}:{n2} {kind:?}: worst {worst:e}");
+        let (qa, qb) = sol.tie_heat[0];
+        assert!((qa + qb).abs() <= 1e-12 * qa.abs());
+    }
+}
+
+/// Dash is a penalty tie: on the two slabs it leaves the jump q/P with
+/// P = β_D k_eff / h_e (here h_e = 1/3, the smaller cell, and k_eff = 1), i.e. an error
+/// it predicts; the temperatures match the two-slab solution with that conductance.
+#[test]
+fn dash_penalty_error_is_the_predicted_one() {
+    let s = setup(3, 2, SolidKind::Hex8);
+    let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+        .filter_map(|i| {
+            let z = s.mesh.coords[i][2];
+            (z == 0.0 || z == 2.0).then_some((NodeId(i as u32), z / 2.0))
+        })
+        .collect();
+    let first_b = 4 * 4 * 4;
+    for factor in [10.0, 1e3, 1e6] {
+        let materials = [Material {
+            conductivity: 1.0,
+            rho_c: 1.0,
+        }; 2];
+        let hf = |_: &HInput| Ok(HValue::default());
+        let k = [1.0, 1.0];
+        let sol = solve_steady(&SteadyProblem {
+            mesh: &s.mesh,
+            materials: &materials,
+            source: None,
+            dirichlet: &dirichlet,
+            face_bcs: &[],
+            ties: vec![],
+            contact: vec![ContactTerm {
+                side_a: &s.a,
+                side_b: &s.b,
+                points: &s.points,
+                form: InterfaceForm {
+                    form: Form::Penalty,
+                    h: &hf,
+                    offset: 0.0,
+                    beta: factor,
+                    conductivity: &k,
+                },
+                linear: true,
+            }],
+            tolerance: 1e-13,
+            max_iterations: 3,
+        })
+        .unwrap();
+        let p = factor * 1.0 / (1.0 / 3.0);
+        let q = 1.0 / (1.0 + 1.0 / p + 1.0);
+        for i in 0..s.mesh.num_nodes() {
+            let z = s.mesh.coords[i][2];
+            let predicted = if i < first_b {
+                q * z
+            } else {
+                1.0 - q * (2.0 - z)
+            };
+            assert!(
+                (sol.temperature[i] - predicted).abs() < 1e-10,
+                "factor {factor}: node {i}"
+            );
+        }
+    }
+}
