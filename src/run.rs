@@ -48,10 +48,12 @@ use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
 use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use crate::heat::{FaceBc, Material};
 use crate::interaction;
-use crate::mesh::{self, Mesh, NodeId};
+use std::collections::HashSet;
+
+use crate::mesh::{self, Mesh, NodeId, Side};
 use crate::output::vtu::write_vtu;
 use crate::script::{Limits, Sandbox};
-use crate::search::pairing::Integration;
+use crate::search::pairing::{Integration, PointStatus};
 use crate::search::scene::{Pairing, search_definition};
 use crate::surface;
 
@@ -112,6 +114,10 @@ pub struct BcSpec {
     pub value: Value,
     #[serde(default)]
     pub ambient: Option<f64>,
+    /// Keep this flux or convection on faces in contact too (Aria's `no_coverage_flux`);
+    /// by default it is masked there.
+    #[serde(default)]
+    pub no_coverage_flux: bool,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -268,7 +274,7 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
     let mut sandbox = None;
     let materials = materials(&problem, &mesh, &mut diags);
     let dirichlet = dirichlet(&problem, &mesh, &mut sandbox, &mut diags);
-    let face_bcs = face_bcs(&problem, &mesh, &mut sandbox, &mut diags);
+    let mut face_bcs = face_bcs(&problem, &mesh, &mut sandbox, &mut diags);
     let source = nodal_source(&problem, &mesh, &mut sandbox, &mut diags);
     if diags.has_errors() {
         return Err(RunError::Input(diags, SourceMap::default()));
@@ -417,6 +423,39 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         return Err(RunError::Input(diags, loaded.sources));
     }
 
+    // Aria masks ordinary flux and convection conditions on faces in contact: a side-A
+    // face with matched points, or a side-B face some point paired with. A condition
+    // with `no_coverage_flux = true` stays.
+    let mut in_contact: HashSet<Side> = HashSet::new();
+    for p in &pairings {
+        if p.periodic {
+            continue;
+        }
+        for q in p
+            .result
+            .points
+            .iter()
+            .filter(|q| q.status == PointStatus::Matched)
+        {
+            if q.a_face != u32::MAX {
+                in_contact.insert(p.side_a_geometry.faces[q.a_face as usize].side);
+            }
+            in_contact.insert(p.side_b_geometry.faces[q.b_face as usize].side);
+        }
+    }
+    let before = face_bcs.len();
+    face_bcs.retain(|(bc, keep)| *keep || !in_contact.contains(&bc_side(bc)));
+    let masked = before - face_bcs.len();
+    if masked > 0 {
+        diags.push(
+            Diagnostic::warning(
+                "W0701",
+                format!("{masked} face condition(s) on faces in contact are masked (Aria's rule)"),
+            )
+            .help("set `no_coverage_flux = true` in the [[bc]] to keep a condition on faces in contact"),
+        );
+    }
+    let face_bcs: Vec<FaceBc> = face_bcs.into_iter().map(|(bc, _)| bc).collect();
     let conductivity: Vec<f64> = materials.iter().map(|m| m.conductivity).collect();
     // Each conductance model seen by the interface forms: the point's gap and
     // temperatures in, h and dh/dT out (pressure is 0 until a pressure field is given).
@@ -709,12 +748,19 @@ fn dirichlet(
     out
 }
 
+fn bc_side(bc: &FaceBc) -> Side {
+    match *bc {
+        FaceBc::Flux { side, .. } | FaceBc::Convection { side, .. } => side,
+    }
+}
+
+/// Every face condition, with whether it opts out of masking on faces in contact.
 fn face_bcs(
     p: &Problem,
     mesh: &Mesh,
     sandbox: &mut Option<Sandbox>,
     diags: &mut Diagnostics,
-) -> Vec<FaceBc> {
+) -> Vec<(FaceBc, bool)> {
     let mut out = Vec::new();
     for bc in p.bc.iter().filter(|b| b.kind != BcKind::Temperature) {
         for s in &bc.surfaces {
@@ -743,14 +789,15 @@ fn face_bcs(
                         return out;
                     }
                 };
-                out.push(match bc.kind {
+                let face = match bc.kind {
                     BcKind::Flux => FaceBc::Flux { side, q: v },
                     _ => FaceBc::Convection {
                         side,
                         h: v,
                         t_inf: bc.ambient.unwrap_or(0.0),
                     },
-                });
+                };
+                out.push((face, bc.no_coverage_flux));
             }
         }
     }

@@ -117,3 +117,62 @@ fn verification_cases_meet_their_requirements() {
     }
     assert!(ran >= 4, "only {ran} cases found");
 }
+
+/// Aria masks ordinary face conditions on faces in contact: a convection condition on
+/// the base's top, which the lid covers, changes nothing — unless it opts out with
+/// `no_coverage_flux = true`.
+#[test]
+fn face_conditions_on_faces_in_contact_are_masked_unless_asked() {
+    let dir = std::env::temp_dir().join(format!("seam-mask-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
+    std::fs::write(
+        dir.join("contact.i"),
+        "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
+         begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = tied_temperature\n end\nend\n",
+    )
+    .unwrap();
+    let run = |extra: &str| {
+        std::fs::write(
+            dir.join("problem.toml"),
+            format!(
+                "[mesh]\nfile = {:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 1\n{extra}\
+                 [contact]\nfile = \"contact.i\"\n",
+                mesh.to_str().unwrap()
+            ),
+        )
+        .unwrap();
+        match seam::run::run(&dir.join("problem.toml")) {
+            Ok(r) => (
+                r.solution.temperature,
+                r.warnings.0.iter().map(|d| d.code).collect::<Vec<_>>(),
+            ),
+            Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+            Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
+        }
+    };
+    let convection =
+        "[[bc]]\nkind = \"convection\"\nsurfaces = [\"base_top\"]\nvalue = 50.0\nambient = 5.0\n";
+    let (plain, _) = run("");
+    let (masked, codes) = run(convection);
+    let (kept, _) = run(&format!("{convection}no_coverage_flux = true\n"));
+    let diff = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    assert_eq!(
+        diff(&plain, &masked),
+        0.0,
+        "a masked condition changes nothing"
+    );
+    assert!(codes.contains(&"W0701"), "{codes:?}");
+    assert!(
+        diff(&plain, &kept) > 0.1,
+        "an unmasked hot convection heats the interface"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
