@@ -513,6 +513,11 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
             side_b: &p.side_b_geometry,
             points: &p.result.points,
             offset: c.offset,
+            multipliers: if c.dual {
+                crate::enforce::mortar::Multipliers::Dual
+            } else {
+                crate::enforce::mortar::Multipliers::Standard
+            },
         })
         .collect();
     let source_fn = source

@@ -10,7 +10,7 @@
 //! | `Tied_Ip_<field>` | symmetric interior penalty |
 //! | `Dash` | mortar-integrated penalty `Dash Penalty Factor × k_eff / h_e` |
 //! | `Plugin Library = "lib.so" [Model = m]` | resistance with the conductance the plugin returns |
-//! | `Tied` with `Side B Variable b To a` | Lagrange multipliers on side A, mortar-integrated |
+//! | `Tied` with `Side B Variable b To a` | Lagrange multipliers on side A, mortar-integrated; `Tied Multipliers = Dual` condenses them (SPD) |
 //!
 //! `Offset Temperature = ΔT` prescribes the jump; `Integer Data`/`Real Data` are kept for
 //! plugin models.
@@ -34,6 +34,8 @@ pub struct ModelChoice {
     pub penalty_factor: Option<f64>,
     /// `Tied` with `Side B Variable`: a Lagrange-multiplier mortar tie (`form` unused).
     pub mortar: bool,
+    /// For mortar ties: `Multipliers = Dual` (condensed, SPD) instead of standard.
+    pub dual: bool,
 }
 
 /// A conductance law as the deck gives it.
@@ -79,6 +81,7 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         offset,
         penalty_factor: None,
         mortar: false,
+        dual: false,
     };
     if let Some(map) = &e.side_b_variable {
         let known = ["temperature"];
@@ -103,8 +106,13 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         }
     }
     if e.side_b_variable.is_some() || name == "tied" {
+        let dual = m.args.iter().any(|a| {
+            (a.key.eq_ignore_ascii_case("multipliers") && a.value.eq_ignore_ascii_case("dual"))
+                || (a.key.is_empty() && a.value.eq_ignore_ascii_case("dual"))
+        });
         return Ok(ModelChoice {
             mortar: true,
+            dual,
             ..base(Form::TiedNitsche)
         });
     }

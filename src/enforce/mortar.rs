@@ -47,6 +47,18 @@ pub struct MortarTie {
     pub side_b_dofs: Vec<u32>,
 }
 
+/// Which multiplier basis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Multipliers {
+    /// The side-A trace shape functions (standard mortar): a saddle-point solve.
+    #[default]
+    Standard,
+    /// Biorthogonal to the trace shape functions face by face (Wohlmuth's dual
+    /// mortar): the side-A block of C is diagonal, so side A's interface values are
+    /// condensed out and the system stays symmetric positive definite.
+    Dual,
+}
+
 /// Build the constraint rows. `constrained` holds nodes that must not get a multiplier
 /// (Dirichlet nodes and nodes tied by earlier interfaces); the tie's own nodes are added
 /// to it.
@@ -60,6 +72,7 @@ pub fn mortar_tie(
     points: &[ContactPoint],
     conductivity: &[f64],
     constrained: &mut HashSet<NodeId>,
+    multipliers: Multipliers,
 ) -> Result<MortarTie, InterfaceError> {
     let mut index: BTreeMap<NodeId, u32> = BTreeMap::new();
     let mut crosspoints = Vec::new();
@@ -79,6 +92,32 @@ pub fn mortar_tie(
             index.insert(n, k);
         }
     }
+    // Dual basis: per side-A face, ψ_k = Σ_l A_kl N_l with A = D M⁻¹, M_kl = ∫ N_k N_l and
+    // D = diag(Σ_l M_kl), both integrated with the same points as the constraint, so
+    // ∫ ψ_k N_l = δ_kl D_kk exactly.
+    let dual: Vec<Option<[[f64; 4]; 4]>> = match multipliers {
+        Multipliers::Standard => vec![None; a.faces.len()],
+        Multipliers::Dual => {
+            let mut m = vec![[[0.0f64; 4]; 4]; a.faces.len()];
+            for p in points
+                .iter()
+                .filter(|p| p.status == PointStatus::Matched && p.a_face != u32::MAX)
+            {
+                let f = &a.faces[p.a_face as usize];
+                let n = face_shape_values(f.len as usize, p.xi_a);
+                for k in 0..f.len as usize {
+                    for l in 0..f.len as usize {
+                        m[p.a_face as usize][k][l] += p.weight * n[k] * n[l];
+                    }
+                }
+            }
+            a.faces
+                .iter()
+                .zip(m)
+                .map(|(f, m)| dual_coefficients(&m, f.len as usize))
+                .collect()
+        }
+    };
     let mut entries: BTreeMap<(u32, u32), f64> = BTreeMap::new();
     let mut psi_integral = vec![0.0; index.len()];
     let mut side_a = Vec::new();
@@ -103,17 +142,29 @@ pub fn mortar_tie(
                 .map_or(0.0, |i| ea.n[i])
         };
         let face = &fa.nodes[..fa.len as usize];
+        // The multiplier basis at this point, per face node: N, or the dual ψ.
+        let basis: Vec<f64> = match &dual[p.a_face as usize] {
+            None => face.iter().map(|&n| shape_of(n)).collect(),
+            Some(c) => {
+                let nf = face_shape_values(face.len(), p.xi_a);
+                (0..face.len())
+                    .map(|k| (0..face.len()).map(|l| c[k][l] * nf[l]).sum())
+                    .collect()
+            }
+        };
         let kept: Vec<(u32, f64)> = face
             .iter()
-            .filter_map(|n| index.get(n).map(|&k| (k, shape_of(*n))))
+            .zip(&basis)
+            .filter_map(|(n, &b)| index.get(n).map(|&k| (k, b)))
             .collect();
         if kept.is_empty() {
             continue;
         }
         let dropped: f64 = face
             .iter()
-            .filter(|n| !index.contains_key(n))
-            .map(|&n| shape_of(n))
+            .zip(&basis)
+            .filter(|(n, _)| !index.contains_key(n))
+            .map(|(_, &b)| b)
             .sum();
         let share = dropped / kept.len() as f64;
         for &(k, n_k) in &kept {
@@ -156,4 +207,66 @@ pub fn mortar_tie(
         side_a_dofs: side_a,
         side_b_dofs: side_b,
     })
+}
+
+/// Trace shape functions of a face at face coordinates `xi` (Tri3 or Quad4, Exodus order).
+fn face_shape_values(len: usize, xi: [f64; 2]) -> [f64; 4] {
+    let (s, t) = (xi[0], xi[1]);
+    if len == 3 {
+        [1.0 - s - t, s, t, 0.0]
+    } else {
+        [
+            0.25 * (1.0 - s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 + t),
+            0.25 * (1.0 - s) * (1.0 + t),
+        ]
+    }
+}
+
+/// `A = D M⁻¹` for a face mass matrix `M` (n × n, n ≤ 4), by Gauss–Jordan elimination;
+/// `None` for a face without integration points (no overlap).
+fn dual_coefficients(m: &[[f64; 4]; 4], n: usize) -> Option<[[f64; 4]; 4]> {
+    let scale = (0..n).map(|k| m[k][k].abs()).fold(0.0, f64::max);
+    if scale == 0.0 {
+        return None;
+    }
+    // Solve M X = I; then A = D X.
+    let mut a = [[0.0f64; 8]; 4];
+    for k in 0..n {
+        for l in 0..n {
+            a[k][l] = m[k][l];
+        }
+        a[k][n + k] = 1.0;
+    }
+    for col in 0..n {
+        let pivot = (col..n).max_by(|&x, &y| a[x][col].abs().total_cmp(&a[y][col].abs()))?;
+        if a[pivot][col].abs() <= 1e-14 * scale {
+            return None;
+        }
+        a.swap(col, pivot);
+        let d = a[col][col];
+        for v in a[col].iter_mut().take(2 * n) {
+            *v /= d;
+        }
+        for r in 0..n {
+            if r != col {
+                let f = a[r][col];
+                if f != 0.0 {
+                    let pivot_row = a[col];
+                    for (x, p) in a[r].iter_mut().zip(pivot_row).take(2 * n) {
+                        *x -= f * p;
+                    }
+                }
+            }
+        }
+    }
+    let mut out = [[0.0f64; 4]; 4];
+    for k in 0..n {
+        let d: f64 = (0..n).map(|l| m[k][l]).sum();
+        for l in 0..n {
+            out[k][l] = d * a[k][n + l];
+        }
+    }
+    Some(out)
 }

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::enforce::interface::{InterfaceForm, InterfaceSystem, interface_terms};
-use crate::enforce::mortar::mortar_tie;
+use crate::enforce::mortar::{MortarTie, Multipliers, mortar_tie};
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, SurfaceGeometry};
 use crate::solve::{Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv};
@@ -41,6 +41,7 @@ pub struct TieTerm<'a> {
     pub points: &'a [ContactPoint],
     /// Prescribed jump `a − b` (`Offset Temperature`).
     pub offset: f64,
+    pub multipliers: Multipliers,
 }
 
 /// A steady problem on a mesh.
@@ -113,9 +114,21 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             t.points,
             &conductivity,
             &mut constrained,
+            t.multipliers,
         )
         .map_err(|e| HeatError::Contact(e.to_string()))?;
         ties.push(tie);
+    }
+    let dual = p.ties.iter().any(|t| t.multipliers == Multipliers::Dual);
+    if dual {
+        if p.ties.iter().any(|t| t.multipliers != Multipliers::Dual)
+            || p.contact.iter().any(|c| !c.linear)
+        {
+            return Err(HeatError::Contact(
+                "dual mortar ties are condensed in a linear solve: do not mix them with standard ties or temperature-dependent conductances".into(),
+            ));
+        }
+        return solve_dual(p, dofs, field, bcs, ties);
     }
     let mut lambda_first = Vec::with_capacity(ties.len());
     for tie in &ties {
@@ -307,6 +320,217 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         heat,
         tie_heat,
         crosspoints,
+        timing,
+    })
+}
+
+/// The dual-mortar path: every tie's side-A interface values are condensed out
+/// (`u_A,k = (ΔT ∫ψ_k − Σ_j C_kj u_j) / D_k`, D the diagonal side-A block of C), the
+/// system `Tᵀ K T ũ = Tᵀ (F − K g)` stays symmetric positive definite and is solved by
+/// Cholesky; the multipliers are recovered from the condensed rows.
+fn solve_dual(
+    p: &SteadyProblem<'_>,
+    dofs: DofMap,
+    field: crate::assembly::FieldId,
+    bcs: Vec<(usize, f64)>,
+    ties: Vec<MortarTie>,
+) -> Result<SteadySolution, HeatError> {
+    use faer::sparse::{SparseColMat, Triplet};
+    let mesh = p.mesh;
+    let n = dofs.len();
+    let mut timing = SolveTiming::default();
+    let t = Instant::now();
+    // K and F with the flux-type contact terms (linear: evaluated at u = 0).
+    let zero = vec![0.0; n];
+    let mut pattern = Pattern::new(mesh, &dofs);
+    let mut terms = Vec::new();
+    let mut firsts = Vec::new();
+    let mut couplings = Vec::new();
+    for c in &p.contact {
+        let s = interface_terms(
+            mesh, &dofs, field, c.side_a, c.side_b, c.points, &c.form, &zero,
+        )
+        .map_err(|e| HeatError::Contact(e.to_string()))?;
+        let cp = s.couplings();
+        firsts.push(pattern.add_couplings(&cp)?.start);
+        couplings.push(cp);
+        terms.push(s);
+    }
+    pattern.build()?;
+    let mut asm = Assembler::new(&pattern);
+    assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
+    for (k, s) in terms.iter().enumerate() {
+        s.add_to(&mut asm, &couplings[k], firsts[k]);
+    }
+    let k = asm.matrix()?;
+    let mut f = asm.rhs();
+    for s in &terms {
+        for &(d, v) in &s.rhs {
+            f[d as usize] += v;
+        }
+    }
+    drop(asm);
+    // The condensation map: condensed dof → (constant, [(dof, coefficient)]).
+    type Condensed = Option<(f64, Vec<(usize, f64)>)>;
+    let mut map: Vec<Condensed> = vec![None; n];
+    let mut diag = vec![0.0; n];
+    for (t, tie) in ties.iter().enumerate() {
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); tie.nodes.len()];
+        for &(kk, d, c) in &tie.entries {
+            rows[kk as usize].push((d as usize, c));
+        }
+        for (kk, node) in tie.nodes.iter().enumerate() {
+            let own = dofs
+                .dof(field, *node)
+                .ok_or(HeatError::NoTemperatureField)?
+                .index();
+            let d = rows[kk]
+                .iter()
+                .filter(|(j, _)| *j == own)
+                .map(|(_, c)| c)
+                .sum::<f64>();
+            if d == 0.0 {
+                continue; // a node no point reached: left free
+            }
+            diag[own] = d;
+            let others = rows[kk]
+                .iter()
+                .filter(|(j, _)| *j != own)
+                .map(|&(j, c)| (j, -c / d))
+                .collect();
+            map[own] = Some((p.ties[t].offset * tie.psi_integral[kk] / d, others));
+        }
+    }
+    // Side-A rows of a dual basis reference no other condensed dof (biorthogonality);
+    // a non-negligible one means a face without full overlap.
+    for (i, m) in map.iter().enumerate() {
+        if let Some((_, row)) = m {
+            for &(j, a) in row {
+                if map[j].is_some() && a.abs() > 1e-9 {
+                    return Err(HeatError::Contact(format!(
+                        "dual mortar: the side-A rows of dofs {i} and {j} are coupled ({a:.3e}); a side-A face is only partly covered by side B — use standard multipliers (`Multipliers = Standard`) there"
+                    )));
+                }
+            }
+        }
+    }
+    let expand = |i: usize| -> Vec<(usize, f64)> {
+        match &map[i] {
+            Some((_, row)) => row
+                .iter()
+                .filter(|(j, _)| map[*j].is_none())
+                .copied()
+                .collect(),
+            None => vec![(i, 1.0)],
+        }
+    };
+    // g: the constant part of u; reduced rhs Tᵀ (F − K g).
+    let mut g = vec![0.0; n];
+    for (i, m) in map.iter().enumerate() {
+        if let Some((c, _)) = m {
+            g[i] = *c;
+        }
+    }
+    let mut kg = vec![0.0; n];
+    spmv(&k, &g, &mut kg);
+    let mut triplets = Vec::with_capacity(k.compute_nnz() * 2);
+    let sym = k.symbolic();
+    let vals = k.val();
+    for j in 0..n {
+        let ej = expand(j);
+        for pos in sym.col_range(j) {
+            let i = sym.row_idx()[pos];
+            let v = vals[pos];
+            for &(a, wa) in &expand(i) {
+                for &(b, wb) in &ej {
+                    triplets.push(Triplet::new(a, b, wa * v * wb));
+                }
+            }
+        }
+    }
+    let mut rhs = vec![0.0; n];
+    for i in 0..n {
+        let r = f[i] - kg[i];
+        for (a, w) in expand(i) {
+            rhs[a] += w * r;
+        }
+    }
+    // Condensed dofs keep an identity row so the reduced matrix stays non-singular.
+    for (i, m) in map.iter().enumerate() {
+        if m.is_some() {
+            triplets.push(Triplet::new(i, i, 1.0));
+            rhs[i] = 0.0;
+        }
+    }
+    let mut reduced = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
+        .map_err(|e| HeatError::Contact(format!("reduced system: {e:?}")))?;
+    apply_dirichlet(&mut reduced, &mut rhs, &bcs)?;
+    timing.assembly_s += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let mut chol = Cholesky::new(Ordering::Metis);
+    chol.factor(&reduced)?;
+    timing.factor_s += t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    chol.solve(&mut rhs)?;
+    timing.solve_s += t.elapsed().as_secs_f64();
+    let mut u = rhs;
+    for (i, m) in map.iter().enumerate() {
+        if let Some((c, row)) = m {
+            u[i] = c + row.iter().map(|&(j, a)| a * u[j]).sum::<f64>();
+        }
+    }
+    // Multipliers from the condensed rows: D_k λ_k = −(K u − F)_k.
+    let mut ku = vec![0.0; n];
+    spmv(&k, &u, &mut ku);
+    let tie_heat = ties
+        .iter()
+        .map(|tie| {
+            let mut ct = std::collections::HashMap::<u32, f64>::new();
+            let lambda: Vec<f64> = tie
+                .nodes
+                .iter()
+                .map(|node| {
+                    let d = dofs.dof(field, *node).map_or(0, |d| d.index());
+                    if diag[d] == 0.0 {
+                        0.0
+                    } else {
+                        -(ku[d] - f[d]) / diag[d]
+                    }
+                })
+                .collect();
+            for &(kk, d, c) in &tie.entries {
+                *ct.entry(d).or_default() += c * lambda[kk as usize];
+            }
+            let sum = |set: &[u32]| {
+                set.iter()
+                    .map(|d| ct.get(d).copied().unwrap_or(0.0))
+                    .sum::<f64>()
+            };
+            (sum(&tie.side_a_dofs), sum(&tie.side_b_dofs))
+        })
+        .collect();
+    let heat = terms
+        .iter()
+        .zip(&p.contact)
+        .map(|(_, c)| {
+            let s = interface_terms(
+                mesh, &dofs, field, c.side_a, c.side_b, c.points, &c.form, &u,
+            )
+            .map_err(|e| HeatError::Contact(e.to_string()))?;
+            Ok(s.heat())
+        })
+        .collect::<Result<Vec<_>, HeatError>>()?;
+    let temperature = dofs.nodal_values(field, &u);
+    Ok(SteadySolution {
+        crosspoints: ties.iter().map(|t| t.crosspoints.clone()).collect(),
+        dofs,
+        u,
+        temperature,
+        newton_iterations: 1,
+        converged: true,
+        residual_history: Vec::new(),
+        heat,
+        tie_heat,
         timing,
     })
 }

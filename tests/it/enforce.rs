@@ -544,56 +544,72 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
     }
 }
 
-/// The mortar tie with Lagrange multipliers passes the linear patch test on hex 3:2,
-/// hex 7:3 and tet 3:2 non-matching meshes, with every outer node Dirichlet (so the
-/// interface rim is all crosspoints).
+/// The mortar tie with Lagrange multipliers, standard (saddle point) and dual (condensed
+/// to an SPD system), passes the linear patch test on hex 3:2, hex 7:3 and tet 3:2
+/// non-matching meshes, with every outer node Dirichlet (so the interface rim is all
+/// crosspoints).
 #[test]
 fn mortar_lagrange_tie_passes_the_patch_test() {
+    use seam::enforce::mortar::Multipliers;
     use seam::heat::steady::TieTerm;
-    for (n1, n2, kind) in [
-        (3, 2, SolidKind::Hex8),
-        (7, 3, SolidKind::Hex8),
-        (3, 2, SolidKind::Tet4),
-    ] {
-        let s = setup(n1, n2, kind);
-        let on_boundary = |p: [f64; 3]| {
-            p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 1.0 || p[2] == 0.0 || p[2] == 2.0
-        };
-        let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
-            .filter(|&i| on_boundary(s.mesh.coords[i]))
-            .map(|i| (NodeId(i as u32), linear_field(s.mesh.coords[i])))
-            .collect();
-        let materials = [Material {
-            conductivity: 1.0,
-            rho_c: 1.0,
-        }; 2];
-        let sol = solve_steady(&SteadyProblem {
-            mesh: &s.mesh,
-            materials: &materials,
-            source: None,
-            dirichlet: &dirichlet,
-            face_bcs: &[],
-            contact: vec![],
-            ties: vec![TieTerm {
-                side_a: &s.a,
-                side_b: &s.b,
-                points: &s.points,
-                offset: 0.0,
-            }],
-            tolerance: 1e-13,
-            max_iterations: 3,
-        })
-        .unwrap();
-        assert!(
-            !sol.crosspoints[0].is_empty(),
-            "the rim nodes are crosspoints"
-        );
-        let worst = (0..s.mesh.num_nodes())
-            .map(|i| (sol.temperature[i] - linear_field(s.mesh.coords[i])).abs())
-            .fold(0.0, f64::max);
-        assert!(worst < 1e-12 * 6.0, "{n1}:{n2} {kind:?}: worst {worst:e}");
-        let (qa, qb) = sol.tie_heat[0];
-        assert!((qa + qb).abs() <= 1e-12 * qa.abs());
+    for multipliers in [Multipliers::Standard, Multipliers::Dual] {
+        for (n1, n2, kind) in [
+            (3, 2, SolidKind::Hex8),
+            (7, 3, SolidKind::Hex8),
+            (3, 2, SolidKind::Tet4),
+        ] {
+            let s = setup(n1, n2, kind);
+            let on_boundary = |p: [f64; 3]| {
+                p[0] == 0.0
+                    || p[0] == 1.0
+                    || p[1] == 0.0
+                    || p[1] == 1.0
+                    || p[2] == 0.0
+                    || p[2] == 2.0
+            };
+            let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+                .filter(|&i| on_boundary(s.mesh.coords[i]))
+                .map(|i| (NodeId(i as u32), linear_field(s.mesh.coords[i])))
+                .collect();
+            let materials = [Material {
+                conductivity: 1.0,
+                rho_c: 1.0,
+            }; 2];
+            let sol = solve_steady(&SteadyProblem {
+                mesh: &s.mesh,
+                materials: &materials,
+                source: None,
+                dirichlet: &dirichlet,
+                face_bcs: &[],
+                contact: vec![],
+                ties: vec![TieTerm {
+                    side_a: &s.a,
+                    side_b: &s.b,
+                    points: &s.points,
+                    offset: 0.0,
+                    multipliers,
+                }],
+                tolerance: 1e-13,
+                max_iterations: 3,
+            })
+            .unwrap();
+            assert!(
+                !sol.crosspoints[0].is_empty(),
+                "the rim nodes are crosspoints"
+            );
+            let worst = (0..s.mesh.num_nodes())
+                .map(|i| (sol.temperature[i] - linear_field(s.mesh.coords[i])).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst < 1e-12 * 6.0,
+                "{multipliers:?} {n1}:{n2} {kind:?}: worst {worst:e}"
+            );
+            let (qa, qb) = sol.tie_heat[0];
+            assert!(
+                (qa + qb).abs() <= 1e-12 * qa.abs(),
+                "{multipliers:?}: heat {qa} {qb}"
+            );
+        }
     }
 }
 
