@@ -146,6 +146,10 @@ pub struct SolveSpec {
     pub tolerance: f64,
     #[serde(default = "default_iterations")]
     pub max_iterations: usize,
+    /// `direct` (sparse Cholesky/LU, default) or `amg` (CG with algebraic multigrid, for
+    /// large symmetric problems).
+    #[serde(default)]
+    pub linear_solver: Option<String>,
 }
 
 impl Default for SolveSpec {
@@ -154,6 +158,7 @@ impl Default for SolveSpec {
             kind: steady(),
             tolerance: default_tolerance(),
             max_iterations: default_iterations(),
+            linear_solver: None,
         }
     }
 }
@@ -258,6 +263,16 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         );
         RunError::Input(d, sources)
     })?;
+    if let Some(ls) = problem.solve.linear_solver.as_deref()
+        && ls != "direct"
+        && ls != "amg"
+    {
+        return Err(input_error(
+            "E0708",
+            format!("unknown linear solver `{ls}`"),
+            "use linear_solver = \"direct\" or \"amg\"",
+        ));
+    }
     if problem.solve.kind != "steady" {
         return Err(input_error(
             "E0900",
@@ -531,6 +546,7 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         face_bcs: &face_bcs,
         contact,
         ties,
+        iterative: problem.solve.linear_solver.as_deref() == Some("amg"),
         tolerance: problem.solve.tolerance,
         max_iterations: problem.solve.max_iterations,
     };

@@ -16,7 +16,9 @@ use crate::enforce::interface::{InterfaceForm, InterfaceSystem, interface_terms}
 use crate::enforce::mortar::{MortarTie, Multipliers, mortar_tie};
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, SurfaceGeometry};
-use crate::solve::{Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv};
+use crate::solve::{
+    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
+};
 use std::collections::HashSet;
 
 use super::{
@@ -54,6 +56,10 @@ pub struct SteadyProblem<'a> {
     pub contact: Vec<ContactTerm<'a>>,
     /// Mortar ties with multipliers (solved as a saddle-point system).
     pub ties: Vec<TieTerm<'a>>,
+    /// Solve the linear systems by CG with the algebraic-multigrid preconditioner
+    /// instead of a factorisation (symmetric problems without multipliers; for sizes a
+    /// factorisation does not fit).
+    pub iterative: bool,
     /// Relative tolerance on the residual norm.
     pub tolerance: f64,
     pub max_iterations: usize,
@@ -178,6 +184,10 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
 
     let symmetric = p.contact.iter().all(|c| c.linear);
     let mut chol = Cholesky::new(Ordering::Metis);
+    let mut amg = AmgCg::new(AmgOptions {
+        tolerance: 1e-11,
+        ..AmgOptions::default()
+    });
     let mut saddle = SaddleLdlt::with_primal(n_primal, n, Ordering::Metis);
     let mut lu = Lu::new();
     let mut history = Vec::new();
@@ -270,6 +280,18 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         apply_dirichlet(&mut jac, &mut rhs, &zero)?;
         timing.assembly_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
+        if p.iterative && symmetric && ties.is_empty() {
+            amg.factor(&jac)?;
+            timing.factor_s += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            amg.solve(&mut rhs)?;
+            timing.solve_s += t.elapsed().as_secs_f64();
+            last_step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (ui, d) in u.iter_mut().zip(&rhs) {
+                *ui += d;
+            }
+            continue;
+        }
         let saddle_ok = !ties.is_empty() && symmetric && saddle.factor(&jac).is_ok();
         let use_chol = !saddle_ok && ties.is_empty() && symmetric && chol.factor(&jac).is_ok();
         if !saddle_ok && !use_chol {

@@ -100,6 +100,7 @@ fn solve(
             },
             linear: true,
         }],
+        iterative: false,
         tolerance: 1e-13,
         max_iterations: 3,
     };
@@ -312,6 +313,7 @@ fn curved_interface_converges_with_mortar_ties() {
                     offset: 0.0,
                     multipliers,
                 }],
+                iterative: false,
                 tolerance: 1e-13,
                 max_iterations: 3,
             })
@@ -593,6 +595,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
                 },
                 linear: false,
             }],
+            iterative: false,
             tolerance: 1e-12,
             max_iterations: 10,
         })
@@ -664,6 +667,7 @@ fn mortar_lagrange_tie_passes_the_patch_test() {
                     offset: 0.0,
                     multipliers,
                 }],
+                iterative: false,
                 tolerance: 1e-13,
                 max_iterations: 3,
             })
@@ -728,6 +732,7 @@ fn dash_penalty_error_is_the_predicted_one() {
                 },
                 linear: true,
             }],
+            iterative: false,
             tolerance: 1e-13,
             max_iterations: 3,
         })
@@ -840,6 +845,7 @@ fn crosspoints_of_a_tie_with_dirichlet_and_periodic_faces() {
         face_bcs: &[],
         contact: vec![],
         ties,
+        iterative: false,
         tolerance: 1e-13,
         max_iterations: 3,
     })
@@ -857,4 +863,74 @@ fn crosspoints_of_a_tie_with_dirichlet_and_periodic_faces() {
         .map(|i| (sol.temperature[i] - field(mesh.coords[i])).abs())
         .fold(0.0, f64::max);
     assert!(worst < 1e-11, "worst nodal error {worst:e}");
+}
+
+/// The iterative path (AMG-preconditioned CG) gives the direct solution of a tied
+/// non-matching problem to its tolerance.
+#[test]
+fn amg_cg_path_matches_the_direct_solve() {
+    let s = setup(7, 3, SolidKind::Hex8);
+    let on_boundary = |p: [f64; 3]| p[2] == 0.0 || p[2] == 2.0 || p[0] == 0.0;
+    let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+        .filter(|&i| on_boundary(s.mesh.coords[i]))
+        .map(|i| {
+            (
+                NodeId(i as u32),
+                (3.0 * s.mesh.coords[i][0]).sin() + s.mesh.coords[i][2],
+            )
+        })
+        .collect();
+    let materials = [
+        Material {
+            conductivity: 1.0,
+            rho_c: 1.0,
+        },
+        Material {
+            conductivity: 4.0,
+            rho_c: 1.0,
+        },
+    ];
+    let hf = |_: &HInput| {
+        Ok(HValue {
+            h: 7.0,
+            ..HValue::default()
+        })
+    };
+    let k = [1.0, 4.0];
+    let solve_with = |iterative: bool| {
+        solve_steady(&SteadyProblem {
+            mesh: &s.mesh,
+            materials: &materials,
+            source: None,
+            dirichlet: &dirichlet,
+            face_bcs: &[],
+            ties: vec![],
+            contact: vec![ContactTerm {
+                side_a: &s.a,
+                side_b: &s.b,
+                points: &s.points,
+                form: InterfaceForm {
+                    form: Form::GapConductance,
+                    h: &hf,
+                    offset: 0.0,
+                    beta: DEFAULT_BETA,
+                    conductivity: &k,
+                },
+                linear: true,
+            }],
+            iterative,
+            tolerance: 1e-12,
+            max_iterations: 5,
+        })
+        .unwrap()
+    };
+    let (direct, amg) = (solve_with(false), solve_with(true));
+    assert!(amg.converged);
+    let worst = direct
+        .temperature
+        .iter()
+        .zip(&amg.temperature)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-8, "AMG-CG differs from Cholesky by {worst:e}");
 }
