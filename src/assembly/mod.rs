@@ -524,6 +524,13 @@ impl<'p> Assembler<'p> {
         }
     }
 
+    /// Zero the coupling and diagonal slots (keeping the element slots), so interface
+    /// terms can be assembled again without re-running the element kernels.
+    pub fn reset_couplings(&mut self) {
+        let start = self.pattern.elem_values;
+        self.values[start..].fill(0.0);
+    }
+
     /// Add values to coupling `k`: `v_ij` at `(i, j)` and `v_ji` at `(j, i)`.
     pub fn add_coupling(&mut self, k: usize, v_ij: f64, v_ji: f64) {
         let base = self.pattern.elem_values + 2 * k;

@@ -226,17 +226,36 @@ fn outward_normal(mesh: &Mesh, side: Side) -> [f64; 3] {
 }
 
 /// Volume of the element over the area of the side: the element's thickness normal to
-/// the interface (exact for a box cell; within a factor ~3 for tets).
+/// the interface. The volume is det J at the reference centroid times the reference
+/// volume — exact for affine elements and a fair length scale for others, which is all
+/// a penalty length needs (one shape-function evaluation, no quadrature).
 fn element_length(mesh: &Mesh, elem: ElemId, side: Side) -> f64 {
     let topology = mesh.topology(elem);
+    let Some(reference) = reference_nodes(topology) else {
+        return 0.0;
+    };
     let nodes = mesh.elem_nodes(elem);
     let mut coords = [[0.0; 3]; MAX_NODES];
     for (k, n) in nodes.iter().enumerate() {
         coords[k] = mesh.coords[n.index()];
     }
-    let volume = crate::heat::Basis::standard(topology)
-        .and_then(|b| crate::heat::kernel::measure(&b, &coords[..nodes.len()]).ok())
-        .unwrap_or(0.0);
+    let mut center = [0.0; 3];
+    for r in reference {
+        for d in 0..3 {
+            center[d] += r[d] / reference.len() as f64;
+        }
+    }
+    let reference_volume = match topology {
+        Topology::Hex8 => 8.0,
+        Topology::Tet4 => 1.0 / 6.0,
+        Topology::Wedge6 => 1.0,
+        Topology::Pyramid5 => 4.0 / 3.0,
+        Topology::Quad4 => 4.0,
+        Topology::Tri3 => 0.5,
+        _ => 0.0,
+    };
+    let volume = eval_point(topology, &coords[..nodes.len()], center, reference_volume)
+        .map_or(0.0, |pv| pv.jxw.abs());
     let p: Vec<[f64; 3]> = mesh
         .side_nodes(side)
         .map(|n| mesh.coords[n.index()])

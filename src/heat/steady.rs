@@ -174,12 +174,12 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         tie_coupling_first.push(pattern.add_couplings(&pairs)?.start);
     }
     pattern.build()?;
-    // The conduction part is linear: assemble it once, keep K and F.
-    let mut vol = Assembler::new(&pattern);
-    assemble_conduction(&mut vol, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
-    let k_vol = vol.matrix()?;
-    let f_vol = vol.rhs();
-    drop(vol);
+    // The conduction part is linear: assemble it once, keep K and F, and keep the
+    // assembler's element slots for every Newton step (only interface slots change).
+    let mut asm = Assembler::new(&pattern);
+    assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
+    let k_vol = asm.matrix()?;
+    let f_vol = asm.rhs();
     timing.assembly_s += t.elapsed().as_secs_f64();
 
     let symmetric = p.contact.iter().all(|c| c.linear);
@@ -262,9 +262,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         }
         iterations += 1;
         let t = Instant::now();
-        let mut asm = Assembler::new(&pattern);
-        // The element slots repeat the conduction terms (cheap, and keeps one pattern).
-        assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
+        asm.reset_couplings();
         for (k, s) in terms.iter().enumerate() {
             s.add_to(&mut asm, &couplings[k], first[k]);
         }
@@ -274,7 +272,6 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             }
         }
         let mut jac = asm.matrix()?;
-        drop(asm);
         let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
         let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
         apply_dirichlet(&mut jac, &mut rhs, &zero)?;
