@@ -220,3 +220,38 @@ fn gmsh_meshes_work_end_to_end() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The bundled run: 1-D through the two blocks (insulated sides), so the heat through the
+/// interface is q = 100 / (1/16 + 1/500 + 0.5/200) per unit area, and JSON keys are there.
+#[test]
+fn example_run_gives_the_series_resistance_heat() {
+    let out = seam(&["run", "examples/two_blocks/problem.toml", "--json"]);
+    let r = json(&out);
+    for key in ["dofs", "newton_iterations", "interactions", "timing"] {
+        assert!(r.get(key).is_some(), "missing {key}: {r}");
+    }
+    for key in [
+        "surfaces_s",
+        "search_s",
+        "assembly_s",
+        "factor_s",
+        "solve_s",
+        "total_s",
+    ] {
+        assert!(r["timing"].get(key).is_some(), "missing timing.{key}");
+    }
+    let i = &r["interactions"][0];
+    let q = 100.0 / (1.0 / 16.0 + 1.0 / 500.0 + 0.5 / 200.0);
+    let a = i["heat_side_a"].as_f64().unwrap();
+    assert!(
+        (a + q).abs() < 1e-9 * q,
+        "heat out of the base {a}, expected {}",
+        -q
+    );
+    assert!(i["imbalance"].as_f64().unwrap().abs() < 1e-12 * q);
+    assert!(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("examples/two_blocks/out/temperature.vtu")
+            .is_file()
+    );
+}
