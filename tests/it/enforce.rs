@@ -268,6 +268,52 @@ fn ring_exact(k: [f64; 2], h: f64) -> impl Fn([f64; 3], bool) -> (f64, [f64; 3])
     }
 }
 
+/// Solve on rings m = 1, 2, 4 with `solve_ring` (given the setup and the exact
+/// Dirichlet data on r = 0.5 and r = 1.5) and check L2 rate 2 ± 0.1 and H1 rate 1 ± 0.1.
+fn check_ring_rates(
+    label: &str,
+    k: [f64; 2],
+    h: f64,
+    solve_ring: impl Fn(&Setup, &[(NodeId, f64)]) -> seam::heat::steady::SteadySolution,
+) {
+    let exact = ring_exact(k, h);
+    let mut errors = Vec::new();
+    for m in [1, 2, 4] {
+        let s = rings(m);
+        let n_a = s.mesh.elem_nodes(s.mesh.blocks[1].first_elem)[0].index(); // ring B's first node
+        let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+            .filter_map(|i| {
+                let p = s.mesh.coords[i];
+                let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+                ((r - 0.5).abs() < 1e-12 || (r - 1.5).abs() < 1e-12)
+                    .then(|| (NodeId(i as u32), exact(p, i < n_a).0))
+            })
+            .collect();
+        let sol = solve_ring(&s, &dirichlet);
+        let mut e = (0.0, 0.0);
+        for (blk, inner) in [(0usize, true), (1usize, false)] {
+            let f = |p: [f64; 3]| exact(p, inner).0;
+            let g = |p: [f64; 3]| exact(p, inner).1;
+            let n = seam::heat::error_norms(&s.mesh, &[blk], &sol.temperature, &f, &g, 4).unwrap();
+            e.0 += n.l2 * n.l2;
+            e.1 += n.h1 * n.h1;
+        }
+        errors.push((e.0.sqrt(), e.1.sqrt()));
+    }
+    for w in errors.windows(2) {
+        let (l2, h1) = ((w[0].0 / w[1].0).log2(), (w[0].1 / w[1].1).log2());
+        eprintln!("{label}: L2 rate {l2:.3}, H1 rate {h1:.3}");
+        assert!(
+            (l2 - 2.0).abs() <= 0.1,
+            "{label}: L2 rate {l2:.3} ({errors:?})"
+        );
+        assert!(
+            (h1 - 1.0).abs() <= 0.1,
+            "{label}: H1 rate {h1:.3} ({errors:?})"
+        );
+    }
+}
+
 /// Convergence across a curved non-matching interface with mortar ties (standard and
 /// dual multipliers): L2 rate 2 ± 0.1, H1 rate 1 ± 0.1.
 #[test]
@@ -275,72 +321,43 @@ fn curved_interface_converges_with_mortar_ties() {
     use seam::enforce::mortar::Multipliers;
     use seam::heat::steady::TieTerm;
     let k = [1.0, 3.0];
-    let exact = ring_exact(k, f64::INFINITY);
     for multipliers in [Multipliers::Standard, Multipliers::Dual] {
-        let mut errors = Vec::new();
-        for m in [1, 2, 4] {
-            let s = rings(m);
-            let n_a = s.mesh.elem_nodes(s.mesh.blocks[1].first_elem)[0].index();
-            let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
-                .filter_map(|i| {
-                    let p = s.mesh.coords[i];
-                    let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
-                    ((r - 0.5).abs() < 1e-12 || (r - 1.5).abs() < 1e-12)
-                        .then(|| (NodeId(i as u32), exact(p, i < n_a).0))
+        check_ring_rates(
+            &format!("{multipliers:?} mortar"),
+            k,
+            f64::INFINITY,
+            |s, dirichlet| {
+                let materials = [
+                    Material {
+                        conductivity: k[0],
+                        rho_c: 1.0,
+                    },
+                    Material {
+                        conductivity: k[1],
+                        rho_c: 1.0,
+                    },
+                ];
+                solve_steady(&SteadyProblem {
+                    mesh: &s.mesh,
+                    materials: &materials,
+                    source: None,
+                    dirichlet,
+                    face_bcs: &[],
+                    contact: vec![],
+                    ties: vec![TieTerm {
+                        side_a: &s.a,
+                        side_b: &s.b,
+                        points: &s.points,
+                        offset: 0.0,
+                        multipliers,
+                    }],
+                    iterative: false,
+                    tolerance: 1e-13,
+                    max_iterations: 3,
                 })
-                .collect();
-            let materials = [
-                Material {
-                    conductivity: k[0],
-                    rho_c: 1.0,
-                },
-                Material {
-                    conductivity: k[1],
-                    rho_c: 1.0,
-                },
-            ];
-            let sol = solve_steady(&SteadyProblem {
-                mesh: &s.mesh,
-                materials: &materials,
-                source: None,
-                dirichlet: &dirichlet,
-                face_bcs: &[],
-                contact: vec![],
-                ties: vec![TieTerm {
-                    side_a: &s.a,
-                    side_b: &s.b,
-                    points: &s.points,
-                    offset: 0.0,
-                    multipliers,
-                }],
-                iterative: false,
-                tolerance: 1e-13,
-                max_iterations: 3,
-            })
-            .unwrap();
-            let mut e = (0.0, 0.0);
-            for (blk, inner) in [(0usize, true), (1usize, false)] {
-                let f = |p: [f64; 3]| exact(p, inner).0;
-                let g = |p: [f64; 3]| exact(p, inner).1;
-                let n =
-                    seam::heat::error_norms(&s.mesh, &[blk], &sol.temperature, &f, &g, 4).unwrap();
-                e.0 += n.l2 * n.l2;
-                e.1 += n.h1 * n.h1;
-            }
-            errors.push((e.0.sqrt(), e.1.sqrt()));
-        }
-        for w in errors.windows(2) {
-            let (l2, h1) = ((w[0].0 / w[1].0).log2(), (w[0].1 / w[1].1).log2());
-            eprintln!("{multipliers:?} mortar: L2 rate {l2:.3}, H1 rate {h1:.3}");
-            assert!(
-                (l2 - 2.0).abs() <= 0.1,
-                "{multipliers:?}: L2 rate {l2:.3} ({errors:?})"
-            );
-            assert!(
-                (h1 - 1.0).abs() <= 0.1,
-                "{multipliers:?}: H1 rate {h1:.3} ({errors:?})"
-            );
-        }
+                .unwrap()
+            },
+        );
     }
 }
 
@@ -355,45 +372,10 @@ fn curved_interface_converges_at_optimal_rates() {
         (Form::GapConductance, 10.0),
         (Form::Conductance, 10.0),
     ] {
-        let exact = ring_exact(k, h);
-        let mut errors = Vec::new();
-        for m in [1, 2, 4] {
-            let s = rings(m);
-            let first_b = s.mesh.blocks[1].first_elem;
-            let n_a = s.mesh.elem_nodes(first_b)[0].index(); // nodes of ring B start here
-            let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
-                .filter_map(|i| {
-                    let p = s.mesh.coords[i];
-                    let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
-                    ((r - 0.5).abs() < 1e-12 || (r - 1.5).abs() < 1e-12)
-                        .then(|| (NodeId(i as u32), exact(p, i < n_a).0))
-                })
-                .collect();
-            let hh = if h.is_finite() { h } else { 0.0 };
-            let sol = solve(&s, form, hh, k, &dirichlet);
-            let mut e = (0.0, 0.0);
-            for (blk, inner) in [(0usize, true), (1usize, false)] {
-                let f = |p: [f64; 3]| exact(p, inner).0;
-                let g = |p: [f64; 3]| exact(p, inner).1;
-                let n =
-                    seam::heat::error_norms(&s.mesh, &[blk], &sol.temperature, &f, &g, 4).unwrap();
-                e.0 += n.l2 * n.l2;
-                e.1 += n.h1 * n.h1;
-            }
-            errors.push((e.0.sqrt(), e.1.sqrt()));
-        }
-        for w in errors.windows(2) {
-            let (l2, h1) = ((w[0].0 / w[1].0).log2(), (w[0].1 / w[1].1).log2());
-            eprintln!("{form:?}: L2 rate {l2:.3}, H1 rate {h1:.3}");
-            assert!(
-                (l2 - 2.0).abs() <= 0.1,
-                "{form:?}: L2 rate {l2:.3} ({errors:?})"
-            );
-            assert!(
-                (h1 - 1.0).abs() <= 0.1,
-                "{form:?}: H1 rate {h1:.3} ({errors:?})"
-            );
-        }
+        let hh = if h.is_finite() { h } else { 0.0 };
+        check_ring_rates(&format!("{form:?}"), k, h, |s, dirichlet| {
+            solve(s, form, hh, k, dirichlet)
+        });
     }
 }
 
