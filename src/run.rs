@@ -473,17 +473,18 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
     let face_bcs: Vec<FaceBc> = face_bcs.into_iter().map(|(bc, _)| bc).collect();
     let conductivity: Vec<f64> = materials.iter().map(|m| m.conductivity).collect();
     // Each conductance model seen by the interface forms: the point's gap and
-    // temperatures in, h and dh/dT out (pressure is 0 until a pressure field is given).
+    // temperatures and the enforcement's contact pressure in, h and dh/dT out.
     let h_fns: Vec<Box<HFn<'_>>> = choices
         .iter()
-        .map(|(_, _, model)| {
+        .map(|(choice, _, model)| {
+            let pressure = choice.pressure;
             let f = move |p: &HInput| -> Result<HValue, String> {
                 let Some(m) = model else {
                     return Ok(HValue::default());
                 };
                 let state = PointState {
                     gap: p.gap,
-                    pressure: 0.0,
+                    pressure,
                     temp_a: p.temp_a,
                     temp_b: p.temp_b,
                     x: p.x,

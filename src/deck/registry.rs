@@ -195,56 +195,56 @@ pub static COMMANDS: &[CommandSpec] = &[
         "model",
         [ENF],
         "<equation> = <model> [<key> = <value> | <word>]...",
-        "The enforcement model for one equation, with its arguments.",
-        planned
+        "The enforcement model for one equation, with its arguments."
     ),
     cmd!(
         "integer data",
         "integer_data",
         [ENF],
         "[=] <i>...",
-        "Integers handed to a plugin model.",
-        planned
+        "Integers handed to a plugin model."
     ),
     cmd!(
         "real data",
         "real_data",
         [ENF],
         "[=] <r>...",
-        "Reals handed to a plugin model.",
-        planned
+        "Reals handed to a plugin model."
     ),
     cmd!(
         "side b variable",
         "side_b_variable",
         [ENF],
         "<side B variable> to <side A variable>",
-        "Tie a variable on side B to another on side A (Lagrange multipliers).",
-        planned
+        "Tie a variable on side B to another on side A (Lagrange multipliers)."
     ),
     cmd!(
         "slave variable",
         "slave_variable",
         [ENF],
         "<side B variable> to <side A variable>",
-        "Deprecated alias of `side b variable`.",
-        planned
+        "Deprecated alias of `side b variable`."
     ),
     cmd!(
         "dash penalty factor",
         "dash_penalty_factor",
         [ENF],
         "= <f>",
-        "Penalty factor of the Dash (mortar penalty) model.",
-        planned
+        "Penalty factor of the Dash (mortar penalty) model."
     ),
     cmd!(
         "offset temperature",
         "offset_temperature",
         [ENF],
         "= <t>",
-        "Temperature offset added across the interface.",
-        planned
+        "Temperature offset added across the interface."
+    ),
+    cmd!(
+        "contact pressure",
+        "contact_pressure",
+        [ENF],
+        "= <p>",
+        "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins)."
     ),
     cmd!(
         "use toggle block",

@@ -1130,14 +1130,14 @@ impl Lower {
                     };
                     e.side_b_variable = Some(VariableMap { side_b, side_a });
                 }
-                "dash_penalty_factor" | "offset_temperature" => {
+                "dash_penalty_factor" | "offset_temperature" | "contact_pressure" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();
                     if let Some((v, _)) = self.number(&mut c, "a number") {
-                        if c.cmd.key == "dash_penalty_factor" {
-                            e.dash_penalty_factor = Some(v);
-                        } else {
-                            e.offset_temperature = Some(v);
+                        match c.cmd.key {
+                            "dash_penalty_factor" => e.dash_penalty_factor = Some(v),
+                            "offset_temperature" => e.offset_temperature = Some(v),
+                            _ => e.contact_pressure = Some(v),
                         }
                     }
                 }

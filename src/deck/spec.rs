@@ -294,6 +294,9 @@ pub struct Enforcement {
     pub dash_penalty_factor: Option<f64>,
     #[serde(default)]
     pub offset_temperature: Option<f64>,
+    /// `Contact Pressure = p` (Pa), for pressure-dependent conductance models.
+    #[serde(default)]
+    pub contact_pressure: Option<f64>,
     #[serde(default)]
     pub use_toggle_block: Option<String>,
     #[serde(skip)]

@@ -36,6 +36,8 @@ pub struct ModelChoice {
     pub mortar: bool,
     /// For mortar ties: `Multipliers = Dual` (condensed, SPD) instead of standard.
     pub dual: bool,
+    /// `Contact Pressure = p`, seen by pressure-dependent conductance models (0 if none).
+    pub pressure: f64,
 }
 
 /// A conductance law as the deck gives it.
@@ -82,6 +84,7 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         penalty_factor: None,
         mortar: false,
         dual: false,
+        pressure: e.contact_pressure.unwrap_or(0.0),
     };
     if let Some(map) = &e.side_b_variable {
         let known = ["temperature"];
