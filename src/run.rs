@@ -474,10 +474,20 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
     let conductivity: Vec<f64> = materials.iter().map(|m| m.conductivity).collect();
     // Each conductance model seen by the interface forms: the point's gap and
     // temperatures and the enforcement's contact pressure in, h and dh/dT out.
+    // Per interaction: the points a model failed at, with the reason (quarantine).
+    type Quarantined = std::cell::RefCell<Vec<([f64; 3], String)>>;
+    let quarantined: Vec<Quarantined> = choices.iter().map(|_| Default::default()).collect();
     let h_fns: Vec<Box<HFn<'_>>> = choices
         .iter()
-        .map(|(choice, _, model)| {
+        .zip(&quarantined)
+        .zip(&pairings)
+        .map(|(((choice, _, model), log), pairing)| {
             let pressure = choice.pressure;
+            let quarantine = choice.quarantine;
+            let label = format!(
+                "interaction {} / {} ({})",
+                pairing.side_a, pairing.side_b, choice.name
+            );
             let f = move |p: &HInput| -> Result<HValue, String> {
                 let Some(m) = model else {
                     return Ok(HValue::default());
@@ -490,7 +500,23 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
                     x: p.x,
                     time: 0.0,
                 };
-                let c = m.evaluate(&state).map_err(|e| e.to_string())?;
+                let c = match m.evaluate(&state) {
+                    Ok(c) => c,
+                    // Quarantine: the point contributes nothing; it is reported after the
+                    // run. Each Newton step evaluates it again, so keep it once.
+                    Err(e) if quarantine => {
+                        let mut log = log.borrow_mut();
+                        if !log.iter().any(|(x, _)| *x == p.x) {
+                            log.push((p.x, e.to_string()));
+                        }
+                        return Ok(HValue::default());
+                    }
+                    Err(e) => {
+                        return Err(format!(
+                            "{label}: {e} (add `Quarantine Faulty Points` to the enforcement to skip such points)"
+                        ));
+                    }
+                };
                 Ok(HValue {
                     h: c.h,
                     dh_dtemp_a: c.dh_dtemp_a,
@@ -552,6 +578,21 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
         max_iterations: problem.solve.max_iterations,
     };
     let solution = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+    for ((p, (c, _, _)), log) in pairings.iter().zip(&choices).zip(&quarantined) {
+        let log = log.borrow();
+        if let Some((x, first)) = log.first() {
+            diags.push(
+                Diagnostic::warning(
+                    "W0501",
+                    format!(
+                        "interaction {} / {} ({}): {} point(s) quarantined; the first at ({:.6}, {:.6}, {:.6}): {first}",
+                        p.side_a, p.side_b, c.name, log.len(), x[0], x[1], x[2]
+                    ),
+                )
+                .help("the conductance model failed there; those points carry no heat"),
+            );
+        }
+    }
     timing.assembly_s = solution.timing.assembly_s;
     timing.factor_s = solution.timing.factor_s;
     timing.solve_s = solution.timing.solve_s;

@@ -240,6 +240,13 @@ pub static COMMANDS: &[CommandSpec] = &[
         "Temperature offset added across the interface."
     ),
     cmd!(
+        "quarantine faulty points",
+        "quarantine_faulty_points",
+        [ENF],
+        "[= on|off]",
+        "A point where the conductance model (plugin, Lua) fails contributes nothing and is reported, instead of stopping the run."
+    ),
+    cmd!(
         "contact pressure",
         "contact_pressure",
         [ENF],

@@ -1130,6 +1130,15 @@ impl Lower {
                     };
                     e.side_b_variable = Some(VariableMap { side_b, side_a });
                 }
+                "quarantine_faulty_points" => {
+                    self.once(&mut seen, &c);
+                    c.skip_sep();
+                    e.quarantine_faulty_points = if c.peek().is_some() {
+                        self.switch(&mut c).unwrap_or(false)
+                    } else {
+                        true
+                    };
+                }
                 "dash_penalty_factor" | "offset_temperature" | "contact_pressure" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();

@@ -297,6 +297,10 @@ pub struct Enforcement {
     /// `Contact Pressure = p` (Pa), for pressure-dependent conductance models.
     #[serde(default)]
     pub contact_pressure: Option<f64>,
+    /// `Quarantine Faulty Points`: a failing model point contributes nothing and is
+    /// reported instead of stopping the run.
+    #[serde(default)]
+    pub quarantine_faulty_points: bool,
     #[serde(default)]
     pub use_toggle_block: Option<String>,
     #[serde(skip)]

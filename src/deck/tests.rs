@@ -224,6 +224,7 @@ fn full_expected() -> Deck {
             dash_penalty_factor: Some(10.0),
             offset_temperature: Some(273.15),
             contact_pressure: None,
+            quarantine_faulty_points: false,
             use_toggle_block: Some("tog".into()),
             at: Default::default(),
         }],

@@ -132,8 +132,13 @@ pub enum InterfaceError {
         elem: i64,
         field: String,
     },
-    #[error("conductance at ({x:.6}, {y:.6}, {z:.6}): {message}", x = at[0], y = at[1], z = at[2])]
-    Conductance { at: [f64; 3], message: String },
+    #[error("conductance at point ({x:.6}, {y:.6}, {z:.6}) of side-A face (element {elem}, side {side}): {message}", x = at[0], y = at[1], z = at[2])]
+    Conductance {
+        at: [f64; 3],
+        elem: i64,
+        side: u8,
+        message: String,
+    },
     #[error(transparent)]
     Assembly(#[from] AssemblyError),
 }
@@ -387,7 +392,12 @@ pub fn interface_terms(
                 temp_b,
                 x: p.x,
             })
-            .map_err(|message| InterfaceError::Conductance { at: p.x, message })?,
+            .map_err(|message| InterfaceError::Conductance {
+                at: p.x,
+                elem: mesh.elem_number(fa.side.elem),
+                side: fa.side.side,
+                message,
+            })?,
             _ => HValue::default(),
         };
         let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, l.alpha);

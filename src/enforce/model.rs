@@ -38,6 +38,8 @@ pub struct ModelChoice {
     pub dual: bool,
     /// `Contact Pressure = p`, seen by pressure-dependent conductance models (0 if none).
     pub pressure: f64,
+    /// `Quarantine Faulty Points`.
+    pub quarantine: bool,
 }
 
 /// A conductance law as the deck gives it.
@@ -85,6 +87,7 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         mortar: false,
         dual: false,
         pressure: e.contact_pressure.unwrap_or(0.0),
+        quarantine: e.quarantine_faulty_points,
     };
     if let Some(map) = &e.side_b_variable {
         let known = ["temperature"];

@@ -1091,3 +1091,62 @@ fn deck_data_arrives_at_the_plugin_as_written() {
     assert_eq!(r[0].value, 1.5 + 2000.0 + 100.0 - 0.25 + 6.0);
     assert_eq!(r[0].d_temp_a.rem_euclid(1e6), 4.0 + 3.0e3);
 }
+
+/// A plugin that returns NaN (the faulty test plugin does so at pressures ≥ 100, hence the
+/// contact pressure) stops a run with an error naming the plugin, the interaction, the
+/// face and the point; with `Quarantine Faulty Points` the run goes on,
+/// the points carry no heat, and a warning reports them.
+#[test]
+fn faulty_plugin_in_a_run_stops_it_or_is_quarantined() {
+    let nan = faulty("NAN").to_str().unwrap().to_string();
+    let dir = tmp().join("run-faulty");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = root().join("examples/two_blocks/two_blocks.exo");
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = {:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 1\n[contact]\nfile = \"contact.i\"\n",
+            mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let deck = |extra: &str| {
+        format!(
+            "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
+             begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{nan}\"\n  contact pressure = 1000\n{extra} end\nend\n"
+        )
+    };
+    std::fs::write(dir.join("contact.i"), deck("")).unwrap();
+    match seam::run::run(&dir.join("problem.toml")) {
+        Err(seam::run::RunError::Solve(e)) => {
+            for needle in [
+                "faulty",
+                "base_face / lid_face",
+                "side-A face (element",
+                "at point (",
+                "NaN",
+            ] {
+                assert!(e.contains(needle), "`{needle}` missing from: {e}");
+            }
+        }
+        Ok(_) => panic!("a NaN plugin must stop the run"),
+        Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+    }
+    std::fs::write(dir.join("contact.i"), deck("  quarantine faulty points\n")).unwrap();
+    let r = match seam::run::run(&dir.join("problem.toml")) {
+        Ok(r) => r,
+        Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
+        Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+    };
+    assert!(
+        r.warnings.0.iter().any(|d| d.code == "W0501"),
+        "{:?}",
+        r.warnings
+    );
+    assert_eq!(
+        r.summary.interactions[0].heat_side_a, 0.0,
+        "quarantined points carry no heat"
+    );
+}
