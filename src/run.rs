@@ -757,10 +757,18 @@ fn evaluate(
             if sandbox.is_none() {
                 *sandbox = Some(Sandbox::new(Limits::default()).map_err(|e| e.to_string())?);
             }
-            let s = sandbox.as_ref().expect("just built");
-            let f = s
-                .expression(chunk, e, &["x", "y", "z", "t"])
-                .map_err(|e| e.to_string())?;
+            let s = sandbox.as_mut().expect("just built");
+            // Compile each expression once per run: the sandbox keeps them by text.
+            let f = match s.cached(e) {
+                Some(f) => f,
+                None => {
+                    let f = s
+                        .expression(chunk, e, &["x", "y", "z", "t"])
+                        .map_err(|e| e.to_string())?;
+                    s.cache(e, f.clone());
+                    f
+                }
+            };
             s.call(&f, &[x[0], x[1], x[2], 0.0])
                 .map_err(|e| e.to_string())
         }

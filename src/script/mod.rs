@@ -70,6 +70,8 @@ pub struct ScriptFn {
 /// One sandboxed Lua state.
 pub struct Sandbox {
     lua: Lua,
+    /// Compiled expressions by their text, for callers that evaluate one many times.
+    compiled: std::collections::HashMap<String, ScriptFn>,
     used: Arc<AtomicU64>,
     exceeded: Arc<AtomicBool>,
     limits: Limits,
@@ -118,6 +120,7 @@ impl Sandbox {
         .map_err(setup)?;
         Ok(Sandbox {
             lua,
+            compiled: std::collections::HashMap::new(),
             used,
             exceeded,
             limits,
@@ -212,6 +215,16 @@ impl Sandbox {
             f,
             name: format!("`{expr}` ({chunk})"),
         })
+    }
+
+    /// A function compiled earlier and kept with [`Sandbox::cache`].
+    pub fn cached(&self, text: &str) -> Option<ScriptFn> {
+        self.compiled.get(text).cloned()
+    }
+
+    /// Keep a compiled function under its source text.
+    pub fn cache(&mut self, text: &str, f: ScriptFn) {
+        self.compiled.insert(text.to_string(), f);
     }
 
     /// Call a function with numeric arguments; it must return one finite number.

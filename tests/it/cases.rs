@@ -164,9 +164,10 @@ fn face_conditions_on_faces_in_contact_are_masked_unless_asked() {
             .map(|(x, y)| (x - y).abs())
             .fold(0.0, f64::max)
     };
-    assert_eq!(
-        diff(&plain, &masked),
-        0.0,
+    // Equal up to round-off: the factorisation runs in parallel and may sum in another
+    // order from one run to the next (differences of a few 1e-15 are seen).
+    assert!(
+        diff(&plain, &masked) < 1e-12,
         "a masked condition changes nothing"
     );
     assert!(codes.contains(&"W0701"), "{codes:?}");

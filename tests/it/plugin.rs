@@ -998,7 +998,8 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 
 /// A plugin returning a constant h (the C table plugin with a flat table), and a Lua
 /// expression `10`, give the temperatures of the built-in Contact_Resistance with h = 10
-/// to round-off; the Rust example plugin reduced to its radiation part (no gas, no
+/// to round-off (1e-12: the parallel factorisation may sum in another order from run to
+/// run, a few 1e-15 on temperatures of order 1); the Rust example plugin reduced to its radiation part (no gas, no
 /// contact pressure) gives those of the built-in radiation model, a nonlinear case.
 #[test]
 fn plugin_and_lua_models_match_the_built_in_ones_in_a_run() {
@@ -1024,12 +1025,12 @@ fn plugin_and_lua_models_match_the_built_in_ones_in_a_run() {
         "lua",
     );
     assert!(
-        max_diff(&builtin, &plugin) <= 1e-14,
+        max_diff(&builtin, &plugin) <= 1e-12,
         "{}",
         max_diff(&builtin, &plugin)
     );
     assert!(
-        max_diff(&builtin, &lua) <= 1e-14,
+        max_diff(&builtin, &lua) <= 1e-12,
         "{}",
         max_diff(&builtin, &lua)
     );
