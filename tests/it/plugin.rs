@@ -1151,3 +1151,28 @@ fn faulty_plugin_in_a_run_stops_it_or_is_quarantined() {
         "quarantined points carry no heat"
     );
 }
+
+/// The TOML twin of the plugin enforcement gives the same plugin spec as the Sierra line.
+#[test]
+fn plugin_enforcement_in_toml_matches_the_sierra_line() {
+    let sierra = "begin contact definition\n begin enforcement\n  enforcement for energy = plugin library = \"lib/libModel.so\" model = table\n  integer data 4 5\n  real data 0.5 2\n end\nend\n";
+    let toml = r#"
+[[contact_definition]]
+[[contact_definition.enforcement]]
+integer_data = [4, 5]
+real_data = [0.5, 2.0]
+model = [{ equation = "energy", model = "plugin", args = [{ key = "library", value = "lib/libModel.so" }, { key = "model", value = "table" }] }]
+"#;
+    let (a, da) = seam::deck::parse_sierra(&std::sync::Arc::from("d.i"), sierra);
+    let (b, db) = seam::deck::parse_toml(&std::sync::Arc::from("d.toml"), toml);
+    assert!(!da.has_errors() && !db.has_errors(), "{da:?} {db:?}");
+    let dir = std::path::Path::new("/decks");
+    let sa =
+        seam::plugin::PluginSpec::from_enforcement(&a.contact_definitions[0].enforcements[0], dir)
+            .unwrap();
+    let sb =
+        seam::plugin::PluginSpec::from_enforcement(&b.contact_definitions[0].enforcements[0], dir)
+            .unwrap();
+    assert_eq!(sa, sb);
+    assert_eq!(sa.path, dir.join("lib/libModel.so"));
+}
