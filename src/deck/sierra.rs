@@ -1248,6 +1248,23 @@ impl Lower {
         out
     }
 
+    /// The recognised line commands of block `b` (of type `key`), in order; sub-blocks
+    /// that may not appear there and unrecognised lines are reported on the way.
+    fn commands<'b>(&mut self, b: &'b Block, key: &'static str) -> Vec<Cur<'b>> {
+        let mut out = Vec::new();
+        for item in &b.items {
+            match item {
+                Item::Block(sub) => self.misplaced(sub, key),
+                Item::Line(line) => {
+                    if let Matched::Command(c) = self.command(key, line) {
+                        out.push(c);
+                    }
+                }
+            }
+        }
+        out
+    }
+
     fn interaction(&mut self, d: usize, i: usize, b: &Block) -> Interaction {
         let mut x = Interaction {
             name: self.block_name(b),
@@ -1255,17 +1272,7 @@ impl Lower {
             ..Default::default()
         };
         let mut seen = HashSet::new();
-        for item in &b.items {
-            let line = match item {
-                Item::Block(sub) => {
-                    self.misplaced(sub, INT);
-                    continue;
-                }
-                Item::Line(line) => line,
-            };
-            let Matched::Command(mut c) = self.command(INT, line) else {
-                continue;
-            };
+        for mut c in self.commands(b, INT) {
             c.skip_sep();
             match c.cmd.key {
                 "side_a" => x.side_a.extend(self.names(&mut c, "surface names")),
@@ -1301,17 +1308,7 @@ impl Lower {
             ..Default::default()
         };
         let mut seen = HashSet::new();
-        for item in &b.items {
-            let line = match item {
-                Item::Block(sub) => {
-                    self.misplaced(sub, DEF);
-                    continue;
-                }
-                Item::Line(line) => line,
-            };
-            let Matched::Command(mut c) = self.command(DEF, line) else {
-                continue;
-            };
+        for mut c in self.commands(b, DEF) {
             c.skip_sep();
             match c.cmd.key {
                 "general_contact" => {
@@ -1345,17 +1342,7 @@ impl Lower {
             ..Default::default()
         };
         let mut seen = HashSet::new();
-        for item in &b.items {
-            let line = match item {
-                Item::Block(sub) => {
-                    self.misplaced(sub, SO);
-                    continue;
-                }
-                Item::Line(line) => line,
-            };
-            let Matched::Command(mut c) = self.command(SO, line) else {
-                continue;
-            };
+        for mut c in self.commands(b, SO) {
             c.skip_sep();
             self.once(&mut seen, &c);
             let key = c.cmd.key;
@@ -1403,17 +1390,8 @@ impl Lower {
                 .set(format!("{d}.surface.{s}.name"), t.loc(&self.file));
         }
         let mut seen = HashSet::new();
-        for item in &b.items {
-            let line = match item {
-                Item::Block(sub) => {
-                    self.misplaced(sub, CS);
-                    continue;
-                }
-                Item::Line(line) => line,
-            };
-            let Matched::Command(mut c) = self.command(CS, line) else {
-                continue;
-            };
+        for mut c in self.commands(b, CS) {
+            let line = c.line;
             let at = self.line_loc(line);
             match c.cmd.key {
                 "include_all_blocks" => {
