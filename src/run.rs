@@ -413,7 +413,16 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
                                                 .map_err(|e| e.to_string())
                                         });
                                 match loaded_plugin {
-                                    Ok(c) => Some(Box::new(c) as Box<dyn ConductanceModel>),
+                                    Ok(c) => {
+                                        if let Some(notice) = c.plugin().derivative_notice() {
+                                            diags.push(
+                                                Diagnostic::warning("W0502", notice)
+                                                    .at(Some(enf.at.clone()))
+                                                    .help("a plugin that returns its own derivatives (PROVIDES_DERIVATIVES) saves those calls"),
+                                            );
+                                        }
+                                        Some(Box::new(c) as Box<dyn ConductanceModel>)
+                                    }
                                     Err(e) => {
                                         diags.push(
                                             Diagnostic::error("E0500", e)

@@ -1176,3 +1176,39 @@ model = [{ equation = "energy", model = "plugin", args = [{ key = "library", val
     assert_eq!(sa, sb);
     assert_eq!(sa.path, dir.join("lib/libModel.so"));
 }
+
+/// A plugin without derivatives works in a run, and the log says once that seam forms
+/// them by finite differences.
+#[test]
+fn plugin_without_derivatives_in_a_run_is_noted_once() {
+    let smooth = c_plugins().smooth.to_str().unwrap().to_string();
+    let dir = tmp().join("run-smooth");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = root().join("examples/two_blocks/two_blocks.exo");
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = {:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400\n[contact]\nfile = \"contact.i\"\n",
+            mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
+             begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{smooth}\"\n end\nend\n"
+        ),
+    )
+    .unwrap();
+    let r = match seam::run::run(&dir.join("problem.toml")) {
+        Ok(r) => r,
+        Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
+        Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+    };
+    assert!(r.summary.converged);
+    let notes = r.warnings.0.iter().filter(|d| d.code == "W0502").count();
+    assert_eq!(notes, 1, "{:?}", r.warnings);
+}
