@@ -290,7 +290,7 @@ pub fn run(path: &Path) -> Result<RunResult, RunError> {
     let materials = materials(&problem, &mesh, &mut diags);
     let dirichlet = dirichlet(&problem, &mesh, &mut sandbox, &mut diags);
     let mut face_bcs = face_bcs(&problem, &mesh, &mut sandbox, &mut diags);
-    let source = nodal_source(&problem, &mesh, &mut sandbox, &mut diags);
+    let source = nodal_source(&problem, &mesh, &mut diags);
     if diags.has_errors() {
         return Err(RunError::Input(diags, SourceMap::default()));
     }
@@ -889,7 +889,6 @@ fn face_bcs(
 fn nodal_source(
     p: &Problem,
     mesh: &Mesh,
-    _sandbox: &mut Option<Sandbox>,
     diags: &mut Diagnostics,
 ) -> Option<impl Fn([f64; 3]) -> f64 + Sync + use<>> {
     let mut constant = None;

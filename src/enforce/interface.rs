@@ -149,19 +149,10 @@ pub enum InterfaceError {
 fn reference_point(topology: Topology, side: u8, xi: [f64; 2]) -> Option<[f64; 3]> {
     let nodes = reference_nodes(topology)?;
     let local = topology.sides().get(side as usize - 1)?;
-    let w: Vec<f64> = match local.len() {
-        3 => vec![1.0 - xi[0] - xi[1], xi[0], xi[1]],
-        4 => {
-            let (s, t) = (xi[0], xi[1]);
-            vec![
-                0.25 * (1.0 - s) * (1.0 - t),
-                0.25 * (1.0 + s) * (1.0 - t),
-                0.25 * (1.0 + s) * (1.0 + t),
-                0.25 * (1.0 - s) * (1.0 + t),
-            ]
-        }
-        _ => return None,
-    };
+    if !matches!(local.len(), 3 | 4) {
+        return None;
+    }
+    let w = face_shape_values(local.len(), xi);
     let mut p = [0.0; 3];
     for (k, &l) in local.iter().enumerate() {
         for d in 0..3 {
@@ -169,6 +160,22 @@ fn reference_point(topology: Topology, side: u8, xi: [f64; 2]) -> Option<[f64; 3
         }
     }
     Some(p)
+}
+
+/// Trace shape functions of a Tri3 (`len` 3) or Quad4 face at face coordinates `xi`,
+/// Exodus node order (the fourth value is 0 for a triangle).
+pub(crate) fn face_shape_values(len: usize, xi: [f64; 2]) -> [f64; 4] {
+    let (s, t) = (xi[0], xi[1]);
+    if len == 3 {
+        [1.0 - s - t, s, t, 0.0]
+    } else {
+        [
+            0.25 * (1.0 - s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 + t),
+            0.25 * (1.0 - s) * (1.0 + t),
+        ]
+    }
 }
 
 /// Evaluate one side at a point of face `side`, face coordinates `xi`.

@@ -29,7 +29,7 @@ use crate::assembly::{DofMap, FieldId};
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
 
-use super::interface::{InterfaceError, side_eval};
+use super::interface::{InterfaceError, face_shape_values, side_eval};
 
 /// The constraint rows of one mortar tie.
 #[derive(Clone, Debug, Default)]
@@ -207,21 +207,6 @@ pub fn mortar_tie(
         side_a_dofs: side_a,
         side_b_dofs: side_b,
     })
-}
-
-/// Trace shape functions of a face at face coordinates `xi` (Tri3 or Quad4, Exodus order).
-fn face_shape_values(len: usize, xi: [f64; 2]) -> [f64; 4] {
-    let (s, t) = (xi[0], xi[1]);
-    if len == 3 {
-        [1.0 - s - t, s, t, 0.0]
-    } else {
-        [
-            0.25 * (1.0 - s) * (1.0 - t),
-            0.25 * (1.0 + s) * (1.0 - t),
-            0.25 * (1.0 + s) * (1.0 + t),
-            0.25 * (1.0 - s) * (1.0 + t),
-        ]
-    }
 }
 
 /// `A = D M⁻¹` for a face mass matrix `M` (n × n, n ≤ 4), by Gauss–Jordan elimination;
