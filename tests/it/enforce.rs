@@ -145,6 +145,8 @@ fn linear_field_crosses_non_matching_ties_exactly() {
             let worst = (0..s.mesh.num_nodes())
                 .map(|i| (sol.temperature[i] - linear_field(s.mesh.coords[i])).abs())
                 .fold(0.0, f64::max);
+            // Relative to the field's size (|T| ≤ 6 here). Gap conductance at h = 1e12
+            // keeps a jump q/h ≈ 3e-12 and a penalty-sized condition number, hence 1e-10.
             let tol = if form == Form::GapConductance {
                 1e-10
             } else {
@@ -487,6 +489,9 @@ fn interface_jacobian_matches_finite_differences() {
             for i in 0..n {
                 let fd = (rp[i] - rm[i]) / (2.0 * eps);
                 let an = jac[i * n + j];
+                // Relative to the entry, with a floor of 1e-3 (entries here are O(1)–O(100)):
+                // structurally zero entries are then held to 1e-9 absolute, above the
+                // central-difference round-off ε/δ ≈ 1e-10 of this residual.
                 let scale = an.abs().max(fd.abs()).max(1e-3);
                 assert!(
                     (fd - an).abs() <= 1e-6 * scale,
@@ -662,6 +667,7 @@ fn mortar_lagrange_tie_passes_the_patch_test() {
                 .map(|i| (sol.temperature[i] - linear_field(s.mesh.coords[i])).abs())
                 .fold(0.0, f64::max);
             assert!(
+                // 1e-12 relative to the field's size: |1 + x + 2y − 3z| ≤ 6 on the slabs.
                 worst < 1e-12 * 6.0,
                 "{multipliers:?} {n1}:{n2} {kind:?}: worst {worst:e}"
             );
