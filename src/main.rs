@@ -10,7 +10,7 @@ use clap::{Parser, Subcommand};
 use serde::Serialize;
 
 use seam::deck::{self, LoadedDeck};
-use seam::diag::{Diagnostic, Diagnostics};
+
 use seam::mesh::{self, ElemId, Mesh};
 use seam::surface::{self, SurfaceKind};
 
@@ -63,11 +63,14 @@ enum Command {
     /// Solve a heat-transfer problem with contact (a TOML problem file) and write the
     /// temperature as VTK XML. Exit 1 if Newton does not converge.
     Run {
-        /// The problem file (see docs/run.md).
-        problem: PathBuf,
+        /// The problem file (see docs/run.md); the bundled two-block scene when omitted.
+        problem: Option<PathBuf>,
         /// Print one JSON object instead of text.
         #[arg(long)]
         json: bool,
+        /// Continue a transient run from this checkpoint (`checkpoint.seam`).
+        #[arg(long)]
+        restart: Option<PathBuf>,
     },
     /// Load an enforcement plugin, print its descriptor, and probe it on a grid of
     /// states: outputs finite and non-negative, derivatives against finite differences.
@@ -106,7 +109,11 @@ fn main() -> ExitCode {
             segments,
             order,
         } => search(&deck, &mesh, json, segments, order),
-        Command::Run { problem, json } => run(&problem, json),
+        Command::Run {
+            problem,
+            json,
+            restart,
+        } => run(problem, json, restart),
         Command::CheckPlugin {
             path,
             real,
@@ -184,7 +191,6 @@ fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) 
         }
     };
     let mut diags = loaded.diagnostics.clone();
-    diags.extend(not_yet_carried_out(&loaded, false));
     let mut rows = Vec::new();
     for def in &loaded.deck.contact_definitions {
         let set = surface::build_with_dead(&mesh, def, &loaded.sources, &dead);
@@ -455,8 +461,37 @@ fn format_number(x: f64) -> String {
     }
 }
 
-fn run(path: &Path, json: bool) -> ExitCode {
-    match seam::run::run(path) {
+/// The scene `seam run` solves when given no problem file.
+const DEFAULT_SCENE: &str = "examples/two_blocks/problem.toml";
+
+fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode {
+    let path = match path {
+        Some(p) => p,
+        None => {
+            // The bundled scene, next to the executable's source tree or the working
+            // directory.
+            let here = Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_SCENE);
+            let p = if Path::new(DEFAULT_SCENE).exists() {
+                PathBuf::from(DEFAULT_SCENE)
+            } else {
+                here
+            };
+            if !json {
+                eprintln!(
+                    "seam run: no problem file given; solving the bundled scene {}",
+                    p.display()
+                );
+            }
+            p
+        }
+    };
+    let path = path.as_path();
+    let progress = progress_printer(json);
+    let options = seam::run::RunOptions {
+        restart,
+        progress: Some(progress),
+    };
+    match seam::run::run_with(path, &options) {
         Ok(r) => {
             let s = &r.summary;
             if json {
@@ -479,6 +514,12 @@ fn run(path: &Path, json: bool) -> ExitCode {
                     println!(
                         "  {} / {} ({}): heat out of A {:.6e}, out of B {:.6e}, imbalance {:.3e}",
                         i.side_a, i.side_b, i.model, i.heat_side_a, i.heat_side_b, i.imbalance
+                    );
+                }
+                if let Some(t) = &s.transient {
+                    println!(
+                        "  {} time step(s) to t = {} ({} rejected and retried)",
+                        t.steps, t.end_time, t.rejected_steps
                     );
                 }
                 if let Some(o) = &s.output {
@@ -514,6 +555,35 @@ fn run(path: &Path, json: bool) -> ExitCode {
     }
 }
 
+/// Progress of a run's steps on stderr: a bar redrawn in place on a terminal, a plain
+/// line every tenth of the run in logs (and nothing with `--json` off a terminal).
+fn progress_printer(json: bool) -> Box<dyn Fn(&seam::heat::transient::StepReport)> {
+    use std::io::IsTerminal as _;
+    let terminal = std::io::stderr().is_terminal();
+    let last = std::cell::Cell::new(std::time::Instant::now());
+    Box::new(move |r| {
+        if r.dt == 0.0 {
+            return; // a steady solve: one step
+        }
+        let now = std::time::Instant::now();
+        if terminal {
+            if now.duration_since(last.get()).as_millis() >= 100 {
+                eprint!(
+                    "\r  step {:>6}  t = {:<12.6e} dt = {:<10.3e} Newton {:>2}  ",
+                    r.step, r.time, r.dt, r.newton_iterations
+                );
+                last.set(now);
+            }
+        } else if !json && now.duration_since(last.get()).as_secs() >= 5 {
+            eprintln!(
+                "  step {} t = {:e} dt = {:e} Newton {}",
+                r.step, r.time, r.dt, r.newton_iterations
+            );
+            last.set(now);
+        }
+    })
+}
+
 fn check_plugin(path: &Path, real: &[f64], integer: &[i64]) -> ExitCode {
     let mut stdout = std::io::stdout();
     match seam::plugin::check_plugin(path, real, integer, &mut stdout) {
@@ -532,7 +602,6 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
         Err(code) => return code,
     };
     let mut diags = loaded.diagnostics.clone();
-    diags.extend(not_yet_carried_out(&loaded, true));
     let mut count = 0;
     for def in &loaded.deck.contact_definitions {
         for e in &def.enforcements {
@@ -582,32 +651,6 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
         None => println!("ok: {defs} contact definition(s)"),
     }
     ExitCode::SUCCESS
-}
-
-/// Commands the deck recognises whose meaning this version does not carry out yet.
-/// `seam check` reports them as errors; `seam surfaces`, which does not need them,
-/// as warnings — never silently.
-fn not_yet_carried_out(loaded: &LoadedDeck, as_errors: bool) -> Diagnostics {
-    let mut out = Diagnostics::default();
-    for def in &loaded.deck.contact_definitions {
-        for e in def
-            .enforcements
-            .iter()
-            .filter(|e| e.use_toggle_block.is_some())
-        {
-            let message =
-                "`Use Toggle Block` is recognised but not carried out by this version of seam";
-            let d = if as_errors {
-                Diagnostic::error("E0900", message)
-            } else {
-                Diagnostic::warning("W0900", message)
-            };
-            out.push(d.at(Some(e.at.clone())).help(
-                "toggling an enforcement on and off in time arrives with transient runs; remove the line meanwhile",
-            ));
-        }
-    }
-    out
 }
 
 /// Parse `3,7,10-20` into dense element ids, checking every number exists.

@@ -194,6 +194,10 @@ impl DofMap {
     }
 
     /// Block indices a field lives on (sorted).
+    pub fn field_count(&self) -> usize {
+        self.fields.len()
+    }
+
     pub fn field_blocks(&self, field: FieldId) -> &[usize] {
         &self.fields[field.0 as usize].blocks
     }

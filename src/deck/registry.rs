@@ -254,12 +254,18 @@ pub static COMMANDS: &[CommandSpec] = &[
         "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins)."
     ),
     cmd!(
+        "contact pressure variable",
+        "contact_pressure_variable",
+        [ENF],
+        "= <nodal field>",
+        "Contact pressure from a nodal field of the run (a `[[nodal_field]]` of the problem file), interpolated on side A at each contact point."
+    ),
+    cmd!(
         "use toggle block",
         "use_toggle_block",
         [ENF],
         "= <name>",
-        "Switch the enforcement on and off with this toggle block.",
-        planned
+        "Switch the enforcement on and off in time with this toggle block (a `[[toggle]]` of the problem file)."
     ),
     // Interaction, Interaction Defaults.
     cmd!(

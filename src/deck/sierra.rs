@@ -1150,6 +1150,13 @@ impl Lower {
                         }
                     }
                 }
+                "contact_pressure_variable" => {
+                    self.once(&mut seen, &c);
+                    c.skip_sep();
+                    if let Some((v, _)) = self.name(&mut c, "a nodal field name") {
+                        e.contact_pressure_variable = Some(v);
+                    }
+                }
                 "use_toggle_block" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();

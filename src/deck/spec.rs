@@ -297,6 +297,9 @@ pub struct Enforcement {
     /// `Contact Pressure = p` (Pa), for pressure-dependent conductance models.
     #[serde(default)]
     pub contact_pressure: Option<f64>,
+    /// `Contact Pressure Variable = name`: the pressure from a nodal field of the run.
+    #[serde(default)]
+    pub contact_pressure_variable: Option<String>,
     /// `Quarantine Faulty Points`: a failing model point contributes nothing and is
     /// reported instead of stopping the run.
     #[serde(default)]

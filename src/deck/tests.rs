@@ -226,6 +226,7 @@ fn full_expected() -> Deck {
             contact_pressure: None,
             quarantine_faulty_points: false,
             use_toggle_block: Some("tog".into()),
+            contact_pressure_variable: None,
             at: Default::default(),
         }],
         interactions: vec![Interaction {

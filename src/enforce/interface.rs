@@ -82,6 +82,24 @@ pub struct HInput {
     pub temp_a: f64,
     pub temp_b: f64,
     pub x: [f64; 3],
+    /// Index of the point in the pairing's point list (for per-point data such as a
+    /// nodal contact pressure).
+    pub point: usize,
+}
+
+/// The fields an interface couples: side A's and side B's (`Side B Variable b To a`
+/// ties a side-B field to a different side-A field). A single field converts into the
+/// pair of itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FieldPair {
+    pub a: FieldId,
+    pub b: FieldId,
+}
+
+impl From<FieldId> for FieldPair {
+    fn from(f: FieldId) -> Self {
+        FieldPair { a: f, b: f }
+    }
 }
 
 /// A conductance law at a point: h and its derivatives, or why it failed.
@@ -365,26 +383,31 @@ pub struct InterfaceSystem {
 pub fn interface_terms(
     mesh: &Mesh,
     dofs: &DofMap,
-    field: FieldId,
+    fields: impl Into<FieldPair>,
     a: &SurfaceGeometry,
     b: &SurfaceGeometry,
     points: &[ContactPoint],
     form: &InterfaceForm<'_>,
     u: &[f64],
 ) -> Result<InterfaceSystem, InterfaceError> {
+    let fields = fields.into();
     let mut blocks: HashMap<(u32, u32), (Vec<u32>, Vec<f64>)> = HashMap::new();
     let mut rhs: HashMap<u32, f64> = HashMap::new();
     let mut residual: HashMap<u32, f64> = HashMap::new();
     let mut side_a = Vec::new();
     let mut side_b = Vec::new();
-    for p in points.iter().filter(|p| p.status == PointStatus::Matched) {
+    for (index, p) in points
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.status == PointStatus::Matched)
+    {
         if p.a_face == u32::MAX {
             continue; // node points carry no face to integrate over
         }
         let fa = &a.faces[p.a_face as usize];
         let fb = &b.faces[p.b_face as usize];
-        let ea = side_eval(mesh, dofs, field, fa.side, p.xi_a, form.conductivity)?;
-        let eb = side_eval(mesh, dofs, field, fb.side, p.xi_b, form.conductivity)?;
+        let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
+        let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, form.conductivity)?;
         let l = local(&ea, &eb, form.form, form.beta);
         let nl = l.dofs.len();
         let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[l.dofs[i] as usize]).sum() };
@@ -398,6 +421,7 @@ pub fn interface_terms(
                 temp_a,
                 temp_b,
                 x: p.x,
+                point: index,
             })
             .map_err(|message| InterfaceError::Conductance {
                 at: p.x,

@@ -40,6 +40,12 @@ pub struct ModelChoice {
     pub pressure: f64,
     /// `Quarantine Faulty Points`.
     pub quarantine: bool,
+    /// `Contact Pressure Variable`: the nodal field the pressure comes from.
+    pub pressure_variable: Option<String>,
+    /// `Use Toggle Block`: the toggle that switches the enforcement on and off.
+    pub toggle: Option<String>,
+    /// `Side B Variable b To a`: (side-A field a, side-B field b), as written.
+    pub variables: Option<(String, String)>,
 }
 
 /// A conductance law as the deck gives it.
@@ -65,8 +71,18 @@ const MODELS: [&str; 7] = [
     "dash",
 ];
 
-/// The energy model of an enforcement block, or the diagnostics that say why not.
+/// The energy model of an enforcement block, or the diagnostics that say why not, for a
+/// problem whose only field is `temperature`.
 pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
+    resolve_with_fields(e, &["temperature"])
+}
+
+/// As [`resolve`], for a problem with the given fields (`Side B Variable` must name
+/// two of them).
+pub fn resolve_with_fields(
+    e: &Enforcement,
+    fields: &[&str],
+) -> Result<ModelChoice, Vec<Diagnostic>> {
     let Some(m) = e.models.iter().find(|m| m.equation == "energy") else {
         let d = Diagnostic::error(
             "E0420",
@@ -88,13 +104,19 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
         dual: false,
         pressure: e.contact_pressure.unwrap_or(0.0),
         quarantine: e.quarantine_faulty_points,
+        pressure_variable: e.contact_pressure_variable.clone(),
+        toggle: e.use_toggle_block.clone(),
+        variables: e
+            .side_b_variable
+            .as_ref()
+            .map(|m| (m.side_a.to_ascii_lowercase(), m.side_b.to_ascii_lowercase())),
     };
     if let Some(map) = &e.side_b_variable {
-        let known = ["temperature"];
+        let known = fields;
         let mut ds = Vec::new();
         for (role, field) in [("side B", &map.side_b), ("side A", &map.side_a)] {
             if !known.contains(&field.to_ascii_lowercase().as_str()) {
-                let hint = did_you_mean(field, known)
+                let hint = did_you_mean(field, known.iter().copied())
                     .map(|s| format!("did you mean `{s}`? "))
                     .unwrap_or_default();
                 ds.push(
@@ -103,7 +125,10 @@ pub fn resolve(e: &Enforcement) -> Result<ModelChoice, Vec<Diagnostic>> {
                         format!("unknown {role} field `{field}` in `Side B Variable`"),
                     )
                     .at(Some(e.at.clone()))
-                    .help(format!("{hint}the fields of this problem are: temperature")),
+                    .help(format!(
+                        "{hint}the fields of this problem are: {}",
+                        known.join(", ")
+                    )),
                 );
             }
         }

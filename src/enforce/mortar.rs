@@ -25,11 +25,11 @@
 
 use std::collections::{BTreeMap, HashSet};
 
-use crate::assembly::{DofMap, FieldId};
+use crate::assembly::DofMap;
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
 
-use super::interface::{InterfaceError, face_shape_values, side_eval};
+use super::interface::{FieldPair, InterfaceError, face_shape_values, side_eval};
 
 /// The constraint rows of one mortar tie.
 #[derive(Clone, Debug, Default)]
@@ -66,7 +66,7 @@ pub enum Multipliers {
 pub fn mortar_tie(
     mesh: &Mesh,
     dofs: &DofMap,
-    field: FieldId,
+    fields: impl Into<FieldPair>,
     a: &SurfaceGeometry,
     b: &SurfaceGeometry,
     points: &[ContactPoint],
@@ -74,6 +74,7 @@ pub fn mortar_tie(
     constrained: &mut HashSet<NodeId>,
     multipliers: Multipliers,
 ) -> Result<MortarTie, InterfaceError> {
+    let fields = fields.into();
     let mut index: BTreeMap<NodeId, u32> = BTreeMap::new();
     let mut crosspoints = Vec::new();
     // Multipliers on the side-A faces' nodes, in node order (deterministic).
@@ -128,8 +129,8 @@ pub fn mortar_tie(
     {
         let fa = &a.faces[p.a_face as usize];
         let fb = &b.faces[p.b_face as usize];
-        let ea = side_eval(mesh, dofs, field, fa.side, p.xi_a, conductivity)?;
-        let eb = side_eval(mesh, dofs, field, fb.side, p.xi_b, conductivity)?;
+        let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, conductivity)?;
+        let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, conductivity)?;
         let nodes_a = mesh.elem_nodes(ea.elem);
         // ψ on this face: each kept node's trace shape function, plus an equal share of
         // the dropped (crosspoint) nodes' — so the multipliers still sum to one and can

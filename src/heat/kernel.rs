@@ -388,6 +388,37 @@ pub fn face_convection(
     }
 }
 
+/// A face load that depends on the face temperature: `R_a += ∫_side N_a g(T) dA` and
+/// `J_ab += ∫_side N_a N_b g'(T) dA`, where `g(T, x)` returns `(g, dg/dT)` — the heat
+/// leaving the body per area (convection `h (T − T∞)`, radiation `εσ(T⁴ − T∞⁴)`, a
+/// flux `−q`). `t` holds the element's nodal temperatures; `side` is 1-based.
+pub fn face_load(
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+    t: &[f64],
+    g: impl Fn(f64, [f64; 3]) -> (f64, f64),
+    re: &mut [f64],
+    je: &mut [f64],
+) {
+    let nn = topology.node_count();
+    let (face, local, fc) = side_geometry(topology, coords, side);
+    for fp in face_points(face, &fc, face_rule(face)) {
+        let tq: f64 = local
+            .iter()
+            .enumerate()
+            .map(|(k, &a)| fp.n[k] * t[a as usize])
+            .sum();
+        let (gq, dg) = g(tq, fp.x);
+        for (k, &a) in local.iter().enumerate() {
+            re[a as usize] += gq * fp.n[k] * fp.jxw;
+            for (m, &b) in local.iter().enumerate() {
+                je[a as usize * nn + b as usize] += dg * fp.n[k] * fp.n[m] * fp.jxw;
+            }
+        }
+    }
+}
+
 /// Nonlinear conduction: `R_a += ∫ k(T) ∇N_a·∇T dV` and its exact Jacobian
 /// `J_ab += ∫ [k ∇N_a·∇N_b + (dk/dT) N_b ∇N_a·∇T] dV`; `k(T, x)` returns `(k, dk/dT)`.
 pub fn conduction_residual_jacobian(

@@ -17,9 +17,11 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod kernel;
+pub mod law;
 pub mod quadrature;
 pub mod shape;
 pub mod steady;
+pub mod transient;
 
 use std::sync::Mutex;
 
@@ -64,6 +66,14 @@ pub enum HeatError {
     BadSide { number: i64, side: u8 },
     #[error("contact: {0}")]
     Contact(String),
+    #[error(
+        "a radiation condition is nonlinear: the linear steady assembly cannot take it\n  help: solve with seam::heat::transient (seam run does so by itself)"
+    )]
+    NonlinearFace,
+    #[error("material of block {block}: {message}")]
+    Material { block: i64, message: String },
+    #[error("{0}")]
+    Step(String),
     #[error(transparent)]
     Assembly(#[from] AssemblyError),
     #[error(transparent)]
@@ -86,12 +96,39 @@ pub enum FaceBc {
     Flux { side: Side, q: f64 },
     /// Convection `h (T − T∞)` out of the body.
     Convection { side: Side, h: f64, t_inf: f64 },
+    /// Radiation to ambient `εσ(T⁴ − T∞⁴)` out of the body (nonlinear: solved by
+    /// [`transient`], refused by the linear assembly).
+    Radiation {
+        side: Side,
+        emissivity: f64,
+        t_inf: f64,
+    },
 }
 
+/// The Stefan–Boltzmann constant σ (W/m²/K⁴, CODATA 2018, exact in SI).
+pub const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
+
 impl FaceBc {
-    fn side(&self) -> Side {
+    /// The element side the condition acts on.
+    pub fn side(&self) -> Side {
         match *self {
-            FaceBc::Flux { side, .. } | FaceBc::Convection { side, .. } => side,
+            FaceBc::Flux { side, .. }
+            | FaceBc::Convection { side, .. }
+            | FaceBc::Radiation { side, .. } => side,
+        }
+    }
+
+    /// Heat leaving the body per area at face temperature `t`, and its derivative.
+    pub fn outflow(&self, t: f64) -> (f64, f64) {
+        match *self {
+            FaceBc::Flux { q, .. } => (-q, 0.0),
+            FaceBc::Convection { h, t_inf, .. } => (h * (t - t_inf), h),
+            FaceBc::Radiation {
+                emissivity, t_inf, ..
+            } => {
+                let es = emissivity * STEFAN_BOLTZMANN;
+                (es * (t.powi(4) - t_inf.powi(4)), 4.0 * es * t.powi(3))
+            }
         }
     }
 }
@@ -261,6 +298,10 @@ pub fn assemble_conduction(
                 FaceBc::Flux { side, q } => kernel::face_flux(topo, x, side.side, |_| q, fe),
                 FaceBc::Convection { side, h, t_inf } => {
                     kernel::face_convection(topo, x, side.side, h, t_inf, ke, fe)
+                }
+                FaceBc::Radiation { .. } => {
+                    errors.record(e, HeatError::NonlinearFace);
+                    return;
                 }
             }
         }

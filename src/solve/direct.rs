@@ -198,12 +198,24 @@ fn ensure_analysis(
     Ok(())
 }
 
+/// One thread when asked, else faer's global setting.
+fn parallelism(sequential: bool) -> faer::Par {
+    if sequential {
+        faer::Par::Seq
+    } else {
+        faer::get_global_parallelism()
+    }
+}
+
 /// Sparse Cholesky LLᵀ for symmetric positive definite matrices.
 pub struct Cholesky {
     ordering: Ordering,
     analysis: Option<Analysis>,
     values: Vec<f64>,
     factored: bool,
+    /// Run the numeric factorisation and solves on one thread (bit-for-bit
+    /// reproducible); the global faer setting otherwise.
+    pub sequential: bool,
     /// Number of symbolic analyses done (1 while the pattern holds).
     pub symbolic_count: usize,
 }
@@ -216,6 +228,7 @@ impl Cholesky {
             values: Vec::new(),
             factored: false,
             symbolic_count: 0,
+            sequential: false,
         }
     }
 
@@ -255,7 +268,7 @@ impl LinearSolver for Cholesky {
         let an = self.analysis.as_ref().unwrap();
         let sym = &an.symbolic;
         self.values.resize(sym.len_val(), 0.0);
-        let par = faer::get_global_parallelism();
+        let par = parallelism(self.sequential);
         let mut mem =
             MemBuffer::try_new(sym.factorize_numeric_llt_scratch::<f64>(par, Default::default()))
                 .map_err(faer_err)?;
@@ -287,7 +300,7 @@ impl LinearSolver for Cholesky {
         }
         let sym = &an.symbolic;
         check_rhs(sym.nrows(), b)?;
-        let par = faer::get_global_parallelism();
+        let par = parallelism(self.sequential);
         let mut mem =
             MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
         let n = b.len();
@@ -326,6 +339,8 @@ pub struct SaddleLdlt {
     analysis: Option<Analysis>,
     values: Vec<f64>,
     matrix: Option<SparseColMat<usize, f64>>,
+    /// As [`Cholesky::sequential`].
+    pub sequential: bool,
 }
 
 impl SaddleLdlt {
@@ -337,6 +352,7 @@ impl SaddleLdlt {
             delta: 1e-8,
             tolerance: 1e-13,
             max_refinement: 5,
+            sequential: false,
             analysis: None,
             values: Vec::new(),
             matrix: None,
@@ -352,7 +368,7 @@ impl SaddleLdlt {
     fn solve_once(&self, b: &mut [f64]) -> Result<(), SolveError> {
         let an = self.analysis.as_ref().ok_or(SolveError::NotFactored)?;
         let sym = &an.symbolic;
-        let par = faer::get_global_parallelism();
+        let par = parallelism(self.sequential);
         let mut mem =
             MemBuffer::try_new(sym.solve_in_place_scratch::<f64>(1, par)).map_err(faer_err)?;
         let n = b.len();
@@ -389,7 +405,7 @@ impl LinearSolver for SaddleLdlt {
             }
         }
         let scale = if dmax > 0.0 { dmax } else { 1.0 };
-        let par = faer::get_global_parallelism();
+        let par = parallelism(self.sequential);
         let mut mem =
             MemBuffer::try_new(sym.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()))
                 .map_err(faer_err)?;

@@ -14,3 +14,4 @@ mod plugin;
 mod search;
 mod search_kernels;
 mod surfaces;
+mod transient;

@@ -126,6 +126,21 @@ pub enum ConductanceError {
         state: PointState,
         message: String,
     },
+    /// The model asks for a smaller time step (a plugin's `SEAM_STATUS_CUTBACK`): the
+    /// step is retried, it is not an error of the run.
+    #[error("conductance model `{model}` at ({state}): {message}")]
+    Cutback {
+        model: String,
+        state: PointState,
+        message: String,
+    },
+}
+
+impl ConductanceError {
+    /// Whether the model asks for a smaller step rather than failing.
+    pub fn is_cutback(&self) -> bool {
+        matches!(self, ConductanceError::Cutback { .. })
+    }
 }
 
 /// A conductance coefficient h(g, p, T_A, T_B, x, t) ≥ 0 with its exact (or, for user

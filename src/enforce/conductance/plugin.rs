@@ -82,10 +82,21 @@ impl ConductanceModel for PluginConductance {
         let mut out = [PointResult::default()];
         self.plugin
             .evaluate(&ctx, &[point], &mut out, None)
-            .map_err(|e| ConductanceError::Evaluation {
-                model: self.name(),
-                state: *s,
-                message: e.to_string(),
+            .map_err(|e| {
+                let (model, state, message) = (self.name(), *s, e.to_string());
+                if e.is_cutback() {
+                    ConductanceError::Cutback {
+                        model,
+                        state,
+                        message,
+                    }
+                } else {
+                    ConductanceError::Evaluation {
+                        model,
+                        state,
+                        message,
+                    }
+                }
             })?;
         let r = out[0];
         check(

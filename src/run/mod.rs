@@ -1,0 +1,1746 @@
+//! `seam run`: a heat-transfer problem file (TOML) solved end to end — mesh, materials,
+//! boundary conditions, sources, the Sierra contact definition, the steady solve, the
+//! results (`.vtu`) and a summary.
+//!
+//! Entry point: [`run`]. Field by field:
+//!
+//! ```toml
+//! [mesh]
+//! file = "two_blocks.exo"            # Exodus II or Gmsh 4.1, relative to this file
+//! [[material]]
+//! blocks = ["block_1", "block_2"]
+//! conductivity = 1.0                 # W/m/K
+//! [[bc]]
+//! kind = "temperature"               # temperature | flux | convection
+//! surfaces = ["surface_1"]           # side sets (or node sets, for temperature)
+//! value = "1 + x + 2*y - 3*z"        # a number or a Lua expression of x, y, z, t
+//! ambient = 300.0                    # convection only: T∞ (value is then h)
+//! [[source]]                         # optional volumetric source (W/m³)
+//! blocks = ["block_1"]
+//! value = "0"
+//! [contact]
+//! file = "contact.i"                 # Sierra-syntax contact definition(s)
+//! integration = "segments"           # segments (exact, default) | quadrature
+//! order = 5
+//! [solve]
+//! kind = "steady"
+//! tolerance = 1e-10
+//! max_iterations = 20
+//! [output]
+//! dir = "out"
+//! ```
+//!
+//! A flux or convection value given as a Lua expression is evaluated at each face's
+//! centroid; temperature values at the nodes; sources at the nodes and interpolated
+//! (each exact for the linear fields of a patch test). The time `t` is 0 in a steady
+//! solve.
+
+mod steps;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::assembly::DofMap;
+use crate::deck::{self, LoadedDeck};
+use crate::diag::{Diagnostic, Diagnostics, SourceMap, did_you_mean};
+use crate::enforce::conductance::{self, ConductanceModel, PointState};
+use crate::enforce::interface::{DEFAULT_BETA, Form, HFn, HInput, HValue, InterfaceForm};
+use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_with_fields as resolve_model};
+use crate::heat::law::Law;
+use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
+use crate::heat::transient::{
+    self, BlockLaws, FieldSpec, Loads, Scheme, State, StepReport, TimeMode, TransientProblem,
+    initial_state,
+};
+use crate::heat::{FaceBc, HeatError, Material, TEMPERATURE};
+use crate::interaction;
+use std::collections::HashSet;
+
+use crate::mesh::{self, Mesh, NodeId, Side};
+use crate::output::vtu::write_vtu;
+use crate::script::{Limits, Sandbox};
+use crate::search::pairing::{Integration, PointStatus};
+use crate::search::scene::{Pairing, search_definition};
+use crate::surface;
+
+/// A number, a Lua expression, or a piecewise-linear table `{ table = [[s, v], …] }`
+/// (in time t for boundary values, in temperature T for material laws).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Value {
+    Number(f64),
+    Expr(String),
+    Table { table: Vec<(f64, f64)> },
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Problem {
+    pub mesh: MeshSpec,
+    #[serde(default)]
+    pub material: Vec<MaterialSpec>,
+    #[serde(default)]
+    pub bc: Vec<BcSpec>,
+    #[serde(default)]
+    pub source: Vec<SourceSpec>,
+    #[serde(default)]
+    pub contact: Option<ContactSpec>,
+    #[serde(default)]
+    pub solve: SolveSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// Initial temperature of a transient run (and the first guess of a nonlinear
+    /// steady one).
+    #[serde(default)]
+    pub initial: Option<InitialSpec>,
+    /// Continue from a checkpoint.
+    #[serde(default)]
+    pub restart: Option<RestartSpec>,
+    /// Named on/off schedules for `Use Toggle Block`.
+    #[serde(default)]
+    pub toggle: Vec<ToggleSpec>,
+    /// Named nodal fields (e.g. a contact pressure for `Contact Pressure Variable`).
+    #[serde(default)]
+    pub nodal_field: Vec<NodalFieldSpec>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InitialSpec {
+    /// A number or a Lua expression of x, y, z.
+    pub temperature: Value,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RestartSpec {
+    /// A checkpoint written by an earlier run (relative to the problem file).
+    pub file: PathBuf,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToggleSpec {
+    pub name: String,
+    /// Closed time intervals `[[t0, t1], …]` in which the enforcement is on.
+    pub on: Vec<(f64, f64)>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodalFieldSpec {
+    pub name: String,
+    /// A number or a Lua expression of x, y, z, t, evaluated at the nodes.
+    pub value: Value,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    pub file: PathBuf,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    pub blocks: Vec<String>,
+    /// k: a number, a Lua expression of T (and x, y, z, t), or a table in T.
+    pub conductivity: Value,
+    /// ρ (kg/m³): a number.
+    #[serde(default)]
+    pub density: Option<f64>,
+    /// c_p (J/kg/K): a number, a Lua expression of T, or a table in T.
+    #[serde(default)]
+    pub specific_heat: Option<Value>,
+    /// ρc_p (J/m³/K) in one number, instead of density and specific_heat.
+    #[serde(default)]
+    pub rho_c: Option<f64>,
+    /// The name of the field these blocks carry (`temperature` by default); two
+    /// fields are joined by `Side B Variable b To a`.
+    #[serde(default)]
+    pub field: Option<String>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BcKind {
+    Temperature,
+    Flux,
+    Convection,
+    /// εσ(T⁴ − T∞⁴): `value` is the emissivity ε, `ambient` T∞.
+    Radiation,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BcSpec {
+    pub kind: BcKind,
+    pub surfaces: Vec<String>,
+    pub value: Value,
+    #[serde(default)]
+    pub ambient: Option<f64>,
+    /// Keep this flux or convection on faces in contact too (Aria's `no_coverage_flux`);
+    /// by default it is masked there.
+    #[serde(default)]
+    pub no_coverage_flux: bool,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SourceSpec {
+    pub blocks: Vec<String>,
+    pub value: Value,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    pub file: PathBuf,
+    #[serde(default)]
+    pub integration: Option<String>,
+    #[serde(default)]
+    pub order: Option<usize>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolveSpec {
+    /// `steady` or `transient`.
+    #[serde(default = "steady")]
+    pub kind: String,
+    /// `backward_euler` or `bdf2` (transient).
+    #[serde(default)]
+    pub scheme: Option<String>,
+    /// The (first) time step.
+    #[serde(default)]
+    pub dt: Option<f64>,
+    #[serde(default)]
+    pub start_time: Option<f64>,
+    #[serde(default)]
+    pub end_time: Option<f64>,
+    /// Adapt the step to keep the local error below `time_tolerance`.
+    #[serde(default)]
+    pub adaptive: bool,
+    /// Local error per step, K (adaptive steps; default 1e-2).
+    #[serde(default)]
+    pub time_tolerance: Option<f64>,
+    #[serde(default)]
+    pub dt_min: Option<f64>,
+    #[serde(default)]
+    pub dt_max: Option<f64>,
+    /// Time at which a steady problem's data are evaluated (default 0).
+    #[serde(default)]
+    pub time: Option<f64>,
+    /// Sequential factorisations, so runs and restarts repeat bit for bit (default
+    /// true; false lets the factorisation use every core).
+    #[serde(default)]
+    pub reproducible: Option<bool>,
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    #[serde(default = "default_iterations")]
+    pub max_iterations: usize,
+    /// `direct` (sparse Cholesky/LU, default) or `amg` (CG with algebraic multigrid, for
+    /// large symmetric problems).
+    #[serde(default)]
+    pub linear_solver: Option<String>,
+}
+
+impl Default for SolveSpec {
+    fn default() -> Self {
+        SolveSpec {
+            kind: steady(),
+            scheme: None,
+            dt: None,
+            start_time: None,
+            end_time: None,
+            adaptive: false,
+            time_tolerance: None,
+            dt_min: None,
+            dt_max: None,
+            time: None,
+            reproducible: None,
+            tolerance: default_tolerance(),
+            max_iterations: default_iterations(),
+            linear_solver: None,
+        }
+    }
+}
+
+fn steady() -> String {
+    "steady".into()
+}
+fn default_tolerance() -> f64 {
+    1e-10
+}
+fn default_iterations() -> usize {
+    20
+}
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    #[serde(default)]
+    pub dir: Option<PathBuf>,
+    /// Write the fields every this many steps (and always the last step).
+    #[serde(default)]
+    pub every: Option<usize>,
+    /// Write a checkpoint every this many steps (`checkpoint_<step>.seam`); the last
+    /// step's is always written as `checkpoint.seam`.
+    #[serde(default)]
+    pub checkpoint_every: Option<usize>,
+}
+
+/// One interaction's line in the summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct InteractionHeat {
+    pub side_a: String,
+    pub side_b: String,
+    pub model: String,
+    pub heat_side_a: f64,
+    pub heat_side_b: f64,
+    pub imbalance: f64,
+}
+
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Timing {
+    pub surfaces_s: f64,
+    pub search_s: f64,
+    pub assembly_s: f64,
+    pub factor_s: f64,
+    pub solve_s: f64,
+    pub total_s: f64,
+}
+
+/// The `--json` summary (an interface: keys are stable).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub dofs: usize,
+    pub newton_iterations: usize,
+    pub converged: bool,
+    pub interactions: Vec<InteractionHeat>,
+    pub timing: Timing,
+    pub output: Option<PathBuf>,
+    /// Transient runs only.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub transient: Option<TransientSummary>,
+}
+
+/// What a transient run did.
+#[derive(Clone, Debug, Serialize)]
+pub struct TransientSummary {
+    pub steps: usize,
+    pub rejected_steps: usize,
+    pub end_time: f64,
+}
+
+/// What went wrong: bad input (diagnostics) or a solve that failed.
+#[derive(Debug)]
+pub enum RunError {
+    Input(Diagnostics, SourceMap),
+    Solve(String),
+}
+
+/// Everything a run made, for callers that want more than the summary.
+pub struct RunResult {
+    pub summary: Summary,
+    pub mesh: Mesh,
+    /// The final state (the last step of a transient run).
+    pub solution: SteadySolution,
+    /// Every accepted step (transient and nonlinear runs; empty for linear steady).
+    pub history: Vec<StepReport>,
+    pub warnings: Diagnostics,
+    pub sources: SourceMap,
+}
+
+fn input_error(code: &'static str, message: String, help: &str) -> RunError {
+    let mut d = Diagnostics::default();
+    d.push(Diagnostic::error(code, message).help(help));
+    RunError::Input(d, SourceMap::default())
+}
+
+/// Solve the problem in `path`.
+pub fn run(path: &Path) -> Result<RunResult, RunError> {
+    run_with(path, &RunOptions::default())
+}
+
+/// How to run beyond the problem file.
+#[derive(Default)]
+pub struct RunOptions {
+    /// Continue from this checkpoint (overrides `[restart]`).
+    pub restart: Option<PathBuf>,
+    /// Called after every accepted step (progress display).
+    #[allow(clippy::type_complexity)]
+    pub progress: Option<Box<dyn Fn(&StepReport)>>,
+}
+
+/// Solve the problem in `path` with `options`.
+pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError> {
+    let start = Instant::now();
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        input_error(
+            "E0700",
+            format!("cannot read problem file {}: {e}", path.display()),
+            "check the path",
+        )
+    })?;
+    let problem: Problem = toml::from_str(&text).map_err(|e| {
+        let file = crate::diag::file_label(path);
+        let mut sources = SourceMap::default();
+        sources.add(&file, &text);
+        let loc = e.span().map(|r| {
+            let before = &text[..r.start.min(text.len())];
+            let line = before.matches('\n').count() as u32 + 1;
+            let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) as u32 + 1;
+            crate::diag::Loc::new(&file, line, col, (r.end - r.start).max(1) as u32)
+        });
+        let mut d = Diagnostics::default();
+        d.push(
+            Diagnostic::error("E0701", e.message().to_string())
+                .at(loc)
+                .help("see the problem-file fields in docs/run.md"),
+        );
+        RunError::Input(d, sources)
+    })?;
+    if let Some(ls) = problem.solve.linear_solver.as_deref()
+        && ls != "direct"
+        && ls != "amg"
+    {
+        return Err(input_error(
+            "E0708",
+            format!("unknown linear solver `{ls}`"),
+            "use linear_solver = \"direct\" or \"amg\"",
+        ));
+    }
+    let transient = match problem.solve.kind.as_str() {
+        "steady" => false,
+        "transient" => true,
+        other => {
+            return Err(input_error(
+                "E0709",
+                format!("unknown solve kind `{other}`"),
+                "use kind = \"steady\" or \"transient\"",
+            ));
+        }
+    };
+    let mesh = mesh::read(&dir.join(&problem.mesh.file))
+        .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
+    let mut diags = Diagnostics::default();
+    let sandbox: SharedSandbox = Default::default();
+    let probe = match problem.initial.as_ref().map(|i| &i.temperature) {
+        Some(Value::Number(t)) => *t,
+        _ => 300.0,
+    };
+    let materials = materials(&problem, &mesh, probe, &mut diags);
+    let dirichlet = dirichlet_nodes(&problem, &mesh, &mut diags);
+    let mut face_sites = face_sites(&problem, &mesh, &mut diags);
+    let block_source = block_sources(&problem, &mesh, &mut diags);
+    // One value everywhere: a plain source function (both solvers); else per block.
+    let uniform = block_source.windows(2).all(|w| w[0] == w[1]);
+    let source = block_source
+        .first()
+        .copied()
+        .filter(|q| uniform && *q != 0.0)
+        .map(|q| move |_: [f64; 3]| q);
+    let timing_spec = time_spec(&problem, transient, &mut diags);
+    if diags.has_errors() {
+        return Err(RunError::Input(diags, SourceMap::default()));
+    }
+    // Boundary data at the start: every expression is tried once here, so a bad one
+    // is an input error, not a failure in the middle of a run.
+    let start_time = timing_spec.start;
+    if let Err(e) = loads_at(
+        &problem,
+        &mesh,
+        &dirichlet,
+        &face_sites,
+        &sandbox,
+        start_time,
+    ) {
+        return Err(input_error(
+            "E0707",
+            e,
+            "a number, a table [[t, v], …] or a Lua expression of x, y, z, t",
+        ));
+    }
+    let mut field_names: Vec<String> = materials.fields.clone();
+    field_names.sort();
+    field_names.dedup();
+    let field_refs: Vec<&str> = field_names.iter().map(String::as_str).collect();
+
+    // Contact: surfaces, interactions, search, enforcement per interaction.
+    let mut timing = Timing::default();
+    let mut loaded = LoadedDeck::default();
+    let mut pairings: Vec<Pairing> = Vec::new();
+    let mut choices = Vec::new();
+    if let Some(c) = &problem.contact {
+        let deck_path = dir.join(&c.file);
+        loaded = deck::load(&deck_path);
+        if loaded.diagnostics.has_errors() {
+            return Err(RunError::Input(loaded.diagnostics, loaded.sources));
+        }
+        let integration = match c.integration.as_deref() {
+            None | Some("segments") => Integration::Segments {
+                order: c.order.unwrap_or(5),
+            },
+            Some("quadrature") => Integration::Quadrature {
+                order: c.order.unwrap_or(2),
+            },
+            Some(other) => {
+                return Err(input_error(
+                    "E0702",
+                    format!("unknown integration `{other}`"),
+                    "use \"segments\" or \"quadrature\"",
+                ));
+            }
+        };
+        let deck_dir = deck_path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        for def in &loaded.deck.contact_definitions {
+            let t = Instant::now();
+            let set = surface::build(&mesh, def, &loaded.sources);
+            timing.surfaces_s += t.elapsed().as_secs_f64();
+            diags.extend(set.diagnostics.clone());
+            let (list, d) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
+            diags.extend(d);
+            if diags.has_errors() {
+                continue;
+            }
+            let t = Instant::now();
+            let scene = search_definition(
+                &mesh,
+                def,
+                &set,
+                &list,
+                &deck_dir,
+                &loaded.sources,
+                integration,
+            );
+            timing.search_s += t.elapsed().as_secs_f64();
+            diags.extend(scene.diagnostics);
+            for p in scene.pairings {
+                // The interaction's enforcement: by name, or the only block there is.
+                let named = list
+                    .iter()
+                    .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b)
+                    .and_then(|i| i.enforcement.clone());
+                let enf = match &named {
+                    Some(n) => def
+                        .enforcements
+                        .iter()
+                        .find(|e| e.name.as_deref() == Some(n.as_str())),
+                    None => def.enforcements.first(),
+                };
+                let Some(enf) = enf else {
+                    diags.push(
+                        Diagnostic::error(
+                            "E0426",
+                            format!("interaction {} / {} has no enforcement", p.side_a, p.side_b),
+                        )
+                        .at(Some(def.at.clone()))
+                        .help("add a `begin Enforcement` block with `Enforcement for Energy = …`"),
+                    );
+                    continue;
+                };
+                match resolve_model(enf, &field_refs) {
+                    Ok(choice) => {
+                        let tied = matches!(
+                            choice.form,
+                            Form::TiedNitsche | Form::TiedInteriorPenalty | Form::Penalty
+                        );
+                        if tied && p.result.stats.matched == 0 {
+                            diags.push(
+                                Diagnostic::error(
+                                    "E0427",
+                                    format!("`{}` ties {} / {}, but the two surfaces do not overlap anywhere", choice.name, p.side_a, p.side_b),
+                                )
+                                .at(Some(enf.at.clone()))
+                                .help("check the surfaces of the interaction; `seam search` shows why points did not pair"),
+                            );
+                            continue;
+                        }
+                        let scale = list
+                            .iter()
+                            .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b)
+                            .map_or(1.0, |i| i.penalty_scale);
+                        let model: Option<Box<dyn ConductanceModel>> = match choice.conductance {
+                            Some(ConductanceLaw::Constant(h)) => Some(Box::new(
+                                conductance::Constant::new(h).expect("h checked non-negative"),
+                            )),
+                            Some(ConductanceLaw::Coefficient) => {
+                                let (m, d) =
+                                    conductance::from_properties(enf, &deck_dir, &loaded.sources);
+                                diags.extend(d);
+                                if m.is_none() {
+                                    continue;
+                                }
+                                m
+                            }
+                            Some(ConductanceLaw::Plugin) => {
+                                let loaded_plugin =
+                                    crate::plugin::PluginSpec::from_enforcement(enf, &deck_dir)
+                                        .and_then(|spec| spec.load())
+                                        .map_err(|e| e.to_string())
+                                        .and_then(|pl| {
+                                            conductance::PluginConductance::new(pl)
+                                                .map(|c| c.on_surfaces(&p.side_a, &p.side_b))
+                                                .map_err(|e| e.to_string())
+                                        });
+                                match loaded_plugin {
+                                    Ok(c) => {
+                                        if let Some(notice) = c.plugin().derivative_notice() {
+                                            diags.push(
+                                                Diagnostic::warning("W0502", notice)
+                                                    .at(Some(enf.at.clone()))
+                                                    .help("a plugin that returns its own derivatives (PROVIDES_DERIVATIVES) saves those calls"),
+                                            );
+                                        }
+                                        Some(Box::new(c) as Box<dyn ConductanceModel>)
+                                    }
+                                    Err(e) => {
+                                        diags.push(
+                                            Diagnostic::error("E0500", e)
+                                                .at(Some(enf.at.clone()))
+                                                .help("`seam check-plugin LIB` loads and probes a plugin on its own"),
+                                        );
+                                        continue;
+                                    }
+                                }
+                            }
+                            None => None,
+                        };
+                        choices.push((choice, scale, model));
+                        pairings.push(p);
+                    }
+                    Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
+                }
+            }
+        }
+    }
+    if diags.has_errors() {
+        return Err(RunError::Input(diags, loaded.sources));
+    }
+
+    // Aria masks ordinary flux and convection conditions on faces in contact: a side-A
+    // face with matched points, or a side-B face some point paired with. A condition
+    // with `no_coverage_flux = true` stays.
+    let mut in_contact: HashSet<Side> = HashSet::new();
+    for p in &pairings {
+        if p.periodic {
+            continue;
+        }
+        for q in p
+            .result
+            .points
+            .iter()
+            .filter(|q| q.status == PointStatus::Matched)
+        {
+            if q.a_face != u32::MAX {
+                in_contact.insert(p.side_a_geometry.faces[q.a_face as usize].side);
+            }
+            in_contact.insert(p.side_b_geometry.faces[q.b_face as usize].side);
+        }
+    }
+    let before = face_sites.len();
+    face_sites.retain(|f| f.keep || !in_contact.contains(&bc_side_of(f)));
+    let masked = before - face_sites.len();
+    if masked > 0 {
+        diags.push(
+            Diagnostic::warning(
+                "W0701",
+                format!("{masked} face condition(s) on faces in contact are masked (Aria's rule)"),
+            )
+            .help("set `no_coverage_flux = true` in the [[bc]] to keep a condition on faces in contact"),
+        );
+    }
+
+    // Per interaction: its toggle, its fields, its contact pressure per point.
+    let toggles = resolve_toggles(&problem, &choices, &mut diags);
+    let term_fields = interaction_fields(
+        &mesh,
+        &materials,
+        &field_names,
+        &pairings,
+        &choices,
+        &mut diags,
+    );
+    let pressures = point_pressures(
+        &problem, &mesh, &pairings, &choices, &sandbox, start_time, &mut diags,
+    );
+    if diags.has_errors() {
+        return Err(RunError::Input(diags, loaded.sources));
+    }
+    // Nitsche weights need one k per block: the law at the probe temperature.
+    let conductivity: Vec<f64> = materials
+        .laws
+        .iter()
+        .map(|l| {
+            l.conductivity
+                .eval(probe, [0.0; 3], start_time)
+                .map_or(1.0, |v| v.0)
+        })
+        .collect();
+    // The time every conductance model sees (set by the solver through the loads).
+    let clock = std::cell::Cell::new(start_time);
+    let cutback = std::cell::Cell::new(false);
+    // Each conductance model seen by the interface forms: the point's gap and
+    // temperatures and the enforcement's contact pressure in, h and dh/dT out.
+    // Per interaction: the points a model failed at, with the reason (quarantine).
+    type Quarantined = std::cell::RefCell<Vec<([f64; 3], String)>>;
+    let quarantined: Vec<Quarantined> = choices.iter().map(|_| Default::default()).collect();
+    let h_fns: Vec<Box<HFn<'_>>> = choices
+        .iter()
+        .zip(&quarantined)
+        .zip(&pairings)
+        .zip(&pressures)
+        .map(|((((choice, _, model), log), pairing), at_points)| {
+            let pressure = choice.pressure;
+            let quarantine = choice.quarantine;
+            let label = format!(
+                "interaction {} / {} ({})",
+                pairing.side_a, pairing.side_b, choice.name
+            );
+            let (clock, cutback) = (&clock, &cutback);
+            let f = move |p: &HInput| -> Result<HValue, String> {
+                let Some(m) = model else {
+                    return Ok(HValue::default());
+                };
+                let state = PointState {
+                    gap: p.gap,
+                    pressure: at_points.as_ref().map_or(pressure, |v| v[p.point]),
+                    temp_a: p.temp_a,
+                    temp_b: p.temp_b,
+                    x: p.x,
+                    time: clock.get(),
+                };
+                let c = match m.evaluate(&state) {
+                    Ok(c) => c,
+                    Err(e) if e.is_cutback() => {
+                        cutback.set(true);
+                        return Err(format!("{label}: {e}"));
+                    }
+                    // Quarantine: the point contributes nothing; it is reported after the
+                    // run. Each Newton step evaluates it again, so keep it once.
+                    Err(e) if quarantine => {
+                        let mut log = log.borrow_mut();
+                        if !log.iter().any(|(x, _)| *x == p.x) {
+                            log.push((p.x, e.to_string()));
+                        }
+                        return Ok(HValue::default());
+                    }
+                    Err(e) => {
+                        return Err(format!(
+                            "{label}: {e} (add `Quarantine Faulty Points` to the enforcement to skip such points)"
+                        ));
+                    }
+                };
+                Ok(HValue {
+                    h: c.h,
+                    dh_dtemp_a: c.dh_dtemp_a,
+                    dh_dtemp_b: c.dh_dtemp_b,
+                })
+            };
+            Box::new(f) as Box<HFn<'_>>
+        })
+        .collect();
+    let contact_terms = || -> Vec<ContactTerm<'_>> {
+        pairings
+            .iter()
+            .zip(&choices)
+            .zip(&h_fns)
+            .filter(|((_, (c, _, _)), _)| !c.mortar)
+            .map(|((p, (c, scale, model)), h)| ContactTerm {
+                side_a: &p.side_a_geometry,
+                side_b: &p.side_b_geometry,
+                points: &p.result.points,
+                form: InterfaceForm {
+                    form: c.form,
+                    h: h.as_ref(),
+                    offset: c.offset,
+                    beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
+                    conductivity: &conductivity,
+                },
+                // A constant conductance keeps the system linear and symmetric.
+                linear: model.as_ref().is_none_or(|m| m.name() == "constant"),
+            })
+            .collect()
+    };
+    let tie_terms = || -> Vec<TieTerm<'_>> {
+        pairings
+            .iter()
+            .zip(&choices)
+            .filter(|(_, (c, _, _))| c.mortar)
+            .map(|(p, (c, _, _))| TieTerm {
+                side_a: &p.side_a_geometry,
+                side_b: &p.side_b_geometry,
+                points: &p.result.points,
+                offset: c.offset,
+                multipliers: if c.dual {
+                    crate::enforce::mortar::Multipliers::Dual
+                } else {
+                    crate::enforce::mortar::Multipliers::Standard
+                },
+            })
+            .collect()
+    };
+    // The solver's term order (contact terms, then ties) → choice index.
+    let term_choice: Vec<usize> = (0..choices.len())
+        .filter(|&k| !choices[k].0.mortar)
+        .chain((0..choices.len()).filter(|&k| choices[k].0.mortar))
+        .collect();
+    let source_fn = source
+        .as_ref()
+        .map(|s| s as &(dyn Fn([f64; 3]) -> f64 + Sync));
+    let out_dir = match &problem.output.dir {
+        Some(d) => {
+            let out_dir = dir.join(d);
+            std::fs::create_dir_all(&out_dir).map_err(|e| {
+                RunError::Solve(format!("cannot create {}: {e}", out_dir.display()))
+            })?;
+            Some(out_dir)
+        }
+        None => None,
+    };
+
+    let linear_steady = !transient
+        && uniform
+        && materials.constant().is_some()
+        && field_names.len() == 1
+        && toggles.iter().all(Option::is_none)
+        && problem.bc.iter().all(|b| b.kind != BcKind::Radiation);
+    let mut history = Vec::new();
+    let solution = if linear_steady {
+        let materials = materials.constant().expect("checked constant");
+        let loads = loads_at(
+            &problem,
+            &mesh,
+            &dirichlet,
+            &face_sites,
+            &sandbox,
+            start_time,
+        )
+        .map_err(RunError::Solve)?;
+        let steady = SteadyProblem {
+            mesh: &mesh,
+            materials: &materials,
+            source: source_fn,
+            dirichlet: &loads.dirichlet,
+            face_bcs: &loads.faces,
+            contact: contact_terms(),
+            ties: tie_terms(),
+            iterative: problem.solve.linear_solver.as_deref() == Some("amg"),
+            tolerance: problem.solve.tolerance,
+            max_iterations: problem.solve.max_iterations,
+        };
+        solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?
+    } else {
+        if problem.solve.linear_solver.as_deref() == Some("amg") {
+            return Err(input_error(
+                "E0708",
+                "linear_solver = \"amg\" is for linear steady problems".into(),
+                "drop it: transient and nonlinear problems are solved with sparse direct factorisations",
+            ));
+        }
+        let loads = |t: f64| -> Result<Loads, HeatError> {
+            clock.set(t);
+            loads_at(&problem, &mesh, &dirichlet, &face_sites, &sandbox, t).map_err(HeatError::Step)
+        };
+        let active = |k: usize, t: f64| -> bool {
+            toggles[term_choice[k]]
+                .as_ref()
+                .is_none_or(|on| on.iter().any(|&(a, b)| a <= t && t <= b))
+        };
+        let tp = TransientProblem {
+            mesh: &mesh,
+            fields: field_names
+                .iter()
+                .map(|f| FieldSpec {
+                    name: f.clone(),
+                    blocks: (0..mesh.blocks.len())
+                        .filter(|&b| {
+                            mesh.blocks[b].topology.is_solid() && materials.fields[b] == *f
+                        })
+                        .collect(),
+                })
+                .collect(),
+            laws: &materials.laws,
+            source: source_fn,
+            block_source: (!uniform).then_some(block_source.as_slice()),
+            loads: &loads,
+            contact: contact_terms(),
+            ties: tie_terms(),
+            term_fields: term_choice.iter().map(|&k| term_fields[k]).collect(),
+            active: Some(&active),
+            cutback: Some(&cutback),
+            tolerance: problem.solve.tolerance,
+            max_iterations: problem.solve.max_iterations,
+            reproducible: problem.solve.reproducible.unwrap_or(true),
+        };
+        let state = match (&problem.restart, options.restart.as_ref()) {
+            (_, Some(file)) => steps::read_checkpoint(file)?,
+            (Some(r), None) => steps::read_checkpoint(&dir.join(&r.file))?,
+            (None, None) => {
+                let initial = initial_values(&problem, &mesh, &dirichlet, &sandbox, start_time)?;
+                initial_state(&tp, start_time, timing_spec.dt, &|n| initial[n.index()])
+                    .map_err(|e| RunError::Solve(e.to_string()))?
+            }
+        };
+        let mode = if transient {
+            TimeMode::Transient {
+                scheme: timing_spec.scheme,
+                end: timing_spec.end,
+                adaptive: timing_spec.adaptive,
+                dt_min: timing_spec.dt_min,
+            }
+        } else {
+            TimeMode::Steady { time: start_time }
+        };
+        let mut writer =
+            steps::StepWriter::new(out_dir.as_deref(), &mesh, &problem.output, transient);
+        let mut on_step = |r: &StepReport, st: &State, dofs: &DofMap| -> Result<(), HeatError> {
+            if let Some(progress) = options.progress.as_ref() {
+                progress(r);
+            }
+            writer
+                .step(r, st, dofs, &field_names)
+                .map_err(|e| HeatError::Step(e.to_string()))?;
+            history.push(r.clone());
+            Ok(())
+        };
+        let outcome = transient::solve(&tp, mode, state, &mut on_step)
+            .map_err(|e| RunError::Solve(e.to_string()))?;
+        writer
+            .finish(&outcome.state, &outcome.dofs, &field_names)
+            .map_err(|e| RunError::Solve(e.to_string()))?;
+        steps::final_solution(outcome, &history, &field_names, tp.contact.len())
+    };
+    for ((p, (c, _, _)), log) in pairings.iter().zip(&choices).zip(&quarantined) {
+        let log = log.borrow();
+        if let Some((x, first)) = log.first() {
+            diags.push(
+                Diagnostic::warning(
+                    "W0501",
+                    format!(
+                        "interaction {} / {} ({}): {} point(s) quarantined; the first at ({:.6}, {:.6}, {:.6}): {first}",
+                        p.side_a, p.side_b, c.name, log.len(), x[0], x[1], x[2]
+                    ),
+                )
+                .help("the conductance model failed there; those points carry no heat"),
+            );
+        }
+    }
+    timing.assembly_s = solution.timing.assembly_s;
+    timing.factor_s = solution.timing.factor_s;
+    timing.solve_s = solution.timing.solve_s;
+
+    let output = match &out_dir {
+        Some(out_dir) => {
+            let file = out_dir.join("temperature.vtu");
+            let mut point: Vec<(&str, &[f64])> = vec![("temperature", &solution.temperature)];
+            let per_field: Vec<(String, Vec<f64>)> = if field_names.len() > 1 {
+                field_names
+                    .iter()
+                    .filter_map(|f| {
+                        solution
+                            .dofs
+                            .field(f)
+                            .map(|id| (f.clone(), solution.dofs.nodal_values(id, &solution.u)))
+                    })
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            for (name, v) in &per_field {
+                point.push((name.as_str(), v));
+            }
+            write_vtu(&file, &mesh, &point)
+                .map_err(|e| RunError::Solve(format!("cannot write {}: {e}", file.display())))?;
+            if !history.is_empty() {
+                let labels: Vec<(String, String, String)> = term_choice
+                    .iter()
+                    .map(|&k| {
+                        (
+                            pairings[k].side_a.clone(),
+                            pairings[k].side_b.clone(),
+                            choices[k].0.name.clone(),
+                        )
+                    })
+                    .collect();
+                steps::write_history(out_dir, &history, &labels)
+                    .map_err(|e| RunError::Solve(format!("cannot write the history: {e}")))?;
+            }
+            Some(file)
+        }
+        None => None,
+    };
+    // Heat per pairing, in pairing order: flux-type terms and ties were solved apart.
+    let (mut flux_heat, mut tie_heat) = (solution.heat.iter(), solution.tie_heat.iter());
+    let heats: Vec<(f64, f64)> = choices
+        .iter()
+        .map(|(c, _, _)| {
+            let next = if c.mortar {
+                tie_heat.next()
+            } else {
+                flux_heat.next()
+            };
+            next.copied().unwrap_or((0.0, 0.0))
+        })
+        .collect();
+    for (t, cps) in solution.crosspoints.iter().enumerate() {
+        if !cps.is_empty() {
+            let numbers: Vec<String> = cps
+                .iter()
+                .take(10)
+                .map(|n| mesh.node_number(*n).to_string())
+                .collect();
+            diags.push(
+                Diagnostic::warning(
+                    "W0430",
+                    format!(
+                        "tie #{}: {} side-A node(s) already constrained (Dirichlet data or an earlier tie) get no multiplier: {}{}",
+                        t + 1,
+                        cps.len(),
+                        numbers.join(", "),
+                        if cps.len() > 10 { ", …" } else { "" }
+                    ),
+                )
+                .help("a crosspoint keeps its Dirichlet value (or its first tie); this keeps the system non-singular"),
+            );
+        }
+    }
+    let interactions = pairings
+        .iter()
+        .zip(&choices)
+        .zip(&heats)
+        .map(|((p, (c, _, _)), &(a, b))| InteractionHeat {
+            side_a: p.side_a.clone(),
+            side_b: p.side_b.clone(),
+            model: c.name.clone(),
+            heat_side_a: a,
+            heat_side_b: b,
+            imbalance: a + b,
+        })
+        .collect();
+    timing.total_s = start.elapsed().as_secs_f64();
+    let transient_summary = transient.then(|| TransientSummary {
+        steps: history.len(),
+        rejected_steps: history.iter().map(|r| r.rejected).sum(),
+        end_time: history.last().map_or(start_time, |r| r.time),
+    });
+    let summary = Summary {
+        dofs: solution.dofs.len(),
+        newton_iterations: solution.newton_iterations,
+        converged: solution.converged,
+        interactions,
+        timing,
+        output,
+        transient: transient_summary,
+    };
+    Ok(RunResult {
+        summary,
+        mesh,
+        solution,
+        history,
+        warnings: diags,
+        sources: loaded.sources,
+    })
+}
+
+fn block_index(mesh: &Mesh, name: &str, diags: &mut Diagnostics, what: &str) -> Option<usize> {
+    let found = mesh.find_block(name);
+    if found.is_none() {
+        let names: Vec<String> = mesh.blocks.iter().map(|b| b.sierra_name()).collect();
+        let help = did_you_mean(name, names.iter().map(String::as_str)).map_or_else(
+            || format!("the blocks are: {}", names.join(", ")),
+            |s| format!("did you mean `{s}`?"),
+        );
+        diags
+            .push(Diagnostic::error("E0703", format!("{what}: unknown block `{name}`")).help(help));
+    }
+    found
+}
+
+/// The materials of the blocks: per block its laws and its field name.
+struct Materials {
+    laws: Vec<BlockLaws>,
+    fields: Vec<String>,
+}
+
+impl Materials {
+    /// Constant k and ρc per block, for the linear steady solver.
+    fn constant(&self) -> Option<Vec<Material>> {
+        self.laws
+            .iter()
+            .map(|l| match (&l.conductivity, &l.capacity) {
+                (Law::Constant(k), Law::Constant(c)) => Some(Material {
+                    conductivity: *k,
+                    rho_c: *c,
+                }),
+                _ => None,
+            })
+            .collect()
+    }
+}
+
+/// A material value as a law of T: numbers, Lua expressions of T (x, y, z, t), tables
+/// in T; checked positive at `probe` (a Lua law only where it can be evaluated).
+fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law> {
+    let law = match v {
+        Value::Number(k) => Law::Constant(*k),
+        Value::Expr(e) => match e.trim().parse::<f64>() {
+            Ok(k) => Law::Constant(k),
+            Err(_) => Law::Lua {
+                expr: e.clone(),
+                chunk: what.to_string(),
+            },
+        },
+        Value::Table { table } => match Law::table(table.clone()) {
+            Ok(l) => l,
+            Err(m) => {
+                diags.push(
+                    Diagnostic::error("E0704", format!("{what}: {m}"))
+                        .help("a table is [[T, value], …] with T increasing"),
+                );
+                return None;
+            }
+        },
+    };
+    let bad = |v: f64| !(v > 0.0 && v.is_finite());
+    let problem = match &law {
+        Law::Constant(k) if bad(*k) => Some(format!("must be positive, found {k}")),
+        Law::Table(p) => p
+            .iter()
+            .find(|q| bad(q.1))
+            .map(|q| format!("must be positive, found {} at T = {}", q.1, q.0)),
+        Law::Lua { .. } => match law.eval(probe, [0.0; 3], 0.0) {
+            Err(e) => Some(e),
+            Ok((k, _)) if bad(k) => Some(format!("must be positive, found {k} at T = {probe}")),
+            Ok(_) => None,
+        },
+        _ => None,
+    };
+    if let Some(m) = problem {
+        diags.push(
+            Diagnostic::error("E0704", format!("{what} {m}"))
+                .help("k in W/m/K, ρ in kg/m³, c_p in J/kg/K: positive numbers, tables or Lua expressions of T"),
+        );
+        return None;
+    }
+    Some(law)
+}
+
+fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> Materials {
+    let mut out: Vec<Option<(BlockLaws, String)>> = vec![None; mesh.blocks.len()];
+    for (i, m) in p.material.iter().enumerate() {
+        let what = format!("[[material]] #{} conductivity", i + 1);
+        let Some(k) = law(&m.conductivity, &what, probe, diags) else {
+            continue;
+        };
+        let capacity = match (&m.density, &m.specific_heat, m.rho_c) {
+            (_, _, Some(rc)) if m.density.is_some() || m.specific_heat.is_some() => {
+                diags.push(
+                    Diagnostic::error(
+                        "E0704",
+                        format!(
+                            "[[material]] #{}: rho_c and density/specific_heat both given",
+                            i + 1
+                        ),
+                    )
+                    .help("give either rho_c, or density and specific_heat"),
+                );
+                let _ = rc;
+                continue;
+            }
+            (_, _, Some(rc)) => law(
+                &Value::Number(rc),
+                &format!("[[material]] #{} rho_c", i + 1),
+                probe,
+                diags,
+            ),
+            (Some(rho), Some(cp), None) => {
+                let cp = law(
+                    cp,
+                    &format!("[[material]] #{} specific_heat", i + 1),
+                    probe,
+                    diags,
+                );
+                let rho_ok = *rho > 0.0 && rho.is_finite();
+                if !rho_ok {
+                    diags.push(
+                        Diagnostic::error(
+                            "E0704",
+                            format!(
+                                "[[material]] #{} density must be positive, found {rho}",
+                                i + 1
+                            ),
+                        )
+                        .help("ρ in kg/m³"),
+                    );
+                }
+                cp.filter(|_| rho_ok).map(|cp| scale_law(cp, *rho))
+            }
+            (None, None, None) => Some(Law::Constant(1.0)),
+            _ => {
+                diags.push(
+                    Diagnostic::error(
+                        "E0704",
+                        format!(
+                            "[[material]] #{}: density and specific_heat go together",
+                            i + 1
+                        ),
+                    )
+                    .help("give both (or rho_c)"),
+                );
+                continue;
+            }
+        };
+        let Some(capacity) = capacity else { continue };
+        let field = m
+            .field
+            .clone()
+            .unwrap_or_else(|| TEMPERATURE.to_string())
+            .to_ascii_lowercase();
+        for b in &m.blocks {
+            if let Some(i) = block_index(mesh, b, diags, "[[material]]") {
+                out[i] = Some((
+                    BlockLaws {
+                        conductivity: k.clone(),
+                        capacity: capacity.clone(),
+                    },
+                    field.clone(),
+                ));
+            }
+        }
+    }
+    let mut laws = Vec::with_capacity(out.len());
+    let mut fields = Vec::with_capacity(out.len());
+    for (i, m) in out.into_iter().enumerate() {
+        match m {
+            Some((l, f)) => {
+                laws.push(l);
+                fields.push(f);
+            }
+            None => {
+                if mesh.blocks[i].topology.is_solid() {
+                    diags.push(
+                        Diagnostic::error(
+                            "E0705",
+                            format!("block {} has no material", mesh.blocks[i].sierra_name()),
+                        )
+                        .help("add it to the `blocks` of a [[material]]"),
+                    );
+                }
+                laws.push(BlockLaws {
+                    conductivity: Law::Constant(1.0),
+                    capacity: Law::Constant(1.0),
+                });
+                fields.push(TEMPERATURE.to_string());
+            }
+        }
+    }
+    Materials { laws, fields }
+}
+
+/// ρ·c_p(T) from c_p(T).
+fn scale_law(cp: Law, rho: f64) -> Law {
+    match cp {
+        Law::Constant(c) => Law::Constant(rho * c),
+        Law::Table(p) => Law::Table(p.into_iter().map(|(t, v)| (t, rho * v)).collect()),
+        Law::Lua { expr, chunk } => Law::Lua {
+            expr: format!("{rho:e} * ({expr})"),
+            chunk,
+        },
+    }
+}
+
+/// The sandbox of the run's boundary and initial expressions.
+type SharedSandbox = std::cell::RefCell<Option<Sandbox>>;
+
+/// Evaluate a value at a point and time: numbers directly, tables in t, expressions in
+/// a sandbox shared by the run (built on first use, each expression compiled once).
+fn evaluate(
+    v: &Value,
+    x: [f64; 3],
+    t: f64,
+    sandbox: &SharedSandbox,
+    chunk: &str,
+) -> Result<f64, String> {
+    match v {
+        Value::Number(n) => Ok(*n),
+        Value::Table { table } => {
+            let law = Law::table(table.clone())?;
+            law.eval(t, x, t).map(|(v, _)| v)
+        }
+        Value::Expr(e) => {
+            let mut slot = sandbox.borrow_mut();
+            if slot.is_none() {
+                *slot = Some(Sandbox::new(Limits::default()).map_err(|e| e.to_string())?);
+            }
+            let s = slot.as_mut().expect("just built");
+            let f = match s.cached(e) {
+                Some(f) => f,
+                None => {
+                    let f = s
+                        .expression(chunk, e, &["x", "y", "z", "t"])
+                        .map_err(|e| e.to_string())?;
+                    s.cache(e, f.clone());
+                    f
+                }
+            };
+            s.call(&f, &[x[0], x[1], x[2], t])
+                .map_err(|e| e.to_string())
+        }
+    }
+}
+
+/// The nodes of each temperature condition, with the condition.
+fn dirichlet_nodes(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<(NodeId, usize)> {
+    let mut out = Vec::new();
+    for (k, bc) in
+        p.bc.iter()
+            .enumerate()
+            .filter(|(_, b)| b.kind == BcKind::Temperature)
+    {
+        let mut nodes = Vec::new();
+        for s in &bc.surfaces {
+            if let Some(i) = mesh.find_side_set(s) {
+                for &side in &mesh.side_sets[i].sides {
+                    nodes.extend(mesh.side_nodes(side));
+                }
+            } else if let Some(i) = mesh.find_node_set(s) {
+                nodes.extend_from_slice(&mesh.node_sets[i].nodes);
+            } else {
+                diags.push(
+                    Diagnostic::error(
+                        "E0706",
+                        format!("[[bc]]: unknown side set or node set `{s}`"),
+                    )
+                    .help("bc surfaces name side sets (surface_<id> or their names) or node sets"),
+                );
+            }
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        out.extend(nodes.into_iter().map(|n| (n, k)));
+    }
+    // A node in two conditions keeps the later one.
+    out.sort_by_key(|&(n, k)| (n, std::cmp::Reverse(k)));
+    out.dedup_by_key(|&mut (n, _)| n);
+    out
+}
+
+/// One face condition before evaluation: its side, condition index, face centroid and
+/// whether it opts out of masking on faces in contact.
+#[derive(Clone, Copy, Debug)]
+struct FaceSite {
+    side: Side,
+    bc: usize,
+    centroid: [f64; 3],
+    keep: bool,
+}
+
+fn face_sites(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<FaceSite> {
+    let mut out = Vec::new();
+    for (k, bc) in
+        p.bc.iter()
+            .enumerate()
+            .filter(|(_, b)| b.kind != BcKind::Temperature)
+    {
+        if bc.kind == BcKind::Radiation && bc.ambient.is_none() {
+            diags.push(
+                Diagnostic::error("E0706", "[[bc]] radiation needs `ambient` (T∞, K)")
+                    .help("add ambient = 293.15 (say); value is the emissivity"),
+            );
+        }
+        for s in &bc.surfaces {
+            let Some(i) = mesh.find_side_set(s) else {
+                diags.push(
+                    Diagnostic::error("E0706", format!("[[bc]]: unknown side set `{s}`"))
+                        .help("flux, convection and radiation conditions act on side sets"),
+                );
+                continue;
+            };
+            for &side in &mesh.side_sets[i].sides {
+                let nodes: Vec<_> = mesh.side_nodes(side).collect();
+                let mut c = [0.0; 3];
+                for n in &nodes {
+                    for (cd, xd) in c.iter_mut().zip(mesh.coords[n.index()]) {
+                        *cd += xd / nodes.len() as f64;
+                    }
+                }
+                out.push(FaceSite {
+                    side,
+                    bc: k,
+                    centroid: c,
+                    keep: bc.no_coverage_flux,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The boundary data at time t.
+fn loads_at(
+    p: &Problem,
+    mesh: &Mesh,
+    dirichlet: &[(NodeId, usize)],
+    faces: &[FaceSite],
+    sandbox: &SharedSandbox,
+    t: f64,
+) -> Result<Loads, String> {
+    let mut out = Loads::default();
+    for &(n, k) in dirichlet {
+        let v = evaluate(
+            &p.bc[k].value,
+            mesh.coords[n.index()],
+            t,
+            sandbox,
+            "[[bc]] value",
+        )
+        .map_err(|e| format!("[[bc]] #{} value: {e}", k + 1))?;
+        out.dirichlet.push((n, v));
+    }
+    for f in faces {
+        let bc = &p.bc[f.bc];
+        let v = evaluate(&bc.value, f.centroid, t, sandbox, "[[bc]] value")
+            .map_err(|e| format!("[[bc]] #{} value: {e}", f.bc + 1))?;
+        let t_inf = bc.ambient.unwrap_or(0.0);
+        out.faces.push(match bc.kind {
+            BcKind::Flux => FaceBc::Flux { side: f.side, q: v },
+            BcKind::Radiation => FaceBc::Radiation {
+                side: f.side,
+                emissivity: v,
+                t_inf,
+            },
+            _ => FaceBc::Convection {
+                side: f.side,
+                h: v,
+                t_inf,
+            },
+        });
+    }
+    Ok(out)
+}
+
+/// The volumetric source per block (W/m³; 0 where none is given). Each block may be
+/// named once over all `[[source]]`s.
+fn block_sources(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<f64> {
+    let mut out = vec![0.0; mesh.blocks.len()];
+    let mut given = vec![false; mesh.blocks.len()];
+    for (k, s) in p.source.iter().enumerate() {
+        let q = match &s.value {
+            Value::Number(q) => Some(*q),
+            Value::Expr(e) => e.trim().parse::<f64>().ok(),
+            Value::Table { .. } => None,
+        };
+        let Some(q) = q.filter(|q| q.is_finite()) else {
+            diags.push(
+                Diagnostic::error(
+                    "E0714",
+                    format!(
+                        "[[source]] #{}: the value must be a finite number (W/m³)",
+                        k + 1
+                    ),
+                )
+                .help("sources are constant per block in this version of seam"),
+            );
+            continue;
+        };
+        for b in &s.blocks {
+            if let Some(i) = block_index(mesh, b, diags, "[[source]]") {
+                if given[i] {
+                    diags.push(
+                        Diagnostic::error(
+                            "E0714",
+                            format!("[[source]]: block `{b}` is given a source twice"),
+                        )
+                        .help("name each block in one [[source]] only"),
+                    );
+                }
+                given[i] = true;
+                out[i] = q;
+            }
+        }
+    }
+    out
+}
+
+/// An interaction's model, penalty scale and conductance model.
+type Choice = (ModelChoice, f64, Option<Box<dyn ConductanceModel>>);
+
+fn bc_side_of(f: &FaceSite) -> Side {
+    f.side
+}
+
+/// The time controls of `[solve]`, checked.
+struct TimeSpec {
+    start: f64,
+    end: f64,
+    dt: f64,
+    dt_min: f64,
+    scheme: Scheme,
+    adaptive: Option<transient::Adaptive>,
+}
+
+fn time_spec(p: &Problem, transient: bool, diags: &mut Diagnostics) -> TimeSpec {
+    let s = &p.solve;
+    let start = s.start_time.or(s.time).unwrap_or(0.0);
+    let mut spec = TimeSpec {
+        start,
+        end: start,
+        dt: 1.0,
+        dt_min: 0.0,
+        scheme: Scheme::BackwardEuler,
+        adaptive: None,
+    };
+    if !transient {
+        return spec;
+    }
+    let mut err =
+        |m: String, help: &str| diags.push(Diagnostic::error("E0710", m).help(help.to_string()));
+    spec.scheme = match s.scheme.as_deref() {
+        None | Some("bdf2") => Scheme::Bdf2,
+        Some("backward_euler") => Scheme::BackwardEuler,
+        Some(other) => {
+            err(
+                format!("unknown time scheme `{other}`"),
+                "use scheme = \"backward_euler\" or \"bdf2\"",
+            );
+            Scheme::Bdf2
+        }
+    };
+    match (s.dt, s.end_time) {
+        (Some(dt), Some(end)) if dt > 0.0 && dt.is_finite() && end > start => {
+            spec.dt = dt;
+            spec.end = end;
+        }
+        (Some(dt), Some(end)) => err(
+            format!(
+                "[solve]: need dt > 0 and end_time > start_time, found dt = {dt}, end_time = {end}, start = {start}"
+            ),
+            "set dt and end_time in [solve]",
+        ),
+        _ => err(
+            "a transient run needs `dt` and `end_time` in [solve]".into(),
+            "e.g. dt = 0.1, end_time = 10",
+        ),
+    }
+    if p.initial.is_none() && p.restart.is_none() {
+        err(
+            "a transient run needs an initial temperature".into(),
+            "add [initial] temperature = 293.15 (a number or a Lua expression of x, y, z)",
+        );
+    }
+    spec.dt_min = s.dt_min.unwrap_or(spec.dt * 1e-6);
+    if s.adaptive {
+        spec.adaptive = Some(transient::Adaptive {
+            tolerance: s.time_tolerance.unwrap_or(1e-2),
+            dt_min: spec.dt_min,
+            dt_max: s.dt_max.unwrap_or(spec.end - spec.start),
+        });
+    }
+    spec
+}
+
+/// Each interaction's toggle intervals (`Use Toggle Block` → `[[toggle]]`).
+fn resolve_toggles(
+    p: &Problem,
+    choices: &[Choice],
+    diags: &mut Diagnostics,
+) -> Vec<Option<Vec<(f64, f64)>>> {
+    choices
+        .iter()
+        .map(|(c, _, _)| {
+            let name = c.toggle.as_ref()?;
+            match p.toggle.iter().find(|t| t.name.eq_ignore_ascii_case(name)) {
+                Some(t) => Some(t.on.clone()),
+                None => {
+                    let names = p.toggle.iter().map(|t| t.name.as_str());
+                    let help = did_you_mean(name, names).map_or_else(
+                        || format!("add [[toggle]] name = \"{name}\", on = [[t0, t1]] to the problem file"),
+                        |s| format!("did you mean `{s}`?"),
+                    );
+                    diags.push(
+                        Diagnostic::error("E0711", format!("`Use Toggle Block = {name}`: no [[toggle]] of that name"))
+                            .help(help),
+                    );
+                    None
+                }
+            }
+        })
+        .collect()
+}
+
+/// Each interaction's (side-A field, side-B field), as indices into `field_names`,
+/// checked against `Side B Variable`.
+fn interaction_fields(
+    mesh: &Mesh,
+    materials: &Materials,
+    field_names: &[String],
+    pairings: &[Pairing],
+    choices: &[Choice],
+    diags: &mut Diagnostics,
+) -> Vec<(usize, usize)> {
+    let index = |f: &str| field_names.iter().position(|g| g == f).unwrap_or(0);
+    pairings
+        .iter()
+        .zip(choices)
+        .map(|(p, (c, _, _))| {
+            let side_field = |g: &crate::search::pairing::SurfaceGeometry| {
+                g.faces
+                    .first()
+                    .map(|f| materials.fields[mesh.block_of(f.side.elem)].clone())
+            };
+            let fa = side_field(&p.side_a_geometry).unwrap_or_else(|| TEMPERATURE.into());
+            let fb = side_field(&p.side_b_geometry).unwrap_or_else(|| TEMPERATURE.into());
+            match &c.variables {
+                Some((a, b)) if (a, b) != (&fa, &fb) => diags.push(
+                    Diagnostic::error(
+                        "E0428",
+                        format!(
+                            "interaction {} / {}: `Side B Variable {b} To {a}`, but side A carries `{fa}` and side B `{fb}`",
+                            p.side_a, p.side_b
+                        ),
+                    )
+                    .help(format!("write `Side B Variable {fb} To {fa}` (the fields come from [[material]] field)")),
+                ),
+                None if fa != fb => diags.push(
+                    Diagnostic::error(
+                        "E0428",
+                        format!(
+                            "interaction {} / {} joins two fields, `{fa}` on side A and `{fb}` on side B",
+                            p.side_a, p.side_b
+                        ),
+                    )
+                    .help(format!("say how they map: `Side B Variable {fb} To {fa}` in the enforcement")),
+                ),
+                _ => {}
+            }
+            (index(&fa), index(&fb))
+        })
+        .collect()
+}
+
+/// Per interaction with `Contact Pressure Variable`: the pressure at each of its
+/// points, interpolated on side A from the named `[[nodal_field]]` (evaluated at the
+/// nodes at `time`).
+fn point_pressures(
+    p: &Problem,
+    mesh: &Mesh,
+    pairings: &[Pairing],
+    choices: &[Choice],
+    sandbox: &SharedSandbox,
+    time: f64,
+    diags: &mut Diagnostics,
+) -> Vec<Option<Vec<f64>>> {
+    pairings
+        .iter()
+        .zip(choices)
+        .map(|(pairing, (c, _, _))| {
+            let name = c.pressure_variable.as_ref()?;
+            let Some(field) = p.nodal_field.iter().find(|f| f.name.eq_ignore_ascii_case(name)) else {
+                let help = did_you_mean(name, p.nodal_field.iter().map(|f| f.name.as_str()))
+                    .map_or_else(
+                        || format!("add [[nodal_field]] name = \"{name}\", value = … to the problem file"),
+                        |s| format!("did you mean `{s}`?"),
+                    );
+                diags.push(
+                    Diagnostic::error(
+                        "E0712",
+                        format!("`Contact Pressure Variable = {name}`: no [[nodal_field]] of that name"),
+                    )
+                    .help(help),
+                );
+                return None;
+            };
+            let mut nodal = std::collections::HashMap::new();
+            let mut at = |n: NodeId| -> Result<f64, String> {
+                if let Some(v) = nodal.get(&n) {
+                    return Ok(*v);
+                }
+                let v = evaluate(&field.value, mesh.coords[n.index()], time, sandbox, "[[nodal_field]] value")?;
+                nodal.insert(n, v);
+                Ok(v)
+            };
+            let mut out = Vec::with_capacity(pairing.result.points.len());
+            for q in &pairing.result.points {
+                if q.a_face == u32::MAX {
+                    let node = pairing.side_a_geometry.nodes.get(q.a_node as usize).map(|n| n.0);
+                    out.push(node.map_or(Ok(0.0), &mut at));
+                    continue;
+                }
+                let f = &pairing.side_a_geometry.faces[q.a_face as usize];
+                let n = crate::enforce::interface::face_shape_values(f.len as usize, q.xi_a);
+                let mut v = Ok(0.0);
+                for (node, nk) in f.nodes.iter().zip(n).take(f.len as usize) {
+                    v = v.and_then(|acc| at(*node).map(|x| acc + nk * x));
+                }
+                out.push(v);
+            }
+            match out.into_iter().collect::<Result<Vec<f64>, String>>() {
+                Ok(v) => Some(v),
+                Err(e) => {
+                    diags.push(
+                        Diagnostic::error("E0712", format!("[[nodal_field]] {name}: {e}"))
+                            .help("a number or a Lua expression of x, y, z, t"),
+                    );
+                    None
+                }
+            }
+        })
+        .collect()
+}
+
+/// Initial nodal temperatures: `[initial] temperature`, else (a steady nonlinear
+/// solve's first guess) the mean of the Dirichlet values, else 0.
+fn initial_values(
+    p: &Problem,
+    mesh: &Mesh,
+    dirichlet: &[(NodeId, usize)],
+    sandbox: &SharedSandbox,
+    time: f64,
+) -> Result<Vec<f64>, RunError> {
+    match &p.initial {
+        Some(init) => mesh
+            .coords
+            .iter()
+            .map(|x| {
+                evaluate(
+                    &init.temperature,
+                    *x,
+                    time,
+                    sandbox,
+                    "[initial] temperature",
+                )
+            })
+            .collect::<Result<Vec<f64>, String>>()
+            .map_err(|e| {
+                input_error(
+                    "E0707",
+                    format!("[initial] temperature: {e}"),
+                    "a number or a Lua expression of x, y, z",
+                )
+            }),
+        None => {
+            let mut sum = 0.0;
+            for &(n, k) in dirichlet {
+                sum += evaluate(
+                    &p.bc[k].value,
+                    mesh.coords[n.index()],
+                    time,
+                    sandbox,
+                    "[[bc]] value",
+                )
+                .unwrap_or(0.0);
+            }
+            let mean = if dirichlet.is_empty() {
+                0.0
+            } else {
+                sum / dirichlet.len() as f64
+            };
+            Ok(vec![mean; mesh.num_nodes()])
+        }
+    }
+}
