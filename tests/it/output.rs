@@ -4,7 +4,7 @@
 //! outputs are also checked by `tests/python/check_results.py`.
 
 use std::io::ErrorKind;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{self, Mesh, NodeId, NodeSet, Topology};
@@ -222,4 +222,211 @@ fn output_exodus_round_trip_2d() {
 
 fn ids(v: &[u32]) -> Vec<NodeId> {
     v.iter().map(|&n| NodeId(n)).collect()
+}
+
+// ---------------------------------------------------------------- VTU and PVD
+
+/// The text of the `DataArray` named `name` (or, for `None`, the first one without a
+/// name) and its `format` attribute.
+fn data_array<'a>(xml: &'a str, name: Option<&str>) -> (&'a str, &'a str) {
+    let mut rest = xml;
+    while let Some(at) = rest.find("<DataArray ") {
+        let tag_end = at + rest[at..].find('>').unwrap();
+        let tag = &rest[at..tag_end];
+        let body_end = tag_end + rest[tag_end..].find("</DataArray>").unwrap();
+        let attr = |key: &str| {
+            tag.find(&format!(" {key}=\""))
+                .map(|p| &tag[p + key.len() + 3..][..tag[p + key.len() + 3..].find('"').unwrap()])
+        };
+        if attr("Name") == name {
+            return (rest[tag_end + 1..body_end].trim(), attr("format").unwrap());
+        }
+        rest = &rest[body_end..];
+    }
+    panic!("no DataArray {name:?}");
+}
+
+/// Decode standard base64 (test-side, independent of the writer's encoder).
+fn base64_decode(s: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("bad base64 character {c}"),
+    };
+    let clean: Vec<u8> = s.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    let mut out = Vec::new();
+    for quad in clean.chunks(4) {
+        let pad = quad.iter().filter(|&&c| c == b'=').count();
+        let mut n = 0u32;
+        for &c in quad {
+            n = n << 6 | if c == b'=' { 0 } else { u32::from(value(c)) };
+        }
+        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
+    }
+    out
+}
+
+/// The values of a data array as f64 (Float64, Int64 or UInt8), in either encoding.
+fn decode(xml: &str, name: Option<&str>, size: usize) -> Vec<f64> {
+    let (body, format) = data_array(xml, name);
+    if format == "ascii" {
+        return body
+            .split_ascii_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect();
+    }
+    assert_eq!(format, "binary");
+    let bytes = base64_decode(body);
+    let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    assert_eq!(n, bytes.len() - 8, "byte count header of {name:?}");
+    bytes[8..]
+        .chunks(size)
+        .map(|c| match size {
+            8 if name.is_none()
+                || !["connectivity", "offsets", "block_id"].contains(&name.unwrap()) =>
+            {
+                f64::from_le_bytes(c.try_into().unwrap())
+            }
+            8 => i64::from_le_bytes(c.try_into().unwrap()) as f64,
+            1 => f64::from(c[0]),
+            _ => unreachable!(),
+        })
+        .collect()
+}
+
+/// Cell `k` of a parsed file: its VTK type and nodes.
+fn cells(xml: &str) -> Vec<(u8, Vec<u32>)> {
+    let conn = decode(xml, Some("connectivity"), 8);
+    let offsets = decode(xml, Some("offsets"), 8);
+    let types = decode(xml, Some("types"), 1);
+    let mut start = 0;
+    offsets
+        .iter()
+        .zip(&types)
+        .map(|(&end, &t)| {
+            let nodes = conn[start..end as usize]
+                .iter()
+                .map(|&n| n as u32)
+                .collect();
+            start = end as usize;
+            (t as u8, nodes)
+        })
+        .collect()
+}
+
+#[test]
+fn output_vtu_cell_data_follows_element_order_in_both_encodings() {
+    use seam::mesh::ElemId;
+    use seam::output::vtu::{write_vtu, write_vtu_cells};
+    let m = two_part_mesh();
+    let dir = out_dir("output-vtu");
+    let t = nodal_values(&m, 2, 0);
+    let index: Vec<f64> = (0..m.num_elems()).map(|e| e as f64).collect();
+    let src = element_values(&m, 1);
+    write_vtu_cells(
+        &dir.join("cells.vtu"),
+        &m,
+        &[("temperature", &t)],
+        &[("index", &index), ("source", &src)],
+    )
+    .unwrap();
+    write_vtu(&dir.join("points.vtu"), &m, &[("temperature", &t)]).unwrap();
+    let binary = std::fs::read_to_string(dir.join("cells.vtu")).unwrap();
+    let ascii = std::fs::read_to_string(dir.join("points.vtu")).unwrap();
+    for xml in [&binary, &ascii] {
+        assert!(xml.contains(&format!(
+            "NumberOfPoints=\"{}\" NumberOfCells=\"{}\"",
+            m.num_nodes(),
+            m.num_elems()
+        )));
+        let c = cells(xml);
+        assert_eq!(c.len(), m.num_elems());
+        for (k, (ty, nodes)) in c.iter().enumerate() {
+            let want: Vec<u32> = m.elem_nodes(ElemId(k as u32)).iter().map(|n| n.0).collect();
+            assert_eq!(nodes, &want, "cell {k}");
+            let expect_ty = match m.topology(ElemId(k as u32)) {
+                Topology::Hex8 => 12,
+                Topology::Tet4 => 10,
+                other => panic!("unexpected {other:?}"),
+            };
+            assert_eq!(*ty, expect_ty, "cell {k}");
+        }
+        let xyz: Vec<f64> = m.coords.iter().flatten().copied().collect();
+        assert_eq!(bits(&decode(xml, None, 8)), bits(&xyz), "points");
+        assert_eq!(bits(&decode(xml, Some("temperature"), 8)), bits(&t));
+        let blocks = decode(xml, Some("block_id"), 8);
+        assert_eq!(blocks[0], 1.0);
+        assert_eq!(blocks[m.num_elems() - 1], 2.0);
+    }
+    assert_eq!(decode(&binary, Some("index"), 8), index);
+    assert_eq!(bits(&decode(&binary, Some("source"), 8)), bits(&src));
+    // Base64 of computed doubles is shorter than their round-trip decimal text.
+    let (b, a) = (
+        data_array(&binary, Some("temperature")).0.len(),
+        data_array(&ascii, Some("temperature")).0.len(),
+    );
+    assert!(2 * b < a + a / 4, "temperature: {b} vs {a} bytes");
+}
+
+#[test]
+fn output_vtu_refuses_wrong_lengths() {
+    use seam::output::vtu::write_vtu_cells;
+    let m = generate::unit_hex();
+    let path = out_dir("output-vtu").join("bad.vtu");
+    let e = write_vtu_cells(&path, &m, &[("temperature", &[0.0; 5])], &[]).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::InvalidInput);
+    assert!(
+        e.to_string()
+            .contains("`temperature` has 5 values, expected 8"),
+        "{e}"
+    );
+    let e = write_vtu_cells(&path, &m, &[], &[("q", &[0.0; 2])]).unwrap_err();
+    assert!(
+        e.to_string().contains("`q` has 2 values, expected 1"),
+        "{e}"
+    );
+}
+
+#[test]
+fn output_pvd_is_a_complete_series_after_every_add() {
+    use seam::output::vtu::{PvdSeries, write_vtu};
+    let m = generate::unit_hex();
+    let dir = out_dir("output-pvd");
+    std::fs::create_dir_all(dir.join("steps")).unwrap();
+    let mut series = PvdSeries::new(&dir.join("run.pvd"));
+    let times = [0.0, 0.5, 1.25];
+    for (k, &time) in times.iter().enumerate() {
+        let rel = PathBuf::from(format!("steps/t{k}.vtu"));
+        write_vtu(&dir.join(&rel), &m, &[("temperature", &[time; 8])]).unwrap();
+        // Alternate relative and absolute paths: both must be listed relative.
+        let given = if k % 2 == 0 {
+            rel.clone()
+        } else {
+            dir.join(&rel)
+        };
+        series.add(time, &given).unwrap();
+        let pvd = std::fs::read_to_string(dir.join("run.pvd")).unwrap();
+        assert!(pvd.trim_end().ends_with("</VTKFile>"));
+        let listed: Vec<(f64, String)> = pvd
+            .lines()
+            .filter(|l| l.starts_with("<DataSet"))
+            .map(|l| {
+                let get = |key: &str| {
+                    let from = l.find(&format!("{key}=\"")).unwrap() + key.len() + 2;
+                    l[from..from + l[from..].find('"').unwrap()].to_string()
+                };
+                (get("timestep").parse().unwrap(), get("file"))
+            })
+            .collect();
+        assert_eq!(listed.len(), k + 1);
+        for (j, (t, f)) in listed.iter().enumerate() {
+            assert_eq!(*t, times[j]);
+            assert_eq!(f, &format!("steps/t{j}.vtu"));
+            assert!(dir.join(f).is_file());
+        }
+    }
+    assert!(series.add(f64::NAN, Path::new("x.vtu")).is_err());
 }
