@@ -10,5 +10,7 @@
 //!   by seam itself, for a look without ParaView.
 
 pub mod exodus;
+mod font;
 mod netcdf;
+pub mod plot;
 pub mod vtu;

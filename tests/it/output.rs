@@ -430,3 +430,215 @@ fn output_pvd_is_a_complete_series_after_every_add() {
     }
     assert!(series.add(f64::NAN, Path::new("x.vtu")).is_err());
 }
+
+// ---------------------------------------------------------------- PNG plots
+
+/// Decode a PNG written by `Plot::write_png` into (width, height, RGB rows).
+fn decode_png(path: &Path) -> (usize, usize, Vec<u8>) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    assert_eq!(info.bit_depth, png::BitDepth::Eight);
+    buf.truncate(info.buffer_size());
+    (info.width as usize, info.height as usize, buf)
+}
+
+/// Pixels `(x, y)` of colour `c`.
+fn pixels_of(w: usize, rgb: &[u8], c: [u8; 3]) -> Vec<(usize, usize)> {
+    rgb.chunks(3)
+        .enumerate()
+        .filter(|(_, p)| *p == c)
+        .map(|(i, _)| (i % w, i / w))
+        .collect()
+}
+
+#[test]
+fn output_plot_draws_known_lines_where_they_belong() {
+    use seam::output::plot::{Plot, Series, series_colour};
+    // No labels, so no legend covers the lines.
+    let diagonal = Series {
+        label: String::new(),
+        points: (0..=10).map(|k| (k as f64, k as f64)).collect(),
+    };
+    let level = Series {
+        label: String::new(),
+        points: vec![(0.0, 5.0), (10.0, 5.0)],
+    };
+    let plot = Plot {
+        title: "Two lines (test)".into(),
+        x_label: "x".into(),
+        y_label: "T [K]".into(),
+        log_y: false,
+        series: vec![diagonal, level],
+    };
+    let path = out_dir("output-plot").join("lines.png");
+    plot.write_png(&path).unwrap();
+    let (w, h, rgb) = decode_png(&path);
+    assert_eq!((w, h), (960, 640));
+    assert_ne!(series_colour(0), series_colour(1));
+
+    // The level line: one 2-pixel band of rows spanning the plot area.
+    let flat: Vec<_> = pixels_of(w, &rgb, series_colour(1));
+    let band_row = {
+        let mut rows = std::collections::BTreeMap::<usize, usize>::new();
+        for &(_, y) in &flat {
+            *rows.entry(y).or_default() += 1;
+        }
+        *rows.iter().max_by_key(|(_, n)| **n).unwrap().0
+    };
+    let band: Vec<usize> = flat
+        .iter()
+        .filter(|(_, y)| y.abs_diff(band_row) <= 1)
+        .map(|&(x, _)| x)
+        .collect();
+    let (x0, x1) = (*band.iter().min().unwrap(), *band.iter().max().unwrap());
+    assert!(x1 - x0 > w / 2, "level line spans {x0}..{x1}");
+
+    // The diagonal: over the same columns, its row falls linearly from bottom to top
+    // and crosses the level line half way (x = 5 where y = 5).
+    let diag: Vec<(usize, usize)> = pixels_of(w, &rgb, series_colour(0))
+        .into_iter()
+        .filter(|&(x, _)| x >= x0 && x <= x1)
+        .collect();
+    let row_at = |col: usize| -> Option<f64> {
+        let ys: Vec<usize> = diag.iter().filter(|p| p.0 == col).map(|p| p.1).collect();
+        (!ys.is_empty()).then(|| ys.iter().sum::<usize>() as f64 / ys.len() as f64)
+    };
+    let first = row_at(x0 + 2).expect("diagonal at the left end");
+    let last = row_at(x1 - 2).expect("diagonal at the right end");
+    assert!(
+        first > last + (h / 3) as f64,
+        "diagonal rows {first} → {last}"
+    );
+    let slope = (last - first) / ((x1 - 2) - (x0 + 2)) as f64;
+    for col in (x0 + 2..x1 - 2).step_by(37) {
+        // Away from the crossing, where the level line's pixels cover the diagonal's.
+        if col.abs_diff((x0 + x1) / 2) < 6 {
+            continue;
+        }
+        let want = first + slope * (col - x0 - 2) as f64;
+        let got = row_at(col).unwrap_or_else(|| panic!("no diagonal pixel in column {col}"));
+        assert!(
+            (got - want).abs() <= 2.0,
+            "column {col}: row {got}, expected {want}"
+        );
+    }
+    let mid = (x0 + x1) as f64 / 2.0;
+    let crossing = first + slope * (mid - (x0 + 2) as f64);
+    assert!(
+        (crossing - band_row as f64).abs() <= 3.0,
+        "crossing at {crossing}, level at {band_row}"
+    );
+}
+
+#[test]
+fn output_plot_gives_each_series_its_colour_and_copes_with_awkward_data() {
+    use seam::output::plot::{Plot, Series, series_colour};
+    let dir = out_dir("output-plot");
+    // Five series: constant data, a single point, NaN and infinity inside, negative
+    // values on a log axis; every one must show in its own colour.
+    let series = vec![
+        Series {
+            label: "constant".into(),
+            points: vec![(0.0, 1.0), (1.0, 1.0), (2.0, 1.0)],
+        },
+        Series {
+            label: "one point".into(),
+            points: vec![(1.0, 1e-2)],
+        },
+        Series {
+            label: "gaps".into(),
+            points: vec![
+                (0.0, 1e-4),
+                (0.5, f64::NAN),
+                (1.0, 1e-3),
+                (1.5, f64::INFINITY),
+                (2.0, 1e-1),
+            ],
+        },
+        Series {
+            label: "sign changes".into(),
+            points: vec![(0.0, 1e-5), (1.0, -1.0), (1.5, 0.0), (2.0, 1e-2)],
+        },
+        Series {
+            label: "residual 95% (°C)".into(),
+            points: (0..20)
+                .map(|k| (k as f64 / 10.0, 10f64.powi(-k / 3)))
+                .collect(),
+        },
+    ];
+    let plot = Plot {
+        title: "Residuals".into(),
+        x_label: "iteration".into(),
+        y_label: "norm".into(),
+        log_y: true,
+        series,
+    };
+    let path = dir.join("awkward.png");
+    plot.write_png(&path).unwrap();
+    let (w, _, rgb) = decode_png(&path);
+    for k in 0..5 {
+        let n = pixels_of(w, &rgb, series_colour(k)).len();
+        // More than the legend swatch (25 × 2 pixels) alone.
+        assert!(n > 60, "series {k} has {n} pixels of its colour");
+        for j in 0..k {
+            assert_ne!(series_colour(j), series_colour(k));
+        }
+    }
+    // Constant data on a linear axis draws a flat line inside the frame.
+    let flat = Plot {
+        log_y: false,
+        series: vec![Series {
+            label: String::new(),
+            points: vec![(0.0, 300.0), (1.0, 300.0)],
+        }],
+        ..Plot::default()
+    };
+    flat.write_png(&dir.join("flat.png")).unwrap();
+    let (w, _, rgb) = decode_png(&dir.join("flat.png"));
+    let px = pixels_of(w, &rgb, series_colour(0));
+    let rows: std::collections::BTreeSet<usize> = px.iter().map(|p| p.1).collect();
+    assert!(
+        px.len() > 500 && rows.len() <= 2,
+        "{} pixels in rows {rows:?}",
+        px.len()
+    );
+}
+
+#[test]
+fn output_plot_refuses_what_it_cannot_draw() {
+    use seam::output::plot::{Plot, Series};
+    let path = out_dir("output-plot").join("never.png");
+    let none = Plot {
+        title: "empty".into(),
+        ..Plot::default()
+    };
+    let e = none.write_png(&path).unwrap_err();
+    assert_eq!(e.kind(), ErrorKind::InvalidInput);
+    assert!(e.to_string().contains("no series"), "{e}");
+    let pointless = Plot {
+        series: vec![Series {
+            label: "T".into(),
+            points: vec![],
+        }],
+        ..Plot::default()
+    };
+    let e = pointless.write_png(&path).unwrap_err();
+    assert!(
+        e.to_string().contains("`T`") && e.to_string().contains("no points"),
+        "{e}"
+    );
+    let negative = Plot {
+        log_y: true,
+        series: vec![Series {
+            label: "r".into(),
+            points: vec![(0.0, -1.0), (1.0, f64::NAN)],
+        }],
+        ..Plot::default()
+    };
+    let e = negative.write_png(&path).unwrap_err();
+    assert!(e.to_string().contains("y > 0"), "{e}");
+    assert!(!path.exists());
+}
