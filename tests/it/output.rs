@@ -642,3 +642,122 @@ fn output_plot_refuses_what_it_cannot_draw() {
     assert!(e.to_string().contains("y > 0"), "{e}");
     assert!(!path.exists());
 }
+
+// ---------------------------------------------------------------- all formats together
+
+/// Write what a transient `seam run` writes: a `.vtu` per step listed by a `.pvd`, one
+/// Exodus file with every step, and a plot.
+fn write_sample(dir: &Path, m: &Mesh, steps: usize, poison: bool) {
+    use seam::output::plot::{Plot, Series};
+    use seam::output::vtu::{PvdSeries, write_vtu_cells};
+    std::fs::create_dir_all(dir).unwrap();
+    let mut exo = ExodusWriter::create(
+        &dir.join("results.exo"),
+        m,
+        &["temperature", "flux_z"],
+        &["heat_source"],
+    )
+    .unwrap();
+    let mut pvd = PvdSeries::new(&dir.join("results.pvd"));
+    let mut peak = Vec::new();
+    for s in 0..steps {
+        let time = 0.5 * s as f64;
+        let mut t: Vec<f64> = nodal_values(m, s, 0)
+            .iter()
+            .map(|v| 300.0 + 10.0 * v)
+            .collect();
+        if poison && s + 1 == steps {
+            t[0] = f64::NAN;
+        }
+        let q = nodal_values(m, s, 1);
+        let src = element_values(m, s);
+        let name = format!("results_{s:04}.vtu");
+        write_vtu_cells(
+            &dir.join(&name),
+            m,
+            &[("temperature", &t), ("flux_z", &q)],
+            &[("heat_source", &src)],
+        )
+        .unwrap();
+        pvd.add(time, Path::new(&name)).unwrap();
+        exo.write_step(time, &[&t, &q], &[&src]).unwrap();
+        peak.push((time, t.iter().copied().fold(f64::NEG_INFINITY, f64::max)));
+    }
+    exo.finish().unwrap();
+    let plot = Plot {
+        title: "Peak temperature".into(),
+        x_label: "time (s)".into(),
+        y_label: "T (K)".into(),
+        log_y: false,
+        series: vec![Series {
+            label: "max T".into(),
+            points: peak,
+        }],
+    };
+    plot.write_png(&dir.join("temperature.png")).unwrap();
+}
+
+/// Runs `tests/python/check_results.py` on `dir` with `python`; (exit code, stdout).
+fn python_check(python: &str, dir: &Path) -> (i32, String) {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_results.py");
+    let out = std::process::Command::new(python)
+        .arg(&script)
+        .arg(dir)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run SEAM_PYTHON={python}: {e}"));
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    (out.status.code().unwrap_or(-1), format!("{stdout}{stderr}"))
+}
+
+/// The sample outputs agree with each other (node counts, temperatures, times) as seam's
+/// own readers see them; with `SEAM_PYTHON` set, meshio must agree too and must reject
+/// a sample with a NaN temperature or with mismatched meshes.
+#[test]
+fn output_sample_results_pass_the_python_check() {
+    let m = two_part_mesh();
+    let root = out_dir("output-sample");
+    let good = root.join("good");
+    let _ = std::fs::remove_dir_all(&good);
+    write_sample(&good, &m, 3, false);
+    let exo = good.join("results.exo");
+    assert_eq!(mesh::exodus::read_times(&exo).unwrap(), vec![0.0, 0.5, 1.0]);
+    let last = mesh::exodus::read_nodal_variable(&exo, "temperature", 2).unwrap();
+    let vtu = std::fs::read_to_string(good.join("results_0002.vtu")).unwrap();
+    assert_eq!(bits(&decode(&vtu, Some("temperature"), 8)), bits(&last));
+
+    let Ok(python) = std::env::var("SEAM_PYTHON") else {
+        eprintln!(
+            "SEAM_PYTHON not set: skipping the meshio check of {}",
+            good.display()
+        );
+        return;
+    };
+    let (code, out) = python_check(&python, &good);
+    assert_eq!(code, 0, "{out}");
+    assert!(
+        out.starts_with("ok: 3 vtu, 1 pvd (3 steps), 1 exodus (3 steps)"),
+        "{out}"
+    );
+
+    let nan = root.join("nan");
+    let _ = std::fs::remove_dir_all(&nan);
+    write_sample(&nan, &m, 2, true);
+    let (code, out) = python_check(&python, &nan);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("not finite"), "{out}");
+
+    let mixed = root.join("mixed");
+    let _ = std::fs::remove_dir_all(&mixed);
+    write_sample(&mixed, &m, 1, false);
+    let other = generate::unit_hex();
+    seam::output::vtu::write_vtu(
+        &mixed.join("extra.vtu"),
+        &other,
+        &[("temperature", &[1.0; 8])],
+    )
+    .unwrap();
+    let (code, out) = python_check(&python, &mixed);
+    assert_eq!(code, 1, "{out}");
+    assert!(out.contains("node counts differ"), "{out}");
+}
