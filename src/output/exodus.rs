@@ -581,18 +581,30 @@ fn check_values(
     Ok(())
 }
 
-fn write_doubles(out: &mut impl Write, values: impl Iterator<Item = f64>) -> io::Result<()> {
+/// Big-endian values through a fixed buffer (one `write_all` per 64 KiB, not per value).
+fn write_be<const N: usize>(
+    out: &mut impl Write,
+    values: impl Iterator<Item = [u8; N]>,
+) -> io::Result<()> {
+    let mut buf = [0u8; 1 << 16];
+    let mut n = 0;
     for v in values {
-        out.write_all(&v.to_be_bytes())?;
+        buf[n..n + N].copy_from_slice(&v);
+        n += N;
+        if n + N > buf.len() {
+            out.write_all(&buf[..n])?;
+            n = 0;
+        }
     }
-    Ok(())
+    out.write_all(&buf[..n])
+}
+
+fn write_doubles(out: &mut impl Write, values: impl Iterator<Item = f64>) -> io::Result<()> {
+    write_be(out, values.map(f64::to_be_bytes))
 }
 
 fn write_ints(out: &mut impl Write, values: impl Iterator<Item = i32>) -> io::Result<()> {
-    for v in values {
-        out.write_all(&v.to_be_bytes())?;
-    }
-    Ok(())
+    write_be(out, values.map(i32::to_be_bytes))
 }
 
 /// Write every fixed variable's data in definition order, each padded to its `vsize`.

@@ -182,6 +182,18 @@ impl Arrays {
         });
     }
 
+    /// Int32 when every value fits (half the bytes of Int64), else Int64.
+    fn ints(&mut self, name: &str, values: impl Iterator<Item = i64> + Clone) {
+        let fits = values.clone().all(|v| i32::try_from(v).is_ok());
+        if fits {
+            self.array("Int32", Some(name), 1, values.map(|v| v as i32), |v, b| {
+                b.extend_from_slice(&v.to_le_bytes())
+            });
+        } else {
+            self.i64s(name, values);
+        }
+    }
+
     fn u8s(&mut self, name: &str, values: impl Iterator<Item = u8>) {
         self.array("UInt8", Some(name), 1, values, |v, b| b.push(v));
     }
@@ -201,21 +213,23 @@ const BASE64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz
 
 /// Standard base64 (RFC 4648, with `=` padding) of `bytes`, appended to `out`.
 fn base64_into(bytes: &[u8], out: &mut String) {
+    let sextet = |n: u32, k: u32| BASE64[(n >> (18 - 6 * k) & 63) as usize] as char;
     out.reserve(bytes.len().div_ceil(3) * 4);
-    for chunk in bytes.chunks(3) {
-        let b = [
-            chunk[0],
-            chunk.get(1).copied().unwrap_or(0),
-            chunk.get(2).copied().unwrap_or(0),
-        ];
-        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
-        for k in 0..4 {
-            if k <= chunk.len() {
-                out.push(BASE64[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
+    let mut chunks = bytes.chunks_exact(3);
+    for c in &mut chunks {
+        let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
+        out.extend([sextet(n, 0), sextet(n, 1), sextet(n, 2), sextet(n, 3)]);
+    }
+    match *chunks.remainder() {
+        [a] => {
+            let n = u32::from(a) << 16;
+            out.extend([sextet(n, 0), sextet(n, 1), '=', '=']);
         }
+        [a, b] => {
+            let n = (u32::from(a) << 16) | (u32::from(b) << 8);
+            out.extend([sextet(n, 0), sextet(n, 1), sextet(n, 2), '=']);
+        }
+        _ => {}
     }
 }
 
@@ -252,20 +266,17 @@ pub fn write_vtu_with(
     a.f64s(None, 3, mesh.coords.iter().flatten().copied());
     a.s.push_str("</Points>\n<Cells>\n");
     let blocks = || mesh.blocks.iter();
-    a.i64s(
+    a.ints(
         "connectivity",
         blocks().flat_map(|b| b.connectivity.iter().map(|n| i64::from(n.0))),
     );
-    let mut off = 0i64;
-    a.i64s(
-        "offsets",
-        blocks()
-            .flat_map(|b| std::iter::repeat_n(b.topology.node_count() as i64, b.len()))
-            .map(|n| {
-                off += n;
-                off
-            }),
-    );
+    let offsets = blocks()
+        .flat_map(|b| std::iter::repeat_n(b.topology.node_count() as i64, b.len()))
+        .scan(0i64, |off, n| {
+            *off += n;
+            Some(*off)
+        });
+    a.ints("offsets", offsets);
     a.u8s(
         "types",
         blocks().flat_map(|b| std::iter::repeat_n(vtk_type(b.topology), b.len())),

@@ -227,19 +227,25 @@ fn ids(v: &[u32]) -> Vec<NodeId> {
 // ---------------------------------------------------------------- VTU and PVD
 
 /// The text of the `DataArray` named `name` (or, for `None`, the first one without a
-/// name) and its `format` attribute.
-fn data_array<'a>(xml: &'a str, name: Option<&str>) -> (&'a str, &'a str) {
+/// name), its `format` and its `type` attribute.
+fn data_array<'a>(xml: &'a str, name: Option<&str>) -> (&'a str, &'a str, &'a str) {
     let mut rest = xml;
     while let Some(at) = rest.find("<DataArray ") {
         let tag_end = at + rest[at..].find('>').unwrap();
         let tag = &rest[at..tag_end];
         let body_end = tag_end + rest[tag_end..].find("</DataArray>").unwrap();
         let attr = |key: &str| {
-            tag.find(&format!(" {key}=\""))
-                .map(|p| &tag[p + key.len() + 3..][..tag[p + key.len() + 3..].find('"').unwrap()])
+            tag.find(&format!(" {key}=\"")).map(|p| {
+                let from = p + key.len() + 3;
+                &tag[from..from + tag[from..].find('"').unwrap()]
+            })
         };
         if attr("Name") == name {
-            return (rest[tag_end + 1..body_end].trim(), attr("format").unwrap());
+            return (
+                rest[tag_end + 1..body_end].trim(),
+                attr("format").unwrap(),
+                attr("type").unwrap(),
+            );
         }
         rest = &rest[body_end..];
     }
@@ -269,9 +275,9 @@ fn base64_decode(s: &str) -> Vec<u8> {
     out
 }
 
-/// The values of a data array as f64 (Float64, Int64 or UInt8), in either encoding.
-fn decode(xml: &str, name: Option<&str>, size: usize) -> Vec<f64> {
-    let (body, format) = data_array(xml, name);
+/// The values of a data array as f64 (Float64, Int64, Int32 or UInt8), either encoding.
+fn decode(xml: &str, name: Option<&str>) -> Vec<f64> {
+    let (body, format, ty) = data_array(xml, name);
     if format == "ascii" {
         return body
             .split_ascii_whitespace()
@@ -282,26 +288,28 @@ fn decode(xml: &str, name: Option<&str>, size: usize) -> Vec<f64> {
     let bytes = base64_decode(body);
     let n = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
     assert_eq!(n, bytes.len() - 8, "byte count header of {name:?}");
+    let size = match ty {
+        "Float64" | "Int64" => 8,
+        "Int32" => 4,
+        "UInt8" => 1,
+        other => panic!("unexpected type {other}"),
+    };
     bytes[8..]
         .chunks(size)
-        .map(|c| match size {
-            8 if name.is_none()
-                || !["connectivity", "offsets", "block_id"].contains(&name.unwrap()) =>
-            {
-                f64::from_le_bytes(c.try_into().unwrap())
-            }
-            8 => i64::from_le_bytes(c.try_into().unwrap()) as f64,
-            1 => f64::from(c[0]),
-            _ => unreachable!(),
+        .map(|c| match ty {
+            "Float64" => f64::from_le_bytes(c.try_into().unwrap()),
+            "Int64" => i64::from_le_bytes(c.try_into().unwrap()) as f64,
+            "Int32" => f64::from(i32::from_le_bytes(c.try_into().unwrap())),
+            _ => f64::from(c[0]),
         })
         .collect()
 }
 
 /// Cell `k` of a parsed file: its VTK type and nodes.
 fn cells(xml: &str) -> Vec<(u8, Vec<u32>)> {
-    let conn = decode(xml, Some("connectivity"), 8);
-    let offsets = decode(xml, Some("offsets"), 8);
-    let types = decode(xml, Some("types"), 1);
+    let conn = decode(xml, Some("connectivity"));
+    let offsets = decode(xml, Some("offsets"));
+    let types = decode(xml, Some("types"));
     let mut start = 0;
     offsets
         .iter()
@@ -355,14 +363,14 @@ fn output_vtu_cell_data_follows_element_order_in_both_encodings() {
             assert_eq!(*ty, expect_ty, "cell {k}");
         }
         let xyz: Vec<f64> = m.coords.iter().flatten().copied().collect();
-        assert_eq!(bits(&decode(xml, None, 8)), bits(&xyz), "points");
-        assert_eq!(bits(&decode(xml, Some("temperature"), 8)), bits(&t));
-        let blocks = decode(xml, Some("block_id"), 8);
+        assert_eq!(bits(&decode(xml, None)), bits(&xyz), "points");
+        assert_eq!(bits(&decode(xml, Some("temperature"))), bits(&t));
+        let blocks = decode(xml, Some("block_id"));
         assert_eq!(blocks[0], 1.0);
         assert_eq!(blocks[m.num_elems() - 1], 2.0);
     }
-    assert_eq!(decode(&binary, Some("index"), 8), index);
-    assert_eq!(bits(&decode(&binary, Some("source"), 8)), bits(&src));
+    assert_eq!(decode(&binary, Some("index")), index);
+    assert_eq!(bits(&decode(&binary, Some("source"))), bits(&src));
     // Base64 of computed doubles is shorter than their round-trip decimal text.
     let (b, a) = (
         data_array(&binary, Some("temperature")).0.len(),
@@ -724,7 +732,7 @@ fn output_sample_results_pass_the_python_check() {
     assert_eq!(mesh::exodus::read_times(&exo).unwrap(), vec![0.0, 0.5, 1.0]);
     let last = mesh::exodus::read_nodal_variable(&exo, "temperature", 2).unwrap();
     let vtu = std::fs::read_to_string(good.join("results_0002.vtu")).unwrap();
-    assert_eq!(bits(&decode(&vtu, Some("temperature"), 8)), bits(&last));
+    assert_eq!(bits(&decode(&vtu, Some("temperature"))), bits(&last));
 
     let Ok(python) = std::env::var("SEAM_PYTHON") else {
         eprintln!(
@@ -760,4 +768,59 @@ fn output_sample_results_pass_the_python_check() {
     let (code, out) = python_check(&python, &mixed);
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("node counts differ"), "{out}");
+}
+
+/// Size and speed of the writers on a 10⁶-element hex box (1 030 301 nodes): run with
+/// `cargo test --release --test it output_large -- --ignored --nocapture`.
+#[test]
+#[ignore = "timing report, seconds to minutes"]
+fn output_large_mesh_write_times() {
+    use std::time::Instant;
+    let t0 = Instant::now();
+    let m = generate::single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [100, 100, 100], 1));
+    eprintln!(
+        "mesh: {} nodes, {:.2} s",
+        m.num_nodes(),
+        t0.elapsed().as_secs_f64()
+    );
+    let dir = out_dir("output-large");
+    let path = dir.join("large.exo");
+    let t = nodal_values(&m, 0, 0);
+    let t0 = Instant::now();
+    let mut w = ExodusWriter::create(&path, &m, &["temperature"], &[]).unwrap();
+    let create = t0.elapsed().as_secs_f64();
+    let size0 = std::fs::metadata(&path).unwrap().len() as f64 / 1e6;
+    let t0 = Instant::now();
+    for s in 0..5 {
+        w.write_step(s as f64, &[&t], &[]).unwrap();
+    }
+    let step = t0.elapsed().as_secs_f64() / 5.0;
+    w.finish().unwrap();
+    let size1 = std::fs::metadata(&path).unwrap().len() as f64 / 1e6;
+    eprintln!(
+        "exodus: create {create:.2} s ({size0:.1} MB), step {step:.3} s ({:.1} MB each)",
+        (size1 - size0) / 5.0
+    );
+    let t0 = Instant::now();
+    let back = mesh::exodus::read_nodal_variable(&path, "temperature", 4).unwrap();
+    eprintln!("exodus: read one step {:.3} s", t0.elapsed().as_secs_f64());
+    assert_eq!(bits(&back), bits(&t));
+    let t0 = Instant::now();
+    seam::output::vtu::write_vtu_cells(&dir.join("large.vtu"), &m, &[("temperature", &t)], &[])
+        .unwrap();
+    let vtu_mb = std::fs::metadata(dir.join("large.vtu")).unwrap().len() as f64 / 1e6;
+    eprintln!(
+        "vtu (base64): {:.2} s, {vtu_mb:.1} MB",
+        t0.elapsed().as_secs_f64()
+    );
+    let t0 = Instant::now();
+    seam::output::vtu::write_vtu(&dir.join("large_ascii.vtu"), &m, &[("temperature", &t)]).unwrap();
+    let ascii_mb = std::fs::metadata(dir.join("large_ascii.vtu"))
+        .unwrap()
+        .len() as f64
+        / 1e6;
+    eprintln!(
+        "vtu (ascii): {:.2} s, {ascii_mb:.1} MB",
+        t0.elapsed().as_secs_f64()
+    );
 }
