@@ -142,6 +142,7 @@ impl ExodusWriter {
                 mesh.dim
             )));
         }
+        check_indices(mesh)?;
         let mut names: Vec<&str> = Vec::new();
         names.extend(mesh.blocks.iter().map(|b| b.name.as_str()));
         names.extend(mesh.side_sets.iter().map(|s| s.name.as_str()));
@@ -495,6 +496,12 @@ impl ExodusWriter {
         nodal: &[&[f64]],
         element: &[&[f64]],
     ) -> io::Result<()> {
+        if !time.is_finite() {
+            return Err(invalid(format!(
+                "step {} has time {time}; Exodus times must be finite",
+                self.steps + 1
+            )));
+        }
         check_values("nodal", &self.nodal, nodal, self.num_nodes, "mesh node")?;
         check_values("element", &self.element, element, self.num_elems, "element")?;
         let start = self.record_begin + self.steps as u64 * self.record_size;
@@ -541,6 +548,39 @@ impl ExodusWriter {
     pub fn finish(self) -> io::Result<()> {
         self.file.sync_all()
     }
+}
+
+/// Every node and element a block or set refers to must exist: the file stores them as
+/// 1-based positions that readers trust.
+fn check_indices(mesh: &Mesh) -> io::Result<()> {
+    let (nn, ne) = (mesh.num_nodes(), mesh.num_elems());
+    for b in &mesh.blocks {
+        if let Some(n) = b.connectivity.iter().find(|n| n.index() >= nn) {
+            return Err(invalid(format!(
+                "block {} refers to node index {}, but the mesh has {nn} nodes; the mesh is \
+                 inconsistent (validate it before writing)",
+                b.id, n.0
+            )));
+        }
+    }
+    for s in &mesh.node_sets {
+        if let Some(n) = s.nodes.iter().find(|n| n.index() >= nn) {
+            return Err(invalid(format!(
+                "node set {} refers to node index {}, but the mesh has {nn} nodes",
+                s.id, n.0
+            )));
+        }
+    }
+    for s in &mesh.side_sets {
+        if let Some(side) = s.sides.iter().find(|x| x.elem.index() >= ne || x.side == 0) {
+            return Err(invalid(format!(
+                "side set {} holds element index {} side {}, but the mesh has {ne} elements \
+                 and sides count from 1",
+                s.id, side.elem.0, side.side
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The `elem_type` attribute: the bare shape names that Cubit writes and every reader

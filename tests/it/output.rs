@@ -186,6 +186,22 @@ fn output_exodus_refuses_wrong_lengths_and_names() {
 
     let e = ExodusWriter::create(&path, &m, &["t", "t"], &[]).unwrap_err();
     assert_eq!(e.kind(), ErrorKind::InvalidInput);
+    assert!(
+        w_again(&path, &m)
+            .write_step(f64::NAN, &[&[1.0; 8]], &[&[3.0]])
+            .is_err()
+    );
+    let mut broken = generate::unit_hex();
+    broken.node_sets.push(NodeSet {
+        id: 3,
+        name: String::new(),
+        nodes: vec![NodeId(8)],
+    });
+    let e = ExodusWriter::create(&path, &broken, &[], &[]).unwrap_err();
+    assert!(
+        e.to_string().contains("node set 3 refers to node index 8"),
+        "{e}"
+    );
     let mut big = generate::unit_hex();
     big.blocks[0].id = 1 << 40;
     let e = ExodusWriter::create(&path, &big, &[], &[]).unwrap_err();
@@ -218,6 +234,10 @@ fn output_exodus_round_trip_2d() {
     let u = mesh::exodus::read_nodal_variable(&path, "U", 0).unwrap();
     assert_eq!(&u[..4], &[1.0, 2.0, 3.0, 4.0]);
     assert!(u[4].is_nan());
+}
+
+fn w_again(path: &Path, m: &Mesh) -> ExodusWriter {
+    ExodusWriter::create(path, m, &["temperature"], &["q"]).unwrap()
 }
 
 fn ids(v: &[u32]) -> Vec<NodeId> {
