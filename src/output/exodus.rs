@@ -6,7 +6,8 @@
 //! sets `node_nsN`/`ns_prop1`/`ns_names`, side sets `ss_elemN`/`ss_sideN`/`ss_prop1`/
 //! `ss_names`) and declares the result variables: nodal `vals_nod_varK` named by
 //! `name_nod_var`, element `vals_elem_varVebB` named by `name_elem_var` with the truth
-//! table `elem_var_tab`, and `time_whole`. [`ExodusWriter::write_step`] appends one
+//! table `elem_var_tab`, optional global variables `vals_glo_var` named by
+//! `name_glo_var`, and `time_whole`. [`ExodusWriter::write_step`] appends one
 //! record (a time and every variable's values) and then bumps `numrecs` in the header,
 //! so the file is complete and readable after every step and a killed run keeps the
 //! steps written so far. Nothing of a step is kept in memory after it is written.
@@ -35,6 +36,7 @@ pub struct ExodusWriter {
     num_nodes: usize,
     num_elems: usize,
     nodal: Vec<String>,
+    global: Vec<String>,
     element: Vec<String>,
     /// Element range (first, count) of every non-empty block, in file order.
     block_ranges: Vec<(usize, usize)>,
@@ -100,9 +102,23 @@ impl ExodusWriter {
     /// Create `path` (overwriting it) with `mesh` and the names of the nodal and element
     /// variables that every [`write_step`](Self::write_step) will give.
     pub fn create(path: &Path, mesh: &Mesh, nodal: &[&str], element: &[&str]) -> io::Result<Self> {
+        Self::create_with_globals(path, mesh, nodal, element, &[])
+    }
+
+    /// As [`create`](Self::create), with global (one value per step) variables too
+    /// (`name_glo_var`, `vals_glo_var`), given to
+    /// [`write_step_with_globals`](Self::write_step_with_globals).
+    pub fn create_with_globals(
+        path: &Path,
+        mesh: &Mesh,
+        nodal: &[&str],
+        element: &[&str],
+        global: &[&str],
+    ) -> io::Result<Self> {
         check_names("nodal", nodal)?;
         check_names("element", element)?;
-        let (schema, fills) = Self::schema(path, mesh, nodal, element)?;
+        check_names("global", global)?;
+        let (schema, fills) = Self::schema(path, mesh, nodal, element, global)?;
         let layout = schema.layout()?;
         let file = File::create(path)?;
         let mut out = BufWriter::with_capacity(1 << 20, &file);
@@ -120,6 +136,7 @@ impl ExodusWriter {
             num_elems: mesh.num_elems(),
             nodal: nodal.iter().map(|s| s.to_string()).collect(),
             element: element.iter().map(|s| s.to_string()).collect(),
+            global: global.iter().map(|s| s.to_string()).collect(),
             block_ranges: mesh
                 .blocks
                 .iter()
@@ -135,6 +152,7 @@ impl ExodusWriter {
         mesh: &Mesh,
         nodal: &[&str],
         element: &[&str],
+        global: &[&str],
     ) -> io::Result<(Schema, Vec<Option<Fill>>)> {
         if !(mesh.dim == 2 || mesh.dim == 3) {
             return Err(invalid(format!(
@@ -149,6 +167,7 @@ impl ExodusWriter {
         names.extend(mesh.node_sets.iter().map(|s| s.name.as_str()));
         names.extend(nodal);
         names.extend(element);
+        names.extend(global);
         let longest = names.iter().map(|n| n.len()).max().unwrap_or(0);
         // Exodus' default name length is 32 (+ NUL); longer names widen the table.
         let max_name = longest.max(32);
@@ -193,6 +212,24 @@ impl ExodusWriter {
         };
 
         add(&mut s, "time_whole", &[time], NcType::Double, None);
+        if !global.is_empty() {
+            let num_glo_var = s.dim("num_glo_var", global.len() as u64);
+            let names: Vec<String> = global.iter().map(|n| n.to_string()).collect();
+            add(
+                &mut s,
+                "name_glo_var",
+                &[num_glo_var, len_name],
+                NcType::Char,
+                Some(Fill::Chars(name_table(&names, name_len))),
+            );
+            add(
+                &mut s,
+                "vals_glo_var",
+                &[time, num_glo_var],
+                NcType::Double,
+                None,
+            );
+        }
 
         let axes = ["x", "y", "z"].map(String::from);
         add(
@@ -496,6 +533,26 @@ impl ExodusWriter {
         nodal: &[&[f64]],
         element: &[&[f64]],
     ) -> io::Result<()> {
+        self.write_step_with_globals(time, nodal, element, &[])
+    }
+
+    /// As [`write_step`](Self::write_step), with one value per global variable declared
+    /// in [`create_with_globals`](Self::create_with_globals).
+    pub fn write_step_with_globals(
+        &mut self,
+        time: f64,
+        nodal: &[&[f64]],
+        element: &[&[f64]],
+        global: &[f64],
+    ) -> io::Result<()> {
+        if global.len() != self.global.len() {
+            return Err(invalid(format!(
+                "{} global values given, but the file was created with {} global variables ({})",
+                global.len(),
+                self.global.len(),
+                self.global.join(", ")
+            )));
+        }
         if !time.is_finite() {
             return Err(invalid(format!(
                 "step {} has time {time}; Exodus times must be finite",
@@ -508,6 +565,7 @@ impl ExodusWriter {
         self.file.seek(SeekFrom::Start(start))?;
         let mut out = BufWriter::with_capacity(1 << 20, &self.file);
         out.write_all(&time.to_be_bytes())?;
+        write_doubles(&mut out, global.iter().copied())?;
         if self.num_nodes > 0 {
             for values in nodal {
                 write_doubles(&mut out, values.iter().copied())?;

@@ -208,6 +208,39 @@ fn output_exodus_refuses_wrong_lengths_and_names() {
     assert!(e.to_string().contains("block id"), "{e}");
 }
 
+#[test]
+fn output_exodus_global_variables_per_step() {
+    let m = generate::unit_hex();
+    let path = out_dir("output-exodus").join("globals.exo");
+    let mut w = ExodusWriter::create_with_globals(
+        &path,
+        &m,
+        &["temperature"],
+        &[],
+        &["heat_in", "heat_out"],
+    )
+    .unwrap();
+    let t = [1.0; 8];
+    let e = w.write_step(0.0, &[&t], &[]).unwrap_err();
+    assert!(e.to_string().contains("heat_in, heat_out"), "{e}");
+    let steps = [[1.5, -1.25], [2.0, -2.0 / 3.0]];
+    for (s, g) in steps.iter().enumerate() {
+        w.write_step_with_globals(s as f64, &[&t], &[], g).unwrap();
+    }
+    w.finish().unwrap();
+    let nc = netcdf_reader::NcFile::open(&path).unwrap();
+    let names = nc.read_variable_as_strings("name_glo_var").unwrap();
+    let names: Vec<&str> = names.iter().map(|n| n.trim_end_matches('\0')).collect();
+    assert_eq!(names, ["heat_in", "heat_out"]);
+    let vals = nc.read_variable::<f64>("vals_glo_var").unwrap();
+    assert_eq!(vals.shape(), &[2, 2]);
+    let flat: Vec<f64> = vals.iter().copied().collect();
+    assert_eq!(bits(&flat), bits(&steps.concat()));
+    // The nodal values after the globals in each record are intact.
+    let back = mesh::exodus::read_nodal_variable(&path, "temperature", 1).unwrap();
+    assert_eq!(back, t);
+}
+
 /// A 2-D mesh of quads and triangles (num_dim 2, no `coordz`) with a shell-free layout.
 #[test]
 fn output_exodus_round_trip_2d() {
