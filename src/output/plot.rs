@@ -3,7 +3,8 @@
 //!
 //! Entry point: [`Plot::write_png`]. The image is 960×640 RGB: a title, a framed plot
 //! area with light grid lines at the ticks, tick labels, axis labels (the y label turned
-//! upright) and a legend in the upper right when any series has a label. Text uses
+//! upright) and, when any series has a label, a legend in the inside corner that hides
+//! the least of the lines (upper right on a tie). Text uses
 //! seam's own 5×7 font drawn at twice its size. Series get the colours of
 //! [`series_colour`] in order and are drawn as 2-pixel lines between consecutive
 //! drawable points; a point with no drawable neighbour gets a square marker.
@@ -212,6 +213,20 @@ impl Canvas {
         }
     }
 
+    /// Pixels in the rectangle whose colour is none of `background`.
+    fn count_not(&self, x0: i64, y0: i64, x1: i64, y1: i64, background: &[[u8; 3]]) -> usize {
+        let mut n = 0;
+        for y in y0.max(0)..=y1.min(HEIGHT as i64 - 1) {
+            for x in x0.max(0)..=x1.min(WIDTH as i64 - 1) {
+                let i = 3 * (y as usize * WIDTH + x as usize);
+                if !background.iter().any(|b| self.px[i..i + 3] == *b) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
     fn rect(&mut self, x0: i64, y0: i64, x1: i64, y1: i64, c: [u8; 3]) {
         for y in y0..=y1 {
             for x in x0..=x1 {
@@ -414,7 +429,7 @@ impl Plot {
             }
         }
 
-        // Legend, upper right inside the frame.
+        // Legend, in the inside corner that covers the fewest drawn pixels.
         if self.series.iter().any(|s| !s.label.is_empty()) {
             let widest = self
                 .series
@@ -423,7 +438,16 @@ impl Plot {
                 .max()
                 .unwrap_or(0);
             let (w, h) = (widest + 48, (self.series.len() * LINE_HEIGHT) as i64 + 12);
-            let (x0, y0) = (right - 10 - w, top + 10);
+            let corners = [
+                (right - 10 - w, top + 10),
+                (left + 10, top + 10),
+                (right - 10 - w, bottom - 10 - h),
+                (left + 10, bottom - 10 - h),
+            ];
+            let (x0, y0) = corners
+                .into_iter()
+                .min_by_key(|&(x, y)| c.count_not(x, y, x + w, y + h, &[WHITE, GRID]))
+                .unwrap_or(corners[0]);
             c.rect(x0, y0, x0 + w, y0 + h, WHITE);
             c.rect(x0, y0, x0 + w, y0, BLACK);
             c.rect(x0, y0 + h, x0 + w, y0 + h, BLACK);
