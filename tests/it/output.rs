@@ -241,6 +241,24 @@ fn output_exodus_global_variables_per_step() {
     assert_eq!(back, t);
 }
 
+/// A shell block keeps its thickness (`attribN` named `thickness`) through the file.
+#[test]
+fn output_exodus_round_trip_shell_thickness() {
+    let mut m = generate::unit_hex();
+    let top: Vec<NodeId> = m.blocks[0].elem_nodes(0)[4..].to_vec();
+    m.push_block(20, "skin", Topology::Shell4, top, None);
+    m.blocks[1].thickness = Some(0.0125);
+    let path = out_dir("output-exodus").join("shell.exo");
+    ExodusWriter::create(&path, &m, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    let back = mesh::read(&path).unwrap();
+    assert_same_mesh(&m, &back);
+    assert_eq!(back.blocks[1].thickness, Some(0.0125));
+    assert_eq!(back.blocks[0].thickness, None);
+}
+
 /// A 2-D mesh of quads and triangles (num_dim 2, no `coordz`) with a shell-free layout.
 #[test]
 fn output_exodus_round_trip_2d() {
