@@ -1,7 +1,7 @@
 //! Exodus II reader (netCDF classic, 64-bit offset, CDF-5 and netCDF-4/HDF5), on the
 //! pure-Rust `netcdf-reader` crate.
 //!
-//! Entry point: [`read`]. It reads coordinates (`coordx/coordy/coordz` or `coord`), the
+//! Entry points: [`read`]; results with [`read_times`] and [`read_nodal_variable`]. It reads coordinates (`coordx/coordy/coordz` or `coord`), the
 //! number maps (`node_num_map`, `elem_num_map`; 1..n when absent), element blocks
 //! (`connectN` with its `elem_type`, ids `eb_prop1`, names `eb_names`, shell thickness
 //! from `attribN`), side sets (`ss_elemN`/`ss_sideN`, `ss_prop1`, `ss_names`), node sets
@@ -17,13 +17,18 @@
 
 use std::path::Path;
 
-use netcdf_reader::{NcFile, NcType};
+use netcdf_reader::{NcFile, NcSliceInfo, NcSliceInfoElem, NcType};
 
 use super::{Assembly, AssemblyKind, Mesh, MeshError, NodeId, NodeSet, Side, SideSet, Topology};
 use crate::mesh::ElemId;
 
 /// Read an Exodus II file. The mesh is not validated here; [`super::read`] does that.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
+    open(path)?.read_mesh()
+}
+
+/// Open `path` as netCDF, with the data bound its size allows.
+fn open(path: &Path) -> Result<ExoFile<'_>, MeshError> {
     let file = NcFile::open(path).map_err(|e| match e {
         netcdf_reader::Error::Io(source) => MeshError::Open {
             path: path.to_path_buf(),
@@ -48,12 +53,117 @@ pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     } else {
         file_len.saturating_mul(1100).saturating_add(1 << 20)
     };
-    let ex = ExoFile {
+    Ok(ExoFile {
         path,
         file,
         max_bytes,
+    })
+}
+
+/// The times of the steps stored in an Exodus file (`time_whole`); empty when the file
+/// holds no steps.
+pub fn read_times(path: &Path) -> Result<Vec<f64>, MeshError> {
+    let ex = open(path)?;
+    let steps = ex.dim_opt("time_step").unwrap_or(0);
+    if steps == 0 || !ex.has_var("time_whole") {
+        return Ok(Vec::new());
+    }
+    ex.floats("time_whole", steps)
+}
+
+/// The values of nodal variable `name` at step `step` (0-based, as in [`read_times`]), one
+/// per node in the order [`super::read`] numbers the nodes. Reads `vals_nod_varK` (or the
+/// older combined `vals_nod_var`) named by `name_nod_var`; names match exactly, else
+/// ignoring case.
+pub fn read_nodal_variable(path: &Path, name: &str, step: usize) -> Result<Vec<f64>, MeshError> {
+    let ex = open(path)?;
+    let nvar = ex.dim_opt("num_nod_var").unwrap_or(0);
+    let names = ex.names("name_nod_var", nvar)?;
+    let k = names
+        .iter()
+        .position(|n| n == name)
+        .or_else(|| names.iter().position(|n| n.eq_ignore_ascii_case(name)));
+    let Some(k) = k else {
+        let have = if names.is_empty() {
+            "the file has no nodal variables".to_string()
+        } else {
+            format!(
+                "the file has {}",
+                names
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        return Err(ex.err(
+            format!("no nodal variable `{name}`: {have}"),
+            "use one of the names the file has (`seam run` writes `temperature`)",
+        ));
     };
-    ex.read_mesh()
+    let steps = ex.dim_opt("time_step").unwrap_or(0);
+    if step >= steps {
+        return Err(ex.err(
+            format!("step {step} asked for, but the file holds {steps} step(s) (numbered from 0)"),
+            "ask for a step below the count; a run that stopped early holds fewer steps",
+        ));
+    }
+    let nodes = ex.dim_opt("num_nodes").unwrap_or(0);
+    if nodes == 0 {
+        return Ok(Vec::new());
+    }
+    let (var, selection) = if ex.has_var(&format!("vals_nod_var{}", k + 1)) {
+        (
+            format!("vals_nod_var{}", k + 1),
+            vec![
+                NcSliceInfoElem::Index(step as u64),
+                NcSliceInfoElem::Slice {
+                    start: 0,
+                    end: nodes as u64,
+                    step: 1,
+                },
+            ],
+        )
+    } else {
+        (
+            "vals_nod_var".to_string(),
+            vec![
+                NcSliceInfoElem::Index(step as u64),
+                NcSliceInfoElem::Index(k as u64),
+                NcSliceInfoElem::Slice {
+                    start: 0,
+                    end: nodes as u64,
+                    step: 1,
+                },
+            ],
+        )
+    };
+    if !ex.has_var(&var) {
+        return Err(ex.err(
+            format!("nodal variable `{name}` is named but its values (`{var}`) are missing"),
+            MISSING_HELP,
+        ));
+    }
+    ex.bound(&var, nodes, 4)?;
+    let values = ex
+        .file
+        .read_variable_slice_as_f64(
+            &var,
+            &NcSliceInfo {
+                selections: selection,
+            },
+        )
+        .map_err(|e| ex.nc_err(&var, e))?;
+    if values.len() != nodes {
+        return Err(ex.err(
+            format!(
+                "`{var}` gives {} values at step {step}, expected {nodes}",
+                values.len()
+            ),
+            "the file's dimensions disagree with its data; re-export it",
+        ));
+    }
+    Ok(values.iter().copied().collect())
 }
 
 struct ExoFile<'a> {

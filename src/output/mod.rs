@@ -1,5 +1,16 @@
-//! Results for people and viewers: VTK XML (`.vtu`) for ParaView and meshio.
+//! Results for people and viewers.
 //!
-//! Entry point: [`vtu::write_vtu`].
+//! - [`exodus::ExodusWriter`]: Exodus II (netCDF 64-bit offset), the mesh with nodal and
+//!   element variables over time, appended step by step; read back by
+//!   [`crate::mesh::exodus`], ParaView, meshio and the SEACAS tools.
+//! - [`vtu::write_vtu`], [`vtu::write_vtu_cells`]: VTK XML unstructured grids (`.vtu`)
+//!   with point and cell data; [`vtu::PvdSeries`] collects them into a ParaView time
+//!   series (`.pvd`).
+//! - [`plot::Plot`]: PNG line plots (residual histories, temperatures along a line) drawn
+//!   by seam itself, for a look without ParaView.
 
+pub mod exodus;
+mod font;
+mod netcdf;
+pub mod plot;
 pub mod vtu;

@@ -1,13 +1,22 @@
-//! VTK XML unstructured grid (`.vtu`) writer: the mesh's solid blocks with point data,
-//! readable by ParaView and meshio.
+//! VTK XML unstructured grid (`.vtu`) writer: the mesh's blocks with point and cell
+//! data, readable by ParaView and meshio; and `.pvd` collections that make a time series
+//! of them.
 //!
-//! Entry point: [`write_vtu`]. ASCII format (small files stay inspectable; ParaView
-//! reads it as fast as it needs for the sizes seam writes in one piece). Cell types by
+//! Entry points: [`write_vtu`] (point data, ASCII: small files stay inspectable),
+//! [`write_vtu_cells`] (point and cell data, base64 "binary" inline data: computed doubles
+//! take 10.7 characters instead of ~22, exact to the bit), [`PvdSeries`]. Cells are written block
+//! after block in mesh order, i.e. in dense element order, so cell data is indexed like
+//! [`crate::mesh::ElemId`]; every file carries the cell data `block_id`. Cell types by
 //! topology: Hex8 12, Tet4 10, Wedge6 13, Pyramid5 14, Quad4 9 (shells too), Tri3 5,
 //! Bar2 3; the node orders of Exodus and VTK coincide for these linear cells.
+//!
+//! Binary encoding (VTK XML file format, `format="binary"` without compression): each
+//! array is one base64 stream of a UInt64 byte count followed by the little-endian
+//! values, as VTK and meshio write it.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::io;
+use std::path::{Path, PathBuf};
 
 use crate::mesh::{Mesh, Topology};
 
@@ -24,66 +33,356 @@ fn vtk_type(t: Topology) -> u8 {
 }
 
 /// Write `mesh` with nodal fields `(name, values)` (one value per node; NaN for nodes
-/// without a value) to `path`.
-pub fn write_vtu(path: &Path, mesh: &Mesh, fields: &[(&str, &[f64])]) -> std::io::Result<()> {
+/// without a value) to `path`, in ASCII.
+pub fn write_vtu(path: &Path, mesh: &Mesh, fields: &[(&str, &[f64])]) -> io::Result<()> {
+    write_vtu_with(path, mesh, fields, &[], VtuEncoding::Ascii)
+}
+
+/// How array values are stored in a `.vtu`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VtuEncoding {
+    /// Decimal text (`format="ascii"`).
+    Ascii,
+    /// Base64 of the raw little-endian values (`format="binary"`).
+    Base64,
+}
+
+/// Write `mesh` with point data and cell data `(name, values)`: one value per node, one
+/// per element in dense element order (blocks concatenated in mesh order). Base64
+/// encoded; see [`write_vtu_with`].
+pub fn write_vtu_cells(
+    path: &Path,
+    mesh: &Mesh,
+    point: &[(&str, &[f64])],
+    cell: &[(&str, &[f64])],
+) -> io::Result<()> {
+    write_vtu_with(path, mesh, point, cell, VtuEncoding::Base64)
+}
+
+fn invalid(message: String) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidInput, message)
+}
+
+/// Check that every array has `expect` values and that names are usable.
+fn check_arrays(kind: &str, arrays: &[(&str, &[f64])], expect: usize, per: &str) -> io::Result<()> {
+    for (k, (name, values)) in arrays.iter().enumerate() {
+        if name.is_empty() {
+            return Err(invalid(format!(
+                "{kind} array {} has an empty name; name every array",
+                k + 1
+            )));
+        }
+        if values.len() != expect {
+            return Err(invalid(format!(
+                "{kind} array `{name}` has {} values, expected {expect} (one per {per})",
+                values.len()
+            )));
+        }
+        if name == &"block_id" && kind == "cell data" {
+            return Err(invalid(
+                "cell data array `block_id` clashes with the block ids every .vtu carries; \
+                 rename it"
+                    .to_string(),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Escape text for an XML attribute value.
+fn xml_escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Appends `DataArray` elements in one encoding.
+struct Arrays {
+    s: String,
+    encoding: VtuEncoding,
+    bytes: Vec<u8>,
+}
+
+impl Arrays {
+    fn open(&mut self, ty: &str, name: Option<&str>, components: usize) {
+        let format = match self.encoding {
+            VtuEncoding::Ascii => "ascii",
+            VtuEncoding::Base64 => "binary",
+        };
+        let _ = write!(self.s, "<DataArray type=\"{ty}\"");
+        if let Some(name) = name {
+            let _ = write!(self.s, " Name=\"{}\"", xml_escape(name));
+        }
+        if components > 1 {
+            let _ = write!(self.s, " NumberOfComponents=\"{components}\"");
+        }
+        let _ = writeln!(self.s, " format=\"{format}\">");
+    }
+
+    /// One array of `T`; in ASCII, `per_line` values to a line.
+    fn array<T: Copy + std::fmt::Display>(
+        &mut self,
+        ty: &str,
+        name: Option<&str>,
+        components: usize,
+        values: impl Iterator<Item = T>,
+        le: impl Fn(T, &mut Vec<u8>),
+    ) {
+        self.open(ty, name, components);
+        match self.encoding {
+            VtuEncoding::Ascii => {
+                for (k, v) in values.enumerate() {
+                    let sep = if (k + 1) % components.max(1) == 0 {
+                        '\n'
+                    } else {
+                        ' '
+                    };
+                    let _ = write!(self.s, "{v}{sep}");
+                }
+            }
+            VtuEncoding::Base64 => {
+                self.bytes.clear();
+                self.bytes.extend_from_slice(&[0; 8]);
+                for v in values {
+                    le(v, &mut self.bytes);
+                }
+                let n = (self.bytes.len() - 8) as u64;
+                self.bytes[..8].copy_from_slice(&n.to_le_bytes());
+                base64_into(&self.bytes, &mut self.s);
+                self.s.push('\n');
+            }
+        }
+        self.s.push_str("</DataArray>\n");
+    }
+
+    fn f64s(&mut self, name: Option<&str>, components: usize, values: impl Iterator<Item = f64>) {
+        match self.encoding {
+            // `{:e}` keeps every digit needed to round-trip.
+            VtuEncoding::Ascii => {
+                self.array("Float64", name, components, values.map(Sci), |_, _| {})
+            }
+            VtuEncoding::Base64 => self.array("Float64", name, components, values, |v, b| {
+                b.extend_from_slice(&v.to_le_bytes())
+            }),
+        }
+    }
+
+    fn i64s(&mut self, name: &str, values: impl Iterator<Item = i64>) {
+        self.array("Int64", Some(name), 1, values, |v, b| {
+            b.extend_from_slice(&v.to_le_bytes())
+        });
+    }
+
+    /// Int32 when every value fits (half the bytes of Int64), else Int64.
+    fn ints(&mut self, name: &str, values: impl Iterator<Item = i64> + Clone) {
+        let fits = values.clone().all(|v| i32::try_from(v).is_ok());
+        if fits {
+            self.array("Int32", Some(name), 1, values.map(|v| v as i32), |v, b| {
+                b.extend_from_slice(&v.to_le_bytes())
+            });
+        } else {
+            self.i64s(name, values);
+        }
+    }
+
+    fn u8s(&mut self, name: &str, values: impl Iterator<Item = u8>) {
+        self.array("UInt8", Some(name), 1, values, |v, b| b.push(v));
+    }
+}
+
+/// An f64 printed in shortest round-trip scientific notation.
+#[derive(Clone, Copy)]
+struct Sci(f64);
+
+impl std::fmt::Display for Sci {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{:e}", self.0)
+    }
+}
+
+const BASE64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/// Standard base64 (RFC 4648, with `=` padding) of `bytes`, appended to `out`.
+fn base64_into(bytes: &[u8], out: &mut String) {
+    let sextet = |n: u32, k: u32| BASE64[(n >> (18 - 6 * k) & 63) as usize] as char;
+    out.reserve(bytes.len().div_ceil(3) * 4);
+    let mut chunks = bytes.chunks_exact(3);
+    for c in &mut chunks {
+        let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
+        out.extend([sextet(n, 0), sextet(n, 1), sextet(n, 2), sextet(n, 3)]);
+    }
+    match *chunks.remainder() {
+        [a] => {
+            let n = u32::from(a) << 16;
+            out.extend([sextet(n, 0), sextet(n, 1), '=', '=']);
+        }
+        [a, b] => {
+            let n = (u32::from(a) << 16) | (u32::from(b) << 8);
+            out.extend([sextet(n, 0), sextet(n, 1), sextet(n, 2), '=']);
+        }
+        _ => {}
+    }
+}
+
+/// Write `mesh` with point and cell data in the given encoding. Lengths are checked:
+/// a wrong one is an `InvalidInput` error naming the array.
+pub fn write_vtu_with(
+    path: &Path,
+    mesh: &Mesh,
+    point: &[(&str, &[f64])],
+    cell: &[(&str, &[f64])],
+    encoding: VtuEncoding,
+) -> io::Result<()> {
+    check_arrays("point data", point, mesh.num_nodes(), "mesh node")?;
     let cells: usize = mesh.blocks.iter().map(|b| b.len()).sum();
-    let mut s = String::with_capacity(64 * mesh.num_nodes() + 64 * cells);
-    s.push_str("<?xml version=\"1.0\"?>\n");
-    s.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
-    s.push_str("<UnstructuredGrid>\n");
+    check_arrays("cell data", cell, cells, "element")?;
+    let mut a = Arrays {
+        s: String::with_capacity(32 * mesh.num_nodes() * (3 + point.len()) + 64 * cells),
+        encoding,
+        bytes: Vec::new(),
+    };
+    a.s.push_str("<?xml version=\"1.0\"?>\n");
+    a.s.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
+    a.s.push_str("<UnstructuredGrid>\n");
     let _ = writeln!(
-        s,
+        a.s,
         "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">",
         mesh.num_nodes()
     );
-    s.push_str("<PointData>\n");
-    for (name, values) in fields {
-        let _ = writeln!(
-            s,
-            "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-        );
-        for v in values.iter() {
-            let _ = writeln!(s, "{v:e}");
+    a.s.push_str("<PointData>\n");
+    for (name, values) in point {
+        a.f64s(Some(name), 1, values.iter().copied());
+    }
+    a.s.push_str("</PointData>\n<Points>\n");
+    a.f64s(None, 3, mesh.coords.iter().flatten().copied());
+    a.s.push_str("</Points>\n<Cells>\n");
+    let blocks = || mesh.blocks.iter();
+    a.ints(
+        "connectivity",
+        blocks().flat_map(|b| b.connectivity.iter().map(|n| i64::from(n.0))),
+    );
+    let offsets = blocks()
+        .flat_map(|b| std::iter::repeat_n(b.topology.node_count() as i64, b.len()))
+        .scan(0i64, |off, n| {
+            *off += n;
+            Some(*off)
+        });
+    a.ints("offsets", offsets);
+    a.u8s(
+        "types",
+        blocks().flat_map(|b| std::iter::repeat_n(vtk_type(b.topology), b.len())),
+    );
+    a.s.push_str("</Cells>\n<CellData>\n");
+    a.i64s(
+        "block_id",
+        blocks().flat_map(|b| std::iter::repeat_n(b.id, b.len())),
+    );
+    for (name, values) in cell {
+        a.f64s(Some(name), 1, values.iter().copied());
+    }
+    a.s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    std::fs::write(path, a.s)
+}
+
+/// A ParaView time series (`.pvd`): a list of `(time, file)` rewritten whole on every
+/// [`add`](Self::add), through a temporary file renamed into place, so the series on disk
+/// is always complete.
+#[derive(Clone, Debug)]
+pub struct PvdSeries {
+    path: PathBuf,
+    entries: Vec<(f64, String)>,
+}
+
+impl PvdSeries {
+    /// A series to be written at `path` (nothing is written until the first `add`).
+    pub fn new(path: &Path) -> Self {
+        PvdSeries {
+            path: path.to_path_buf(),
+            entries: Vec::new(),
         }
-        s.push_str("</DataArray>\n");
     }
-    s.push_str("</PointData>\n<Points>\n");
-    s.push_str("<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for p in &mesh.coords {
-        let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
+
+    /// Add `file` at `time` and rewrite the `.pvd`. A relative `file` is taken relative
+    /// to the `.pvd`'s directory; an absolute one under that directory is made relative
+    /// to it (so the output directory can be moved), any other is kept as is.
+    pub fn add(&mut self, time: f64, file: &Path) -> io::Result<()> {
+        if !time.is_finite() {
+            return Err(invalid(format!(
+                "time {time} for {} in series {} is not finite",
+                file.display(),
+                self.path.display()
+            )));
+        }
+        let dir = self.path.parent().unwrap_or(Path::new(""));
+        let rel = if file.is_absolute() {
+            let abs_dir = std::path::absolute(dir)?;
+            file.strip_prefix(&abs_dir).unwrap_or(file)
+        } else {
+            file
+        };
+        // ParaView reads `/` on every platform.
+        let rel = rel
+            .components()
+            .map(|c| c.as_os_str().to_string_lossy())
+            .collect::<Vec<_>>()
+            .join("/");
+        self.entries.push((time, rel));
+        let mut s = String::new();
+        s.push_str("<?xml version=\"1.0\"?>\n");
+        s.push_str("<VTKFile type=\"Collection\" version=\"1.0\" byte_order=\"LittleEndian\">\n<Collection>\n");
+        for (t, f) in &self.entries {
+            let _ = writeln!(
+                s,
+                "<DataSet timestep=\"{}\" part=\"0\" file=\"{}\"/>",
+                Sci(*t),
+                xml_escape(f)
+            );
+        }
+        s.push_str("</Collection>\n</VTKFile>\n");
+        let mut tmp = self.path.clone().into_os_string();
+        tmp.push(".tmp");
+        std::fs::write(&tmp, s)?;
+        std::fs::rename(&tmp, &self.path)
     }
-    s.push_str("</DataArray>\n</Points>\n<Cells>\n");
-    s.push_str("<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-    for b in &mesh.blocks {
-        for k in 0..b.len() {
-            let nodes: Vec<String> = b.elem_nodes(k).iter().map(|n| n.0.to_string()).collect();
-            s.push_str(&nodes.join(" "));
-            s.push('\n');
+
+    /// Number of entries so far.
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// RFC 4648 section 10 test vectors.
+    #[test]
+    fn base64_matches_the_rfc_vectors() {
+        for (plain, coded) in [
+            ("", ""),
+            ("f", "Zg=="),
+            ("fo", "Zm8="),
+            ("foo", "Zm9v"),
+            ("foob", "Zm9vYg=="),
+            ("fooba", "Zm9vYmE="),
+            ("foobar", "Zm9vYmFy"),
+        ] {
+            let mut s = String::new();
+            base64_into(plain.as_bytes(), &mut s);
+            assert_eq!(s, coded, "{plain}");
         }
     }
-    s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
-    let mut off = 0;
-    for b in &mesh.blocks {
-        for _ in 0..b.len() {
-            off += b.topology.node_count();
-            let _ = writeln!(s, "{off}");
-        }
-    }
-    s.push_str("</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-    for b in &mesh.blocks {
-        let t = vtk_type(b.topology);
-        for _ in 0..b.len() {
-            let _ = writeln!(s, "{t}");
-        }
-    }
-    s.push_str("</DataArray>\n</Cells>\n");
-    // The block of each cell, so ParaView can threshold by block.
-    s.push_str("<CellData>\n<DataArray type=\"Int64\" Name=\"block_id\" format=\"ascii\">\n");
-    for b in &mesh.blocks {
-        for _ in 0..b.len() {
-            let _ = writeln!(s, "{}", b.id);
-        }
-    }
-    s.push_str("</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    std::fs::write(path, s)
 }

@@ -10,6 +10,7 @@ mod enforce;
 mod fem;
 mod interactions;
 mod mesh_io;
+mod output;
 mod plugin;
 mod search;
 mod search_kernels;
