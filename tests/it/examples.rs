@@ -207,8 +207,8 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Nodes by position (rounded to `1e-9 × scale`), to pair nodes of two meshes or of two
-/// faces.
+/// Nodes by position (keyed to cells of `1e-9 × scale`), to pair nodes of two meshes or
+/// of two faces.
 fn locate(coords: &[[f64; 3]], scale: f64) -> HashMap<[i64; 3], usize> {
     let key = |p: &[f64; 3]| p.map(|v| (v / (1e-9 * scale)).round() as i64);
     coords
@@ -218,9 +218,13 @@ fn locate(coords: &[[f64; 3]], scale: f64) -> HashMap<[i64; 3], usize> {
         .collect()
 }
 
+/// The node within about `1e-9 × scale` of `p` in each coordinate (its key's cell or a
+/// neighbouring one, so a position near a cell's edge is still found).
 fn find(index: &HashMap<[i64; 3], usize>, p: [f64; 3], scale: f64) -> Option<usize> {
-    index
-        .get(&p.map(|v| (v / (1e-9 * scale)).round() as i64))
+    let key = p.map(|v| (v / (1e-9 * scale)).round() as i64);
+    (-1..=1)
+        .flat_map(|a| (-1..=1).flat_map(move |b| (-1..=1).map(move |c| [a, b, c])))
+        .find_map(|d| index.get(&[key[0] + d[0], key[1] + d[1], key[2] + d[2]]))
         .copied()
 }
 
@@ -251,8 +255,13 @@ fn turbine_sector_equals_the_full_ring() {
     let ring = run(&dir.join("ring_problem.toml"));
     let problem = problem_table(&dir.join("problem.toml"));
 
-    // Node by node on the sector.
-    let r_out = 0.2;
+    // Node by node on the sector (positions keyed to 1e-9 of the outer radius).
+    let r_out = ring
+        .mesh
+        .coords
+        .iter()
+        .map(|p| p[0].hypot(p[1]))
+        .fold(0.0, f64::max);
     let index = locate(&ring.mesh.coords, r_out);
     let t_spread = spread(&ring.solution.temperature);
     let mut worst: f64 = 0.0;
@@ -338,16 +347,15 @@ fn twisted_channel_is_periodic_under_its_lua_map() {
     let problem = problem_table(&dir.join("problem.toml"));
     let t = &r.solution.temperature;
     let length = r.mesh.coords.iter().map(|p| p[2]).fold(0.0, f64::max);
-    let scale = length;
-    let index = locate(&r.mesh.coords, scale);
+    let index = locate(&r.mesh.coords, length);
     let t_spread = spread(t);
     let outlet = side_node_set(&r.mesh, "outlet");
     let (mut worst, mut untwisted): (f64, f64) = (0.0, 0.0);
     for n in &outlet {
         let p = r.mesh.coords[n.index()];
-        let image = find(&index, [-p[1], p[0], p[2] - length], scale)
+        let image = find(&index, [-p[1], p[0], p[2] - length], length)
             .unwrap_or_else(|| panic!("no inlet node at the image of {p:?}"));
-        let straight = find(&index, [p[0], p[1], p[2] - length], scale).unwrap();
+        let straight = find(&index, [p[0], p[1], p[2] - length], length).unwrap();
         worst = worst.max((t[n.index()] - t[image]).abs());
         untwisted = untwisted.max((t[n.index()] - t[straight]).abs());
     }
