@@ -7,6 +7,7 @@ mod cli;
 mod conductance;
 mod docs;
 mod enforce;
+mod examples;
 mod fem;
 mod interactions;
 mod mesh_io;

@@ -1,0 +1,544 @@
+//! The bundled scenes in `examples/`: each runs as `seam run examples/<scene>/problem.toml`
+//! does and is checked against a physics invariant (a reference solution, a periodicity,
+//! a heat balance), with its tolerance and the reason for it.
+//!
+//! Each scene is copied into its own directory under `$CARGO_TARGET_TMPDIR` and run
+//! there, so the results (`out/`) stay out of the source tree. Heat flows are integrated
+//! here from the nodal temperatures, independently of seam's assembly: a 2 × 2 Gauss rule
+//! on each bilinear face (exact for h (T − T∞) on the flat faces these meshes have) and a
+//! 2 × 2 × 2 rule for element volumes (exact for trilinear hexes).
+//!
+//! The balances hold to round-off in the discrete problem itself: conduction rows of a
+//! conforming element sum to zero, and seam integrates sources, fluxes and convection
+//! exactly for these fields, so the heat put in equals the heat taken out up to the
+//! Newton tolerance (1e-12 relative in the problem files) and round-off. 1e-9 relative
+//! leaves three orders of margin for the conditioning of the solve.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use seam::mesh::{Mesh, NodeId, Side};
+use seam::run::{RunError, RunResult};
+
+/// Relative tolerance of every discrete heat balance (see the module comment).
+const BALANCE: f64 = 1e-9;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh copy of the files (not the subdirectories) of `examples/<scene>`.
+fn copy_scene(scene: &str) -> PathBuf {
+    let from = root().join("examples").join(scene);
+    let to = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("examples")
+        .join(format!("{scene}-{}", std::process::id()));
+    std::fs::remove_dir_all(&to).ok();
+    std::fs::create_dir_all(&to).unwrap();
+    for entry in std::fs::read_dir(&from).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_file() {
+            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
+        }
+    }
+    to
+}
+
+fn run(problem: &Path) -> RunResult {
+    match seam::run::run(problem) {
+        Ok(r) => {
+            assert!(
+                r.summary.converged,
+                "{} did not converge",
+                problem.display()
+            );
+            r
+        }
+        Err(RunError::Input(d, s)) => panic!("{}: {}", problem.display(), d.render(&s)),
+        Err(RunError::Solve(e)) => panic!("{}: {e}", problem.display()),
+    }
+}
+
+/// The problem file as plain TOML, for the numbers the checks need.
+fn problem_table(path: &Path) -> toml::Table {
+    toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The `[[bc]]` on `surface`.
+fn bc<'a>(problem: &'a toml::Table, surface: &str) -> &'a toml::Table {
+    problem["bc"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b.as_table().unwrap())
+        .find(|b| b["surfaces"].as_array().unwrap()[0].as_str() == Some(surface))
+        .unwrap_or_else(|| panic!("no [[bc]] on {surface}"))
+}
+
+fn number(v: &toml::Value) -> f64 {
+    v.as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .unwrap()
+}
+
+fn sides<'a>(mesh: &'a Mesh, name: &str) -> &'a [Side] {
+    let i = mesh
+        .find_side_set(name)
+        .unwrap_or_else(|| panic!("no side set {name}"));
+    &mesh.side_sets[i].sides
+}
+
+fn side_node_set(mesh: &Mesh, name: &str) -> Vec<NodeId> {
+    let mut nodes: Vec<NodeId> = sides(mesh, name)
+        .iter()
+        .flat_map(|&s| mesh.side_nodes(s))
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+const GAUSS_2: [f64; 2] = [-0.577_350_269_189_625_8, 0.577_350_269_189_625_8];
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// ∫ f(x, T) dA over the side sets' quadrilateral faces, T bilinear from the nodes.
+fn face_integral(
+    mesh: &Mesh,
+    temperature: &[f64],
+    side_set: &str,
+    f: impl Fn([f64; 3], f64) -> f64,
+) -> f64 {
+    let mut total = 0.0;
+    for &side in sides(mesh, side_set) {
+        let nodes: Vec<NodeId> = mesh.side_nodes(side).collect();
+        assert_eq!(nodes.len(), 4, "quadrilateral faces only");
+        let x: Vec<[f64; 3]> = nodes.iter().map(|n| mesh.coords[n.index()]).collect();
+        let t: Vec<f64> = nodes.iter().map(|n| temperature[n.index()]).collect();
+        for xi in GAUSS_2 {
+            for eta in GAUSS_2 {
+                // Corners in cyclic order at (ξ, η) = (−,−), (+,−), (+,+), (−,+).
+                let sx = [-1.0, 1.0, 1.0, -1.0];
+                let sy = [-1.0, -1.0, 1.0, 1.0];
+                let (mut p, mut dxi, mut deta, mut tq) = ([0.0; 3], [0.0; 3], [0.0; 3], 0.0);
+                for a in 0..4 {
+                    let n = 0.25 * (1.0 + sx[a] * xi) * (1.0 + sy[a] * eta);
+                    let nxi = 0.25 * sx[a] * (1.0 + sy[a] * eta);
+                    let neta = 0.25 * sy[a] * (1.0 + sx[a] * xi);
+                    for d in 0..3 {
+                        p[d] += n * x[a][d];
+                        dxi[d] += nxi * x[a][d];
+                        deta[d] += neta * x[a][d];
+                    }
+                    tq += n * t[a];
+                }
+                total += f(p, tq) * norm(cross(dxi, deta));
+            }
+        }
+    }
+    total
+}
+
+/// The area of a side set.
+fn area(mesh: &Mesh, side_set: &str) -> f64 {
+    face_integral(mesh, &vec![0.0; mesh.num_nodes()], side_set, |_, _| 1.0)
+}
+
+/// The volume of a block of Hex8 elements (2 × 2 × 2 Gauss: exact for trilinear maps).
+fn volume(mesh: &Mesh, block: &str) -> f64 {
+    let b = &mesh.blocks[mesh.find_block(block).unwrap()];
+    let corners: [[f64; 3]; 8] = [
+        [-1.0, -1.0, -1.0],
+        [1.0, -1.0, -1.0],
+        [1.0, 1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+        [1.0, -1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, 1.0],
+    ];
+    let n_elems = b.connectivity.len() / 8;
+    let mut total = 0.0;
+    for e in 0..n_elems {
+        let x: Vec<[f64; 3]> = b
+            .elem_nodes(e)
+            .iter()
+            .map(|n| mesh.coords[n.index()])
+            .collect();
+        for q in GAUSS_2.iter().flat_map(|&a| {
+            GAUSS_2
+                .iter()
+                .flat_map(move |&b| GAUSS_2.iter().map(move |&c| [a, b, c]))
+        }) {
+            let mut j = [[0.0; 3]; 3];
+            for (c, xa) in corners.iter().zip(&x) {
+                for r in 0..3 {
+                    let mut dn = 0.125 * c[r];
+                    for s in (0..3).filter(|&s| s != r) {
+                        dn *= 1.0 + c[s] * q[s];
+                    }
+                    for d in 0..3 {
+                        j[r][d] += dn * xa[d];
+                    }
+                }
+            }
+            total += dot(j[0], cross(j[1], j[2])).abs();
+        }
+    }
+    total
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Nodes by position (keyed to cells of `1e-9 × scale`), to pair nodes of two meshes or
+/// of two faces.
+fn locate(coords: &[[f64; 3]], scale: f64) -> HashMap<[i64; 3], usize> {
+    let key = |p: &[f64; 3]| p.map(|v| (v / (1e-9 * scale)).round() as i64);
+    coords
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (key(p), i))
+        .collect()
+}
+
+/// The node within about `1e-9 × scale` of `p` in each coordinate (its key's cell or a
+/// neighbouring one, so a position near a cell's edge is still found).
+fn find(index: &HashMap<[i64; 3], usize>, p: [f64; 3], scale: f64) -> Option<usize> {
+    let key = p.map(|v| (v / (1e-9 * scale)).round() as i64);
+    (-1..=1)
+        .flat_map(|a| (-1..=1).flat_map(move |b| (-1..=1).map(move |c| [a, b, c])))
+        .find_map(|d| index.get(&[key[0] + d[0], key[1] + d[1], key[2] + d[2]]))
+        .copied()
+}
+
+fn spread(t: &[f64]) -> f64 {
+    let (lo, hi) = t
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    hi - lo
+}
+
+/// Turbine sector: the 1/12 sector with cylindrical periodicity gives the full ring's
+/// temperatures node by node, and the rim's heat leaves through the bore.
+///
+/// The ring mesh is the sector mesh turned 12 times, so the sector's nodes are ring
+/// nodes; the cut faces match, and the mortar tie makes their temperatures equal node
+/// for node. The sector's equations are then the ring's for its first 30° (the ring's
+/// solution is periodic: its load and mesh are), so the two agree to round-off. The
+/// tolerance, 1e-9 of the temperature spread, is the balance tolerance's reason again.
+/// The load is not symmetric within the sector, so heat crosses the cut faces: a sector
+/// with insulated cuts would not reproduce the ring, and this is checked to be the case
+/// (the cut carries over 1 % of the rim's heat).
+#[test]
+fn turbine_sector_equals_the_full_ring() {
+    let dir = copy_scene("turbine_sector");
+    let sector = run(&dir.join("problem.toml"));
+    let ring = run(&dir.join("ring_problem.toml"));
+    let problem = problem_table(&dir.join("problem.toml"));
+
+    // Node by node on the sector (positions keyed to 1e-9 of the outer radius).
+    let r_out = ring
+        .mesh
+        .coords
+        .iter()
+        .map(|p| p[0].hypot(p[1]))
+        .fold(0.0, f64::max);
+    let index = locate(&ring.mesh.coords, r_out);
+    let t_spread = spread(&ring.solution.temperature);
+    let mut worst: f64 = 0.0;
+    for (i, p) in sector.mesh.coords.iter().enumerate() {
+        let j =
+            find(&index, *p, r_out).unwrap_or_else(|| panic!("sector node {p:?} not in the ring"));
+        worst = worst.max((sector.solution.temperature[i] - ring.solution.temperature[j]).abs());
+    }
+    eprintln!(
+        "turbine sector vs ring: worst nodal difference {worst:e} K of a {t_spread:.1} K spread"
+    );
+    assert!(
+        worst <= 1e-9 * t_spread,
+        "sector and ring differ by {worst:e} K (spread {t_spread} K)"
+    );
+
+    // The rim's flux, q(θ) = q0 (1 + 0.5 cos(12θ − 1)); seam evaluates it at each face's
+    // centroid, so it is summed here the same way: one value per face times its area.
+    let rim = bc(&problem, "rim");
+    assert_eq!(
+        rim["value"].as_str(),
+        Some("5e4 * (1 + 0.5 * math.cos(12 * math.atan(y, x) - 1))"),
+        "the check below restates the rim flux"
+    );
+    let q = |p: [f64; 3]| 5e4 * (1.0 + 0.5 * (12.0 * p[1].atan2(p[0]) - 1.0).cos());
+    let rim_heat = |r: &RunResult| -> f64 {
+        sides(&r.mesh, "rim")
+            .iter()
+            .map(|&s| {
+                let nodes: Vec<[f64; 3]> = r
+                    .mesh
+                    .side_nodes(s)
+                    .map(|n| r.mesh.coords[n.index()])
+                    .collect();
+                let c = nodes.iter().fold([0.0; 3], |c, p| {
+                    [c[0] + p[0] / 4.0, c[1] + p[1] / 4.0, c[2] + p[2] / 4.0]
+                });
+                let a = 0.5 * norm(cross(sub(nodes[2], nodes[0]), sub(nodes[3], nodes[1])));
+                q(c) * a
+            })
+            .sum()
+    };
+    let bore = bc(&problem, "bore");
+    let (h, t_inf) = (number(&bore["value"]), number(&bore["ambient"]));
+    for (name, r, parts) in [("sector", &sector, 12.0), ("ring", &ring, 1.0)] {
+        let heat_in = rim_heat(r);
+        let heat_out = face_integral(&r.mesh, &r.solution.temperature, "bore", |_, t| {
+            h * (t - t_inf)
+        });
+        eprintln!(
+            "turbine {name}: rim {heat_in:.6} W in, bore {heat_out:.6} W out (relative {:e}), ring total {:.6} W",
+            (heat_in - heat_out).abs() / heat_in,
+            heat_in * parts
+        );
+        assert!(
+            (heat_in - heat_out).abs() <= BALANCE * heat_in,
+            "{name}: {heat_in} W in, {heat_out} W out"
+        );
+    }
+    let cut = &sector.summary.interactions[0];
+    assert!(
+        cut.heat_side_a.abs() > 0.01 * rim_heat(&sector),
+        "the cut carries {} W: the load should not be symmetric within the sector",
+        cut.heat_side_a
+    );
+    assert!(cut.imbalance.abs() <= BALANCE * cut.heat_side_a.abs());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Twisted channel: the outlet's temperatures equal the inlet's at the image under the
+/// deck's Lua map (a quarter turn about the axis plus a translation by the length), and
+/// the heat made in the bar and put through its heated face leaves by convection.
+///
+/// The section grid is symmetric under the quarter turn, so every outlet node has an
+/// inlet node at its image and the mortar tie makes them equal to round-off: 1e-9 of the
+/// temperature spread (the balance tolerance's reason). Pairing the outlet with the
+/// inlet *without* the turn would miss by a good part of that spread, which is checked,
+/// so the twist is what is tested.
+#[test]
+fn twisted_channel_is_periodic_under_its_lua_map() {
+    let dir = copy_scene("twisted_channel");
+    let r = run(&dir.join("problem.toml"));
+    let problem = problem_table(&dir.join("problem.toml"));
+    let t = &r.solution.temperature;
+    let length = r.mesh.coords.iter().map(|p| p[2]).fold(0.0, f64::max);
+    let index = locate(&r.mesh.coords, length);
+    let t_spread = spread(t);
+    let outlet = side_node_set(&r.mesh, "outlet");
+    let (mut worst, mut untwisted): (f64, f64) = (0.0, 0.0);
+    for n in &outlet {
+        let p = r.mesh.coords[n.index()];
+        let image = find(&index, [-p[1], p[0], p[2] - length], length)
+            .unwrap_or_else(|| panic!("no inlet node at the image of {p:?}"));
+        let straight = find(&index, [p[0], p[1], p[2] - length], length).unwrap();
+        worst = worst.max((t[n.index()] - t[image]).abs());
+        untwisted = untwisted.max((t[n.index()] - t[straight]).abs());
+    }
+    eprintln!(
+        "twisted channel: {} outlet nodes, worst |T(p) − T(map p)| {worst:e} K (untwisted pairs: {untwisted:.3} K) of a {t_spread:.2} K spread",
+        outlet.len()
+    );
+    assert_eq!(outlet.len(), 49);
+    assert!(worst <= 1e-9 * t_spread, "periodicity off by {worst:e} K");
+    assert!(untwisted > 0.05 * t_spread, "the twist should matter");
+
+    let source = number(&problem["source"].as_array().unwrap()[0]["value"]);
+    let flux = number(&bc(&problem, "heated")["value"]);
+    let cooled = bc(&problem, "cooled");
+    let (h, t_inf) = (number(&cooled["value"]), number(&cooled["ambient"]));
+    let heat_in = source * volume(&r.mesh, "bar") + flux * area(&r.mesh, "heated");
+    let heat_out = face_integral(&r.mesh, t, "cooled", |_, t| h * (t - t_inf));
+    let cut = &r.summary.interactions[0];
+    eprintln!(
+        "twisted channel: {heat_in:.9} W in, {heat_out:.9} W out (relative {:e}); {:.6} W through the periodic faces",
+        (heat_in - heat_out).abs() / heat_in,
+        cut.heat_side_a
+    );
+    assert!((heat_in - heat_out).abs() <= BALANCE * heat_in);
+    assert!(cut.imbalance.abs() <= BALANCE * heat_in);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The library name the plugin scene's deck asks for, next to the deck.
+const PLUGIN_LIBRARY: &str = "libseam_c_table.so";
+
+/// Compile the C example plugin with `$CC` (default `cc`) and the CI flags into `dir`.
+fn compile_c_table(dir: &Path) -> PathBuf {
+    let out = dir.join(PLUGIN_LIBRARY);
+    let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let status = Command::new(&compiler)
+        .args([
+            "-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-shared", "-fPIC",
+        ])
+        .arg("-I")
+        .arg(root().join("plugins/include"))
+        .arg(root().join("plugins/examples/c_table/c_table.c"))
+        .arg("-o")
+        .arg(&out)
+        .status()
+        .unwrap_or_else(|e| panic!("cannot run the C compiler `{compiler}`: {e}"));
+    assert!(status.success(), "compiling the c_table plugin failed");
+    out
+}
+
+/// The numbers after `keyword [=]` on the deck's line that starts with it.
+fn deck_numbers(deck: &str, keyword: &str) -> Vec<f64> {
+    let line = deck
+        .lines()
+        .map(str::trim)
+        .find(|l| l.to_ascii_lowercase().starts_with(keyword))
+        .unwrap_or_else(|| panic!("no `{keyword}` line"));
+    line[keyword.len()..]
+        .split(|c: char| c.is_whitespace() || c == '=')
+        .filter(|w| !w.is_empty())
+        .map(|w| w.parse().unwrap())
+        .collect()
+}
+
+/// A piecewise-linear table (p0 h0 p1 h1 …) read at `p`, flat beyond its ends.
+fn table_at(pairs: &[f64], p: f64) -> f64 {
+    let points: Vec<(f64, f64)> = pairs.chunks(2).map(|c| (c[0], c[1])).collect();
+    if p <= points[0].0 {
+        return points[0].1;
+    }
+    for w in points.windows(2) {
+        let ((p0, h0), (p1, h1)) = (w[0], w[1]);
+        if p <= p1 {
+            return h0 + (h1 - h0) * (p - p0) / (p1 - p0);
+        }
+    }
+    points[points.len() - 1].1
+}
+
+/// Plugin conductance: the C table plugin is the interface conductance between two
+/// plates with insulated sides, so the problem is one-dimensional: the heat is
+/// A ΔT / (L_base/k_base + 1/h + L_cover/k_cover) with h the table's value at the deck's
+/// contact pressure (read here from the deck's data), the interface jump is uniform and
+/// h A (T_A − T_B) is the interface heat, and sides A and B carry opposite heats.
+///
+/// The exact field is linear in each plate, which trilinear hexes hold, and the
+/// interface integrals are exact on the non-matching faces, so round-off is all that
+/// is left: the balance tolerance, 1e-9 relative.
+#[test]
+fn plugin_conductance_carries_the_series_heat_flow() {
+    let dir = copy_scene("plugin_conductance");
+    let deck = std::fs::read_to_string(dir.join("contact.i")).unwrap();
+    assert!(deck.contains(&format!("\"{PLUGIN_LIBRARY}\"")));
+    compile_c_table(&dir);
+    let r = run(&dir.join("problem.toml"));
+    let problem = problem_table(&dir.join("problem.toml"));
+
+    let h = table_at(
+        &deck_numbers(&deck, "real data"),
+        deck_numbers(&deck, "contact pressure")[0],
+    );
+    let k = |block: &str| {
+        problem["material"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["blocks"].as_array().unwrap()[0].as_str() == Some(block))
+            .map(|m| number(&m["conductivity"]))
+            .unwrap()
+    };
+    let z_range = |block: &str| {
+        let b = &r.mesh.blocks[r.mesh.find_block(block).unwrap()];
+        b.connectivity
+            .iter()
+            .map(|n| r.mesh.coords[n.index()][2])
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
+                (lo.min(z), hi.max(z))
+            })
+    };
+    let (base_lo, base_hi) = z_range("base");
+    let (cover_lo, cover_hi) = z_range("cover");
+    assert_eq!(base_hi, cover_lo, "the plates touch");
+    let t_hot = number(&bc(&problem, "base_bottom")["value"]);
+    let t_cold = number(&bc(&problem, "cover_top")["value"]);
+    let a = area(&r.mesh, "base_top");
+    let flux = (t_hot - t_cold)
+        / ((base_hi - base_lo) / k("base") + 1.0 / h + (cover_hi - cover_lo) / k("cover"));
+    let expected = flux * a;
+
+    let t = &r.solution.temperature;
+    let mean =
+        |nodes: &[NodeId]| nodes.iter().map(|n| t[n.index()]).sum::<f64>() / nodes.len() as f64;
+    let (side_a, side_b) = (
+        side_node_set(&r.mesh, "base_top"),
+        side_node_set(&r.mesh, "cover_bottom"),
+    );
+    let jump = mean(&side_a) - mean(&side_b);
+    let jump_spread = spread(&side_a.iter().map(|n| t[n.index()]).collect::<Vec<_>>()).max(spread(
+        &side_b.iter().map(|n| t[n.index()]).collect::<Vec<_>>(),
+    ));
+    let i = &r.summary.interactions[0];
+    eprintln!(
+        "plugin conductance: h = {h} W/m²K, expected {expected:.9} W, side A {:.9} W (relative {:e}), side B {:.9} W, h·A·ΔT {:.9} W (relative {:e}, ΔT = {jump:.6} K)",
+        i.heat_side_a,
+        (i.heat_side_a - expected).abs() / expected,
+        i.heat_side_b,
+        h * a * jump,
+        (h * a * jump - i.heat_side_a).abs() / expected
+    );
+    assert!(
+        jump_spread <= BALANCE * (t_hot - t_cold),
+        "the interface temperatures are uniform"
+    );
+    assert!((i.heat_side_a - expected).abs() <= BALANCE * expected);
+    assert!((h * a * jump - i.heat_side_a).abs() <= BALANCE * expected);
+    assert!(i.imbalance.abs() <= BALANCE * expected);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Electronics: the die's power (the flux on its active face times its area) leaves the
+/// heat sink by convection, and all of it crosses the die–sink interface (the die's
+/// other faces are insulated). Discrete balances, to the balance tolerance.
+#[test]
+fn electronics_power_leaves_by_convection() {
+    let dir = copy_scene("electronics");
+    let r = run(&dir.join("problem.toml"));
+    let problem = problem_table(&dir.join("problem.toml"));
+    let power = number(&bc(&problem, "chip_bottom")["value"]) * area(&r.mesh, "chip_bottom");
+    let cooled = bc(&problem, "sink_cooled");
+    let (h, t_inf) = (number(&cooled["value"]), number(&cooled["ambient"]));
+    let convected = face_integral(&r.mesh, &r.solution.temperature, "sink_cooled", |_, t| {
+        h * (t - t_inf)
+    });
+    let i = &r.summary.interactions[0];
+    eprintln!(
+        "electronics: {power:.9} W made, {convected:.9} W convected (relative {:e}), {:.9} W across the interface (relative {:e}, imbalance {:e})",
+        (convected - power).abs() / power,
+        i.heat_side_a,
+        (i.heat_side_a - power).abs() / power,
+        i.imbalance
+    );
+    assert!((convected - power).abs() <= BALANCE * power);
+    assert!((i.heat_side_a - power).abs() <= BALANCE * power);
+    assert!(i.imbalance.abs() <= BALANCE * power);
+    std::fs::remove_dir_all(&dir).ok();
+}
