@@ -810,6 +810,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         && toggles.iter().all(Option::is_none)
         && problem.bc.iter().all(|b| b.kind != BcKind::Radiation);
     let mut history = Vec::new();
+    let mut writer = steps::StepWriter::new(out_dir.as_deref(), &mesh, &problem.output, transient);
     let solution = if linear_steady {
         let materials = materials.constant().expect("checked constant");
         let loads = loads_at(
@@ -956,20 +957,39 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             }
             write_vtu(&file, &mesh, &point)
                 .map_err(|e| RunError::Solve(format!("cannot write {}: {e}", file.display())))?;
-            if !history.is_empty() {
-                let labels: Vec<(String, String, String)> = term_choice
-                    .iter()
-                    .map(|&k| {
-                        (
-                            pairings[k].side_a.clone(),
-                            pairings[k].side_b.clone(),
-                            choices[k].0.name.clone(),
-                        )
-                    })
-                    .collect();
-                steps::write_history(out_dir, &history, &labels)
-                    .map_err(|e| RunError::Solve(format!("cannot write the history: {e}")))?;
+            let io = |e: std::io::Error| {
+                RunError::Solve(format!("cannot write the results in {}: {e}", out_dir.display()))
+            };
+            if linear_steady {
+                writer
+                    .write_temperature(0, start_time, &solution.temperature)
+                    .map_err(io)?;
+                writer.close().map_err(io)?;
             }
+            let labels: Vec<(String, String, String)> = term_choice
+                .iter()
+                .map(|&k| {
+                    (
+                        pairings[k].side_a.clone(),
+                        pairings[k].side_b.clone(),
+                        choices[k].0.name.clone(),
+                    )
+                })
+                .collect();
+            if !history.is_empty() {
+                steps::write_history(out_dir, &history, &labels).map_err(io)?;
+            }
+            // The plotted line: through the first matched point of the first
+            // interaction, along its side-A normal.
+            let line = pairings.iter().find_map(|p| {
+                p.result
+                    .points
+                    .iter()
+                    .find(|q| q.status == PointStatus::Matched)
+                    .map(|q| (q.x, q.normal_a))
+            });
+            steps::write_plots(out_dir, &mesh, &solution.temperature, &history, &labels, line)
+                .map_err(io)?;
             Some(file)
         }
         None => None,

@@ -9,7 +9,9 @@ use crate::assembly::DofMap;
 use crate::heat::steady::{SolveTiming, SteadySolution};
 use crate::heat::transient::{Outcome, State, StepReport};
 use crate::mesh::Mesh;
-use crate::output::vtu::write_vtu;
+use crate::output::exodus::ExodusWriter;
+use crate::output::plot::{Plot, Series};
+use crate::output::vtu::{PvdSeries, write_vtu};
 
 use super::{OutputSpec, RunError};
 
@@ -38,8 +40,10 @@ pub(super) struct StepWriter<'m> {
     every: usize,
     checkpoint_every: Option<usize>,
     transient: bool,
-    /// (time, file name) of the fields written, for the `.pvd`.
-    series: Vec<(f64, String)>,
+    /// The `.pvd` of the fields written.
+    series: Option<PvdSeries>,
+    /// `results.exo`: every step written, for ParaView and Sierra users.
+    exodus: Option<ExodusWriter>,
     last_written: Option<usize>,
 }
 
@@ -56,7 +60,8 @@ impl<'m> StepWriter<'m> {
             every: spec.every.unwrap_or(1).max(1),
             checkpoint_every: spec.checkpoint_every.filter(|&n| n > 0),
             transient,
-            series: Vec::new(),
+            series: None,
+            exodus: None,
             last_written: None,
         }
     }
@@ -85,52 +90,59 @@ impl<'m> StepWriter<'m> {
         Ok(())
     }
 
-    fn write_fields(
-        &mut self,
-        state: &State,
-        dofs: &DofMap,
-        fields: &[String],
-    ) -> std::io::Result<()> {
-        let Some(dir) = &self.dir else { return Ok(()) };
-        let name = format!("temperature_{:05}.vtu", state.step);
+    fn write_fields(&mut self, state: &State, dofs: &DofMap, fields: &[String]) -> std::io::Result<()> {
         let t = nodal_temperature(dofs, &state.u, fields);
-        write_vtu(&dir.join(&name), self.mesh, &[("temperature", &t)])?;
-        self.series.push((state.time, name));
-        self.last_written = Some(state.step);
-        write_pvd(&dir.join("temperature.pvd"), &self.series)
+        self.write_temperature(state.step, state.time, &t)
     }
 
-    /// The last step's fields (if not written yet) and the final checkpoint.
-    pub(super) fn finish(
-        &mut self,
-        state: &State,
-        dofs: &DofMap,
-        fields: &[String],
-    ) -> std::io::Result<()> {
-        if !self.transient || self.dir.is_none() {
+    /// One step's temperature: `temperature_<step>.vtu` in the `.pvd` series (transient
+    /// runs) and a step of `results.exo`.
+    pub(super) fn write_temperature(&mut self, step: usize, time: f64, t: &[f64]) -> std::io::Result<()> {
+        let Some(dir) = self.dir.clone() else { return Ok(()) };
+        if self.transient {
+            let name = format!("temperature_{step:05}.vtu");
+            write_vtu(&dir.join(&name), self.mesh, &[("temperature", t)])?;
+            self.series
+                .get_or_insert_with(|| PvdSeries::new(&dir.join("temperature.pvd")))
+                .add(time, Path::new(&name))?;
+        }
+        if self.exodus.is_none() {
+            self.exodus = Some(ExodusWriter::create(&dir.join("results.exo"), self.mesh, &["temperature"], &[])?);
+        }
+        // Nodes without a temperature (shells, bars) hold 0 in the Exodus file.
+        let values: Vec<f64> = t.iter().map(|v| if v.is_nan() { 0.0 } else { *v }).collect();
+        self.exodus
+            .as_mut()
+            .expect("just made")
+            .write_step(time, &[&values], &[])?;
+        self.last_written = Some(step);
+        Ok(())
+    }
+
+    /// The last step's fields (if not written yet), `results.exo` closed, and (transient
+    /// runs) the final checkpoint.
+    pub(super) fn finish(&mut self, state: &State, dofs: &DofMap, fields: &[String]) -> std::io::Result<()> {
+        if self.dir.is_none() {
             return Ok(());
         }
         if self.last_written != Some(state.step) {
             self.write_fields(state, dofs, fields)?;
         }
+        self.close()?;
+        if !self.transient {
+            return Ok(());
+        }
         let dir = self.dir.as_ref().expect("checked");
         write_checkpoint(&dir.join("checkpoint.seam"), state)
     }
-}
 
-/// A ParaView collection of the steps written so far (rewritten each time, so a run
-/// stopped midway leaves a valid series).
-fn write_pvd(path: &Path, series: &[(f64, String)]) -> std::io::Result<()> {
-    let mut s = String::from(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n",
-    );
-    for (t, f) in series {
-        s.push_str(&format!(
-            "<DataSet timestep=\"{t:e}\" part=\"0\" file=\"{f}\"/>\n"
-        ));
+    /// Close `results.exo`.
+    pub(super) fn close(&mut self) -> std::io::Result<()> {
+        match self.exodus.take() {
+            Some(x) => x.finish(),
+            None => Ok(()),
+        }
     }
-    s.push_str("</Collection>\n</VTKFile>\n");
-    std::fs::write(path, s)
 }
 
 const MAGIC: &[u8; 8] = b"SEAMCKP1";
@@ -278,4 +290,117 @@ pub(super) fn final_solution(
         crosspoints: outcome.crosspoints,
         timing,
     }
+}
+
+/// Quick-look plots in `plots/`: temperature along a line through the first
+/// interface, interface heat over time (transient runs), and Newton convergence.
+pub(super) fn write_plots(
+    dir: &Path,
+    mesh: &Mesh,
+    temperature: &[f64],
+    history: &[StepReport],
+    labels: &[(String, String, String)],
+    line: Option<([f64; 3], [f64; 3])>,
+) -> std::io::Result<Vec<PathBuf>> {
+    let plots = dir.join("plots");
+    std::fs::create_dir_all(&plots)?;
+    let mut written = Vec::new();
+    if let Some((origin, axis)) = line {
+        let series = line_samples(mesh, temperature, origin, axis);
+        if !series.is_empty() {
+            let p = plots.join("temperature_line.png");
+            Plot {
+                title: "Temperature along a line through the interface".into(),
+                x_label: "distance along the interface normal".into(),
+                y_label: "T".into(),
+                log_y: false,
+                series,
+            }
+            .write_png(&p)?;
+            written.push(p);
+        }
+    }
+    if history.len() > 1 && !labels.is_empty() {
+        let series = labels
+            .iter()
+            .enumerate()
+            .map(|(k, (a, b, m))| Series {
+                label: format!("{a} / {b} ({m})"),
+                points: history
+                    .iter()
+                    .map(|r| (r.time, r.heat.get(k).map_or(f64::NAN, |h| h.0)))
+                    .collect(),
+            })
+            .collect();
+        let p = plots.join("interface_heat.png");
+        Plot {
+            title: "Heat out of side A".into(),
+            x_label: "t".into(),
+            y_label: "W".into(),
+            log_y: false,
+            series,
+        }
+        .write_png(&p)?;
+        written.push(p);
+    }
+    if let Some(last) = history.last().filter(|r| !r.residual_history.is_empty()) {
+        let p = plots.join("newton.png");
+        Plot {
+            title: "Newton convergence (last step)".into(),
+            x_label: "iteration".into(),
+            y_label: "residual norm".into(),
+            log_y: true,
+            series: vec![Series {
+                label: format!("step {} (t = {:e})", last.step, last.time),
+                points: last
+                    .residual_history
+                    .iter()
+                    .enumerate()
+                    .map(|(i, r)| (i as f64, *r))
+                    .collect(),
+            }],
+        }
+        .write_png(&p)?;
+        written.push(p);
+    }
+    Ok(written)
+}
+
+/// Nodal temperatures near the line `origin + s·axis`, per block, as (s, T): the nodes
+/// of each block within 1.5 times that block's least distance to the line.
+fn line_samples(mesh: &Mesh, t: &[f64], origin: [f64; 3], axis: [f64; 3]) -> Vec<Series> {
+    let mut out = Vec::new();
+    for block in &mesh.blocks {
+        let mut nodes: Vec<u32> = (0..block.len())
+            .flat_map(|k| block.elem_nodes(k).iter().map(|n| n.0))
+            .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        let at = |n: u32| {
+            let x = mesh.coords[n as usize];
+            let d = [x[0] - origin[0], x[1] - origin[1], x[2] - origin[2]];
+            let s = d[0] * axis[0] + d[1] * axis[1] + d[2] * axis[2];
+            let r2 = (d[0] - s * axis[0]).powi(2)
+                + (d[1] - s * axis[1]).powi(2)
+                + (d[2] - s * axis[2]).powi(2);
+            (s, r2.sqrt())
+        };
+        let least = nodes
+            .iter()
+            .map(|&n| at(n).1)
+            .fold(f64::INFINITY, f64::min);
+        let mut points: Vec<(f64, f64)> = nodes
+            .iter()
+            .filter(|&&n| at(n).1 <= 1.5 * least + 1e-12 && t[n as usize].is_finite())
+            .map(|&n| (at(n).0, t[n as usize]))
+            .collect();
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if !points.is_empty() {
+            out.push(Series {
+                label: block.sierra_name(),
+                points,
+            });
+        }
+    }
+    out
 }
