@@ -7,6 +7,7 @@
 pub mod assembly;
 pub mod deck;
 pub mod diag;
+pub mod embed;
 pub mod enforce;
 pub mod heat;
 pub mod interaction;
