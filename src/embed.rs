@@ -927,6 +927,22 @@ impl Embedding {
             let searcher = Searcher::new(&p.b, &p.settings);
             let mut result = searcher.search(&p.a, &p.b, &p.settings, self.integration, None);
             result.treat_overclosure(p.overclosure);
+            let tie = match &p.enforcement {
+                Enforcement::Tie { .. } => true,
+                Enforcement::Flux { form, .. } => matches!(
+                    form,
+                    Form::TiedNitsche | Form::TiedInteriorPenalty | Form::Penalty
+                ),
+            };
+            if tie && result.stats.matched == 0 {
+                return Err(argument(
+                    format!(
+                        "interaction {} / {} ties two surfaces that do not overlap anywhere ({} points, none paired)",
+                        p.side_a.name, p.side_b.name, result.stats.points
+                    ),
+                    "check the surfaces' faces and the search tolerances (normal tolerance, field factor)",
+                ));
+            }
             p.searcher = Some(searcher);
             p.result = Some(result);
         }

@@ -500,6 +500,22 @@ fn embed_bad_input_is_an_error_that_says_where() {
     .unwrap();
     let err = e.contributions(&[0.0; 8]).unwrap_err();
     assert!(matches!(err, EmbedError::Order { .. }), "{err}");
+    // Top and bottom of one element face apart, a unit away: nothing to tie.
+    let err = e.search().unwrap_err();
+    assert!(err.to_string().contains("do not overlap anywhere"), "{err}");
+    let mut e = Embedding::builder(&coords)
+        .block("b", Topology::Hex8, &conn, 1.0)
+        .face_set("top", &[[4, 5, 6, 7]])
+        .side_set("bottom", &[(0, 5)])
+        .dofs(&conn)
+        .build()
+        .unwrap();
+    e.add_interaction(Interaction::new(
+        "top",
+        "bottom",
+        Model::Conductance { h: 1.0 },
+    ))
+    .unwrap();
     e.search().unwrap();
     let err = e.contributions(&[0.0; 3]).unwrap_err();
     assert!(err.to_string().contains("dof 3 is needed"), "{err}");
