@@ -56,7 +56,7 @@ extern "C" {
 #define SEAM_CONDUCTANCE 1       /* q = h [u] on side A (contact resistance) */
 #define SEAM_GAP_CONDUCTANCE 2   /* Robin-Nitsche gap conductance, h in [0, inf] */
 #define SEAM_TIED_NITSCHE 3      /* weighted symmetric Nitsche tie */
-#define SEAM_TIED_MORTAR 4       /* mortar tie, standard multipliers (Rust API only for rows) */
+#define SEAM_TIED_MORTAR 4       /* mortar tie, standard multipliers: rows C u = g */
 #define SEAM_TIED_DUAL_MORTAR 5  /* mortar tie, dual multipliers: condensed rows */
 
 /* Integration of side A. */
@@ -121,16 +121,31 @@ int seam_load(const seam_embedding *embedding, size_t *out_n, const int64_t **ou
 int seam_heat(const seam_embedding *embedding, size_t index, double *out_side_a,
               double *out_side_b);
 
-/* --- dual mortar ties, for hosts without multipliers --------------------------------- */
-/* Rows u[dofs[r]] = constants[r] + sum over k in offsets[r]..offsets[r+1]-1 of
- * coefficients[k] * u[cols[k]]; offsets has n_rows + 1 entries. */
+/* --- mortar ties ------------------------------------------------------------------ */
+/* Compute every tie's rows (after seam_search). Returns the condensed rows of the dual
+ * ties, for hosts without multipliers:
+ *   u[dofs[r]] = constants[r] + sum over k in offsets[r]..offsets[r+1]-1 of
+ *                coefficients[k] * u[cols[k]]
+ * offsets has n_rows + 1 entries. Standard ties add no rows here (see seam_tie_rows). */
 int seam_constraints(seam_embedding *embedding, size_t *out_n_rows, const int64_t **out_dofs,
                      const double **out_constants, const size_t **out_offsets,
                      const int64_t **out_cols, const double **out_coefficients);
-/* Heat through dual tie `tie` (0-based among ties) from the host's residual K u - F
- * without the tie (n entries, by host dof) at its solution. */
-int seam_tie_heat(const seam_embedding *embedding, size_t tie, const double *residual, size_t n,
+/* Number of ties (0-based tie indices follow interaction order). */
+int seam_tie_count(const seam_embedding *embedding, size_t *out_count);
+/* C u = g of one tie, for hosts that carry multipliers: the host dof of each
+ * multiplier's side-A node, g (one per multiplier) and the entries
+ * C[multipliers[k]][dofs[k]] = values[k]. */
+int seam_tie_rows(const seam_embedding *embedding, size_t tie, size_t *out_n_multipliers,
+                  const int64_t **out_multiplier_dofs, const double **out_rhs,
+                  size_t *out_n_entries, const int64_t **out_multipliers,
+                  const int64_t **out_dofs, const double **out_values);
+/* Heat (W) through a tie for the host's multipliers lambda (n = number of multipliers). */
+int seam_tie_heat(const seam_embedding *embedding, size_t tie, const double *lambda, size_t n,
                   double *out_side_a, double *out_side_b);
+/* Heat through a dual tie the host condensed, from its own residual K u - F without
+ * the tie (n entries, by host dof) at its solution. */
+int seam_dual_tie_heat(const seam_embedding *embedding, size_t tie, const double *residual,
+                       size_t n, double *out_side_a, double *out_side_b);
 
 #ifdef __cplusplus
 }

@@ -4,7 +4,7 @@
 //! host's nodes, blocks, surfaces and dof numbers; `seam_embedding_new` checks them and
 //! makes an embedding handle; interactions come from `seam_add_interaction` or
 //! `seam_add_deck`; then `seam_search`, `seam_move_nodes`, `seam_evaluate` with the
-//! accessors of its results, and `seam_constraints` for mortar ties.
+//! accessors of its results, and `seam_constraints` with `seam_tie_*` for mortar ties.
 //!
 //! Conventions:
 //! - Every function returns a [`SeamStatus`] code (0 is success). On failure the
@@ -172,7 +172,7 @@ struct Evaluated {
     heat: Vec<Option<(f64, f64)>>,
 }
 
-/// Condensed rows of every dual tie, in compressed-row form.
+/// Condensed rows of every dual tie, in compressed-row form, and each tie's rows.
 #[derive(Default)]
 struct Rows {
     dofs: Vec<i64>,
@@ -180,7 +180,26 @@ struct Rows {
     offsets: Vec<usize>,
     cols: Vec<i64>,
     coefficients: Vec<f64>,
-    ties: Vec<TieConstraints>,
+    ties: Vec<(TieConstraints, TieArrays)>,
+}
+
+/// One tie's `C u = g` as C arrays.
+struct TieArrays {
+    multiplier_dofs: Vec<i64>,
+    multipliers: Vec<i64>,
+    dofs: Vec<i64>,
+    values: Vec<f64>,
+}
+
+impl TieArrays {
+    fn from(t: &TieConstraints) -> Self {
+        TieArrays {
+            multiplier_dofs: t.multiplier_dofs.iter().map(|&d| as_i64(d)).collect(),
+            multipliers: t.entries.iter().map(|e| as_i64(e.0)).collect(),
+            dofs: t.entries.iter().map(|e| as_i64(e.1)).collect(),
+            values: t.entries.iter().map(|e| e.2).collect(),
+        }
+    }
 }
 
 /// The embedding handle.
@@ -669,7 +688,7 @@ pub unsafe extern "C" fn seam_jacobian(
 }
 
 /// Heat (W) leaving side A and side B of interaction `index` at the last evaluation.
-/// For a mortar tie use `seam_tie_heat`.
+/// For a mortar tie use `seam_tie_heat` or `seam_dual_tie_heat`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_heat(
     embedding: *const SeamEmbedding,
@@ -686,7 +705,7 @@ pub unsafe extern "C" fn seam_heat(
             Some(None) => {
                 return Err(bad(
                     format!("interaction {index} is a mortar tie"),
-                    "read its heat with seam_tie_heat",
+                    "read its heat with seam_tie_heat or seam_dual_tie_heat",
                 ));
             }
             None => {
@@ -706,9 +725,11 @@ pub unsafe extern "C" fn seam_heat(
     })
 }
 
-/// The condensed rows of every dual mortar tie:
+/// Compute the rows of every mortar tie (after `seam_search`) and return the
+/// condensed rows of the dual ones:
 /// `u[dofs[r]] = constants[r] + Σ_{k in offsets[r]..offsets[r+1]} coefficients[k] u[cols[k]]`.
-/// `offsets` has `n_rows + 1` entries.
+/// `offsets` has `n_rows + 1` entries. Ties with standard multipliers add no condensed
+/// rows; read their `C u = g` with `seam_tie_rows`.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn seam_constraints(
@@ -722,16 +743,8 @@ pub unsafe extern "C" fn seam_constraints(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
+        e.rows = None;
         let ties = e.inner.constraints()?;
-        if let Some(t) = ties.iter().find(|t| t.condensed.is_empty()) {
-            return Err(bad(
-                format!(
-                    "interaction {} is a tie with standard multipliers, which cannot be condensed",
-                    t.interaction
-                ),
-                "use SEAM_TIED_DUAL_MORTAR (or `Tied Multipliers = Dual` in the deck)",
-            ));
-        }
         let mut r = Rows {
             offsets: vec![0],
             ..Rows::default()
@@ -745,7 +758,13 @@ pub unsafe extern "C" fn seam_constraints(
             }
             r.offsets.push(r.cols.len());
         }
-        r.ties = ties;
+        r.ties = ties
+            .into_iter()
+            .map(|t| {
+                let arrays = TieArrays::from(&t);
+                (t, arrays)
+            })
+            .collect();
         let r = e.rows.insert(r);
         unsafe {
             out(out_n_rows, r.dofs.len(), "out_n_rows")?;
@@ -762,33 +781,112 @@ pub unsafe extern "C" fn seam_constraints(
     })
 }
 
-/// Heat through dual tie `tie` (0-based among the ties, in interaction order) from the
-/// host's own residual `K u − F` (without the tie, `n` entries by host dof) at its
-/// solution. Call `seam_constraints` first.
+fn tie<'a>(
+    e: *const SeamEmbedding,
+    index: usize,
+) -> Result<&'a (TieConstraints, TieArrays), Failure> {
+    // SAFETY: a non-null handle came from this library (module Safety).
+    let e = unsafe { e.as_ref() }.ok_or_else(|| null("embedding"))?;
+    let rows = e.rows.as_ref().ok_or_else(|| {
+        Failure(
+            SeamStatus::Order,
+            "no constraints yet\n  help: call seam_constraints first (after seam_search)".into(),
+        )
+    })?;
+    rows.ties.get(index).ok_or_else(|| {
+        bad(
+            format!("tie {index} does not exist ({} in all)", rows.ties.len()),
+            "ties are numbered from 0 in interaction order",
+        )
+    })
+}
+
+/// Number of mortar ties (after `seam_constraints`).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_tie_count(
+    embedding: *const SeamEmbedding,
+    out_count: *mut usize,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let n = e.rows.as_ref().map_or(0, |r| r.ties.len());
+        unsafe { out(out_count, n, "out_count") }
+    })
+}
+
+/// The rows `C u = g` of tie `index`: `n_multipliers` multipliers, the host dof of
+/// each one's side-A node, `rhs` (g, one per multiplier), and `n_entries` entries
+/// `C[multipliers[k]][dofs[k]] = values[k]`. For hosts that carry multipliers.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_tie_rows(
+    embedding: *const SeamEmbedding,
+    index: usize,
+    out_n_multipliers: *mut usize,
+    out_multiplier_dofs: *mut *const i64,
+    out_rhs: *mut *const f64,
+    out_n_entries: *mut usize,
+    out_multipliers: *mut *const i64,
+    out_dofs: *mut *const i64,
+    out_values: *mut *const f64,
+) -> c_int {
+    guard(|| {
+        let (t, a) = tie(embedding, index)?;
+        unsafe {
+            out(
+                out_n_multipliers,
+                a.multiplier_dofs.len(),
+                "out_n_multipliers",
+            )?;
+            out(
+                out_multiplier_dofs,
+                a.multiplier_dofs.as_ptr(),
+                "out_multiplier_dofs",
+            )?;
+            out(out_rhs, t.rhs.as_ptr(), "out_rhs")?;
+            out(out_n_entries, a.values.len(), "out_n_entries")?;
+            out(out_multipliers, a.multipliers.as_ptr(), "out_multipliers")?;
+            out(out_dofs, a.dofs.as_ptr(), "out_dofs")?;
+            out(out_values, a.values.as_ptr(), "out_values")
+        }
+    })
+}
+
+/// Heat through tie `index` for the host's multipliers `lambda` (one per multiplier).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_tie_heat(
     embedding: *const SeamEmbedding,
-    tie: usize,
+    index: usize,
+    lambda: *const f64,
+    n: usize,
+    out_side_a: *mut f64,
+    out_side_b: *mut f64,
+) -> c_int {
+    guard(|| {
+        let (t, _) = tie(embedding, index)?;
+        let lambda = unsafe { slice(lambda, n, "lambda") }?;
+        let heat = t.heat(lambda)?;
+        unsafe {
+            out(out_side_a, heat.side_a, "out_side_a")?;
+            out(out_side_b, heat.side_b, "out_side_b")
+        }
+    })
+}
+
+/// Heat through dual tie `index` of a host that condensed it, from its own residual
+/// `K u − F` without the tie (`n` entries, by host dof) at its solution.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_dual_tie_heat(
+    embedding: *const SeamEmbedding,
+    index: usize,
     residual: *const f64,
     n: usize,
     out_side_a: *mut f64,
     out_side_b: *mut f64,
 ) -> c_int {
     guard(|| {
-        // SAFETY: a non-null handle came from this library (module Safety).
-        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let rows = e.rows.as_ref().ok_or_else(|| {
-            Failure(
-                SeamStatus::Order,
-                "no constraints yet\n  help: call seam_constraints first".into(),
-            )
-        })?;
-        let t = rows.ties.get(tie).ok_or_else(|| {
-            bad(
-                format!("tie {tie} does not exist ({} in all)", rows.ties.len()),
-                "ties are numbered from 0 in interaction order",
-            )
-        })?;
+        let (t, _) = tie(embedding, index)?;
         let r = unsafe { slice(residual, n, "residual") }?;
         let heat = t.heat(&t.dual_multipliers(r)?)?;
         unsafe {

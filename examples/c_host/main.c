@@ -6,7 +6,9 @@
  * [0,1]^2 x [1,1.5] of 4x4x3 Hex8 (k = 200) meeting non-conformingly at z = 1, base
  * bottom at 300 K, lid top at 400 K, gap conductance h = 500 W/m^2K. The host meshes
  * the blocks itself, assembles its own trilinear conduction, adds seam's Jacobian, and
- * prints the interface heat.
+ * prints the interface heat; then ties the blocks by dual mortar instead, condenses
+ * seam's constraint rows into its system (it carries no multipliers) and prints that
+ * heat too.
  *
  * Build and run from the repository root (after `cargo build`):
  *   cc -Wall -Wextra -O2 -Iinclude examples/c_host/main.c -Ltarget/debug -lseam \
@@ -154,6 +156,37 @@ static int solve_dense(double *a, double *b, size_t n) {
     return 0;
 }
 
+/* The host's conduction matrix of both blocks, dense, in host numbering. */
+static void assemble_conduction(double *k, size_t n, const double *coords, const int64_t *dof,
+                                const int64_t *const blocks[2], const size_t counts[2]) {
+    const double conductivity[2] = {16.0, 200.0};
+    memset(k, 0, sizeof(double) * n * n);
+    for (int blk = 0; blk < 2; blk++)
+        for (size_t el = 0; el < counts[blk]; el++) {
+            const int64_t *c = blocks[blk] + 8 * el;
+            double x[8][3], ke[8][8];
+            for (int a = 0; a < 8; a++) memcpy(x[a], coords + 3 * c[a], sizeof x[a]);
+            hex8_conduction(x, conductivity[blk], ke);
+            for (int a = 0; a < 8; a++)
+                for (int b = 0; b < 8; b++) k[dof[c[a]] * n + dof[c[b]]] += ke[a][b];
+        }
+}
+
+/* Impose u[d] = fixed[d] (not NaN) by symmetric elimination. */
+static void apply_dirichlet(double *k, double *f, size_t n, const double *fixed) {
+    for (size_t d = 0; d < n; d++) {
+        if (isnan(fixed[d])) continue;
+        for (size_t r = 0; r < n; r++) {
+            f[r] -= k[r * n + d] * fixed[d];
+            k[r * n + d] = 0.0;
+        }
+        for (size_t c = 0; c < n; c++) k[d * n + c] = 0.0;
+        k[d * n + d] = 1.0;
+    }
+    for (size_t d = 0; d < n; d++)
+        if (!isnan(fixed[d])) f[d] = fixed[d];
+}
+
 int main(void) {
     Box base = {6, 6, 6, 0};
     Box lid = {4, 4, 3, 0};
@@ -177,6 +210,16 @@ int main(void) {
     for (size_t i = 0; i < n_nodes; i++)
         dof[i] = i < (size_t)lid.first ? (int64_t)(i + n_lid_nodes) : (int64_t)(i - lid.first);
 
+    /* Dirichlet data by host dof: base bottom (z = 0) 300 K, lid top (z = 1.5) 400 K. */
+    double *fixed = malloc(sizeof(double) * n_nodes);
+    int64_t *fixed_nodes = malloc(sizeof(int64_t) * n_nodes);
+    size_t n_fixed = 0;
+    for (size_t i = 0; i < n_nodes; i++) {
+        double z = coords[3 * i + 2];
+        fixed[dof[i]] = fabs(z) < 1e-12 ? 300.0 : fabs(z - 1.5) < 1e-12 ? 400.0 : NAN;
+        if (!isnan(fixed[dof[i]])) fixed_nodes[n_fixed++] = (int64_t)i;
+    }
+
     seam_builder *b = NULL;
     seam_embedding *e = NULL;
     CHECK(seam_builder_new(coords, n_nodes, &b));
@@ -185,8 +228,8 @@ int main(void) {
     CHECK(seam_builder_add_face_set(b, "base_top", faces_base, 4, (size_t)base.nx * base.ny));
     CHECK(seam_builder_add_face_set(b, "lid_bottom", faces_lid, 4, (size_t)lid.nx * lid.ny));
     CHECK(seam_builder_set_dofs(b, dof, n_nodes));
+    CHECK(seam_builder_set_fixed_nodes(b, fixed_nodes, n_fixed));
     CHECK(seam_embedding_new(b, &e));
-    seam_builder_free(b);
 
     /* A misspelt surface is an error with a message, not a crash. */
     int status = seam_add_interaction(e, "base_topp", "lid_bottom", SEAM_GAP_CONDUCTANCE, 500.0,
@@ -200,21 +243,12 @@ int main(void) {
 
     /* The host's system: conduction of both blocks, dense, in host numbering. */
     size_t n = n_nodes;
-    double *k = calloc(n * n, sizeof(double));
+    double *k = malloc(sizeof(double) * n * n);
     double *f = calloc(n, sizeof(double));
     double *u = calloc(n, sizeof(double));
-    const int64_t *blocks[2] = {conn_base, conn_lid};
+    const int64_t *const blocks[2] = {conn_base, conn_lid};
     const size_t counts[2] = {n_base, n_lid};
-    const double conductivity[2] = {16.0, 200.0};
-    for (int blk = 0; blk < 2; blk++)
-        for (size_t el = 0; el < counts[blk]; el++) {
-            const int64_t *c = blocks[blk] + 8 * el;
-            double x[8][3], ke[8][8];
-            for (int a = 0; a < 8; a++) memcpy(x[a], coords + 3 * c[a], sizeof x[a]);
-            hex8_conduction(x, conductivity[blk], ke);
-            for (int a = 0; a < 8; a++)
-                for (int bb = 0; bb < 8; bb++) k[dof[c[a]] * n + dof[c[bb]]] += ke[a][bb];
-        }
+    assemble_conduction(k, n, coords, dof, blocks, counts);
 
     /* seam's interface terms: linear (constant h), so take them at u = 0. */
     size_t nj, nl;
@@ -226,23 +260,7 @@ int main(void) {
     CHECK(seam_load(e, &nl, &load_dofs, &load_vals));
     for (size_t t = 0; t < nl; t++) f[load_dofs[t]] += load_vals[t];
 
-    /* Dirichlet: base bottom (z = 0) at 300 K, lid top (z = 1.5) at 400 K. */
-    double *fixed = malloc(sizeof(double) * n);
-    for (size_t i = 0; i < n; i++) {
-        double z = coords[3 * i + 2];
-        fixed[dof[i]] = fabs(z) < 1e-12 ? 300.0 : fabs(z - 1.5) < 1e-12 ? 400.0 : NAN;
-    }
-    for (size_t d = 0; d < n; d++) {
-        if (isnan(fixed[d])) continue;
-        for (size_t r = 0; r < n; r++) {
-            f[r] -= k[r * n + d] * fixed[d];
-            k[r * n + d] = 0.0;
-        }
-        for (size_t c = 0; c < n; c++) k[d * n + c] = 0.0;
-        k[d * n + d] = 1.0;
-    }
-    for (size_t d = 0; d < n; d++)
-        if (!isnan(fixed[d])) f[d] = fixed[d];
+    apply_dirichlet(k, f, n, fixed);
     if (solve_dense(k, f, n) != 0) {
         fprintf(stderr, "singular system\n");
         return 1;
@@ -255,7 +273,61 @@ int main(void) {
     printf("interface heat: side A %.17g W, side B %.17g W\n", q_a, q_b);
 
     seam_embedding_free(e);
+
+    /* The same blocks tied by dual mortar, which this host (no multipliers) condenses:
+     * u = T v + g, solve T^T K T v = T^T (F - K g), then recover the side-A values. */
+    seam_embedding *tie = NULL;
+    size_t n_rows;
+    const int64_t *row_dof, *row_cols;
+    const double *row_const, *row_coef;
+    const size_t *row_off;
+    CHECK(seam_embedding_new(b, &tie));
+    CHECK(seam_add_interaction(tie, "base_top", "lid_bottom", SEAM_TIED_DUAL_MORTAR, 0.0, 0.0,
+                               NULL));
+    CHECK(seam_search(tie));
+    CHECK(seam_constraints(tie, &n_rows, &row_dof, &row_const, &row_off, &row_cols, &row_coef));
+    double *k0 = malloc(sizeof(double) * n * n);
+    assemble_conduction(k0, n, coords, dof, blocks, counts);
+    memcpy(k, k0, sizeof(double) * n * n);
+    memset(f, 0, sizeof(double) * n);
+    for (size_t r = 0; r < n_rows; r++)
+        for (size_t i = 0; i < n; i++) f[i] -= k0[i * n + row_dof[r]] * row_const[r];
+    for (size_t r = 0; r < n_rows; r++) /* rows: T^T */
+        for (size_t t = row_off[r]; t < row_off[r + 1]; t++) {
+            f[row_cols[t]] += row_coef[t] * f[row_dof[r]];
+            for (size_t c = 0; c < n; c++) k[row_cols[t] * n + c] += row_coef[t] * k[row_dof[r] * n + c];
+        }
+    for (size_t r = 0; r < n_rows; r++) /* columns: T */
+        for (size_t t = row_off[r]; t < row_off[r + 1]; t++)
+            for (size_t i = 0; i < n; i++) k[i * n + row_cols[t]] += row_coef[t] * k[i * n + row_dof[r]];
+    for (size_t r = 0; r < n_rows; r++) {
+        size_t d = (size_t)row_dof[r];
+        for (size_t i = 0; i < n; i++) k[d * n + i] = k[i * n + d] = 0.0;
+        k[d * n + d] = 1.0;
+        f[d] = 0.0;
+    }
+    apply_dirichlet(k, f, n, fixed);
+    if (solve_dense(k, f, n) != 0) {
+        fprintf(stderr, "singular condensed system\n");
+        return 1;
+    }
+    for (size_t r = 0; r < n_rows; r++) {
+        double v = row_const[r];
+        for (size_t t = row_off[r]; t < row_off[r + 1]; t++) v += row_coef[t] * f[row_cols[t]];
+        f[row_dof[r]] = v;
+    }
+    /* The heat follows from the host's own residual K u - F (F = 0 here). */
+    for (size_t i = 0; i < n; i++) {
+        double s = 0.0;
+        for (size_t c = 0; c < n; c++) s += k0[i * n + c] * f[c];
+        u[i] = s;
+    }
+    CHECK(seam_dual_tie_heat(tie, 0, u, n, &q_a, &q_b));
+    printf("dual tie heat: side A %.17g W, side B %.17g W\n", q_a, q_b);
+
+    seam_embedding_free(tie);
+    seam_builder_free(b);
     free(coords), free(conn_base), free(conn_lid), free(faces_base), free(faces_lid);
-    free(dof), free(k), free(f), free(u), free(fixed);
+    free(dof), free(k), free(k0), free(f), free(u), free(fixed), free(fixed_nodes);
     return 0;
 }

@@ -119,7 +119,12 @@ fn embed_c_host_matches_seam_run() {
         "{}",
         String::from_utf8_lossy(&build.stderr)
     );
-    let run = Command::new(&out).output().unwrap();
+    // cargo's LD_LIBRARY_PATH for tests also names target/<profile>, where an older
+    // libseam.so from `cargo build` may sit; it outranks the rpath, so pin it here.
+    let run = Command::new(&out)
+        .env("LD_LIBRARY_PATH", &lib)
+        .output()
+        .unwrap();
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(
         run.status.success(),
@@ -153,15 +158,31 @@ fn embed_c_host_matches_seam_run() {
         relative(b, reference_b) <= TOLERANCE,
         "{b} vs {reference_b}"
     );
+    // Its dual mortar tie, condensed in C, against seam run's dual solve.
+    let dual: Vec<f64> = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("dual tie heat: side A "))
+        .map(|rest| {
+            rest.split(|c: char| c == ',' || c.is_whitespace())
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        })
+        .unwrap_or_else(|| panic!("no dual tie heat line in:\n{stdout}"));
+    let (reference, _) = seam_run("c-dual", &tie_deck("dual"));
+    println!(
+        "C host dual tie {:.15e} W, seam run {reference:.15e} W: {:.2e}",
+        dual[0],
+        relative(dual[0], reference)
+    );
+    assert!(relative(dual[0], reference) <= TOLERANCE);
+    assert!(relative(-dual[1], reference) <= TOLERANCE);
     let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
-/// Dual mortar through the condensed rows: a host without multipliers substitutes
-/// `u_A = g + Σ c u` and solves the reduced SPD system; its heat (from its residual)
-/// matches `seam run`'s saddle-free dual solve.
-#[test]
-fn embed_dual_mortar_rows_match_seam_run() {
-    let deck = "begin contact definition tie
+/// The two-block interface tied by mortar with `multipliers` (`dual` or `standard`).
+fn tie_deck(multipliers: &str) -> String {
+    format!(
+        "begin contact definition tie
   contact surface interface_base contains base_top
   contact surface interface_lid contains lid_bottom
   begin interaction
@@ -169,12 +190,21 @@ fn embed_dual_mortar_rows_match_seam_run() {
     side b interface_lid
   end
   begin enforcement
-    enforcement for energy = tied multipliers = dual
+    enforcement for energy = tied multipliers = {multipliers}
     side b variable temperature to temperature
   end
 end
-";
-    let (reference, _) = seam_run("dual", deck);
+"
+    )
+}
+
+/// Dual mortar through the condensed rows: a host without multipliers substitutes
+/// `u_A = g + Σ c u` and solves the reduced SPD system; its heat (from its residual)
+/// matches `seam run`'s saddle-free dual solve.
+#[test]
+fn embed_dual_mortar_rows_match_seam_run() {
+    let deck = tie_deck("dual");
+    let (reference, _) = seam_run("dual", &deck);
     let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
     let n = mesh.num_nodes();
     let dof = example::host_dofs(&mesh);
@@ -184,7 +214,7 @@ end
         .fixed_nodes(&fixed_nodes)
         .build()
         .unwrap();
-    seam.add_deck("tie.i", deck).unwrap();
+    seam.add_deck("tie.i", &deck).unwrap();
     seam.search().unwrap();
     let ties = seam.constraints().unwrap();
     assert_eq!(ties.len(), 1);
@@ -257,6 +287,69 @@ end
     );
     assert!(err <= TOLERANCE, "{err:.3e}");
     assert!(relative(-heat.side_b, reference) <= TOLERANCE);
+}
+
+/// Standard multipliers: a host that carries them solves `[K Cᵀ; C 0] [u; λ] = [F; g]`
+/// with seam's rows (here densely, with pivoting) and gets `seam run`'s heat from λ.
+#[test]
+fn embed_standard_mortar_rows_match_seam_run() {
+    let deck = tie_deck("standard");
+    let (reference, _) = seam_run("standard", &deck);
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let n = mesh.num_nodes();
+    let dof = example::host_dofs(&mesh);
+    let fixed = example::dirichlet(&mesh, &dof).unwrap();
+    let fixed_nodes: Vec<usize> = (0..n).filter(|&i| fixed[dof[i]].is_some()).collect();
+    let mut seam = example::embedding(&mesh, &dof)
+        .fixed_nodes(&fixed_nodes)
+        .build()
+        .unwrap();
+    seam.add_deck("tie.i", &deck).unwrap();
+    seam.search().unwrap();
+    let ties = seam.constraints().unwrap();
+    let tie = &ties[0];
+    assert!(
+        tie.condensed.is_empty(),
+        "standard multipliers are not condensed"
+    );
+    let m = tie.multiplier_dofs.len();
+    let size = n + m;
+    let k = example::conduction(&mesh, &dof).unwrap();
+    let mut a = vec![0.0; size * size];
+    for row in 0..n {
+        a[row * size..row * size + n].copy_from_slice(&k[row * n..(row + 1) * n]);
+    }
+    for &(mult, j, c) in &tie.entries {
+        a[(n + mult) * size + j] += c;
+        a[j * size + n + mult] += c;
+    }
+    let mut f = vec![0.0; size];
+    f[n..].copy_from_slice(&tie.rhs);
+    for (d, value) in fixed.iter().enumerate() {
+        if let Some(g) = value {
+            for row in 0..size {
+                f[row] -= a[row * size + d] * g;
+                a[row * size + d] = 0.0;
+            }
+            a[d * size..(d + 1) * size].fill(0.0);
+            a[d * size + d] = 1.0;
+        }
+    }
+    for (d, value) in fixed.iter().enumerate() {
+        if let Some(g) = value {
+            f[d] = *g;
+        }
+    }
+    let x = example::solve_dense(a, f, size).unwrap();
+    let heat = tie.heat(&x[n..]).unwrap();
+    let err = relative(heat.side_a, reference);
+    println!(
+        "standard rows {:.15e} W, seam run {reference:.15e} W: {err:.2e}",
+        heat.side_a
+    );
+    assert!(err <= TOLERANCE, "{err:.3e}");
+    // A host that condensed standard multipliers has nothing to read them from.
+    assert!(tie.dual_multipliers(&vec![0.0; n]).is_err());
 }
 
 /// The Jacobian in host numbering is the derivative of the residual in host
