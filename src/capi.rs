@@ -116,6 +116,12 @@ unsafe fn slice<'a, T>(ptr: *const T, len: usize, what: &str) -> Result<&'a [T],
     if ptr.is_null() {
         return Err(null(what));
     }
+    if len > isize::MAX as usize / std::mem::size_of::<T>().max(1) {
+        return Err(bad(
+            format!("{what}: {len} entries is more than any array can hold"),
+            "check the count passed with the array",
+        ));
+    }
     // SAFETY: the caller promises `ptr` is valid for `len` elements (module Safety).
     Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
 }
