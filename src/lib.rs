@@ -5,8 +5,10 @@
 //! rules), [`plugin`] (user enforcement models loaded as shared libraries). Diagnostics shared by all of them live in [`diag`].
 
 pub mod assembly;
+pub mod capi;
 pub mod deck;
 pub mod diag;
+pub mod embed;
 pub mod enforce;
 pub mod heat;
 pub mod interaction;

@@ -6,6 +6,7 @@ mod cases;
 mod cli;
 mod conductance;
 mod docs;
+mod embed;
 mod enforce;
 mod examples;
 mod fem;

@@ -1,0 +1,710 @@
+//! The embedding APIs (`seam::embed`, `libseam` + `seam.h`) against `seam run` on the
+//! same scene, their Jacobian against finite differences, and their error paths.
+//!
+//! Tolerance of the heat comparisons: 1e-9 relative. The hosts assemble the same
+//! discrete equations as `seam run` but in other orders (own numbering, dense
+//! Gaussian elimination instead of sparse Cholesky, a mesh generated in C), so the
+//! answers differ by round-off amplified by the condition number of the system
+//! (~1e4 here): ~1e-12 relative; 1e-9 leaves room for that and still catches any
+//! modelling difference (a wrong dof mapping, a missed face or a changed form moves
+//! the heat by percents).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use seam::embed::{EmbedError, Embedding, Interaction, Model, Multipliers, Topology};
+
+#[path = "../../examples/embed.rs"]
+#[allow(dead_code)]
+mod example;
+
+const TOLERANCE: f64 = 1e-9;
+
+fn scene() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("seam-embed-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `seam run` on the two-block problem with the contact deck `deck` (text), written
+/// to a scratch folder without output; returns (heat side A, heat side B).
+fn seam_run(name: &str, deck: &str) -> (f64, f64) {
+    let dir = scratch(name);
+    let problem = std::fs::read_to_string(scene().join("problem.toml")).unwrap();
+    let mesh = scene().join("two_blocks.exo");
+    let problem = problem
+        .replace(
+            "file = \"two_blocks.exo\"",
+            &format!("file = {:?}", mesh.display().to_string()),
+        )
+        .replace("file = \"contact_run.i\"", "file = \"contact.i\"")
+        .replace("[output]\ndir = \"out\"", "");
+    assert!(
+        !problem.contains("out\""),
+        "the reference run must write nothing"
+    );
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    std::fs::write(dir.join("contact.i"), deck).unwrap();
+    let result = match seam::run::run(&dir.join("problem.toml")) {
+        Ok(r) => r,
+        Err(e) => panic!("seam run failed: {e:?}"),
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    let i = &result.summary.interactions[0];
+    (i.heat_side_a, i.heat_side_b)
+}
+
+fn relative(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+#[test]
+fn embed_rust_example_matches_seam_run() {
+    let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
+    let (reference, _) = seam_run("rust", &deck);
+    let outcome = example::solve(&scene()).unwrap();
+    let err = relative(outcome.heat.side_a, reference);
+    println!(
+        "embed example {:.15e} W, seam run {reference:.15e} W: relative difference {err:.2e}",
+        outcome.heat.side_a
+    );
+    assert!(err <= TOLERANCE, "{err:.3e}");
+    // The lid (400 K) heats the base (300 K): heat leaving side A (the base) is negative.
+    assert!(reference < 0.0, "{reference}");
+    // A constant h is linear: one Newton step solves, the second confirms.
+    assert_eq!(outcome.newton_steps, 2);
+}
+
+/// Where cargo put libseam: `cargo test` builds the cdylib next to this test binary in
+/// target/<profile>/deps/; `cargo build` puts it in target/<profile>/.
+fn library_dir(file: &str) -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let deps = exe.parent().unwrap();
+    [deps, deps.parent().unwrap()]
+        .into_iter()
+        .find(|d| d.join(file).exists())
+        .unwrap_or_else(|| panic!("{file} is in neither {} nor its parent: seam is built as a cdylib (Cargo.toml [lib] crate-type)", deps.display()))
+        .to_path_buf()
+}
+
+#[test]
+fn embed_c_host_matches_seam_run() {
+    let lib = library_dir(if cfg!(target_os = "macos") {
+        "libseam.dylib"
+    } else {
+        "libseam.so"
+    });
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = scratch("c").join("c_host");
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let build = Command::new(&cc)
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-I"])
+        .arg(root.join("include"))
+        .arg(root.join("examples/c_host/main.c"))
+        .arg("-L")
+        .arg(&lib)
+        .arg("-lseam")
+        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        .arg("-lm")
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run the C compiler `{cc}`: {e}"));
+    assert!(
+        build.status.success(),
+        "{}",
+        String::from_utf8_lossy(&build.stderr)
+    );
+    // cargo's LD_LIBRARY_PATH for tests also names target/<profile>, where an older
+    // libseam.so from `cargo build` may sit; it outranks the rpath, so pin it here.
+    let run = Command::new(&out)
+        .env("LD_LIBRARY_PATH", &lib)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    // The misspelt surface came back as SEAM_ERR_ARGUMENT with a suggestion.
+    assert!(
+        stdout.contains("expected error 4: unknown surface `base_topp`")
+            && stdout.contains("did you mean `base_top`?"),
+        "{stdout}"
+    );
+    let heat: Vec<f64> = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("interface heat: side A "))
+        .map(|rest| {
+            rest.split(|c: char| c == ',' || c.is_whitespace())
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        })
+        .unwrap_or_else(|| panic!("no heat line in:\n{stdout}"));
+    let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
+    let (reference, reference_b) = seam_run("c-reference", &deck);
+    let (a, b) = (heat[0], heat[1]);
+    println!(
+        "C host {a:.15e} W, seam run {reference:.15e} W: {:.2e}",
+        relative(a, reference)
+    );
+    assert!(relative(a, reference) <= TOLERANCE, "{a} vs {reference}");
+    assert!(
+        relative(b, reference_b) <= TOLERANCE,
+        "{b} vs {reference_b}"
+    );
+    // Its dual mortar tie, condensed in C, against seam run's dual solve.
+    let dual: Vec<f64> = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("dual tie heat: side A "))
+        .map(|rest| {
+            rest.split(|c: char| c == ',' || c.is_whitespace())
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        })
+        .unwrap_or_else(|| panic!("no dual tie heat line in:\n{stdout}"));
+    let (reference, _) = seam_run("c-dual", &tie_deck("dual"));
+    println!(
+        "C host dual tie {:.15e} W, seam run {reference:.15e} W: {:.2e}",
+        dual[0],
+        relative(dual[0], reference)
+    );
+    assert!(relative(dual[0], reference) <= TOLERANCE);
+    assert!(relative(-dual[1], reference) <= TOLERANCE);
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
+
+/// The two-block interface tied by mortar with `multipliers` (`dual` or `standard`).
+fn tie_deck(multipliers: &str) -> String {
+    format!(
+        "begin contact definition tie
+  contact surface interface_base contains base_top
+  contact surface interface_lid contains lid_bottom
+  begin interaction
+    side a interface_base
+    side b interface_lid
+  end
+  begin enforcement
+    enforcement for energy = tied multipliers = {multipliers}
+    side b variable temperature to temperature
+  end
+end
+"
+    )
+}
+
+/// Dual mortar through the condensed rows: a host without multipliers substitutes
+/// `u_A = g + Σ c u` and solves the reduced SPD system; its heat (from its residual)
+/// matches `seam run`'s saddle-free dual solve.
+#[test]
+fn embed_dual_mortar_rows_match_seam_run() {
+    let deck = tie_deck("dual");
+    let (reference, _) = seam_run("dual", &deck);
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let n = mesh.num_nodes();
+    let dof = example::host_dofs(&mesh);
+    let fixed = example::dirichlet(&mesh, &dof).unwrap();
+    let fixed_nodes: Vec<usize> = (0..n).filter(|&i| fixed[dof[i]].is_some()).collect();
+    let mut seam = example::embedding(&mesh, &dof)
+        .fixed_nodes(&fixed_nodes)
+        .build()
+        .unwrap();
+    seam.add_deck("tie.i", &deck).unwrap();
+    seam.search().unwrap();
+    let ties = seam.constraints().unwrap();
+    assert_eq!(ties.len(), 1);
+    let rows = &ties[0].condensed;
+    // One row per base_top node: a 7 × 7 grid.
+    assert_eq!(rows.len(), 49);
+
+    // Reduce K u = 0 (no sources) by u = T ũ + g, then impose the Dirichlet data.
+    let k = example::conduction(&mesh, &dof).unwrap();
+    let mut a = k.clone();
+    let mut f = vec![0.0; n];
+    for r in rows {
+        for row in 0..n {
+            f[row] -= k[row * n + r.dof] * r.constant;
+        }
+    }
+    for r in rows {
+        for &(j, c) in &r.terms {
+            f[j] += c * f[r.dof];
+            for col in 0..n {
+                a[j * n + col] += c * a[r.dof * n + col];
+            }
+        }
+    }
+    for r in rows {
+        for &(j, c) in &r.terms {
+            for row in 0..n {
+                a[row * n + j] += c * a[row * n + r.dof];
+            }
+        }
+    }
+    let condensed: Vec<usize> = rows.iter().map(|r| r.dof).collect();
+    for &d in &condensed {
+        for i in 0..n {
+            a[d * n + i] = 0.0;
+            a[i * n + d] = 0.0;
+        }
+        a[d * n + d] = 1.0;
+        f[d] = 0.0;
+    }
+    for (d, value) in fixed.iter().enumerate() {
+        if let Some(g) = value {
+            for row in 0..n {
+                f[row] -= a[row * n + d] * g;
+                a[row * n + d] = 0.0;
+            }
+            a[d * n..(d + 1) * n].fill(0.0);
+            a[d * n + d] = 1.0;
+        }
+    }
+    for (d, value) in fixed.iter().enumerate() {
+        if let Some(g) = value {
+            f[d] = *g;
+        }
+    }
+    let mut u = example::solve_dense(a, f, n).unwrap();
+    for r in rows {
+        u[r.dof] = r.constant + r.terms.iter().map(|&(j, c)| c * u[j]).sum::<f64>();
+    }
+    // The host's own residual K u − F (F = 0) gives the multipliers and the heat.
+    let residual: Vec<f64> = (0..n)
+        .map(|row| (0..n).map(|col| k[row * n + col] * u[col]).sum())
+        .collect();
+    let lambda = ties[0].dual_multipliers(&residual).unwrap();
+    let heat = ties[0].heat(&lambda).unwrap();
+    let err = relative(heat.side_a, reference);
+    println!(
+        "dual rows {:.15e} W, seam run {reference:.15e} W: {err:.2e}",
+        heat.side_a
+    );
+    assert!(err <= TOLERANCE, "{err:.3e}");
+    assert!(relative(-heat.side_b, reference) <= TOLERANCE);
+}
+
+/// Standard multipliers: a host that carries them solves `[K Cᵀ; C 0] [u; λ] = [F; g]`
+/// with seam's rows (here densely, with pivoting) and gets `seam run`'s heat from λ.
+#[test]
+fn embed_standard_mortar_rows_match_seam_run() {
+    let deck = tie_deck("standard");
+    let (reference, _) = seam_run("standard", &deck);
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let n = mesh.num_nodes();
+    let dof = example::host_dofs(&mesh);
+    let fixed = example::dirichlet(&mesh, &dof).unwrap();
+    let fixed_nodes: Vec<usize> = (0..n).filter(|&i| fixed[dof[i]].is_some()).collect();
+    let mut seam = example::embedding(&mesh, &dof)
+        .fixed_nodes(&fixed_nodes)
+        .build()
+        .unwrap();
+    seam.add_deck("tie.i", &deck).unwrap();
+    seam.search().unwrap();
+    let ties = seam.constraints().unwrap();
+    let tie = &ties[0];
+    assert!(
+        tie.condensed.is_empty(),
+        "standard multipliers are not condensed"
+    );
+    let m = tie.multiplier_dofs.len();
+    let size = n + m;
+    let k = example::conduction(&mesh, &dof).unwrap();
+    let mut a = vec![0.0; size * size];
+    for row in 0..n {
+        a[row * size..row * size + n].copy_from_slice(&k[row * n..(row + 1) * n]);
+    }
+    for &(mult, j, c) in &tie.entries {
+        a[(n + mult) * size + j] += c;
+        a[j * size + n + mult] += c;
+    }
+    let mut f = vec![0.0; size];
+    f[n..].copy_from_slice(&tie.rhs);
+    for (d, value) in fixed.iter().enumerate() {
+        if let Some(g) = value {
+            for row in 0..size {
+                f[row] -= a[row * size + d] * g;
+                a[row * size + d] = 0.0;
+            }
+            a[d * size..(d + 1) * size].fill(0.0);
+            a[d * size + d] = 1.0;
+        }
+    }
+    for (d, value) in fixed.iter().enumerate() {
+        if let Some(g) = value {
+            f[d] = *g;
+        }
+    }
+    let x = example::solve_dense(a, f, size).unwrap();
+    let heat = tie.heat(&x[n..]).unwrap();
+    let err = relative(heat.side_a, reference);
+    println!(
+        "standard rows {:.15e} W, seam run {reference:.15e} W: {err:.2e}",
+        heat.side_a
+    );
+    assert!(err <= TOLERANCE, "{err:.3e}");
+    // A host that condensed standard multipliers has nothing to read them from.
+    assert!(tie.dual_multipliers(&vec![0.0; n]).is_err());
+}
+
+/// The Jacobian in host numbering is the derivative of the residual in host
+/// numbering: central differences of a temperature-dependent (radiation) conductance,
+/// step 1e-3 K on a ~350 K field (truncation ~1e-6 × h'' relative, round-off ~1e-13 /
+/// 1e-3), agree to 1e-6 relative of the largest entry.
+#[test]
+fn embed_jacobian_matches_finite_differences() {
+    let deck = "begin contact definition rad
+  contact surface a contains base_top
+  contact surface b contains lid_bottom
+  begin interaction
+    side a a
+    side b b
+  end
+  begin enforcement
+    enforcement for energy = gap_conductance
+    gap conductance coefficient = radiation emissivity_a = 0.8 emissivity_b = 0.6
+  end
+end
+";
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let n = mesh.num_nodes();
+    let dof = example::host_dofs(&mesh);
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_deck("rad.i", deck).unwrap();
+    seam.search().unwrap();
+    // A field that varies over the interface: T = 300 + 50 z + 10 x y.
+    let mut u = vec![0.0; n];
+    for (i, x) in mesh.coords.iter().enumerate() {
+        u[dof[i]] = 300.0 + 50.0 * x[2] + 10.0 * x[0] * x[1];
+    }
+    let c = seam.contributions(&u).unwrap();
+    let mut jac = vec![0.0; n * n];
+    for &(i, j, v) in &c.jacobian {
+        jac[i * n + j] += v;
+    }
+    let dense_residual = |u: &[f64]| {
+        let mut r = vec![0.0; n];
+        for (d, v) in seam.contributions(u).unwrap().residual {
+            r[d] += v;
+        }
+        r
+    };
+    let scale = jac.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0);
+    let step = 1e-3;
+    let mut worst = 0.0f64;
+    let columns: Vec<usize> = c.jacobian.iter().map(|t| t.1).step_by(97).collect();
+    assert!(columns.len() > 10);
+    for &col in &columns {
+        let (mut up, mut down) = (u.clone(), u.clone());
+        up[col] += step;
+        down[col] -= step;
+        let (rp, rm) = (dense_residual(&up), dense_residual(&down));
+        for row in 0..n {
+            let fd = (rp[row] - rm[row]) / (2.0 * step);
+            worst = worst.max((fd - jac[row * n + col]).abs() / scale);
+        }
+    }
+    assert!(worst <= 1e-6, "{worst:.3e}");
+    // The model really is nonlinear here: the Jacobian differs from the one at a
+    // uniform shift of the field.
+    let shifted: Vec<f64> = u.iter().map(|x| x + 100.0).collect();
+    let c2 = seam.contributions(&shifted).unwrap();
+    assert_ne!(c.jacobian, c2.jacobian);
+}
+
+/// Programmatic interactions and face lists: the same gap conductance built in code on
+/// faces given by their nodes gives the heat of the deck on side sets.
+#[test]
+fn embed_face_lists_and_code_match_deck_and_side_sets() {
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let mut u = vec![0.0; mesh.num_nodes()];
+    for (i, x) in mesh.coords.iter().enumerate() {
+        u[dof[i]] = 300.0 + 60.0 * x[2] - 5.0 * x[0];
+    }
+    let mut by_deck = example::embedding(&mesh, &dof).build().unwrap();
+    by_deck
+        .add_deck_file(&scene().join("contact_run.i"))
+        .unwrap();
+    by_deck.search().unwrap();
+    let expected = by_deck.contributions(&u).unwrap().heat[0].unwrap();
+
+    let faces = |set: &str| -> Vec<Vec<usize>> {
+        let s = mesh.find_side_set(set).unwrap();
+        mesh.side_sets[s]
+            .sides
+            .iter()
+            // Reversed node order: orientation comes from the element, not the list.
+            .map(|&side| {
+                let mut nodes: Vec<usize> = mesh.side_nodes(side).map(|n| n.index()).collect();
+                nodes.reverse();
+                nodes
+            })
+            .collect()
+    };
+    let mut builder = Embedding::builder(&mesh.coords);
+    for block in &mesh.blocks {
+        let conn: Vec<usize> = block.connectivity.iter().map(|n| n.index()).collect();
+        builder = builder.block(
+            &block.name,
+            block.topology,
+            &conn,
+            example::conductivity_of(&block.name),
+        );
+    }
+    let mut by_code = builder
+        .face_set("top", &faces("base_top"))
+        .face_set("bottom", &faces("lid_bottom"))
+        .dofs(&dof)
+        .build()
+        .unwrap();
+    by_code
+        .add_interaction(Interaction::new(
+            "top",
+            "bottom",
+            Model::GapConductance { h: 500.0 },
+        ))
+        .unwrap();
+    by_code.search().unwrap();
+    let got = by_code.contributions(&u).unwrap().heat[0].unwrap();
+    assert!(relative(got.side_a, expected.side_a) <= 1e-12);
+    assert!(relative(got.side_b, expected.side_b) <= 1e-12);
+    assert!(expected.side_a.abs() > 1.0);
+}
+
+/// Moving the lid up keeps the pairing and measures the opened gap; a new search pairs
+/// the same points again.
+#[test]
+fn embed_move_nodes_updates_gaps() {
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_interaction(Interaction::new(
+        "base_top",
+        "lid_bottom",
+        Model::Conductance { h: 500.0 },
+    ))
+    .unwrap();
+    seam.search().unwrap();
+    let before = seam.search_stats(0).unwrap().clone();
+    assert!(before.gap_max.unwrap().abs() < 1e-12, "{before:?}");
+    let lid = mesh.find_block("lid").unwrap();
+    let mut lid_nodes: Vec<usize> = mesh.blocks[lid]
+        .connectivity
+        .iter()
+        .map(|n| n.index())
+        .collect();
+    lid_nodes.sort_unstable();
+    lid_nodes.dedup();
+    let mut moved = mesh.coords.clone();
+    for n in lid_nodes {
+        moved[n][2] += 1e-3;
+    }
+    seam.move_nodes(&moved).unwrap();
+    let after = seam.search_stats(0).unwrap();
+    assert_eq!(after.matched, before.matched);
+    let g = after.gap_max.unwrap();
+    assert!((g - 1e-3).abs() < 1e-12, "{g}");
+    seam.search().unwrap();
+    assert_eq!(seam.search_stats(0).unwrap().matched, before.matched);
+}
+
+#[test]
+fn embed_bad_input_is_an_error_that_says_where() {
+    let coords = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    let conn: Vec<usize> = (0..8).collect();
+    let message = |r: Result<Embedding, EmbedError>| match r {
+        Ok(_) => panic!("accepted bad input"),
+        Err(e) => e.to_string(),
+    };
+    // A node index past the end.
+    let mut bad = conn.clone();
+    bad[3] = 8;
+    let m = message(
+        Embedding::builder(&coords)
+            .block("b", Topology::Hex8, &bad, 1.0)
+            .dofs(&conn)
+            .build(),
+    );
+    assert!(
+        m.contains("element 0 (local node 4): node 8 does not exist") && m.contains("help:"),
+        "{m}"
+    );
+    // A face that is no side of any element.
+    let m = message(
+        Embedding::builder(&coords)
+            .block("b", Topology::Hex8, &conn, 1.0)
+            .face_set("top", &[[0, 1, 6, 7]])
+            .dofs(&conn)
+            .build(),
+    );
+    assert!(
+        m.contains("surface `top`, face 0") && m.contains("no side"),
+        "{m}"
+    );
+    // Missing dofs, then a short field.
+    let m = message(
+        Embedding::builder(&coords)
+            .block("b", Topology::Hex8, &conn, 1.0)
+            .build(),
+    );
+    assert!(m.contains("no dof numbers"), "{m}");
+    let mut e = Embedding::builder(&coords)
+        .block("b", Topology::Hex8, &conn, 1.0)
+        .face_set("top", &[[4, 5, 6, 7]])
+        .side_set("bottom", &[(0, 5)])
+        .dofs(&conn)
+        .build()
+        .unwrap();
+    let err = e
+        .add_interaction(Interaction::new("topp", "bottom", Model::TiedNitsche))
+        .unwrap_err();
+    assert!(err.to_string().contains("did you mean `top`?"), "{err}");
+    let err = e
+        .add_interaction(Interaction::new(
+            "top",
+            "bottom",
+            Model::GapConductance { h: -1.0 },
+        ))
+        .unwrap_err();
+    assert!(err.to_string().contains("h = -1"), "{err}");
+    e.add_interaction(Interaction::new(
+        "top",
+        "bottom",
+        Model::TiedMortar {
+            multipliers: Multipliers::Dual,
+        },
+    ))
+    .unwrap();
+    let err = e.contributions(&[0.0; 8]).unwrap_err();
+    assert!(matches!(err, EmbedError::Order { .. }), "{err}");
+    // Top and bottom of one element face apart, a unit away: nothing to tie.
+    let err = e.search().unwrap_err();
+    assert!(err.to_string().contains("do not overlap anywhere"), "{err}");
+    let mut e = Embedding::builder(&coords)
+        .block("b", Topology::Hex8, &conn, 1.0)
+        .face_set("top", &[[4, 5, 6, 7]])
+        .side_set("bottom", &[(0, 5)])
+        .dofs(&conn)
+        .build()
+        .unwrap();
+    e.add_interaction(Interaction::new(
+        "top",
+        "bottom",
+        Model::Conductance { h: 1.0 },
+    ))
+    .unwrap();
+    e.search().unwrap();
+    let err = e.contributions(&[0.0; 3]).unwrap_err();
+    assert!(err.to_string().contains("dof 3 is needed"), "{err}");
+    let err = e.add_deck("bad.i", "begin contact definition\n  frobnicate\nend\n");
+    assert!(matches!(err, Err(EmbedError::Deck(_))), "{err:?}");
+}
+
+/// The C API's boundary: null pointers, unknown codes and a panic-free failure path,
+/// called through the Rust declarations of the same functions.
+#[test]
+fn embed_c_api_reports_errors_by_code() {
+    use seam::capi::*;
+    use std::ffi::CStr;
+    let last = || {
+        unsafe { CStr::from_ptr(seam_last_error()) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    let mut b = std::ptr::null_mut();
+    let status = unsafe { seam_builder_new(std::ptr::null(), 3, &mut b) };
+    assert_eq!(status, SeamStatus::NullArgument as i32);
+    assert!(last().contains("coords is null"), "{}", last());
+    let coords = [0.0f64; 24];
+    assert_eq!(unsafe { seam_builder_new(coords.as_ptr(), 8, &mut b) }, 0);
+    let conn: Vec<i64> = (0..8).collect();
+    let name = c"b";
+    let status = unsafe { seam_builder_add_block(b, name.as_ptr(), 99, conn.as_ptr(), 1, 1.0) };
+    assert_eq!(status, SeamStatus::Argument as i32);
+    assert!(last().contains("unknown topology code 99"), "{}", last());
+    // All nodes at the origin: the element is degenerate, a mesh error, not a crash.
+    assert_eq!(
+        unsafe { seam_builder_add_block(b, name.as_ptr(), 1, conn.as_ptr(), 1, 1.0) },
+        0
+    );
+    assert_eq!(unsafe { seam_builder_set_dofs(b, conn.as_ptr(), 8) }, 0);
+    let mut e = std::ptr::null_mut();
+    let status = unsafe { seam_embedding_new(b, &mut e) };
+    assert_eq!(status, SeamStatus::Mesh as i32, "{}", last());
+    assert!(e.is_null());
+    assert!(last().contains("degenerate"), "{}", last());
+    unsafe { seam_builder_free(b) };
+    let status = unsafe { seam_search(std::ptr::null_mut()) };
+    assert_eq!(status, SeamStatus::NullArgument as i32);
+}
+
+/// Every function the C API exports is declared in `include/seam.h` and every
+/// declaration is exported, with the same number of parameters.
+#[test]
+fn embed_header_declares_the_exported_functions() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let source = std::fs::read_to_string(root.join("src/capi.rs")).unwrap();
+    let text = std::fs::read_to_string(root.join("include/seam.h")).unwrap();
+    // Declarations only: drop the comments (their usage lines name the functions too).
+    let mut header = String::new();
+    let mut rest = text.as_str();
+    while let Some(open) = rest.find("/*") {
+        header.push_str(&rest[..open]);
+        rest = rest[open..]
+            .find("*/")
+            .map_or("", |close| &rest[open + close + 2..]);
+    }
+    header.push_str(rest);
+    // name → parameter count, from `extern "C" fn name(a: A, b: B) -> R`.
+    let arity = |text: &str, open: usize| -> usize {
+        let close = open + text[open..].find(')').unwrap();
+        let inside = text[open + 1..close].trim();
+        if inside.is_empty() || inside == "void" {
+            0
+        } else {
+            inside.split(',').filter(|p| !p.trim().is_empty()).count()
+        }
+    };
+    let mut exported = Vec::new();
+    for (at, _) in source.match_indices("extern \"C\" fn seam_") {
+        let start = at + "extern \"C\" fn ".len();
+        let open = start + source[start..].find('(').unwrap();
+        let name = &source[start..open];
+        exported.push((name.to_string(), arity(&source, open)));
+    }
+    let mut declared = Vec::new();
+    for (at, _) in header
+        .match_indices(" seam_")
+        .chain(header.match_indices("*seam_"))
+    {
+        let start = at + 1;
+        let Some(len) = header[start..].find(|c: char| !(c.is_alphanumeric() || c == '_')) else {
+            continue;
+        };
+        let name = &header[start..start + len];
+        if header[start + len..].starts_with('(') {
+            declared.push((name.to_string(), arity(&header, start + len)));
+        }
+    }
+    exported.sort();
+    declared.sort();
+    declared.dedup();
+    assert!(exported.len() >= 20, "{exported:?}");
+    assert_eq!(exported, declared);
+}
