@@ -958,7 +958,10 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             write_vtu(&file, &mesh, &point)
                 .map_err(|e| RunError::Solve(format!("cannot write {}: {e}", file.display())))?;
             let io = |e: std::io::Error| {
-                RunError::Solve(format!("cannot write the results in {}: {e}", out_dir.display()))
+                RunError::Solve(format!(
+                    "cannot write the results in {}: {e}",
+                    out_dir.display()
+                ))
             };
             if linear_steady {
                 writer
@@ -988,8 +991,15 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                     .find(|q| q.status == PointStatus::Matched)
                     .map(|q| (q.x, q.normal_a))
             });
-            steps::write_plots(out_dir, &mesh, &solution.temperature, &history, &labels, line)
-                .map_err(io)?;
+            steps::write_plots(
+                out_dir,
+                &mesh,
+                &solution.temperature,
+                &history,
+                &labels,
+                line,
+            )
+            .map_err(io)?;
             Some(file)
         }
         None => None,

@@ -90,15 +90,27 @@ impl<'m> StepWriter<'m> {
         Ok(())
     }
 
-    fn write_fields(&mut self, state: &State, dofs: &DofMap, fields: &[String]) -> std::io::Result<()> {
+    fn write_fields(
+        &mut self,
+        state: &State,
+        dofs: &DofMap,
+        fields: &[String],
+    ) -> std::io::Result<()> {
         let t = nodal_temperature(dofs, &state.u, fields);
         self.write_temperature(state.step, state.time, &t)
     }
 
     /// One step's temperature: `temperature_<step>.vtu` in the `.pvd` series (transient
     /// runs) and a step of `results.exo`.
-    pub(super) fn write_temperature(&mut self, step: usize, time: f64, t: &[f64]) -> std::io::Result<()> {
-        let Some(dir) = self.dir.clone() else { return Ok(()) };
+    pub(super) fn write_temperature(
+        &mut self,
+        step: usize,
+        time: f64,
+        t: &[f64],
+    ) -> std::io::Result<()> {
+        let Some(dir) = self.dir.clone() else {
+            return Ok(());
+        };
         if self.transient {
             let name = format!("temperature_{step:05}.vtu");
             write_vtu(&dir.join(&name), self.mesh, &[("temperature", t)])?;
@@ -107,10 +119,18 @@ impl<'m> StepWriter<'m> {
                 .add(time, Path::new(&name))?;
         }
         if self.exodus.is_none() {
-            self.exodus = Some(ExodusWriter::create(&dir.join("results.exo"), self.mesh, &["temperature"], &[])?);
+            self.exodus = Some(ExodusWriter::create(
+                &dir.join("results.exo"),
+                self.mesh,
+                &["temperature"],
+                &[],
+            )?);
         }
         // Nodes without a temperature (shells, bars) hold 0 in the Exodus file.
-        let values: Vec<f64> = t.iter().map(|v| if v.is_nan() { 0.0 } else { *v }).collect();
+        let values: Vec<f64> = t
+            .iter()
+            .map(|v| if v.is_nan() { 0.0 } else { *v })
+            .collect();
         self.exodus
             .as_mut()
             .expect("just made")
@@ -121,7 +141,12 @@ impl<'m> StepWriter<'m> {
 
     /// The last step's fields (if not written yet), `results.exo` closed, and (transient
     /// runs) the final checkpoint.
-    pub(super) fn finish(&mut self, state: &State, dofs: &DofMap, fields: &[String]) -> std::io::Result<()> {
+    pub(super) fn finish(
+        &mut self,
+        state: &State,
+        dofs: &DofMap,
+        fields: &[String],
+    ) -> std::io::Result<()> {
         if self.dir.is_none() {
             return Ok(());
         }
@@ -385,10 +410,7 @@ fn line_samples(mesh: &Mesh, t: &[f64], origin: [f64; 3], axis: [f64; 3]) -> Vec
                 + (d[2] - s * axis[2]).powi(2);
             (s, r2.sqrt())
         };
-        let least = nodes
-            .iter()
-            .map(|&n| at(n).1)
-            .fold(f64::INFINITY, f64::min);
+        let least = nodes.iter().map(|&n| at(n).1).fold(f64::INFINITY, f64::min);
         let mut points: Vec<(f64, f64)> = nodes
             .iter()
             .filter(|&&n| at(n).1 <= 1.5 * least + 1e-12 && t[n as usize].is_finite())

@@ -542,3 +542,44 @@ fn electronics_power_leaves_by_convection() {
     assert!(i.imbalance.abs() <= BALANCE * power);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `electronics/transient.toml`: the warm-up. Heat crosses the interface in balance at
+/// every step (1e-12 relative: the gap conductance is conservative to round-off) and,
+/// after the first step, within 2 % of the die's 10 W (the die's capacity, 0.16 J/K,
+/// stores a negligible share once it follows the sink). The sink warms with time
+/// constant τ ≈ 75 s (its capacity over its convective conductance), so after 400 s ≈
+/// 5τ the temperature rise of the hottest node is within 1.5 % of the steady rise
+/// (e^-5 = 0.7 %, plus the time error of 5 s BDF2 steps).
+#[test]
+fn electronics_warms_up_toward_its_steady_state() {
+    let dir = copy_scene("electronics");
+    let steady = run(&dir.join("problem.toml"));
+    let r = run(&dir.join("transient.toml"));
+    assert_eq!(r.history.len(), 80);
+    for s in &r.history {
+        let (a, b) = s.heat[0];
+        assert!(
+            (a + b).abs() <= 1e-12 * a.abs().max(1.0),
+            "step {}: {a} + {b}",
+            s.step
+        );
+        if s.step > 1 {
+            assert!((a.abs() - 10.0).abs() < 0.2, "step {}: {a} W", s.step);
+        }
+    }
+    let hottest = |t: &[f64]| t.iter().copied().fold(f64::MIN, f64::max);
+    let rise = hottest(&r.solution.temperature) - 293.15;
+    let steady_rise = hottest(&steady.solution.temperature) - 293.15;
+    assert!(
+        rise < steady_rise && rise > 0.985 * steady_rise,
+        "rise {rise} K against {steady_rise} K steady"
+    );
+    for f in [
+        "temperature.pvd",
+        "results.exo",
+        "interface_heat.csv",
+        "plots/interface_heat.png",
+    ] {
+        assert!(dir.join("out").join(f).exists(), "{f} missing");
+    }
+}
