@@ -337,6 +337,26 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
             }
         }
     }
+    // A strongly twisted face can hide its closest point in a valley a 3 × 3 grid does
+    // not start in: where a 5 × 5 sample of the face is closer than what was found,
+    // start Newton from that sample too.
+    if warped {
+        let found = best.map_or(d2_edge, |b| b.2.min(d2_edge));
+        let mut seed = None;
+        let mut d2_seed = found;
+        for a in [-0.8, -0.4, 0.0, 0.4, 0.8] {
+            for b in [-0.8, -0.4, 0.0, 0.4, 0.8] {
+                let d2 = norm2(sub(p, map_quad4(x, [a, b])));
+                if d2 < d2_seed {
+                    d2_seed = d2;
+                    seed = Some([a, b]);
+                }
+            }
+        }
+        if let Some(xi0) = seed {
+            best = closer(best, stationary(xi0));
+        }
+    }
     if let Some((xi_c, q, d2)) = best
         && d2 <= d2_edge
     {
