@@ -182,31 +182,17 @@ pub struct Outcome {
     pub crosspoints: Vec<Vec<NodeId>>,
 }
 
-/// Dofs and initial state for a problem: the map, its fields, and `u` filled from the
-/// nodal initial temperature.
-pub fn initial_state(
-    p: &TransientProblem<'_>,
-    time: f64,
-    dt: f64,
-    initial: &dyn Fn(NodeId) -> f64,
-) -> Result<State, HeatError> {
-    let setup = Setup::new(p, time)?;
-    let mut u = vec![0.0; setup.n];
-    for (f, spec) in setup.fields.iter().zip(&p.fields_or_default()) {
-        let _ = spec;
-        for node in 0..p.mesh.num_nodes() {
-            if let Some(d) = setup.dofs.dof(*f, NodeId(node as u32)) {
-                u[d.index()] = initial(NodeId(node as u32));
-            }
-        }
-    }
-    Ok(State {
-        step: 0,
-        time,
-        dt,
-        u,
-        past: Vec::new(),
-    })
+/// Where a run starts.
+pub enum Start<'s> {
+    /// At `time` with first step `dt`, every field at the nodal `initial` value and the
+    /// multipliers at 0.
+    Fresh {
+        time: f64,
+        dt: f64,
+        initial: &'s dyn Fn(NodeId) -> f64,
+    },
+    /// From a saved state (a checkpoint).
+    Restart(State),
 }
 
 impl TransientProblem<'_> {
@@ -247,6 +233,9 @@ struct Setup {
     lambda_first: Vec<usize>,
     dirichlet_dofs: Vec<usize>,
     lumped: Vec<LumpedWeight>,
+    /// The blocks carrying a field, and the element basis of each.
+    blocks: Vec<usize>,
+    rules: Vec<Option<kernel::Basis>>,
 }
 
 impl Setup {
@@ -298,6 +287,16 @@ impl Setup {
             .map(|t| dofs.add_extra(t.nodes.len()).start)
             .collect();
         let lumped = lumped_weights(mesh, &dofs)?;
+        let mut blocks: Vec<usize> = Vec::new();
+        let mut rules = vec![None; mesh.blocks.len()];
+        for &f in &fields {
+            blocks.extend_from_slice(dofs.field_blocks(f));
+            for (b, r) in block_rules(mesh, &dofs, f)?.into_iter().enumerate() {
+                if r.is_some() {
+                    rules[b] = r;
+                }
+            }
+        }
         let n = dofs.len();
         Ok(Setup {
             dofs,
@@ -308,6 +307,8 @@ impl Setup {
             lambda_first,
             dirichlet_dofs,
             lumped,
+            blocks,
+            rules,
         })
     }
 }
@@ -409,10 +410,34 @@ impl From<HeatError> for Failure {
 pub fn solve(
     p: &TransientProblem<'_>,
     mode: TimeMode,
-    mut state: State,
+    start: Start<'_>,
     on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
 ) -> Result<Outcome, HeatError> {
-    let setup = Setup::new(p, state.time)?;
+    let time0 = match &start {
+        Start::Fresh { time, .. } => *time,
+        Start::Restart(s) => s.time,
+    };
+    let setup = Setup::new(p, time0)?;
+    let mut state = match start {
+        Start::Restart(s) => s,
+        Start::Fresh { time, dt, initial } => {
+            let mut u = vec![0.0; setup.n];
+            for &f in &setup.fields {
+                for node in (0..p.mesh.num_nodes()).map(|n| NodeId(n as u32)) {
+                    if let Some(d) = setup.dofs.dof(f, node) {
+                        u[d.index()] = initial(node);
+                    }
+                }
+            }
+            State {
+                step: 0,
+                time,
+                dt,
+                u,
+                past: Vec::new(),
+            }
+        }
+    };
     if state.u.len() != setup.n {
         return Err(HeatError::Step(format!(
             "the state has {} values but the problem has {} dofs (a checkpoint of another problem?)",
@@ -873,18 +898,7 @@ impl Context<'_, '_> {
         let setup = self.setup;
         let mesh = p.mesh;
         let dofs = &setup.dofs;
-        let mut blocks: Vec<usize> = Vec::new();
-        for f in &setup.fields {
-            blocks.extend_from_slice(dofs.field_blocks(*f));
-        }
-        let mut rules = vec![None; mesh.blocks.len()];
-        for f in &setup.fields {
-            for (b, r) in block_rules(mesh, dofs, *f)?.into_iter().enumerate() {
-                if r.is_some() {
-                    rules[b] = r;
-                }
-            }
-        }
+        let (blocks, rules) = (&setup.blocks, &setup.rules);
         let mut faces: Vec<(u32, usize)> = loads
             .faces
             .iter()
@@ -894,7 +908,7 @@ impl Context<'_, '_> {
         faces.sort_unstable();
         let errors = FirstError::new();
         let (laws, source, block_source) = (p.laws, p.source, p.block_source);
-        asm.elements(mesh, Some(&blocks), |e, je, re| {
+        asm.elements(mesh, Some(blocks), |e, je, re| {
             let b = mesh.block_of(e);
             let topo = mesh.blocks[b].topology;
             let rule = rules[b].as_ref().expect("rule of a field block");

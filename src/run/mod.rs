@@ -51,8 +51,7 @@ use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_with_fields as 
 use crate::heat::law::Law;
 use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use crate::heat::transient::{
-    self, BlockLaws, FieldSpec, Loads, Scheme, State, StepReport, TimeMode, TransientProblem,
-    initial_state,
+    self, BlockLaws, FieldSpec, Loads, Scheme, Start, State, StepReport, TimeMode, TransientProblem,
 };
 use crate::heat::{FaceBc, HeatError, Material, TEMPERATURE};
 use crate::interaction;
@@ -132,7 +131,8 @@ pub struct ToggleSpec {
 #[serde(deny_unknown_fields)]
 pub struct NodalFieldSpec {
     pub name: String,
-    /// A number or a Lua expression of x, y, z, t, evaluated at the nodes.
+    /// A number or a Lua expression of x, y, z, t, evaluated at the nodes once, at the
+    /// start time of the run.
     pub value: Value,
 }
 
@@ -171,6 +171,18 @@ pub enum BcKind {
     Convection,
     /// εσ(T⁴ − T∞⁴): `value` is the emissivity ε, `ambient` T∞.
     Radiation,
+}
+
+impl BcKind {
+    /// The name as the problem file writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            BcKind::Temperature => "temperature",
+            BcKind::Flux => "flux",
+            BcKind::Convection => "convection",
+            BcKind::Radiation => "radiation",
+        }
+    }
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -434,6 +446,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         _ => 300.0,
     };
     let materials = materials(&problem, &mesh, probe, &mut diags);
+    check_bcs(&problem, &mut diags);
     let dirichlet = dirichlet_nodes(&problem, &mesh, &mut diags);
     let mut face_sites = face_sites(&problem, &mesh, &mut diags);
     let block_source = block_sources(&problem, &mesh, &mut diags);
@@ -643,7 +656,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         }
     }
     let before = face_sites.len();
-    face_sites.retain(|f| f.keep || !in_contact.contains(&bc_side_of(f)));
+    face_sites.retain(|f| f.keep || !in_contact.contains(&f.side));
     let masked = before - face_sites.len();
     if masked > 0 {
         diags.push(
@@ -878,14 +891,23 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             max_iterations: problem.solve.max_iterations,
             reproducible: problem.solve.reproducible.unwrap_or(true),
         };
-        let state = match (&problem.restart, options.restart.as_ref()) {
-            (_, Some(file)) => steps::read_checkpoint(file)?,
-            (Some(r), None) => steps::read_checkpoint(&dir.join(&r.file))?,
-            (None, None) => {
-                let initial = initial_values(&problem, &mesh, &dirichlet, &sandbox, start_time)?;
-                initial_state(&tp, start_time, timing_spec.dt, &|n| initial[n.index()])
-                    .map_err(|e| RunError::Solve(e.to_string()))?
-            }
+        let restart = match (&problem.restart, options.restart.as_ref()) {
+            (_, Some(file)) => Some(steps::read_checkpoint(file)?),
+            (Some(r), None) => Some(steps::read_checkpoint(&dir.join(&r.file))?),
+            (None, None) => None,
+        };
+        let initial = match restart {
+            Some(_) => Vec::new(),
+            None => initial_values(&problem, &mesh, &dirichlet, &sandbox, start_time)?,
+        };
+        let at_node = |n: NodeId| initial[n.index()];
+        let start = match restart {
+            Some(state) => Start::Restart(state),
+            None => Start::Fresh {
+                time: start_time,
+                dt: timing_spec.dt,
+                initial: &at_node,
+            },
         };
         let mode = if transient {
             TimeMode::Transient {
@@ -909,7 +931,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             history.push(r.clone());
             Ok(())
         };
-        let outcome = transient::solve(&tp, mode, state, &mut on_step)
+        let outcome = transient::solve(&tp, mode, start, &mut on_step)
             .map_err(|e| RunError::Solve(e.to_string()))?;
         writer
             .finish(&outcome.state, &outcome.dofs, &field_names)
@@ -1168,7 +1190,7 @@ fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> M
             continue;
         };
         let capacity = match (&m.density, &m.specific_heat, m.rho_c) {
-            (_, _, Some(rc)) if m.density.is_some() || m.specific_heat.is_some() => {
+            (_, _, Some(_)) if m.density.is_some() || m.specific_heat.is_some() => {
                 diags.push(
                     Diagnostic::error(
                         "E0704",
@@ -1179,7 +1201,6 @@ fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> M
                     )
                     .help("give either rho_c, or density and specific_heat"),
                 );
-                let _ = rc;
                 continue;
             }
             (_, _, Some(rc)) => law(
@@ -1324,6 +1345,52 @@ fn evaluate(
     }
 }
 
+/// The fields of each `[[bc]]` that go with its kind: `ambient` for convection and
+/// radiation only (never taken as 0 K), an emissivity in (0, 1].
+fn check_bcs(p: &Problem, diags: &mut Diagnostics) {
+    for (k, bc) in p.bc.iter().enumerate() {
+        let exchange = matches!(bc.kind, BcKind::Convection | BcKind::Radiation);
+        if exchange && bc.ambient.is_none() {
+            diags.push(
+                Diagnostic::error(
+                    "E0706",
+                    format!(
+                        "[[bc]] #{}: {} needs `ambient` (T∞, K)",
+                        k + 1,
+                        bc.kind.name()
+                    ),
+                )
+                .help("add ambient = 293.15 (say): it is not taken as 0 K"),
+            );
+        }
+        if !exchange && bc.ambient.is_some() {
+            diags.push(
+                Diagnostic::error(
+                    "E0706",
+                    format!(
+                        "[[bc]] #{}: `ambient` belongs to convection and radiation, not {}",
+                        k + 1,
+                        bc.kind.name()
+                    ),
+                )
+                .help("remove `ambient`, or make the condition a convection or radiation"),
+            );
+        }
+        if bc.kind == BcKind::Radiation
+            && let Value::Number(e) = bc.value
+            && !(e > 0.0 && e <= 1.0)
+        {
+            diags.push(
+                Diagnostic::error(
+                    "E0706",
+                    format!("[[bc]] #{}: emissivity {e} is not in (0, 1]", k + 1),
+                )
+                .help("for radiation, `value` is the emissivity ε"),
+            );
+        }
+    }
+}
+
 /// The nodes of each temperature condition, with the condition.
 fn dirichlet_nodes(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<(NodeId, usize)> {
     let mut out = Vec::new();
@@ -1377,12 +1444,6 @@ fn face_sites(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<FaceSite
             .enumerate()
             .filter(|(_, b)| b.kind != BcKind::Temperature)
     {
-        if bc.kind == BcKind::Radiation && bc.ambient.is_none() {
-            diags.push(
-                Diagnostic::error("E0706", "[[bc]] radiation needs `ambient` (T∞, K)")
-                    .help("add ambient = 293.15 (say); value is the emissivity"),
-            );
-        }
         for s in &bc.surfaces {
             let Some(i) = mesh.find_side_set(s) else {
                 diags.push(
@@ -1499,10 +1560,6 @@ fn block_sources(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<f64> 
 
 /// An interaction's model, penalty scale and conductance model.
 type Choice = (ModelChoice, f64, Option<Box<dyn ConductanceModel>>);
-
-fn bc_side_of(f: &FaceSite) -> Side {
-    f.side
-}
 
 /// The time controls of `[solve]`, checked.
 struct TimeSpec {

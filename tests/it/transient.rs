@@ -413,3 +413,31 @@ ambient = 300.0
     .unwrap();
     assert!(e.contains("E0704") && e.contains("increase"), "{e}");
 }
+
+/// Boundary fields that do not go with their kind are input errors, not silent
+/// defaults: convection without `ambient` (it would be 0 K), `ambient` on a
+/// temperature condition, an emissivity outside (0, 1].
+#[test]
+fn boundary_fields_are_checked_against_their_kind() {
+    let dir = scratch("bc-fields");
+    let materials = "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n";
+    for (bc, expect) in [
+        (
+            "kind = \"convection\"\nsurfaces = [\"lid_top\"]\nvalue = 10.0\n",
+            "convection needs `ambient`",
+        ),
+        (
+            "kind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 10.0\nambient = 3.0\n",
+            "not temperature",
+        ),
+        (
+            "kind = \"radiation\"\nsurfaces = [\"lid_top\"]\nvalue = 1.5\nambient = 300.0\n",
+            "emissivity 1.5",
+        ),
+    ] {
+        let e = run_case(&dir, GAP_DECK, &format!("{materials}[[bc]]\n{bc}"))
+            .err()
+            .unwrap();
+        assert!(e.contains("E0706") && e.contains(expect), "{e}");
+    }
+}
