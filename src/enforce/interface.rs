@@ -38,8 +38,6 @@
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas' subscripts
 
-use std::collections::HashMap;
-
 use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId};
 use crate::heat::kernel::{MAX_NODES, eval_point};
 use crate::heat::shape::reference_nodes;
@@ -361,6 +359,32 @@ fn local(a: &SideEval, b: &SideEval, form: Form, beta: f64) -> Local {
     l
 }
 
+/// Where the entries of an interaction's blocks go in an [`Assembler`]: see
+/// [`InterfacePoints::scatter`].
+#[derive(Clone, Debug, Default)]
+pub struct Scatter {
+    slots: Vec<Slot>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    Diagonal(usize),
+    /// `(i, j)` of coupling k, i < j.
+    Upper(usize),
+    /// `(j, i)` of coupling k.
+    Lower(usize),
+}
+
+fn push_couplings(dofs: &[u32], out: &mut Vec<(usize, usize)>) {
+    for (a, &i) in dofs.iter().enumerate() {
+        for &j in &dofs[a + 1..] {
+            if i != j {
+                out.push((i.min(j) as usize, i.max(j) as usize));
+            }
+        }
+    }
+}
+
 /// The assembled interface terms of one interaction: for each pair of elements
 /// (A, B) met by some point, a dense block over their dofs, and a right-hand side.
 #[derive(Clone, Debug, Default)]
@@ -378,7 +402,8 @@ pub struct InterfaceSystem {
 
 /// Evaluate the interface form of one interaction at the field `u` (global dof vector):
 /// the Jacobian blocks (exact, including dh/dT), the residual and, for linear models,
-/// the right-hand side of `K u = f`.
+/// the right-hand side of `K u = f`. Builds an [`InterfacePoints`] and evaluates it once;
+/// callers that evaluate repeatedly (Newton, time steps) keep the [`InterfacePoints`].
 #[allow(clippy::too_many_arguments)]
 pub fn interface_terms(
     mesh: &Mesh,
@@ -390,117 +415,304 @@ pub fn interface_terms(
     form: &InterfaceForm<'_>,
     u: &[f64],
 ) -> Result<InterfaceSystem, InterfaceError> {
-    let fields = fields.into();
-    let mut blocks: HashMap<(u32, u32), (Vec<u32>, Vec<f64>)> = HashMap::new();
-    let mut rhs: HashMap<u32, f64> = HashMap::new();
-    let mut residual: HashMap<u32, f64> = HashMap::new();
-    let mut side_a = Vec::new();
-    let mut side_b = Vec::new();
-    for (index, p) in points
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p.status == PointStatus::Matched)
-    {
-        if p.a_face == u32::MAX {
-            continue; // node points carry no face to integrate over
-        }
-        let fa = &a.faces[p.a_face as usize];
-        let fb = &b.faces[p.b_face as usize];
-        let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
-        let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, form.conductivity)?;
-        let l = local(&ea, &eb, form.form, form.beta);
-        let nl = l.dofs.len();
-        let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[l.dofs[i] as usize]).sum() };
-        let jump_u = value(&l.jump) - form.offset;
-        let flux_u = value(&l.flux);
-        let temp_a: f64 = (0..l.na).map(|i| l.jump[i] * u[l.dofs[i] as usize]).sum();
-        let temp_b = temp_a - (jump_u + form.offset);
-        let hv = match form.form {
-            Form::Conductance | Form::GapConductance => (form.h)(&HInput {
-                gap: p.gap - p.offset,
-                temp_a,
-                temp_b,
-                x: p.x,
-                point: index,
-            })
-            .map_err(|message| InterfaceError::Conductance {
-                at: p.x,
-                elem: mesh.elem_number(fa.side.elem),
-                side: fa.side.side,
-                message,
-            })?,
-            _ => HValue::default(),
-        };
-        let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, l.alpha);
-        let w = p.weight;
-        // dh/du_j: T_A = Σ_A N u, T_B = Σ_B N u (jump entries of B are −N).
-        let dh: Vec<f64> = (0..nl)
-            .map(|j| {
-                if j < l.na {
-                    hv.dh_dtemp_a * l.jump[j]
-                } else {
-                    -hv.dh_dtemp_b * l.jump[j]
-                }
-            })
-            .collect();
-        let key = (ea.elem.0, eb.elem.0);
-        let entry = blocks
-            .entry(key)
-            .or_insert_with(|| (l.dofs.clone(), vec![0.0; nl * nl]));
-        for i in 0..nl {
-            let (ji, fi) = (l.jump[i], l.flux[i]);
-            // Residual r_i = w [P J_i [u]' − θ (F_i [u]' + J_i F(u)) − S F_i F(u)].
-            let r_p = ji * jump_u;
-            let r_t = -(fi * jump_u + ji * flux_u);
-            let r_s = -fi * flux_u;
-            *residual.entry(l.dofs[i]).or_default() += w * (cp * r_p + ct * r_t + cs * r_s);
-            // Right-hand side of the linear form (the offset terms).
-            *rhs.entry(l.dofs[i]).or_default() += w * form.offset * (cp * ji - ct * fi);
-            let dr_dh = dp * r_p + dt * r_t + ds * r_s;
-            for j in 0..nl {
-                let (jj, fj) = (l.jump[j], l.flux[j]);
-                let lin = cp * ji * jj - ct * (fi * jj + ji * fj) - cs * fi * fj;
-                entry.1[i * nl + j] += w * (lin + dr_dh * dh[j]);
-            }
-        }
-        side_a.extend_from_slice(&l.dofs[..l.na]);
-        side_b.extend_from_slice(&l.dofs[l.na..]);
-    }
-    side_a.sort_unstable();
-    side_a.dedup();
-    side_b.sort_unstable();
-    side_b.dedup();
-    let mut blocks: Vec<_> = blocks.into_iter().collect();
-    blocks.sort_by_key(|(k, _)| *k);
-    let mut rhs: Vec<_> = rhs.into_iter().collect();
-    rhs.sort_unstable_by_key(|x| x.0);
-    let mut residual: Vec<_> = residual.into_iter().collect();
-    residual.sort_unstable_by_key(|x| x.0);
-    Ok(InterfaceSystem {
-        blocks: blocks.into_iter().map(|(_, v)| v).collect(),
-        rhs,
-        residual,
-        side_a_dofs: side_a,
-        side_b_dofs: side_b,
-    })
+    InterfacePoints::new(mesh, dofs, fields, a, b, points, form)?.evaluate(form, u)
 }
 
-impl InterfaceSystem {
-    /// The dof pairs (i < j) the blocks couple, for [`Pattern::add_couplings`].
+/// The geometric part of one interaction's interface form, evaluated once per search:
+/// at every matched face point the jump and flux-average of each local basis function,
+/// the weight and the penalty. What changes between evaluations — the field, and h
+/// through it — is applied by [`InterfacePoints::evaluate`] in a few flops per entry.
+///
+/// Points are grouped by their element pair (side A, side B) — the dense blocks of
+/// [`InterfaceSystem`] — in element-pair order; within a group they keep the pairing's
+/// order, so sums run in the same order at every evaluation.
+#[derive(Clone, Debug, Default)]
+pub struct InterfacePoints {
+    /// The groups' dof lists, concatenated (`group_dofs[g]..group_dofs[g+1]`).
+    dofs: Vec<u32>,
+    group_dofs: Vec<usize>,
+    /// The groups' points (`group_points[g]..group_points[g+1]` into `points`).
+    group_points: Vec<usize>,
+    points: Vec<CachedPoint>,
+    /// Per point, its jump then flux entries (`2 nl` values from `CachedPoint::at`).
+    values: Vec<f64>,
+    /// Every dof met, sorted, and each group entry's position in it.
+    touched: Vec<u32>,
+    position: Vec<u32>,
+    side_a_dofs: Vec<u32>,
+    side_b_dofs: Vec<u32>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct CachedPoint {
+    /// Index in the pairing's point list.
+    index: u32,
+    /// Side-A element (its number) and side, for messages.
+    elem: i64,
+    side: u8,
+    na: u32,
+    at: u32,
+    weight: f64,
+    gap: f64,
+    x: [f64; 3],
+    alpha: f64,
+}
+
+impl InterfacePoints {
+    /// Evaluate the geometry of every matched face point of a pairing.
+    pub fn new(
+        mesh: &Mesh,
+        dofs: &DofMap,
+        fields: impl Into<FieldPair>,
+        a: &SurfaceGeometry,
+        b: &SurfaceGeometry,
+        points: &[ContactPoint],
+        form: &InterfaceForm<'_>,
+    ) -> Result<InterfacePoints, InterfaceError> {
+        let fields = fields.into();
+        // (element pair, point order, point, its dofs, jump and flux values)
+        let mut evaluated = Vec::new();
+        for (index, p) in points.iter().enumerate() {
+            if p.status != PointStatus::Matched || p.a_face == u32::MAX {
+                continue; // node points carry no face to integrate over
+            }
+            let fa = &a.faces[p.a_face as usize];
+            let fb = &b.faces[p.b_face as usize];
+            let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
+            let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, form.conductivity)?;
+            let l = local(&ea, &eb, form.form, form.beta);
+            let point = CachedPoint {
+                index: index as u32,
+                elem: mesh.elem_number(fa.side.elem),
+                side: fa.side.side,
+                na: l.na as u32,
+                at: 0,
+                weight: p.weight,
+                gap: p.gap - p.offset,
+                x: p.x,
+                alpha: l.alpha,
+            };
+            evaluated.push(((ea.elem.0, eb.elem.0), point, l));
+        }
+        // Stable: points of a group keep their order.
+        evaluated.sort_by_key(|e| e.0);
+        let mut out = InterfacePoints {
+            group_dofs: vec![0],
+            group_points: vec![0],
+            ..Default::default()
+        };
+        let mut last_key = None;
+        for (key, mut point, l) in evaluated {
+            if last_key != Some(key) {
+                if last_key.is_some() {
+                    out.group_dofs.push(out.dofs.len());
+                    out.group_points.push(out.points.len());
+                }
+                out.dofs.extend_from_slice(&l.dofs);
+                last_key = Some(key);
+            }
+            point.at = out.values.len() as u32;
+            out.values.extend_from_slice(&l.jump);
+            out.values.extend_from_slice(&l.flux);
+            out.side_a_dofs.extend_from_slice(&l.dofs[..l.na]);
+            out.side_b_dofs.extend_from_slice(&l.dofs[l.na..]);
+            out.points.push(point);
+        }
+        if last_key.is_some() {
+            out.group_dofs.push(out.dofs.len());
+            out.group_points.push(out.points.len());
+        }
+        out.touched = out.dofs.clone();
+        out.touched.sort_unstable();
+        out.touched.dedup();
+        out.position = out
+            .dofs
+            .iter()
+            .map(|d| out.touched.binary_search(d).expect("listed") as u32)
+            .collect();
+        for set in [&mut out.side_a_dofs, &mut out.side_b_dofs] {
+            set.sort_unstable();
+            set.dedup();
+        }
+        Ok(out)
+    }
+
+    /// Number of element-pair groups (dense blocks).
+    pub fn groups(&self) -> usize {
+        self.group_points.len().saturating_sub(1)
+    }
+
+    /// Number of matched face points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// The dofs of group `g` (side A's element, then side B's).
+    fn group(&self, g: usize) -> &[u32] {
+        &self.dofs[self.group_dofs[g]..self.group_dofs[g + 1]]
+    }
+
+    /// The dof pairs (i < j) the groups couple, for [`Pattern::add_couplings`]
+    /// (the same list [`InterfaceSystem::couplings`] gives for every evaluation).
+    ///
+    /// [`Pattern::add_couplings`]: crate::assembly::Pattern::add_couplings
     pub fn couplings(&self) -> Vec<(usize, usize)> {
         let mut out = Vec::new();
-        for (dofs, _) in &self.blocks {
-            for (a, &i) in dofs.iter().enumerate() {
-                for &j in &dofs[a + 1..] {
-                    if i != j {
-                        out.push((i.min(j) as usize, i.max(j) as usize));
-                    }
-                }
-            }
+        for g in 0..self.groups() {
+            push_couplings(self.group(g), &mut out);
         }
         out.sort_unstable();
         out.dedup();
         out
+    }
+
+    /// Where every block entry goes in an assembler whose pattern holds `couplings`
+    /// (as returned by [`Self::couplings`], registered at `first` onwards): worked out
+    /// once, so [`InterfaceSystem::add_scattered`] adds without searching.
+    pub fn scatter(&self, couplings: &[(usize, usize)], first: usize) -> Scatter {
+        let mut slots = Vec::new();
+        for g in 0..self.groups() {
+            let dofs = self.group(g);
+            for &i in dofs {
+                for &j in dofs {
+                    let (i, j) = (i as usize, j as usize);
+                    slots.push(if i == j {
+                        Slot::Diagonal(i)
+                    } else {
+                        let k = couplings
+                            .binary_search(&(i.min(j), i.max(j)))
+                            .expect("coupling registered from the same groups");
+                        if i < j {
+                            Slot::Upper(first + k)
+                        } else {
+                            Slot::Lower(first + k)
+                        }
+                    });
+                }
+            }
+        }
+        Scatter { slots }
+    }
+
+    /// The form at the field `u`: Jacobian blocks (exact, including dh/dT), residual,
+    /// and the right-hand side of the offset terms.
+    pub fn evaluate(
+        &self,
+        form: &InterfaceForm<'_>,
+        u: &[f64],
+    ) -> Result<InterfaceSystem, InterfaceError> {
+        let mut residual = vec![0.0; self.touched.len()];
+        let mut rhs = vec![0.0; self.touched.len()];
+        let mut blocks = Vec::with_capacity(self.groups());
+        let mut dh = [0.0; 2 * MAX_NODES];
+        for g in 0..self.groups() {
+            let dofs = self.group(g);
+            let position = &self.position[self.group_dofs[g]..self.group_dofs[g + 1]];
+            let nl = dofs.len();
+            let mut m = vec![0.0; nl * nl];
+            for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
+                let at = p.at as usize;
+                let jump = &self.values[at..at + nl];
+                let flux = &self.values[at + nl..at + 2 * nl];
+                let na = p.na as usize;
+                let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[dofs[i] as usize]).sum() };
+                let jump_u = value(jump) - form.offset;
+                let flux_u = value(flux);
+                let temp_a: f64 = (0..na).map(|i| jump[i] * u[dofs[i] as usize]).sum();
+                let temp_b = temp_a - (jump_u + form.offset);
+                let hv = match form.form {
+                    Form::Conductance | Form::GapConductance => (form.h)(&HInput {
+                        gap: p.gap,
+                        temp_a,
+                        temp_b,
+                        x: p.x,
+                        point: p.index as usize,
+                    })
+                    .map_err(|message| InterfaceError::Conductance {
+                        at: p.x,
+                        elem: p.elem,
+                        side: p.side,
+                        message,
+                    })?,
+                    _ => HValue::default(),
+                };
+                let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, p.alpha);
+                let w = p.weight;
+                // dh/du_j: T_A = Σ_A N u, T_B = Σ_B N u (jump entries of B are −N).
+                let nonlinear = hv.dh_dtemp_a != 0.0 || hv.dh_dtemp_b != 0.0;
+                for j in 0..nl {
+                    dh[j] = if j < na {
+                        hv.dh_dtemp_a * jump[j]
+                    } else {
+                        -hv.dh_dtemp_b * jump[j]
+                    };
+                }
+                for i in 0..nl {
+                    let (ji, fi) = (jump[i], flux[i]);
+                    // Residual r_i = w [P J_i [u]' − θ (F_i [u]' + J_i F(u)) − S F_i F(u)].
+                    let r_p = ji * jump_u;
+                    let r_t = -(fi * jump_u + ji * flux_u);
+                    let r_s = -fi * flux_u;
+                    let k = position[i] as usize;
+                    residual[k] += w * (cp * r_p + ct * r_t + cs * r_s);
+                    // Right-hand side of the linear form (the offset terms).
+                    rhs[k] += w * form.offset * (cp * ji - ct * fi);
+                    let row = &mut m[i * nl..(i + 1) * nl];
+                    let dr_dh = if nonlinear {
+                        dp * r_p + dt * r_t + ds * r_s
+                    } else {
+                        0.0
+                    };
+                    for j in 0..nl {
+                        let (jj, fj) = (jump[j], flux[j]);
+                        let lin = cp * ji * jj - ct * (fi * jj + ji * fj) - cs * fi * fj;
+                        row[j] += w * (lin + dr_dh * dh[j]);
+                    }
+                }
+            }
+            blocks.push((dofs.to_vec(), m));
+        }
+        let pairs = |v: Vec<f64>| -> Vec<(u32, f64)> { self.touched.iter().copied().zip(v).collect() };
+        Ok(InterfaceSystem {
+            blocks,
+            rhs: pairs(rhs),
+            residual: pairs(residual),
+            side_a_dofs: self.side_a_dofs.clone(),
+            side_b_dofs: self.side_b_dofs.clone(),
+        })
+    }
+}
+
+impl InterfaceSystem {
+    /// The dof pairs (i < j) the blocks couple, for [`Pattern::add_couplings`].
+    ///
+    /// [`Pattern::add_couplings`]: crate::assembly::Pattern::add_couplings
+    pub fn couplings(&self) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for (dofs, _) in &self.blocks {
+            push_couplings(dofs, &mut out);
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Add the blocks of a system evaluated from the [`InterfacePoints`] that made
+    /// `scatter`.
+    pub fn add_scattered(&self, asm: &mut Assembler<'_>, scatter: &Scatter) {
+        let values = self.blocks.iter().flat_map(|(_, m)| m);
+        debug_assert_eq!(values.clone().count(), scatter.slots.len());
+        for (&slot, &v) in scatter.slots.iter().zip(values) {
+            match slot {
+                Slot::Diagonal(i) => asm.add_diagonal(i, v),
+                Slot::Upper(k) => asm.add_coupling(k, v, 0.0),
+                Slot::Lower(k) => asm.add_coupling(k, 0.0, v),
+            }
+        }
     }
 
     /// Add the blocks into `asm`, whose pattern holds `couplings` (as returned by

@@ -33,7 +33,7 @@ use std::collections::HashSet;
 use rayon::prelude::*;
 
 use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
-use crate::enforce::interface::{FieldPair, InterfaceSystem, interface_terms};
+use crate::enforce::interface::{FieldPair, InterfacePoints, InterfaceSystem, Scatter};
 use crate::enforce::mortar::{MortarTie, mortar_tie};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet};
@@ -448,10 +448,10 @@ pub fn solve(
     let mesh = p.mesh;
     // The pattern: elements, interface couplings (from a first evaluation), ties.
     let mut pattern = Pattern::new(mesh, &setup.dofs);
-    let mut couplings = Vec::with_capacity(p.contact.len());
-    let mut first = Vec::with_capacity(p.contact.len());
+    let mut points = Vec::with_capacity(p.contact.len());
+    let mut scatters = Vec::with_capacity(p.contact.len());
     for (k, c) in p.contact.iter().enumerate() {
-        let s = interface_terms(
+        let cache = InterfacePoints::new(
             mesh,
             &setup.dofs,
             p.term_pair(k, &setup.fields),
@@ -459,20 +459,12 @@ pub fn solve(
             c.side_b,
             c.points,
             &c.form,
-            &state.u,
-        );
-        let s = match s {
-            Ok(s) => s,
-            Err(e) => {
-                if let Some(c) = p.cutback {
-                    c.set(false);
-                }
-                return Err(HeatError::Contact(e.to_string()));
-            }
-        };
-        let cp = s.couplings();
-        first.push(pattern.add_couplings(&cp)?.start);
-        couplings.push(cp);
+        )
+        .map_err(|e| HeatError::Contact(e.to_string()))?;
+        let cp = cache.couplings();
+        let first = pattern.add_couplings(&cp)?.start;
+        scatters.push(cache.scatter(&cp, first));
+        points.push(cache);
     }
     let mut tie_first = Vec::with_capacity(setup.ties.len());
     for (t, tie) in setup.ties.iter().enumerate() {
@@ -489,8 +481,8 @@ pub fn solve(
     let ctx = Context {
         p,
         setup: &setup,
-        couplings: &couplings,
-        first: &first,
+        points: &points,
+        scatters: &scatters,
         tie_first: &tie_first,
     };
 
@@ -733,8 +725,9 @@ impl Solvers {
 struct Context<'c, 'a> {
     p: &'c TransientProblem<'a>,
     setup: &'c Setup,
-    couplings: &'c [Vec<(usize, usize)>],
-    first: &'c [usize],
+    /// Per contact term: its points' geometry and where its blocks go.
+    points: &'c [InterfacePoints],
+    scatters: &'c [Scatter],
     tie_first: &'c [usize],
 }
 
@@ -1004,16 +997,7 @@ impl Context<'_, '_> {
                 systems.push(None);
                 continue;
             }
-            let s = interface_terms(
-                mesh,
-                dofs,
-                p.term_pair(k, &setup.fields),
-                c.side_a,
-                c.side_b,
-                c.points,
-                &c.form,
-                u,
-            );
+            let s = self.points[k].evaluate(&c.form, u);
             let s = match s {
                 Ok(s) => s,
                 Err(e) => {
@@ -1028,7 +1012,7 @@ impl Context<'_, '_> {
             for &(d, v) in &s.residual {
                 r[d as usize] += v;
             }
-            s.add_to(asm, &self.couplings[k], self.first[k]);
+            s.add_scattered(asm, &self.scatters[k]);
             systems.push(Some(s));
         }
         // Ties: Cᵀλ and C u − ΔT ∫ψ; a tie switched off keeps λ = 0.

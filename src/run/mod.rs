@@ -774,8 +774,8 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                     beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
                     conductivity: &conductivity,
                 },
-                // A constant conductance keeps the system linear and symmetric.
-                linear: model.as_ref().is_none_or(|m| m.name() == "constant"),
+                // A conductance independent of T keeps the system linear and symmetric.
+                linear: model.as_ref().is_none_or(|m| !m.depends_on_temperature()),
             })
             .collect()
     };

@@ -30,10 +30,13 @@ fn root() -> &'static Path {
 
 /// A fresh copy of the files (not the subdirectories) of `examples/<scene>`.
 fn copy_scene(scene: &str) -> PathBuf {
+    // One directory per call: tests of the same scene run side by side.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let from = root().join("examples").join(scene);
     let to = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("examples")
-        .join(format!("{scene}-{}", std::process::id()));
+        .join(format!("{scene}-{}-{call}", std::process::id()));
     std::fs::remove_dir_all(&to).ok();
     std::fs::create_dir_all(&to).unwrap();
     for entry in std::fs::read_dir(&from).unwrap() {

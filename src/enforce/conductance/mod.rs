@@ -163,6 +163,13 @@ pub trait ConductanceModel {
     fn value(&self, state: &PointState) -> Result<f64, ConductanceError> {
         self.evaluate(state).map(|c| c.h)
     }
+
+    /// Whether h may change with the temperatures. A model that says no keeps the
+    /// heat problem linear in T (one Newton step, a symmetric factorisation reused
+    /// while the matrix stays the same), so the default is the safe yes.
+    fn depends_on_temperature(&self) -> bool {
+        true
+    }
 }
 
 /// The result check every model applies: finite values, h ≥ 0.
@@ -234,6 +241,9 @@ impl Constant {
 impl ConductanceModel for Constant {
     fn name(&self) -> String {
         "constant".into()
+    }
+    fn depends_on_temperature(&self) -> bool {
+        false
     }
     fn evaluate(&self, _state: &PointState) -> Result<Conductance, ConductanceError> {
         // h was checked (finite, ≥ 0) at construction.
@@ -331,6 +341,9 @@ impl GasGap {
 impl ConductanceModel for GasGap {
     fn name(&self) -> String {
         "gas_gap".into()
+    }
+    fn depends_on_temperature(&self) -> bool {
+        self.beta != 0.0
     }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let (a, da) = self.inverse_length(s.gap);
@@ -439,6 +452,9 @@ impl ConductanceModel for Cmy {
     fn name(&self) -> String {
         "cmy".into()
     }
+    fn depends_on_temperature(&self) -> bool {
+        false
+    }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let p = s.pressure;
         let c = if p > 0.0 {
@@ -540,6 +556,9 @@ impl ConductanceModel for Table {
     fn name(&self) -> String {
         format!("table of {}", self.variable.as_str())
     }
+    fn depends_on_temperature(&self) -> bool {
+        self.variable == TableVariable::Temperature
+    }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let mut c = Conductance::default();
         match self.variable {
@@ -574,6 +593,9 @@ impl ConductanceModel for Sum {
     fn name(&self) -> String {
         let names: Vec<String> = self.parts.iter().map(|p| p.name()).collect();
         format!("sum of {}", names.join(" + "))
+    }
+    fn depends_on_temperature(&self) -> bool {
+        self.parts.iter().any(|p| p.depends_on_temperature())
     }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let mut total = Conductance::default();
