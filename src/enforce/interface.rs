@@ -619,7 +619,8 @@ impl InterfacePoints {
                 let jump = &self.values[at..at + nl];
                 let flux = &self.values[at + nl..at + 2 * nl];
                 let na = p.na as usize;
-                let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[dofs[i] as usize]).sum() };
+                let value =
+                    |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[dofs[i] as usize]).sum() };
                 let jump_u = value(jump) - form.offset;
                 let flux_u = value(flux);
                 let temp_a: f64 = (0..na).map(|i| jump[i] * u[dofs[i] as usize]).sum();
@@ -676,7 +677,8 @@ impl InterfacePoints {
             }
             blocks.push((dofs.to_vec(), m));
         }
-        let pairs = |v: Vec<f64>| -> Vec<(u32, f64)> { self.touched.iter().copied().zip(v).collect() };
+        let pairs =
+            |v: Vec<f64>| -> Vec<(u32, f64)> { self.touched.iter().copied().zip(v).collect() };
         Ok(InterfaceSystem {
             blocks,
             rhs: pairs(rhs),
@@ -741,6 +743,27 @@ impl InterfaceSystem {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// Move a linear form's residual from u to u + du (exact when h does not depend
+    /// on u: the blocks are then the form's matrix).
+    pub fn advance(&mut self, du: &[f64]) {
+        let mut change: Vec<(u32, f64)> = Vec::new();
+        for (dofs, m) in &self.blocks {
+            let n = dofs.len();
+            for a in 0..n {
+                let v: f64 = (0..n).map(|c| m[a * n + c] * du[dofs[c] as usize]).sum();
+                change.push((dofs[a], v));
+            }
+        }
+        change.sort_by_key(|c| c.0);
+        let mut k = 0;
+        for (d, r) in self.residual.iter_mut() {
+            while k < change.len() && change[k].0 == *d {
+                *r += change[k].1;
+                k += 1;
             }
         }
     }
