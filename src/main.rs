@@ -526,7 +526,8 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                     println!("  wrote {}", o.display());
                 }
                 println!(
-                    "  time: surfaces {:.3} s, search {:.3} s, assembly {:.3} s, factor {:.3} s, solve {:.3} s, total {:.3} s",
+                    "  time: mesh {:.3} s, surfaces {:.3} s, search {:.3} s, assembly {:.3} s, factor {:.3} s, solve {:.3} s, total {:.3} s",
+                    s.timing.mesh_s,
                     s.timing.surfaces_s,
                     s.timing.search_s,
                     s.timing.assembly_s,
@@ -534,6 +535,9 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                     s.timing.solve_s,
                     s.timing.total_s
                 );
+                if let Some(m) = s.peak_memory_mib {
+                    println!("  peak memory {m:.0} MiB");
+                }
             }
             use std::io::Write as _;
             let _ = std::io::stdout().flush();

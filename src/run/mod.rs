@@ -317,6 +317,8 @@ pub struct InteractionHeat {
 
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct Timing {
+    /// Reading the mesh.
+    pub mesh_s: f64,
     pub surfaces_s: f64,
     pub search_s: f64,
     pub assembly_s: f64,
@@ -337,6 +339,18 @@ pub struct Summary {
     /// Transient runs only.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub transient: Option<TransientSummary>,
+    /// The process's peak resident memory (MiB) at the end of the run, where the
+    /// system reports it (Linux: `VmHWM` in `/proc/self/status`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub peak_memory_mib: Option<f64>,
+}
+
+/// Peak resident memory of this process in MiB (Linux only; None elsewhere).
+pub fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
 }
 
 /// What a transient run did.
@@ -437,8 +451,10 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             ));
         }
     };
+    let clock = Instant::now();
     let mesh = mesh::read(&dir.join(&problem.mesh.file))
         .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
+    let mesh_s = clock.elapsed().as_secs_f64();
     let mut diags = Diagnostics::default();
     let sandbox: SharedSandbox = Default::default();
     let probe = match problem.initial.as_ref().map(|i| &i.temperature) {
@@ -1074,6 +1090,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             imbalance: a + b,
         })
         .collect();
+    timing.mesh_s = mesh_s;
     timing.total_s = start.elapsed().as_secs_f64();
     let transient_summary = transient.then(|| TransientSummary {
         steps: history.len(),
@@ -1088,6 +1105,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         timing,
         output,
         transient: transient_summary,
+        peak_memory_mib: peak_memory_mib(),
     };
     Ok(RunResult {
         summary,

@@ -256,16 +256,21 @@ pub(super) fn write_history(
     history: &[StepReport],
     labels: &[(String, String, String)],
 ) -> std::io::Result<()> {
-    let mut s = String::from("step,time,dt,newton_iterations,rejected,residual\n");
+    let mut s = String::from(
+        "step,time,dt,newton_iterations,rejected,residual,assembly_s,factor_s,solve_s\n",
+    );
     for r in history {
         s.push_str(&format!(
-            "{},{:e},{:e},{},{},{:e}\n",
+            "{},{:e},{:e},{},{},{:e},{:.6},{:.6},{:.6}\n",
             r.step,
             r.time,
             r.dt,
             r.newton_iterations,
             r.rejected,
-            r.residual_history.last().copied().unwrap_or(0.0)
+            r.residual_history.last().copied().unwrap_or(0.0),
+            r.assembly_s,
+            r.factor_s,
+            r.solve_s
         ));
     }
     std::fs::write(dir.join("steps.csv"), s)?;
