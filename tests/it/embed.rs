@@ -91,20 +91,22 @@ fn library_dir(file: &str) -> PathBuf {
         .to_path_buf()
 }
 
-#[test]
-fn embed_c_host_matches_seam_run() {
+/// Compile `examples/c_host/<source>` against libseam with the CI flags and run it;
+/// returns its standard output (the run must succeed).
+fn run_c_host(source: &str) -> String {
     let lib = library_dir(if cfg!(target_os = "macos") {
         "libseam.dylib"
     } else {
         "libseam.so"
     });
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = scratch("c").join("c_host");
+    let dir = scratch(source);
+    let out = dir.join("host");
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let build = Command::new(&cc)
         .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-I"])
         .arg(root.join("include"))
-        .arg(root.join("examples/c_host/main.c"))
+        .arg(root.join("examples/c_host").join(source))
         .arg("-L")
         .arg(&lib)
         .arg("-lseam")
@@ -125,27 +127,39 @@ fn embed_c_host_matches_seam_run() {
         .env("LD_LIBRARY_PATH", &lib)
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
     assert!(
         run.status.success(),
         "{stdout}{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    let _ = std::fs::remove_dir_all(&dir);
+    stdout
+}
+
+/// The numbers after `prefix` on the line of `stdout` that starts with it.
+fn printed(stdout: &str, prefix: &str) -> Vec<f64> {
+    stdout
+        .lines()
+        .find_map(|l| l.strip_prefix(prefix))
+        .map(|rest| {
+            rest.split(|c: char| c == ',' || c.is_whitespace())
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        })
+        .unwrap_or_else(|| panic!("no `{prefix}` line in:\n{stdout}"))
+}
+
+#[test]
+fn embed_c_host_matches_seam_run() {
+    let stdout = run_c_host("main.c");
     // The misspelt surface came back as SEAM_ERR_ARGUMENT with a suggestion.
     assert!(
         stdout.contains("expected error 4: unknown surface `base_topp`")
             && stdout.contains("did you mean `base_top`?"),
         "{stdout}"
     );
-    let heat: Vec<f64> = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("interface heat: side A "))
-        .map(|rest| {
-            rest.split(|c: char| c == ',' || c.is_whitespace())
-                .filter_map(|w| w.parse().ok())
-                .collect()
-        })
-        .unwrap_or_else(|| panic!("no heat line in:\n{stdout}"));
+    let heat = printed(&stdout, "interface heat: side A ");
     let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
     let (reference, reference_b) = seam_run("c-reference", &deck);
     let (a, b) = (heat[0], heat[1]);
@@ -159,15 +173,7 @@ fn embed_c_host_matches_seam_run() {
         "{b} vs {reference_b}"
     );
     // Its dual mortar tie, condensed in C, against seam run's dual solve.
-    let dual: Vec<f64> = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("dual tie heat: side A "))
-        .map(|rest| {
-            rest.split(|c: char| c == ',' || c.is_whitespace())
-                .filter_map(|w| w.parse().ok())
-                .collect()
-        })
-        .unwrap_or_else(|| panic!("no dual tie heat line in:\n{stdout}"));
+    let dual = printed(&stdout, "dual tie heat: side A ");
     let (reference, _) = seam_run("c-dual", &tie_deck("dual"));
     println!(
         "C host dual tie {:.15e} W, seam run {reference:.15e} W: {:.2e}",
@@ -176,7 +182,6 @@ fn embed_c_host_matches_seam_run() {
     );
     assert!(relative(dual[0], reference) <= TOLERANCE);
     assert!(relative(-dual[1], reference) <= TOLERANCE);
-    let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
 /// The two-block interface tied by mortar with `multipliers` (`dual` or `standard`).
@@ -1142,4 +1147,42 @@ fn embed_plugin_faults_and_cutbacks_are_reported() {
         "{message}"
     );
     unsafe { seam_builder_free(b) };
+}
+
+/// The C host of the turbine sector (`examples/c_host/sector.c`): its own mesh (the
+/// grid of make_meshes.py, generated in C), its own assembly, and the cylindrical
+/// periodicity from `seam_add_periodic_interaction`, against `seam run` on the scene.
+///
+/// Tolerance 1e-9 relative (the module's): the C host's coordinates come from its own
+/// trigonometry and powers (an ulp from numpy's in the mesh file) and it solves densely,
+/// so round-off differs; a wrong map, face or dof would move the heat by percents.
+#[test]
+fn embed_c_sector_host_matches_seam_run() {
+    let stdout = run_c_host("sector.c");
+    assert!(
+        stdout.contains("expected error 4: periodic interaction cut_start / cut_end: its image does not land on `cut_end`"),
+        "{stdout}"
+    );
+    let reference = run_scene(&turbine(), &turbine(), "problem.toml");
+    let cut = &reference.summary.interactions[0];
+    let heat = printed(&stdout, "periodic tie heat: side A ");
+    let range = printed(&stdout, "temperature: min ");
+    let t = &reference.solution.temperature;
+    let (lo, hi) = t
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(*v), h.max(*v))
+        });
+    println!(
+        "C sector host: cut heat {:.15e} W, seam run {:.15e} W: {:.2e}; lowest and highest temperatures off by {:.2e} and {:.2e} of the spread",
+        heat[0],
+        cut.heat_side_a,
+        relative(heat[0], cut.heat_side_a),
+        (range[0] - lo).abs() / (hi - lo),
+        (range[1] - hi).abs() / (hi - lo)
+    );
+    assert!(relative(heat[0], cut.heat_side_a) <= TOLERANCE);
+    assert!(relative(heat[1], cut.heat_side_b) <= TOLERANCE);
+    assert!((range[0] - lo).abs() <= TOLERANCE * (hi - lo));
+    assert!((range[1] - hi).abs() <= TOLERANCE * (hi - lo));
 }
