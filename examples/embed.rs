@@ -36,15 +36,15 @@ pub fn host_dofs(mesh: &Mesh) -> Vec<usize> {
 
 /// Hand the mesh over as plain arrays: blocks, and the side sets as (element, side).
 pub fn embedding(mesh: &Mesh, dof: &[usize]) -> EmbeddingBuilder {
+    embedding_with(mesh, dof, conductivity_of)
+}
+
+/// As [`embedding`], with the conductivity `k(block name)` of another scene.
+pub fn embedding_with(mesh: &Mesh, dof: &[usize], k: impl Fn(&str) -> f64) -> EmbeddingBuilder {
     let mut builder = Embedding::builder(&mesh.coords);
     for block in &mesh.blocks {
         let conn: Vec<usize> = block.connectivity.iter().map(|n| n.index()).collect();
-        builder = builder.block(
-            &block.name,
-            block.topology,
-            &conn,
-            conductivity_of(&block.name),
-        );
+        builder = builder.block(&block.name, block.topology, &conn, k(&block.name));
     }
     for set in &mesh.side_sets {
         let sides: Vec<(usize, u8)> = set.sides.iter().map(|s| (s.elem.index(), s.side)).collect();
@@ -55,6 +55,15 @@ pub fn embedding(mesh: &Mesh, dof: &[usize]) -> EmbeddingBuilder {
 
 /// Conduction of every block, dense (row-major), in host numbering.
 pub fn conduction(mesh: &Mesh, dof: &[usize]) -> Result<Vec<f64>, Box<dyn Error>> {
+    conduction_with(mesh, dof, conductivity_of)
+}
+
+/// As [`conduction`], with the conductivity `k(block name)` of another scene.
+pub fn conduction_with(
+    mesh: &Mesh,
+    dof: &[usize],
+    k_of: impl Fn(&str) -> f64,
+) -> Result<Vec<f64>, Box<dyn Error>> {
     let n = mesh.num_nodes();
     let mut k = vec![0.0; n * n];
     for block in &mesh.blocks {
@@ -64,7 +73,7 @@ pub fn conduction(mesh: &Mesh, dof: &[usize]) -> Result<Vec<f64>, Box<dyn Error>
             let nodes = block.elem_nodes(e);
             let x: Vec<[f64; 3]> = nodes.iter().map(|n| mesh.coords[n.index()]).collect();
             let mut ke = vec![0.0; nn * nn];
-            conductivity(&basis, &x, |_| conductivity_of(&block.name), &mut ke)
+            conductivity(&basis, &x, |_| k_of(&block.name), &mut ke)
                 .map_err(|b| format!("element {e} of block {}: det J = {:e}", block.name, b.det))?;
             for (a, na) in nodes.iter().enumerate() {
                 for (b, nb) in nodes.iter().enumerate() {
@@ -78,8 +87,17 @@ pub fn conduction(mesh: &Mesh, dof: &[usize]) -> Result<Vec<f64>, Box<dyn Error>
 
 /// The prescribed value of each host unknown: base bottom 300 K, lid top 400 K.
 pub fn dirichlet(mesh: &Mesh, dof: &[usize]) -> Result<Vec<Option<f64>>, Box<dyn Error>> {
+    dirichlet_on(mesh, dof, &[("base_bottom", 300.0), ("lid_top", 400.0)])
+}
+
+/// The prescribed value of each host unknown from (side set, value) pairs.
+pub fn dirichlet_on(
+    mesh: &Mesh,
+    dof: &[usize],
+    sets: &[(&str, f64)],
+) -> Result<Vec<Option<f64>>, Box<dyn Error>> {
     let mut fixed = vec![None; mesh.num_nodes()];
-    for (set, value) in [("base_bottom", 300.0), ("lid_top", 400.0)] {
+    for &(set, value) in sets {
         let s = mesh.find_side_set(set).ok_or("missing side set")?;
         for &side in &mesh.side_sets[s].sides {
             for node in mesh.side_nodes(side) {
@@ -93,20 +111,31 @@ pub fn dirichlet(mesh: &Mesh, dof: &[usize]) -> Result<Vec<Option<f64>>, Box<dyn
 /// Solve the two-block scene in `dir` as a host would.
 pub fn solve(dir: &Path) -> Result<Outcome, Box<dyn Error>> {
     let mesh = seam::mesh::read(&dir.join("two_blocks.exo"))?;
-    let n = mesh.num_nodes();
     let dof = host_dofs(&mesh);
     let mut seam = embedding(&mesh, &dof).build()?;
     seam.add_deck_file(&dir.join("contact_run.i"))?;
     seam.search()?;
     let k = conduction(&mesh, &dof)?;
     let fixed = dirichlet(&mesh, &dof)?;
-    let mut u: Vec<f64> = fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
+    let (u, newton_steps) = newton(&seam, &k, &fixed)?;
+    let heat = seam.contributions(&u)?.heat[0].ok_or("not a flux-type interaction")?;
+    Ok(Outcome { heat, newton_steps })
+}
 
-    // Newton: R(u) = K u + R_Γ(u), J = K + J_Γ; stop when a step moves no unknown by
-    // more than 1e-9 K (a constant h is linear: the second step only confirms).
+/// The host's Newton iteration on `K u + R_Γ(u) = 0` with the unknowns `fixed` held
+/// (K dense, row-major, in host numbering): J = K + J_Γ; stops when a step moves no
+/// unknown by more than 1e-9 K (a constant h is linear: the second step only confirms).
+/// Returns the field and the number of steps.
+pub fn newton(
+    seam: &Embedding,
+    k: &[f64],
+    fixed: &[Option<f64>],
+) -> Result<(Vec<f64>, usize), Box<dyn Error>> {
+    let n = fixed.len();
+    let mut u: Vec<f64> = fixed.iter().map(|f| f.unwrap_or(0.0)).collect();
     for step in 1..=10 {
         let c = seam.contributions(&u)?;
-        let mut j = k.clone();
+        let mut j = k.to_vec();
         let mut r = vec![0.0; n];
         for row in 0..n {
             r[row] = (0..n).map(|col| k[row * n + col] * u[col]).sum();
@@ -131,11 +160,7 @@ pub fn solve(dir: &Path) -> Result<Outcome, Box<dyn Error>> {
             *x += d;
         }
         if largest <= 1e-9 {
-            let heat = seam.contributions(&u)?.heat[0].ok_or("not a flux-type interaction")?;
-            return Ok(Outcome {
-                heat,
-                newton_steps: step,
-            });
+            return Ok((u, step));
         }
     }
     Err("Newton did not converge in 10 steps".into())

@@ -45,6 +45,8 @@ extern "C" {
 #define SEAM_ERR_ORDER 5         /* a call out of order (e.g. evaluate before search) */
 #define SEAM_ERR_ENFORCEMENT 6   /* an enforcement failed at a contact point */
 #define SEAM_ERR_INTERNAL 7      /* a bug in seam (a caught panic) */
+#define SEAM_ERR_PLUGIN 8        /* a plugin could not be loaded, or failed at a contact point */
+#define SEAM_CUTBACK 9           /* a plugin asks for a smaller step (seam_cutback_factor) */
 
 /* Element topologies (3-D solids). */
 #define SEAM_HEX8 1
@@ -58,6 +60,11 @@ extern "C" {
 #define SEAM_TIED_NITSCHE 3      /* weighted symmetric Nitsche tie */
 #define SEAM_TIED_MORTAR 4       /* mortar tie, standard multipliers: rows C u = g */
 #define SEAM_TIED_DUAL_MORTAR 5  /* mortar tie, dual multipliers: condensed rows */
+
+/* Periodic maps of seam_add_periodic_interaction, with their parameters. */
+#define SEAM_PERIODIC_RECTANGULAR 1   /* offset: dx dy dz */
+#define SEAM_PERIODIC_CYLINDRICAL 2   /* axis x y z, center x y z, angle (degrees, right-hand) */
+#define SEAM_PERIODIC_ALIGN_SURFACE 3 /* nothing, or invert_normals (1 default, or 0) */
 
 /* Integration of side A. */
 #define SEAM_SEGMENTS 0   /* mortar segments (exact; default, order 5) */
@@ -96,9 +103,20 @@ void seam_embedding_free(seam_embedding *embedding);
  * jump u_A - u_B. out_index (may be NULL) receives the interaction's index. */
 int seam_add_interaction(seam_embedding *embedding, const char *side_a, const char *side_b,
                          int model, double h, double offset, size_t *out_index);
-/* Interactions of a Sierra-syntax contact deck; name labels messages (may be NULL). */
+/* As seam_add_interaction, between the image of side_a under a periodic map (a
+ * SEAM_PERIODIC_* code with n_params parameters) and side_b; the image must land on
+ * side_b. Lua maps come in a deck. */
+int seam_add_periodic_interaction(seam_embedding *embedding, const char *side_a,
+                                  const char *side_b, int model, double h, double offset,
+                                  int transform, const double *params, size_t n_params,
+                                  size_t *out_index);
+/* Interactions of a Sierra-syntax contact deck; name labels messages (may be NULL).
+ * Periodic conditions and plugin enforcements are taken; relative paths in the deck
+ * (Lua files, plugin libraries) are taken from the working directory. */
 int seam_add_deck(seam_embedding *embedding, const char *deck_text, const char *name,
                   size_t *out_count);
+/* The same from a deck file (Sierra syntax or .toml); relative paths from its folder. */
+int seam_add_deck_file(seam_embedding *embedding, const char *path, size_t *out_count);
 int seam_interaction_count(const seam_embedding *embedding, size_t *out_count);
 /* Pair every interaction anew. */
 int seam_search(seam_embedding *embedding);
@@ -106,8 +124,11 @@ int seam_search(seam_embedding *embedding);
 int seam_move_nodes(seam_embedding *embedding, const double *coords, size_t n_nodes);
 
 /* --- interface terms ---------------------------------------------------------------- */
-/* Evaluate at the host's field u (n entries, by host dof). */
+/* Evaluate at the host's field u (n entries, by host dof). A plugin's failure is
+ * SEAM_ERR_PLUGIN; its request for a smaller step is SEAM_CUTBACK (nothing evaluated). */
 int seam_evaluate(seam_embedding *embedding, const double *u, size_t n);
+/* After SEAM_CUTBACK: the plugin's suggested new/old step in (0, 1), or 0 (host decides). */
+int seam_cutback_factor(const seam_embedding *embedding, double *out_factor);
 /* Residual entries to add to R(u) = K u - F; dofs may repeat. */
 int seam_residual(const seam_embedding *embedding, size_t *out_n, const int64_t **out_dofs,
                   const double **out_values);

@@ -2,8 +2,8 @@
 //!
 //! Entry points mirror the Rust API: a builder handle (`seam_builder_*`) takes the
 //! host's nodes, blocks, surfaces and dof numbers; `seam_embedding_new` checks them and
-//! makes an embedding handle; interactions come from `seam_add_interaction` or
-//! `seam_add_deck`; then `seam_search`, `seam_move_nodes`, `seam_evaluate` with the
+//! makes an embedding handle; interactions come from `seam_add_interaction`,
+//! `seam_add_periodic_interaction`, `seam_add_deck` or `seam_add_deck_file`; then `seam_search`, `seam_move_nodes`, `seam_evaluate` with the
 //! accessors of its results, and `seam_constraints` with `seam_tie_*` for mortar ties.
 //!
 //! Conventions:
@@ -28,7 +28,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use crate::embed::{
     Contributions, EmbedError, Embedding, EmbeddingBuilder, Integration, Interaction, Model,
-    Multipliers, TieConstraints, Topology,
+    Multipliers, Periodic, TieConstraints, Topology,
 };
 
 /// Status codes (`SEAM_OK` … in `seam.h`).
@@ -50,6 +50,10 @@ pub enum SeamStatus {
     Enforcement = 6,
     /// A bug in seam (a caught panic).
     Internal = 7,
+    /// A plugin enforcement could not be loaded, or its plugin failed at a contact point.
+    Plugin = 8,
+    /// A plugin asks for a smaller step (`seam_cutback_factor` gives its suggestion).
+    Cutback = 9,
 }
 
 thread_local! {
@@ -70,6 +74,8 @@ impl From<EmbedError> for Failure {
             EmbedError::Deck(_) => SeamStatus::Deck,
             EmbedError::Order { .. } => SeamStatus::Order,
             EmbedError::Enforcement { .. } => SeamStatus::Enforcement,
+            EmbedError::Plugin { .. } => SeamStatus::Plugin,
+            EmbedError::Cutback { .. } => SeamStatus::Cutback,
             _ => SeamStatus::Argument,
         };
         Failure(status, e.to_string())
@@ -213,6 +219,8 @@ pub struct SeamEmbedding {
     inner: Embedding,
     evaluated: Option<Evaluated>,
     rows: Option<Rows>,
+    /// The step factor a plugin suggested when the last evaluation asked for a cutback.
+    cutback: Option<f64>,
 }
 
 fn as_i64(v: usize) -> i64 {
@@ -462,6 +470,7 @@ pub unsafe extern "C" fn seam_embedding_new(
             inner,
             evaluated: None,
             rows: None,
+            cutback: None,
         });
         unsafe { out(out_embedding, Box::into_raw(e), "out_embedding") }
     })
@@ -493,32 +502,114 @@ pub unsafe extern "C" fn seam_add_interaction(
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
         let (a, b) = unsafe { (text(side_a, "side_a")?, text(side_b, "side_b")?) };
-        let model = match model {
-            1 => Model::Conductance { h },
-            2 => Model::GapConductance { h },
-            3 => Model::TiedNitsche,
-            4 => Model::TiedMortar {
-                multipliers: Multipliers::Standard,
-            },
-            5 => Model::TiedMortar {
-                multipliers: Multipliers::Dual,
-            },
-            other => {
-                return Err(bad(
-                    format!("unknown model code {other}"),
-                    "use one of the SEAM_CONDUCTANCE … SEAM_TIED_DUAL_MORTAR codes of seam.h",
-                ));
-            }
-        };
-        let i = e
-            .inner
-            .add_interaction(Interaction::new(a, b, model).offset(offset))?;
-        e.evaluated = None;
-        e.rows = None;
-        if !out_index.is_null() {
-            unsafe { out(out_index, i, "out_index") }?;
+        let model = model_of(model, h)?;
+        add(e, Interaction::new(a, b, model).offset(offset), out_index)
+    })
+}
+
+fn model_of(code: c_int, h: f64) -> Result<Model, Failure> {
+    Ok(match code {
+        1 => Model::Conductance { h },
+        2 => Model::GapConductance { h },
+        3 => Model::TiedNitsche,
+        4 => Model::TiedMortar {
+            multipliers: Multipliers::Standard,
+        },
+        5 => Model::TiedMortar {
+            multipliers: Multipliers::Dual,
+        },
+        other => {
+            return Err(bad(
+                format!("unknown model code {other}"),
+                "use one of the SEAM_CONDUCTANCE … SEAM_TIED_DUAL_MORTAR codes of seam.h",
+            ));
         }
-        Ok(())
+    })
+}
+
+fn add(e: &mut SeamEmbedding, i: Interaction, out_index: *mut usize) -> Result<(), Failure> {
+    let i = e.inner.add_interaction(i)?;
+    e.evaluated = None;
+    e.rows = None;
+    if !out_index.is_null() {
+        unsafe { out(out_index, i, "out_index") }?;
+    }
+    Ok(())
+}
+
+/// The periodic map of `transform` (a SEAM_PERIODIC_* code) from its parameters.
+fn periodic_of(transform: c_int, p: &[f64]) -> Result<Periodic, Failure> {
+    let count = |want: &[usize], usage: &str| -> Result<(), Failure> {
+        if want.contains(&p.len()) {
+            Ok(())
+        } else {
+            Err(bad(
+                format!("{} parameters for periodic map {transform}", p.len()),
+                usage,
+            ))
+        }
+    };
+    Ok(match transform {
+        1 => {
+            count(&[3], "SEAM_PERIODIC_RECTANGULAR takes the offset: dx dy dz")?;
+            Periodic::Rectangular {
+                offset: [p[0], p[1], p[2]],
+            }
+        }
+        2 => {
+            count(
+                &[7],
+                "SEAM_PERIODIC_CYLINDRICAL takes axis x y z, center x y z and the angle in degrees",
+            )?;
+            Periodic::Cylindrical {
+                axis: [p[0], p[1], p[2]],
+                center: [p[3], p[4], p[5]],
+                angle: p[6],
+            }
+        }
+        3 => {
+            count(
+                &[0, 1],
+                "SEAM_PERIODIC_ALIGN_SURFACE takes nothing or invert_normals (1 or 0)",
+            )?;
+            Periodic::AlignSurface {
+                invert_normals: p.first().is_none_or(|&v| v != 0.0),
+            }
+        }
+        other => {
+            return Err(bad(
+                format!("unknown periodic map code {other}"),
+                "use SEAM_PERIODIC_RECTANGULAR, SEAM_PERIODIC_CYLINDRICAL or SEAM_PERIODIC_ALIGN_SURFACE (Lua maps come in a deck: seam_add_deck)",
+            ));
+        }
+    })
+}
+
+/// As `seam_add_interaction`, between the image of `side_a` under a periodic map and
+/// `side_b`. `transform` is a SEAM_PERIODIC_* code with `n_params` parameters (see
+/// seam.h); the image must land on `side_b`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_add_periodic_interaction(
+    embedding: *mut SeamEmbedding,
+    side_a: *const c_char,
+    side_b: *const c_char,
+    model: c_int,
+    h: f64,
+    offset: f64,
+    transform: c_int,
+    params: *const f64,
+    n_params: usize,
+    out_index: *mut usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let (a, b) = unsafe { (text(side_a, "side_a")?, text(side_b, "side_b")?) };
+        let model = model_of(model, h)?;
+        let periodic = periodic_of(transform, unsafe { slice(params, n_params, "params") }?)?;
+        let i = Interaction::new(a, b, model)
+            .offset(offset)
+            .periodic(periodic);
+        add(e, i, out_index)
     })
 }
 
@@ -540,6 +631,27 @@ pub unsafe extern "C" fn seam_add_deck(
             unsafe { text(name, "name") }?
         };
         let added = e.inner.add_deck(name, deck)?;
+        e.evaluated = None;
+        e.rows = None;
+        if !out_count.is_null() {
+            unsafe { out(out_count, added.len(), "out_count") }?;
+        }
+        Ok(())
+    })
+}
+
+/// Add the interactions of a deck file (Sierra syntax or `.toml`); relative paths in
+/// it (Lua files, plugin libraries) are taken from its folder.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_add_deck_file(
+    embedding: *mut SeamEmbedding,
+    path: *const c_char,
+    out_count: *mut usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let path = unsafe { text(path, "path") }?;
+        let added = e.inner.add_deck_file(std::path::Path::new(path))?;
         e.evaluated = None;
         e.rows = None;
         if !out_count.is_null() {
@@ -603,8 +715,37 @@ pub unsafe extern "C" fn seam_evaluate(
         let e = unsafe { handle(embedding, "embedding") }?;
         let u = unsafe { slice(u, n, "u") }?;
         e.evaluated = None;
-        e.evaluated = Some(Evaluated::from(e.inner.contributions(u)?));
+        e.cutback = None;
+        match e.inner.contributions(u) {
+            Ok(c) => e.evaluated = Some(Evaluated::from(c)),
+            Err(err) => {
+                if let EmbedError::Cutback { factor, .. } = &err {
+                    e.cutback = Some(*factor);
+                }
+                return Err(err.into());
+            }
+        }
         Ok(())
+    })
+}
+
+/// After `seam_evaluate` returned SEAM_CUTBACK: the new/old step the plugin suggests,
+/// in (0, 1), or 0 when it leaves the choice to the host.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_cutback_factor(
+    embedding: *const SeamEmbedding,
+    out_factor: *mut f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let factor = e.cutback.ok_or_else(|| {
+            Failure(
+                SeamStatus::Order,
+                "the last evaluation asked for no cutback\n  help: call this after seam_evaluate returned SEAM_CUTBACK".into(),
+            )
+        })?;
+        unsafe { out(out_factor, factor, "out_factor") }
     })
 }
 

@@ -12,6 +12,14 @@
 //! ([`Embedding::constraints`]); dual multipliers give them in the condensed form
 //! `u_A = g + Σ c_j u_j`, for hosts that carry no multipliers.
 //!
+//! Periodic conditions pair the image of a surface under a map with its partner, from a
+//! deck's `Periodicity For S = …` or in code ([`Interaction::periodic`]); the terms
+//! couple each side-A node with the side-B nodes its image lands between, in host dof
+//! numbers, like any other interaction. Plugin enforcements (`Enforcement for Energy =
+//! Plugin Library = …`) load their library when the deck is added; a plugin that fails
+//! at a point is [`EmbedError::Plugin`], one that asks for a smaller step is
+//! [`EmbedError::Cutback`].
+//!
 //! ```no_run
 //! use seam::embed::{Embedding, Interaction, Model, Topology};
 //! # fn host() -> Result<(), seam::embed::EmbedError> {
@@ -42,14 +50,18 @@
 //! - Nothing here panics on host input: every check returns an [`EmbedError`] that says
 //!   what is wrong, where, and how to fix it.
 
+use std::cell::Cell;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 use std::sync::Arc;
 
 use crate::assembly::{DofMap, FieldId};
+use crate::deck::spec::{ContactDefinition, Enforcement as DeckEnforcement, PeriodicTransform};
 use crate::deck::{self, Deck};
 use crate::diag::{Diagnostics, SourceMap, did_you_mean};
-use crate::enforce::conductance::{ConductanceModel, PointState};
+use crate::enforce::conductance::{
+    ConductanceError, ConductanceModel, PluginConductance, PointState,
+};
 use crate::enforce::interface::{
     DEFAULT_BETA, Form, HInput, HValue, InterfaceError, InterfaceForm, interface_terms,
 };
@@ -57,7 +69,12 @@ use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
 use crate::enforce::mortar::mortar_tie;
 use crate::interaction::SearchSettings;
 use crate::mesh::{ElemId, Mesh, NodeId, Side, SideSet, ValidationError};
-use crate::search::pairing::{SearchResult, SearchStats, Searcher, SurfaceGeometry};
+use crate::periodic::PeriodicMap;
+use crate::search::pairing::{SearchResult, SearchStats, Searcher, Sphere, SurfaceGeometry};
+use crate::search::scene::{
+    PeriodicError, SceneSearch, check_closure, landing, periodic_map, search_periodicity,
+    surface_geometries,
+};
 use crate::surface::{ContactSurface, SurfaceFace, SurfaceKind};
 
 pub use crate::deck::spec::Overclosure;
@@ -93,6 +110,29 @@ pub enum EmbedError {
         side_b: String,
         source: InterfaceError,
     },
+    /// A plugin enforcement could not be loaded (`add_deck`), or its plugin failed at a
+    /// contact point (`contributions`): an error status, a non-finite or negative value.
+    /// The message names the plugin's library and, at a point, where it is.
+    #[error(
+        "interaction {side_a} / {side_b}: {message}\n  help: `seam check-plugin LIB` loads and probes a plugin on its own"
+    )]
+    Plugin {
+        side_a: String,
+        side_b: String,
+        message: String,
+    },
+    /// A plugin asks for a smaller step (`SEAM_STATUS_CUTBACK`): not a failure of the
+    /// model, a request to the host to retry its time (or load) step with a smaller one.
+    #[error(
+        "interaction {side_a} / {side_b}: {message}\n  help: retry the step with a smaller one (suggested new/old step {factor}; 0: the host decides)"
+    )]
+    Cutback {
+        side_a: String,
+        side_b: String,
+        /// The plugin's suggested new/old step in (0, 1), or 0: the host decides.
+        factor: f64,
+        message: String,
+    },
 }
 
 fn mesh_error(what: String, help: &str) -> EmbedError {
@@ -124,6 +164,63 @@ pub enum Model {
     TiedMortar { multipliers: Multipliers },
 }
 
+/// A periodic map of an interaction built in code: side A's image under the map is
+/// paired with side B, as `Periodicity For A = …` pairs it with its destination in a deck
+/// ([`crate::periodic`]). Side A keeps its own nodes and dofs: the interaction couples
+/// each point of A with the point of B its image lands on.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Periodic {
+    /// `Rectangular Offset`: `x ↦ x + offset`.
+    Rectangular { offset: [f64; 3] },
+    /// `Cylindrical`: a turn by `angle` degrees (counter-clockwise, right-hand rule)
+    /// about the line through `center` along `axis`. An N-fold turn (`360/angle` an
+    /// integer N) must come back to the start after N turns.
+    Cylindrical {
+        axis: [f64; 3],
+        center: [f64; 3],
+        angle: f64,
+    },
+    /// `Align_Surface`: the rigid map taking A's centroid and mean normal onto B's,
+    /// normals opposed when `invert_normals` (two sides of an interface face each other).
+    AlignSurface { invert_normals: bool },
+    /// `Mapped`: each component a Lua expression in `x`, `y`, `z` or
+    /// `file.lua:function` (a file under the working directory); without `z`, z is kept.
+    Mapped {
+        x: String,
+        y: String,
+        z: Option<String>,
+    },
+}
+
+impl Periodic {
+    /// The deck's transform, with `side_b` as the destination.
+    fn transform(&self, side_b: &str) -> PeriodicTransform {
+        match self {
+            Periodic::Rectangular { offset } => PeriodicTransform::Rectangular {
+                offset: offset.to_vec(),
+            },
+            Periodic::Cylindrical {
+                axis,
+                center,
+                angle,
+            } => PeriodicTransform::Cylindrical {
+                axis: axis.to_vec(),
+                center: center.to_vec(),
+                angle: *angle,
+            },
+            Periodic::AlignSurface { invert_normals } => PeriodicTransform::AlignSurface {
+                destination: side_b.to_string(),
+                invert_normals: *invert_normals,
+            },
+            Periodic::Mapped { x, y, z } => PeriodicTransform::Mapped {
+                x_map: x.clone(),
+                y_map: y.clone(),
+                z_map: z.clone(),
+            },
+        }
+    }
+}
+
 /// One interaction built in code: two surfaces and a model.
 #[derive(Clone, Debug)]
 pub struct Interaction {
@@ -133,6 +230,7 @@ pub struct Interaction {
     offset: f64,
     beta: f64,
     settings: Option<SearchSettings>,
+    periodic: Option<Periodic>,
 }
 
 impl Interaction {
@@ -145,7 +243,14 @@ impl Interaction {
             offset: 0.0,
             beta: DEFAULT_BETA,
             settings: None,
+            periodic: None,
         }
+    }
+
+    /// Pair the image of side A under `map` with side B (a periodic condition).
+    pub fn periodic(mut self, map: Periodic) -> Self {
+        self.periodic = Some(map);
+        self
     }
 
     /// A prescribed jump `u_A − u_B = ΔT` (`Offset Temperature`).
@@ -605,6 +710,10 @@ enum Law {
     /// A model from the deck (`Gap Conductance Coefficient = …`) and the contact
     /// pressure it sees.
     Model(Box<dyn ConductanceModel>, f64),
+    /// A plugin (`Enforcement for Energy = Plugin …`) and the contact pressure it sees:
+    /// its faults and cutback requests become [`EmbedError::Plugin`] and
+    /// [`EmbedError::Cutback`].
+    Plugin(Box<PluginConductance>, f64),
 }
 
 enum Enforcement {
@@ -620,14 +729,25 @@ enum Enforcement {
     },
 }
 
+/// The map of a periodic pair: side A is the image of its surface under it.
+struct Image {
+    map: Box<dyn PeriodicMap>,
+    name: String,
+}
+
 /// One interaction and its search state.
 struct Pair {
     side_a: ContactSurface,
     side_b: ContactSurface,
+    /// Side A's geometry as searched (for a periodic pair: the image).
     a: SurfaceGeometry,
     b: SurfaceGeometry,
     settings: SearchSettings,
-    overclosure: Overclosure,
+    /// `None` for periodic pairs, which keep their gaps as found (as `seam run`).
+    overclosure: Option<Overclosure>,
+    /// `Restrict Contact To Subdomain` of the deck's definition.
+    subdomain: Option<Sphere>,
+    image: Option<Image>,
     enforcement: Enforcement,
     searcher: Option<Searcher>,
     result: Option<SearchResult>,
@@ -695,31 +815,99 @@ impl Embedding {
         })
     }
 
-    fn push_pair(
-        &mut self,
+    fn geometry(&self, s: &ContactSurface) -> Result<SurfaceGeometry, EmbedError> {
+        SurfaceGeometry::from_surface(&self.mesh, s, &self.mesh.coords)
+            .map_err(|e| argument(e.to_string(), "interfaces are searched in 3-D"))
+    }
+
+    fn pair(
+        &self,
         side_a: ContactSurface,
         side_b: ContactSurface,
         settings: SearchSettings,
         overclosure: Overclosure,
+        subdomain: Option<Sphere>,
         enforcement: Enforcement,
-    ) -> Result<usize, EmbedError> {
-        let geometry = |s: &ContactSurface| {
-            SurfaceGeometry::from_surface(&self.mesh, s, &self.mesh.coords)
-                .map_err(|e| argument(e.to_string(), "interfaces are searched in 3-D"))
-        };
-        let (a, b) = (geometry(&side_a)?, geometry(&side_b)?);
-        self.pairs.push(Pair {
+    ) -> Result<Pair, EmbedError> {
+        let (a, b) = (self.geometry(&side_a)?, self.geometry(&side_b)?);
+        Ok(Pair {
             side_a,
             side_b,
             a,
             b,
             settings,
-            overclosure,
+            overclosure: Some(overclosure),
+            subdomain,
+            image: None,
             enforcement,
             searcher: None,
             result: None,
-        });
-        Ok(self.pairs.len() - 1)
+        })
+    }
+
+    /// A periodic pair built in code: side A's image under `periodic`, checked to land
+    /// on side B (the checks of a deck's periodicity: an N-fold turn closes up, the
+    /// worst image node is within 5 % of B's mean face size).
+    fn periodic_pair(
+        &self,
+        side_a: ContactSurface,
+        side_b: ContactSurface,
+        settings: SearchSettings,
+        periodic: &Periodic,
+        enforcement: Enforcement,
+    ) -> Result<Pair, EmbedError> {
+        let label = format!("periodic interaction {} / {}", side_a.name, side_b.name);
+        let fail = |e: &dyn std::fmt::Display, help: &str| argument(format!("{label}: {e}"), help);
+        let (source, b) = (self.geometry(&side_a)?, self.geometry(&side_b)?);
+        let transform = periodic.transform(&side_b.name);
+        let model_size = self.mesh.model_size();
+        check_closure(&transform, &source, model_size).map_err(|e| {
+            fail(
+                &e,
+                "give the angle to full precision (e.g. 360/7 as 51.428571428571431)",
+            )
+        })?;
+        let mut map = periodic_map(
+            &transform,
+            &source,
+            Some(&b),
+            Path::new("."),
+            &label,
+            model_size,
+        )
+        .map_err(|e| {
+            let help = match e {
+                PeriodicError::ZeroAxis => "give a non-zero axis",
+                PeriodicError::NoMeanNormal => "`AlignSurface` needs two roughly planar surfaces",
+                _ => {
+                    "fix the Lua map: each component is an expression in x, y, z or `file.lua:function` (under the working directory)"
+                }
+            };
+            fail(&e, help)
+        })?;
+        let name = format!("{}_image", side_a.name);
+        let a = source
+            .mapped(map.as_mut(), &name)
+            .map_err(|e| fail(&e, "the map failed while mapping side A's nodes"))?;
+        landing(&a, &b).check(&side_b.name).map_err(|e| {
+            fail(
+                &e,
+                "the map must carry side A exactly onto side B; check the offset, axis, centre, angle or map",
+            )
+        })?;
+        Ok(Pair {
+            side_a,
+            side_b,
+            a,
+            b,
+            settings,
+            overclosure: None,
+            subdomain: None,
+            image: Some(Image { map, name }),
+            enforcement,
+            searcher: None,
+            result: None,
+        })
     }
 
     /// Add an interaction built in code; returns its index.
@@ -776,13 +964,20 @@ impl Embedding {
         }
         let (a, b) = (self.surface(&i.side_a)?, self.surface(&i.side_b)?);
         let settings = i.settings.unwrap_or_else(|| SearchSettings::defaults(3));
-        self.push_pair(a, b, settings, Overclosure::StoreOffsets, enforcement)
+        let pair = match &i.periodic {
+            None => self.pair(a, b, settings, Overclosure::StoreOffsets, None, enforcement)?,
+            Some(periodic) => self.periodic_pair(a, b, settings, periodic, enforcement)?,
+        };
+        self.pairs.push(pair);
+        Ok(self.pairs.len() - 1)
     }
 
     /// Add the interactions of a Sierra-syntax contact deck (`name` labels messages;
-    /// relative paths in the deck are taken from the working directory). Contact
-    /// surfaces name the host's surfaces (`Contact Surface s Contains base_top`) or
-    /// blocks (the block's skin). Returns the new interactions' indices.
+    /// relative paths in the deck — Lua files, plugin libraries — are taken from the
+    /// working directory). Contact surfaces name the host's surfaces (`Contact Surface s
+    /// Contains base_top`) or blocks (the block's skin). Periodic conditions add one
+    /// interaction each, after the definition's own. Returns the new interactions'
+    /// indices; on an error none is added.
     pub fn add_deck(&mut self, name: &str, text: &str) -> Result<Vec<usize>, EmbedError> {
         let file: Arc<str> = Arc::from(name);
         let (deck, diags) = deck::parse_sierra(&file, text);
@@ -812,12 +1007,6 @@ impl Embedding {
         }
         let mut added = Vec::new();
         for def in &deck.contact_definitions {
-            if !def.periodicity.is_empty() {
-                return Err(argument(
-                    "periodic conditions are not available through the embedding API yet".into(),
-                    "run periodic problems with `seam run`, or build the image surface in the host",
-                ));
-            }
             let set = crate::surface::build(&self.mesh, def, &sources);
             diags.extend(set.diagnostics.clone());
             let (list, d) = crate::interaction::resolve(def, &set, 3, &sources);
@@ -825,69 +1014,83 @@ impl Embedding {
             if diags.has_errors() {
                 return Err(fail(&diags));
             }
+            let subdomain = crate::search::scene::subdomain(def);
             for i in &list {
-                let enf = match &i.enforcement {
-                    Some(n) => def
-                        .enforcements
-                        .iter()
-                        .find(|e| e.name.as_deref() == Some(n.as_str())),
-                    None => def.enforcements.first(),
-                };
-                let Some(enf) = enf else {
-                    return Err(argument(
-                        format!(
-                            "interaction {} / {} has no enforcement",
-                            i.side_a_name, i.side_b_name
-                        ),
-                        "add a `begin Enforcement` block with `Enforcement for Energy = …`",
-                    ));
-                };
-                let choice = resolve_model(enf).map_err(|ds| {
-                    let mut d = Diagnostics::default();
-                    ds.into_iter().for_each(|x| d.push(x));
-                    fail(&d)
-                })?;
-                let enforcement = if choice.mortar {
-                    Enforcement::Tie {
-                        multipliers: if choice.dual {
-                            Multipliers::Dual
-                        } else {
-                            Multipliers::Standard
-                        },
-                        offset: choice.offset,
-                    }
-                } else {
-                    let law = match choice.conductance {
-                        None => Law::Constant(0.0),
-                        Some(ConductanceLaw::Constant(h)) => Law::Constant(h),
-                        Some(ConductanceLaw::Coefficient) => {
-                            let (m, d) =
-                                crate::enforce::conductance::from_properties(enf, dir, &sources);
-                            match m {
-                                Some(m) => Law::Model(m, choice.pressure),
-                                None => return Err(fail(&d)),
-                            }
-                        }
-                        Some(ConductanceLaw::Plugin) => {
-                            return Err(argument(
-                                format!(
-                                    "interaction {} / {}: plugin enforcements are not available through the embedding API yet",
-                                    i.side_a_name, i.side_b_name
-                                ),
-                                "run plugin models with `seam run`",
-                            ));
-                        }
-                    };
-                    Enforcement::Flux {
-                        form: choice.form,
-                        law,
-                        offset: choice.offset,
-                        beta: choice.penalty_factor.unwrap_or(DEFAULT_BETA) * i.penalty_scale,
-                    }
-                };
+                let enforcement = self.deck_enforcement(
+                    def,
+                    i.enforcement.as_deref(),
+                    (&i.side_a_name, &i.side_b_name),
+                    i.penalty_scale,
+                    dir,
+                    &sources,
+                )?;
                 let a = set.surfaces[i.side_a].clone();
                 let b = set.surfaces[i.side_b].clone();
-                added.push(self.push_pair(a, b, i.settings.clone(), i.overclosure, enforcement)?);
+                added.push(self.pair(
+                    a,
+                    b,
+                    i.settings.clone(),
+                    i.overclosure,
+                    subdomain,
+                    enforcement,
+                )?);
+            }
+            // Periodic conditions: the image of a surface paired with its destination,
+            // found and checked as `seam run` does.
+            if def.periodicity.is_empty() {
+                continue;
+            }
+            let mut scene = SceneSearch::default();
+            let geometry = surface_geometries(&self.mesh, &set, &mut scene.diagnostics);
+            let mut found = Vec::new();
+            for p in &def.periodicity {
+                found.extend(search_periodicity(
+                    &self.mesh,
+                    def,
+                    p,
+                    &set,
+                    &geometry,
+                    dir,
+                    &sources,
+                    self.integration,
+                    &mut scene,
+                ));
+            }
+            diags.extend(scene.diagnostics);
+            if diags.has_errors() {
+                return Err(fail(&diags));
+            }
+            for f in found {
+                let p = f.pairing;
+                // As in `seam run`: an interaction block of the same two surfaces names
+                // the enforcement and the penalty scale, else the first enforcement.
+                let named = list
+                    .iter()
+                    .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b);
+                let enforcement = self.deck_enforcement(
+                    def,
+                    named.and_then(|i| i.enforcement.as_deref()),
+                    (&p.side_a, &p.side_b),
+                    named.map_or(1.0, |i| i.penalty_scale),
+                    dir,
+                    &sources,
+                )?;
+                added.push(Pair {
+                    side_a: set.surfaces[p.side_a_surface].clone(),
+                    side_b: set.surfaces[p.side_b_surface].clone(),
+                    a: p.side_a_geometry,
+                    b: p.side_b_geometry,
+                    settings: crate::search::scene::base_settings(def, 3),
+                    overclosure: None,
+                    subdomain,
+                    image: Some(Image {
+                        map: f.map,
+                        name: format!("{}_image", p.side_a),
+                    }),
+                    enforcement,
+                    searcher: None,
+                    result: None,
+                });
             }
         }
         if added.is_empty() {
@@ -896,7 +1099,71 @@ impl Embedding {
                 "add a `begin Contact Definition` block with two contact surfaces",
             ));
         }
-        Ok(added)
+        let first = self.pairs.len();
+        self.pairs.extend(added);
+        Ok((first..self.pairs.len()).collect())
+    }
+
+    /// The enforcement of one deck interaction: its named `begin Enforcement` block (or
+    /// the definition's first), resolved to a form and a conductance law; a plugin is
+    /// loaded here.
+    fn deck_enforcement(
+        &self,
+        def: &ContactDefinition,
+        name: Option<&str>,
+        (side_a, side_b): (&str, &str),
+        penalty_scale: f64,
+        dir: &Path,
+        sources: &SourceMap,
+    ) -> Result<Enforcement, EmbedError> {
+        let fail = |d: &Diagnostics| EmbedError::Deck(d.render(sources));
+        let Some(enf): Option<&DeckEnforcement> = def.enforcement(name) else {
+            return Err(argument(
+                format!("interaction {side_a} / {side_b} has no enforcement"),
+                "add a `begin Enforcement` block with `Enforcement for Energy = …`",
+            ));
+        };
+        let choice = resolve_model(enf).map_err(|ds| {
+            let mut d = Diagnostics::default();
+            ds.into_iter().for_each(|x| d.push(x));
+            fail(&d)
+        })?;
+        if choice.mortar {
+            return Ok(Enforcement::Tie {
+                multipliers: if choice.dual {
+                    Multipliers::Dual
+                } else {
+                    Multipliers::Standard
+                },
+                offset: choice.offset,
+            });
+        }
+        let law = match choice.conductance {
+            None => Law::Constant(0.0),
+            Some(ConductanceLaw::Constant(h)) => Law::Constant(h),
+            Some(ConductanceLaw::Coefficient) => {
+                let (m, d) = crate::enforce::conductance::from_properties(enf, dir, sources);
+                match m {
+                    Some(m) => Law::Model(m, choice.pressure),
+                    None => return Err(fail(&d)),
+                }
+            }
+            Some(ConductanceLaw::Plugin) => {
+                let plugin = PluginConductance::from_enforcement(enf, dir, side_a, side_b)
+                    .map_err(|e| EmbedError::Plugin {
+                        side_a: side_a.to_string(),
+                        side_b: side_b.to_string(),
+                        message: e.to_string(),
+                    })?;
+                Law::Plugin(Box::new(plugin), choice.pressure)
+            }
+        };
+        Ok(Enforcement::Flux {
+            form: choice.form,
+            law,
+            offset: choice.offset,
+            beta: choice.penalty_factor.unwrap_or(DEFAULT_BETA) * penalty_scale,
+        })
     }
 
     /// Number of interactions.
@@ -925,8 +1192,11 @@ impl Embedding {
                 ));
             }
             let searcher = Searcher::new(&p.b, &p.settings);
-            let mut result = searcher.search(&p.a, &p.b, &p.settings, self.integration, None);
-            result.treat_overclosure(p.overclosure);
+            let mut result =
+                searcher.search(&p.a, &p.b, &p.settings, self.integration, p.subdomain);
+            if let Some(treatment) = p.overclosure {
+                result.treat_overclosure(treatment);
+            }
             let tie = match &p.enforcement {
                 Enforcement::Tie { .. } => true,
                 Enforcement::Flux { form, .. } => matches!(
@@ -974,6 +1244,18 @@ impl Embedding {
             for (surface, geometry) in [(&p.side_a, &mut p.a), (&p.side_b, &mut p.b)] {
                 *geometry = SurfaceGeometry::from_surface(&self.mesh, surface, coords)
                     .map_err(|e| argument(e.to_string(), "interfaces are searched in 3-D"))?;
+            }
+            // A periodic pair's side A is the image of the moved surface.
+            if let Some(image) = &mut p.image {
+                p.a = p.a.mapped(image.map.as_mut(), &image.name).map_err(|e| {
+                    argument(
+                        format!(
+                            "periodic interaction {} / {}: {e}",
+                            p.side_a.name, p.side_b.name
+                        ),
+                        "the map failed on the moved nodes of side A",
+                    )
+                })?;
             }
             if let Some(r) = &mut p.result {
                 r.update_geometry(&p.a, &p.b);
@@ -1034,28 +1316,40 @@ impl Embedding {
                 out.heat.push(None);
                 continue;
             };
+            // A plugin's fault, kept to tell a plugin failure or cutback request from
+            // the other failures once the interface terms stop at it.
+            let fault: Cell<Option<ConductanceError>> = Cell::new(None);
             let h = |x: &HInput| -> Result<HValue, String> {
-                match law {
-                    Law::Constant(h) => Ok(HValue {
-                        h: *h,
-                        ..HValue::default()
+                let (model, pressure): (&dyn ConductanceModel, f64) = match law {
+                    Law::Constant(h) => {
+                        return Ok(HValue {
+                            h: *h,
+                            ..HValue::default()
+                        });
+                    }
+                    Law::Model(m, pressure) => (m.as_ref(), *pressure),
+                    Law::Plugin(m, pressure) => (m.as_ref(), *pressure),
+                };
+                let state = PointState {
+                    gap: x.gap,
+                    pressure,
+                    temp_a: x.temp_a,
+                    temp_b: x.temp_b,
+                    x: x.x,
+                    time: 0.0,
+                };
+                match model.evaluate(&state) {
+                    Ok(c) => Ok(HValue {
+                        h: c.h,
+                        dh_dtemp_a: c.dh_dtemp_a,
+                        dh_dtemp_b: c.dh_dtemp_b,
                     }),
-                    Law::Model(m, pressure) => {
-                        let c = m
-                            .evaluate(&PointState {
-                                gap: x.gap,
-                                pressure: *pressure,
-                                temp_a: x.temp_a,
-                                temp_b: x.temp_b,
-                                x: x.x,
-                                time: 0.0,
-                            })
-                            .map_err(|e| e.to_string())?;
-                        Ok(HValue {
-                            h: c.h,
-                            dh_dtemp_a: c.dh_dtemp_a,
-                            dh_dtemp_b: c.dh_dtemp_b,
-                        })
+                    Err(e) => {
+                        let message = e.to_string();
+                        if matches!(law, Law::Plugin(..)) {
+                            fault.set(Some(e));
+                        }
+                        Err(message)
                     }
                 }
             };
@@ -1076,10 +1370,26 @@ impl Embedding {
                 &form,
                 &local,
             )
-            .map_err(|source| EmbedError::Enforcement {
-                side_a: p.side_a.name.clone(),
-                side_b: p.side_b.name.clone(),
-                source,
+            .map_err(|source| {
+                let (side_a, side_b) = (p.side_a.name.clone(), p.side_b.name.clone());
+                match fault.take() {
+                    Some(ConductanceError::Cutback { factor, .. }) => EmbedError::Cutback {
+                        side_a,
+                        side_b,
+                        factor,
+                        message: source.to_string(),
+                    },
+                    Some(_) => EmbedError::Plugin {
+                        side_a,
+                        side_b,
+                        message: source.to_string(),
+                    },
+                    None => EmbedError::Enforcement {
+                        side_a,
+                        side_b,
+                        source,
+                    },
+                }
             })?;
             let host = |d: u32| self.host_dof[d as usize];
             for (dofs, m) in &s.blocks {

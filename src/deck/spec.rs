@@ -58,6 +58,20 @@ pub struct ContactDefinition {
     pub at: Loc,
 }
 
+impl ContactDefinition {
+    /// The enforcement an interaction uses: the one it names, or else the definition's
+    /// first (a periodic pair names none).
+    pub fn enforcement(&self, name: Option<&str>) -> Option<&Enforcement> {
+        match name {
+            Some(n) => self
+                .enforcements
+                .iter()
+                .find(|e| e.name.as_deref() == Some(n)),
+            None => self.enforcements.first(),
+        }
+    }
+}
+
 /// `Scale Penalty [For s1 [With s2]] = f` or `Initial Overclosure [For s1 [With s2]] = …`.
 /// No `surface_1`: the whole contact domain; no `surface_2` (or the same name twice):
 /// the self-interaction of `surface_1`.

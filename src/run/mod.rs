@@ -554,13 +554,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                     .iter()
                     .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b)
                     .and_then(|i| i.enforcement.clone());
-                let enf = match &named {
-                    Some(n) => def
-                        .enforcements
-                        .iter()
-                        .find(|e| e.name.as_deref() == Some(n.as_str())),
-                    None => def.enforcements.first(),
-                };
+                let enf = def.enforcement(named.as_deref());
                 let Some(enf) = enf else {
                     diags.push(
                         Diagnostic::error(
@@ -608,14 +602,9 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                             }
                             Some(ConductanceLaw::Plugin) => {
                                 let loaded_plugin =
-                                    crate::plugin::PluginSpec::from_enforcement(enf, &deck_dir)
-                                        .and_then(|spec| spec.load())
-                                        .map_err(|e| e.to_string())
-                                        .and_then(|pl| {
-                                            conductance::PluginConductance::new(pl)
-                                                .map(|c| c.on_surfaces(&p.side_a, &p.side_b))
-                                                .map_err(|e| e.to_string())
-                                        });
+                                    conductance::PluginConductance::from_enforcement(
+                                        enf, &deck_dir, &p.side_a, &p.side_b,
+                                    );
                                 match loaded_plugin {
                                     Ok(c) => {
                                         if let Some(notice) = c.plugin().derivative_notice() {
@@ -629,7 +618,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                                     }
                                     Err(e) => {
                                         diags.push(
-                                            Diagnostic::error("E0500", e)
+                                            Diagnostic::error("E0500", e.to_string())
                                                 .at(Some(enf.at.clone()))
                                                 .help("`seam check-plugin LIB` loads and probes a plugin on its own"),
                                         );

@@ -1,7 +1,10 @@
 //! The search of a whole contact definition: every interaction, and every periodic
 //! image paired with its destination.
 //!
-//! Entry point: [`search_definition`]. Periodic conditions (`Periodicity For S = …`) are
+//! Entry point: [`search_definition`]; [`search_periodicity`] searches one periodic
+//! condition and keeps its map (for callers that move nodes and search again), and
+//! [`periodic_map`], [`check_closure`] and [`landing`] are its parts, for periodic pairs
+//! built in code (the embedding API). Periodic conditions (`Periodicity For S = …`) are
 //! interactions between the image of `S` (side A) and a destination surface (side B):
 //! `Align_Surface` names it; for the other transforms it is the face surface, other than
 //! `S`, on which most of the image's points land. The inverse map is never asked of the
@@ -24,7 +27,7 @@ use super::pairing::{
     Integration, SearchError, SearchResult, SearchStats, Searcher, Sphere, SurfaceGeometry,
 };
 use crate::deck::spec::{ContactDefinition, PeriodicTransform, Periodicity};
-use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap};
+use crate::diag::{Diagnostic, Diagnostics, SourceMap};
 use crate::interaction::{Interaction, SearchSettings};
 use crate::mesh::Mesh;
 use crate::periodic::{
@@ -78,24 +81,9 @@ pub fn search_definition(
     integration: Integration,
 ) -> SceneSearch {
     let mut out = SceneSearch::default();
-    let subdomain = def.restrict_contact_to_subdomain.as_ref().map(|s| Sphere {
-        center: s.point,
-        radius: s.radius,
-    });
+    let subdomain = subdomain(def);
     let t = Instant::now();
-    let mut geometry: Vec<Option<SurfaceGeometry>> = Vec::with_capacity(surfaces.surfaces.len());
-    for s in &surfaces.surfaces {
-        match SurfaceGeometry::from_surface(mesh, s, &mesh.coords) {
-            Ok(g) => geometry.push(Some(g)),
-            Err(e) => {
-                out.diagnostics.push(
-                    Diagnostic::error("E0312", e.to_string())
-                        .help("2-D meshes give surfaces of edges; search them in a later version"),
-                );
-                geometry.push(None);
-            }
-        }
-    }
+    let geometry = surface_geometries(mesh, surfaces, &mut out.diagnostics);
     out.timing.build_s += t.elapsed().as_secs_f64();
 
     for i in interactions {
@@ -125,26 +113,58 @@ pub fn search_definition(
         });
     }
 
-    let base = base_settings(def, mesh.dim);
     for p in &def.periodicity {
-        periodic_pair(
+        if let Some(found) = search_periodicity(
             mesh,
+            def,
             p,
             surfaces,
             &geometry,
-            &base,
             deck_dir,
             sources,
             integration,
-            subdomain,
             &mut out,
-        );
+        ) {
+            out.pairings.push(found.pairing);
+        }
     }
     out
 }
 
+/// The geometry of every surface of the set on the mesh's coordinates; `None` (and an
+/// E0312 error) for a surface that cannot be searched.
+pub fn surface_geometries(
+    mesh: &Mesh,
+    surfaces: &SurfaceSet,
+    diagnostics: &mut Diagnostics,
+) -> Vec<Option<SurfaceGeometry>> {
+    let mut geometry = Vec::with_capacity(surfaces.surfaces.len());
+    for s in &surfaces.surfaces {
+        match SurfaceGeometry::from_surface(mesh, s, &mesh.coords) {
+            Ok(g) => geometry.push(Some(g)),
+            Err(e) => {
+                diagnostics.push(
+                    Diagnostic::error("E0312", e.to_string())
+                        .help("2-D meshes give surfaces of edges; search them in a later version"),
+                );
+                geometry.push(None);
+            }
+        }
+    }
+    geometry
+}
+
+/// `Restrict Contact To Subdomain` of a definition: the sphere outside which nothing is
+/// searched.
+pub fn subdomain(def: &ContactDefinition) -> Option<Sphere> {
+    def.restrict_contact_to_subdomain.as_ref().map(|s| Sphere {
+        center: s.point,
+        radius: s.radius,
+    })
+}
+
 /// Search settings of periodic pairs: the definition's search options.
-fn base_settings(def: &ContactDefinition, dim: usize) -> SearchSettings {
+pub fn base_settings(def: &ContactDefinition, dim: usize) -> SearchSettings {
     let mut s = SearchSettings::defaults(dim);
     if let Some(o) = &def.search_options {
         s.normal_tolerance = o.normal_tolerance.or(s.normal_tolerance);
@@ -164,19 +184,203 @@ fn face_surface(surfaces: &SurfaceSet, name: &str) -> Option<usize> {
         .position(|s| s.name == name && s.kind == SurfaceKind::Faces)
 }
 
+/// One periodic condition as searched, with the map that made its image.
+pub struct PeriodicPairing {
+    pub pairing: Pairing,
+    /// The map from the source surface to its image (side A of the pairing): callers
+    /// that move nodes map the moved source again.
+    pub map: Box<dyn PeriodicMap>,
+}
+
+/// Why a periodic map cannot be made, or does not carry its surface onto its partner.
+/// Each message reads after "periodicity for `S`: ".
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PeriodicError {
+    #[error("the cylindrical axis is the zero vector")]
+    ZeroAxis,
+    #[error("`Align_Surface` has no destination surface")]
+    NoDestination,
+    #[error("a surface has no mean normal (its faces cancel out)")]
+    NoMeanNormal,
+    #[error(transparent)]
+    Map(#[from] MapError),
+    #[error("{n} rotations by {angle}° miss the start by {miss:.3e}")]
+    NotClosed { n: usize, angle: f64, miss: f64 },
+    #[error(
+        "its image does not land on `{destination}`: the worst image node is {worst:.3e} away (accepted: {limit:.3e})"
+    )]
+    Landing {
+        destination: String,
+        worst: f64,
+        limit: f64,
+    },
+}
+
+/// The map of a periodic transform from `source` (and, for `Align_Surface`, onto
+/// `destination`). Lua files are read relative to `deck_dir` and must stay inside it;
+/// `chunk` names the deck location in Lua messages; `model_size` scales the
+/// finite-difference step of a Lua map's Jacobian.
+pub fn periodic_map(
+    transform: &PeriodicTransform,
+    source: &SurfaceGeometry,
+    destination: Option<&SurfaceGeometry>,
+    deck_dir: &Path,
+    chunk: &str,
+    model_size: f64,
+) -> Result<Box<dyn PeriodicMap>, PeriodicError> {
+    Ok(match transform {
+        PeriodicTransform::Rectangular { offset } => Box::new(Translation(padded(offset))),
+        PeriodicTransform::Cylindrical { .. } => {
+            Box::new(rotation(transform).ok_or(PeriodicError::ZeroAxis)?)
+        }
+        PeriodicTransform::AlignSurface { invert_normals, .. } => {
+            let dg = destination.ok_or(PeriodicError::NoDestination)?;
+            let (cs, ns) = centroid_and_normal(source);
+            let (cd, nd) = centroid_and_normal(dg);
+            let rigid = align_surface(cs, ns, cd, nd, *invert_normals)
+                .ok_or(PeriodicError::NoMeanNormal)?;
+            Box::new(rigid)
+        }
+        PeriodicTransform::Mapped {
+            x_map,
+            y_map,
+            z_map,
+        } => {
+            let (x, y) = (MapSource::parse(x_map), MapSource::parse(y_map));
+            let z = z_map.as_deref().map(MapSource::parse);
+            Box::new(LuaMap::new(
+                [Some(&x), Some(&y), z.as_ref()],
+                deck_dir,
+                chunk,
+                model_size,
+            )?)
+        }
+    })
+}
+
+/// The first three of a deck's numbers (missing ones 0).
+fn padded(v: &[f64]) -> [f64; 3] {
+    let mut o = [0.0; 3];
+    for (slot, x) in o.iter_mut().zip(v) {
+        *slot = *x;
+    }
+    o
+}
+
+/// The rigid map of a cylindrical transform (axis z when the deck gives fewer than 3
+/// components); `None` for other transforms and a zero axis.
+fn rotation(transform: &PeriodicTransform) -> Option<Rigid> {
+    let PeriodicTransform::Cylindrical {
+        axis,
+        center,
+        angle,
+    } = transform
+    else {
+        return None;
+    };
+    let axis = if axis.len() >= 3 {
+        [axis[0], axis[1], axis[2]]
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    Rotation::about(axis, padded(center), *angle)
+}
+
+/// What the closure check of a transform found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Closure {
+    /// Not a cylindrical rotation (or no axis): nothing to check.
+    NotARotation,
+    /// An N-fold rotation that comes back to the start after N turns.
+    Closes { n: usize },
+    /// The angle does not divide 360°: a sector of no full ring (a warning).
+    AngleDoesNotDivide,
+}
+
+/// An N-fold cylindrical rotation (`360/θ` an integer N) must close up: the map applied
+/// N times returns every node of `source` (its first 64 faces) within 1e-12 × model size.
+pub fn check_closure(
+    transform: &PeriodicTransform,
+    source: &SurfaceGeometry,
+    model_size: f64,
+) -> Result<Closure, PeriodicError> {
+    let (Some(mut rot), PeriodicTransform::Cylindrical { angle, .. }) =
+        (rotation(transform), transform)
+    else {
+        return Ok(Closure::NotARotation);
+    };
+    let Some(n) = fold_count(*angle) else {
+        return Ok(Closure::AngleDoesNotDivide);
+    };
+    let mut worst: f64 = 0.0;
+    for f in source.faces.iter().take(64) {
+        for &x in f.coords() {
+            if let Ok(e) = closure_error(&mut rot, x, n) {
+                worst = worst.max(e);
+            }
+        }
+    }
+    if worst > 1e-12 * model_size {
+        return Err(PeriodicError::NotClosed {
+            n,
+            angle: *angle,
+            miss: worst,
+        });
+    }
+    Ok(Closure::Closes { n })
+}
+
+/// How far an image lies from its destination: the worst distance from an image node to
+/// the destination's faces, and the distance accepted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Landing {
+    pub worst: f64,
+    pub limit: f64,
+}
+
+impl Landing {
+    /// An error unless every image node is within the limit (NaN never is).
+    pub fn check(&self, destination: &str) -> Result<(), PeriodicError> {
+        if self.worst.is_nan() || self.worst > self.limit {
+            return Err(PeriodicError::Landing {
+                destination: destination.to_string(),
+                worst: self.worst,
+                limit: self.limit,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Measure where `image` lands on `destination` (limit: [`LANDING_TOLERANCE`] of the
+/// destination's mean face size).
+pub fn landing(image: &SurfaceGeometry, destination: &SurfaceGeometry) -> Landing {
+    Landing {
+        worst: worst_distance(image, destination),
+        limit: LANDING_TOLERANCE * destination.mean_face_size(),
+    }
+}
+
+/// Search one `Periodicity For S = …` of `def`: the image of `S` paired with its
+/// destination (given by `Align_Surface`, else the face surface other than `S` on which
+/// most image points land), and the map. `geometry` is [`surface_geometries`] of
+/// `surfaces`. Diagnostics (E0320–E0325, W0320) and timing go to `out`; `None` when the
+/// condition cannot be searched.
 #[allow(clippy::too_many_arguments)]
-fn periodic_pair(
+pub fn search_periodicity(
     mesh: &Mesh,
+    def: &ContactDefinition,
     p: &Periodicity,
     surfaces: &SurfaceSet,
     geometry: &[Option<SurfaceGeometry>],
-    settings: &SearchSettings,
     deck_dir: &Path,
     sources: &SourceMap,
     integration: Integration,
-    subdomain: Option<Sphere>,
     out: &mut SceneSearch,
-) {
+) -> Option<PeriodicPairing> {
+    let settings = base_settings(def, mesh.dim);
+    let subdomain = subdomain(def);
     let at = sources.narrow(&p.at, &p.surface);
     let Some(s) = face_surface(surfaces, &p.surface) else {
         out.diagnostics.push(
@@ -187,110 +391,95 @@ fn periodic_pair(
             .at(Some(at))
             .help("define the surface with `Contact Surface` (or a side set) before using it in a periodicity"),
         );
-        return;
+        return None;
     };
-    let Some(source) = &geometry[s] else { return };
+    let source = geometry[s].as_ref()?;
     let model_size = mesh.model_size();
     let mut destination = None;
-    let map: Box<dyn PeriodicMap> = match &p.transform {
-        PeriodicTransform::Rectangular { offset } => {
-            let mut o = [0.0; 3];
-            for (slot, v) in o.iter_mut().zip(offset) {
-                *slot = *v;
-            }
-            Box::new(Translation(o))
-        }
-        PeriodicTransform::Cylindrical {
-            axis,
-            center,
-            angle,
-        } => {
-            let axis = if axis.len() >= 3 {
-                [axis[0], axis[1], axis[2]]
-            } else {
-                [0.0, 0.0, 1.0]
-            };
-            let mut c = [0.0; 3];
-            for (slot, v) in c.iter_mut().zip(center) {
-                *slot = *v;
-            }
-            let Some(rot) = Rotation::about(axis, c, *angle) else {
-                return; // a zero axis is rejected by the deck checks
-            };
-            check_closure(rot, *angle, source, model_size, &p.surface, &p.at, out);
-            Box::new(rot)
-        }
-        PeriodicTransform::AlignSurface {
-            destination: dest,
-            invert_normals,
-        } => {
-            let Some(d) = face_surface(surfaces, dest) else {
+    if let PeriodicTransform::AlignSurface {
+        destination: dest, ..
+    } = &p.transform
+    {
+        let Some(d) = face_surface(surfaces, dest) else {
+            out.diagnostics.push(
+                Diagnostic::error(
+                    "E0320",
+                    format!(
+                        "periodicity for `{}`: unknown destination surface `{dest}`",
+                        p.surface
+                    ),
+                )
+                .at(Some(sources.narrow(&p.at, dest)))
+                .help("`Destination =` names a contact surface of faces"),
+            );
+            return None;
+        };
+        geometry[d].as_ref()?;
+        destination = Some(d);
+    }
+    match check_closure(&p.transform, source, model_size) {
+        Ok(Closure::AngleDoesNotDivide) => {
+            if let PeriodicTransform::Cylindrical { angle, .. } = &p.transform {
                 out.diagnostics.push(
-                    Diagnostic::error(
-                        "E0320",
+                    Diagnostic::warning(
+                        "W0320",
                         format!(
-                            "periodicity for `{}`: unknown destination surface `{dest}`",
+                            "periodicity for `{}`: the angle {angle}° does not divide 360°",
                             p.surface
                         ),
                     )
-                    .at(Some(sources.narrow(&p.at, dest)))
-                    .help("`Destination =` names a contact surface of faces"),
+                    .at(Some(p.at.clone()))
+                    .help("a sector of a full ring has an angle of 360/N degrees"),
                 );
-                return;
-            };
-            let Some(dg) = &geometry[d] else { return };
-            let (cs, ns) = centroid_and_normal(source);
-            let (cd, nd) = centroid_and_normal(dg);
-            let Some(rigid) = align_surface(cs, ns, cd, nd, *invert_normals) else {
-                out.diagnostics.push(
-                    Diagnostic::error("E0322", format!("periodicity for `{}`: a surface has no mean normal (its faces cancel out)", p.surface))
-                        .at(Some(at))
-                        .help("`Align_Surface` needs two roughly planar surfaces"),
-                );
-                return;
-            };
-            destination = Some(d);
-            Box::new(rigid) as Box<dyn PeriodicMap>
-        }
-        PeriodicTransform::Mapped {
-            x_map,
-            y_map,
-            z_map,
-        } => {
-            let (x, y) = (MapSource::parse(x_map), MapSource::parse(y_map));
-            let z = z_map.as_deref().map(MapSource::parse);
-            let chunk = if p.at.is_unknown() {
-                format!("periodicity for {}", p.surface)
-            } else {
-                format!("{}:{}", p.at.file, p.at.line)
-            };
-            match LuaMap::new(
-                [Some(&x), Some(&y), z.as_ref()],
-                deck_dir,
-                &chunk,
-                model_size,
-            ) {
-                Ok(m) => Box::new(m),
-                Err(e) => {
-                    let help = match &e {
-                        MapError::OutsideDeck(_) => {
-                            "put the Lua file in the deck's directory or below it"
-                        }
-                        _ => {
-                            "fix the Lua map; each map is an expression in x, y, z or `file.lua:function`"
-                        }
-                    };
-                    out.diagnostics.push(
-                        Diagnostic::error("E0321", format!("periodicity for `{}`: {e}", p.surface))
-                            .at(Some(at))
-                            .help(help),
-                    );
-                    return;
-                }
             }
         }
+        Ok(_) => {}
+        Err(e) => out.diagnostics.push(
+            Diagnostic::error("E0325", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(p.at.clone()))
+                .help("give the angle to full precision (e.g. 360/7 as 51.428571428571431)"),
+        ),
+    }
+    let chunk = if p.at.is_unknown() {
+        format!("periodicity for {}", p.surface)
+    } else {
+        format!("{}:{}", p.at.file, p.at.line)
     };
-    let mut map = map;
+    let destination_geometry = destination.and_then(|d| geometry[d].as_ref());
+    let mut map = match periodic_map(
+        &p.transform,
+        source,
+        destination_geometry,
+        deck_dir,
+        &chunk,
+        model_size,
+    ) {
+        Ok(m) => m,
+        // A zero axis is rejected by the deck checks.
+        Err(PeriodicError::ZeroAxis) => return None,
+        Err(e @ PeriodicError::NoMeanNormal) => {
+            out.diagnostics.push(
+                Diagnostic::error("E0322", format!("periodicity for `{}`: {e}", p.surface))
+                    .at(Some(at))
+                    .help("`Align_Surface` needs two roughly planar surfaces"),
+            );
+            return None;
+        }
+        Err(e) => {
+            let help = match &e {
+                PeriodicError::Map(MapError::OutsideDeck(_)) => {
+                    "put the Lua file in the deck's directory or below it"
+                }
+                _ => "fix the Lua map; each map is an expression in x, y, z or `file.lua:function`",
+            };
+            out.diagnostics.push(
+                Diagnostic::error("E0321", format!("periodicity for `{}`: {e}", p.surface))
+                    .at(Some(at))
+                    .help(help),
+            );
+            return None;
+        }
+    };
     let image_name = format!("{}_image", p.surface);
     let t = Instant::now();
     let image = match source.mapped(map.as_mut(), &image_name) {
@@ -301,12 +490,12 @@ fn periodic_pair(
                     .at(Some(at))
                     .help("the map failed while mapping the surface's nodes"),
             );
-            return;
+            return None;
         }
         Err(e) => {
             out.diagnostics
                 .push(Diagnostic::error("E0312", e.to_string()).at(Some(at)));
-            return;
+            return None;
         }
     };
     out.timing.build_s += t.elapsed().as_secs_f64();
@@ -322,10 +511,10 @@ fn periodic_pair(
     for d in candidates {
         let Some(dg) = &geometry[d] else { continue };
         let t = Instant::now();
-        let searcher = Searcher::new(dg, settings);
+        let searcher = Searcher::new(dg, &settings);
         out.timing.build_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let r = searcher.search(&image, dg, settings, integration, subdomain);
+        let r = searcher.search(&image, dg, &settings, integration, subdomain);
         out.timing.search_s += t.elapsed().as_secs_f64();
         if best
             .as_ref()
@@ -343,84 +532,38 @@ fn periodic_pair(
             .at(Some(at))
             .help("check the transform (offset, axis, centre, angle or map): the image of the surface must lie on another contact surface"),
         );
-        return;
+        return None;
     };
     let dg = geometry[d].as_ref().expect("destination geometry exists");
-    let worst = worst_distance(&image, dg);
-    let limit = LANDING_TOLERANCE * dg.mean_face_size();
-    if worst.is_nan() || worst > limit {
+    let landed = landing(&image, dg);
+    if let Err(e) = landed.check(&surfaces.surfaces[d].name) {
         out.diagnostics.push(
-            Diagnostic::error(
-                "E0324",
-                format!(
-                    "periodicity for `{}`: its image does not land on `{}`: the worst image node is {worst:.3e} away (accepted: {limit:.3e})",
-                    p.surface, surfaces.surfaces[d].name
-                ),
-            )
-            .at(Some(at))
-            .help("the transform must carry the surface exactly onto its partner; check the offset, angle or map"),
+            Diagnostic::error("E0324", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(at))
+                .help("the transform must carry the surface exactly onto its partner; check the offset, angle or map"),
         );
     }
-    out.pairings.push(Pairing {
-        side_a: p.surface.to_ascii_lowercase(),
-        side_b: surfaces.surfaces[d].name.clone(),
-        side_a_surface: s,
-        side_b_surface: d,
-        periodic: true,
-        side_a_geometry: image,
-        side_b_geometry: dg.clone(),
-        result,
-        worst_image_distance: Some(worst),
-    });
+    Some(PeriodicPairing {
+        pairing: Pairing {
+            side_a: p.surface.to_ascii_lowercase(),
+            side_b: surfaces.surfaces[d].name.clone(),
+            side_a_surface: s,
+            side_b_surface: d,
+            periodic: true,
+            side_a_geometry: image,
+            side_b_geometry: dg.clone(),
+            result,
+            worst_image_distance: Some(landed.worst),
+        },
+        map,
+    })
 }
 
 /// How far an image node may be from its destination, relative to the destination's
 /// mean face size: room for the faceting of a curved surface meshed differently on the
 /// two sides (the sagitta h²/8R stays below 5 % of h while h < 0.4 R), none for a wrong
 /// offset, angle or map.
-const LANDING_TOLERANCE: f64 = 0.05;
-
-/// An N-fold rotation must come back to the start after N turns.
-fn check_closure(
-    mut rot: Rigid,
-    angle: f64,
-    source: &SurfaceGeometry,
-    model_size: f64,
-    surface: &str,
-    at: &Loc,
-    out: &mut SceneSearch,
-) {
-    match fold_count(angle) {
-        Some(n) => {
-            let mut worst: f64 = 0.0;
-            for f in source.faces.iter().take(64) {
-                for &x in f.coords() {
-                    if let Ok(e) = closure_error(&mut rot, x, n) {
-                        worst = worst.max(e);
-                    }
-                }
-            }
-            if worst > 1e-12 * model_size {
-                out.diagnostics.push(
-                    Diagnostic::error(
-                        "E0325",
-                        format!("periodicity for `{surface}`: {n} rotations by {angle}° miss the start by {worst:.3e}"),
-                    )
-                    .at(Some(at.clone()))
-                    .help("give the angle to full precision (e.g. 360/7 as 51.428571428571431)"),
-                );
-            }
-        }
-        None => out.diagnostics.push(
-            Diagnostic::warning(
-                "W0320",
-                format!("periodicity for `{surface}`: the angle {angle}° does not divide 360°"),
-            )
-            .at(Some(at.clone()))
-            .help("a sector of a full ring has an angle of 360/N degrees"),
-        ),
-    }
-}
+pub const LANDING_TOLERANCE: f64 = 0.05;
 
 fn centroid_and_normal(g: &SurfaceGeometry) -> ([f64; 3], [f64; 3]) {
     let mut c = [0.0; 3];

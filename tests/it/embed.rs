@@ -12,7 +12,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use seam::embed::{EmbedError, Embedding, Interaction, Model, Multipliers, Topology};
+use seam::embed::{EmbedError, Embedding, Interaction, Model, Multipliers, Periodic, Topology};
 
 #[path = "../../examples/embed.rs"]
 #[allow(dead_code)]
@@ -91,20 +91,22 @@ fn library_dir(file: &str) -> PathBuf {
         .to_path_buf()
 }
 
-#[test]
-fn embed_c_host_matches_seam_run() {
+/// Compile `examples/c_host/<source>` against libseam with the CI flags and run it;
+/// returns its standard output (the run must succeed).
+fn run_c_host(source: &str) -> String {
     let lib = library_dir(if cfg!(target_os = "macos") {
         "libseam.dylib"
     } else {
         "libseam.so"
     });
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let out = scratch("c").join("c_host");
+    let dir = scratch(source);
+    let out = dir.join("host");
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let build = Command::new(&cc)
         .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-I"])
         .arg(root.join("include"))
-        .arg(root.join("examples/c_host/main.c"))
+        .arg(root.join("examples/c_host").join(source))
         .arg("-L")
         .arg(&lib)
         .arg("-lseam")
@@ -125,27 +127,39 @@ fn embed_c_host_matches_seam_run() {
         .env("LD_LIBRARY_PATH", &lib)
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
     assert!(
         run.status.success(),
         "{stdout}{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    let _ = std::fs::remove_dir_all(&dir);
+    stdout
+}
+
+/// The numbers after `prefix` on the line of `stdout` that starts with it.
+fn printed(stdout: &str, prefix: &str) -> Vec<f64> {
+    stdout
+        .lines()
+        .find_map(|l| l.strip_prefix(prefix))
+        .map(|rest| {
+            rest.split(|c: char| c == ',' || c.is_whitespace())
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        })
+        .unwrap_or_else(|| panic!("no `{prefix}` line in:\n{stdout}"))
+}
+
+#[test]
+fn embed_c_host_matches_seam_run() {
+    let stdout = run_c_host("main.c");
     // The misspelt surface came back as SEAM_ERR_ARGUMENT with a suggestion.
     assert!(
         stdout.contains("expected error 4: unknown surface `base_topp`")
             && stdout.contains("did you mean `base_top`?"),
         "{stdout}"
     );
-    let heat: Vec<f64> = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("interface heat: side A "))
-        .map(|rest| {
-            rest.split(|c: char| c == ',' || c.is_whitespace())
-                .filter_map(|w| w.parse().ok())
-                .collect()
-        })
-        .unwrap_or_else(|| panic!("no heat line in:\n{stdout}"));
+    let heat = printed(&stdout, "interface heat: side A ");
     let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
     let (reference, reference_b) = seam_run("c-reference", &deck);
     let (a, b) = (heat[0], heat[1]);
@@ -159,15 +173,7 @@ fn embed_c_host_matches_seam_run() {
         "{b} vs {reference_b}"
     );
     // Its dual mortar tie, condensed in C, against seam run's dual solve.
-    let dual: Vec<f64> = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("dual tie heat: side A "))
-        .map(|rest| {
-            rest.split(|c: char| c == ',' || c.is_whitespace())
-                .filter_map(|w| w.parse().ok())
-                .collect()
-        })
-        .unwrap_or_else(|| panic!("no dual tie heat line in:\n{stdout}"));
+    let dual = printed(&stdout, "dual tie heat: side A ");
     let (reference, _) = seam_run("c-dual", &tie_deck("dual"));
     println!(
         "C host dual tie {:.15e} W, seam run {reference:.15e} W: {:.2e}",
@@ -176,7 +182,6 @@ fn embed_c_host_matches_seam_run() {
     );
     assert!(relative(dual[0], reference) <= TOLERANCE);
     assert!(relative(-dual[1], reference) <= TOLERANCE);
-    let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
 /// The two-block interface tied by mortar with `multipliers` (`dual` or `standard`).
@@ -707,4 +712,477 @@ fn embed_header_declares_the_exported_functions() {
     declared.dedup();
     assert!(exported.len() >= 20, "{exported:?}");
     assert_eq!(exported, declared);
+}
+
+/// `seam run` on `examples/<scene>/<problem>` as it stands, except that the mesh and the
+/// contact deck are read in place (absolute paths) and nothing is written; the deck's
+/// folder may be another copy of the scene (a plugin library built next to it).
+fn run_scene(scene: &Path, deck_dir: &Path, problem: &str) -> seam::run::RunResult {
+    let text = std::fs::read_to_string(scene.join(problem)).unwrap();
+    let mut table: toml::Table = toml::from_str(&text).unwrap();
+    for (key, folder) in [("mesh", scene), ("contact", deck_dir)] {
+        if let Some(section) = table.get_mut(key).and_then(toml::Value::as_table_mut) {
+            let file = section["file"].as_str().unwrap().to_string();
+            section.insert(
+                "file".into(),
+                folder.join(file).display().to_string().into(),
+            );
+        }
+    }
+    table.remove("output");
+    let dir = scratch(&format!("run-{problem}"));
+    let name = deck_dir.file_name().unwrap().to_string_lossy().into_owned();
+    let path = dir.join(format!("{name}-{problem}"));
+    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
+    let result = match seam::run::run(&path) {
+        Ok(r) => r,
+        Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+        Err(seam::run::RunError::Solve(e)) => panic!("seam run failed: {e}"),
+    };
+    let _ = std::fs::remove_file(&path);
+    assert!(result.summary.converged);
+    result
+}
+
+fn turbine() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/turbine_sector")
+}
+
+/// The turbine-sector problem as a host assembles it (problem.toml restated): k = 20,
+/// the rim's flux q(θ) = 5e4 (1 + 0.5 cos(12θ − 1)) evaluated at each face's centroid
+/// (as `seam run` evaluates an expression), the bore's convection h = 2000 to 300 K,
+/// with seam's public element kernels; then the tie's rows `C u = g` from `tie`, and
+/// `[K Cᵀ; C 0] [u; λ] = [F; g]` solved densely with pivoting. Returns the temperature
+/// by node and the tie's heat from λ.
+fn turbine_host(
+    mesh: &seam::mesh::Mesh,
+    dof: &[usize],
+    tie: &seam::embed::TieConstraints,
+) -> (Vec<f64>, seam::embed::Heat) {
+    use seam::heat::kernel::{face_convection, face_flux};
+    let n = mesh.num_nodes();
+    let m = tie.multiplier_dofs.len();
+    let size = n + m;
+    let k = example::conduction_with(mesh, dof, |_| 20.0).unwrap();
+    let mut a = vec![0.0; size * size];
+    for row in 0..n {
+        a[row * size..row * size + n].copy_from_slice(&k[row * n..(row + 1) * n]);
+    }
+    let mut f = vec![0.0; size];
+    let side_set = |name: &str| &mesh.side_sets[mesh.find_side_set(name).unwrap()].sides;
+    for (set, convection) in [("rim", false), ("bore", true)] {
+        for &side in side_set(set) {
+            let topology = mesh.topology(side.elem);
+            let nodes = mesh.elem_nodes(side.elem);
+            let x: Vec<[f64; 3]> = nodes.iter().map(|v| mesh.coords[v.index()]).collect();
+            let nn = nodes.len();
+            let (mut ke, mut fe) = (vec![0.0; nn * nn], vec![0.0; nn]);
+            if convection {
+                face_convection(topology, &x, side.side, 2000.0, 300.0, &mut ke, &mut fe);
+            } else {
+                let corners: Vec<[f64; 3]> = mesh
+                    .side_nodes(side)
+                    .map(|v| mesh.coords[v.index()])
+                    .collect();
+                let c = corners.iter().fold([0.0; 3], |c, p| {
+                    std::array::from_fn(|d| c[d] + p[d] / corners.len() as f64)
+                });
+                let q = 5e4 * (1.0 + 0.5 * (12.0 * c[1].atan2(c[0]) - 1.0).cos());
+                face_flux(topology, &x, side.side, |_| q, &mut fe);
+            }
+            for (i, vi) in nodes.iter().enumerate() {
+                f[dof[vi.index()]] += fe[i];
+                for (j, vj) in nodes.iter().enumerate() {
+                    a[dof[vi.index()] * size + dof[vj.index()]] += ke[i * nn + j];
+                }
+            }
+        }
+    }
+    for &(mult, j, c) in &tie.entries {
+        a[(n + mult) * size + j] += c;
+        a[j * size + n + mult] += c;
+    }
+    f[n..].copy_from_slice(&tie.rhs);
+    let x = example::solve_dense(a, f, size).unwrap();
+    let heat = tie.heat(&x[n..]).unwrap();
+    ((0..n).map(|i| x[dof[i]]).collect(), heat)
+}
+
+fn relative_spread(a: &[f64], b: &[f64]) -> f64 {
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    let (lo, hi) = b
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(*v), h.max(*v))
+        });
+    worst / (hi - lo)
+}
+
+/// The turbine sector's cylindrical periodicity through the embedding API — from its
+/// deck, and built in code — gives `seam run`'s temperatures and cut heat.
+///
+/// The host assembles the same discrete equations as `seam run` (the same kernels and
+/// the same tie rows) but solves them densely with partial pivoting instead of a sparse
+/// saddle-point factorisation: what differs is round-off amplified by the conditioning
+/// of the saddle-point system. 1e-10 relative (of the heat; of the temperature spread
+/// node by node) leaves room for that, while a missed face, a wrong image or a dof
+/// mapped wrong moves the answers by percents.
+#[test]
+fn embed_turbine_sector_periodic_tie_matches_seam_run() {
+    let reference = run_scene(&turbine(), &turbine(), "problem.toml");
+    let cut = &reference.summary.interactions[0];
+    let mesh = seam::mesh::read(&turbine().join("sector.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let builder = || {
+        example::embedding_with(&mesh, &dof, |_| 20.0)
+            .build()
+            .unwrap()
+    };
+
+    let mut by_deck = builder();
+    assert_eq!(
+        by_deck
+            .add_deck_file(&turbine().join("contact.i"))
+            .unwrap()
+            .len(),
+        1
+    );
+    assert_eq!(by_deck.surfaces(0), Some(("start", "end")));
+    by_deck.search().unwrap();
+    let ties = by_deck.constraints().unwrap();
+    assert_eq!(ties.len(), 1);
+    // One multiplier per node of cut_start: 7 radii × 3 heights.
+    assert_eq!(ties[0].multiplier_dofs.len(), 21);
+    let (temperature, heat) = turbine_host(&mesh, &dof, &ties[0]);
+    let t_err = relative_spread(&temperature, &reference.solution.temperature);
+    let q_err = relative(heat.side_a, cut.heat_side_a);
+    println!(
+        "turbine sector by deck: cut heat {:.15e} W, seam run {:.15e} W: {q_err:.2e}; temperatures {t_err:.2e} of the spread",
+        heat.side_a, cut.heat_side_a
+    );
+    assert!(q_err <= 1e-10, "{q_err:.3e}");
+    assert!(relative(heat.side_b, cut.heat_side_b) <= 1e-10);
+    assert!(t_err <= 1e-10, "{t_err:.3e}");
+    // Heat crosses the cut (the load is not symmetric within the sector).
+    assert!(heat.side_a.abs() > 1.0, "{}", heat.side_a);
+
+    // The same periodicity built in code, on the side sets themselves.
+    let mut by_code = builder();
+    by_code
+        .add_interaction(
+            Interaction::new(
+                "cut_start",
+                "cut_end",
+                Model::TiedMortar {
+                    multipliers: Multipliers::Standard,
+                },
+            )
+            .periodic(Periodic::Cylindrical {
+                axis: [0.0, 0.0, 1.0],
+                center: [0.0; 3],
+                angle: 30.0,
+            }),
+        )
+        .unwrap();
+    by_code.search().unwrap();
+    let code_ties = by_code.constraints().unwrap();
+    assert_eq!(code_ties[0].entries, ties[0].entries);
+    let (_, code_heat) = turbine_host(&mesh, &dof, &code_ties[0]);
+    assert_eq!(code_heat, heat);
+
+    // Moving every node by a rigid turn about the axis keeps the sector periodic: the
+    // image is remade from the moved cut and the pairing keeps its gaps at zero.
+    let (s, c) = 10f64.to_radians().sin_cos();
+    let turned: Vec<[f64; 3]> = mesh
+        .coords
+        .iter()
+        .map(|p| [c * p[0] - s * p[1], s * p[0] + c * p[1], p[2]])
+        .collect();
+    by_code.move_nodes(&turned).unwrap();
+    let stats = by_code.search_stats(0).unwrap();
+    assert!(
+        stats.gap_max.unwrap().abs() < 1e-12 && stats.gap_min.unwrap().abs() < 1e-12,
+        "{stats:?}"
+    );
+
+    // A wrong angle is refused in code as in a deck: the image misses side B.
+    let mut wrong = builder();
+    let err = wrong
+        .add_interaction(
+            Interaction::new("cut_start", "cut_end", Model::TiedNitsche).periodic(
+                Periodic::Cylindrical {
+                    axis: [0.0, 0.0, 1.0],
+                    center: [0.0; 3],
+                    angle: 20.0,
+                },
+            ),
+        )
+        .unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("its image does not land on `cut_end`"),
+        "{err}"
+    );
+}
+
+/// The plugin-conductance scene through the embedding API: the deck's C table plugin
+/// (built next to a copy of the deck, as `seam run` finds it) loaded by `add_deck_file`
+/// with its Real Data, the host's Newton solve, against `seam run`'s interface heat.
+///
+/// Both solve the same discrete equations by Newton to a converged field (the plugin's
+/// h = 5500 W/m²K does not depend on the temperatures): the difference is round-off in
+/// the solves, 1e-10 relative leaves two orders above it.
+#[test]
+fn embed_plugin_conductance_matches_seam_run() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/plugin_conductance");
+    let deck_dir = crate::examples::copy_scene_as("plugin_conductance", "embed-plugin");
+    crate::examples::compile_c_table(&deck_dir);
+    let reference = run_scene(&scene, &deck_dir, "problem.toml");
+    let i = &reference.summary.interactions[0];
+
+    let mesh = seam::mesh::read(&scene.join("plugin_conductance.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let k = |block: &str| if block == "base" { 16.0 } else { 200.0 };
+    let mut seam = example::embedding_with(&mesh, &dof, k).build().unwrap();
+    seam.add_deck_file(&deck_dir.join("contact.i")).unwrap();
+    seam.search().unwrap();
+    let conduction = example::conduction_with(&mesh, &dof, k).unwrap();
+    let fixed = example::dirichlet_on(&mesh, &dof, &[("base_bottom", 350.0), ("cover_top", 300.0)])
+        .unwrap();
+    let (u, steps) = example::newton(&seam, &conduction, &fixed).unwrap();
+    let heat = seam.contributions(&u).unwrap().heat[0].unwrap();
+    let err = relative(heat.side_a, i.heat_side_a);
+    println!(
+        "plugin conductance: embedding {:.15e} W, seam run {:.15e} W: {err:.2e} ({steps} Newton steps)",
+        heat.side_a, i.heat_side_a
+    );
+    assert!(err <= 1e-10, "{err:.3e}");
+    assert!(relative(heat.side_b, i.heat_side_b) <= 1e-10);
+    // The base (350 K) heats the cover: heat leaves side A.
+    assert!(heat.side_a > 0.0);
+    let _ = std::fs::remove_dir_all(&deck_dir);
+}
+
+/// Compile the faulty test plugin with FAULT_<fault> (faults strike points with contact
+/// pressure ≥ 100) into this module's own folder; returns its path.
+fn faulty_plugin(fault: &str) -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("embed-plugins");
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join(format!(
+        "{}faulty_{}{}",
+        std::env::consts::DLL_PREFIX,
+        fault.to_lowercase(),
+        std::env::consts::DLL_SUFFIX
+    ));
+    // A private name, then a rename: a library already mapped keeps its inode.
+    let partial = dir.join(format!("{fault}.{}.partial", std::process::id()));
+    let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let status = Command::new(&cc)
+        .args([
+            "-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-shared", "-fPIC", "-I",
+        ])
+        .arg(root.join("plugins/include"))
+        .arg(format!("-DFAULT_{fault}"))
+        .arg(root.join("plugins/tests/faulty/faulty.c"))
+        .arg("-o")
+        .arg(&partial)
+        .arg("-lm")
+        .status()
+        .unwrap_or_else(|e| panic!("cannot run the C compiler `{cc}`: {e}"));
+    assert!(
+        status.success(),
+        "compiling the FAULT_{fault} plugin failed"
+    );
+    std::fs::rename(&partial, &out).unwrap();
+    out
+}
+
+/// The two-block interface with the plugin `library` as its conductance, at contact
+/// pressure `pressure`.
+fn plugin_deck(library: &Path, pressure: f64) -> String {
+    format!(
+        "begin contact definition plugged
+  contact surface a contains base_top
+  contact surface b contains lid_bottom
+  begin interaction
+    side a a
+    side b b
+  end
+  begin enforcement
+    enforcement for energy = plugin library = {library:?}
+    contact pressure = {pressure}
+  end
+end
+",
+        library = library.display().to_string()
+    )
+}
+
+/// A plugin's error and its cutback request come back from `contributions` as their
+/// own errors, naming the plugin and the point, and through the C API as
+/// SEAM_ERR_PLUGIN and SEAM_CUTBACK with the plugin's suggested factor; a library that
+/// is not there is SEAM_ERR_PLUGIN when the deck is added.
+#[test]
+fn embed_plugin_faults_and_cutbacks_are_reported() {
+    use seam::capi::*;
+    use std::ffi::{CStr, CString};
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let u = vec![300.0; mesh.num_nodes()];
+    let (error, cutback) = (faulty_plugin("ERROR"), faulty_plugin("CUTBACK"));
+
+    // Rust: below the faults' pressure the plugin answers h = 1; above, it fails.
+    let evaluate = |library: &Path, pressure: f64| {
+        let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+        seam.add_deck("plugged.i", &plugin_deck(library, pressure))
+            .unwrap();
+        seam.search().unwrap();
+        seam.contributions(&u)
+    };
+    assert!(evaluate(&error, 50.0).is_ok());
+    match evaluate(&error, 1000.0) {
+        Err(e @ EmbedError::Plugin { .. }) => {
+            let m = e.to_string();
+            for needle in [
+                "interaction a / b",
+                "plugin faulty",
+                "side-A face (element",
+                "pressure 1000 is beyond the measured range",
+                "seam check-plugin",
+            ] {
+                assert!(m.contains(needle), "`{needle}` missing from: {m}");
+            }
+        }
+        other => panic!("expected a plugin error, got {other:?}"),
+    }
+    match evaluate(&cutback, 1000.0) {
+        Err(EmbedError::Cutback {
+            factor, message, ..
+        }) => {
+            assert_eq!(factor, 0.25);
+            assert!(
+                message.contains("coating creep increment too large"),
+                "{message}"
+            );
+        }
+        other => panic!("expected a cutback, got {other:?}"),
+    }
+
+    // C: the same through seam.h's functions.
+    let last = || {
+        unsafe { CStr::from_ptr(seam_last_error()) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    let coords: Vec<f64> = mesh.coords.iter().flatten().copied().collect();
+    let dofs: Vec<i64> = dof.iter().map(|&d| d as i64).collect();
+    let mut b = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { seam_builder_new(coords.as_ptr(), mesh.num_nodes(), &mut b) },
+        0
+    );
+    for block in &mesh.blocks {
+        let conn: Vec<i64> = block.connectivity.iter().map(|v| v.0 as i64).collect();
+        let name = CString::new(block.name.as_str()).unwrap();
+        let k = example::conductivity_of(&block.name);
+        let status =
+            unsafe { seam_builder_add_block(b, name.as_ptr(), 1, conn.as_ptr(), block.len(), k) };
+        assert_eq!(status, 0, "{}", last());
+    }
+    for set in &mesh.side_sets {
+        let elems: Vec<i64> = set.sides.iter().map(|s| s.elem.0 as i64).collect();
+        let sides: Vec<i32> = set.sides.iter().map(|s| i32::from(s.side)).collect();
+        let name = CString::new(set.name.as_str()).unwrap();
+        let status = unsafe {
+            seam_builder_add_side_set(
+                b,
+                name.as_ptr(),
+                elems.as_ptr(),
+                sides.as_ptr(),
+                elems.len(),
+            )
+        };
+        assert_eq!(status, 0, "{}", last());
+    }
+    assert_eq!(
+        unsafe { seam_builder_set_dofs(b, dofs.as_ptr(), dofs.len()) },
+        0
+    );
+    let c_evaluate = |deck: &str| -> (i32, String, Option<f64>) {
+        let mut e = std::ptr::null_mut();
+        assert_eq!(unsafe { seam_embedding_new(b, &mut e) }, 0, "{}", last());
+        let text = CString::new(deck).unwrap();
+        let mut status =
+            unsafe { seam_add_deck(e, text.as_ptr(), std::ptr::null(), std::ptr::null_mut()) };
+        if status == 0 {
+            assert_eq!(unsafe { seam_search(e) }, 0, "{}", last());
+            status = unsafe { seam_evaluate(e, u.as_ptr(), u.len()) };
+        }
+        let message = last();
+        let mut factor = f64::NAN;
+        let factor = (unsafe { seam_cutback_factor(e, &mut factor) } == 0).then_some(factor);
+        unsafe { seam_embedding_free(e) };
+        (status, message, factor)
+    };
+    let (status, message, factor) = c_evaluate(&plugin_deck(&error, 1000.0));
+    assert_eq!(status, SeamStatus::Plugin as i32, "{message}");
+    assert_eq!(status, 8, "SEAM_ERR_PLUGIN in seam.h");
+    assert!(message.contains("plugin faulty"), "{message}");
+    assert_eq!(factor, None);
+    let (status, message, factor) = c_evaluate(&plugin_deck(&cutback, 1000.0));
+    assert_eq!(status, SeamStatus::Cutback as i32, "{message}");
+    assert_eq!(status, 9, "SEAM_CUTBACK in seam.h");
+    assert!(message.contains("plugin faulty"), "{message}");
+    assert_eq!(factor, Some(0.25));
+    let missing = error.with_file_name("libnot_there.so");
+    let (status, message, _) = c_evaluate(&plugin_deck(&missing, 1000.0));
+    assert_eq!(status, SeamStatus::Plugin as i32, "{message}");
+    assert!(
+        message.contains("libnot_there.so") && message.contains("does not exist"),
+        "{message}"
+    );
+    unsafe { seam_builder_free(b) };
+}
+
+/// The C host of the turbine sector (`examples/c_host/sector.c`): its own mesh (the
+/// grid of make_meshes.py, generated in C), its own assembly, and the cylindrical
+/// periodicity from `seam_add_periodic_interaction`, against `seam run` on the scene.
+///
+/// Tolerance 1e-9 relative (the module's): the C host's coordinates come from its own
+/// trigonometry and powers (an ulp from numpy's in the mesh file) and it solves densely,
+/// so round-off differs; a wrong map, face or dof would move the heat by percents.
+#[test]
+fn embed_c_sector_host_matches_seam_run() {
+    let stdout = run_c_host("sector.c");
+    assert!(
+        stdout.contains("expected error 4: periodic interaction cut_start / cut_end: its image does not land on `cut_end`"),
+        "{stdout}"
+    );
+    let reference = run_scene(&turbine(), &turbine(), "problem.toml");
+    let cut = &reference.summary.interactions[0];
+    let heat = printed(&stdout, "periodic tie heat: side A ");
+    let range = printed(&stdout, "temperature: min ");
+    let t = &reference.solution.temperature;
+    let (lo, hi) = t
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(*v), h.max(*v))
+        });
+    println!(
+        "C sector host: cut heat {:.15e} W, seam run {:.15e} W: {:.2e}; lowest and highest temperatures off by {:.2e} and {:.2e} of the spread",
+        heat[0],
+        cut.heat_side_a,
+        relative(heat[0], cut.heat_side_a),
+        (range[0] - lo).abs() / (hi - lo),
+        (range[1] - hi).abs() / (hi - lo)
+    );
+    assert!(relative(heat[0], cut.heat_side_a) <= TOLERANCE);
+    assert!(relative(heat[1], cut.heat_side_b) <= TOLERANCE);
+    assert!((range[0] - lo).abs() <= TOLERANCE * (hi - lo));
+    assert!((range[1] - hi).abs() <= TOLERANCE * (hi - lo));
 }

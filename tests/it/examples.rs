@@ -30,13 +30,18 @@ fn root() -> &'static Path {
 
 /// A fresh copy of the files (not the subdirectories) of `examples/<scene>`.
 fn copy_scene(scene: &str) -> PathBuf {
-    // One directory per call: tests of the same scene run side by side.
+    copy_scene_as(scene, scene)
+}
+
+/// As [`copy_scene`], into a folder named after `tag` and the call (tests that copy
+/// the same scene at the same time each get their own).
+pub(crate) fn copy_scene_as(scene: &str, tag: &str) -> PathBuf {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let from = root().join("examples").join(scene);
     let to = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("examples")
-        .join(format!("{scene}-{}-{call}", std::process::id()));
+        .join(format!("{tag}-{}-{call}", std::process::id()));
     std::fs::remove_dir_all(&to).ok();
     std::fs::create_dir_all(&to).unwrap();
     for entry in std::fs::read_dir(&from).unwrap() {
@@ -388,10 +393,10 @@ fn twisted_channel_is_periodic_under_its_lua_map() {
 }
 
 /// The library name the plugin scene's deck asks for, next to the deck.
-const PLUGIN_LIBRARY: &str = "libseam_c_table.so";
+pub(crate) const PLUGIN_LIBRARY: &str = "libseam_c_table.so";
 
 /// Compile the C example plugin with `$CC` (default `cc`) and the CI flags into `dir`.
-fn compile_c_table(dir: &Path) -> PathBuf {
+pub(crate) fn compile_c_table(dir: &Path) -> PathBuf {
     let out = dir.join(PLUGIN_LIBRARY);
     let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let status = Command::new(&compiler)
@@ -555,7 +560,8 @@ fn electronics_power_leaves_by_convection() {
 /// (e^-5 = 0.7 %, plus the time error of 5 s BDF2 steps).
 #[test]
 fn electronics_warms_up_toward_its_steady_state() {
-    let dir = copy_scene("electronics");
+    // Its own copy: the steady test copies (and at its end removes) this scene too.
+    let dir = copy_scene_as("electronics", "electronics-transient");
     let steady = run(&dir.join("problem.toml"));
     let r = run(&dir.join("transient.toml"));
     assert_eq!(r.history.len(), 80);

@@ -26,7 +26,7 @@ use std::fmt;
 
 pub use deck::{codes, from_properties};
 pub use lua::{FD_FLOOR_GAP, FD_FLOOR_PRESSURE, FD_FLOOR_TEMPERATURE, LuaConductance};
-pub use plugin::PluginConductance;
+pub use plugin::{PluginConductance, PluginLoadError};
 
 /// The Stefan–Boltzmann constant σ in W/(m²·K⁴), CODATA 2018 (exact in the 2019 SI).
 pub const STEFAN_BOLTZMANN: f64 = 5.670374419e-8;
@@ -132,6 +132,8 @@ pub enum ConductanceError {
     Cutback {
         model: String,
         state: PointState,
+        /// The suggested new/old step in (0, 1), or 0: the host decides.
+        factor: f64,
         message: String,
     },
 }

@@ -1,8 +1,24 @@
 //! The plugin adapter: a loaded enforcement plugin that returns conductance, used as a
 //! conductance model.
 
+use std::path::Path;
+
 use super::{Conductance, ConductanceError, ConductanceModel, PointState, check};
-use crate::plugin::{ContactPoint, Plugin, PointResult, StepContext};
+use crate::deck::spec::Enforcement;
+use crate::plugin::{
+    ContactPoint, Plugin, PluginError, PluginFault, PluginSpec, PointResult, StepContext,
+};
+
+/// Why a deck's plugin enforcement could not be made a conductance model: the library
+/// (missing, not a plugin, refused its data) or the plugin's kind (returns flux, keeps
+/// state). Both messages name the plugin's library.
+#[derive(Debug, thiserror::Error)]
+pub enum PluginLoadError {
+    #[error(transparent)]
+    Plugin(#[from] PluginError),
+    #[error(transparent)]
+    Conductance(#[from] ConductanceError),
+}
 
 /// A [`Plugin`] without `RETURNS_FLUX` and without per-point state, called one point at
 /// a time. The host validates the plugin's output (finite, h ≥ 0) and forms finite
@@ -46,6 +62,19 @@ impl PluginConductance {
         })
     }
 
+    /// The plugin of the deck's `Enforcement for Energy = Plugin Library = "…" Model = …`
+    /// with the block's `Integer Data` / `Real Data` (a relative library path is taken
+    /// from `deck_dir`), loaded and told the interaction's surfaces.
+    pub fn from_enforcement(
+        enforcement: &Enforcement,
+        deck_dir: &Path,
+        surface_a: &str,
+        surface_b: &str,
+    ) -> Result<PluginConductance, PluginLoadError> {
+        let plugin = PluginSpec::from_enforcement(enforcement, deck_dir)?.load()?;
+        Ok(PluginConductance::new(plugin)?.on_surfaces(surface_a, surface_b))
+    }
+
     /// The surfaces the plugin is told about.
     pub fn on_surfaces(mut self, surface_a: &str, surface_b: &str) -> Self {
         self.surface_a = surface_a.into();
@@ -84,10 +113,11 @@ impl ConductanceModel for PluginConductance {
             .evaluate(&ctx, &[point], &mut out, None)
             .map_err(|e| {
                 let (model, state, message) = (self.name(), *s, e.to_string());
-                if e.is_cutback() {
+                if let PluginFault::Cutback { factor, .. } = e {
                     ConductanceError::Cutback {
                         model,
                         state,
+                        factor,
                         message,
                     }
                 } else {
