@@ -53,7 +53,7 @@
 use std::cell::Cell;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
 use crate::deck::spec::{ContactDefinition, Enforcement as DeckEnforcement, PeriodicTransform};
@@ -63,7 +63,7 @@ use crate::enforce::conductance::{
     ConductanceError, ConductanceModel, PluginConductance, PointState,
 };
 use crate::enforce::interface::{
-    DEFAULT_BETA, Form, HInput, HValue, InterfaceError, InterfaceForm, interface_terms,
+    DEFAULT_BETA, Form, HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints,
 };
 use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
 use crate::enforce::mortar::mortar_tie;
@@ -751,6 +751,9 @@ struct Pair {
     enforcement: Enforcement,
     searcher: Option<Searcher>,
     result: Option<SearchResult>,
+    /// The interface geometry at the points of `result`, made at the first
+    /// `contributions` after a search or a move and reused until the next.
+    points: OnceLock<InterfacePoints>,
 }
 
 /// seam inside a host: the host's mesh and numbering, its interactions and their search.
@@ -842,6 +845,7 @@ impl Embedding {
             enforcement,
             searcher: None,
             result: None,
+            points: OnceLock::new(),
         })
     }
 
@@ -907,6 +911,7 @@ impl Embedding {
             enforcement,
             searcher: None,
             result: None,
+            points: OnceLock::new(),
         })
     }
 
@@ -1090,6 +1095,7 @@ impl Embedding {
                     enforcement,
                     searcher: None,
                     result: None,
+                    points: OnceLock::new(),
                 });
             }
         }
@@ -1215,6 +1221,7 @@ impl Embedding {
             }
             p.searcher = Some(searcher);
             p.result = Some(result);
+            p.points = OnceLock::new();
         }
         Ok(())
     }
@@ -1260,6 +1267,7 @@ impl Embedding {
             if let Some(r) = &mut p.result {
                 r.update_geometry(&p.a, &p.b);
             }
+            p.points = OnceLock::new();
             if let Some(s) = &mut p.searcher {
                 s.refit(&p.b);
             }
@@ -1360,17 +1368,27 @@ impl Embedding {
                 beta: *beta,
                 conductivity: &self.conductivity,
             };
-            let s = interface_terms(
-                &self.mesh,
-                &self.dofs,
-                self.field,
-                &p.a,
-                &p.b,
-                &result.points,
-                &form,
-                &local,
-            )
-            .map_err(|source| {
+            let points = match p.points.get() {
+                Some(points) => points,
+                None => {
+                    let made = InterfacePoints::new(
+                        &self.mesh,
+                        &self.dofs,
+                        self.field,
+                        &p.a,
+                        &p.b,
+                        &result.points,
+                        &form,
+                    )
+                    .map_err(|source| EmbedError::Enforcement {
+                        side_a: p.side_a.name.clone(),
+                        side_b: p.side_b.name.clone(),
+                        source,
+                    })?;
+                    p.points.get_or_init(|| made)
+                }
+            };
+            let s = points.evaluate(&form, &local).map_err(|source| {
                 let (side_a, side_b) = (p.side_a.name.clone(), p.side_b.name.clone());
                 match fault.take() {
                     Some(ConductanceError::Cutback { factor, .. }) => EmbedError::Cutback {
