@@ -441,3 +441,46 @@ fn boundary_fields_are_checked_against_their_kind() {
         assert!(e.contains("E0706") && e.contains(expect), "{e}");
     }
 }
+
+/// A linear step is solved with one assembly: its residual and interface heat after the
+/// solve are carried forward as R + J du instead of being assembled again. The same
+/// conductance written as a Lua expression counts as temperature-dependent, so that run
+/// takes full Newton steps with a fresh assembly at every iterate. Both must report the
+/// same heat at every step and end at the same temperatures, to the Newton tolerance
+/// (1e-10 relative; the difference measured is far below it), and the linear run must
+/// take one Newton iteration per step while the other takes at least two.
+#[test]
+fn linear_steps_carry_their_residual_exactly() {
+    let lua_deck = GAP_DECK.replace("constant h = 500", "lua \"500 + 0*temp_a\"");
+    assert_ne!(lua_deck, GAP_DECK);
+    let problem = format!(
+        "{MATERIALS}{WARMING}[solve]\nkind = \"transient\"\nscheme = \"bdf2\"\ndt = 0.1\nend_time = 1.0\ntolerance = 1e-12\n"
+    );
+    let linear = ok(&scratch("carry-linear"), GAP_DECK, &problem);
+    let newton = ok(&scratch("carry-newton"), &lua_deck, &problem);
+    assert_eq!(linear.history.len(), newton.history.len());
+    for (l, n) in linear.history.iter().zip(&newton.history) {
+        assert_eq!(l.newton_iterations, 1, "step {}: linear", l.step);
+        assert!(n.newton_iterations >= 2, "step {}: Newton", n.step);
+        let (a, b) = (l.heat[0].0, n.heat[0].0);
+        assert!(
+            (a - b).abs() <= 1e-10 * b.abs(),
+            "step {}: heat {a} (one assembly) against {b} (Newton)",
+            l.step
+        );
+        assert!(
+            *l.residual_history.last().unwrap() <= 1e-9 * l.residual_history[0],
+            "step {}: residual {:?}",
+            l.step,
+            l.residual_history
+        );
+    }
+    let spread = newton
+        .solution
+        .temperature
+        .iter()
+        .fold(0.0f64, |m, t| m.max((t - 300.0).abs()));
+    let d = max_diff(&linear.solution.temperature, &newton.solution.temperature);
+    eprintln!("one assembly vs Newton: max temperature difference {d:e} K over a {spread} K rise");
+    assert!(d <= 1e-10 * spread);
+}

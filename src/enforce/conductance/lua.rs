@@ -175,6 +175,12 @@ impl ConductanceModel for LuaConductance {
         self.label.clone()
     }
 
+    /// An expression that never names `temp_a`/`temp_b` (`T_A`/`T_B`) cannot depend on
+    /// them; a file function may.
+    fn depends_on_temperature(&self) -> bool {
+        self.uses.temp_a || self.uses.temp_b
+    }
+
     fn value(&self, s: &PointState) -> Result<f64, ConductanceError> {
         let c = Conductance {
             h: self.call(s)?,

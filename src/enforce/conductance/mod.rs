@@ -666,4 +666,34 @@ mod tests {
             "{m}"
         );
     }
+
+    /// A model that says it does not depend on T (so the heat problem is solved as
+    /// linear) must give the same h, with zero temperature derivatives, at every
+    /// temperature; the ones that say they do must show it somewhere in the sweep.
+    #[test]
+    fn temperature_independence_is_claimed_only_when_true() {
+        let models: Vec<Box<dyn ConductanceModel>> = vec![
+            Box::new(Constant::new(500.0).unwrap()),
+            Box::new(GasGap::new(0.025).unwrap()),
+            Box::new(GasGap::with(0.025, 2e-3, 300.0, 1e-6, 1e6, MinGapOrder::Zero).unwrap()),
+            Box::new(Radiation::new(0.8, 0.6).unwrap()),
+            Box::new(Cmy::new(150.0, 200.0, 0.1, 1e-6, 1e9).unwrap()),
+            Box::new(Table::new(TableVariable::Gap, &[(0.0, 1e4), (1e-3, 10.0)]).unwrap()),
+            Box::new(
+                Table::new(TableVariable::Temperature, &[(300.0, 10.0), (600.0, 90.0)]).unwrap(),
+            ),
+            Box::new(LuaConductance::expression("test", "1e4 / (1 + gap * 1e3)").unwrap()),
+            Box::new(LuaConductance::expression("test", "10 + 0.1 * T_A").unwrap()),
+        ];
+        for m in &models {
+            let at = |ta: f64, tb: f64| m.evaluate(&state(2e-4, 5e5, ta, tb)).unwrap();
+            let base = at(300.0, 300.0);
+            let sweep = [(350.0, 320.0), (500.0, 450.0), (900.0, 700.0)].map(|(a, b)| at(a, b));
+            let varies = sweep
+                .iter()
+                .any(|c| c.h != base.h || c.dh_dtemp_a != 0.0 || c.dh_dtemp_b != 0.0)
+                || base.dh_dtemp_a != 0.0;
+            assert_eq!(m.depends_on_temperature(), varies, "{}", m.name());
+        }
+    }
 }
