@@ -503,6 +503,21 @@ impl<'p> Assembler<'p> {
     where
         F: Fn(ElemId, &mut [f64], &mut [f64]) + Sync,
     {
+        self.elements_with(mesh, blocks, false, kernel)
+    }
+
+    /// As [`Self::elements`]; with `keep_matrix` the element matrix slots are handed to
+    /// the kernel as they are (not zeroed), for kernels that reuse the element matrices
+    /// of the last call and only compute the vectors.
+    pub fn elements_with<F>(
+        &mut self,
+        mesh: &Mesh,
+        blocks: Option<&[usize]>,
+        keep_matrix: bool,
+        kernel: F,
+    ) where
+        F: Fn(ElemId, &mut [f64], &mut [f64]) + Sync,
+    {
         let pattern = self.pattern;
         let mut vec_off = 0;
         for (b, block) in mesh.blocks.iter().enumerate() {
@@ -519,7 +534,9 @@ impl<'p> Assembler<'p> {
                     .enumerate()
                     .with_min_len(256)
                     .for_each(|(k, (ke, fe))| {
-                        ke.fill(0.0);
+                        if !keep_matrix {
+                            ke.fill(0.0);
+                        }
                         fe.fill(0.0);
                         kernel(ElemId(first + k as u32), ke, fe);
                     });

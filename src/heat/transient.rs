@@ -27,7 +27,7 @@
 //! [`TransientProblem::reproducible`] is set — so a run restarted from a
 //! [`State`] continues exactly as the uninterrupted run.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashSet;
 
 use rayon::prelude::*;
@@ -483,6 +483,7 @@ pub fn solve(
         setup: &setup,
         points: &points,
         scatters: &scatters,
+        element_matrices: RefCell::new(None),
         tie_first: &tie_first,
     };
 
@@ -728,6 +729,9 @@ struct Context<'c, 'a> {
     /// Per contact term: its points' geometry and where its blocks go.
     points: &'c [InterfacePoints],
     scatters: &'c [Scatter],
+    /// The face-derivative signature under which the element matrix slots were last
+    /// computed for a linear problem (None: not kept).
+    element_matrices: RefCell<Option<Vec<(u32, u8, f64)>>>,
     tie_first: &'c [usize],
 }
 
@@ -779,7 +783,7 @@ impl Context<'_, '_> {
             let clock = std::time::Instant::now();
             let (mut r, mut terms) = match carried.take() {
                 Some(x) => x,
-                None => match self.assemble(asm, u, t, &loads, history.as_ref()) {
+                None => match self.assemble(asm, u, t, &loads, history.as_ref(), linear) {
                     Ok(x) => x,
                     Err(Failure::Retry(msg)) => return Ok(Err(msg)),
                     Err(Failure::Fatal(e)) => return Err(e),
@@ -904,6 +908,7 @@ impl Context<'_, '_> {
         t: f64,
         loads: &Loads,
         history: Option<&History<'_>>,
+        linear: bool,
     ) -> Result<(Vec<f64>, Vec<Option<InterfaceSystem>>), Failure> {
         let p = self.p;
         let setup = self.setup;
@@ -919,7 +924,19 @@ impl Context<'_, '_> {
         faces.sort_unstable();
         let errors = FirstError::new();
         let (laws, source, block_source) = (p.laws, p.source, p.block_source);
-        asm.elements(mesh, Some(blocks), |e, je, re| {
+        // A linear problem's element matrices (conduction, and the faces' dg/dT) stay
+        // the same while the face conditions' derivatives do: then they are kept in
+        // their slots and only the vectors are computed. Either way a linear element's
+        // residual is `K_e T_e + g(0) − f`, so keeping or recomputing gives the same bits.
+        let signature: Option<Vec<(u32, u8, f64)>> = linear.then(|| {
+            loads
+                .faces
+                .iter()
+                .map(|f| (f.side().elem.0, f.side().side, f.outflow(0.0).1))
+                .collect()
+        });
+        let keep = signature.is_some() && *self.element_matrices.borrow() == signature;
+        asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
             let b = mesh.block_of(e);
             let topo = mesh.blocks[b].topology;
             let rule = rules[b].as_ref().expect("rule of a field block");
@@ -931,6 +948,8 @@ impl Context<'_, '_> {
             for (k, d) in elem_dofs.iter().enumerate() {
                 te[k] = u[*d as usize];
             }
+            // Linear: the matrix at T = 0, then the residual from it.
+            let t_eval = if linear { [0.0; kernel::MAX_NODES] } else { te };
             let law = &laws[b].conductivity;
             let failed = Cell::new(None);
             let k = |temp: f64, xq: [f64; 3]| match law.eval(temp, xq, t) {
@@ -940,20 +959,12 @@ impl Context<'_, '_> {
                     (0.0, 0.0)
                 }
             };
-            let r = kernel::conduction_residual_jacobian(rule, &x[..nn], &te[..nn], k, re, je)
-                .and_then(|_| {
-                    let mut f = [0.0; kernel::MAX_NODES];
-                    match (block_source, source) {
-                        (Some(qb), _) if qb[b] != 0.0 => {
-                            kernel::source(rule, &x[..nn], |_| qb[b], &mut f)?
-                        }
-                        (None, Some(q)) => kernel::source(rule, &x[..nn], q, &mut f)?,
-                        _ => {}
-                    }
-                    re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
-                    Ok(())
-                });
-            if let Err(bad) = r {
+            let conduction = if keep {
+                Ok(())
+            } else {
+                kernel::conduction_residual_jacobian(rule, &x[..nn], &t_eval[..nn], k, re, je)
+            };
+            if let Err(bad) = conduction {
                 errors.record(e, bad_jacobian(mesh, e, bad));
                 return;
             }
@@ -968,21 +979,47 @@ impl Context<'_, '_> {
                 return;
             }
             let start = faces.partition_point(|f| f.0 < e.0);
+            let mut scratch = [0.0; kernel::MAX_NODES * kernel::MAX_NODES];
             for &(_, k) in faces[start..].iter().take_while(|f| f.0 == e.0) {
                 let bc = loads.faces[k];
+                // Kept matrices hold the faces' dg/dT already.
+                let jf = if keep {
+                    &mut scratch[..nn * nn]
+                } else {
+                    &mut *je
+                };
                 kernel::face_load(
                     topo,
                     &x[..nn],
                     bc.side().side,
-                    &te[..nn],
+                    &t_eval[..nn],
                     |temp, _| bc.outflow(temp),
                     re,
-                    je,
+                    jf,
                 );
             }
+            if linear {
+                for a in 0..nn {
+                    re[a] += (0..nn).map(|c| je[a * nn + c] * te[c]).sum::<f64>();
+                }
+            }
+            let mut f = [0.0; kernel::MAX_NODES];
+            let sourced = match (block_source, source) {
+                (Some(qb), _) if qb[b] != 0.0 => kernel::source(rule, &x[..nn], |_| qb[b], &mut f),
+                (None, Some(q)) => kernel::source(rule, &x[..nn], q, &mut f),
+                _ => Ok(()),
+            };
+            if let Err(bad) = sourced {
+                errors.record(e, bad_jacobian(mesh, e, bad));
+                return;
+            }
+            re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
         });
         errors.into_result()?;
-        asm.check_finite(mesh).map_err(HeatError::from)?;
+        if !keep {
+            asm.check_finite(mesh).map_err(HeatError::from)?;
+        }
+        *self.element_matrices.borrow_mut() = signature;
         asm.reset_couplings();
         let mut r = asm.rhs();
         // Capacity (lumped): M(u)(α₀u + α₁uⁿ + α₂uⁿ⁻¹)/Δt on the diagonal.

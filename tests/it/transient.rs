@@ -484,3 +484,57 @@ fn linear_steps_carry_their_residual_exactly() {
     eprintln!("one assembly vs Newton: max temperature difference {d:e} K over a {spread} K rise");
     assert!(d <= 1e-10 * spread);
 }
+
+/// A linear problem keeps its element matrices from step to step and only recomputes
+/// them when a face condition's derivative changes. Here the convection coefficient on
+/// the lid follows a table in time, so the kept matrices go stale at every step unless
+/// they are refreshed. The same problem with the base's conductivity written as a Lua
+/// expression of T is solved by full Newton with every matrix recomputed: both must end
+/// at the same temperatures (1e-10 of the rise; a stale h moves them by percents).
+#[test]
+fn kept_element_matrices_follow_a_changing_convection() {
+    let case = |conductivity: &str, name: &str| {
+        let problem = format!(
+            "[[material]]
+blocks = [\"base\"]
+conductivity = {conductivity}
+rho_c = 16.0
+[[material]]
+blocks = [\"lid\"]
+conductivity = 200.0
+rho_c = 100.0
+[[bc]]
+kind = \"temperature\"
+surfaces = [\"base_bottom\"]
+value = 300.0
+[[bc]]
+kind = \"convection\"
+surfaces = [\"lid_top\"]
+value = {{ table = [[0.0, 10.0], [0.5, 2000.0], [1.0, 50.0]] }}
+ambient = 400.0
+[initial]
+temperature = 300.0
+[solve]
+kind = \"transient\"
+scheme = \"bdf2\"
+dt = 0.05
+end_time = 1.0
+tolerance = 1e-13
+"
+        );
+        ok(&scratch(name), GAP_DECK, &problem)
+    };
+    let kept = case("16.0", "kept-constant");
+    let newton = case("\"16 + 0*T\"", "kept-lua");
+    assert!(kept.history.iter().all(|s| s.newton_iterations == 1));
+    assert!(newton.history.iter().any(|s| s.newton_iterations >= 2));
+    let rise = newton
+        .solution
+        .temperature
+        .iter()
+        .fold(0.0f64, |m, t| m.max(t - 300.0));
+    let d = max_diff(&kept.solution.temperature, &newton.solution.temperature);
+    eprintln!("kept matrices vs Newton under h(t): {d:e} K over a {rise} K rise");
+    assert!(rise > 1.0, "the convection must warm the body");
+    assert!(d <= 1e-10 * rise, "{d} K");
+}
