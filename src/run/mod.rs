@@ -1302,6 +1302,7 @@ fn scale_law(cp: Law, rho: f64) -> Law {
             expr: format!("{rho:e} * ({expr})"),
             chunk,
         },
+        Law::TimeTable(p) => Law::TimeTable(p.into_iter().map(|(t, v)| (t, rho * v)).collect()),
     }
 }
 
