@@ -15,9 +15,10 @@
 //! surfaces = ["surface_1"]           # side sets (or node sets, for temperature)
 //! value = "1 + x + 2*y - 3*z"        # a number or a Lua expression of x, y, z, t
 //! ambient = 300.0                    # convection only: T∞ (value is then h)
-//! [[source]]                         # optional volumetric source (W/m³)
+//! [[source]]                         # optional volumetric source Q (W/m³)
 //! blocks = ["block_1"]
-//! value = "0"
+//! value = "1e3*x"                    # a number, a Lua expression of x, y, z, t and T, or
+//!                                    # { table = [[t, Q], …] } in time
 //! [contact]
 //! file = "contact.i"                 # Sierra-syntax contact definition(s)
 //! integration = "segments"           # segments (exact, default) | quadrature
@@ -31,9 +32,9 @@
 //! ```
 //!
 //! A flux or convection value given as a Lua expression is evaluated at each face's
-//! centroid; temperature values at the nodes; sources at the nodes and interpolated
-//! (each exact for the linear fields of a patch test). The time `t` is 0 in a steady
-//! solve.
+//! centroid; temperature values at the nodes; sources at the quadrature points, where a
+//! source that names `T` sees the interpolated temperature (and makes the problem
+//! nonlinear). The time `t` is 0 in a steady solve.
 
 mod steps;
 
@@ -203,6 +204,8 @@ pub struct BcSpec {
 #[serde(deny_unknown_fields)]
 pub struct SourceSpec {
     pub blocks: Vec<String>,
+    /// Q (W/m³): a number, a Lua expression of x, y, z, t and T (the local temperature),
+    /// or a table in t.
     pub value: Value,
 }
 
@@ -449,17 +452,23 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
     check_bcs(&problem, &mut diags);
     let dirichlet = dirichlet_nodes(&problem, &mesh, &mut diags);
     let mut face_sites = face_sites(&problem, &mesh, &mut diags);
-    let block_source = block_sources(&problem, &mesh, &mut diags);
-    // One value everywhere: a plain source function (both solvers); else per block.
-    let uniform = block_source.windows(2).all(|w| w[0] == w[1]);
+    let timing_spec = time_spec(&problem, transient, &mut diags);
+    let at = ProblemText {
+        file: crate::diag::file_label(path),
+        text,
+    };
+    let block_source = block_sources(&problem, &mesh, &at, probe, timing_spec.start, &mut diags);
+    // One law of x and t everywhere: a plain source function (both solvers); else per
+    // block (the general solver). A source failing at a point is reported after the solve.
+    let uniform = block_source.windows(2).all(|w| w[0] == w[1])
+        && !block_source.first().is_some_and(Law::uses_temperature);
+    let source_failed = std::sync::Mutex::new(None::<String>);
     let source = block_source
         .first()
-        .copied()
-        .filter(|q| uniform && *q != 0.0)
-        .map(|q| move |_: [f64; 3]| q);
-    let timing_spec = time_spec(&problem, transient, &mut diags);
+        .filter(|q| uniform && **q != Law::Constant(0.0))
+        .map(|q| source_of_x(q, timing_spec.start, &source_failed));
     if diags.has_errors() {
-        return Err(RunError::Input(diags, SourceMap::default()));
+        return Err(RunError::Input(diags, at.sources()));
     }
     // Boundary data at the start: every expression is tried once here, so a bad one
     // is an input error, not a failure in the middle of a run.
@@ -847,7 +856,11 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
         };
-        solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?
+        let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+        if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
+            return Err(RunError::Solve(format!("[[source]]: {e}")));
+        }
+        solved
     } else {
         if problem.solve.linear_solver.as_deref() == Some("amg") {
             return Err(input_error(
@@ -879,8 +892,8 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                 })
                 .collect(),
             laws: &materials.laws,
-            source: source_fn,
-            block_source: (!uniform).then_some(block_source.as_slice()),
+            source: None,
+            block_source: Some(&block_source),
             loads: &loads,
             contact: contact_terms(),
             ties: tie_terms(),
@@ -1516,30 +1529,66 @@ fn loads_at(
     Ok(out)
 }
 
-/// The volumetric source per block (W/m³; 0 where none is given). Each block may be
-/// named once over all `[[source]]`s.
-fn block_sources(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<f64> {
-    let mut out = vec![0.0; mesh.blocks.len()];
+/// The problem file's text, for the line and column of a value in a diagnostic.
+struct ProblemText {
+    file: std::sync::Arc<str>,
+    text: String,
+}
+
+impl ProblemText {
+    /// Where `key` of entry `k` of the array of tables `array` sits (the entry itself
+    /// when it has no `key`).
+    fn loc(&self, array: &str, k: usize, key: &str) -> Option<crate::diag::Loc> {
+        use toml::{Spanned, de::DeTable, de::DeValue};
+        fn find<'a, 'i>(t: &'a DeTable<'i>, name: &str) -> Option<&'a Spanned<DeValue<'i>>> {
+            t.iter().find(|(n, _)| n.get_ref() == name).map(|(_, v)| v)
+        }
+        let root = DeTable::parse(&self.text).ok()?;
+        let entry = find(root.get_ref(), array)?.get_ref().as_array()?.get(k)?;
+        let node = entry.get_ref().as_table().and_then(|t| find(t, key));
+        let span = node.unwrap_or(entry).span();
+        Some(deck::byte_span_loc(&self.file, &self.text, span))
+    }
+
+    fn sources(&self) -> SourceMap {
+        let mut s = SourceMap::default();
+        s.add(&self.file, &self.text);
+        s
+    }
+}
+
+/// The volumetric source per block, Q(T, x, t) in W/m³ (0 where none is given): a
+/// number, a Lua expression of x, y, z, t and T, or a table in t. Each block may be
+/// named once over all `[[source]]`s. A value is tried once, at the first node of its
+/// first block, at temperature `probe` and time `time`: a bad expression is an input
+/// error at its line, not a failure in the middle of a run.
+fn block_sources(
+    p: &Problem,
+    mesh: &Mesh,
+    at: &ProblemText,
+    probe: f64,
+    time: f64,
+    diags: &mut Diagnostics,
+) -> Vec<Law> {
+    let mut out = vec![Law::Constant(0.0); mesh.blocks.len()];
     let mut given = vec![false; mesh.blocks.len()];
     for (k, s) in p.source.iter().enumerate() {
-        let q = match &s.value {
-            Value::Number(q) => Some(*q),
-            Value::Expr(e) => e.trim().parse::<f64>().ok(),
-            Value::Table { .. } => None,
+        let loc = at.loc("source", k, "value");
+        let law = match &s.value {
+            Value::Number(q) => Ok(Law::Constant(*q)),
+            Value::Expr(e) => Ok(e.trim().parse().map_or_else(
+                |_| Law::Lua {
+                    expr: e.clone(),
+                    chunk: format!("[[source]] #{} value", k + 1),
+                },
+                Law::Constant,
+            )),
+            Value::Table { table } => Law::table(table.clone()).map(|l| match l {
+                Law::Table(points) => Law::TimeTable(points),
+                other => other,
+            }),
         };
-        let Some(q) = q.filter(|q| q.is_finite()) else {
-            diags.push(
-                Diagnostic::error(
-                    "E0714",
-                    format!(
-                        "[[source]] #{}: the value must be a finite number (W/m³)",
-                        k + 1
-                    ),
-                )
-                .help("sources are constant per block in this version of seam"),
-            );
-            continue;
-        };
+        let mut blocks = Vec::new();
         for b in &s.blocks {
             if let Some(i) = block_index(mesh, b, diags, "[[source]]") {
                 if given[i] {
@@ -1552,11 +1601,57 @@ fn block_sources(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<f64> 
                     );
                 }
                 given[i] = true;
-                out[i] = q;
+                blocks.push(i);
             }
+        }
+        let x = blocks
+            .first()
+            .filter(|&&b| !mesh.blocks[b].is_empty())
+            .map_or([0.0; 3], |&b| {
+                mesh.coords[mesh.elem_nodes(mesh.blocks[b].first_elem)[0].index()]
+            });
+        let tried = law.and_then(|l| match l.eval(probe, x, time) {
+            Ok((q, dq)) if q.is_finite() && dq.is_finite() => Ok(l),
+            Ok((q, _)) => Err(format!(
+                "Q = {q} at ({}, {}, {}), T = {probe}, t = {time}",
+                x[0], x[1], x[2]
+            )),
+            // The first line: a Lua stack trace says nothing about a one-line expression.
+            Err(e) => Err(e.lines().next().unwrap_or_default().to_string()),
+        });
+        match tried {
+            Ok(law) => blocks.iter().for_each(|&i| out[i] = law.clone()),
+            Err(m) => diags.push(
+                Diagnostic::error("E0714", format!("[[source]] #{}: {m}", k + 1))
+                    .at(loc)
+                    .help("Q (W/m³) is a number, a Lua expression of x, y, z, t and T (the local temperature), or { table = [[t, Q], …] } with t increasing"),
+            ),
         }
     }
     out
+}
+
+/// A source law that does not depend on T as a function of x at `time`, for the linear
+/// steady solver; the first failure (a Lua error, a non-finite value) is kept in
+/// `failed` and the point contributes nothing.
+fn source_of_x<'a>(
+    law: &'a Law,
+    time: f64,
+    failed: &'a std::sync::Mutex<Option<String>>,
+) -> impl Fn([f64; 3]) -> f64 + Sync + 'a {
+    move |x| match law.eval(0.0, x, time) {
+        Ok((v, _)) if v.is_finite() => v,
+        r => {
+            let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
+            let what = match r {
+                Err(e) => e.lines().next().unwrap_or_default().to_string(),
+                Ok((v, _)) => format!("Q = {v}"),
+            };
+            let [x0, x1, x2] = x;
+            slot.get_or_insert_with(|| format!("{what} at ({x0:.6}, {x1:.6}, {x2:.6})"));
+            0.0
+        }
+    }
 }
 
 /// An interaction's model, penalty scale and conductance model.
