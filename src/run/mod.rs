@@ -133,8 +133,22 @@ pub struct ToggleSpec {
 pub struct NodalFieldSpec {
     pub name: String,
     /// A number or a Lua expression of x, y, z, t, evaluated at the nodes once, at the
-    /// start time of the run.
-    pub value: Value,
+    /// start time of the run. Either this or `file`.
+    #[serde(default)]
+    pub value: Option<Value>,
+    /// An Exodus II file (relative to the problem file) on the run's mesh whose nodal
+    /// variable `variable` holds the field.
+    #[serde(default)]
+    pub file: Option<PathBuf>,
+    /// The nodal variable in `file` (default: `name`).
+    #[serde(default)]
+    pub variable: Option<String>,
+    /// The stored time to read (default: the last step).
+    #[serde(default)]
+    pub time: Option<f64>,
+    /// Or the step to read, 1 = the first stored.
+    #[serde(default)]
+    pub step: Option<usize>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -458,6 +472,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         text,
     };
     let block_source = block_sources(&problem, &mesh, &at, probe, timing_spec.start, &mut diags);
+    check_nodal_fields(&problem, &at, &mut diags);
     // One law of x and t everywhere: a plain source function (both solvers); else per
     // block (the general solver). A source failing at a point is reported after the solve.
     let uniform = block_source.windows(2).all(|w| w[0] == w[1])
@@ -640,6 +655,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             }
         }
     }
+    loaded.sources.add(&at.file, &at.text);
     if diags.has_errors() {
         return Err(RunError::Input(diags, loaded.sources));
     }
@@ -688,7 +704,14 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         &mut diags,
     );
     let pressures = point_pressures(
-        &problem, &mesh, &pairings, &choices, &sandbox, start_time, &mut diags,
+        &problem,
+        &mesh,
+        &pairings,
+        &choices,
+        &sandbox,
+        start_time,
+        (&dir, &at),
+        &mut diags,
     );
     if diags.has_errors() {
         return Err(RunError::Input(diags, loaded.sources));
@@ -1654,6 +1677,149 @@ fn source_of_x<'a>(
     }
 }
 
+/// Each `[[nodal_field]]` has a `value` or a `file`, and the file's `variable`, `time`
+/// and `step` only with a file.
+fn check_nodal_fields(p: &Problem, at: &ProblemText, diags: &mut Diagnostics) {
+    for (k, f) in p.nodal_field.iter().enumerate() {
+        let by_file = f.variable.is_some() || f.time.is_some() || f.step.is_some();
+        let wrong = match (&f.value, &f.file) {
+            (Some(_), Some(_)) => Some("has both `value` and `file`"),
+            (None, None) => Some("needs a `value` or a `file`"),
+            (Some(_), None) if by_file => Some("has `variable`, `time` or `step` without `file`"),
+            _ if f.time.is_some() && f.step.is_some() => Some("has both `time` and `step`"),
+            _ => None,
+        };
+        if let Some(m) = wrong {
+            diags.push(
+                Diagnostic::error("E0712", format!("[[nodal_field]] {}: {m}", f.name))
+                    .at(at.loc("nodal_field", k, ""))
+                    .help("value = a number or a Lua expression; or file = \"f.exo\", variable = \"v\" and time = t or step = n (default the last step)"),
+            );
+        }
+    }
+}
+
+/// A `[[nodal_field]]` read from a nodal variable of an Exodus II file, one value per
+/// mesh node, at `step` (1 = the first stored), at the stored `time`, or at the last
+/// step. The file's nodes are matched to the mesh's by their node numbers and must sit
+/// where the mesh's do (to 1e-6 of the mesh's size, so coordinates stored in single
+/// precision pass and another mesh with as many nodes does not). Errors: message, help.
+fn read_nodal_field(
+    f: &NodalFieldSpec,
+    file: &Path,
+    mesh: &Mesh,
+) -> Result<Vec<f64>, (String, String)> {
+    use crate::mesh::{MeshError, exodus};
+    let split = |e: MeshError| match e {
+        MeshError::Format {
+            path,
+            message,
+            help,
+        } => (format!("{}: {message}", path.display()), help),
+        MeshError::Open { path, source } => (
+            format!("cannot open {}: {source}", path.display()),
+            "the file is relative to the problem file".into(),
+        ),
+        other => (other.to_string(), "check the file".into()),
+    };
+    let name = f.variable.as_deref().unwrap_or(&f.name);
+    let shown = file.display();
+    let times = exodus::read_times(file).map_err(split)?;
+    let n = times.len();
+    let step = match (f.step, f.time) {
+        _ if n == 0 => {
+            return Err((
+                format!("{shown} holds no time steps, so no values of `{name}`"),
+                "write the field as a nodal variable with at least one step".into(),
+            ));
+        }
+        (Some(s), _) if s == 0 || s > n => {
+            return Err((
+                format!(
+                    "{shown}: step {s} asked for, but the file holds {n} step(s), numbered from 1"
+                ),
+                format!("give step = 1 … {n}, or leave it out for the last"),
+            ));
+        }
+        (Some(s), _) => s - 1,
+        (None, Some(t)) => {
+            let scale = times.iter().fold(t.abs(), |m, v| m.max(v.abs()));
+            let nearest = (0..n)
+                .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
+                .expect("n > 0");
+            if (times[nearest] - t).abs() > 1e-9 * scale {
+                return Err((
+                    format!(
+                        "{shown} has no step at time {t} for `{name}`: it holds {n} step(s) from t = {} to {}; the nearest is t = {} (step {})",
+                        times[0],
+                        times[n - 1],
+                        times[nearest],
+                        nearest + 1
+                    ),
+                    "give a stored time, or the step as step = n".into(),
+                ));
+            }
+            nearest
+        }
+        (None, None) => n - 1,
+    };
+    let values = exodus::read_nodal_variable(file, name, step).map_err(split)?;
+    let source = exodus::read(file).map_err(split)?;
+    let help = "write the field on the run's mesh: the same nodes, paired by the node number map";
+    if source.num_nodes() != mesh.num_nodes() {
+        return Err((
+            format!(
+                "{shown}: `{name}` has values at {} nodes, but the mesh has {} nodes",
+                source.num_nodes(),
+                mesh.num_nodes()
+            ),
+            help.into(),
+        ));
+    }
+    let by_number: std::collections::HashMap<i64, usize> = (source.node_numbers.iter())
+        .enumerate()
+        .map(|(j, &number)| (number, j))
+        .collect();
+    let (lo, hi) = mesh.coords.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), x| {
+            (
+                std::array::from_fn(|d| lo[d].min(x[d])),
+                std::array::from_fn(|d| hi[d].max(x[d])),
+            )
+        },
+    );
+    let size = (0..3).map(|d| (hi[d] - lo[d]).powi(2)).sum::<f64>().sqrt();
+    let mut out = Vec::with_capacity(mesh.num_nodes());
+    for (x, &number) in mesh.coords.iter().zip(&mesh.node_numbers) {
+        let Some(&j) = by_number.get(&number) else {
+            return Err((
+                format!("{shown}: node {number} of the mesh is not in the file's node number map"),
+                help.into(),
+            ));
+        };
+        let y = source.coords[j];
+        let d = (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt();
+        if d > 1e-6 * size {
+            return Err((
+                format!(
+                    "{shown}: node {number} is at ({}, {}, {}) there but at ({}, {}, {}) in the mesh",
+                    y[0], y[1], y[2], x[0], x[1], x[2]
+                ),
+                help.into(),
+            ));
+        }
+        if !values[j].is_finite() {
+            return Err((
+                format!("{shown}: `{name}` is {} at node {number}", values[j]),
+                "the field must be finite at every node".into(),
+            ));
+        }
+        out.push(values[j]);
+    }
+    Ok(out)
+}
+
 /// An interaction's model, penalty scale and conductance model.
 type Choice = (ModelChoice, f64, Option<Box<dyn ConductanceModel>>);
 
@@ -1809,6 +1975,7 @@ fn interaction_fields(
 /// Per interaction with `Contact Pressure Variable`: the pressure at each of its
 /// points, interpolated on side A from the named `[[nodal_field]]` (evaluated at the
 /// nodes at `time`).
+#[allow(clippy::too_many_arguments)]
 fn point_pressures(
     p: &Problem,
     mesh: &Mesh,
@@ -1816,6 +1983,7 @@ fn point_pressures(
     choices: &[Choice],
     sandbox: &SharedSandbox,
     time: f64,
+    (dir, at): (&Path, &ProblemText),
     diags: &mut Diagnostics,
 ) -> Vec<Option<Vec<f64>>> {
     pairings
@@ -1838,12 +2006,25 @@ fn point_pressures(
                 );
                 return None;
             };
+            // From a file: every node read at once; else evaluated at the nodes used.
+            let read = field.file.as_ref().map(|f| read_nodal_field(field, &dir.join(f), mesh));
+            let from_file = match read {
+                Some(Err((m, help))) => {
+                    let k = p.nodal_field.iter().position(|f| std::ptr::eq(f, field));
+                    let loc = k.and_then(|k| at.loc("nodal_field", k, "file"));
+                    diags.push(Diagnostic::error("E0712", format!("[[nodal_field]] {name}: {m}")).at(loc).help(help));
+                    return None;
+                }
+                Some(Ok(v)) => Some(v),
+                None => None,
+            };
+            let value = field.value.clone().unwrap_or(Value::Number(0.0));
             let mut nodal = std::collections::HashMap::new();
             let mut at = |n: NodeId| -> Result<f64, String> {
-                if let Some(v) = nodal.get(&n) {
-                    return Ok(*v);
+                if let Some(v) = from_file.as_ref().map(|v| v[n.index()]).or(nodal.get(&n).copied()) {
+                    return Ok(v);
                 }
-                let v = evaluate(&field.value, mesh.coords[n.index()], time, sandbox, "[[nodal_field]] value")?;
+                let v = evaluate(&value, mesh.coords[n.index()], time, sandbox, "[[nodal_field]] value")?;
                 nodal.insert(n, v);
                 Ok(v)
             };
