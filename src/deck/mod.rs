@@ -131,7 +131,7 @@ fn sort_by_place(diags: &mut Diagnostics) {
 }
 
 /// The 1-based line and character column of a byte range (clamped to its first line).
-fn byte_span_loc(file: &Arc<str>, text: &str, r: std::ops::Range<usize>) -> Loc {
+pub(crate) fn byte_span_loc(file: &Arc<str>, text: &str, r: std::ops::Range<usize>) -> Loc {
     let start = floor_char_boundary(text, r.start.min(text.len()));
     let end = floor_char_boundary(text, r.end.min(text.len()).max(start));
     let before = text.get(..start).unwrap_or_default();

@@ -1,9 +1,11 @@
 //! Material laws of temperature: k(T), ρc(T) as a number, a piecewise-linear table or
-//! a Lua expression of `T, x, y, z, t`.
+//! a Lua expression of `T, x, y, z, t`; a volumetric source Q(T, x, t) the same way, or
+//! as a table in time.
 //!
 //! Entry point: [`Law::eval`], which returns the value and its derivative in T. Tables
-//! are held constant beyond their ends (no jump to zero); Lua expressions are
-//! differentiated by central differences. Laws are evaluated inside the parallel
+//! are held constant beyond their ends (no jump to zero); Lua expressions that name `T`
+//! are differentiated by central differences (the others have dQ/dT = 0 and cost one
+//! call). Laws are evaluated inside the parallel
 //! element loops, so a Lua law compiles its expression once per worker thread, in a
 //! sandbox of that thread.
 
@@ -23,6 +25,9 @@ pub enum Law {
         expr: String,
         chunk: String,
     },
+    /// `(t, value)` points in time t (strictly increasing), the same at every
+    /// temperature: a source given as a table.
+    TimeTable(Vec<(f64, f64)>),
 }
 
 thread_local! {
@@ -35,7 +40,7 @@ impl Law {
     /// A table law, checked: at least one point, T strictly increasing, finite values.
     pub fn table(points: Vec<(f64, f64)>) -> Result<Law, String> {
         if points.is_empty() {
-            return Err("a table needs at least one (T, value) point".into());
+            return Err("a table needs at least one (T or t, value) point".into());
         }
         if let Some(p) = points
             .iter()
@@ -45,7 +50,7 @@ impl Law {
         }
         if let Some(w) = points.windows(2).find(|w| w[1].0 <= w[0].0) {
             return Err(format!(
-                "table temperatures must increase strictly: {} is followed by {}",
+                "the first values of a table (T or t) must increase strictly: {} is followed by {}",
                 w[0].0, w[1].0
             ));
         }
@@ -56,8 +61,18 @@ impl Law {
     pub fn is_constant(&self) -> bool {
         match self {
             Law::Constant(_) => true,
-            Law::Table(p) => p.len() == 1,
+            Law::Table(p) | Law::TimeTable(p) => p.len() == 1,
             Law::Lua { .. } => false,
+        }
+    }
+
+    /// Does the value depend on temperature? (A source that does makes the problem
+    /// nonlinear.) A Lua expression does when it names the variable `T`.
+    pub fn uses_temperature(&self) -> bool {
+        match self {
+            Law::Constant(_) | Law::TimeTable(_) => false,
+            Law::Table(p) => p.len() > 1,
+            Law::Lua { expr, .. } => names_temperature(expr),
         }
     }
 
@@ -66,9 +81,13 @@ impl Law {
         match self {
             Law::Constant(v) => Ok((*v, 0.0)),
             Law::Table(p) => Ok(table(p, t)),
+            Law::TimeTable(p) => Ok((table(p, time).0, 0.0)),
             Law::Lua { expr, chunk } => {
                 let h = 1e-6 * t.abs().max(1.0);
                 let v = lua_value(expr, chunk, [t, x[0], x[1], x[2], time])?;
+                if !names_temperature(expr) {
+                    return Ok((v, 0.0));
+                }
                 let up = lua_value(expr, chunk, [t + h, x[0], x[1], x[2], time])?;
                 let down = lua_value(expr, chunk, [t - h, x[0], x[1], x[2], time])?;
                 Ok((v, (up - down) / (2.0 * h)))
@@ -81,6 +100,21 @@ impl Law {
     pub fn check(&self, t: f64) -> Result<(), String> {
         self.eval(t, [0.0; 3], 0.0).map(|_| ())
     }
+}
+
+/// Does `expr` name the variable `T`: a `T` not inside a longer name and not a field
+/// (`a.T`; the concatenation `..T` is the variable)? A `T` in a string or comment
+/// counts too: that only costs Newton iterations, never a wrong derivative.
+fn names_temperature(expr: &str) -> bool {
+    let b = expr.as_bytes();
+    let word = |c: u8| c.is_ascii_alphanumeric() || c == b'_';
+    (0..b.len()).any(|i| {
+        let field = i >= 1 && b[i - 1] == b'.' && (i < 2 || b[i - 2] != b'.');
+        b[i] == b'T'
+            && !field
+            && (i == 0 || !word(b[i - 1]))
+            && b.get(i + 1).is_none_or(|&c| !word(c))
+    })
 }
 
 /// Piecewise-linear interpolation, constant beyond the ends.
@@ -155,5 +189,28 @@ mod tests {
         };
         let e = bad.check(300.0).unwrap_err();
         assert!(e.contains("material 1"), "{e}");
+    }
+
+    /// Only a `T` of its own is the temperature; a law without one has dQ/dT = 0, and a
+    /// time table follows t whatever the temperature.
+    #[test]
+    fn temperature_dependence_is_seen() {
+        let lua = |e: &str| Law::Lua {
+            expr: e.into(),
+            chunk: "test".into(),
+        };
+        for e in ["T", "2*T^2", "math.exp(-T/300)", "x+(T)", "'a'..T"] {
+            assert!(lua(e).uses_temperature(), "{e}");
+        }
+        for e in ["x*t", "Tx + 1", "math.T", "x_T", "t"] {
+            assert!(!lua(e).uses_temperature(), "{e}");
+        }
+        assert_eq!(
+            lua("1e3*x + t").eval(500.0, [2.0, 0.0, 0.0], 1.0).unwrap(),
+            (2001.0, 0.0)
+        );
+        let q = Law::TimeTable(vec![(0.0, 0.0), (2.0, 10.0)]);
+        assert_eq!(q.eval(900.0, [0.0; 3], 0.5).unwrap(), (2.5, 0.0));
+        assert!(!q.uses_temperature() && !q.is_constant());
     }
 }

@@ -72,6 +72,8 @@ pub enum HeatError {
     NonlinearFace,
     #[error("material of block {block}: {message}")]
     Material { block: i64, message: String },
+    #[error("source of block {block}: {message}")]
+    Source { block: i64, message: String },
     #[error("{0}")]
     Step(String),
     #[error(transparent)]

@@ -4,11 +4,12 @@
 //! Entry point: [`solve`]. The discrete problem at each step, for the dof vector `u`:
 //!
 //! ```text
-//! R(u) = M(u) (α₀ u + α₁ uⁿ + α₂ uⁿ⁻¹)/Δt + ∫ k(T) ∇N·∇T − ∫ Q N + Σ_faces ∫ N g(T)
+//! R(u) = M(u) (α₀ u + α₁ uⁿ + α₂ uⁿ⁻¹)/Δt + ∫ k(T) ∇N·∇T − ∫ Q(T) N + Σ_faces ∫ N g(T)
 //!        + Σ_Γ R_Γ(u) + Cᵀλ          (and C u = ΔT ∫ψ on the multiplier rows)
 //! ```
 //!
-//! with M the lumped capacity `∫ ρc(T_a) N_a` at each node, g the heat leaving through a
+//! with M the lumped capacity `∫ ρc(T_a) N_a` at each node, Q(T, x, t) the source of
+//! the element's block (its dQ/dT enters the Jacobian), g the heat leaving through a
 //! face (flux, convection, radiation; see [`FaceBc::outflow`]), R_Γ the interface forms
 //! of [`crate::enforce::interface`] and C the mortar ties. Backward Euler has
 //! `(α₀, α₁, α₂) = (1, −1, 0)`; BDF2 with step ratio ω = Δtₙ/Δtₙ₋₁ has
@@ -93,8 +94,9 @@ pub struct TransientProblem<'a> {
     /// Laws per mesh block (entries of blocks without a field are not used).
     pub laws: &'a [BlockLaws],
     pub source: Option<SourceFn<'a>>,
-    /// A constant source per mesh block (W/m³), used instead of `source` when given.
-    pub block_source: Option<&'a [f64]>,
+    /// The source per mesh block, Q(T, x, t) in W/m³ (a [`Law`]: a number, a Lua
+    /// expression, a table in time), used instead of `source` when given.
+    pub block_source: Option<&'a [Law]>,
     /// Boundary data at time t.
     pub loads: &'a dyn Fn(f64) -> Result<Loads, HeatError>,
     pub contact: Vec<ContactTerm<'a>>,
@@ -887,7 +889,8 @@ impl Context<'_, '_> {
         unreachable!("the loop returns at its last iteration")
     }
 
-    /// Is the step's system linear (constant laws, linear faces, constant conductances)?
+    /// Is the step's system linear (constant laws, linear faces, constant conductances,
+    /// sources that do not depend on T)?
     fn is_linear(&self, loads: &Loads) -> bool {
         self.p
             .laws
@@ -898,6 +901,7 @@ impl Context<'_, '_> {
                 .iter()
                 .all(|f| !matches!(f, FaceBc::Radiation { .. }))
             && self.p.contact.iter().all(|c| c.linear)
+            && (self.p.block_source).is_none_or(|s| s.iter().all(|q| !q.uses_temperature()))
     }
 
     /// Residual and Jacobian (left in `asm`) at `u`, and the interface systems.
@@ -959,6 +963,21 @@ impl Context<'_, '_> {
                     (0.0, 0.0)
                 }
             };
+            // Q(T, x, t) and dQ/dT; a failure or a non-finite value stops the run there.
+            let q_failed = Cell::new(None);
+            let q = |temp: f64, xq: [f64; 3]| {
+                let v = block_source.map_or(Ok((0.0, 0.0)), |s| s[b].eval(temp, xq, t));
+                let what = match v {
+                    Ok((q, dq)) if q.is_finite() && dq.is_finite() => return (q, dq),
+                    Ok((q, dq)) => format!("Q = {q}, dQ/dT = {dq}"),
+                    Err(m) => m.lines().next().unwrap_or_default().to_string(),
+                };
+                let [x0, x1, x2] = xq;
+                q_failed.set(Some(format!(
+                    "{what} at ({x0:.6}, {x1:.6}, {x2:.6}), T = {temp}, t = {t}"
+                )));
+                (0.0, 0.0)
+            };
             let conduction = if keep {
                 Ok(())
             } else {
@@ -1003,14 +1022,29 @@ impl Context<'_, '_> {
                     re[a] += (0..nn).map(|c| je[a * nn + c] * te[c]).sum::<f64>();
                 }
             }
+            // Sources at the element's temperatures (a linear problem's do not depend on
+            // T, so their dQ/dT adds nothing to the kept matrices).
             let mut f = [0.0; kernel::MAX_NODES];
+            let mut scratch = [0.0; kernel::MAX_NODES * kernel::MAX_NODES];
             let sourced = match (block_source, source) {
-                (Some(qb), _) if qb[b] != 0.0 => kernel::source(rule, &x[..nn], |_| qb[b], &mut f),
+                (Some(qb), _) if !matches!(qb[b], Law::Constant(v) if v == 0.0) => {
+                    let js = if keep {
+                        &mut scratch[..nn * nn]
+                    } else {
+                        &mut *je
+                    };
+                    kernel::source_residual_jacobian(rule, &x[..nn], &te[..nn], q, re, js)
+                }
                 (None, Some(q)) => kernel::source(rule, &x[..nn], q, &mut f),
                 _ => Ok(()),
             };
             if let Err(bad) = sourced {
                 errors.record(e, bad_jacobian(mesh, e, bad));
+                return;
+            }
+            if let Some(message) = q_failed.take() {
+                let block = mesh.blocks[b].id;
+                errors.record(e, HeatError::Source { block, message });
                 return;
             }
             re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);

@@ -15,9 +15,10 @@
 //! surfaces = ["surface_1"]           # side sets (or node sets, for temperature)
 //! value = "1 + x + 2*y - 3*z"        # a number or a Lua expression of x, y, z, t
 //! ambient = 300.0                    # convection only: T∞ (value is then h)
-//! [[source]]                         # optional volumetric source (W/m³)
+//! [[source]]                         # optional volumetric source Q (W/m³)
 //! blocks = ["block_1"]
-//! value = "0"
+//! value = "1e3*x"                    # a number, a Lua expression of x, y, z, t and T, or
+//!                                    # { table = [[t, Q], …] } in time
 //! [contact]
 //! file = "contact.i"                 # Sierra-syntax contact definition(s)
 //! integration = "segments"           # segments (exact, default) | quadrature
@@ -31,9 +32,9 @@
 //! ```
 //!
 //! A flux or convection value given as a Lua expression is evaluated at each face's
-//! centroid; temperature values at the nodes; sources at the nodes and interpolated
-//! (each exact for the linear fields of a patch test). The time `t` is 0 in a steady
-//! solve.
+//! centroid; temperature values at the nodes; sources at the quadrature points, where a
+//! source that names `T` sees the interpolated temperature (and makes the problem
+//! nonlinear). The time `t` is 0 in a steady solve.
 
 mod steps;
 
@@ -132,8 +133,22 @@ pub struct ToggleSpec {
 pub struct NodalFieldSpec {
     pub name: String,
     /// A number or a Lua expression of x, y, z, t, evaluated at the nodes once, at the
-    /// start time of the run.
-    pub value: Value,
+    /// start time of the run. Either this or `file`.
+    #[serde(default)]
+    pub value: Option<Value>,
+    /// An Exodus II file (relative to the problem file) on the run's mesh whose nodal
+    /// variable `variable` holds the field.
+    #[serde(default)]
+    pub file: Option<PathBuf>,
+    /// The nodal variable in `file` (default: `name`).
+    #[serde(default)]
+    pub variable: Option<String>,
+    /// The stored time to read (default: the last step).
+    #[serde(default)]
+    pub time: Option<f64>,
+    /// Or the step to read, 1 = the first stored.
+    #[serde(default)]
+    pub step: Option<usize>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -203,6 +218,8 @@ pub struct BcSpec {
 #[serde(deny_unknown_fields)]
 pub struct SourceSpec {
     pub blocks: Vec<String>,
+    /// Q (W/m³): a number, a Lua expression of x, y, z, t and T (the local temperature),
+    /// or a table in t.
     pub value: Value,
 }
 
@@ -465,17 +482,24 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
     check_bcs(&problem, &mut diags);
     let dirichlet = dirichlet_nodes(&problem, &mesh, &mut diags);
     let mut face_sites = face_sites(&problem, &mesh, &mut diags);
-    let block_source = block_sources(&problem, &mesh, &mut diags);
-    // One value everywhere: a plain source function (both solvers); else per block.
-    let uniform = block_source.windows(2).all(|w| w[0] == w[1]);
+    let timing_spec = time_spec(&problem, transient, &mut diags);
+    let at = ProblemText {
+        file: crate::diag::file_label(path),
+        text,
+    };
+    let block_source = block_sources(&problem, &mesh, &at, probe, timing_spec.start, &mut diags);
+    check_nodal_fields(&problem, &at, &mut diags);
+    // One law of x and t everywhere: a plain source function (both solvers); else per
+    // block (the general solver). A source failing at a point is reported after the solve.
+    let uniform = block_source.windows(2).all(|w| w[0] == w[1])
+        && !block_source.first().is_some_and(Law::uses_temperature);
+    let source_failed = std::sync::Mutex::new(None::<String>);
     let source = block_source
         .first()
-        .copied()
-        .filter(|q| uniform && *q != 0.0)
-        .map(|q| move |_: [f64; 3]| q);
-    let timing_spec = time_spec(&problem, transient, &mut diags);
+        .filter(|q| uniform && **q != Law::Constant(0.0))
+        .map(|q| source_of_x(q, timing_spec.start, &source_failed));
     if diags.has_errors() {
-        return Err(RunError::Input(diags, SourceMap::default()));
+        return Err(RunError::Input(diags, at.sources()));
     }
     // Boundary data at the start: every expression is tried once here, so a bad one
     // is an input error, not a failure in the middle of a run.
@@ -636,6 +660,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             }
         }
     }
+    loaded.sources.add(&at.file, &at.text);
     if diags.has_errors() {
         return Err(RunError::Input(diags, loaded.sources));
     }
@@ -684,7 +709,14 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         &mut diags,
     );
     let pressures = point_pressures(
-        &problem, &mesh, &pairings, &choices, &sandbox, start_time, &mut diags,
+        &problem,
+        &mesh,
+        &pairings,
+        &choices,
+        &sandbox,
+        start_time,
+        (&dir, &at),
+        &mut diags,
     );
     if diags.has_errors() {
         return Err(RunError::Input(diags, loaded.sources));
@@ -852,7 +884,11 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
         };
-        solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?
+        let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+        if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
+            return Err(RunError::Solve(format!("[[source]]: {e}")));
+        }
+        solved
     } else {
         if problem.solve.linear_solver.as_deref() == Some("amg") {
             return Err(input_error(
@@ -884,8 +920,8 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                 })
                 .collect(),
             laws: &materials.laws,
-            source: source_fn,
-            block_source: (!uniform).then_some(block_source.as_slice()),
+            source: None,
+            block_source: Some(&block_source),
             loads: &loads,
             contact: contact_terms(),
             ties: tie_terms(),
@@ -1309,6 +1345,7 @@ fn scale_law(cp: Law, rho: f64) -> Law {
             expr: format!("{rho:e} * ({expr})"),
             chunk,
         },
+        Law::TimeTable(p) => Law::TimeTable(p.into_iter().map(|(t, v)| (t, rho * v)).collect()),
     }
 }
 
@@ -1522,30 +1559,66 @@ fn loads_at(
     Ok(out)
 }
 
-/// The volumetric source per block (W/m³; 0 where none is given). Each block may be
-/// named once over all `[[source]]`s.
-fn block_sources(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<f64> {
-    let mut out = vec![0.0; mesh.blocks.len()];
+/// The problem file's text, for the line and column of a value in a diagnostic.
+struct ProblemText {
+    file: std::sync::Arc<str>,
+    text: String,
+}
+
+impl ProblemText {
+    /// Where `key` of entry `k` of the array of tables `array` sits (the entry itself
+    /// when it has no `key`).
+    fn loc(&self, array: &str, k: usize, key: &str) -> Option<crate::diag::Loc> {
+        use toml::{Spanned, de::DeTable, de::DeValue};
+        fn find<'a, 'i>(t: &'a DeTable<'i>, name: &str) -> Option<&'a Spanned<DeValue<'i>>> {
+            t.iter().find(|(n, _)| n.get_ref() == name).map(|(_, v)| v)
+        }
+        let root = DeTable::parse(&self.text).ok()?;
+        let entry = find(root.get_ref(), array)?.get_ref().as_array()?.get(k)?;
+        let node = entry.get_ref().as_table().and_then(|t| find(t, key));
+        let span = node.unwrap_or(entry).span();
+        Some(deck::byte_span_loc(&self.file, &self.text, span))
+    }
+
+    fn sources(&self) -> SourceMap {
+        let mut s = SourceMap::default();
+        s.add(&self.file, &self.text);
+        s
+    }
+}
+
+/// The volumetric source per block, Q(T, x, t) in W/m³ (0 where none is given): a
+/// number, a Lua expression of x, y, z, t and T, or a table in t. Each block may be
+/// named once over all `[[source]]`s. A value is tried once, at the first node of its
+/// first block, at temperature `probe` and time `time`: a bad expression is an input
+/// error at its line, not a failure in the middle of a run.
+fn block_sources(
+    p: &Problem,
+    mesh: &Mesh,
+    at: &ProblemText,
+    probe: f64,
+    time: f64,
+    diags: &mut Diagnostics,
+) -> Vec<Law> {
+    let mut out = vec![Law::Constant(0.0); mesh.blocks.len()];
     let mut given = vec![false; mesh.blocks.len()];
     for (k, s) in p.source.iter().enumerate() {
-        let q = match &s.value {
-            Value::Number(q) => Some(*q),
-            Value::Expr(e) => e.trim().parse::<f64>().ok(),
-            Value::Table { .. } => None,
+        let loc = at.loc("source", k, "value");
+        let law = match &s.value {
+            Value::Number(q) => Ok(Law::Constant(*q)),
+            Value::Expr(e) => Ok(e.trim().parse().map_or_else(
+                |_| Law::Lua {
+                    expr: e.clone(),
+                    chunk: format!("[[source]] #{} value", k + 1),
+                },
+                Law::Constant,
+            )),
+            Value::Table { table } => Law::table(table.clone()).map(|l| match l {
+                Law::Table(points) => Law::TimeTable(points),
+                other => other,
+            }),
         };
-        let Some(q) = q.filter(|q| q.is_finite()) else {
-            diags.push(
-                Diagnostic::error(
-                    "E0714",
-                    format!(
-                        "[[source]] #{}: the value must be a finite number (W/m³)",
-                        k + 1
-                    ),
-                )
-                .help("sources are constant per block in this version of seam"),
-            );
-            continue;
-        };
+        let mut blocks = Vec::new();
         for b in &s.blocks {
             if let Some(i) = block_index(mesh, b, diags, "[[source]]") {
                 if given[i] {
@@ -1558,11 +1631,200 @@ fn block_sources(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<f64> 
                     );
                 }
                 given[i] = true;
-                out[i] = q;
+                blocks.push(i);
             }
+        }
+        let x = blocks
+            .first()
+            .filter(|&&b| !mesh.blocks[b].is_empty())
+            .map_or([0.0; 3], |&b| {
+                mesh.coords[mesh.elem_nodes(mesh.blocks[b].first_elem)[0].index()]
+            });
+        let tried = law.and_then(|l| match l.eval(probe, x, time) {
+            Ok((q, dq)) if q.is_finite() && dq.is_finite() => Ok(l),
+            Ok((q, _)) => Err(format!(
+                "Q = {q} at ({}, {}, {}), T = {probe}, t = {time}",
+                x[0], x[1], x[2]
+            )),
+            // The first line: a Lua stack trace says nothing about a one-line expression.
+            Err(e) => Err(e.lines().next().unwrap_or_default().to_string()),
+        });
+        match tried {
+            Ok(law) => blocks.iter().for_each(|&i| out[i] = law.clone()),
+            Err(m) => diags.push(
+                Diagnostic::error("E0714", format!("[[source]] #{}: {m}", k + 1))
+                    .at(loc)
+                    .help("Q (W/m³) is a number, a Lua expression of x, y, z, t and T (the local temperature), or { table = [[t, Q], …] } with t increasing"),
+            ),
         }
     }
     out
+}
+
+/// A source law that does not depend on T as a function of x at `time`, for the linear
+/// steady solver; the first failure (a Lua error, a non-finite value) is kept in
+/// `failed` and the point contributes nothing.
+fn source_of_x<'a>(
+    law: &'a Law,
+    time: f64,
+    failed: &'a std::sync::Mutex<Option<String>>,
+) -> impl Fn([f64; 3]) -> f64 + Sync + 'a {
+    move |x| match law.eval(0.0, x, time) {
+        Ok((v, _)) if v.is_finite() => v,
+        r => {
+            let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
+            let what = match r {
+                Err(e) => e.lines().next().unwrap_or_default().to_string(),
+                Ok((v, _)) => format!("Q = {v}"),
+            };
+            let [x0, x1, x2] = x;
+            slot.get_or_insert_with(|| format!("{what} at ({x0:.6}, {x1:.6}, {x2:.6})"));
+            0.0
+        }
+    }
+}
+
+/// Each `[[nodal_field]]` has a `value` or a `file`, and the file's `variable`, `time`
+/// and `step` only with a file.
+fn check_nodal_fields(p: &Problem, at: &ProblemText, diags: &mut Diagnostics) {
+    for (k, f) in p.nodal_field.iter().enumerate() {
+        let by_file = f.variable.is_some() || f.time.is_some() || f.step.is_some();
+        let wrong = match (&f.value, &f.file) {
+            (Some(_), Some(_)) => Some("has both `value` and `file`"),
+            (None, None) => Some("needs a `value` or a `file`"),
+            (Some(_), None) if by_file => Some("has `variable`, `time` or `step` without `file`"),
+            _ if f.time.is_some() && f.step.is_some() => Some("has both `time` and `step`"),
+            _ => None,
+        };
+        if let Some(m) = wrong {
+            diags.push(
+                Diagnostic::error("E0712", format!("[[nodal_field]] {}: {m}", f.name))
+                    .at(at.loc("nodal_field", k, ""))
+                    .help("value = a number or a Lua expression; or file = \"f.exo\", variable = \"v\" and time = t or step = n (default the last step)"),
+            );
+        }
+    }
+}
+
+/// A `[[nodal_field]]` read from a nodal variable of an Exodus II file, one value per
+/// mesh node, at `step` (1 = the first stored), at the stored `time`, or at the last
+/// step. The file's nodes are matched to the mesh's by their node numbers and must sit
+/// where the mesh's do (to 1e-6 of the mesh's size, so coordinates stored in single
+/// precision pass and another mesh with as many nodes does not). Errors: message, help.
+fn read_nodal_field(
+    f: &NodalFieldSpec,
+    file: &Path,
+    mesh: &Mesh,
+) -> Result<Vec<f64>, (String, String)> {
+    use crate::mesh::{MeshError, exodus};
+    let split = |e: MeshError| match e {
+        MeshError::Format {
+            path,
+            message,
+            help,
+        } => (format!("{}: {message}", path.display()), help),
+        MeshError::Open { path, source } => (
+            format!("cannot open {}: {source}", path.display()),
+            "the file is relative to the problem file".into(),
+        ),
+        other => (other.to_string(), "check the file".into()),
+    };
+    let name = f.variable.as_deref().unwrap_or(&f.name);
+    let shown = file.display();
+    let times = exodus::read_times(file).map_err(split)?;
+    let n = times.len();
+    let step = match (f.step, f.time) {
+        _ if n == 0 => {
+            return Err((
+                format!("{shown} holds no time steps, so no values of `{name}`"),
+                "write the field as a nodal variable with at least one step".into(),
+            ));
+        }
+        (Some(s), _) if s == 0 || s > n => {
+            return Err((
+                format!(
+                    "{shown}: step {s} asked for, but the file holds {n} step(s), numbered from 1"
+                ),
+                format!("give step = 1 … {n}, or leave it out for the last"),
+            ));
+        }
+        (Some(s), _) => s - 1,
+        (None, Some(t)) => {
+            let scale = times.iter().fold(t.abs(), |m, v| m.max(v.abs()));
+            let nearest = (0..n)
+                .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
+                .expect("n > 0");
+            if (times[nearest] - t).abs() > 1e-9 * scale {
+                return Err((
+                    format!(
+                        "{shown} has no step at time {t} for `{name}`: it holds {n} step(s) from t = {} to {}; the nearest is t = {} (step {})",
+                        times[0],
+                        times[n - 1],
+                        times[nearest],
+                        nearest + 1
+                    ),
+                    "give a stored time, or the step as step = n".into(),
+                ));
+            }
+            nearest
+        }
+        (None, None) => n - 1,
+    };
+    let values = exodus::read_nodal_variable(file, name, step).map_err(split)?;
+    let source = exodus::read(file).map_err(split)?;
+    let help = "write the field on the run's mesh: the same nodes, paired by the node number map";
+    if source.num_nodes() != mesh.num_nodes() {
+        return Err((
+            format!(
+                "{shown}: `{name}` has values at {} nodes, but the mesh has {} nodes",
+                source.num_nodes(),
+                mesh.num_nodes()
+            ),
+            help.into(),
+        ));
+    }
+    let by_number: std::collections::HashMap<i64, usize> = (source.node_numbers.iter())
+        .enumerate()
+        .map(|(j, &number)| (number, j))
+        .collect();
+    let (lo, hi) = mesh.coords.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), x| {
+            (
+                std::array::from_fn(|d| lo[d].min(x[d])),
+                std::array::from_fn(|d| hi[d].max(x[d])),
+            )
+        },
+    );
+    let size = (0..3).map(|d| (hi[d] - lo[d]).powi(2)).sum::<f64>().sqrt();
+    let mut out = Vec::with_capacity(mesh.num_nodes());
+    for (x, &number) in mesh.coords.iter().zip(&mesh.node_numbers) {
+        let Some(&j) = by_number.get(&number) else {
+            return Err((
+                format!("{shown}: node {number} of the mesh is not in the file's node number map"),
+                help.into(),
+            ));
+        };
+        let y = source.coords[j];
+        let d = (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt();
+        if d > 1e-6 * size {
+            return Err((
+                format!(
+                    "{shown}: node {number} is at ({}, {}, {}) there but at ({}, {}, {}) in the mesh",
+                    y[0], y[1], y[2], x[0], x[1], x[2]
+                ),
+                help.into(),
+            ));
+        }
+        if !values[j].is_finite() {
+            return Err((
+                format!("{shown}: `{name}` is {} at node {number}", values[j]),
+                "the field must be finite at every node".into(),
+            ));
+        }
+        out.push(values[j]);
+    }
+    Ok(out)
 }
 
 /// An interaction's model, penalty scale and conductance model.
@@ -1720,6 +1982,7 @@ fn interaction_fields(
 /// Per interaction with `Contact Pressure Variable`: the pressure at each of its
 /// points, interpolated on side A from the named `[[nodal_field]]` (evaluated at the
 /// nodes at `time`).
+#[allow(clippy::too_many_arguments)]
 fn point_pressures(
     p: &Problem,
     mesh: &Mesh,
@@ -1727,6 +1990,7 @@ fn point_pressures(
     choices: &[Choice],
     sandbox: &SharedSandbox,
     time: f64,
+    (dir, at): (&Path, &ProblemText),
     diags: &mut Diagnostics,
 ) -> Vec<Option<Vec<f64>>> {
     pairings
@@ -1749,12 +2013,25 @@ fn point_pressures(
                 );
                 return None;
             };
+            // From a file: every node read at once; else evaluated at the nodes used.
+            let read = field.file.as_ref().map(|f| read_nodal_field(field, &dir.join(f), mesh));
+            let from_file = match read {
+                Some(Err((m, help))) => {
+                    let k = p.nodal_field.iter().position(|f| std::ptr::eq(f, field));
+                    let loc = k.and_then(|k| at.loc("nodal_field", k, "file"));
+                    diags.push(Diagnostic::error("E0712", format!("[[nodal_field]] {name}: {m}")).at(loc).help(help));
+                    return None;
+                }
+                Some(Ok(v)) => Some(v),
+                None => None,
+            };
+            let value = field.value.clone().unwrap_or(Value::Number(0.0));
             let mut nodal = std::collections::HashMap::new();
             let mut at = |n: NodeId| -> Result<f64, String> {
-                if let Some(v) = nodal.get(&n) {
-                    return Ok(*v);
+                if let Some(v) = from_file.as_ref().map(|v| v[n.index()]).or(nodal.get(&n).copied()) {
+                    return Ok(v);
                 }
-                let v = evaluate(&field.value, mesh.coords[n.index()], time, sandbox, "[[nodal_field]] value")?;
+                let v = evaluate(&value, mesh.coords[n.index()], time, sandbox, "[[nodal_field]] value")?;
                 nodal.insert(n, v);
                 Ok(v)
             };

@@ -16,5 +16,6 @@ mod output;
 mod plugin;
 mod search;
 mod search_kernels;
+mod sources;
 mod surfaces;
 mod transient;

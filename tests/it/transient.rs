@@ -1,6 +1,6 @@
 //! Transient and nonlinear runs of `seam run`: temporal order of backward Euler and
 //! BDF2, restart bit for bit, toggles, two fields joined by `Side B Variable`, a nodal
-//! contact pressure, radiation and k(T).
+//! contact pressure (from Lua or from an Exodus variable), radiation and k(T).
 //!
 //! Every case runs on the bundled two-block mesh (base k = 16 under lid k = 200, joined
 //! through a non-matching interface at z = 1) with problem files written here.
@@ -360,6 +360,156 @@ fn contact_pressure_from_a_nodal_field() {
     .err()
     .unwrap();
     assert!(e.contains("E0712"), "{e}");
+}
+
+/// A contact pressure read from a nodal variable of an Exodus file (written here with
+/// seam's own writer, two steps) gives the same interface heat as the same field given
+/// in Lua, to 1e-12 relative (the same numbers reach the model), whether the step is
+/// picked by time, by number or by default (the last), and when the file stores the
+/// nodes in another order (paired by node number). A missing variable, a time the file
+/// does not hold, a file on another mesh (other count, or nodes elsewhere) are input
+/// errors (E0712) naming the file and the variable.
+#[test]
+fn contact_pressure_from_an_exodus_variable() {
+    use seam::output::exodus::ExodusWriter;
+    let dir = scratch("pressure-exodus");
+    let base = "[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n[[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n";
+    let deck = CMY_DECK.replace("PRESSURE", "contact pressure variable = p");
+    let heat = |field: &str| {
+        ok(
+            &dir,
+            &deck,
+            &format!("{base}[[nodal_field]]\nname = \"p\"\n{field}"),
+        )
+        .summary
+        .interactions[0]
+            .heat_side_a
+    };
+    let mesh = seam::mesh::read(&mesh()).unwrap();
+    let ramp: Vec<f64> = mesh.coords.iter().map(|x| 0.5e6 + 1e6 * x[0]).collect();
+    let flat = vec![1.0; mesh.num_nodes()];
+    let mut w = ExodusWriter::create(&dir.join("pressure.exo"), &mesh, &["pressure"], &[]).unwrap();
+    w.write_step(0.0, &[&flat], &[]).unwrap();
+    w.write_step(1.0, &[&ramp], &[]).unwrap();
+    w.finish().unwrap();
+    let lua = heat("value = \"0.5e6 + 1e6*x\"\n");
+    for pick in ["time = 1.0\n", "step = 2\n", ""] {
+        let exo = heat(&format!(
+            "file = \"pressure.exo\"\nvariable = \"pressure\"\n{pick}"
+        ));
+        eprintln!("{pick:?}: Lua {lua}, Exodus {exo}");
+        assert!(
+            (exo - lua).abs() <= 1e-12 * lua.abs(),
+            "{pick:?}: Exodus {exo} vs Lua {lua}"
+        );
+    }
+    // The nodes stored in reverse order with their numbers: paired by number, the same
+    // heat; the same file with the numbers left in place puts nodes elsewhere: an error.
+    let n = mesh.num_nodes();
+    let mut reversed = mesh.clone();
+    reversed.coords.reverse();
+    reversed.node_numbers.reverse();
+    for b in &mut reversed.blocks {
+        b.connectivity
+            .iter_mut()
+            .for_each(|v| v.0 = (n - 1) as u32 - v.0);
+    }
+    for s in &mut reversed.node_sets {
+        s.nodes.iter_mut().for_each(|v| v.0 = (n - 1) as u32 - v.0);
+    }
+    let back: Vec<f64> = ramp.iter().rev().copied().collect();
+    for (name, numbers) in [
+        ("reversed.exo", reversed.node_numbers.clone()),
+        ("moved.exo", mesh.node_numbers.clone()),
+    ] {
+        let m = seam::mesh::Mesh {
+            node_numbers: numbers,
+            ..reversed.clone()
+        };
+        let mut w = ExodusWriter::create(&dir.join(name), &m, &["pressure"], &[]).unwrap();
+        w.write_step(1.0, &[&back], &[]).unwrap();
+        w.finish().unwrap();
+    }
+    let exo = heat("file = \"reversed.exo\"\nvariable = \"pressure\"\n");
+    assert!(
+        (exo - lua).abs() <= 1e-12 * lua.abs(),
+        "reversed: {exo} vs {lua}"
+    );
+    let e = run_case(
+        &dir,
+        &deck,
+        &format!(
+            "{base}[[nodal_field]]\nname = \"p\"\nfile = \"moved.exo\"\nvariable = \"pressure\"\n"
+        ),
+    )
+    .err()
+    .unwrap();
+    assert!(
+        e.contains("E0712") && e.contains("moved.exo: node") && e.contains("there but at"),
+        "{e}"
+    );
+    // Step 1 holds the flat field of 1 Pa: much less heat than the ramp.
+    let first = heat("file = \"pressure.exo\"\nvariable = \"pressure\"\nstep = 1\n");
+    assert!(first.abs() < 0.5 * lua.abs(), "{first} vs {lua}");
+    // Another mesh with the same variable.
+    let other = seam::mesh::generate::boxes(
+        &[seam::mesh::generate::BoxSpec::hex(
+            [0.0; 3],
+            [1.0; 3],
+            [2, 2, 2],
+            1,
+        )],
+        false,
+    );
+    let values = vec![1e6; other.num_nodes()];
+    let mut w = ExodusWriter::create(&dir.join("other.exo"), &other, &["pressure"], &[]).unwrap();
+    w.write_step(0.0, &[&values], &[]).unwrap();
+    w.finish().unwrap();
+    // (file, variable, what the message says); the caret is on the `file` line (21).
+    for (file, variable, expect) in [
+        ("pressure.exo", "presure", "no nodal variable `presure`"),
+        ("pressure.exo", "pressure", "no step at time 0.5"),
+        (
+            "other.exo",
+            "pressure",
+            "has values at 27 nodes, but the mesh has",
+        ),
+    ] {
+        let time = if expect.contains("0.5") {
+            "time = 0.5\n"
+        } else {
+            ""
+        };
+        let field = format!("file = \"{file}\"\nvariable = \"{variable}\"\n{time}");
+        let e = run_case(
+            &dir,
+            &deck,
+            &format!("{base}[[nodal_field]]\nname = \"p\"\n{field}"),
+        )
+        .err()
+        .unwrap();
+        eprintln!("{e}");
+        assert!(e.contains("error[E0712]") && e.contains(expect), "{e}");
+        assert!(
+            e.contains(file) && e.contains(&format!("`{variable}`")),
+            "{e}"
+        );
+        assert!(
+            e.contains("problem.toml:21:8") && e.contains("= help:"),
+            "{e}"
+        );
+    }
+    let e = run_case(
+        &dir,
+        &deck,
+        &format!("{base}[[nodal_field]]\nname = \"p\"\nfile = \"pressure.exo\"\nvalue = 1.0\n"),
+    )
+    .err()
+    .unwrap();
+    assert!(
+        e.contains("E0712") && e.contains("both `value` and `file`"),
+        "{e}"
+    );
 }
 
 /// k(T) as a Lua expression and radiation to ambient, steady: Newton converges
