@@ -138,14 +138,14 @@ pub static COMMANDS: &[CommandSpec] = &[
         "visualize_contact",
         [CD],
         "[= on|off]",
-        "Write contact variables (gap, status, flux) to the results."
+        "Write the contact fields per face (gap, contact fraction, interface flux) to the results: `contact.vtu` and nodal variables in `results.exo` (`seam run`), each face's contact fraction in `seam search --json`."
     ),
     cmd!(
         "output rule",
         "output_rule",
         [CD],
         "= none|summary|verbose|more verbose",
-        "How much the contact search reports in the log."
+        "How much contact reports: in the search log (`seam search`), and with `visualize contact` in the results of `seam run` (none: no contact fields; summary: side-A faces; verbose: and side-B faces; more verbose: and every contact point)."
     ),
     cmd!(
         "update search every",

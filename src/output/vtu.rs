@@ -4,9 +4,11 @@
 //!
 //! Entry points: [`write_vtu`] (point data, ASCII: small files stay inspectable),
 //! [`write_vtu_cells`] (point and cell data, base64 "binary" inline data: computed doubles
-//! take 10.7 characters instead of ~22, exact to the bit), [`PvdSeries`]. Cells are written block
+//! take 10.7 characters instead of ~22, exact to the bit), [`write_vtu_arrays`] (arrays
+//! of several components, e.g. a flux vector per cell), [`write_vtu_polygons`] (a
+//! surface grid of its own, e.g. contact faces), [`PvdSeries`]. Mesh cells are written block
 //! after block in mesh order, i.e. in dense element order, so cell data is indexed like
-//! [`crate::mesh::ElemId`]; every file carries the cell data `block_id`. Cell types by
+//! [`crate::mesh::ElemId`]; every mesh file carries the cell data `block_id`. Cell types by
 //! topology: Hex8 12, Tet4 10, Wedge6 13, Pyramid5 14, Quad4 9 (shells too), Tri3 5,
 //! Bar2 3; the node orders of Exodus and VTK coincide for these linear cells.
 //!
@@ -61,32 +63,6 @@ pub fn write_vtu_cells(
 
 fn invalid(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
-}
-
-/// Check that every array has `expect` values and that names are usable.
-fn check_arrays(kind: &str, arrays: &[(&str, &[f64])], expect: usize, per: &str) -> io::Result<()> {
-    for (k, (name, values)) in arrays.iter().enumerate() {
-        if name.is_empty() {
-            return Err(invalid(format!(
-                "{kind} array {} has an empty name; name every array",
-                k + 1
-            )));
-        }
-        if values.len() != expect {
-            return Err(invalid(format!(
-                "{kind} array `{name}` has {} values, expected {expect} (one per {per})",
-                values.len()
-            )));
-        }
-        if name == &"block_id" && kind == "cell data" {
-            return Err(invalid(
-                "cell data array `block_id` clashes with the block ids every .vtu carries; \
-                 rename it"
-                    .to_string(),
-            ));
-        }
-    }
-    Ok(())
 }
 
 /// Escape text for an XML attribute value.
@@ -242,11 +218,210 @@ pub fn write_vtu_with(
     cell: &[(&str, &[f64])],
     encoding: VtuEncoding,
 ) -> io::Result<()> {
-    check_arrays("point data", point, mesh.num_nodes(), "mesh node")?;
+    let point: Vec<Array<'_>> = point.iter().map(|&(n, v)| Array::scalar(n, v)).collect();
+    let cell: Vec<Array<'_>> = cell.iter().map(|&(n, v)| Array::scalar(n, v)).collect();
+    write_vtu_arrays(path, mesh, &point, &cell, encoding)
+}
+
+/// A named array of `components` values per point or per cell (interleaved: the
+/// components of one point or cell together, as VTK stores them).
+#[derive(Clone, Copy, Debug)]
+pub struct Array<'a> {
+    pub name: &'a str,
+    pub components: usize,
+    pub values: &'a [f64],
+}
+
+impl<'a> Array<'a> {
+    /// One value per point or cell.
+    pub fn scalar(name: &'a str, values: &'a [f64]) -> Self {
+        Array {
+            name,
+            components: 1,
+            values,
+        }
+    }
+
+    /// Three values (x, y, z) per point or cell.
+    pub fn vector(name: &'a str, values: &'a [f64]) -> Self {
+        Array {
+            name,
+            components: 3,
+            values,
+        }
+    }
+}
+
+/// Check that every array has `components × expect` values and a usable name; cell
+/// data may not be called `reserved` (an array the file carries anyway).
+fn check_multi(
+    kind: &str,
+    arrays: &[Array<'_>],
+    expect: usize,
+    per: &str,
+    reserved: Option<&str>,
+) -> io::Result<()> {
+    for (k, a) in arrays.iter().enumerate() {
+        if a.name.is_empty() {
+            return Err(invalid(format!(
+                "{kind} array {} has an empty name; name every array",
+                k + 1
+            )));
+        }
+        if a.components == 0 {
+            return Err(invalid(format!(
+                "{kind} array `{}` has 0 components",
+                a.name
+            )));
+        }
+        if a.values.len() != a.components * expect {
+            let each = match a.components {
+                1 => format!("one per {per}"),
+                c => format!("{c} per {per}"),
+            };
+            return Err(invalid(format!(
+                "{kind} array `{}` has {} values, expected {} ({each})",
+                a.name,
+                a.values.len(),
+                a.components * expect,
+            )));
+        }
+        if Some(a.name) == reserved {
+            return Err(invalid(format!(
+                "{kind} array `{}` clashes with the {} every .vtu carries; rename it",
+                a.name, a.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Write `mesh` with point and cell arrays of any number of components (e.g. a heat
+/// flux vector per cell), base64 or ASCII. Lengths are checked as in
+/// [`write_vtu_with`].
+pub fn write_vtu_arrays(
+    path: &Path,
+    mesh: &Mesh,
+    point: &[Array<'_>],
+    cell: &[Array<'_>],
+    encoding: VtuEncoding,
+) -> io::Result<()> {
+    check_multi("point data", point, mesh.num_nodes(), "mesh node", None)?;
     let cells: usize = mesh.blocks.iter().map(|b| b.len()).sum();
-    check_arrays("cell data", cell, cells, "element")?;
+    check_multi("cell data", cell, cells, "element", Some("block_id"))?;
+    let blocks = || mesh.blocks.iter();
+    let offsets = blocks()
+        .flat_map(|b| std::iter::repeat_n(b.topology.node_count() as i64, b.len()))
+        .scan(0i64, |off, n| {
+            *off += n;
+            Some(*off)
+        });
+    let block_id: Vec<i64> = blocks()
+        .flat_map(|b| std::iter::repeat_n(b.id, b.len()))
+        .collect();
+    let s = piece(
+        Piece {
+            points: &mesh.coords,
+            cells,
+            connectivity: blocks().flat_map(|b| b.connectivity.iter().map(|n| i64::from(n.0))),
+            offsets,
+            types: blocks().flat_map(|b| std::iter::repeat_n(vtk_type(b.topology), b.len())),
+            point,
+            cell_ints: &[("block_id", &block_id)],
+            cell,
+        },
+        encoding,
+    );
+    std::fs::write(path, s)
+}
+
+/// Write a grid of its own — `points` and polygon cells, each a list of 3 (triangle,
+/// VTK type 5), 4 (quad, 9), 2 (line, 3) or 1 (vertex, 1) indices into `points` — with
+/// point arrays, integer cell arrays and real cell arrays: e.g. the faces of contact
+/// surfaces, or contact points.
+pub fn write_vtu_polygons(
+    path: &Path,
+    points: &[[f64; 3]],
+    polygons: &[Vec<u32>],
+    point: &[Array<'_>],
+    cell_ints: &[(&str, &[i64])],
+    cell: &[Array<'_>],
+    encoding: VtuEncoding,
+) -> io::Result<()> {
+    check_multi("point data", point, points.len(), "point", None)?;
+    check_multi("cell data", cell, polygons.len(), "cell", None)?;
+    for (name, v) in cell_ints {
+        if v.len() != polygons.len() {
+            return Err(invalid(format!(
+                "cell data array `{name}` has {} values, expected {} (one per cell)",
+                v.len(),
+                polygons.len()
+            )));
+        }
+    }
+    let mut types = Vec::with_capacity(polygons.len());
+    for (k, p) in polygons.iter().enumerate() {
+        types.push(match p.len() {
+            1 => 1,
+            2 => 3,
+            3 => 5,
+            4 => 9,
+            n => {
+                return Err(invalid(format!(
+                    "cell {k} has {n} points; a cell here has 1 (vertex), 2, 3 or 4"
+                )));
+            }
+        });
+        if let Some(&i) = p.iter().find(|&&i| i as usize >= points.len()) {
+            return Err(invalid(format!(
+                "cell {k} names point {i}, but there are {} points",
+                points.len()
+            )));
+        }
+    }
+    let offsets = polygons.iter().scan(0i64, |off, p| {
+        *off += p.len() as i64;
+        Some(*off)
+    });
+    let s = piece(
+        Piece {
+            points,
+            cells: polygons.len(),
+            connectivity: polygons.iter().flatten().map(|&i| i64::from(i)),
+            offsets,
+            types: types.iter().copied(),
+            point,
+            cell_ints,
+            cell,
+        },
+        encoding,
+    );
+    std::fs::write(path, s)
+}
+
+/// Everything one `<Piece>` holds.
+struct Piece<'a, C, O, T> {
+    points: &'a [[f64; 3]],
+    cells: usize,
+    connectivity: C,
+    offsets: O,
+    types: T,
+    point: &'a [Array<'a>],
+    cell_ints: &'a [(&'a str, &'a [i64])],
+    cell: &'a [Array<'a>],
+}
+
+/// The whole file of one piece, arrays already checked.
+fn piece<C, O, T>(p: Piece<'_, C, O, T>, encoding: VtuEncoding) -> String
+where
+    C: Iterator<Item = i64> + Clone,
+    O: Iterator<Item = i64> + Clone,
+    T: Iterator<Item = u8>,
+{
+    let values: usize = p.point.iter().map(|a| a.values.len()).sum::<usize>()
+        + p.cell.iter().map(|a| a.values.len()).sum::<usize>();
     let mut a = Arrays {
-        s: String::with_capacity(32 * mesh.num_nodes() * (3 + point.len()) + 64 * cells),
+        s: String::with_capacity(32 * (3 * p.points.len() + values) + 64 * p.cells),
         encoding,
         bytes: Vec::new(),
     };
@@ -255,42 +430,29 @@ pub fn write_vtu_with(
     a.s.push_str("<UnstructuredGrid>\n");
     let _ = writeln!(
         a.s,
-        "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">",
-        mesh.num_nodes()
+        "<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
+        p.points.len(),
+        p.cells
     );
     a.s.push_str("<PointData>\n");
-    for (name, values) in point {
-        a.f64s(Some(name), 1, values.iter().copied());
+    for x in p.point {
+        a.f64s(Some(x.name), x.components, x.values.iter().copied());
     }
     a.s.push_str("</PointData>\n<Points>\n");
-    a.f64s(None, 3, mesh.coords.iter().flatten().copied());
+    a.f64s(None, 3, p.points.iter().flatten().copied());
     a.s.push_str("</Points>\n<Cells>\n");
-    let blocks = || mesh.blocks.iter();
-    a.ints(
-        "connectivity",
-        blocks().flat_map(|b| b.connectivity.iter().map(|n| i64::from(n.0))),
-    );
-    let offsets = blocks()
-        .flat_map(|b| std::iter::repeat_n(b.topology.node_count() as i64, b.len()))
-        .scan(0i64, |off, n| {
-            *off += n;
-            Some(*off)
-        });
-    a.ints("offsets", offsets);
-    a.u8s(
-        "types",
-        blocks().flat_map(|b| std::iter::repeat_n(vtk_type(b.topology), b.len())),
-    );
+    a.ints("connectivity", p.connectivity);
+    a.ints("offsets", p.offsets);
+    a.u8s("types", p.types);
     a.s.push_str("</Cells>\n<CellData>\n");
-    a.i64s(
-        "block_id",
-        blocks().flat_map(|b| std::iter::repeat_n(b.id, b.len())),
-    );
-    for (name, values) in cell {
-        a.f64s(Some(name), 1, values.iter().copied());
+    for (name, v) in p.cell_ints {
+        a.i64s(name, v.iter().copied());
+    }
+    for x in p.cell {
+        a.f64s(Some(x.name), x.components, x.values.iter().copied());
     }
     a.s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    std::fs::write(path, a.s)
+    a.s
 }
 
 /// A ParaView time series (`.pvd`): a list of `(time, file)` rewritten whole on every

@@ -1,6 +1,7 @@
 //! `seam run`: a heat-transfer problem file (TOML) solved end to end — mesh, materials,
 //! boundary conditions, sources, the Sierra contact definition, the steady solve, the
-//! results (`.vtu`) and a summary.
+//! results (`.vtu`, Exodus; the heat flux and, with `Visualize Contact`, the contact
+//! fields: `fields`; the files and histories: `steps`) and a summary.
 //!
 //! Entry point: [`run`]. Field by field:
 //!
@@ -36,6 +37,7 @@
 //! source that names `T` sees the interpolated temperature (and makes the problem
 //! nonlinear). The time `t` is 0 in a steady solve.
 
+mod fields;
 mod steps;
 
 use std::path::{Path, PathBuf};
@@ -59,11 +61,12 @@ use crate::interaction;
 use std::collections::HashSet;
 
 use crate::mesh::{self, Mesh, NodeId, Side};
-use crate::output::vtu::write_vtu;
 use crate::script::{Limits, Sandbox};
 use crate::search::pairing::{Integration, PointStatus};
 use crate::search::scene::{Pairing, search_definition};
 use crate::surface;
+
+use fields::{ContactView, Derived};
 
 /// A number, a Lua expression, or a piecewise-linear table `{ table = [[s, v], …] }`
 /// (in time t for boundary values, in temperature T for material laws).
@@ -528,6 +531,8 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
     let mut loaded = LoadedDeck::default();
     let mut pairings: Vec<Pairing> = Vec::new();
     let mut choices = Vec::new();
+    // Per pairing: what its contact output holds (`Visualize Contact`, `Output Rule`).
+    let mut views: Vec<ContactView> = Vec::new();
     if let Some(c) = &problem.contact {
         let deck_path = dir.join(&c.file);
         loaded = deck::load(&deck_path);
@@ -551,6 +556,16 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         };
         let deck_dir = deck_path.parent().unwrap_or(Path::new(".")).to_path_buf();
         for def in &loaded.deck.contact_definitions {
+            if ContactView::of(def).silenced {
+                diags.push(
+                    Diagnostic::warning(
+                        "W0702",
+                        "`Visualize Contact` is on, but `Output Rule = none`: this definition writes no contact fields",
+                    )
+                    .at(Some(def.at.clone()))
+                    .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
+                );
+            }
             let t = Instant::now();
             let set = surface::build(&mesh, def, &loaded.sources);
             timing.surfaces_s += t.elapsed().as_secs_f64();
@@ -654,6 +669,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                         };
                         choices.push((choice, scale, model));
                         pairings.push(p);
+                        views.push(ContactView::of(def));
                     }
                     Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
                 }
@@ -839,6 +855,131 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         .filter(|&k| !choices[k].0.mortar)
         .chain((0..choices.len()).filter(|&k| choices[k].0.mortar))
         .collect();
+    // Per interaction: the names of its conductance's mechanisms (empty unless a sum).
+    let mechanism_names: Vec<Vec<String>> = choices
+        .iter()
+        .map(|(_, _, m)| {
+            m.as_ref()
+                .map_or_else(Vec::new, |m| fields::mechanism_names(m.as_ref()))
+        })
+        .collect();
+    // What a state gives beyond its temperature: per interaction the flux at its points
+    // (where the contact output or a mechanism split needs it; `faces` asks for the
+    // contact output) and the heat of each mechanism.
+    let derive = |u: &[f64], dofs: &DofMap, time: f64, faces: bool| -> Result<Derived, String> {
+        clock.set(time);
+        let mut out = Derived::default();
+        for (k, ((p, (c, scale, model)), h)) in
+            pairings.iter().zip(&choices).zip(&h_fns).enumerate()
+        {
+            let split = !mechanism_names[k].is_empty();
+            if c.mortar || !(split || (faces && views[k].faces)) {
+                out.fluxes.push(None);
+                out.mechanisms.push(Vec::new());
+                continue;
+            }
+            let field = |i: usize| {
+                dofs.field(&field_names[i])
+                    .ok_or_else(|| format!("no dofs of field `{}`", field_names[i]))
+            };
+            let (fa, fb) = term_fields[k];
+            let pair = crate::enforce::interface::FieldPair {
+                a: field(fa)?,
+                b: field(fb)?,
+            };
+            let form = InterfaceForm {
+                form: c.form,
+                h: h.as_ref(),
+                offset: c.offset,
+                beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
+                conductivity: &conductivity,
+            };
+            let q = crate::enforce::interface::point_flux(
+                &mesh,
+                dofs,
+                pair,
+                &p.side_a_geometry,
+                &p.side_b_geometry,
+                &p.result.points,
+                &form,
+                u,
+            )
+            .map_err(|e| format!("interaction {} / {}: {e}", p.side_a, p.side_b));
+            // The output evaluates the models once more; a cutback asked for here is not
+            // the next step's.
+            cutback.set(false);
+            let mut q = q?;
+            let on = toggles[k]
+                .as_ref()
+                .is_none_or(|on| on.iter().any(|&(a, b)| a <= time && time <= b));
+            if !on {
+                q.iter_mut().flatten().for_each(|f| f.q = 0.0);
+            }
+            let mechanisms = match model {
+                Some(m) if split => fields::mechanism_heat(
+                    m.as_ref(),
+                    p,
+                    &q,
+                    |i| pressures[k].as_ref().map_or(c.pressure, |v| v[i]),
+                    time,
+                ),
+                _ => Vec::new(),
+            };
+            out.fluxes.push(Some(q));
+            out.mechanisms.push(mechanisms);
+        }
+        Ok(out)
+    };
+    // The contact faces of a derived state, when some interaction visualises contact.
+    let contact_of = |d: &Derived| -> Option<fields::ContactFields> {
+        if !views.iter().any(|v| v.faces) {
+            return None;
+        }
+        let mut out = fields::ContactFields::default();
+        for (k, p) in pairings.iter().enumerate().filter(|(k, _)| views[*k].faces) {
+            fields::contact_faces(
+                p,
+                k as u32 + 1,
+                d.fluxes[k].as_deref(),
+                views[k].side_b,
+                &mut out,
+            );
+        }
+        Some(out)
+    };
+    // Mechanism heats in the solver's term order.
+    let term_mechanisms = |d: &Derived| -> Vec<Vec<f64>> {
+        term_choice
+            .iter()
+            .map(|&k| d.mechanisms[k].clone())
+            .collect()
+    };
+    let mut split_history: Vec<Vec<Vec<f64>>> = Vec::new();
+    // One state's fields as step `step` of the results (temperature, heat flux, contact
+    // faces), from its derived values when they were made with the faces.
+    let write_state = |writer: &mut steps::StepWriter<'_>,
+                       u: &[f64],
+                       dofs: &DofMap,
+                       step: usize,
+                       time: f64,
+                       derived: Option<Derived>|
+     -> Result<(), String> {
+        let derived = match derived {
+            Some(d) => d,
+            None => derive(u, dofs, time, true)?,
+        };
+        let t = steps::nodal_temperature(dofs, u, &field_names);
+        let q = fields::element_heat_flux(&mesh, &materials.laws, &t, time)?;
+        let contact = contact_of(&derived);
+        let fields = steps::StepFields {
+            temperature: &t,
+            heat_flux: &q,
+            contact: contact.as_ref(),
+        };
+        writer
+            .write_step(step, time, &fields)
+            .map_err(|e| format!("cannot write the results of step {step}: {e}"))
+    };
     let source_fn = source
         .as_ref()
         .map(|s| s as &(dyn Fn([f64; 3]) -> f64 + Sync));
@@ -966,16 +1107,35 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             if let Some(progress) = options.progress.as_ref() {
                 progress(r);
             }
+            let due = writer.due(r.step);
+            let derived = derive(&st.u, dofs, st.time, due).map_err(HeatError::Step)?;
+            split_history.push(term_mechanisms(&derived));
+            if due {
+                write_state(&mut writer, &st.u, dofs, st.step, st.time, Some(derived))
+                    .map_err(HeatError::Step)?;
+            }
             writer
-                .step(r, st, dofs, &field_names)
+                .checkpoint(st)
                 .map_err(|e| HeatError::Step(e.to_string()))?;
             history.push(r.clone());
             Ok(())
         };
         let outcome = transient::solve(&tp, mode, start, &mut on_step)
             .map_err(|e| RunError::Solve(e.to_string()))?;
+        let last = &outcome.state;
+        if out_dir.is_some() && !writer.written(last.step) {
+            write_state(
+                &mut writer,
+                &last.u,
+                &outcome.dofs,
+                last.step,
+                last.time,
+                None,
+            )
+            .map_err(RunError::Solve)?;
+        }
         writer
-            .finish(&outcome.state, &outcome.dofs, &field_names)
+            .finish(last)
             .map_err(|e| RunError::Solve(e.to_string()))?;
         steps::final_solution(outcome, &history, &field_names, tp.contact.len())
     };
@@ -1000,8 +1160,29 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
 
     let output = match &out_dir {
         Some(out_dir) => {
+            let io = |e: std::io::Error| {
+                RunError::Solve(format!(
+                    "cannot write the results in {}: {e}",
+                    out_dir.display()
+                ))
+            };
+            let final_time = history.last().map_or(start_time, |r| r.time);
+            let derived =
+                derive(&solution.u, &solution.dofs, final_time, true).map_err(RunError::Solve)?;
+            let heat_flux = fields::element_heat_flux(
+                &mesh,
+                &materials.laws,
+                &solution.temperature,
+                final_time,
+            )
+            .map_err(RunError::Solve)?;
+            let contact = contact_of(&derived);
+            let state = steps::StepFields {
+                temperature: &solution.temperature,
+                heat_flux: &heat_flux,
+                contact: contact.as_ref(),
+            };
             let file = out_dir.join("temperature.vtu");
-            let mut point: Vec<(&str, &[f64])> = vec![("temperature", &solution.temperature)];
             let per_field: Vec<(String, Vec<f64>)> = if field_names.len() > 1 {
                 field_names
                     .iter()
@@ -1015,21 +1196,33 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             } else {
                 Vec::new()
             };
-            for (name, v) in &per_field {
-                point.push((name.as_str(), v));
-            }
-            write_vtu(&file, &mesh, &point)
+            let extra: Vec<(&str, &[f64])> = per_field
+                .iter()
+                .map(|(name, v)| (name.as_str(), v.as_slice()))
+                .collect();
+            steps::write_temperature_vtu(&file, &mesh, &state, &extra)
                 .map_err(|e| RunError::Solve(format!("cannot write {}: {e}", file.display())))?;
-            let io = |e: std::io::Error| {
-                RunError::Solve(format!(
-                    "cannot write the results in {}: {e}",
-                    out_dir.display()
-                ))
-            };
-            if linear_steady {
-                writer
-                    .write_temperature(0, start_time, &solution.temperature)
+            if let Some(c) = &contact {
+                steps::write_contact_vtu(
+                    &out_dir.join("contact.vtu"),
+                    &mesh,
+                    &solution.temperature,
+                    c,
+                )
+                .map_err(io)?;
+            }
+            let points: Vec<fields::PointsOf<'_>> = pairings
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| views[*k].points)
+                .map(|(k, p)| (k as u32 + 1, p, derived.fluxes[k].as_deref()))
+                .collect();
+            if !points.is_empty() {
+                steps::write_contact_points_vtu(&out_dir.join("contact_points.vtu"), &points)
                     .map_err(io)?;
+            }
+            if linear_steady {
+                writer.write_step(0, start_time, &state).map_err(io)?;
                 writer.close().map_err(io)?;
             }
             let labels: Vec<(String, String, String)> = term_choice
@@ -1042,8 +1235,39 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                     )
                 })
                 .collect();
+            let names: Vec<Vec<String>> = term_choice
+                .iter()
+                .map(|&k| mechanism_names[k].clone())
+                .collect();
             if !history.is_empty() {
-                steps::write_history(out_dir, &history, &labels).map_err(io)?;
+                steps::write_steps(out_dir, &history).map_err(io)?;
+                let rows: Vec<steps::HeatRow<'_>> = history
+                    .iter()
+                    .zip(&split_history)
+                    .map(|(r, m)| steps::HeatRow {
+                        step: r.step,
+                        time: r.time,
+                        heat: &r.heat,
+                        mechanisms: m,
+                    })
+                    .collect();
+                steps::write_interface_heat(out_dir, &rows, &labels, &names).map_err(io)?;
+            } else if !labels.is_empty() {
+                // A linear steady solve: one row per interaction, as step 0.
+                let heat: Vec<(f64, f64)> = solution
+                    .heat
+                    .iter()
+                    .chain(&solution.tie_heat)
+                    .copied()
+                    .collect();
+                let mechanisms = term_mechanisms(&derived);
+                let row = steps::HeatRow {
+                    step: 0,
+                    time: start_time,
+                    heat: &heat,
+                    mechanisms: &mechanisms,
+                };
+                steps::write_interface_heat(out_dir, &[row], &labels, &names).map_err(io)?;
             }
             // The plotted line: through the first matched point of the first
             // interaction, along its side-A normal.

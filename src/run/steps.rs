@@ -1,6 +1,6 @@
-//! What a transient (or nonlinear) run writes as it goes: the fields every few steps
-//! (`.vtu` and a `.pvd` series), checkpoints, and the histories (`steps.csv`,
-//! `interface_heat.csv`).
+//! What a run writes: the fields every few steps (`.vtu` and `.pvd` series of the
+//! temperature and the contact faces, `results.exo`), checkpoints, and the histories
+//! (`steps.csv`, `interface_heat.csv`).
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -11,9 +11,11 @@ use crate::heat::transient::{Outcome, State, StepReport};
 use crate::mesh::Mesh;
 use crate::output::exodus::ExodusWriter;
 use crate::output::plot::{Plot, Series};
-use crate::output::vtu::{PvdSeries, write_vtu};
+use crate::output::vtu::{Array, PvdSeries, VtuEncoding, write_vtu_arrays, write_vtu_polygons};
 
+use super::fields::{ContactFace, ContactFields, PointsOf};
 use super::{OutputSpec, RunError};
+use crate::search::pairing::PointStatus;
 
 /// Nodal temperature over every field (each node carries one field).
 pub(super) fn nodal_temperature(dofs: &DofMap, u: &[f64], fields: &[String]) -> Vec<f64> {
@@ -33,6 +35,16 @@ pub(super) fn nodal_temperature(dofs: &DofMap, u: &[f64], fields: &[String]) -> 
     out.unwrap_or_default()
 }
 
+/// What the results files of one written state hold.
+pub(super) struct StepFields<'a> {
+    /// Nodal temperature (NaN on nodes without one).
+    pub temperature: &'a [f64],
+    /// −k∇T per element, x, y, z interleaved (NaN where there is no temperature).
+    pub heat_flux: &'a [f64],
+    /// The contact faces, when some interaction visualises contact.
+    pub contact: Option<&'a ContactFields>,
+}
+
 /// Writes a run's steps into the output directory.
 pub(super) struct StepWriter<'m> {
     dir: Option<PathBuf>,
@@ -42,10 +54,17 @@ pub(super) struct StepWriter<'m> {
     transient: bool,
     /// The `.pvd` of the fields written.
     series: Option<PvdSeries>,
+    /// The `.pvd` of the contact faces written.
+    contact_series: Option<PvdSeries>,
     /// `results.exo`: every step written, for ParaView and Sierra users.
     exodus: Option<ExodusWriter>,
     last_written: Option<usize>,
 }
+
+/// The element variables of `results.exo`.
+const HEAT_FLUX: [&str; 3] = ["heat_flux_x", "heat_flux_y", "heat_flux_z"];
+/// The nodal contact variables of `results.exo` (with contact output).
+const CONTACT_NODAL: [&str; 3] = ["contact_gap", "contact_fraction", "interface_flux"];
 
 impl<'m> StepWriter<'m> {
     pub(super) fn new(
@@ -61,23 +80,26 @@ impl<'m> StepWriter<'m> {
             checkpoint_every: spec.checkpoint_every.filter(|&n| n > 0),
             transient,
             series: None,
+            contact_series: None,
             exodus: None,
             last_written: None,
         }
     }
 
-    pub(super) fn step(
-        &mut self,
-        r: &StepReport,
-        state: &State,
-        dofs: &DofMap,
-        fields: &[String],
-    ) -> std::io::Result<()> {
-        if !self.transient || self.dir.is_none() {
+    /// Whether accepted step `step` of a transient run writes its fields.
+    pub(super) fn due(&self, step: usize) -> bool {
+        self.transient && self.dir.is_some() && step.is_multiple_of(self.every)
+    }
+
+    /// Whether step `step` has been written.
+    pub(super) fn written(&self, step: usize) -> bool {
+        self.last_written == Some(step)
+    }
+
+    /// After an accepted step of a transient run: its checkpoint, when one is due.
+    pub(super) fn checkpoint(&self, state: &State) -> std::io::Result<()> {
+        if !self.transient {
             return Ok(());
-        }
-        if r.step.is_multiple_of(self.every) {
-            self.write_fields(state, dofs, fields)?;
         }
         if let (Some(n), Some(dir)) = (self.checkpoint_every, &self.dir)
             && state.step.is_multiple_of(n)
@@ -90,68 +112,77 @@ impl<'m> StepWriter<'m> {
         Ok(())
     }
 
-    fn write_fields(
-        &mut self,
-        state: &State,
-        dofs: &DofMap,
-        fields: &[String],
-    ) -> std::io::Result<()> {
-        let t = nodal_temperature(dofs, &state.u, fields);
-        self.write_temperature(state.step, state.time, &t)
-    }
-
-    /// One step's temperature: `temperature_<step>.vtu` in the `.pvd` series (transient
-    /// runs) and a step of `results.exo`.
-    pub(super) fn write_temperature(
+    /// One step's fields: `temperature_<step>.vtu` (and `contact_<step>.vtu`) in the
+    /// `.pvd` series (transient runs) and a step of `results.exo`.
+    pub(super) fn write_step(
         &mut self,
         step: usize,
         time: f64,
-        t: &[f64],
+        fields: &StepFields<'_>,
     ) -> std::io::Result<()> {
         let Some(dir) = self.dir.clone() else {
             return Ok(());
         };
         if self.transient {
             let name = format!("temperature_{step:05}.vtu");
-            write_vtu(&dir.join(&name), self.mesh, &[("temperature", t)])?;
+            write_temperature_vtu(&dir.join(&name), self.mesh, fields, &[])?;
             self.series
                 .get_or_insert_with(|| PvdSeries::new(&dir.join("temperature.pvd")))
                 .add(time, Path::new(&name))?;
+            if let Some(c) = fields.contact {
+                let name = format!("contact_{step:05}.vtu");
+                write_contact_vtu(&dir.join(&name), self.mesh, fields.temperature, c)?;
+                self.contact_series
+                    .get_or_insert_with(|| PvdSeries::new(&dir.join("contact.pvd")))
+                    .add(time, Path::new(&name))?;
+            }
         }
         if self.exodus.is_none() {
+            let mut nodal = vec!["temperature"];
+            if fields.contact.is_some() {
+                nodal.extend(CONTACT_NODAL);
+            }
             self.exodus = Some(ExodusWriter::create(
                 &dir.join("results.exo"),
                 self.mesh,
-                &["temperature"],
-                &[],
+                &nodal,
+                &HEAT_FLUX,
             )?);
         }
-        // Nodes without a temperature (shells, bars) hold 0 in the Exodus file.
-        let values: Vec<f64> = t
-            .iter()
-            .map(|v| if v.is_nan() { 0.0 } else { *v })
+        // Nodes without a temperature (shells, bars) and elements without a flux hold 0
+        // in the Exodus file.
+        let finite = |v: f64| if v.is_finite() { v } else { 0.0 };
+        let mut nodal: Vec<Vec<f64>> =
+            vec![fields.temperature.iter().map(|&v| finite(v)).collect()];
+        if let Some(c) = fields.contact {
+            nodal.extend(c.nodal(self.mesh));
+        }
+        let element: Vec<Vec<f64>> = (0..3)
+            .map(|d| {
+                fields
+                    .heat_flux
+                    .iter()
+                    .skip(d)
+                    .step_by(3)
+                    .map(|&v| finite(v))
+                    .collect()
+            })
             .collect();
+        let nodal: Vec<&[f64]> = nodal.iter().map(Vec::as_slice).collect();
+        let element: Vec<&[f64]> = element.iter().map(Vec::as_slice).collect();
         self.exodus
             .as_mut()
             .expect("just made")
-            .write_step(time, &[&values], &[])?;
+            .write_step(time, &nodal, &element)?;
         self.last_written = Some(step);
         Ok(())
     }
 
-    /// The last step's fields (if not written yet), `results.exo` closed, and (transient
-    /// runs) the final checkpoint.
-    pub(super) fn finish(
-        &mut self,
-        state: &State,
-        dofs: &DofMap,
-        fields: &[String],
-    ) -> std::io::Result<()> {
+    /// The end of a run: `results.exo` closed and (transient runs) the final
+    /// checkpoint.
+    pub(super) fn finish(&mut self, state: &State) -> std::io::Result<()> {
         if self.dir.is_none() {
             return Ok(());
-        }
-        if self.last_written != Some(state.step) {
-            self.write_fields(state, dofs, fields)?;
         }
         self.close()?;
         if !self.transient {
@@ -168,6 +199,129 @@ impl<'m> StepWriter<'m> {
             None => Ok(()),
         }
     }
+}
+
+/// A temperature `.vtu`: point data `temperature` (and `extra` point arrays), cell data
+/// `heat_flux` (3 components).
+pub(super) fn write_temperature_vtu(
+    path: &Path,
+    mesh: &Mesh,
+    fields: &StepFields<'_>,
+    extra: &[(&str, &[f64])],
+) -> std::io::Result<()> {
+    let mut point = vec![Array::scalar("temperature", fields.temperature)];
+    point.extend(extra.iter().map(|&(n, v)| Array::scalar(n, v)));
+    write_vtu_arrays(
+        path,
+        mesh,
+        &point,
+        &[Array::vector("heat_flux", fields.heat_flux)],
+        VtuEncoding::Ascii,
+    )
+}
+
+/// `contact.vtu`: the contact faces as polygon cells over their own points (the mesh
+/// nodes they use, with point data `temperature`), cell data `interaction`, `side`,
+/// `contact_gap`, `contact_fraction`, `contact_area`, `interface_flux`.
+pub(super) fn write_contact_vtu(
+    path: &Path,
+    mesh: &Mesh,
+    temperature: &[f64],
+    contact: &ContactFields,
+) -> std::io::Result<()> {
+    let mut index = std::collections::HashMap::new();
+    let mut points = Vec::new();
+    let mut t = Vec::new();
+    let mut polygons = Vec::with_capacity(contact.faces.len());
+    for f in &contact.faces {
+        let cell = f.nodes[..f.len as usize]
+            .iter()
+            .map(|n| {
+                *index.entry(*n).or_insert_with(|| {
+                    points.push(mesh.coords[n.index()]);
+                    t.push(temperature.get(n.index()).copied().unwrap_or(f64::NAN));
+                    (points.len() - 1) as u32
+                })
+            })
+            .collect();
+        polygons.push(cell);
+    }
+    let column = |g: fn(&ContactFace) -> f64| -> Vec<f64> { contact.faces.iter().map(g).collect() };
+    let (gap, fraction, area, flux) = (
+        column(|f| f.gap),
+        column(|f| f.fraction),
+        column(|f| f.area),
+        column(|f| f.flux),
+    );
+    let interaction: Vec<i64> = contact
+        .faces
+        .iter()
+        .map(|f| i64::from(f.interaction))
+        .collect();
+    let side: Vec<i64> = contact.faces.iter().map(|f| i64::from(f.side)).collect();
+    write_vtu_polygons(
+        path,
+        &points,
+        &polygons,
+        &[Array::scalar("temperature", &t)],
+        &[("interaction", &interaction), ("side", &side)],
+        &[
+            Array::scalar("contact_gap", &gap),
+            Array::scalar("contact_fraction", &fraction),
+            Array::scalar("contact_area", &area),
+            Array::scalar("interface_flux", &flux),
+        ],
+        VtuEncoding::Ascii,
+    )
+}
+
+/// `contact_points.vtu`: every side-A point of the given interactions (1-based index,
+/// pairing, per-point flux) as a vertex cell at its position (for a periodic pair: on
+/// the image), cell data `interaction`, `status` (0 matched, 1 unmatched, 2 rejected
+/// by distance, 3 rejected by angle, 4 outside the subdomain), `weight`, `contact_gap`
+/// and `interface_flux` (NaN at points that are not matched; NaN flux for an
+/// interaction without per-point flux).
+pub(super) fn write_contact_points_vtu(
+    path: &Path,
+    interactions: &[PointsOf<'_>],
+) -> std::io::Result<()> {
+    let mut points = Vec::new();
+    let (mut interaction, mut status) = (Vec::new(), Vec::new());
+    let (mut weight, mut gap, mut flux) = (Vec::new(), Vec::new(), Vec::new());
+    for &(k, p, q) in interactions {
+        for (i, c) in p.result.points.iter().enumerate() {
+            points.push(c.x);
+            interaction.push(i64::from(k));
+            status.push(match c.status {
+                PointStatus::Matched => 0,
+                PointStatus::Unmatched => 1,
+                PointStatus::RejectedDistance => 2,
+                PointStatus::RejectedAngle => 3,
+                PointStatus::RejectedSubdomain => 4,
+            });
+            weight.push(c.weight);
+            let matched = c.status == PointStatus::Matched;
+            gap.push(if matched { c.gap } else { f64::NAN });
+            flux.push(match q.and_then(|q| q.get(i).copied().flatten()) {
+                Some(f) if matched => f.q,
+                _ => f64::NAN,
+            });
+        }
+    }
+    let cells: Vec<Vec<u32>> = (0..points.len() as u32).map(|i| vec![i]).collect();
+    write_vtu_polygons(
+        path,
+        &points,
+        &cells,
+        &[],
+        &[("interaction", &interaction), ("status", &status)],
+        &[
+            Array::scalar("weight", &weight),
+            Array::scalar("contact_gap", &gap),
+            Array::scalar("interface_flux", &flux),
+        ],
+        VtuEncoding::Ascii,
+    )
 }
 
 const MAGIC: &[u8; 8] = b"SEAMCKP1";
@@ -249,13 +403,8 @@ pub(super) fn read_checkpoint(path: &Path) -> Result<State, RunError> {
     })
 }
 
-/// `steps.csv` (one row per step) and `interface_heat.csv` (one row per step and
-/// interaction: the heat through side A and side B and the imbalance).
-pub(super) fn write_history(
-    dir: &Path,
-    history: &[StepReport],
-    labels: &[(String, String, String)],
-) -> std::io::Result<()> {
+/// `steps.csv`: one row per accepted step, with its phase times.
+pub(super) fn write_steps(dir: &Path, history: &[StepReport]) -> std::io::Result<()> {
     let mut s = String::from(
         "step,time,dt,newton_iterations,rejected,residual,assembly_s,factor_s,solve_s\n",
     );
@@ -273,13 +422,54 @@ pub(super) fn write_history(
             r.solve_s
         ));
     }
-    std::fs::write(dir.join("steps.csv"), s)?;
+    std::fs::write(dir.join("steps.csv"), s)
+}
+
+/// One step's interface heat: per term (contact terms, then ties) the heat leaving
+/// side A and side B, and the heat of each mechanism of a summed conductance (empty
+/// for a term that is not a sum).
+pub(super) struct HeatRow<'a> {
+    pub step: usize,
+    pub time: f64,
+    pub heat: &'a [(f64, f64)],
+    pub mechanisms: &'a [Vec<f64>],
+}
+
+/// `interface_heat.csv`: per step and term, one row labelled with the enforcement's
+/// model; a term whose conductance is a sum of mechanisms gets one row per mechanism
+/// (`mechanism` = its name from `names`, `heat_side_b` = −`heat_side_a`: the split is
+/// of one integrand, so each mechanism balances by construction) and then a `total`
+/// row with the interaction's measured heat and imbalance.
+pub(super) fn write_interface_heat(
+    dir: &Path,
+    rows: &[HeatRow<'_>],
+    labels: &[(String, String, String)],
+    names: &[Vec<String>],
+) -> std::io::Result<()> {
     let mut s =
         String::from("step,time,side_a,side_b,mechanism,heat_side_a,heat_side_b,imbalance\n");
-    for r in history {
-        for ((a, b, m), (qa, qb)) in labels.iter().zip(&r.heat) {
+    for r in rows {
+        for (k, ((a, b, m), (qa, qb))) in labels.iter().zip(r.heat).enumerate() {
+            let split = r.mechanisms.get(k).map_or(&[][..], Vec::as_slice);
+            let names = names.get(k).map_or(&[][..], Vec::as_slice);
+            let total = if split.is_empty() || split.len() != names.len() {
+                m.as_str()
+            } else {
+                for (name, q) in names.iter().zip(split) {
+                    s.push_str(&format!(
+                        "{},{:e},{a},{b},{},{:e},{:e},{:e}\n",
+                        r.step,
+                        r.time,
+                        csv_field(name),
+                        q,
+                        -q,
+                        0.0
+                    ));
+                }
+                "total"
+            };
             s.push_str(&format!(
-                "{},{:e},{a},{b},{m},{:e},{:e},{:e}\n",
+                "{},{:e},{a},{b},{total},{:e},{:e},{:e}\n",
                 r.step,
                 r.time,
                 qa,
@@ -289,6 +479,16 @@ pub(super) fn write_history(
         }
     }
     std::fs::write(dir.join("interface_heat.csv"), s)
+}
+
+/// A CSV field, quoted (RFC 4180) when it holds a comma, a quote or a line break — a
+/// Lua mechanism's name quotes its expression.
+fn csv_field(s: &str) -> std::borrow::Cow<'_, str> {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\"")).into()
+    } else {
+        s.into()
+    }
 }
 
 /// The run's final state in the form of a steady solution.

@@ -211,6 +211,90 @@ fn two_slab_jump_is_exact_for_every_conductance() {
     }
 }
 
+/// The flux at each contact point (`point_flux`) on the two slabs: for the resistance,
+/// Robin–Nitsche and tied forms it is the exact −q (from A to B) at every point, to
+/// 1e-9 of q (the solution is exact to round-off, and the flux average differentiates
+/// it on 1/3-size cells) plus 1e-14·h for the resistance form, whose q = h [u]
+/// multiplies the round-off of the jump by h; for every form, Dash included, Σ w q over
+/// the points is the heat read off the interface residual to 1e-12 relative (the two
+/// differ only by the side-A flux-average rows, which sum to w_A k_A ∇(Σ N)·n = 0).
+#[test]
+fn point_flux_is_the_exact_flux_and_sums_to_the_heat() {
+    use seam::enforce::interface::point_flux;
+    let s = setup(3, 2, SolidKind::Hex8);
+    let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+        .filter_map(|i| {
+            let z = s.mesh.coords[i][2];
+            (z == 0.0 || z == 2.0).then(|| (NodeId(i as u32), z / 2.0))
+        })
+        .collect();
+    let k = [1.0, 5.0];
+    for (form, h) in [
+        (Form::Conductance, 1.0),
+        (Form::Conductance, 1e6),
+        (Form::GapConductance, 1.0),
+        (Form::GapConductance, 1e6),
+        (Form::TiedNitsche, f64::INFINITY),
+        (Form::TiedInteriorPenalty, f64::INFINITY),
+        (Form::Penalty, f64::NAN),
+    ] {
+        let sol = solve(&s, form, if h.is_nan() { 1.0 } else { h }, k, &dirichlet);
+        let hf = move |_: &HInput| {
+            Ok(HValue {
+                h: if h.is_nan() { 1.0 } else { h },
+                ..HValue::default()
+            })
+        };
+        let f = InterfaceForm {
+            form,
+            h: &hf,
+            offset: 0.0,
+            beta: DEFAULT_BETA,
+            conductivity: &k,
+        };
+        let field = sol.dofs.field("temperature").unwrap();
+        let q = point_flux(&s.mesh, &sol.dofs, field, &s.a, &s.b, &s.points, &f, &sol.u).unwrap();
+        assert_eq!(q.len(), s.points.len());
+        let exact = 1.0 / (1.0 / k[0] + 1.0 / h + 1.0 / k[1]);
+        let (mut sum, mut worst) = (0.0, 0.0f64);
+        for (p, v) in s.points.iter().zip(&q) {
+            let v = v.expect("every point is matched");
+            sum += p.weight * v.q;
+            if !h.is_nan() {
+                worst = worst.max((v.q + exact).abs() / exact);
+            }
+            if !h.is_nan() {
+                let tol = if form == Form::Conductance {
+                    1e-9 + 1e-14 * h
+                } else {
+                    1e-9
+                };
+                assert!(
+                    (v.q + exact).abs() < tol * exact,
+                    "{form:?} h={h}: q {} vs {}",
+                    v.q,
+                    -exact
+                );
+                // The temperatures either side of z = 1: T_A = q/k_A, T_B = 1 − q/k_B.
+                assert!((v.temp_a - exact / k[0]).abs() < 1e-10, "{form:?}: T_A");
+                assert!(
+                    (v.temp_b - (1.0 - exact / k[1])).abs() < 1e-10,
+                    "{form:?}: T_B"
+                );
+            }
+        }
+        let heat = sol.heat[0].0;
+        eprintln!(
+            "{form:?} h={h}: worst point error {worst:.1e} of q, Σ w q − heat = {:.1e} of heat",
+            (sum - heat).abs() / heat.abs()
+        );
+        assert!(
+            (sum - heat).abs() <= 1e-12 * heat.abs(),
+            "{form:?} h={h}: Σ w q = {sum} vs heat {heat}"
+        );
+    }
+}
+
 /// Two concentric rings meshed apart, 3:2 around (inner 16m facets, outer 24m), 2m cells
 /// through each wall, one layer of height 0.2: inner ring r ∈ [0.5, 1] (side A, its
 /// outer face is side set 1), outer ring r ∈ [1, 1.5] (side B, inner face side set 2).

@@ -450,6 +450,105 @@ fn output_vtu_cell_data_follows_element_order_in_both_encodings() {
     assert!(2 * b < a + a / 4, "temperature: {b} vs {a} bytes");
 }
 
+/// A vector cell array keeps its three components per cell (interleaved, as VTK stores
+/// them) in both encodings; a polygon grid of its own gets its points, cells (vertex,
+/// line, triangle, quad), integer and real cell arrays back; wrong shapes are refused.
+#[test]
+fn output_vtu_vectors_and_polygon_grids_read_back() {
+    use seam::output::vtu::{Array, VtuEncoding, write_vtu_arrays, write_vtu_polygons};
+    let m = two_part_mesh();
+    let dir = out_dir("output-vtu");
+    let t = nodal_values(&m, 0, 0);
+    let q: Vec<f64> = (0..3 * m.num_elems())
+        .map(|i| (i as f64 * 0.3).sin())
+        .collect();
+    for (name, enc) in [
+        ("vec_a.vtu", VtuEncoding::Ascii),
+        ("vec_b.vtu", VtuEncoding::Base64),
+    ] {
+        write_vtu_arrays(
+            &dir.join(name),
+            &m,
+            &[Array::scalar("temperature", &t)],
+            &[Array::vector("heat_flux", &q)],
+            enc,
+        )
+        .unwrap();
+        let xml = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert!(
+            xml.contains("Name=\"heat_flux\" NumberOfComponents=\"3\""),
+            "{name}"
+        );
+        assert_eq!(bits(&decode(&xml, Some("heat_flux"))), bits(&q), "{name}");
+        assert_eq!(bits(&decode(&xml, Some("temperature"))), bits(&t), "{name}");
+        assert_eq!(cells(&xml).len(), m.num_elems());
+    }
+    let e = write_vtu_arrays(
+        &dir.join("bad.vtu"),
+        &m,
+        &[],
+        &[Array::vector("heat_flux", &q[..3])],
+        VtuEncoding::Ascii,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("3 per element"), "{e}");
+
+    let points = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.5],
+    ];
+    let polygons = vec![vec![0, 1, 2, 3], vec![0, 1, 2], vec![2, 3], vec![1]];
+    let ids = [7i64, 8, 9, 10];
+    let gap = [0.5, -1e-300, f64::NAN, 3.0];
+    let path = dir.join("polygons.vtu");
+    write_vtu_polygons(
+        &path,
+        &points,
+        &polygons,
+        &[Array::scalar("temperature", &[1.0, 2.0, 3.0, 4.0])],
+        &[("interaction", &ids)],
+        &[Array::scalar("contact_gap", &gap)],
+        VtuEncoding::Ascii,
+    )
+    .unwrap();
+    let xml = std::fs::read_to_string(&path).unwrap();
+    assert!(xml.contains("NumberOfPoints=\"4\" NumberOfCells=\"4\""));
+    assert!(!xml.contains("block_id"), "a grid of its own has no blocks");
+    let got = cells(&xml);
+    let want: Vec<(u8, Vec<u32>)> = vec![
+        (9, vec![0, 1, 2, 3]),
+        (5, vec![0, 1, 2]),
+        (3, vec![2, 3]),
+        (1, vec![1]),
+    ];
+    assert_eq!(got, want);
+    assert_eq!(decode(&xml, Some("interaction")), vec![7.0, 8.0, 9.0, 10.0]);
+    assert_eq!(bits(&decode(&xml, Some("contact_gap"))), bits(&gap));
+    let xyz: Vec<f64> = points.iter().flatten().copied().collect();
+    assert_eq!(decode(&xml, None), xyz);
+    for (polys, what) in [
+        (vec![vec![0, 1, 2, 3, 0]], "5 points"),
+        (vec![vec![0, 1, 9]], "names point 9"),
+    ] {
+        let e = write_vtu_polygons(&path, &points, &polys, &[], &[], &[], VtuEncoding::Ascii)
+            .unwrap_err();
+        assert!(e.to_string().contains(what), "{e}");
+    }
+    let e = write_vtu_polygons(
+        &path,
+        &points,
+        &polygons,
+        &[],
+        &[("interaction", &ids[..2])],
+        &[],
+        VtuEncoding::Ascii,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("`interaction` has 2 values"), "{e}");
+}
+
 #[test]
 fn output_vtu_refuses_wrong_lengths() {
     use seam::output::vtu::write_vtu_cells;

@@ -172,6 +172,12 @@ pub trait ConductanceModel {
     fn depends_on_temperature(&self) -> bool {
         true
     }
+
+    /// The mechanisms this model adds up, when it is a [`Sum`] (for reports that split
+    /// the heat by mechanism); empty for a single mechanism.
+    fn mechanisms(&self) -> &[Box<dyn ConductanceModel>] {
+        &[]
+    }
 }
 
 /// The result check every model applies: finite values, h ≥ 0.
@@ -606,6 +612,9 @@ impl ConductanceModel for Sum {
         }
         check(self, s, total)
     }
+    fn mechanisms(&self) -> &[Box<dyn ConductanceModel>] {
+        &self.parts
+    }
 }
 
 #[cfg(test)]
@@ -631,6 +640,20 @@ mod tests {
         send_sync::<Cmy>();
         send_sync::<Table>();
         send_sync::<PluginConductance>();
+    }
+
+    #[test]
+    fn a_sum_lists_its_mechanisms_and_a_single_model_none() {
+        let sum = Sum::new(vec![
+            Box::new(Constant::new(300.0).unwrap()),
+            Box::new(Radiation::new(0.5, 0.5).unwrap()),
+        ]);
+        let names: Vec<String> = sum.mechanisms().iter().map(|m| m.name()).collect();
+        assert_eq!(names, ["constant", "radiation"]);
+        let s = state(1e-4, 0.0, 300.0, 400.0);
+        let parts: f64 = sum.mechanisms().iter().map(|m| m.value(&s).unwrap()).sum();
+        assert_eq!(parts, sum.value(&s).unwrap());
+        assert!(Constant::new(1.0).unwrap().mechanisms().is_empty());
     }
 
     #[test]

@@ -1,0 +1,334 @@
+//! What `seam run` derives from a solved state for its results, beyond the nodal
+//! temperature: the heat flux −k∇T per element, the contact fields per face of the
+//! enforced interactions, and the heat of each mechanism of a summed conductance.
+//!
+//! Entry points: [`element_heat_flux`], [`contact_faces`] (and [`ContactFields::nodal`]
+//! for the side-A nodes) as [`ContactView`] asks, [`mechanism_heat`] with
+//! [`mechanism_names`]; [`Derived`] holds what the run derives from one state.
+//!
+//! Conventions: the interface flux is the heat flux from side A to side B (W/m²), the
+//! integrand of the heat leaving side A ([`crate::enforce::interface::point_flux`]);
+//! gaps are the search's signed normal gaps (m, > 0 open); a face's matched area is the
+//! sum of the weights of its matched points (segments integration: the clipped overlap
+//! area, exact for flat faces).
+
+use crate::deck::spec::{ContactDefinition, OutputRule};
+use crate::enforce::conductance::{ConductanceModel, PointState};
+use crate::enforce::interface::PointFlux;
+use crate::heat::kernel::{MAX_NODES, eval_point};
+use crate::heat::shape::reference_nodes;
+use crate::heat::transient::BlockLaws;
+use crate::mesh::{Mesh, NodeId};
+use crate::search::pairing::{PointStatus, SurfaceGeometry};
+use crate::search::scene::Pairing;
+
+/// −k∇T at the centroid of every element, x, y, z interleaved, in dense element order
+/// (W/m²). k is the block's conductivity law at the centroid temperature, position and
+/// `time`. Elements without shape functions (shells, beams) or with a node without a
+/// temperature get NaN. The gradient of trilinear and linear elements at the centroid
+/// is exact for a temperature linear in space, so a 1-D linear field gives q = k ΔT / L
+/// in every element to round-off.
+pub(super) fn element_heat_flux(
+    mesh: &Mesh,
+    laws: &[BlockLaws],
+    temperature: &[f64],
+    time: f64,
+) -> Result<Vec<f64>, String> {
+    let mut out = Vec::with_capacity(3 * mesh.num_elems());
+    for (b, block) in mesh.blocks.iter().enumerate() {
+        let Some(reference) = reference_nodes(block.topology) else {
+            out.extend(std::iter::repeat_n(f64::NAN, 3 * block.len()));
+            continue;
+        };
+        let mut center = [0.0; 3];
+        for r in reference {
+            for d in 0..3 {
+                center[d] += r[d] / reference.len() as f64;
+            }
+        }
+        for k in 0..block.len() {
+            let nodes = block.elem_nodes(k);
+            let mut coords = [[0.0; 3]; MAX_NODES];
+            let mut t = [0.0; MAX_NODES];
+            for (a, n) in nodes.iter().enumerate() {
+                coords[a] = mesh.coords[n.index()];
+                t[a] = temperature.get(n.index()).copied().unwrap_or(f64::NAN);
+            }
+            if t[..nodes.len()].iter().any(|v| !v.is_finite()) {
+                out.extend([f64::NAN; 3]);
+                continue;
+            }
+            let elem = block.first_elem.0 as usize + k;
+            let pv =
+                eval_point(block.topology, &coords[..nodes.len()], center, 1.0).map_err(|e| {
+                    format!(
+                        "heat flux: element {} is inverted at its centroid (det J = {:.3e})",
+                        mesh.elem_numbers
+                            .get(elem)
+                            .copied()
+                            .unwrap_or(elem as i64 + 1),
+                        e.det
+                    )
+                })?;
+            let mut tc = 0.0;
+            let mut grad = [0.0; 3];
+            for ((n, g), t) in pv.n.iter().zip(&pv.grad).zip(&t).take(nodes.len()) {
+                tc += n * t;
+                for (gd, dn) in grad.iter_mut().zip(g) {
+                    *gd += dn * t;
+                }
+            }
+            let (k_c, _) = laws[b].conductivity.eval(tc, pv.x, time).map_err(|e| {
+                format!(
+                    "heat flux: conductivity of block {}: {e}",
+                    block.sierra_name()
+                )
+            })?;
+            out.extend(grad.map(|g| -k_c * g + 0.0));
+        }
+    }
+    Ok(out)
+}
+
+/// One face of the contact output.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct ContactFace {
+    pub nodes: [NodeId; 4],
+    pub len: u8,
+    /// The interaction, 1-based in the run's order (the order of `interface_heat.csv`
+    /// rows and of the `--json` interactions).
+    pub interaction: u32,
+    /// 0 for a side-A face, 1 for a side-B face.
+    pub side: u8,
+    /// Area-weighted mean gap over the matched points (m); 0 with none.
+    pub gap: f64,
+    /// Matched area / face area, in [0, 1].
+    pub fraction: f64,
+    /// Matched area (m²).
+    pub area: f64,
+    /// The face's area (m², as searched).
+    pub face_area: f64,
+    /// Mean heat flux from side A to side B over the matched area (W/m²); 0 with no
+    /// matched point, NaN for an interaction without per-point flux (multiplier ties).
+    pub flux: f64,
+}
+
+/// The contact output of one state: faces and, for Exodus, their values on the side-A
+/// nodes.
+#[derive(Clone, Debug, Default)]
+pub(super) struct ContactFields {
+    pub faces: Vec<ContactFace>,
+}
+
+/// Per matched point and face: the sums a face's fields are made of.
+#[derive(Clone, Copy, Default)]
+struct Sums {
+    weight: f64,
+    gap: f64,
+    flux: f64,
+}
+
+/// The faces of one interaction (`interaction`, 1-based) with their fields: side A's
+/// always, side B's with `side_b`. `fluxes` holds each point's flux (from
+/// [`crate::enforce::interface::point_flux`]), or is `None` for an interaction without
+/// per-point flux.
+pub(super) fn contact_faces(
+    pairing: &Pairing,
+    interaction: u32,
+    fluxes: Option<&[Option<PointFlux>]>,
+    side_b: bool,
+    out: &mut ContactFields,
+) {
+    let a = &pairing.side_a_geometry;
+    let b = &pairing.side_b_geometry;
+    let mut on_a = vec![Sums::default(); a.faces.len()];
+    let mut on_b = vec![Sums::default(); b.faces.len()];
+    for (k, p) in pairing.result.points.iter().enumerate() {
+        if p.status != PointStatus::Matched || p.a_face == u32::MAX {
+            continue;
+        }
+        let q = match fluxes {
+            Some(f) => f.get(k).copied().flatten().map_or(0.0, |f| f.q),
+            None => f64::NAN,
+        };
+        for s in [&mut on_a[p.a_face as usize], &mut on_b[p.b_face as usize]] {
+            s.weight += p.weight;
+            s.gap += p.weight * p.gap;
+            s.flux += p.weight * q;
+        }
+    }
+    let mut push = |geometry: &SurfaceGeometry, sums: &[Sums], side: u8| {
+        for (f, s) in geometry.faces.iter().zip(sums) {
+            let face_area = f.area();
+            let matched = s.weight > 0.0;
+            out.faces.push(ContactFace {
+                nodes: f.nodes,
+                len: f.len,
+                interaction,
+                side,
+                gap: if matched { s.gap / s.weight } else { 0.0 },
+                // Σw of a fully covered flat face is its area up to round-off; clamp.
+                fraction: if face_area > 0.0 {
+                    (s.weight / face_area).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                },
+                area: s.weight,
+                face_area,
+                flux: match (fluxes, matched) {
+                    (None, _) => f64::NAN,
+                    (Some(_), true) => s.flux / s.weight,
+                    (Some(_), false) => 0.0,
+                },
+            });
+        }
+    };
+    push(a, &on_a, 0);
+    if side_b {
+        push(b, &on_b, 1);
+    }
+}
+
+impl ContactFields {
+    /// The side-A faces' fields on their nodes, for a nodal Exodus variable: per node,
+    /// `contact_gap` and `interface_flux` are means over its faces weighted by matched
+    /// area, `contact_fraction` is its faces' matched area over their area; 0 on nodes
+    /// of no side-A face (and NaN fluxes count as 0). Returns (gap, fraction, flux).
+    pub(super) fn nodal(&self, mesh: &Mesh) -> [Vec<f64>; 3] {
+        let n = mesh.num_nodes();
+        let (mut area, mut matched, mut gap, mut flux) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        for f in self.faces.iter().filter(|f| f.side == 0) {
+            for node in &f.nodes[..f.len as usize] {
+                let i = node.index();
+                area[i] += f.face_area;
+                matched[i] += f.area;
+                gap[i] += f.area * f.gap;
+                if f.flux.is_finite() {
+                    flux[i] += f.area * f.flux;
+                }
+            }
+        }
+        let ratio = |num: &[f64], den: &[f64]| -> Vec<f64> {
+            num.iter()
+                .zip(den)
+                .map(|(a, b)| if *b > 0.0 { a / b } else { 0.0 })
+                .collect()
+        };
+        [
+            ratio(&gap, &matched),
+            ratio(&matched, &area)
+                .into_iter()
+                .map(|v| v.min(1.0))
+                .collect(),
+            ratio(&flux, &matched),
+        ]
+    }
+}
+
+/// The labels of a summed model's mechanisms, for `interface_heat.csv`: each part's
+/// name, with `#k` (1-based) added to names that occur more than once. Empty for a
+/// model that is not a sum.
+pub(super) fn mechanism_names(model: &dyn ConductanceModel) -> Vec<String> {
+    let names: Vec<String> = model.mechanisms().iter().map(|m| m.name()).collect();
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| {
+            if names.iter().filter(|m| *m == n).count() > 1 {
+                format!("{n}#{}", k + 1)
+            } else {
+                n.clone()
+            }
+        })
+        .collect()
+}
+
+/// The heat each mechanism of a summed conductance carries out of side A (W): the
+/// point flux q split in proportion to the mechanisms' h at the point's state,
+/// `Q_i = Σ w q h_i / Σ_j h_j`. A mechanism's h in the flux is exact for the resistance
+/// form (q = h [u]) and, for the Robin–Nitsche form, q = h j* with the consistent jump
+/// j* = (α[u] − {k∂u})/(h + α), so each mechanism's share is h_i j* in both, and the
+/// shares add up to the interaction's heat. A point where any mechanism fails (a
+/// quarantined point) or where h is 0 contributes to no mechanism.
+pub(super) fn mechanism_heat(
+    model: &dyn ConductanceModel,
+    pairing: &Pairing,
+    fluxes: &[Option<PointFlux>],
+    pressure: impl Fn(usize) -> f64,
+    time: f64,
+) -> Vec<f64> {
+    let parts = model.mechanisms();
+    let mut out = vec![0.0; parts.len()];
+    let mut h = vec![0.0; parts.len()];
+    for (k, (p, f)) in pairing.result.points.iter().zip(fluxes).enumerate() {
+        let Some(f) = f else { continue };
+        let state = PointState {
+            gap: p.gap - p.offset,
+            pressure: pressure(k),
+            temp_a: f.temp_a,
+            temp_b: f.temp_b,
+            x: p.x,
+            time,
+        };
+        let mut ok = true;
+        for (hi, part) in h.iter_mut().zip(parts) {
+            match part.value(&state) {
+                Ok(v) => *hi = v,
+                Err(_) => ok = false,
+            }
+        }
+        let total: f64 = h.iter().sum();
+        if !ok || total <= 0.0 {
+            continue;
+        }
+        for (o, hi) in out.iter_mut().zip(&h) {
+            *o += p.weight * f.q * hi / total;
+        }
+    }
+    out
+}
+
+/// What one interaction writes as contact output, from its definition's `Visualize
+/// Contact` and `Output Rule`:
+///
+/// | `Output Rule` | with `Visualize Contact` |
+/// |---|---|
+/// | `none` | nothing (warning `W0702`) |
+/// | `summary` (default) | side-A faces in `contact.vtu`, nodal fields in `results.exo` |
+/// | `verbose` | and the side-B faces with their own values |
+/// | `more verbose` | and every side-A point in `contact_points.vtu` |
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct ContactView {
+    pub faces: bool,
+    pub side_b: bool,
+    pub points: bool,
+    /// `Visualize Contact` on and `Output Rule = none`.
+    pub silenced: bool,
+}
+
+impl ContactView {
+    pub(super) fn of(def: &ContactDefinition) -> Self {
+        let rule = def.output_rule.unwrap_or(OutputRule::Summary);
+        let on = def.visualize_contact && rule != OutputRule::None;
+        ContactView {
+            faces: on,
+            side_b: on && matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose),
+            points: on && rule == OutputRule::MoreVerbose,
+            silenced: def.visualize_contact && rule == OutputRule::None,
+        }
+    }
+}
+
+/// The points of one interaction for `contact_points.vtu`: its 1-based index, its
+/// pairing and the flux at its points (if known).
+pub(super) type PointsOf<'a> = (u32, &'a Pairing, Option<&'a [Option<PointFlux>]>);
+
+/// What a solved state gives beyond its temperature, per interaction (in the run's
+/// order): the flux at each point (`None` where not asked for, and for multiplier ties)
+/// and the heat of each mechanism of a summed conductance (empty otherwise).
+#[derive(Debug, Default)]
+pub(super) struct Derived {
+    pub fluxes: Vec<Option<Vec<Option<PointFlux>>>>,
+    pub mechanisms: Vec<Vec<f64>>,
+}
