@@ -486,12 +486,20 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
         }
     };
     let path = path.as_path();
-    let progress = progress_printer(json);
+    let (progress, phase) = progress_printer(json);
     let options = seam::run::RunOptions {
         restart,
         progress: Some(progress),
+        phase: Some(phase),
     };
-    match seam::run::run_with(path, &options) {
+    let result = seam::run::run_with(path, &options);
+    {
+        use std::io::IsTerminal as _;
+        if std::io::stderr().is_terminal() {
+            eprint!("\r\x1b[K"); // clear the progress line
+        }
+    }
+    match result {
         Ok(r) => {
             let s = &r.summary;
             if json {
@@ -559,33 +567,56 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
     }
 }
 
-/// Progress of a run's steps on stderr: a bar redrawn in place on a terminal, a plain
-/// line every tenth of the run in logs (and nothing with `--json` off a terminal).
-fn progress_printer(json: bool) -> Box<dyn Fn(&seam::heat::transient::StepReport)> {
+/// A run's step progress and the phase callback for `RunOptions`.
+type Progress = (
+    Box<dyn Fn(&seam::heat::transient::StepReport)>,
+    Box<dyn Fn(&str)>,
+);
+
+/// Progress of a run on stderr: the phase and the steps redrawn in place on a terminal;
+/// in logs a line per phase from 2 s into the run and a step line at most every 5 s (nothing with
+/// `--json` off a terminal). Every line carries the time since the run started.
+fn progress_printer(json: bool) -> Progress {
     use std::io::IsTerminal as _;
+    use std::rc::Rc;
     let terminal = std::io::stderr().is_terminal();
-    let last = std::cell::Cell::new(std::time::Instant::now());
-    Box::new(move |r| {
-        if r.dt == 0.0 {
-            return; // a steady solve: one step
-        }
-        let now = std::time::Instant::now();
+    let start = std::time::Instant::now();
+    let last = Rc::new(std::cell::Cell::new(start));
+    let phase = move |what: &str| {
+        let at = start.elapsed().as_secs_f64();
         if terminal {
-            if now.duration_since(last.get()).as_millis() >= 100 {
-                eprint!(
-                    "\r  step {:>6}  t = {:<12.6e} dt = {:<10.3e} Newton {:>2}  ",
+            eprint!("\r\x1b[K  [{at:7.1} s] {what} …");
+        } else if !json && at >= 2.0 {
+            // Logs: quiet for short runs, a line per phase once the run takes a while.
+            eprintln!("  [{at:7.1} s] {what}");
+        }
+    };
+    let steps = {
+        let last = Rc::clone(&last);
+        move |r: &seam::heat::transient::StepReport| {
+            if r.dt == 0.0 {
+                return; // a steady solve: one step
+            }
+            let now = std::time::Instant::now();
+            let at = now.duration_since(start).as_secs_f64();
+            if terminal {
+                if now.duration_since(last.get()).as_millis() >= 100 {
+                    eprint!(
+                        "\r\x1b[K  [{at:7.1} s] step {:>6}  t = {:<12.6e} dt = {:<10.3e} Newton {:>2}",
+                        r.step, r.time, r.dt, r.newton_iterations
+                    );
+                    last.set(now);
+                }
+            } else if !json && now.duration_since(last.get()).as_secs() >= 5 {
+                eprintln!(
+                    "  [{at:7.1} s] step {} t = {:e} dt = {:e} Newton {}",
                     r.step, r.time, r.dt, r.newton_iterations
                 );
                 last.set(now);
             }
-        } else if !json && now.duration_since(last.get()).as_secs() >= 5 {
-            eprintln!(
-                "  step {} t = {:e} dt = {:e} Newton {}",
-                r.step, r.time, r.dt, r.newton_iterations
-            );
-            last.set(now);
         }
-    })
+    };
+    (Box::new(steps), Box::new(phase))
 }
 
 fn check_plugin(path: &Path, real: &[f64], integer: &[i64]) -> ExitCode {

@@ -419,6 +419,18 @@ pub struct RunOptions {
     /// Called after every accepted step (progress display).
     #[allow(clippy::type_complexity)]
     pub progress: Option<Box<dyn Fn(&StepReport)>>,
+    /// Called when a phase of the run starts (`reading the mesh`, `search`, `solve`…),
+    /// so long set-up work shows on a progress display too.
+    #[allow(clippy::type_complexity)]
+    pub phase: Option<Box<dyn Fn(&str)>>,
+}
+
+impl RunOptions {
+    fn phase(&self, what: &str) {
+        if let Some(f) = &self.phase {
+            f(what);
+        }
+    }
 }
 
 /// Solve the problem in `path` with `options`.
@@ -472,6 +484,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         }
     };
     let clock = Instant::now();
+    options.phase("reading the mesh");
     let mesh = mesh::read(&dir.join(&problem.mesh.file))
         .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
     let mesh_s = clock.elapsed().as_secs_f64();
@@ -566,6 +579,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                     .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
                 );
             }
+            options.phase("building the contact surfaces");
             let t = Instant::now();
             let set = surface::build(&mesh, def, &loaded.sources);
             timing.surfaces_s += t.elapsed().as_secs_f64();
@@ -575,6 +589,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             if diags.has_errors() {
                 continue;
             }
+            options.phase("contact search");
             let t = Instant::now();
             let scene = search_definition(
                 &mesh,
@@ -1025,6 +1040,10 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
         };
+        options.phase(&format!(
+            "assembling and solving ({} nodes)",
+            mesh.num_nodes()
+        ));
         let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
         if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
             return Err(RunError::Solve(format!("[[source]]: {e}")));
@@ -1120,6 +1139,10 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             history.push(r.clone());
             Ok(())
         };
+        options.phase(&format!(
+            "assembling and factorising the first step ({} nodes)",
+            mesh.num_nodes()
+        ));
         let outcome = transient::solve(&tp, mode, start, &mut on_step)
             .map_err(|e| RunError::Solve(e.to_string()))?;
         let last = &outcome.state;
