@@ -359,6 +359,18 @@ fn local(a: &SideEval, b: &SideEval, form: Form, beta: f64) -> Local {
     l
 }
 
+/// One point's values at a field: see [`InterfacePoints::at_point`].
+struct PointEval<'a> {
+    jump: &'a [f64],
+    flux: &'a [f64],
+    /// `[u] − ΔT` and `{k∂u}` at the point.
+    jump_u: f64,
+    flux_u: f64,
+    hv: HValue,
+    temp_a: f64,
+    temp_b: f64,
+}
+
 /// Where the entries of an interaction's blocks go in an [`Assembler`]: see
 /// [`InterfacePoints::scatter`].
 #[derive(Clone, Debug, Default)]
@@ -598,6 +610,78 @@ impl InterfacePoints {
         Scatter { slots }
     }
 
+    /// The local vectors of point `p` (of a group with `dofs`), the jump and
+    /// flux-average of the field there, and h.
+    fn at_point(
+        &self,
+        p: &CachedPoint,
+        dofs: &[u32],
+        form: &InterfaceForm<'_>,
+        u: &[f64],
+    ) -> Result<PointEval<'_>, InterfaceError> {
+        let nl = dofs.len();
+        let at = p.at as usize;
+        let jump = &self.values[at..at + nl];
+        let flux = &self.values[at + nl..at + 2 * nl];
+        let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[dofs[i] as usize]).sum() };
+        let jump_u = value(jump) - form.offset;
+        let flux_u = value(flux);
+        let temp_a: f64 = (0..p.na as usize)
+            .map(|i| jump[i] * u[dofs[i] as usize])
+            .sum();
+        let temp_b = temp_a - (jump_u + form.offset);
+        let hv = match form.form {
+            Form::Conductance | Form::GapConductance => (form.h)(&HInput {
+                gap: p.gap,
+                temp_a,
+                temp_b,
+                x: p.x,
+                point: p.index as usize,
+            })
+            .map_err(|message| InterfaceError::Conductance {
+                at: p.x,
+                elem: p.elem,
+                side: p.side,
+                message,
+            })?,
+            _ => HValue::default(),
+        };
+        Ok(PointEval {
+            jump,
+            flux,
+            jump_u,
+            flux_u,
+            hv,
+            temp_a,
+            temp_b,
+        })
+    }
+
+    /// The heat flux from side A to side B at every point of the pairing the cache was
+    /// made from (`count` points; `None` where a point is not matched or is a node
+    /// point): `q = P([u] − ΔT) − θ{k∂u}`.
+    pub fn point_flux(
+        &self,
+        form: &InterfaceForm<'_>,
+        u: &[f64],
+        count: usize,
+    ) -> Result<Vec<Option<PointFlux>>, InterfaceError> {
+        let mut out = vec![None; count];
+        for g in 0..self.groups() {
+            let dofs = self.group(g);
+            for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
+                let e = self.at_point(p, dofs, form, u)?;
+                let ([cp, ct, _], _) = coefficients(form.form, e.hv.h, p.alpha);
+                out[p.index as usize] = Some(PointFlux {
+                    q: cp * e.jump_u - ct * e.flux_u,
+                    temp_a: e.temp_a,
+                    temp_b: e.temp_b,
+                });
+            }
+        }
+        Ok(out)
+    }
+
     /// The form at the field `u`: Jacobian blocks (exact, including dh/dT), residual,
     /// and the right-hand side of the offset terms.
     pub fn evaluate(
@@ -615,32 +699,15 @@ impl InterfacePoints {
             let nl = dofs.len();
             let mut m = vec![0.0; nl * nl];
             for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
-                let at = p.at as usize;
-                let jump = &self.values[at..at + nl];
-                let flux = &self.values[at + nl..at + 2 * nl];
+                let PointEval {
+                    jump,
+                    flux,
+                    jump_u,
+                    flux_u,
+                    hv,
+                    ..
+                } = self.at_point(p, dofs, form, u)?;
                 let na = p.na as usize;
-                let value =
-                    |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[dofs[i] as usize]).sum() };
-                let jump_u = value(jump) - form.offset;
-                let flux_u = value(flux);
-                let temp_a: f64 = (0..na).map(|i| jump[i] * u[dofs[i] as usize]).sum();
-                let temp_b = temp_a - (jump_u + form.offset);
-                let hv = match form.form {
-                    Form::Conductance | Form::GapConductance => (form.h)(&HInput {
-                        gap: p.gap,
-                        temp_a,
-                        temp_b,
-                        x: p.x,
-                        point: p.index as usize,
-                    })
-                    .map_err(|message| InterfaceError::Conductance {
-                        at: p.x,
-                        elem: p.elem,
-                        side: p.side,
-                        message,
-                    })?,
-                    _ => HValue::default(),
-                };
                 let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, p.alpha);
                 let w = p.weight;
                 // dh/du_j: T_A = Σ_A N u, T_B = Σ_B N u (jump entries of B are −N).
@@ -812,49 +879,5 @@ pub fn point_flux(
     form: &InterfaceForm<'_>,
     u: &[f64],
 ) -> Result<Vec<Option<PointFlux>>, InterfaceError> {
-    let fields = fields.into();
-    let mut out = Vec::with_capacity(points.len());
-    for (index, p) in points.iter().enumerate() {
-        if p.status != PointStatus::Matched || p.a_face == u32::MAX {
-            out.push(None);
-            continue;
-        }
-        let fa = &a.faces[p.a_face as usize];
-        let fb = &b.faces[p.b_face as usize];
-        let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
-        let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, form.conductivity)?;
-        let l = local(&ea, &eb, form.form, form.beta);
-        let value =
-            |v: &[f64]| -> f64 { v.iter().zip(&l.dofs).map(|(c, &d)| c * u[d as usize]).sum() };
-        let jump = value(&l.jump);
-        let flux = value(&l.flux);
-        let temp_a: f64 = (0..l.na).map(|i| l.jump[i] * u[l.dofs[i] as usize]).sum();
-        let temp_b = temp_a - jump;
-        let h = match form.form {
-            Form::Conductance | Form::GapConductance => {
-                (form.h)(&HInput {
-                    gap: p.gap - p.offset,
-                    temp_a,
-                    temp_b,
-                    x: p.x,
-                    point: index,
-                })
-                .map_err(|message| InterfaceError::Conductance {
-                    at: p.x,
-                    elem: mesh.elem_number(fa.side.elem),
-                    side: fa.side.side,
-                    message,
-                })?
-                .h
-            }
-            _ => 0.0,
-        };
-        let ([cp, ct, _], _) = coefficients(form.form, h, l.alpha);
-        out.push(Some(PointFlux {
-            q: cp * (jump - form.offset) - ct * flux,
-            temp_a,
-            temp_b,
-        }));
-    }
-    Ok(out)
+    InterfacePoints::new(mesh, dofs, fields, a, b, points, form)?.point_flux(form, u, points.len())
 }
