@@ -120,6 +120,9 @@ int seam_add_deck_file(seam_embedding *embedding, const char *path, size_t *out_
 int seam_interaction_count(const seam_embedding *embedding, size_t *out_count);
 /* Pair every interaction anew. */
 int seam_search(seam_embedding *embedding);
+/* The host's time for the next seam_evaluate: conductance models and plugins that
+ * depend on t see it (0 until set; must be finite). */
+int seam_set_time(seam_embedding *embedding, double time);
 /* New coordinates (xyz per node): pairings kept, gaps measured anew. */
 int seam_move_nodes(seam_embedding *embedding, const double *coords, size_t n_nodes);
 

@@ -685,6 +685,18 @@ pub unsafe extern "C" fn seam_search(embedding: *mut SeamEmbedding) -> c_int {
     })
 }
 
+/// The host's time for the next `seam_evaluate` (conductance models and plugins that
+/// depend on t see it).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_set_time(embedding: *mut SeamEmbedding, time: f64) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        e.inner.set_time(time)?;
+        e.evaluated = None;
+        Ok(())
+    })
+}
+
 /// New coordinates of every node (3 per node): pairings are kept, gaps measured anew.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_move_nodes(

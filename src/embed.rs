@@ -613,6 +613,7 @@ impl EmbeddingBuilder {
             fixed: self.fixed.iter().map(|&f| NodeId(f as u32)).collect(),
             integration: self.integration,
             pairs: Vec::new(),
+            time: 0.0,
         })
     }
 }
@@ -767,6 +768,8 @@ pub struct Embedding {
     fixed: Vec<NodeId>,
     integration: Integration,
     pairs: Vec<Pair>,
+    /// The host's time, passed to conductance models and plugins (0 until set).
+    time: f64,
 }
 
 impl Embedding {
@@ -1226,6 +1229,25 @@ impl Embedding {
         Ok(())
     }
 
+    /// The host's time for the next [`Self::contributions`]: conductance models and
+    /// plugins that depend on t (a Lua expression of `t`, a plugin's time argument)
+    /// see it. Must be finite.
+    pub fn set_time(&mut self, time: f64) -> Result<(), EmbedError> {
+        if !time.is_finite() {
+            return Err(argument(
+                format!("the time {time} is not finite"),
+                "pass the host's current time in seconds",
+            ));
+        }
+        self.time = time;
+        Ok(())
+    }
+
+    /// The time set by [`Self::set_time`] (0 until then).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
     /// The nodes moved: keep every pairing, place its points again on the moved faces
     /// and measure gaps anew (`Update Search Every n Steps` between full searches).
     /// Call [`Self::search`] to pair anew.
@@ -1344,7 +1366,7 @@ impl Embedding {
                     temp_a: x.temp_a,
                     temp_b: x.temp_b,
                     x: x.x,
-                    time: 0.0,
+                    time: self.time,
                 };
                 match model.evaluate(&state) {
                     Ok(c) => Ok(HValue {

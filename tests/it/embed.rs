@@ -1186,3 +1186,68 @@ fn embed_c_sector_host_matches_seam_run() {
     assert!((range[0] - lo).abs() <= TOLERANCE * (hi - lo));
     assert!((range[1] - hi).abs() <= TOLERANCE * (hi - lo));
 }
+
+/// The host's clock reaches the conductance: with `h = 100 (1 + t)`, the residual at
+/// t = 2 equals that of a constant h = 300 (to round-off: the same forms at the same h),
+/// and differs from the residual at t = 0; a non-finite time is refused with a message
+/// that says what to pass.
+#[test]
+fn embed_set_time_reaches_time_dependent_conductances() {
+    let deck = |h: &str| {
+        format!(
+            "begin contact definition clock
+  contact surface a contains base_top
+  contact surface b contains lid_bottom
+  begin interaction
+    side a a
+    side b b
+  end
+  begin enforcement
+    enforcement for energy = gap_conductance
+    gap conductance coefficient = {h}
+  end
+end
+"
+        )
+    };
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let n = mesh.num_nodes();
+    let dof = example::host_dofs(&mesh);
+    let build = |h: &str| {
+        let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+        seam.add_deck("clock.i", &deck(h)).unwrap();
+        seam.search().unwrap();
+        seam
+    };
+    let mut clocked = build("lua \"100 * (1 + t)\"");
+    let constant = build("constant h = 300");
+    // A field with a jump across the interface: 300 K below z = 1, 400 K above.
+    let mut u = vec![0.0; n];
+    for (i, x) in mesh.coords.iter().enumerate() {
+        u[dof[i]] = if x[2] > 1.0 - 1e-9 { 400.0 } else { 300.0 };
+    }
+    let residual = |seam: &seam::embed::Embedding| -> Vec<f64> {
+        let mut r = vec![0.0; n];
+        for (d, v) in seam.contributions(&u).unwrap().residual {
+            r[d] += v;
+        }
+        r
+    };
+    let diff = |a: &[f64], b: &[f64]| {
+        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / scale
+    };
+    assert_eq!(clocked.time(), 0.0);
+    let target = residual(&constant);
+    let at_0 = diff(&residual(&clocked), &target);
+    clocked.set_time(2.0).unwrap();
+    let at_2 = diff(&residual(&clocked), &target);
+    println!("against h = 300: t = 0 off by {at_0:.3e}, t = 2 off by {at_2:.3e} (relative)");
+    assert!(at_0 > 1e-2, "{at_0}");
+    assert!(at_2 <= 1e-12, "{at_2}");
+    let e = clocked.set_time(f64::NAN).unwrap_err().to_string();
+    assert!(e.contains("not finite"), "{e}");
+}
