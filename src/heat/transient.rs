@@ -23,8 +23,14 @@
 //! caller's `on_step`, so contact state and output are committed on accepted steps
 //! only.
 //!
+//! A linear step (constant laws, conductances independent of T, linear faces and
+//! sources) costs one assembly: the element matrices are kept while the faces'
+//! derivatives do not change, the residual after the solve is `R + J du`, and a fixed
+//! step reuses its factorisation. The interface geometry at the contact points is
+//! evaluated once per run ([`InterfacePoints`]).
+//!
 //! Results are reproducible bit for bit: element loops write fixed slots, interface
-//! sums run in point order, and the factorisations run sequentially when
+//! sums run in a fixed order, and the factorisations run sequentially when
 //! [`TransientProblem::reproducible`] is set — so a run restarted from a
 //! [`State`] continues exactly as the uninterrupted run.
 

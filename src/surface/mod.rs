@@ -8,7 +8,7 @@
 //! 1. *Inclusion.* Every element of a block named by any surface command (or listed by
 //!    `Element =`) is included in the definition; dead elements never are.
 //! 2. *Skinning.* A block contributes its exterior sides: sides no other included
-//!    element shares (see [`skin`]). Shells contribute top and bottom, lofted by half
+//!    element shares (see the `skin` module). Shells contribute top and bottom, lofted by half
 //!    their thickness; a solid side under an equivalenced shell is sandwiched.
 //! 3. *Side sets* contribute their sides, exterior or not (a dead element's sides drop
 //!    out). *Node sets* make node surfaces.
