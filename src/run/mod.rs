@@ -1954,8 +1954,8 @@ fn check_nodal_fields(p: &Problem, at: &ProblemText, diags: &mut Diagnostics) {
 }
 
 /// A `[[nodal_field]]` read from a nodal variable of an Exodus II file, one value per
-/// mesh node, at `step` (1 = the first stored), at the stored `time`, or at the last
-/// step. The file's nodes are matched to the mesh's by their node numbers and must sit
+/// mesh node, at `step` (1 = the first stored), at `time` (a stored time, or linearly
+/// interpolated between the two around it), or at the last step. The file's nodes are matched to the mesh's by their node numbers and must sit
 /// where the mesh's do (to 1e-6 of the mesh's size, so coordinates stored in single
 /// precision pass and another mesh with as many nodes does not). Errors: message, help.
 fn read_nodal_field(
@@ -1980,7 +1980,9 @@ fn read_nodal_field(
     let shown = file.display();
     let times = exodus::read_times(file).map_err(split)?;
     let n = times.len();
-    let step = match (f.step, f.time) {
+    // The stored steps to read and the weight of the second: a stored time or step is
+    // read as it is; a time between two stored times is interpolated linearly.
+    let (first, second, w) = match (f.step, f.time) {
         _ if n == 0 => {
             return Err((
                 format!("{shown} holds no time steps, so no values of `{name}`"),
@@ -1995,29 +1997,41 @@ fn read_nodal_field(
                 format!("give step = 1 … {n}, or leave it out for the last"),
             ));
         }
-        (Some(s), _) => s - 1,
+        (Some(s), _) => (s - 1, s - 1, 0.0),
         (None, Some(t)) => {
             let scale = times.iter().fold(t.abs(), |m, v| m.max(v.abs()));
             let nearest = (0..n)
                 .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
                 .expect("n > 0");
-            if (times[nearest] - t).abs() > 1e-9 * scale {
+            let increasing = times.windows(2).all(|w| w[1] > w[0]);
+            if (times[nearest] - t).abs() <= 1e-9 * scale {
+                (nearest, nearest, 0.0)
+            } else if increasing && times[0] < t && t < times[n - 1] {
+                let i = times.partition_point(|&v| v <= t) - 1;
+                (i, i + 1, (t - times[i]) / (times[i + 1] - times[i]))
+            } else {
                 return Err((
                     format!(
-                        "{shown} has no step at time {t} for `{name}`: it holds {n} step(s) from t = {} to {}; the nearest is t = {} (step {})",
+                        "{shown}: time {t} for `{name}` is outside the stored times (or they do not increase): {n} step(s) from t = {} to {}; the nearest is t = {} (step {})",
                         times[0],
                         times[n - 1],
                         times[nearest],
                         nearest + 1
                     ),
-                    "give a stored time, or the step as step = n".into(),
+                    "give a time within the stored ones (between two, the field is interpolated linearly), or the step as step = n".into(),
                 ));
             }
-            nearest
         }
-        (None, None) => n - 1,
+        (None, None) => (n - 1, n - 1, 0.0),
     };
-    let values = exodus::read_nodal_variable(file, name, step).map_err(split)?;
+    let mut values = exodus::read_nodal_variable(file, name, first).map_err(split)?;
+    if second != first {
+        let next = exodus::read_nodal_variable(file, name, second).map_err(split)?;
+        values
+            .iter_mut()
+            .zip(&next)
+            .for_each(|(v, u)| *v = (1.0 - w) * *v + w * u);
+    }
     let source = exodus::read(file).map_err(split)?;
     let help = "write the field on the run's mesh: the same nodes, paired by the node number map";
     if source.num_nodes() != mesh.num_nodes() {

@@ -448,6 +448,15 @@ fn contact_pressure_from_an_exodus_variable() {
         e.contains("E0712") && e.contains("moved.exo: node") && e.contains("there but at"),
         "{e}"
     );
+    // Between the stored times the field is interpolated: at t = 0.25 it is
+    // 0.75 · 1 Pa + 0.25 · ramp, the same heat as that field written in Lua.
+    let between = heat("file = \"pressure.exo\"\nvariable = \"pressure\"\ntime = 0.25\n");
+    let blend = heat("value = \"0.75 + 0.25*(0.5e6 + 1e6*x)\"\n");
+    eprintln!("t = 0.25: Exodus interpolated {between}, Lua {blend}");
+    assert!(
+        (between - blend).abs() <= 1e-12 * blend.abs(),
+        "{between} vs {blend}"
+    );
     // Step 1 holds the flat field of 1 Pa: much less heat than the ramp.
     let first = heat("file = \"pressure.exo\"\nvariable = \"pressure\"\nstep = 1\n");
     assert!(first.abs() < 0.5 * lua.abs(), "{first} vs {lua}");
@@ -468,15 +477,19 @@ fn contact_pressure_from_an_exodus_variable() {
     // (file, variable, what the message says); the caret is on the `file` line (21).
     for (file, variable, expect) in [
         ("pressure.exo", "presure", "no nodal variable `presure`"),
-        ("pressure.exo", "pressure", "no step at time 0.5"),
+        (
+            "pressure.exo",
+            "pressure",
+            "time 1.5 for `pressure` is outside",
+        ),
         (
             "other.exo",
             "pressure",
             "has values at 27 nodes, but the mesh has",
         ),
     ] {
-        let time = if expect.contains("0.5") {
-            "time = 0.5\n"
+        let time = if expect.contains("1.5") {
+            "time = 1.5\n"
         } else {
             ""
         };
