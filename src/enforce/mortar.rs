@@ -45,6 +45,24 @@ pub struct MortarTie {
     pub psi_integral: Vec<f64>,
     pub side_a_dofs: Vec<u32>,
     pub side_b_dofs: Vec<u32>,
+    /// `(point, multiplier, ψ)`: the multiplier basis at each matched face point of the
+    /// pairing, for [`MortarTie::point_flux`].
+    pub point_psi: Vec<(u32, u32, f64)>,
+}
+
+impl MortarTie {
+    /// The multiplier field `λ_h = Σ_k ψ_k λ_k` at each of the pairing's `count` points
+    /// (`None` where the tie has no multiplier: unmatched and node points). It is the
+    /// heat flux from side A to side B: the heat leaving side A is
+    /// `Σ_{d∈A} (Cᵀλ)_d = Σ_points w λ_h`, since side A's shape functions sum to one.
+    pub fn point_flux(&self, lambda: &[f64], count: usize) -> Vec<Option<f64>> {
+        let mut out = vec![None; count];
+        for &(p, k, psi) in &self.point_psi {
+            let q = out[p as usize].get_or_insert(0.0);
+            *q += psi * lambda[k as usize];
+        }
+        out
+    }
 }
 
 /// Which multiplier basis.
@@ -123,9 +141,11 @@ pub fn mortar_tie(
     let mut psi_integral = vec![0.0; index.len()];
     let mut side_a = Vec::new();
     let mut side_b = Vec::new();
-    for p in points
+    let mut point_psi = Vec::new();
+    for (at, p) in points
         .iter()
-        .filter(|p| p.status == PointStatus::Matched && p.a_face != u32::MAX)
+        .enumerate()
+        .filter(|(_, p)| p.status == PointStatus::Matched && p.a_face != u32::MAX)
     {
         let fa = &a.faces[p.a_face as usize];
         let fb = &b.faces[p.b_face as usize];
@@ -174,6 +194,7 @@ pub fn mortar_tie(
                 continue;
             }
             psi_integral[k as usize] += p.weight * psi;
+            point_psi.push((at as u32, k, psi));
             for j in 0..ea.len {
                 *entries.entry((k, ea.dofs[j])).or_default() += p.weight * psi * ea.n[j];
             }
@@ -207,6 +228,7 @@ pub fn mortar_tie(
         psi_integral,
         side_a_dofs: side_a,
         side_b_dofs: side_b,
+        point_psi,
     })
 }
 

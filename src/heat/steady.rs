@@ -501,12 +501,10 @@ fn solve_dual(
     // Multipliers from the condensed rows: D_k λ_k = −(K u − F)_k.
     let mut ku = vec![0.0; n];
     spmv(&k, &u, &mut ku);
-    let tie_heat = ties
+    let lambdas: Vec<Vec<f64>> = ties
         .iter()
         .map(|tie| {
-            let mut ct = std::collections::HashMap::<u32, f64>::new();
-            let lambda: Vec<f64> = tie
-                .nodes
+            tie.nodes
                 .iter()
                 .map(|node| {
                     let d = dofs.dof(field, *node).map_or(0, |d| d.index());
@@ -516,7 +514,14 @@ fn solve_dual(
                         -(ku[d] - f[d]) / diag[d]
                     }
                 })
-                .collect();
+                .collect()
+        })
+        .collect();
+    let tie_heat = ties
+        .iter()
+        .zip(&lambdas)
+        .map(|(tie, lambda)| {
+            let mut ct = std::collections::HashMap::<u32, f64>::new();
             for &(kk, d, c) in &tie.entries {
                 *ct.entry(d).or_default() += c * lambda[kk as usize];
             }
@@ -540,6 +545,12 @@ fn solve_dual(
         })
         .collect::<Result<Vec<_>, HeatError>>()?;
     let temperature = dofs.nodal_values(field, &u);
+    // The multipliers after the primal dofs, as the saddle-point path stores them.
+    let mut dofs = dofs;
+    for lambda in &lambdas {
+        dofs.add_extra(lambda.len());
+        u.extend_from_slice(lambda);
+    }
     Ok(SteadySolution {
         crosspoints: ties.iter().map(|t| t.crosspoints.clone()).collect(),
         dofs,

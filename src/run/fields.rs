@@ -109,7 +109,7 @@ pub(super) struct ContactFace {
     /// The face's area (m², as searched).
     pub face_area: f64,
     /// Mean heat flux from side A to side B over the matched area (W/m²); 0 with no
-    /// matched point, NaN for an interaction without per-point flux (multiplier ties).
+    /// matched point, NaN for an interaction whose point fluxes were not derived.
     pub flux: f64,
 }
 
@@ -325,7 +325,8 @@ impl ContactView {
 pub(super) type PointsOf<'a> = (u32, &'a Pairing, Option<&'a [Option<PointFlux>]>);
 
 /// What a solved state gives beyond its temperature, per interaction (in the run's
-/// order): the flux at each point (`None` where not asked for, and for multiplier ties)
+/// order): the flux at each point (`None` where not asked for; a multiplier tie's is its
+/// multiplier field, [`crate::enforce::mortar::MortarTie::point_flux`])
 /// and the heat of each mechanism of a summed conductance (empty otherwise).
 #[derive(Debug, Default)]
 pub(super) struct Derived {

@@ -40,6 +40,8 @@
 mod fields;
 mod steps;
 
+use crate::enforce::interface::PointFlux;
+use crate::enforce::mortar::MortarTie;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -881,6 +883,9 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
     // What a state gives beyond its temperature: per interaction the flux at its points
     // (where the contact output or a mechanism split needs it; `faces` asks for the
     // contact output) and the heat of each mechanism.
+    // The mortar ties as the solver built them, for their multipliers' fluxes (made at
+    // the first state that asks).
+    let tie_geometry: std::cell::OnceCell<Result<Vec<MortarTie>, String>> = Default::default();
     let derive = |u: &[f64], dofs: &DofMap, time: f64, faces: bool| -> Result<Derived, String> {
         clock.set(time);
         let mut out = Derived::default();
@@ -888,6 +893,46 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             pairings.iter().zip(&choices).zip(&h_fns).enumerate()
         {
             let split = !mechanism_names[k].is_empty();
+            if c.mortar && faces && views[k].faces {
+                // A multiplier tie: the flux is its multiplier field λ_h at the points.
+                let ties = tie_geometry.get_or_init(|| {
+                    rebuild_ties(
+                        &mesh,
+                        dofs,
+                        &pairings,
+                        &choices,
+                        &term_fields,
+                        &field_names,
+                        &dirichlet,
+                        &conductivity,
+                    )
+                });
+                let ties = ties.as_ref().map_err(Clone::clone)?;
+                let t = choices[..k].iter().filter(|(c, _, _)| c.mortar).count();
+                let (Some(tie), Some(range)) = (ties.get(t), dofs.extra_ranges().get(t)) else {
+                    return Err(format!(
+                        "interaction {} / {}: no multipliers in the state",
+                        p.side_a, p.side_b
+                    ));
+                };
+                let on = toggles[k]
+                    .as_ref()
+                    .is_none_or(|on| on.iter().any(|&(a, b)| a <= time && time <= b));
+                let q = tie
+                    .point_flux(&u[range.clone()], p.result.points.len())
+                    .into_iter()
+                    .map(|q| {
+                        q.map(|q| PointFlux {
+                            q: if on { q } else { 0.0 },
+                            temp_a: f64::NAN,
+                            temp_b: f64::NAN,
+                        })
+                    })
+                    .collect();
+                out.fluxes.push(Some(q));
+                out.mechanisms.push(Vec::new());
+                continue;
+            }
             if c.mortar || !(split || (faces && views[k].faces)) {
                 out.fluxes.push(None);
                 out.mechanisms.push(Vec::new());
@@ -2375,4 +2420,56 @@ fn initial_values(
             Ok(vec![mean; mesh.num_nodes()])
         }
     }
+}
+
+/// The mortar ties of the run, built as the solvers build them: in interaction order,
+/// with the Dirichlet nodes and the earlier ties' nodes left without multipliers, so
+/// multiplier `k` of tie `t` is entry `k` of the state's `t`-th extra range.
+#[allow(clippy::too_many_arguments)]
+fn rebuild_ties(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    pairings: &[Pairing],
+    choices: &[Choice],
+    term_fields: &[(usize, usize)],
+    field_names: &[String],
+    dirichlet: &[(NodeId, usize)],
+    conductivity: &[f64],
+) -> Result<Vec<MortarTie>, String> {
+    let mut constrained: std::collections::HashSet<NodeId> =
+        dirichlet.iter().map(|&(n, _)| n).collect();
+    let field = |i: usize| {
+        dofs.field(&field_names[i])
+            .ok_or_else(|| format!("no dofs of field `{}`", field_names[i]))
+    };
+    let mut out = Vec::new();
+    for (k, (p, (c, _, _))) in pairings.iter().zip(choices).enumerate() {
+        if !c.mortar {
+            continue;
+        }
+        let (fa, fb) = term_fields[k];
+        let pair = crate::enforce::interface::FieldPair {
+            a: field(fa)?,
+            b: field(fb)?,
+        };
+        let multipliers = if c.dual {
+            crate::enforce::mortar::Multipliers::Dual
+        } else {
+            crate::enforce::mortar::Multipliers::Standard
+        };
+        let tie = crate::enforce::mortar::mortar_tie(
+            mesh,
+            dofs,
+            pair,
+            &p.side_a_geometry,
+            &p.side_b_geometry,
+            &p.result.points,
+            conductivity,
+            &mut constrained,
+            multipliers,
+        )
+        .map_err(|e| format!("interaction {} / {}: {e}", p.side_a, p.side_b))?;
+        out.push(tie);
+    }
+    Ok(out)
 }

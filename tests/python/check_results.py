@@ -18,7 +18,7 @@ Wherever they are present (required with the flags):
 - `--expect-contact`: the contact faces, `contact.vtu` and the files `contact.pvd`
   lists, with cell data `interaction`, `side`, `contact_gap`, `contact_fraction`,
   `contact_area`, `interface_flux` (finite; the fraction in [0, 1]; an interaction's
-  flux may be NaN only on all of its cells: a multiplier tie has no per-point flux),
+  flux may be NaN only on all of its cells, where its point fluxes were not derived),
   and the nodal variables `contact_gap`, `contact_fraction`, `interface_flux` in every
   Exodus file, finite at every step. `contact_points.vtu` is checked when present.
 
