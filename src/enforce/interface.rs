@@ -568,8 +568,7 @@ impl InterfacePoints {
         &self.dofs[self.group_dofs[g]..self.group_dofs[g + 1]]
     }
 
-    /// The dof pairs (i < j) the groups couple, for [`Pattern::add_couplings`]
-    /// (the same list [`InterfaceSystem::couplings`] gives for every evaluation).
+    /// The dof pairs (i < j) the groups couple, for [`Pattern::add_couplings`].
     ///
     /// [`Pattern::add_couplings`]: crate::assembly::Pattern::add_couplings
     pub fn couplings(&self) -> Vec<(usize, usize)> {
@@ -757,19 +756,6 @@ impl InterfacePoints {
 }
 
 impl InterfaceSystem {
-    /// The dof pairs (i < j) the blocks couple, for [`Pattern::add_couplings`].
-    ///
-    /// [`Pattern::add_couplings`]: crate::assembly::Pattern::add_couplings
-    pub fn couplings(&self) -> Vec<(usize, usize)> {
-        let mut out = Vec::new();
-        for (dofs, _) in &self.blocks {
-            push_couplings(dofs, &mut out);
-        }
-        out.sort_unstable();
-        out.dedup();
-        out
-    }
-
     /// Add the blocks of a system evaluated from the [`InterfacePoints`] that made
     /// `scatter`.
     pub fn add_scattered(&self, asm: &mut Assembler<'_>, scatter: &Scatter) {
@@ -780,36 +766,6 @@ impl InterfaceSystem {
                 Slot::Diagonal(i) => asm.add_diagonal(i, v),
                 Slot::Upper(k) => asm.add_coupling(k, v, 0.0),
                 Slot::Lower(k) => asm.add_coupling(k, 0.0, v),
-            }
-        }
-    }
-
-    /// Add the blocks into `asm`, whose pattern holds `couplings` (as returned by
-    /// [`Self::couplings`], registered at `first` onwards).
-    pub fn add_to(&self, asm: &mut Assembler<'_>, couplings: &[(usize, usize)], first: usize) {
-        for (dofs, m) in &self.blocks {
-            let n = dofs.len();
-            for a in 0..n {
-                for c in 0..n {
-                    let (i, j) = (dofs[a] as usize, dofs[c] as usize);
-                    let v = m[a * n + c];
-                    if v == 0.0 {
-                        continue;
-                    }
-                    if i == j {
-                        asm.add_diagonal(i, v);
-                    } else {
-                        let key = (i.min(j), i.max(j));
-                        let k = couplings
-                            .binary_search(&key)
-                            .expect("coupling registered from the same blocks");
-                        if i < j {
-                            asm.add_coupling(first + k, v, 0.0);
-                        } else {
-                            asm.add_coupling(first + k, 0.0, v);
-                        }
-                    }
-                }
             }
         }
     }

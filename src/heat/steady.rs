@@ -12,7 +12,7 @@
 use std::time::Instant;
 
 use crate::assembly::{Assembler, DofMap, Pattern};
-use crate::enforce::interface::{InterfaceForm, InterfaceSystem, interface_terms};
+use crate::enforce::interface::{InterfaceForm, InterfacePoints, InterfaceSystem};
 use crate::enforce::mortar::{MortarTie, Multipliers, mortar_tie};
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, SurfaceGeometry};
@@ -150,18 +150,19 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     // The pattern: elements plus every interface coupling (fixed by the pairing).
     let t = Instant::now();
     let mut pattern = Pattern::new(mesh, &dofs);
-    let mut first = Vec::with_capacity(p.contact.len());
-    let mut couplings = Vec::with_capacity(p.contact.len());
+    // The interface geometry at the points, once; Newton iterations only apply h.
+    let points = interface_points(p, &dofs, field)?;
+    let mut scatters = Vec::with_capacity(p.contact.len());
     let mut terms: Vec<InterfaceSystem> = Vec::with_capacity(p.contact.len());
-    for c in &p.contact {
-        let s = interface_terms(
-            mesh, &dofs, field, c.side_a, c.side_b, c.points, &c.form, &u,
-        )
-        .map_err(|e| HeatError::Contact(e.to_string()))?;
-        let cp = s.couplings();
-        first.push(pattern.add_couplings(&cp)?.start);
-        couplings.push(cp);
-        terms.push(s);
+    for (c, points) in p.contact.iter().zip(&points) {
+        let cp = points.couplings();
+        let first = pattern.add_couplings(&cp)?.start;
+        scatters.push(points.scatter(&cp, first));
+        terms.push(
+            points
+                .evaluate(&c.form, &u)
+                .map_err(|e| HeatError::Contact(e.to_string()))?,
+        );
     }
     // Tie couplings (primal dof, multiplier dof), one per entry of C.
     let mut tie_coupling_first = Vec::with_capacity(ties.len());
@@ -199,10 +200,9 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         let t = Instant::now();
         if it > 0 {
             for (k, c) in p.contact.iter().enumerate() {
-                terms[k] = interface_terms(
-                    mesh, &dofs, field, c.side_a, c.side_b, c.points, &c.form, &u,
-                )
-                .map_err(|e| HeatError::Contact(e.to_string()))?;
+                terms[k] = points[k]
+                    .evaluate(&c.form, &u)
+                    .map_err(|e| HeatError::Contact(e.to_string()))?;
             }
         }
         // R = K u − F + Σ R_Γ.
@@ -263,8 +263,8 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         iterations += 1;
         let t = Instant::now();
         asm.reset_couplings();
-        for (k, s) in terms.iter().enumerate() {
-            s.add_to(&mut asm, &couplings[k], first[k]);
+        for (s, scatter) in terms.iter().zip(&scatters) {
+            s.add_scattered(&mut asm, scatter);
         }
         for (t, tie) in ties.iter().enumerate() {
             for (e, &(_, _, c)) in tie.entries.iter().enumerate() {
@@ -362,24 +362,24 @@ fn solve_dual(
     // K and F with the flux-type contact terms (linear: evaluated at u = 0).
     let zero = vec![0.0; n];
     let mut pattern = Pattern::new(mesh, &dofs);
+    let points = interface_points(p, &dofs, field)?;
     let mut terms = Vec::new();
-    let mut firsts = Vec::new();
-    let mut couplings = Vec::new();
-    for c in &p.contact {
-        let s = interface_terms(
-            mesh, &dofs, field, c.side_a, c.side_b, c.points, &c.form, &zero,
-        )
-        .map_err(|e| HeatError::Contact(e.to_string()))?;
-        let cp = s.couplings();
-        firsts.push(pattern.add_couplings(&cp)?.start);
-        couplings.push(cp);
-        terms.push(s);
+    let mut scatters = Vec::new();
+    for (c, points) in p.contact.iter().zip(&points) {
+        let cp = points.couplings();
+        let first = pattern.add_couplings(&cp)?.start;
+        scatters.push(points.scatter(&cp, first));
+        terms.push(
+            points
+                .evaluate(&c.form, &zero)
+                .map_err(|e| HeatError::Contact(e.to_string()))?,
+        );
     }
     pattern.build()?;
     let mut asm = Assembler::new(&pattern);
     assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
-    for (k, s) in terms.iter().enumerate() {
-        s.add_to(&mut asm, &couplings[k], firsts[k]);
+    for (s, scatter) in terms.iter().zip(&scatters) {
+        s.add_scattered(&mut asm, scatter);
     }
     let k = asm.matrix()?;
     let mut f = asm.rhs();
@@ -533,14 +533,13 @@ fn solve_dual(
             (sum(&tie.side_a_dofs), sum(&tie.side_b_dofs))
         })
         .collect();
-    let heat = terms
+    let heat = points
         .iter()
         .zip(&p.contact)
-        .map(|(_, c)| {
-            let s = interface_terms(
-                mesh, &dofs, field, c.side_a, c.side_b, c.points, &c.form, &u,
-            )
-            .map_err(|e| HeatError::Contact(e.to_string()))?;
+        .map(|(points, c)| {
+            let s = points
+                .evaluate(&c.form, &u)
+                .map_err(|e| HeatError::Contact(e.to_string()))?;
             Ok(s.heat())
         })
         .collect::<Result<Vec<_>, HeatError>>()?;
@@ -563,4 +562,19 @@ fn solve_dual(
         tie_heat,
         timing,
     })
+}
+
+/// The geometry at every contact term's points (see [`InterfacePoints`]).
+fn interface_points(
+    p: &SteadyProblem<'_>,
+    dofs: &DofMap,
+    field: crate::assembly::FieldId,
+) -> Result<Vec<InterfacePoints>, HeatError> {
+    p.contact
+        .iter()
+        .map(|c| {
+            InterfacePoints::new(p.mesh, dofs, field, c.side_a, c.side_b, c.points, &c.form)
+                .map_err(|e| HeatError::Contact(e.to_string()))
+        })
+        .collect()
 }

@@ -40,7 +40,7 @@
 mod fields;
 mod steps;
 
-use crate::enforce::interface::PointFlux;
+use crate::enforce::interface::{InterfaceError, InterfacePoints, PointFlux};
 use crate::enforce::mortar::MortarTie;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -886,6 +886,9 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
     // The mortar ties as the solver built them, for their multipliers' fluxes (made at
     // the first state that asks).
     let tie_geometry: std::cell::OnceCell<Result<Vec<MortarTie>, String>> = Default::default();
+    // Per interaction, the geometry at its points, for the point fluxes.
+    let point_geometry: Vec<std::cell::OnceCell<Result<InterfacePoints, String>>> =
+        pairings.iter().map(|_| Default::default()).collect();
     let derive = |u: &[f64], dofs: &DofMap, time: f64, faces: bool| -> Result<Derived, String> {
         clock.set(time);
         let mut out = Derived::default();
@@ -954,17 +957,25 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                 beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
                 conductivity: &conductivity,
             };
-            let q = crate::enforce::interface::point_flux(
-                &mesh,
-                dofs,
-                pair,
-                &p.side_a_geometry,
-                &p.side_b_geometry,
-                &p.result.points,
-                &form,
-                u,
-            )
-            .map_err(|e| format!("interaction {} / {}: {e}", p.side_a, p.side_b));
+            let named = |e: InterfaceError| format!("interaction {} / {}: {e}", p.side_a, p.side_b);
+            // The points' geometry is made at the first state that asks and kept: the
+            // pairing and the dofs do not change over a run.
+            let points = point_geometry[k].get_or_init(|| {
+                InterfacePoints::new(
+                    &mesh,
+                    dofs,
+                    pair,
+                    &p.side_a_geometry,
+                    &p.side_b_geometry,
+                    &p.result.points,
+                    &form,
+                )
+                .map_err(named)
+            });
+            let points = points.as_ref().map_err(Clone::clone)?;
+            let q = points
+                .point_flux(&form, u, p.result.points.len())
+                .map_err(named);
             // The output evaluates the models once more; a cutback asked for here is not
             // the next step's.
             cutback.set(false);
