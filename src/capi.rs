@@ -223,6 +223,15 @@ pub struct SeamEmbedding {
     cutback: Option<f64>,
 }
 
+impl SeamEmbedding {
+    /// The interactions or the geometry changed: the last evaluation and tie rows no
+    /// longer hold.
+    fn forget_results(&mut self) {
+        self.evaluated = None;
+        self.rows = None;
+    }
+}
+
 fn as_i64(v: usize) -> i64 {
     v as i64
 }
@@ -529,8 +538,7 @@ fn model_of(code: c_int, h: f64) -> Result<Model, Failure> {
 
 fn add(e: &mut SeamEmbedding, i: Interaction, out_index: *mut usize) -> Result<(), Failure> {
     let i = e.inner.add_interaction(i)?;
-    e.evaluated = None;
-    e.rows = None;
+    e.forget_results();
     if !out_index.is_null() {
         unsafe { out(out_index, i, "out_index") }?;
     }
@@ -631,8 +639,7 @@ pub unsafe extern "C" fn seam_add_deck(
             unsafe { text(name, "name") }?
         };
         let added = e.inner.add_deck(name, deck)?;
-        e.evaluated = None;
-        e.rows = None;
+        e.forget_results();
         if !out_count.is_null() {
             unsafe { out(out_count, added.len(), "out_count") }?;
         }
@@ -652,8 +659,7 @@ pub unsafe extern "C" fn seam_add_deck_file(
         let e = unsafe { handle(embedding, "embedding") }?;
         let path = unsafe { text(path, "path") }?;
         let added = e.inner.add_deck_file(std::path::Path::new(path))?;
-        e.evaluated = None;
-        e.rows = None;
+        e.forget_results();
         if !out_count.is_null() {
             unsafe { out(out_count, added.len(), "out_count") }?;
         }
@@ -679,8 +685,7 @@ pub unsafe extern "C" fn seam_search(embedding: *mut SeamEmbedding) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
         e.inner.search()?;
-        e.evaluated = None;
-        e.rows = None;
+        e.forget_results();
         Ok(())
     })
 }
@@ -709,8 +714,7 @@ pub unsafe extern "C" fn seam_move_nodes(
         let xyz = unsafe { slice(coords, n_nodes.saturating_mul(3), "coords") }?;
         let points: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
         e.inner.move_nodes(&points)?;
-        e.evaluated = None;
-        e.rows = None;
+        e.forget_results();
         Ok(())
     })
 }
