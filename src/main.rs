@@ -578,10 +578,9 @@ type Progress = (
 /// `--json` off a terminal). Every line carries the time since the run started.
 fn progress_printer(json: bool) -> Progress {
     use std::io::IsTerminal as _;
-    use std::rc::Rc;
     let terminal = std::io::stderr().is_terminal();
     let start = std::time::Instant::now();
-    let last = Rc::new(std::cell::Cell::new(start));
+    let last = std::cell::Cell::new(start);
     let phase = move |what: &str| {
         let at = start.elapsed().as_secs_f64();
         if terminal {
@@ -591,29 +590,26 @@ fn progress_printer(json: bool) -> Progress {
             eprintln!("  [{at:7.1} s] {what}");
         }
     };
-    let steps = {
-        let last = Rc::clone(&last);
-        move |r: &seam::heat::transient::StepReport| {
-            if r.dt == 0.0 {
-                return; // a steady solve: one step
-            }
-            let now = std::time::Instant::now();
-            let at = now.duration_since(start).as_secs_f64();
-            if terminal {
-                if now.duration_since(last.get()).as_millis() >= 100 {
-                    eprint!(
-                        "\r\x1b[K  [{at:7.1} s] step {:>6}  t = {:<12.6e} dt = {:<10.3e} Newton {:>2}",
-                        r.step, r.time, r.dt, r.newton_iterations
-                    );
-                    last.set(now);
-                }
-            } else if !json && now.duration_since(last.get()).as_secs() >= 5 {
-                eprintln!(
-                    "  [{at:7.1} s] step {} t = {:e} dt = {:e} Newton {}",
+    let steps = move |r: &seam::heat::transient::StepReport| {
+        if r.dt == 0.0 {
+            return; // a steady solve: one step
+        }
+        let now = std::time::Instant::now();
+        let at = now.duration_since(start).as_secs_f64();
+        if terminal {
+            if now.duration_since(last.get()).as_millis() >= 100 {
+                eprint!(
+                    "\r\x1b[K  [{at:7.1} s] step {:>6}  t = {:<12.6e} dt = {:<10.3e} Newton {:>2}",
                     r.step, r.time, r.dt, r.newton_iterations
                 );
                 last.set(now);
             }
+        } else if !json && now.duration_since(last.get()).as_secs() >= 5 {
+            eprintln!(
+                "  [{at:7.1} s] step {} t = {:e} dt = {:e} Newton {}",
+                r.step, r.time, r.dt, r.newton_iterations
+            );
+            last.set(now);
         }
     };
     (Box::new(steps), Box::new(phase))
