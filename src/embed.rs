@@ -1126,12 +1126,12 @@ impl Embedding {
         sources: &SourceMap,
     ) -> Result<Enforcement, EmbedError> {
         let fail = |d: &Diagnostics| EmbedError::Deck(d.render(sources));
-        let Some(enf): Option<&DeckEnforcement> = def.enforcement(name) else {
-            return Err(argument(
-                format!("interaction {side_a} / {side_b} has no enforcement"),
-                "add a `begin Enforcement` block with `Enforcement for Energy = …`",
-            ));
-        };
+        let enf: &DeckEnforcement = crate::scene::enforcement_for(def, name, (side_a, side_b))
+            .map_err(|e| {
+                let mut d = Diagnostics::default();
+                d.push(e);
+                fail(&d)
+            })?;
         let choice = resolve_model(enf).map_err(|ds| {
             let mut d = Diagnostics::default();
             ds.into_iter().for_each(|x| d.push(x));

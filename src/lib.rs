@@ -17,6 +17,7 @@ pub mod output;
 pub mod periodic;
 pub mod plugin;
 pub mod run;
+pub mod scene;
 pub mod script;
 pub mod search;
 pub mod solve;

@@ -10,6 +10,9 @@ use clap::{Parser, Subcommand};
 use serde::Serialize;
 
 use seam::deck::{self, LoadedDeck};
+use seam::diag::{Diagnostic, Diagnostics, SourceMap};
+use seam::run::RunError;
+use seam::scene::{ContactScene, SceneOptions};
 
 use seam::mesh::{self, ElemId, Mesh};
 use seam::surface::{self, SurfaceKind};
@@ -85,11 +88,16 @@ enum Command {
         #[arg(long, num_args = 1.., allow_negative_numbers = true)]
         integer: Vec<i64>,
     },
-    /// Validate a deck (and, with --mesh, its surfaces) and print every diagnostic.
+    /// Validate a deck and print every diagnostic: everything `seam run` checks before
+    /// it solves (enforcement models made, Lua compiled, plugins loaded). With --mesh its
+    /// surfaces, interactions and search too; with --problem the whole problem file.
     Check {
         deck: PathBuf,
         #[arg(long)]
         mesh: Option<PathBuf>,
+        /// A problem file (`seam run`'s) to check up to the solve, with its mesh and deck.
+        #[arg(long)]
+        problem: Option<PathBuf>,
     },
 }
 
@@ -119,7 +127,11 @@ fn main() -> ExitCode {
             real,
             integer,
         } => check_plugin(&path, &real, &integer),
-        Command::Check { deck, mesh } => check(&deck, mesh.as_deref()),
+        Command::Check {
+            deck,
+            mesh,
+            problem,
+        } => check(&deck, mesh.as_deref(), problem.as_deref()),
     }
 }
 
@@ -627,59 +639,88 @@ fn check_plugin(path: &Path, real: &[f64], integer: &[i64]) -> ExitCode {
     }
 }
 
-fn check(deck_path: &Path, mesh_path: Option<&Path>) -> ExitCode {
+/// The pre-flight: every validation `seam run` makes before it solves. The deck alone:
+/// its syntax, each enforcement block resolved and its conductance model made (Lua
+/// compiled, plugins loaded and probed). With `--mesh`: the surfaces, interactions and
+/// search, and each pair's enforcement. With `--problem`: the whole problem file as
+/// `seam run` reads it, up to the solve.
+fn check(deck_path: &Path, mesh_path: Option<&Path>, problem: Option<&Path>) -> ExitCode {
     let (loaded, mesh) = match load(deck_path, mesh_path) {
         Ok(x) => x,
         Err(code) => return code,
     };
+    let deck_dir = deck_path.parent().unwrap_or(Path::new("."));
     let mut diags = loaded.diagnostics.clone();
-    let mut count = 0;
-    for def in &loaded.deck.contact_definitions {
-        for e in &def.enforcements {
-            if let Err(ds) = seam::enforce::model::resolve(e) {
-                ds.into_iter().for_each(|d| diags.push(d));
-            }
-        }
-    }
+    let mut surfaces = 0;
     if let Some(mesh) = &mesh {
-        let deck_dir = deck_path.parent().unwrap_or(Path::new("."));
-        for def in &loaded.deck.contact_definitions {
-            let set = surface::build(mesh, def, &loaded.sources);
-            count += set.surfaces.len();
-            diags.extend(set.diagnostics.clone());
-            let (interactions, d) =
-                seam::interaction::resolve(def, &set, mesh.dim, &loaded.sources);
-            diags.extend(d);
-            if !diags.has_errors() {
-                // The search checks what only geometry can tell: periodic maps that land
-                // nowhere, rotations that do not close, Lua maps that do not run.
-                let scene = seam::search::scene::search_definition(
-                    mesh,
-                    def,
-                    &set,
-                    &interactions,
-                    deck_dir,
-                    &loaded.sources,
-                    seam::search::pairing::Integration::Quadrature { order: 1 },
-                );
-                diags.extend(scene.diagnostics);
+        let scene = ContactScene::build(
+            mesh,
+            &loaded,
+            deck_dir,
+            &SceneOptions {
+                integration: seam::search::pairing::Integration::Segments { order: 5 },
+                fields: None,
+                phase: None,
+                search_only: true,
+            },
+            &mut diags,
+        );
+        surfaces = scene.surfaces;
+    }
+    seam::scene::check_enforcements(&loaded, deck_dir, None, &mut diags);
+    let mut seen = Vec::new();
+    diags.0.retain(|d| {
+        let new = !seen.contains(d);
+        if new {
+            seen.push(d.clone());
+        }
+        new
+    });
+    let mut text = diags.render(&loaded.sources);
+    let mut errors = diags.errors().count();
+    if let Some(p) = problem {
+        let (found, sources) = match seam::run::check(p) {
+            Ok(c) => (c.diagnostics, c.sources),
+            Err(RunError::Input(d, s)) => (d, s),
+            Err(RunError::Solve(e)) => {
+                let mut d = Diagnostics::default();
+                d.push(Diagnostic::error("E0700", e));
+                (d, SourceMap::default())
             }
+        };
+        // The problem's deck is usually DECK itself: say each thing once.
+        for d in found.0 {
+            if seen.contains(&d) {
+                continue;
+            }
+            errors += usize::from(d.is_error());
+            text += &Diagnostics(vec![d.clone()]).render(&sources);
+            seen.push(d);
         }
     }
-    eprint!("{}", diags.render(&loaded.sources));
-    if diags.has_errors() {
-        let n = diags.errors().count();
+    eprint!("{text}");
+    if errors > 0 {
+        let name = problem.unwrap_or(deck_path);
         eprintln!(
-            "{}: {n} error{}",
-            deck_path.display(),
-            if n == 1 { "" } else { "s" }
+            "{}: {errors} error{}",
+            name.display(),
+            if errors == 1 { "" } else { "s" }
         );
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     let defs = loaded.deck.contact_definitions.len();
+    let problem_note = if problem.is_some() {
+        ", problem ready to run"
+    } else {
+        ""
+    };
     match mesh {
-        Some(_) => println!("ok: {defs} contact definition(s), {count} contact surface(s)"),
-        None => println!("ok: {defs} contact definition(s)"),
+        Some(_) => {
+            println!(
+                "ok: {defs} contact definition(s), {surfaces} contact surface(s){problem_note}"
+            )
+        }
+        None => println!("ok: {defs} contact definition(s){problem_note}"),
     }
     ExitCode::SUCCESS
 }

@@ -83,6 +83,15 @@ pub fn resolve_with_fields(
     e: &Enforcement,
     fields: &[&str],
 ) -> Result<ModelChoice, Vec<Diagnostic>> {
+    resolve_for(e, Some(fields))
+}
+
+/// As [`resolve_with_fields`]; with `fields` `None` (a deck checked without its problem
+/// file) the names in `Side B Variable` are not checked.
+pub fn resolve_for(
+    e: &Enforcement,
+    fields: Option<&[&str]>,
+) -> Result<ModelChoice, Vec<Diagnostic>> {
     let Some(m) = e.models.iter().find(|m| m.equation == "energy") else {
         let d = Diagnostic::error(
             "E0420",
@@ -111,8 +120,7 @@ pub fn resolve_with_fields(
             .as_ref()
             .map(|m| (m.side_a.to_ascii_lowercase(), m.side_b.to_ascii_lowercase())),
     };
-    if let Some(map) = &e.side_b_variable {
-        let known = fields;
+    if let (Some(map), Some(known)) = (&e.side_b_variable, fields) {
         let mut ds = Vec::new();
         for (role, field) in [("side B", &map.side_b), ("side A", &map.side_a)] {
             if !known.contains(&field.to_ascii_lowercase().as_str()) {

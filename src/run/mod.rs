@@ -50,23 +50,22 @@ use serde::{Deserialize, Serialize};
 use crate::assembly::DofMap;
 use crate::deck::{self, LoadedDeck};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap, did_you_mean};
-use crate::enforce::conductance::{self, ConductanceModel, PointState};
-use crate::enforce::interface::{DEFAULT_BETA, Form, HFn, HInput, HValue, InterfaceForm};
-use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_with_fields as resolve_model};
+use crate::enforce::conductance::{ConductanceModel, PointState};
+use crate::enforce::interface::{DEFAULT_BETA, HFn, HInput, HValue, InterfaceForm};
+use crate::enforce::model::ModelChoice;
 use crate::heat::law::Law;
 use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use crate::heat::transient::{
     self, BlockLaws, FieldSpec, Loads, Scheme, Start, State, StepReport, TimeMode, TransientProblem,
 };
 use crate::heat::{FaceBc, HeatError, Material, TEMPERATURE};
-use crate::interaction;
 use std::collections::HashSet;
 
 use crate::mesh::{self, Mesh, NodeId, Side};
+use crate::scene::{ContactScene, SceneOptions};
 use crate::script::{Limits, Sandbox};
 use crate::search::pairing::{Integration, PointStatus};
-use crate::search::scene::{Pairing, search_definition};
-use crate::surface;
+use crate::search::scene::Pairing;
 
 use fields::{ContactView, Derived};
 
@@ -437,6 +436,46 @@ impl RunOptions {
 
 /// Solve the problem in `path` with `options`.
 pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError> {
+    match run_until(path, options, Stop::AfterRun)? {
+        Outcome::Ran(result) => Ok(*result),
+        Outcome::Checked(warnings) => Err(RunError::Input(warnings.diagnostics, warnings.sources)),
+    }
+}
+
+/// What a pre-flight found: the warnings, with the sources they point into.
+pub struct Checked {
+    pub diagnostics: Diagnostics,
+    pub sources: SourceMap,
+}
+
+/// Every validation `seam run` makes before it solves — the problem file, the mesh,
+/// materials, conditions, sources, the contact scene with its models (Lua compiled,
+/// plugins loaded) — without solving or writing anything. A problem that passes does
+/// not fail at the start of a run.
+pub fn check(path: &Path) -> Result<Checked, RunError> {
+    match run_until(path, &RunOptions::default(), Stop::BeforeSolve)? {
+        Outcome::Checked(c) => Ok(c),
+        Outcome::Ran(r) => Ok(Checked {
+            diagnostics: r.warnings,
+            sources: r.sources,
+        }),
+    }
+}
+
+/// Where [`run_until`] stops.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stop {
+    BeforeSolve,
+    AfterRun,
+}
+
+enum Outcome {
+    Ran(Box<RunResult>),
+    Checked(Checked),
+}
+
+/// The run, up to `stop`: the checks and set-up, then (unless stopped) the solve and output.
+fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let text = std::fs::read_to_string(path).map_err(|e| {
@@ -581,116 +620,38 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                     .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
                 );
             }
-            options.phase("building the contact surfaces");
-            let t = Instant::now();
-            let set = surface::build(&mesh, def, &loaded.sources);
-            timing.surfaces_s += t.elapsed().as_secs_f64();
-            diags.extend(set.diagnostics.clone());
-            let (list, d) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
-            diags.extend(d);
-            if diags.has_errors() {
-                continue;
+            if let Some(n) = def.update_search_every_n_steps {
+                diags.push(
+                    Diagnostic::warning(
+                        "W0703",
+                        format!("`Update Search Every {n} Steps` has no effect in this run: the mesh does not move, so the first search holds for every step"),
+                    )
+                    .at(Some(def.at.clone()))
+                    .help("remove the line, or keep it for a run coupled to a code that moves the mesh"),
+                );
             }
-            options.phase("contact search");
-            let t = Instant::now();
-            let scene = search_definition(
-                &mesh,
-                def,
-                &set,
-                &list,
-                &deck_dir,
-                &loaded.sources,
+        }
+        let phase = |what: &str| options.phase(what);
+        let scene = ContactScene::build(
+            &mesh,
+            &loaded,
+            &deck_dir,
+            &SceneOptions {
                 integration,
-            );
-            timing.search_s += t.elapsed().as_secs_f64();
-            diags.extend(scene.diagnostics);
-            for p in scene.pairings {
-                // The interaction's enforcement: by name, or the only block there is.
-                let named = list
-                    .iter()
-                    .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b)
-                    .and_then(|i| i.enforcement.clone());
-                let enf = def.enforcement(named.as_deref());
-                let Some(enf) = enf else {
-                    diags.push(
-                        Diagnostic::error(
-                            "E0426",
-                            format!("interaction {} / {} has no enforcement", p.side_a, p.side_b),
-                        )
-                        .at(Some(def.at.clone()))
-                        .help("add a `begin Enforcement` block with `Enforcement for Energy = …`"),
-                    );
-                    continue;
-                };
-                match resolve_model(enf, &field_refs) {
-                    Ok(choice) => {
-                        let tied = matches!(
-                            choice.form,
-                            Form::TiedNitsche | Form::TiedInteriorPenalty | Form::Penalty
-                        );
-                        if tied && p.result.stats.matched == 0 {
-                            diags.push(
-                                Diagnostic::error(
-                                    "E0427",
-                                    format!("`{}` ties {} / {}, but the two surfaces do not overlap anywhere", choice.name, p.side_a, p.side_b),
-                                )
-                                .at(Some(enf.at.clone()))
-                                .help("check the surfaces of the interaction; `seam search` shows why points did not pair"),
-                            );
-                            continue;
-                        }
-                        let scale = list
-                            .iter()
-                            .find(|i| i.side_a_name == p.side_a && i.side_b_name == p.side_b)
-                            .map_or(1.0, |i| i.penalty_scale);
-                        let model: Option<Box<dyn ConductanceModel>> = match choice.conductance {
-                            Some(ConductanceLaw::Constant(h)) => Some(Box::new(
-                                conductance::Constant::new(h).expect("h checked non-negative"),
-                            )),
-                            Some(ConductanceLaw::Coefficient) => {
-                                let (m, d) =
-                                    conductance::from_properties(enf, &deck_dir, &loaded.sources);
-                                diags.extend(d);
-                                if m.is_none() {
-                                    continue;
-                                }
-                                m
-                            }
-                            Some(ConductanceLaw::Plugin) => {
-                                let loaded_plugin =
-                                    conductance::PluginConductance::from_enforcement(
-                                        enf, &deck_dir, &p.side_a, &p.side_b,
-                                    );
-                                match loaded_plugin {
-                                    Ok(c) => {
-                                        if let Some(notice) = c.plugin().derivative_notice() {
-                                            diags.push(
-                                                Diagnostic::warning("W0502", notice)
-                                                    .at(Some(enf.at.clone()))
-                                                    .help("a plugin that returns its own derivatives (PROVIDES_DERIVATIVES) saves those calls"),
-                                            );
-                                        }
-                                        Some(Box::new(c) as Box<dyn ConductanceModel>)
-                                    }
-                                    Err(e) => {
-                                        diags.push(
-                                            Diagnostic::error("E0500", e.to_string())
-                                                .at(Some(enf.at.clone()))
-                                                .help("`seam check-plugin LIB` loads and probes a plugin on its own"),
-                                        );
-                                        continue;
-                                    }
-                                }
-                            }
-                            None => None,
-                        };
-                        choices.push((choice, scale, model));
-                        pairings.push(p);
-                        views.push(ContactView::of(def));
-                    }
-                    Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
-                }
-            }
+                fields: Some(&field_refs),
+                phase: Some(&phase),
+                search_only: false,
+            },
+            &mut diags,
+        );
+        timing.surfaces_s += scene.timing.surfaces_s;
+        timing.search_s += scene.timing.search_s;
+        for e in scene.entries {
+            views.push(ContactView::of(
+                &loaded.deck.contact_definitions[e.definition],
+            ));
+            choices.push((e.choice, e.penalty_scale, e.model));
+            pairings.push(e.pairing);
         }
     }
     loaded.sources.add(&at.file, &at.text);
@@ -753,6 +714,12 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
     );
     if diags.has_errors() {
         return Err(RunError::Input(diags, loaded.sources));
+    }
+    if stop == Stop::BeforeSolve {
+        return Ok(Outcome::Checked(Checked {
+            diagnostics: diags,
+            sources: loaded.sources,
+        }));
     }
     // Nitsche weights need one k per block: the law at the probe temperature.
     let conductivity: Vec<f64> = materials
@@ -1435,14 +1402,14 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
         transient: transient_summary,
         peak_memory_mib: peak_memory_mib(),
     };
-    Ok(RunResult {
+    Ok(Outcome::Ran(Box::new(RunResult {
         summary,
         mesh,
         solution,
         history,
         warnings: diags,
         sources: loaded.sources,
-    })
+    })))
 }
 
 fn block_index(mesh: &Mesh, name: &str, diags: &mut Diagnostics, what: &str) -> Option<usize> {

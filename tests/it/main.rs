@@ -14,6 +14,7 @@ mod interactions;
 mod mesh_io;
 mod output;
 mod plugin;
+mod preflight;
 mod run_fields;
 mod search;
 mod search_kernels;

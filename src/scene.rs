@@ -1,0 +1,354 @@
+//! A deck's contact resolved on a mesh: for every contact definition its surfaces,
+//! interactions and search, and per pairing the enforcement that applies with its
+//! conductance model loaded — the one place where `seam run`, `seam search` and
+//! `seam check` turn a typed deck into contact terms.
+//!
+//! Entry points: [`ContactScene::build`] (with a mesh) and [`check_enforcements`] (the
+//! mesh-free part of the same validation, for `seam check` without `--mesh`). Both load
+//! what a run loads — Lua conductances compiled in their sandbox, plugins opened and
+//! probed — so a deck that passes here does not fail when a run starts.
+//!
+//! Which enforcement block applies to a pair ([`enforcement_for`]): the one an interaction
+//! names with `Enforcement = name`; otherwise the definition's blocks together, one per
+//! equation. Two blocks claiming the same equation on one pair, with no interaction
+//! naming one, is an error (which one was meant is not written anywhere).
+
+use std::path::Path;
+use std::time::Instant;
+
+use crate::deck::LoadedDeck;
+use crate::deck::spec::{ContactDefinition, Enforcement};
+use crate::diag::{Diagnostic, Diagnostics, SourceMap};
+use crate::enforce::conductance::{self, ConductanceModel, PluginConductance};
+use crate::enforce::interface::Form;
+use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_for};
+use crate::interaction;
+use crate::mesh::Mesh;
+use crate::search::pairing::Integration;
+use crate::search::scene::{Pairing, search_definition};
+use crate::surface;
+
+/// The equation every supported enforcement applies to.
+const ENERGY: &str = "energy";
+
+/// One pairing with the enforcement that applies to it.
+pub struct Enforced {
+    pub pairing: Pairing,
+    pub choice: ModelChoice,
+    /// The interaction's penalty scale (Abaqus `Scale Penalty`), 1 by default.
+    pub penalty_scale: f64,
+    /// The conductance model of a `Conductance`/`Gap_Conductance`/plugin enforcement.
+    pub model: Option<Box<dyn ConductanceModel>>,
+    /// Index of the contact definition in the deck.
+    pub definition: usize,
+}
+
+/// How to build a scene.
+pub struct SceneOptions<'a> {
+    pub integration: Integration,
+    /// The fields of the problem, which `Side B Variable` must name; `None` when they
+    /// are not known (a deck checked without its problem file).
+    pub fields: Option<&'a [&'a str]>,
+    /// Called as each phase starts (progress displays).
+    pub phase: Option<&'a dyn Fn(&str)>,
+    /// A definition with no `begin Enforcement` block at all is searched and reported
+    /// with one warning instead of an error (a deck written for `seam search`).
+    pub search_only: bool,
+}
+
+/// Wall-clock seconds of the scene's phases.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SceneTiming {
+    pub surfaces_s: f64,
+    pub search_s: f64,
+}
+
+/// Every pairing of a deck on a mesh, with its enforcement.
+#[derive(Default)]
+pub struct ContactScene {
+    pub entries: Vec<Enforced>,
+    /// Number of contact surfaces built, over every definition.
+    pub surfaces: usize,
+    pub timing: SceneTiming,
+}
+
+impl ContactScene {
+    /// Build the surfaces, interactions and searches of every contact definition of
+    /// `loaded` on `mesh` and resolve each pairing's enforcement. Problems go to `diags`;
+    /// a pairing whose enforcement fails is left out.
+    pub fn build(
+        mesh: &Mesh,
+        loaded: &LoadedDeck,
+        deck_dir: &Path,
+        options: &SceneOptions<'_>,
+        diags: &mut Diagnostics,
+    ) -> ContactScene {
+        let phase = |what: &str| {
+            if let Some(f) = options.phase {
+                f(what);
+            }
+        };
+        let mut scene = ContactScene::default();
+        for (d, def) in loaded.deck.contact_definitions.iter().enumerate() {
+            phase("building the contact surfaces");
+            let t = Instant::now();
+            let set = surface::build(mesh, def, &loaded.sources);
+            scene.timing.surfaces_s += t.elapsed().as_secs_f64();
+            scene.surfaces += set.surfaces.len();
+            diags.extend(set.diagnostics.clone());
+            let (list, found) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
+            diags.extend(found);
+            if diags.has_errors() {
+                continue;
+            }
+            phase("contact search");
+            let t = Instant::now();
+            let searched = search_definition(
+                mesh,
+                def,
+                &set,
+                &list,
+                deck_dir,
+                &loaded.sources,
+                options.integration,
+            );
+            scene.timing.search_s += t.elapsed().as_secs_f64();
+            diags.extend(searched.diagnostics);
+            if options.search_only && def.enforcements.is_empty() {
+                diags.push(
+                    Diagnostic::warning(
+                        "W0426",
+                        "this definition has no `begin Enforcement` block: its pairs can be searched, but `seam run` refuses it",
+                    )
+                    .at(Some(def.at.clone()))
+                    .help("add a `begin Enforcement` block with `Enforcement for Energy = …` to run it"),
+                );
+                continue;
+            }
+            for pairing in searched.pairings {
+                let interaction = list
+                    .iter()
+                    .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
+                let named = interaction.and_then(|i| i.enforcement.as_deref());
+                let pair = (pairing.side_a.as_str(), pairing.side_b.as_str());
+                let enf = match enforcement_for(def, named, pair) {
+                    Ok(e) => e,
+                    Err(e) => {
+                        diags.push(e);
+                        continue;
+                    }
+                };
+                let choice = match resolve_for(enf, options.fields) {
+                    Ok(c) => c,
+                    Err(ds) => {
+                        ds.into_iter().for_each(|x| diags.push(x));
+                        continue;
+                    }
+                };
+                let tied = matches!(
+                    choice.form,
+                    Form::TiedNitsche | Form::TiedInteriorPenalty | Form::Penalty
+                );
+                if tied && pairing.result.stats.matched == 0 {
+                    diags.push(
+                        Diagnostic::error(
+                            "E0427",
+                            format!(
+                                "`{}` ties {} / {}, but the two surfaces do not overlap anywhere",
+                                choice.name, pairing.side_a, pairing.side_b
+                            ),
+                        )
+                        .at(Some(enf.at.clone()))
+                        .help("check the surfaces of the interaction; `seam search` shows why points did not pair"),
+                    );
+                    continue;
+                }
+                let Ok(model) =
+                    conductance_model(enf, &choice, deck_dir, &loaded.sources, pair, diags)
+                else {
+                    continue;
+                };
+                scene.entries.push(Enforced {
+                    pairing,
+                    choice,
+                    penalty_scale: interaction.map_or(1.0, |i| i.penalty_scale),
+                    model,
+                    definition: d,
+                });
+            }
+        }
+        scene
+    }
+}
+
+/// The enforcement block that applies to the pair `(side A, side B)` of `def`: the block
+/// an interaction names, else the definition's block for Energy. Two blocks for Energy
+/// with none named is an error, as is a named block that does not exist.
+pub fn enforcement_for<'d>(
+    def: &'d ContactDefinition,
+    named: Option<&str>,
+    (side_a, side_b): (&str, &str),
+) -> Result<&'d Enforcement, Diagnostic> {
+    if let Some(name) = named {
+        return def
+            .enforcements
+            .iter()
+            .find(|e| e.name.as_deref() == Some(name))
+            .ok_or_else(|| {
+                Diagnostic::error(
+                    "E0426",
+                    format!("interaction {side_a} / {side_b} names enforcement `{name}`, which this definition does not have"),
+                )
+                .at(Some(def.at.clone()))
+                .help("name one of the definition's `begin Enforcement` blocks")
+            });
+    }
+    let claims: Vec<&Enforcement> = def
+        .enforcements
+        .iter()
+        .filter(|e| e.models.iter().any(|m| m.equation == ENERGY))
+        .collect();
+    match claims.as_slice() {
+        [one] => Ok(one),
+        [] => match def.enforcements.as_slice() {
+            // One block with no Energy line: let the model resolution say what is missing.
+            [only] => Ok(only),
+            [] => Err(Diagnostic::error(
+                "E0426",
+                format!("interaction {side_a} / {side_b} has no enforcement"),
+            )
+            .at(Some(def.at.clone()))
+            .help("add a `begin Enforcement` block with `Enforcement for Energy = …`")),
+            _ => Err(Diagnostic::error(
+                "E0420",
+                format!("no enforcement block of this definition has an `Enforcement for Energy` line (interaction {side_a} / {side_b})"),
+            )
+            .at(Some(def.at.clone()))
+            .help("add e.g. `Enforcement for Energy = Gap_Conductance` to one of the blocks")),
+        },
+        [first, second, ..] => Err(double_claim(first, second, Some((side_a, side_b)))),
+    }
+}
+
+/// Two blocks claim Energy, on the pair named or on every pair of the definition.
+fn double_claim(
+    first: &Enforcement,
+    second: &Enforcement,
+    pair: Option<(&str, &str)>,
+) -> Diagnostic {
+    let name = |e: &Enforcement| e.name.clone().unwrap_or_else(|| "(unnamed)".into());
+    let on = pair.map_or_else(
+        || "with no interaction naming one".to_string(),
+        |(a, b)| format!("on interaction {a} / {b}"),
+    );
+    Diagnostic::error(
+        "E0429",
+        format!(
+            "enforcement blocks `{}` and `{}` both claim Energy {on}",
+            name(first),
+            name(second)
+        ),
+    )
+    .at(Some(second.at.clone()))
+    .help(format!(
+        "keep one block per equation, or say which applies with `Enforcement = {}` in the `begin Interaction` block of each pair",
+        first.name.as_deref().unwrap_or("<name>")
+    ))
+}
+
+/// A model that could not be made; the diagnostics say why.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Refused;
+
+/// The conductance model of an enforcement: from its `Gap Conductance Coefficient` lines
+/// (Lua compiled, tables checked) or its plugin (loaded and probed). `Err` when it could
+/// not be made; the reasons are in `diags`.
+pub fn conductance_model(
+    enf: &Enforcement,
+    choice: &ModelChoice,
+    deck_dir: &Path,
+    sources: &SourceMap,
+    (side_a, side_b): (&str, &str),
+    diags: &mut Diagnostics,
+) -> Result<Option<Box<dyn ConductanceModel>>, Refused> {
+    match &choice.conductance {
+        None => Ok(None),
+        Some(ConductanceLaw::Constant(h)) => match conductance::Constant::new(*h) {
+            Ok(c) => Ok(Some(Box::new(c))),
+            Err(e) => {
+                diags.push(
+                    Diagnostic::error("E0424", e.to_string())
+                        .at(Some(enf.at.clone()))
+                        .help("a conductance h ≥ 0 (W/m²K); h = 0 means no heat crosses"),
+                );
+                Err(Refused)
+            }
+        },
+        Some(ConductanceLaw::Coefficient) => {
+            let (m, d) = conductance::from_properties(enf, deck_dir, sources);
+            diags.extend(d);
+            m.map(Some).ok_or(Refused)
+        }
+        Some(ConductanceLaw::Plugin) => {
+            match PluginConductance::from_enforcement(enf, deck_dir, side_a, side_b) {
+                Ok(c) => {
+                    if let Some(notice) = c.plugin().derivative_notice() {
+                        diags.push(
+                            Diagnostic::warning("W0502", notice)
+                                .at(Some(enf.at.clone()))
+                                .help("a plugin that returns its own derivatives (PROVIDES_DERIVATIVES) saves those calls"),
+                        );
+                    }
+                    Ok(Some(Box::new(c)))
+                }
+                Err(e) => {
+                    diags.push(
+                        Diagnostic::error("E0500", e.to_string())
+                            .at(Some(enf.at.clone()))
+                            .help("`seam check-plugin LIB` loads and probes a plugin on its own"),
+                    );
+                    Err(Refused)
+                }
+            }
+        }
+    }
+}
+
+/// Without a mesh: resolve every enforcement block of the deck and make its conductance
+/// model, as a run would, so `seam check DECK` reports what `seam run` would refuse.
+pub fn check_enforcements(
+    loaded: &LoadedDeck,
+    deck_dir: &Path,
+    fields: Option<&[&str]>,
+    diags: &mut Diagnostics,
+) {
+    for def in &loaded.deck.contact_definitions {
+        // Two Energy blocks and no interaction naming one: every pair is ambiguous.
+        let energy: Vec<&Enforcement> = def
+            .enforcements
+            .iter()
+            .filter(|e| e.models.iter().any(|m| m.equation == ENERGY))
+            .collect();
+        if let [first, second, ..] = energy.as_slice()
+            && def.interactions.iter().all(|i| i.enforcement.is_none())
+        {
+            diags.push(double_claim(first, second, None));
+        }
+        for enf in &def.enforcements {
+            match resolve_for(enf, fields) {
+                Ok(choice) => {
+                    let name = enf.name.as_deref().unwrap_or("(check)");
+                    let _ = conductance_model(
+                        enf,
+                        &choice,
+                        deck_dir,
+                        &loaded.sources,
+                        (name, name),
+                        diags,
+                    );
+                }
+                Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
+            }
+        }
+    }
+}

@@ -1,0 +1,204 @@
+//! `seam check` as a pre-flight: a deck it passes does not fail when `seam run` starts,
+//! and what `seam run` refuses, `seam check` refuses with the same code. Also which
+//! enforcement block applies when a definition has several.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use seam::run::RunError;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A scratch folder with the bundled two-block mesh in it.
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("preflight-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    std::fs::copy(
+        root().join("examples/two_blocks/two_blocks.exo"),
+        d.join("two_blocks.exo"),
+    )
+    .unwrap();
+    d
+}
+
+fn seam(dir: &Path, args: &[&str]) -> (Option<i32>, String) {
+    let out: Output = Command::new(env!("CARGO_BIN_EXE_seam"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("seam runs");
+    let text =
+        String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    (out.status.code(), text)
+}
+
+/// The base (k = 16, z ∈ [0, 1]) at 300 K below, the lid (k = 200, z ∈ [1, 1.5]) at
+/// 400 K on top, insulated sides, the interface as the deck says.
+fn problem(dir: &Path, deck: &str, lid_value: &str) -> PathBuf {
+    std::fs::write(dir.join("deck.i"), deck).unwrap();
+    let text = format!(
+        r#"[mesh]
+file = "two_blocks.exo"
+[[material]]
+blocks = ["base"]
+conductivity = 16.0
+[[material]]
+blocks = ["lid"]
+conductivity = 200.0
+[[bc]]
+kind = "temperature"
+surfaces = ["base_bottom"]
+value = 300.0
+[[bc]]
+kind = "temperature"
+surfaces = ["lid_top"]
+value = {lid_value}
+[contact]
+file = "deck.i"
+"#
+    );
+    let p = dir.join("problem.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn deck(enforcements: &str, interaction_extra: &str) -> String {
+    format!(
+        "begin contact definition\n  contact surface a contains base_top\n  contact surface b contains lid_bottom\n  begin interaction\n    side a a\n    side b b\n{interaction_extra}  end\n{enforcements}end\n"
+    )
+}
+
+/// The heat through the series base – resistance h – lid: ΔT over the three resistances.
+fn series_heat(h: f64) -> f64 {
+    100.0 / (1.0 / 16.0 + 1.0 / h + 0.5 / 200.0)
+}
+
+#[test]
+fn check_refuses_what_run_refuses_with_the_same_code() {
+    let cases = [
+        (
+            "negative_coefficient",
+            "  begin enforcement gap\n    enforcement for energy = gap_conductance\n    gap conductance coefficient = constant h = -5\n  end\n",
+            "E0605",
+        ),
+        (
+            "lua_syntax",
+            "  begin enforcement gap\n    enforcement for energy = gap_conductance\n    gap conductance coefficient = lua \"100 + * temp_a\"\n  end\n",
+            "E0607",
+        ),
+        (
+            "plugin_without_library",
+            "  begin enforcement gap\n    enforcement for energy = plugin\n  end\n",
+            "E0500",
+        ),
+        (
+            "plugin_missing_file",
+            "  begin enforcement gap\n    enforcement for energy = plugin library = \"no_such_plugin.so\"\n  end\n",
+            "E0500",
+        ),
+    ];
+    for (name, enforcement, code) in cases {
+        let dir = scratch(name);
+        problem(&dir, &deck(enforcement, ""), "400.0");
+        let (exit, text) = seam(&dir, &["check", "deck.i"]);
+        assert_eq!(exit, Some(2), "{name}: seam check passed:\n{text}");
+        assert!(text.contains(code), "{name}: check lacks {code}:\n{text}");
+        let (exit, text) = seam(&dir, &["check", "deck.i", "--mesh", "two_blocks.exo"]);
+        assert_eq!(exit, Some(2), "{name}: seam check --mesh passed:\n{text}");
+        assert!(text.contains(code), "{name}: check --mesh lacks {code}");
+        let (exit, text) = seam(&dir, &["run", "problem.toml"]);
+        assert_eq!(exit, Some(2), "{name}: seam run did not refuse:\n{text}");
+        assert!(text.contains(code), "{name}: run lacks {code}:\n{text}");
+    }
+}
+
+#[test]
+fn check_with_a_problem_runs_the_problem_file_checks() {
+    let dir = scratch("problem");
+    let good =
+        "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n";
+    problem(&dir, &deck(good, ""), "\"400 + nonsense(\"");
+    // The deck alone is fine; the problem file's Lua boundary value is not.
+    let (exit, text) = seam(&dir, &["check", "deck.i"]);
+    assert_eq!(exit, Some(0), "{text}");
+    let (exit, text) = seam(&dir, &["check", "deck.i", "--problem", "problem.toml"]);
+    assert_eq!(exit, Some(2), "{text}");
+    assert!(text.contains("E0707"), "{text}");
+    let (exit, _) = seam(&dir, &["run", "problem.toml"]);
+    assert_eq!(exit, Some(2));
+
+    let p = problem(&dir, &deck(good, ""), "400.0");
+    let (exit, text) = seam(&dir, &["check", "deck.i", "--problem", "problem.toml"]);
+    assert_eq!(exit, Some(0), "{text}");
+    assert!(text.contains("problem ready to run"), "{text}");
+    // The pre-flight writes nothing.
+    assert!(!dir.join("out").exists());
+    assert!(seam::run::check(&p).is_ok());
+    let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
+    // Heat flows from the hot lid (side B) into the base (side A).
+    let heat = -r.summary.interactions[0].heat_side_a;
+    assert!(
+        (heat - series_heat(5.0)).abs() <= 1e-9 * series_heat(5.0),
+        "heat {heat}, exact {}",
+        series_heat(5.0)
+    );
+}
+
+const TWO_BLOCKS: &str = "  begin enforcement low\n    enforcement for energy = contact_resistance h = 5\n  end\n  begin enforcement high\n    enforcement for energy = contact_resistance h = 500\n  end\n";
+
+#[test]
+fn two_energy_blocks_need_an_interaction_to_name_one() {
+    let dir = scratch("two_blocks");
+    let p = problem(&dir, &deck(TWO_BLOCKS, ""), "400.0");
+    let (exit, text) = seam(&dir, &["check", "deck.i"]);
+    assert_eq!(exit, Some(2), "{text}");
+    assert!(text.contains("E0429"), "{text}");
+    match seam::run::run(&p) {
+        Err(RunError::Input(d, _)) => assert!(d.errors().any(|d| d.code == "E0429"), "{d:?}"),
+        Err(e) => panic!("{e:?}"),
+        Ok(_) => panic!("two Energy blocks, none named, ran"),
+    }
+    // Named, each block applies with its own conductance.
+    for (name, h) in [("low", 5.0), ("high", 500.0)] {
+        let p = problem(
+            &dir,
+            &deck(TWO_BLOCKS, &format!("    enforcement = {name}\n")),
+            "400.0",
+        );
+        let (exit, text) = seam(&dir, &["check", "deck.i"]);
+        assert_eq!(exit, Some(0), "{text}");
+        let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
+        // Heat flows from the hot lid (side B) into the base (side A).
+        let heat = -r.summary.interactions[0].heat_side_a;
+        let exact = series_heat(h);
+        assert!(
+            (heat - exact).abs() <= 1e-9 * exact,
+            "{name}: heat {heat}, exact {exact}"
+        );
+    }
+}
+
+#[test]
+fn update_search_on_a_fixed_mesh_warns_that_it_does_nothing() {
+    let dir = scratch("update_search");
+    let d = deck(
+        "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n",
+        "",
+    )
+    .replace(
+        "begin contact definition\n",
+        "begin contact definition\n  update search every 3 steps\n",
+    );
+    let p = problem(&dir, &d, "400.0");
+    let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
+    let w: Vec<_> = r
+        .warnings
+        .warnings()
+        .filter(|w| w.code == "W0703")
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", r.warnings);
+    assert!(w[0].message.contains("no effect"), "{}", w[0].message);
+}
