@@ -59,6 +59,7 @@ use crate::assembly::{DofMap, FieldId};
 use crate::deck::spec::{ContactDefinition, Enforcement as DeckEnforcement, PeriodicTransform};
 use crate::deck::{self, Deck};
 use crate::diag::{Diagnostics, SourceMap, did_you_mean};
+use crate::enforce::conductance::SeenTemperature;
 use crate::enforce::conductance::{
     ConductanceError, ConductanceModel, PluginConductance, PointState,
 };
@@ -1164,7 +1165,10 @@ impl Embedding {
                         side_b: side_b.to_string(),
                         message: e.to_string(),
                     })?;
-                Law::Plugin(Box::new(plugin), choice.pressure)
+                match crate::enforce::model::seen_temperature(enf) {
+                    SeenTemperature::Both => Law::Plugin(Box::new(plugin), choice.pressure),
+                    seen => Law::Model(seen.wrap(Box::new(plugin)), choice.pressure),
+                }
             }
         };
         Ok(Enforcement::Flux {

@@ -21,7 +21,7 @@ use crate::deck::spec::{ContactDefinition, Enforcement};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap};
 use crate::enforce::conductance::{self, ConductanceModel, PluginConductance};
 use crate::enforce::interface::Form;
-use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_for};
+use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_for, seen_temperature};
 use crate::interaction;
 use crate::mesh::Mesh;
 use crate::search::pairing::Integration;
@@ -299,7 +299,7 @@ pub fn conductance_model(
                                 .help("a plugin that returns its own derivatives (PROVIDES_DERIVATIVES) saves those calls"),
                         );
                     }
-                    Ok(Some(Box::new(c)))
+                    Ok(Some(seen_temperature(enf).wrap(Box::new(c))))
                 }
                 Err(e) => {
                     diags.push(

@@ -18,6 +18,7 @@
 use crate::deck::spec::{Enforcement, EnforcementModel};
 use crate::diag::{Diagnostic, did_you_mean};
 
+use super::conductance::SeenTemperature;
 use super::interface::Form;
 
 /// What one enforcement block asks for.
@@ -235,4 +236,10 @@ fn conductance(e: &Enforcement, m: &EnforcementModel) -> Result<ConductanceLaw, 
         .at(Some(m.at.clone()))
         .help("add `Gap Conductance Coefficient = Constant H = <value>` (or another model) to the enforcement block"),
     ])
+}
+
+/// The temperature the block's conductance models see (`Contact Gap Temperature`).
+pub fn seen_temperature(e: &Enforcement) -> SeenTemperature {
+    let _ = e;
+    SeenTemperature::Both
 }

@@ -75,6 +75,7 @@ pub fn from_properties(
         enforcement,
         diags: Diagnostics::default(),
     };
+    let seen = crate::enforce::model::seen_temperature(enforcement);
     let mut parts = Vec::new();
     let mut failed = false;
     for p in enforcement
@@ -83,7 +84,7 @@ pub fn from_properties(
         .filter(|p| p.property == PROPERTY)
     {
         match cx.line(p) {
-            Some(m) => parts.push(m),
+            Some(m) => parts.push(seen.wrap(m)),
             None => failed = true,
         }
     }

@@ -180,6 +180,87 @@ pub trait ConductanceModel {
     }
 }
 
+/// Which temperature a conductance sees at a point (`Contact Gap Temperature`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SeenTemperature {
+    /// Both sides' temperatures, each model using them as it defines (most take the
+    /// mean; radiation takes both).
+    #[default]
+    Both,
+    /// Side A's temperature, as both T_A and T_B.
+    SideA,
+    /// Side B's temperature (at the projection), as both T_A and T_B.
+    SideB,
+    /// The mean (T_A + T_B)/2, as both T_A and T_B.
+    Mean,
+}
+
+impl SeenTemperature {
+    /// `model` seeing this temperature (itself for [`SeenTemperature::Both`]).
+    pub fn wrap(self, model: Box<dyn ConductanceModel>) -> Box<dyn ConductanceModel> {
+        match self {
+            SeenTemperature::Both => model,
+            seen => Box::new(Seeing { inner: model, seen }),
+        }
+    }
+
+    /// The temperature seen and its derivatives with respect to T_A and T_B.
+    fn of(self, s: &PointState) -> (f64, f64, f64) {
+        match self {
+            SeenTemperature::Both | SeenTemperature::Mean => (s.mean_temperature(), 0.5, 0.5),
+            SeenTemperature::SideA => (s.temp_a, 1.0, 0.0),
+            SeenTemperature::SideB => (s.temp_b, 0.0, 1.0),
+        }
+    }
+}
+
+/// A model evaluated at one temperature T_s on both sides; by the chain rule
+/// dh/dT_A = (∂h/∂T_A + ∂h/∂T_B) dT_s/dT_A, and the same for B.
+struct Seeing {
+    inner: Box<dyn ConductanceModel>,
+    seen: SeenTemperature,
+}
+
+impl Seeing {
+    fn state(&self, s: &PointState) -> (PointState, f64, f64) {
+        let (t, da, db) = self.seen.of(s);
+        (
+            PointState {
+                temp_a: t,
+                temp_b: t,
+                ..*s
+            },
+            da,
+            db,
+        )
+    }
+}
+
+impl ConductanceModel for Seeing {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+
+    fn evaluate(&self, state: &PointState) -> Result<Conductance, ConductanceError> {
+        let (seen, da, db) = self.state(state);
+        let c = self.inner.evaluate(&seen)?;
+        let d = c.dh_dtemp_a + c.dh_dtemp_b;
+        Ok(Conductance {
+            dh_dtemp_a: d * da,
+            dh_dtemp_b: d * db,
+            ..c
+        })
+    }
+
+    fn value(&self, state: &PointState) -> Result<f64, ConductanceError> {
+        self.inner.value(&self.state(state).0)
+    }
+
+    fn depends_on_temperature(&self) -> bool {
+        self.inner.depends_on_temperature()
+    }
+}
+
 /// The result check every model applies: finite values, h ≥ 0.
 pub(crate) fn check(
     model: &dyn ConductanceModel,
@@ -620,6 +701,49 @@ impl ConductanceModel for Sum {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// h = T_A² + 3 T_B: depends on each side differently.
+    struct Lopsided;
+
+    impl ConductanceModel for Lopsided {
+        fn name(&self) -> String {
+            "lopsided".into()
+        }
+        fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
+            Ok(Conductance {
+                h: s.temp_a * s.temp_a + 3.0 * s.temp_b,
+                dh_dtemp_a: 2.0 * s.temp_a,
+                dh_dtemp_b: 3.0,
+                ..Conductance::default()
+            })
+        }
+    }
+
+    #[test]
+    fn seen_temperature_picks_the_side_and_chains_the_derivatives() {
+        let s = state(0.0, 0.0, 10.0, 20.0);
+        let cases = [
+            (SeenTemperature::Both, 10.0 * 10.0 + 60.0),
+            (SeenTemperature::SideA, 100.0 + 30.0),
+            (SeenTemperature::SideB, 400.0 + 60.0),
+            (SeenTemperature::Mean, 225.0 + 45.0),
+        ];
+        for (seen, h) in cases {
+            let m = seen.wrap(Box::new(Lopsided));
+            let c = m.evaluate(&s).unwrap();
+            assert_eq!(c.h, h, "{seen:?}");
+            // Central differences of h in T_A and T_B (h is quadratic: exact but for
+            // round-off).
+            let e = 1e-3;
+            let fd = |da: f64, db: f64| {
+                let up = m.value(&state(0.0, 0.0, 10.0 + da, 20.0 + db)).unwrap();
+                let down = m.value(&state(0.0, 0.0, 10.0 - da, 20.0 - db)).unwrap();
+                (up - down) / (2.0 * e)
+            };
+            assert!((c.dh_dtemp_a - fd(e, 0.0)).abs() < 1e-8, "{seen:?} dT_A");
+            assert!((c.dh_dtemp_b - fd(0.0, e)).abs() < 1e-8, "{seen:?} dT_B");
+        }
+    }
 
     fn state(gap: f64, pressure: f64, temp_a: f64, temp_b: f64) -> PointState {
         PointState {
