@@ -24,7 +24,7 @@ use crate::enforce::interface::Form;
 use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_for, seen_temperature};
 use crate::interaction;
 use crate::mesh::Mesh;
-use crate::search::pairing::Integration;
+use crate::search::pairing::{Integration, SearchStats};
 use crate::search::scene::{Pairing, search_definition};
 use crate::surface;
 
@@ -163,6 +163,26 @@ impl ContactScene {
                     );
                     continue;
                 }
+                if pairing.result.stats.matched == 0 {
+                    diags.push(
+                        Diagnostic::warning(
+                            "W0428",
+                            format!(
+                                "interaction {} / {} pairs no point, so `{}` carries no heat: {}",
+                                pairing.side_a,
+                                pairing.side_b,
+                                choice.name,
+                                if pairing.side_a == pairing.side_b {
+                                    "side A and side B are the same surface, which pairs with itself only where it folds back on itself".to_string()
+                                } else {
+                                    why_nothing_paired(&pairing.result.stats)
+                                }
+                            ),
+                        )
+                        .at(Some(enf.at.clone()))
+                        .help("check the surfaces and the search options (`Normal Tolerance`, `Normal Check Angle`); `seam search --json` gives each point's status"),
+                    );
+                }
                 let Ok(model) =
                     conductance_model(enf, &choice, deck_dir, &loaded.sources, pair, diags)
                 else {
@@ -179,6 +199,41 @@ impl ContactScene {
         }
         scene
     }
+}
+
+/// Why a search paired nothing, from its counts.
+pub fn why_nothing_paired(stats: &SearchStats) -> String {
+    if stats.side_a_area == 0.0 {
+        return "side A is empty (its definition found no face, or every face went to an earlier surface)".into();
+    }
+    if stats.points == 0 {
+        return "no side-B face came within reach of any side-A face (the surfaces are apart: check their names, the normal tolerance and the buffer)".into();
+    }
+    let mut parts = Vec::new();
+    for (n, what) in [
+        (stats.unmatched, "found no side-B face within reach"),
+        (
+            stats.rejected_distance,
+            "lay farther from side B along the normal than the normal tolerance",
+        ),
+        (
+            stats.rejected_angle,
+            "met side-B faces whose normals are not opposed enough",
+        ),
+        (
+            stats.rejected_subdomain,
+            "lie outside the `Restrict Contact To Subdomain` sphere",
+        ),
+    ] {
+        if n > 0 {
+            parts.push(format!("{n} {what}"));
+        }
+    }
+    format!(
+        "of its {} side-A points, {}",
+        stats.points,
+        parts.join("; ")
+    )
 }
 
 /// The enforcement block that applies to the pair `(side A, side B)` of `def`: the block

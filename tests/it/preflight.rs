@@ -202,3 +202,38 @@ fn update_search_on_a_fixed_mesh_warns_that_it_does_nothing() {
     assert_eq!(w.len(), 1, "{:?}", r.warnings);
     assert!(w[0].message.contains("no effect"), "{}", w[0].message);
 }
+
+#[test]
+fn an_interaction_that_pairs_nothing_says_why() {
+    let enforcement =
+        "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n";
+    let cases = [
+        // The base's bottom and the lid's top are 1.5 apart.
+        ("apart", "base_bottom", "lid_top", "the surfaces are apart"),
+        ("same", "base_top", "base_top", "the same surface"),
+    ];
+    for (name, a, b, why) in cases {
+        let dir = scratch(name);
+        let d = deck(enforcement, "")
+            .replace("contains base_top", &format!("contains {a}"))
+            .replace("contains lid_bottom", &format!("contains {b}"));
+        let d = if a == b {
+            d.replace("side b b", "side b a")
+        } else {
+            d
+        };
+        let p = problem(&dir, &d, "400.0");
+        let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        let w: Vec<_> = r
+            .warnings
+            .warnings()
+            .filter(|w| w.code == "W0428")
+            .collect();
+        assert_eq!(w.len(), 1, "{name}: {:?}", r.warnings);
+        assert!(w[0].message.contains(why), "{name}: {}", w[0].message);
+        assert_eq!(r.summary.interactions[0].heat_side_a, 0.0);
+        let (exit, text) = seam(&dir, &["check", "deck.i", "--mesh", "two_blocks.exo"]);
+        assert_eq!(exit, Some(0), "{text}");
+        assert!(text.contains("W0428"), "{name}: {text}");
+    }
+}
