@@ -38,6 +38,7 @@
 //! nonlinear). The time `t` is 0 in a steady solve.
 
 mod fields;
+mod posed;
 mod steps;
 
 use crate::enforce::interface::{InterfaceError, InterfacePoints, PointFlux};
@@ -192,7 +193,35 @@ pub enum BcKind {
     Radiation,
 }
 
+/// Largest temperature (K) a problem file may give: far beyond any physical one, and
+/// small enough that radiation's T⁴ and the squares of residuals stay finite.
+pub const MAX_TEMPERATURE: f64 = 1e12;
+
+/// Largest size of the other numbers a problem file gives (fluxes, coefficients,
+/// sources, material properties): the product of two stays finite.
+pub const MAX_MAGNITUDE: f64 = 1e100;
+
 impl BcKind {
+    /// Whether `v` is a value this kind of condition accepts; if not, the range it does.
+    pub fn accepts(self, v: f64) -> Result<(), &'static str> {
+        let (ok, range) = match self {
+            BcKind::Temperature => (
+                v.abs() <= MAX_TEMPERATURE,
+                "a temperature is finite and within ±1e12 K",
+            ),
+            BcKind::Flux => (
+                v.abs() <= MAX_MAGNITUDE,
+                "a heat flux is finite and within ±1e100 W/m²",
+            ),
+            BcKind::Convection => (
+                (0.0..=MAX_MAGNITUDE).contains(&v),
+                "a heat-transfer coefficient is in [0, 1e100] W/m²K",
+            ),
+            BcKind::Radiation => (v > 0.0 && v <= 1.0, "an emissivity is in (0, 1]"),
+        };
+        if ok { Ok(()) } else { Err(range) }
+    }
+
     /// The name as the problem file writes it.
     pub fn name(self) -> &'static str {
         match self {
@@ -692,6 +721,36 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         );
     }
 
+    // A steady problem needs every part of the mesh held at some temperature level.
+    if !transient {
+        let mut anchored: Vec<NodeId> = dirichlet.iter().map(|&(n, _)| n).collect();
+        for f in &face_sites {
+            let bc = &problem.bc[f.bc];
+            let exchange = matches!(bc.kind, BcKind::Convection | BcKind::Radiation);
+            if exchange && bc.value != Value::Number(0.0) {
+                anchored.extend(mesh.side_nodes(f.side));
+            }
+        }
+        let floating = posed::floating_parts(&mesh, anchored, &pairings);
+        if let Some(first) = floating.first() {
+            let more = match floating.len() {
+                1 => String::new(),
+                n => format!(" (and {} more parts)", n - 1),
+            };
+            diags.push(
+                Diagnostic::error(
+                    "E0715",
+                    format!(
+                        "the steady problem has no unique answer: {} nodes in block(s) {}{more} meet no temperature, convection or radiation condition, through the mesh or a contact interface, so their temperature is fixed only up to a constant (and with fluxes or sources that do not balance, no steady state exists)",
+                        first.nodes,
+                        first.blocks.join(", ")
+                    ),
+                )
+                .help("add a [[bc]] of kind temperature, convection or radiation that reaches those blocks, join them to the rest by a contact interaction, or solve kind = \"transient\""),
+            );
+        }
+    }
+
     // Per interaction: its toggle, its fields, its contact pressure per point.
     let toggles = resolve_toggles(&problem, &choices, &mut diags);
     let term_fields = interaction_fields(
@@ -715,6 +774,13 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     if diags.has_errors() {
         return Err(RunError::Input(diags, loaded.sources));
     }
+    // The initial state is checked here (transient runs start from it).
+    let initial_state = match (&problem.initial, transient) {
+        (Some(_), _) | (None, true) => Some(initial_values(
+            &problem, &mesh, &dirichlet, &sandbox, start_time,
+        )?),
+        (None, false) => None,
+    };
     if stop == Stop::BeforeSolve {
         return Ok(Outcome::Checked(Checked {
             diagnostics: diags,
@@ -1122,7 +1188,10 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         };
         let initial = match restart {
             Some(_) => Vec::new(),
-            None => initial_values(&problem, &mesh, &dirichlet, &sandbox, start_time)?,
+            None => match initial_state {
+                Some(v) => v,
+                None => initial_values(&problem, &mesh, &dirichlet, &sandbox, start_time)?,
+            },
         };
         let at_node = |n: NodeId| initial[n.index()];
         let start = match restart {
@@ -1471,16 +1540,22 @@ fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law
             }
         },
     };
-    let bad = |v: f64| !(v > 0.0 && v.is_finite());
+    let bad = |v: f64| !(v > 0.0 && v <= MAX_MAGNITUDE);
     let problem = match &law {
-        Law::Constant(k) if bad(*k) => Some(format!("must be positive, found {k}")),
-        Law::Table(p) => p
-            .iter()
-            .find(|q| bad(q.1))
-            .map(|q| format!("must be positive, found {} at T = {}", q.1, q.0)),
+        Law::Constant(k) if bad(*k) => {
+            Some(format!("must be positive and at most 1e100, found {k}"))
+        }
+        Law::Table(p) => p.iter().find(|q| bad(q.1)).map(|q| {
+            format!(
+                "must be positive and at most 1e100, found {} at T = {}",
+                q.1, q.0
+            )
+        }),
         Law::Lua { .. } => match law.eval(probe, [0.0; 3], 0.0) {
             Err(e) => Some(e),
-            Ok((k, _)) if bad(k) => Some(format!("must be positive, found {k} at T = {probe}")),
+            Ok((k, _)) if bad(k) => Some(format!(
+                "must be positive and at most 1e100, found {k} at T = {probe}"
+            )),
             Ok(_) => None,
         },
         _ => None,
@@ -1488,7 +1563,7 @@ fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law
     if let Some(m) = problem {
         diags.push(
             Diagnostic::error("E0704", format!("{what} {m}"))
-                .help("k in W/m/K, ρ in kg/m³, c_p in J/kg/K: positive numbers, tables or Lua expressions of T"),
+                .help("k in W/m/K, ρ in kg/m³, c_p in J/kg/K: positive numbers up to 1e100, tables or Lua expressions of T"),
         );
         return None;
     }
@@ -1529,13 +1604,13 @@ fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> M
                     probe,
                     diags,
                 );
-                let rho_ok = *rho > 0.0 && rho.is_finite();
+                let rho_ok = *rho > 0.0 && *rho <= MAX_MAGNITUDE;
                 if !rho_ok {
                     diags.push(
                         Diagnostic::error(
                             "E0704",
                             format!(
-                                "[[material]] #{} density must be positive, found {rho}",
+                                "[[material]] #{} density must be positive and at most 1e100, found {rho}",
                                 i + 1
                             ),
                         )
@@ -1659,6 +1734,19 @@ fn evaluate(
     }
 }
 
+/// `v`, the value of `[[bc]]` #k at `x` and time `t`, if its kind accepts it.
+fn in_range(kind: BcKind, v: f64, k: usize, x: [f64; 3], t: f64) -> Result<(), String> {
+    kind.accepts(v).map_err(|range| {
+        format!(
+            "[[bc]] #{} value is {v:e} at ({}, {}, {}), t = {t}: {range}",
+            k + 1,
+            x[0],
+            x[1],
+            x[2]
+        )
+    })
+}
+
 /// The fields of each `[[bc]]` that go with its kind: `ambient` for convection and
 /// radiation only (never taken as 0 K), an emissivity in (0, 1].
 fn check_bcs(p: &Problem, diags: &mut Diagnostics) {
@@ -1675,6 +1763,17 @@ fn check_bcs(p: &Problem, diags: &mut Diagnostics) {
                     ),
                 )
                 .help("add ambient = 293.15 (say): it is not taken as 0 K"),
+            );
+        }
+        if let Some(a) = bc.ambient
+            && BcKind::Temperature.accepts(a).is_err()
+        {
+            diags.push(
+                Diagnostic::error(
+                    "E0706",
+                    format!("[[bc]] #{}: ambient {a:e} is out of range", k + 1),
+                )
+                .help("a temperature is finite and within ±1e12 K"),
             );
         }
         if !exchange && bc.ambient.is_some() {
@@ -1805,12 +1904,14 @@ fn loads_at(
             "[[bc]] value",
         )
         .map_err(|e| format!("[[bc]] #{} value: {e}", k + 1))?;
+        in_range(BcKind::Temperature, v, k, mesh.coords[n.index()], t)?;
         out.dirichlet.push((n, v));
     }
     for f in faces {
         let bc = &p.bc[f.bc];
         let v = evaluate(&bc.value, f.centroid, t, sandbox, "[[bc]] value")
             .map_err(|e| format!("[[bc]] #{} value: {e}", f.bc + 1))?;
+        in_range(bc.kind, v, f.bc, f.centroid, t)?;
         let t_inf = bc.ambient.unwrap_or(0.0);
         out.faces.push(match bc.kind {
             BcKind::Flux => FaceBc::Flux { side: f.side, q: v },
@@ -1911,7 +2012,7 @@ fn block_sources(
                 mesh.coords[mesh.elem_nodes(mesh.blocks[b].first_elem)[0].index()]
             });
         let tried = law.and_then(|l| match l.eval(probe, x, time) {
-            Ok((q, dq)) if q.is_finite() && dq.is_finite() => Ok(l),
+            Ok((q, dq)) if q.abs() <= MAX_MAGNITUDE && dq.is_finite() => Ok(l),
             Ok((q, _)) => Err(format!(
                 "Q = {q} at ({}, {}, {}), T = {probe}, t = {time}",
                 x[0], x[1], x[2]
@@ -1924,7 +2025,7 @@ fn block_sources(
             Err(m) => diags.push(
                 Diagnostic::error("E0714", format!("[[source]] #{}: {m}", k + 1))
                     .at(loc)
-                    .help("Q (W/m³) is a number, a Lua expression of x, y, z, t and T (the local temperature), or { table = [[t, Q], …] } with t increasing"),
+                    .help("Q (W/m³, finite and within ±1e100) is a number, a Lua expression of x, y, z, t and T (the local temperature), or { table = [[t, Q], …] } with t increasing"),
             ),
         }
     }
@@ -2362,13 +2463,17 @@ fn initial_values(
             .coords
             .iter()
             .map(|x| {
-                evaluate(
+                let v = evaluate(
                     &init.temperature,
                     *x,
                     time,
                     sandbox,
                     "[initial] temperature",
-                )
+                )?;
+                BcKind::Temperature
+                    .accepts(v)
+                    .map_err(|range| format!("{v:e} at ({}, {}, {}): {range}", x[0], x[1], x[2]))?;
+                Ok(v)
             })
             .collect::<Result<Vec<f64>, String>>()
             .map_err(|e| {

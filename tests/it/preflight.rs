@@ -237,3 +237,168 @@ fn an_interaction_that_pairs_nothing_says_why() {
         assert!(text.contains("W0428"), "{name}: {text}");
     }
 }
+
+/// Runs the two-block problem with `[[bc]]`, `[[material]]` and `[initial]` text of its
+/// own (and the h = 5 resistance), returning the exit code and what seam printed.
+fn run_problem(name: &str, body: &str) -> (Option<i32>, String) {
+    let dir = scratch(name);
+    std::fs::write(
+        dir.join("deck.i"),
+        deck(
+            "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n",
+            "",
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!("[mesh]\nfile = \"two_blocks.exo\"\n{body}[contact]\nfile = \"deck.i\"\n"),
+    )
+    .unwrap();
+    let (check, text) = seam(&dir, &["check", "deck.i", "--problem", "problem.toml"]);
+    let (run, run_text) = seam(&dir, &["run", "problem.toml"]);
+    assert_eq!(
+        check, run,
+        "{name}: check and run disagree:\n{text}\n---\n{run_text}"
+    );
+    (run, run_text)
+}
+
+const MATERIALS: &str = "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 16.0\n";
+
+fn bc(kind: &str, surface: &str, value: &str, extra: &str) -> String {
+    format!("[[bc]]\nkind = \"{kind}\"\nsurfaces = [\"{surface}\"]\nvalue = {value}\n{extra}")
+}
+
+#[test]
+fn numbers_out_of_range_are_refused_with_the_range() {
+    let cold = bc("temperature", "base_bottom", "300.0", "");
+    let cases = [
+        (
+            "dirichlet_huge",
+            format!(
+                "{MATERIALS}{cold}{}",
+                bc("temperature", "lid_top", "1e308", "")
+            ),
+            "within ±1e12 K",
+        ),
+        (
+            "dirichlet_inf",
+            format!(
+                "{MATERIALS}{cold}{}",
+                bc("temperature", "lid_top", "inf", "")
+            ),
+            "within ±1e12 K",
+        ),
+        (
+            "dirichlet_nan",
+            format!(
+                "{MATERIALS}{cold}{}",
+                bc("temperature", "lid_top", "nan", "")
+            ),
+            "within ±1e12 K",
+        ),
+        (
+            "dirichlet_lua",
+            format!(
+                "{MATERIALS}{cold}{}",
+                bc("temperature", "lid_top", "\"1e6 * 1e7\"", "")
+            ),
+            "within ±1e12 K",
+        ),
+        (
+            "flux_huge",
+            format!("{MATERIALS}{cold}{}", bc("flux", "lid_top", "1e200", "")),
+            "within ±1e100 W/m²",
+        ),
+        (
+            "convection_negative",
+            format!(
+                "{MATERIALS}{cold}{}",
+                bc("convection", "lid_top", "-1.0", "ambient = 300.0\n")
+            ),
+            "[0, 1e100] W/m²K",
+        ),
+        (
+            "ambient_inf",
+            format!(
+                "{MATERIALS}{cold}{}",
+                bc("convection", "lid_top", "10.0", "ambient = inf\n")
+            ),
+            "within ±1e12 K",
+        ),
+        (
+            "conductivity_huge",
+            format!("[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1e200\n{cold}"),
+            "at most 1e100",
+        ),
+        (
+            "initial_huge",
+            format!("{MATERIALS}{cold}[initial]\ntemperature = 1e13\n"),
+            "within ±1e12 K",
+        ),
+    ];
+    for (name, body, range) in cases {
+        let (code, text) = run_problem(name, &body);
+        assert_eq!(code, Some(2), "{name}:\n{text}");
+        assert!(text.contains(range), "{name}: no range in\n{text}");
+    }
+}
+
+#[test]
+fn a_steady_problem_with_a_floating_part_is_named_before_the_solve() {
+    // No condition at all; only fluxes; the lid held but the base joined to nothing.
+    let flux = |s: &str, q: &str| bc("flux", s, q, "");
+    let cases = [
+        ("no_condition", MATERIALS.to_string(), "blocks base, lid"),
+        (
+            "only_fluxes",
+            format!(
+                "{MATERIALS}{}{}",
+                flux("base_bottom", "100.0"),
+                flux("lid_top", "-100.0")
+            ),
+            "blocks base, lid",
+        ),
+    ];
+    for (name, body, blocks) in cases {
+        let (code, text) = run_problem(name, &body);
+        assert_eq!(code, Some(2), "{name}:\n{text}");
+        assert!(text.contains("E0715"), "{name}:\n{text}");
+        assert!(
+            text.contains(&format!("block(s) {}", &blocks[7..])),
+            "{name}:\n{text}"
+        );
+    }
+    // The same with the contact resistance but the interface apart: the base floats.
+    let dir = scratch("base_floats");
+    std::fs::write(
+        dir.join("deck.i"),
+        deck(
+            "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n",
+            "",
+        )
+        .replace("contains base_top", "contains base_bottom"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = \"two_blocks.exo\"\n{MATERIALS}{}{}[contact]\nfile = \"deck.i\"\n",
+            bc("temperature", "lid_top", "400.0", ""),
+            flux("base_bottom", "10.0")
+        ),
+    )
+    .unwrap();
+    let (code, text) = seam(&dir, &["run", "problem.toml"]);
+    assert_eq!(code, Some(2), "{text}");
+    assert!(text.contains("block(s) base meet no"), "{text}");
+    // A transient problem has its heat capacity: it runs.
+    let (code, text) = run_problem(
+        "transient_no_condition",
+        &format!(
+            "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 16.0\nrho_c = 1e6\n[initial]\ntemperature = 300.0\n[solve]\nkind = \"transient\"\ndt = 1.0\nend_time = 2.0\n"
+        ),
+    );
+    assert_eq!(code, Some(0), "{text}");
+}

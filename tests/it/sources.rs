@@ -298,7 +298,10 @@ fn bad_sources_are_reported_at_their_line() {
         assert!(e.contains("error[E0714]: [[source]] #1"), "{e}");
         assert!(e.contains("problem.toml:12:9"), "{e}");
         assert!(e.contains(&format!("12 | value = {value}")), "{e}");
-        assert!(e.contains("= help: Q (W/m³) is a number"), "{e}");
+        assert!(
+            e.contains("= help: Q (W/m³, finite and within ±1e100) is a number"),
+            "{e}"
+        );
         assert!(e.contains(expect), "{e}");
     }
     let materials = "[[material]]\nblocks = [\"block_1\"]\nconductivity = 1.0\nrho_c = 1.0\n";
