@@ -396,9 +396,7 @@ fn a_steady_problem_with_a_floating_part_is_named_before_the_solve() {
     // A transient problem has its heat capacity: it runs.
     let (code, text) = run_problem(
         "transient_no_condition",
-        &format!(
-            "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 16.0\nrho_c = 1e6\n[initial]\ntemperature = 300.0\n[solve]\nkind = \"transient\"\ndt = 1.0\nend_time = 2.0\n"
-        ),
+        "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 16.0\nrho_c = 1e6\n[initial]\ntemperature = 300.0\n[solve]\nkind = \"transient\"\ndt = 1.0\nend_time = 2.0\n",
     );
     assert_eq!(code, Some(0), "{text}");
 }
