@@ -5,6 +5,8 @@ use std::path::Path;
 
 use seam_plugin_testkit::{Config, Loaded, Report};
 
+use super::guard::{CallSite, guarded};
+
 use super::{ContactPoint, Plugin, PluginData, PluginError, PointResult, StepContext};
 
 /// What [`check_plugin`] found.
@@ -72,7 +74,16 @@ pub fn check_plugin(
     // SAFETY: the descriptor comes from a library seam never unloads, and `load_with`
     // checked its versions, size and evaluate_point.
     let loaded = unsafe { Loaded::from_descriptor(plugin.descriptor()) };
-    let conformance = seam_plugin_testkit::run(&loaded, &config);
+    // The conformance kit calls the plugin itself: a crash or an `exit` there is
+    // reported like one in the host's own calls.
+    let label = format!("`{}` ({})", plugin.info().name, path.display());
+    let site = CallSite {
+        plugin: &label,
+        entry: "the conformance checks",
+        points: &[],
+        current: std::cell::Cell::new(None),
+    };
+    let conformance = guarded(&site, || seam_plugin_testkit::run(&loaded, &config));
     let states = config.grid.states();
     let points: Vec<ContactPoint> = states
         .iter()

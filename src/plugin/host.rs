@@ -12,6 +12,9 @@ use seam_plugin_abi::{
     SeamInstanceIn, SeamPluginDescriptor, SeamPointIn, SeamPointOut, entry_symbol_for,
 };
 
+use std::cell::Cell;
+
+use super::guard::{CallSite, guarded};
 use super::{PluginError, PluginFault};
 
 /// Finite-difference step floors for plugins without derivatives: the host perturbs x
@@ -268,8 +271,15 @@ impl Plugin {
                 host_major: SEAM_PLUGIN_ABI_MAJOR,
             }));
         };
+        let plugin = format!("{}", path.display());
+        let site = CallSite {
+            plugin: &plugin,
+            entry: symbol,
+            points: &[],
+            current: Cell::new(None),
+        };
         // SAFETY: the entry function takes nothing and returns a pointer to static data.
-        let d = unsafe { entry() };
+        let d = guarded(&site, || unsafe { entry() });
         if d.is_null() {
             return Err(PluginError::NullDescriptor {
                 path: path.to_owned(),
@@ -548,29 +558,44 @@ impl Plugin {
         Ok(())
     }
 
-    /// Call the plugin on `ins`, serialised unless it is thread-safe.
+    /// Call the plugin on `ins`, serialised unless it is thread-safe. A crash or an
+    /// `exit` inside the call is reported with the point (see [`super::guard`]).
     fn call(&self, ins: &[SeamPointIn], outs: &mut [SeamPointOut], batch: bool) {
         let _guard = (!self.info.thread_safe())
             .then(|| self.serial.lock().unwrap_or_else(|e| e.into_inner()));
-        match (
-            batch,
-            self.descriptor.evaluate_batch,
-            self.descriptor.evaluate_point,
-        ) {
-            (true, Some(f), _) => {
-                // SAFETY: ins.len() valid inputs whose pointers live for the call and as
-                // many writable outputs; the instance is this plugin's.
-                unsafe { f(self.instance, ins.as_ptr(), outs.as_mut_ptr(), ins.len()) }
-            }
-            (_, _, Some(f)) => {
-                for (i, o) in ins.iter().zip(outs.iter_mut()) {
-                    // SAFETY: as above, one point.
-                    unsafe { f(self.instance, i, o) }
+        let batched = batch && self.descriptor.evaluate_batch.is_some();
+        let site = CallSite {
+            plugin: &self.label,
+            entry: if batched {
+                "evaluate_batch"
+            } else {
+                "evaluate_point"
+            },
+            points: ins,
+            current: Cell::new(None),
+        };
+        guarded(&site, || {
+            match (
+                batch,
+                self.descriptor.evaluate_batch,
+                self.descriptor.evaluate_point,
+            ) {
+                (true, Some(f), _) => {
+                    // SAFETY: ins.len() valid inputs whose pointers live for the call and
+                    // as many writable outputs; the instance is this plugin's.
+                    unsafe { f(self.instance, ins.as_ptr(), outs.as_mut_ptr(), ins.len()) }
                 }
+                (_, _, Some(f)) => {
+                    for (k, (i, o)) in ins.iter().zip(outs.iter_mut()).enumerate() {
+                        site.current.set(Some(k));
+                        // SAFETY: as above, one point.
+                        unsafe { f(self.instance, i, o) }
+                    }
+                }
+                // Checked non-NULL at load.
+                (_, _, None) => {}
             }
-            // Checked non-NULL at load.
-            (_, _, None) => {}
-        }
+        })
     }
 
     fn validate(
@@ -777,7 +802,16 @@ fn instantiate(
     let mut message = [0 as c_char; SEAM_MESSAGE_LEN];
     // SAFETY: input, the instance slot and a SEAM_MESSAGE_LEN buffer are valid for the
     // call, as the ABI requires.
-    let status = unsafe { init(&input, &mut instance, message.as_mut_ptr()) };
+    let plugin = format!("`{}` ({})", info.name, info.path.display());
+    let site = CallSite {
+        plugin: &plugin,
+        entry: "init",
+        points: &[],
+        current: Cell::new(None),
+    };
+    let status = guarded(&site, || unsafe {
+        init(&input, &mut instance, message.as_mut_ptr())
+    });
     if status != SEAM_STATUS_OK {
         message[SEAM_MESSAGE_LEN - 1] = 0;
         return Err(PluginError::Init {

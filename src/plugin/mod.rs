@@ -19,6 +19,7 @@
 //! `plugins/include/seam_plugin.h`; the user guide is `docs/plugins.md`.
 
 mod check;
+mod guard;
 mod host;
 mod spec;
 

@@ -1212,3 +1212,63 @@ fn plugin_without_derivatives_in_a_run_is_noted_once() {
     let notes = r.warnings.0.iter().filter(|d| d.code == "W0502").count();
     assert_eq!(notes, 1, "{:?}", r.warnings);
 }
+
+/// A plugin that crashes (a null pointer) or ends the process (`exit(0)`, as a Fortran
+/// `STOP` does) inside a call cannot be survived in-process, but it is reported — the
+/// library, the entry point, the interaction and the point — and the exit code is 3,
+/// in `seam run` and in `seam check-plugin`.
+#[test]
+fn plugin_that_kills_the_process_is_reported_with_exit_code_3() {
+    let mesh = root().join("examples/two_blocks/two_blocks.exo");
+    for (fault, what) in [("SEGFAULT", "SIGSEGV"), ("EXIT", "exit")] {
+        let lib = cc_shared(
+            "plugins/tests/faulty/faulty.c",
+            &[&format!("-DFAULT_{fault}")],
+            &format!("faulty_{}", fault.to_lowercase()),
+        );
+        let dir = tmp().join(format!("run-kill-{}", fault.to_lowercase()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("problem.toml"),
+            format!(
+                "[mesh]\nfile = {:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 1\n[contact]\nfile = \"contact.i\"\n[output]\ndir = \"out\"\n",
+                mesh.to_str().unwrap()
+            ),
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("contact.i"),
+            format!(
+                "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
+                 begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{}\"\n  contact pressure = 1000\n end\nend\n",
+                lib.display()
+            ),
+        )
+        .unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["run", "problem.toml"])
+            .current_dir(&dir)
+            .output()
+            .expect("seam runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{fault}: {err}");
+        for needle in [
+            "error[E0503]: plugin `faulty`",
+            what,
+            "evaluate_",
+            "on interaction base_face / lid_face",
+        ] {
+            assert!(err.contains(needle), "{fault}: no `{needle}` in\n{err}");
+        }
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["check-plugin", lib.to_str().unwrap()])
+            .output()
+            .expect("seam runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{fault}: check-plugin: {err}");
+        assert!(err.contains("E0503") && err.contains(what), "{err}");
+    }
+}

@@ -9,6 +9,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 /* Not static: FAULT_NULL_EVALUATE leaves it unreferenced. */
 void fault_point(void *instance, const SeamPointIn *in, SeamPointOut *out);
@@ -43,6 +44,13 @@ void fault_point(void *instance, const SeamPointIn *in, SeamPointOut *out) {
     snprintf(out->message, SEAM_MESSAGE_LEN, "coating creep increment too large");
 #elif defined(FAULT_BAD_STATUS)
     out->status = 42;
+#elif defined(FAULT_SEGFAULT)
+    /* A null pointer dereferenced, as a plugin with a bug does. */
+    volatile double *nowhere = NULL;
+    out->value = *nowhere;
+#elif defined(FAULT_EXIT)
+    /* What a Fortran STOP does: exit with status 0. */
+    exit(0);
 #endif
 }
 
