@@ -166,6 +166,102 @@ pub fn read_nodal_variable(path: &Path, name: &str, step: usize) -> Result<Vec<f
     Ok(values.iter().copied().collect())
 }
 
+/// The QA records (code name, version, date, time) and information lines of a file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Records {
+    /// `qa_records`: one `[code, version, date, time]` per record.
+    pub qa: Vec<[String; 4]>,
+    /// `info_records`: one line per record.
+    pub info: Vec<String>,
+}
+
+/// The QA records (`qa_records`, `num_qa_rec`) and information records (`info_records`,
+/// `num_info`) of an Exodus file; empty when it has none.
+pub fn read_records(path: &Path) -> Result<Records, MeshError> {
+    let ex = open(path)?;
+    let mut out = Records::default();
+    let nqa = ex.dim_opt("num_qa_rec").unwrap_or(0);
+    if nqa > 0 && ex.has_var("qa_records") {
+        let flat = ex.names("qa_records", 4 * nqa)?;
+        out.qa = flat
+            .chunks_exact(4)
+            .map(|c| [c[0].clone(), c[1].clone(), c[2].clone(), c[3].clone()])
+            .collect();
+    }
+    let ninfo = ex.dim_opt("num_info").unwrap_or(0);
+    if ninfo > 0 && ex.has_var("info_records") {
+        out.info = ex.names("info_records", ninfo)?;
+    }
+    Ok(out)
+}
+
+/// The values of global variable `name` (named by `name_glo_var`, stored in
+/// `vals_glo_var`), one per step.
+pub fn read_global_variable(path: &Path, name: &str) -> Result<Vec<f64>, MeshError> {
+    let ex = open(path)?;
+    let nvar = ex.dim_opt("num_glo_var").unwrap_or(0);
+    let k = ex.variable_index("name_glo_var", nvar, name, "global")?;
+    let steps = ex.dim_opt("time_step").unwrap_or(0);
+    let all = ex.floats("vals_glo_var", steps * nvar)?;
+    Ok(all.iter().skip(k).step_by(nvar).copied().collect())
+}
+
+/// The values of element variable `name` (named by `name_elem_var`, stored per block in
+/// `vals_elem_varVebB`) at step `step` (0-based), one per element in the order
+/// [`super::read`] numbers them; NaN in blocks where the truth table `elem_var_tab` says
+/// the variable is not stored.
+pub fn read_element_variable(path: &Path, name: &str, step: usize) -> Result<Vec<f64>, MeshError> {
+    let ex = open(path)?;
+    let nvar = ex.dim_opt("num_elem_var").unwrap_or(0);
+    let v = ex.variable_index("name_elem_var", nvar, name, "element")? + 1;
+    ex.check_step(step)?;
+    let nblk = ex.dim_opt("num_el_blk").unwrap_or(0);
+    let mut out = Vec::new();
+    for b in 1..=nblk {
+        let count = ex.dim_opt(&format!("num_el_in_blk{b}")).unwrap_or(0);
+        let var = format!("vals_elem_var{v}eb{b}");
+        if count == 0 {
+            continue;
+        }
+        if ex.has_var(&var) {
+            out.extend(ex.step_slice(&var, step, count)?);
+        } else {
+            out.extend(std::iter::repeat_n(f64::NAN, count));
+        }
+    }
+    Ok(out)
+}
+
+/// The values of side-set variable `name` (named by `name_sset_var`, stored per set in
+/// `vals_sset_varVssS`) on side set `id` (its `ss_prop1` id) at step `step` (0-based),
+/// one per side in the order of the set; `None` when the variable is not stored on that
+/// set (its `sset_var_tab` entry is 0).
+pub fn read_side_set_variable(
+    path: &Path,
+    name: &str,
+    id: i64,
+    step: usize,
+) -> Result<Option<Vec<f64>>, MeshError> {
+    let ex = open(path)?;
+    let nvar = ex.dim_opt("num_sset_var").unwrap_or(0);
+    let v = ex.variable_index("name_sset_var", nvar, name, "side-set")? + 1;
+    ex.check_step(step)?;
+    let nss = ex.dim_opt("num_side_sets").unwrap_or(0);
+    let ids = ex.ids("ss_prop1", nss)?;
+    let Some(s) = ids.iter().position(|&i| i == id) else {
+        return Err(ex.err(
+            format!("no side set with id {id} (`ss_prop1` holds {ids:?})"),
+            "use the id of a side set in the file",
+        ));
+    };
+    let var = format!("vals_sset_var{v}ss{}", s + 1);
+    if !ex.has_var(&var) {
+        return Ok(None);
+    }
+    let count = ex.dim_opt(&format!("num_side_ss{}", s + 1)).unwrap_or(0);
+    ex.step_slice(&var, step, count).map(Some)
+}
+
 struct ExoFile<'a> {
     path: &'a Path,
     file: NcFile,
@@ -197,6 +293,72 @@ impl ExoFile<'_> {
                 "the file may be corrupt; re-export it from Cubit/SEACAS",
             )
         }
+    }
+
+    /// The 0-based index of variable `name` in the name table `table` of `count` names;
+    /// exact match first, then ignoring case.
+    fn variable_index(
+        &self,
+        table: &str,
+        count: usize,
+        name: &str,
+        kind: &str,
+    ) -> Result<usize, MeshError> {
+        let names = self.names(table, count)?;
+        names
+            .iter()
+            .position(|n| n == name)
+            .or_else(|| names.iter().position(|n| n.eq_ignore_ascii_case(name)))
+            .ok_or_else(|| {
+                self.err(
+                    format!("no {kind} variable `{name}` (`{table}` holds {names:?})"),
+                    "use one of the names the file has",
+                )
+            })
+    }
+
+    fn check_step(&self, step: usize) -> Result<(), MeshError> {
+        let steps = self.dim_opt("time_step").unwrap_or(0);
+        if step >= steps {
+            return Err(self.err(
+                format!(
+                    "step {step} asked for, but the file holds {steps} step(s) (numbered from 0)"
+                ),
+                "ask for a step below the count; a run that stopped early holds fewer steps",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Step `step` of the record variable `var(time_step, n)`.
+    fn step_slice(&self, var: &str, step: usize, n: usize) -> Result<Vec<f64>, MeshError> {
+        self.bound(var, n, 4)?;
+        let values = self
+            .file
+            .read_variable_slice_as_f64(
+                var,
+                &NcSliceInfo {
+                    selections: vec![
+                        NcSliceInfoElem::Index(step as u64),
+                        NcSliceInfoElem::Slice {
+                            start: 0,
+                            end: n as u64,
+                            step: 1,
+                        },
+                    ],
+                },
+            )
+            .map_err(|e| self.nc_err(var, e))?;
+        if values.len() != n {
+            return Err(self.err(
+                format!(
+                    "`{var}` gives {} values at step {step}, expected {n}",
+                    values.len()
+                ),
+                "the file's dimensions disagree with its data; re-export it",
+            ));
+        }
+        Ok(values.iter().copied().collect())
     }
 
     /// Refuse `n` entries of `size` bytes when the file cannot hold them.
@@ -602,14 +764,16 @@ impl ExoFile<'_> {
             if count > 0 {
                 let label = set_label("side set", ids[i - 1], &names[i - 1]);
                 let describe = |k: usize| format!("{label}, entry {}", k + 1);
-                let elems = self.positions(
-                    &format!("ss_elem{i}"),
-                    count,
-                    num_elem,
-                    "element",
-                    &describe,
-                )?;
-                let side_name = format!("ss_side{i}");
+                // The Exodus II names are `elem_ssN`/`side_ssN`; `ss_elemN`/`ss_sideN`
+                // are read too: earlier seam versions wrote them.
+                let (elem_name, side_name) = if !self.has_var(&format!("elem_ss{i}"))
+                    && self.has_var(&format!("ss_elem{i}"))
+                {
+                    (format!("ss_elem{i}"), format!("ss_side{i}"))
+                } else {
+                    (format!("elem_ss{i}"), format!("side_ss{i}"))
+                };
+                let elems = self.positions(&elem_name, count, num_elem, "element", &describe)?;
                 let nums = self.ints(&side_name, count)?;
                 sides.reserve_exact(count);
                 for (k, (&e, &s)) in elems.iter().zip(&nums).enumerate() {
