@@ -233,6 +233,14 @@ fn exodus_flavours_read_identically_and_match_the_sidecar() {
 }
 
 #[test]
+fn exodus_side_sets_under_the_names_of_earlier_seam_versions_still_read() {
+    // ss_elemN/ss_sideN instead of elem_ssN/side_ssN; nothing else differs.
+    let legacy = read("legacy_side_set_names.exo");
+    check_against_sidecar(&legacy, &expected()["two_hex"]);
+    assert_same(&read("two_hex_offset64.exo"), &legacy, "legacy names", 0.0);
+}
+
+#[test]
 fn exodus_side_sets_lie_on_the_planes_they_were_written_on() {
     // Both side sets were written on the interface z = 1.
     let m = read("two_hex_nc4.exo");
