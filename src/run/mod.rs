@@ -1026,6 +1026,13 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             .collect()
     };
     let mut split_history: Vec<Vec<Vec<f64>>> = Vec::new();
+    // The global variables of results.exo: the heat leaving each side of every term.
+    let heat_names = steps::interface_heat_names(
+        &term_choice
+            .iter()
+            .map(|&k| (pairings[k].side_a.as_str(), pairings[k].side_b.as_str()))
+            .collect::<Vec<_>>(),
+    );
     // One state's fields as step `step` of the results (temperature, heat flux, contact
     // faces), from its derived values when they were made with the faces.
     let write_state = |writer: &mut steps::StepWriter<'_>,
@@ -1033,7 +1040,8 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                        dofs: &DofMap,
                        step: usize,
                        time: f64,
-                       derived: Option<Derived>|
+                       derived: Option<Derived>,
+                       heat: &[(f64, f64)]|
      -> Result<(), String> {
         let derived = match derived {
             Some(d) => d,
@@ -1046,6 +1054,8 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             temperature: &t,
             heat_flux: &q,
             contact: contact.as_ref(),
+            heat_names: &heat_names,
+            heat,
         };
         writer
             .write_step(step, time, &fields)
@@ -1186,8 +1196,16 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             let derived = derive(&st.u, dofs, st.time, due).map_err(HeatError::Step)?;
             split_history.push(term_mechanisms(&derived));
             if due {
-                write_state(&mut writer, &st.u, dofs, st.step, st.time, Some(derived))
-                    .map_err(HeatError::Step)?;
+                write_state(
+                    &mut writer,
+                    &st.u,
+                    dofs,
+                    st.step,
+                    st.time,
+                    Some(derived),
+                    &r.heat,
+                )
+                .map_err(HeatError::Step)?;
             }
             writer
                 .checkpoint(st)
@@ -1210,6 +1228,7 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
                 last.step,
                 last.time,
                 None,
+                history.last().map_or(&[][..], |r| &r.heat),
             )
             .map_err(RunError::Solve)?;
         }
@@ -1256,10 +1275,18 @@ pub fn run_with(path: &Path, options: &RunOptions) -> Result<RunResult, RunError
             )
             .map_err(RunError::Solve)?;
             let contact = contact_of(&derived);
+            let steady_heat: Vec<(f64, f64)> = solution
+                .heat
+                .iter()
+                .chain(&solution.tie_heat)
+                .copied()
+                .collect();
             let state = steps::StepFields {
                 temperature: &solution.temperature,
                 heat_flux: &heat_flux,
                 contact: contact.as_ref(),
+                heat_names: &heat_names,
+                heat: &steady_heat,
             };
             let file = out_dir.join("temperature.vtu");
             let per_field: Vec<(String, Vec<f64>)> = if field_names.len() > 1 {
