@@ -1,19 +1,27 @@
 //! Exodus II reader (netCDF classic, 64-bit offset, CDF-5 and netCDF-4/HDF5), on the
-//! pure-Rust `netcdf-reader` crate.
+//! pure-Rust `netcdf-reader` crate, with the names of the Exodus II format (the reference
+//! C library's `exodusII_int.h`; the full list, each with the test that checks it
+//! against files written by that library, is in `docs/exodus.md`).
 //!
-//! Entry points: [`read`]; results with [`read_times`] and [`read_nodal_variable`]. It reads coordinates (`coordx/coordy/coordz` or `coord`), the
-//! number maps (`node_num_map`, `elem_num_map`; 1..n when absent), element blocks
-//! (`connectN` with its `elem_type`, ids `eb_prop1`, names `eb_names`, shell thickness
-//! from `attribN`), side sets (`ss_elemN`/`ss_sideN`, `ss_prop1`, `ss_names`), node sets
-//! (`node_nsN`, `ns_prop1`, `ns_names`) and assemblies (`assembly_entityID`).
+//! Entry points: [`read`] for the mesh; [`read_times`], [`read_nodal_variable`],
+//! [`read_element_variable`], [`read_global_variable`], [`read_side_set_variable`],
+//! [`read_node_set_variable`] for results; [`read_records`] for the QA and information
+//! records. The mesh is read from the coordinates (`coordx/coordy/coordz`, or the older
+//! combined `coord`), the number maps (`node_num_map`, `elem_num_map`; 1..n when absent),
+//! element blocks (`connectN` with its `elem_type`, ids `eb_prop1`, names `eb_names`,
+//! shell thickness from `attribN`/`attrib_nameN`), side sets (`elem_ssN`/`side_ssN`,
+//! `num_side_ssN`, `ss_prop1`, `ss_names`; the `ss_elemN`/`ss_sideN` of earlier seam
+//! versions too), node sets (`node_nsN`, `num_nod_nsN`, `ns_prop1`, `ns_names`) and
+//! assemblies (`assembly_entityN`). Distribution factors, status arrays and extra maps
+//! are not needed and not read.
 //!
 //! Conventions, as in the Exodus II API: node indices in `connectN` and `node_nsN`, and
-//! element indices in `ss_elemN`, are 1-based *positions* (not the numbers of the maps);
-//! they become dense 0-based [`NodeId`]/[`ElemId`] here. Integer variables may be 32- or
-//! 64-bit. An empty ("NULL") block has no `num_el_in_blkN` dimension and no `connectN`;
-//! it is kept, with the topology of its `elem_type` if given, else `Hex8` (3-D) / `Quad4`
-//! (2-D). Every index is range-checked while reading, so a corrupt file gives an error
-//! naming the variable and entry, never a panic.
+//! element indices in `elem_ssN`, are 1-based *positions* (not the numbers of the maps);
+//! they become dense 0-based [`NodeId`]/[`ElemId`] here. Integer variables may be 8-,
+//! 16-, 32- or 64-bit. An empty ("NULL") block has no `num_el_in_blkN` dimension and no
+//! `connectN`; it is kept, with the topology of its `elem_type` if given, else `Hex8`
+//! (3-D) / `Quad4` (2-D). Every index is range-checked while reading, so a corrupt file
+//! gives an error naming the file and the variable, never a panic.
 
 use std::path::Path;
 
@@ -242,24 +250,54 @@ pub fn read_side_set_variable(
     id: i64,
     step: usize,
 ) -> Result<Option<Vec<f64>>, MeshError> {
-    let ex = open(path)?;
-    let nvar = ex.dim_opt("num_sset_var").unwrap_or(0);
-    let v = ex.variable_index("name_sset_var", nvar, name, "side-set")? + 1;
-    ex.check_step(step)?;
-    let nss = ex.dim_opt("num_side_sets").unwrap_or(0);
-    let ids = ex.ids("ss_prop1", nss)?;
-    let Some(s) = ids.iter().position(|&i| i == id) else {
-        return Err(ex.err(
-            format!("no side set with id {id} (`ss_prop1` holds {ids:?})"),
-            "use the id of a side set in the file",
-        ));
-    };
-    let var = format!("vals_sset_var{v}ss{}", s + 1);
-    if !ex.has_var(&var) {
-        return Ok(None);
+    open(path)?.set_variable(SetKind::Side, name, id, step)
+}
+
+/// As [`read_side_set_variable`], for node-set variables (`name_nset_var`,
+/// `vals_nset_varVnsS`, `nset_var_tab`) on node set `id` (its `ns_prop1` id), one value
+/// per node of the set.
+pub fn read_node_set_variable(
+    path: &Path,
+    name: &str,
+    id: i64,
+    step: usize,
+) -> Result<Option<Vec<f64>>, MeshError> {
+    open(path)?.set_variable(SetKind::Node, name, id, step)
+}
+
+#[derive(Clone, Copy)]
+enum SetKind {
+    Side,
+    Node,
+}
+
+impl SetKind {
+    /// (kind, set count, `num_*_var`, `name_*_var`, ids, `vals_*_var` stem, set tag,
+    /// set size stem)
+    fn names(self) -> [&'static str; 8] {
+        match self {
+            SetKind::Side => [
+                "side-set",
+                "num_side_sets",
+                "num_sset_var",
+                "name_sset_var",
+                "ss_prop1",
+                "vals_sset_var",
+                "ss",
+                "num_side_ss",
+            ],
+            SetKind::Node => [
+                "node-set",
+                "num_node_sets",
+                "num_nset_var",
+                "name_nset_var",
+                "ns_prop1",
+                "vals_nset_var",
+                "ns",
+                "num_nod_ns",
+            ],
+        }
     }
-    let count = ex.dim_opt(&format!("num_side_ss{}", s + 1)).unwrap_or(0);
-    ex.step_slice(&var, step, count).map(Some)
 }
 
 struct ExoFile<'a> {
@@ -359,6 +397,34 @@ impl ExoFile<'_> {
             ));
         }
         Ok(values.iter().copied().collect())
+    }
+
+    /// A set variable's values on set `id` at `step`; `None` where it is not stored.
+    fn set_variable(
+        &self,
+        kind: SetKind,
+        name: &str,
+        id: i64,
+        step: usize,
+    ) -> Result<Option<Vec<f64>>, MeshError> {
+        let [what, num_sets, num_var, table, prop, vals, tag, size] = kind.names();
+        let nvar = self.dim_opt(num_var).unwrap_or(0);
+        let v = self.variable_index(table, nvar, name, what)? + 1;
+        self.check_step(step)?;
+        let nsets = self.dim_opt(num_sets).unwrap_or(0);
+        let ids = self.ids(prop, nsets)?;
+        let Some(s) = ids.iter().position(|&i| i == id) else {
+            return Err(self.err(
+                format!("no {what} with id {id} (`{prop}` holds {ids:?})"),
+                "use the id of a set in the file",
+            ));
+        };
+        let var = format!("{vals}{v}{tag}{}", s + 1);
+        if !self.has_var(&var) {
+            return Ok(None);
+        }
+        let count = self.dim_opt(&format!("{size}{}", s + 1)).unwrap_or(0);
+        self.step_slice(&var, step, count).map(Some)
     }
 
     /// Refuse `n` entries of `size` bytes when the file cannot hold them.

@@ -265,6 +265,12 @@ fn exodus_other_topologies_match_the_sidecar() {
     assert_eq!(shell.blocks[1].topology, Topology::Shell4);
     assert_eq!(shell.blocks[1].thickness, Some(0.1));
     assert!(shell.blocks[2].is_empty(), "the NULL block is kept");
+    // The assembly (assembly_entity100 with _id, _type = element blocks, _name).
+    assert_eq!(shell.assemblies.len(), 1);
+    let a = &shell.assemblies[0];
+    assert_eq!((a.id, a.name.as_str()), (100, "everything"));
+    assert!(matches!(a.kind, seam::mesh::AssemblyKind::Blocks));
+    assert_eq!(a.members, [1, 2, 3]);
     let tw = read("tet_wedge.exo");
     assert_eq!(tw.blocks[0].topology, Topology::Wedge6);
     assert_eq!(tw.blocks[1].topology, Topology::Tet4);
@@ -494,6 +500,15 @@ fn exodus_reference_library_records_and_variables_read_in_every_flavour() {
                 .expect("stored on the first side set");
             let want: Vec<f64> = (0..count).map(|k| -((k + 1) as f64)).collect();
             assert_eq!(v, want, "{file} vals_sset_var");
+            // Node-set variable: 7 (k + step).
+            let first = &e["node_sets"][0];
+            let id = first["id"].as_i64().unwrap();
+            let count = first["nodes"].as_array().unwrap().len();
+            let v = mesh::exodus::read_node_set_variable(&path, "node_set_value", id, 1)
+                .unwrap()
+                .expect("stored on the first node set");
+            let want: Vec<f64> = (0..count).map(|k| 7.0 * (k + 2) as f64).collect();
+            assert_eq!(v, want, "{file} vals_nset_var");
         }
     }
 }
