@@ -89,10 +89,15 @@ static int num_elems(const struct mesh *m) {
 
 static int node_number(int k) { return 1000 + 7 * k; } /* k: 0-based position */
 static int elem_number(int k) { return 500 - 3 * k; }  /* unordered on purpose */
+static double total_heat(int step) { return 100.0 * step; }
 static double temperature(const struct mesh *m, int k, double t) {
   return 300.0 + m->x[k] + 2.0 * m->y[k] + 3.0 * m->z[k] + 10.0 * t;
 }
 static const double TIMES[2] = {0.0, 2.5};
+static char *QA[2][4] = {{"write_fixtures", "1.0", "01/02/26", "03:04:05"},
+                         {"seam_tests", "2.0", "12/31/25", "23:59:59"}};
+static char *INFO[2] = {"Reference fixture written by libexodus for seam.",
+                        "Second information record."};
 
 static int add_node(struct mesh *m, double x, double y, double z) {
   m->x[m->num_nodes] = x;
@@ -237,12 +242,8 @@ static void write_mesh(const struct mesh *m, const char *path, int mode) {
   par.num_node_maps = 1;
   CHECK(ex_put_init_ext(exo, &par));
 
-  char *qa[2][4] = {{"write_fixtures", "1.0", "01/02/26", "03:04:05"},
-                    {"seam_tests", "2.0", "12/31/25", "23:59:59"}};
-  CHECK(ex_put_qa(exo, 2, qa));
-  char *info[2] = {"Reference fixture written by libexodus for seam.",
-                   "Second information record."};
-  CHECK(ex_put_info(exo, 2, info));
+  CHECK(ex_put_qa(exo, 2, QA));
+  CHECK(ex_put_info(exo, 2, INFO));
 
   CHECK(ex_put_coord(exo, m->x, m->y, m->dim == 3 ? m->z : NULL));
   char *cn[3] = {"x", "y", "z"};
@@ -326,7 +327,7 @@ static void write_mesh(const struct mesh *m, const char *path, int mode) {
   for (int step = 1; step <= 2; step++) {
     double t = TIMES[step - 1];
     CHECK(ex_put_time(exo, step, &t));
-    double g = 100.0 * step;
+    double g = total_heat(step);
     CHECK(ex_put_var(exo, step, EX_GLOBAL, 1, 0, 1, &g));
     double v[MAX_NODES];
     for (int k = 0; k < m->num_nodes; k++) v[k] = temperature(m, k, t);
@@ -421,12 +422,24 @@ static void write_json(FILE *f, const struct mesh *m) {
     json_ints(f, s->nodes, s->count);
     fprintf(f, "}%s\n", i + 1 < m->nns ? "," : "");
   }
-  fprintf(f, "  ],\n  \"qa_records\": [[\"write_fixtures\",\"1.0\",\"01/02/26\",\"03:04:05\"],"
-             "[\"seam_tests\",\"2.0\",\"12/31/25\",\"23:59:59\"]],\n");
-  fprintf(f, "  \"info_records\": [\"Reference fixture written by libexodus for seam.\","
-             "\"Second information record.\"],\n");
+  fprintf(f, "  ],\n  \"qa_records\": [");
+  for (int i = 0; i < 2; i++) {
+    fprintf(f, "%s[", i ? "," : "");
+    for (int j = 0; j < 4; j++) {
+      if (j) fputc(',', f);
+      json_string(f, QA[i][j]);
+    }
+    fputc(']', f);
+  }
+  fprintf(f, "],\n  \"info_records\": [");
+  for (int i = 0; i < 2; i++) {
+    if (i) fputc(',', f);
+    json_string(f, INFO[i]);
+  }
+  fprintf(f, "],\n");
   fprintf(f, "  \"times\": [%.17g,%.17g],\n", TIMES[0], TIMES[1]);
-  fprintf(f, "  \"global_variables\": {\"total_heat\": [100,200]},\n");
+  fprintf(f, "  \"global_variables\": {\"total_heat\": [%.17g,%.17g]},\n", total_heat(1),
+          total_heat(2));
   fprintf(f, "  \"nodal_variables\": {\"temperature\": [");
   for (int step = 0; step < 2; step++) {
     fprintf(f, "%s[", step ? "," : "");
