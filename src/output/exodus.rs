@@ -707,12 +707,14 @@ fn check_indices(mesh: &Mesh) -> io::Result<()> {
 }
 
 /// The `elem_type` attribute: the bare shape names that Cubit writes and every reader
-/// knows (meshio, for one, maps `TETRA4` to no cell type but reads `TETRA`).
+/// knows (meshio, for one, maps `TETRA4` to no cell type but reads `TETRA`). A 3-node
+/// shell is a `TRISHELL3` in Exodus (`SHELL3` would be a 3-node 2-D line shell).
 fn elem_type(t: Topology) -> &'static str {
     match t {
         Topology::Tet4 => "TETRA",
         Topology::Wedge6 => "WEDGE",
         Topology::Pyramid5 => "PYRAMID",
+        Topology::Shell3 => "TRISHELL3",
         other => other.exodus_name(),
     }
 }
