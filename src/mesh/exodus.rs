@@ -766,7 +766,7 @@ impl ExoFile<'_> {
                         "{label}: element type `{elem_type}` with {npe} nodes is not supported"
                     ),
                     "seam supports HEX8, TETRA4, WEDGE6, PYRAMID5, QUAD4/TRI3 (2-D), \
-                     SHELL4/SHELL3 and BAR2; convert higher-order blocks to linear ones \
+                     SHELL4/TRISHELL3 and BAR2; convert higher-order blocks to linear ones \
                      (e.g. Cubit `block N element type hex8`)",
                 ));
             };
