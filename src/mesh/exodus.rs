@@ -1,19 +1,27 @@
 //! Exodus II reader (netCDF classic, 64-bit offset, CDF-5 and netCDF-4/HDF5), on the
-//! pure-Rust `netcdf-reader` crate.
+//! pure-Rust `netcdf-reader` crate, with the names of the Exodus II format (the reference
+//! C library's `exodusII_int.h`; the full list, each with the test that checks it
+//! against files written by that library, is in `docs/exodus.md`).
 //!
-//! Entry points: [`read`]; results with [`read_times`] and [`read_nodal_variable`]. It reads coordinates (`coordx/coordy/coordz` or `coord`), the
-//! number maps (`node_num_map`, `elem_num_map`; 1..n when absent), element blocks
-//! (`connectN` with its `elem_type`, ids `eb_prop1`, names `eb_names`, shell thickness
-//! from `attribN`), side sets (`ss_elemN`/`ss_sideN`, `ss_prop1`, `ss_names`), node sets
-//! (`node_nsN`, `ns_prop1`, `ns_names`) and assemblies (`assembly_entityID`).
+//! Entry points: [`read`] for the mesh; [`read_times`], [`read_nodal_variable`],
+//! [`read_element_variable`], [`read_global_variable`], [`read_side_set_variable`],
+//! [`read_node_set_variable`] for results; [`read_records`] for the QA and information
+//! records. The mesh is read from the coordinates (`coordx/coordy/coordz`, or the older
+//! combined `coord`), the number maps (`node_num_map`, `elem_num_map`; 1..n when absent),
+//! element blocks (`connectN` with its `elem_type`, ids `eb_prop1`, names `eb_names`,
+//! shell thickness from `attribN`/`attrib_nameN`), side sets (`elem_ssN`/`side_ssN`,
+//! `num_side_ssN`, `ss_prop1`, `ss_names`; the `ss_elemN`/`ss_sideN` of earlier seam
+//! versions too), node sets (`node_nsN`, `num_nod_nsN`, `ns_prop1`, `ns_names`) and
+//! assemblies (`assembly_entityN`). Distribution factors, status arrays and extra maps
+//! are not needed and not read.
 //!
 //! Conventions, as in the Exodus II API: node indices in `connectN` and `node_nsN`, and
-//! element indices in `ss_elemN`, are 1-based *positions* (not the numbers of the maps);
-//! they become dense 0-based [`NodeId`]/[`ElemId`] here. Integer variables may be 32- or
-//! 64-bit. An empty ("NULL") block has no `num_el_in_blkN` dimension and no `connectN`;
-//! it is kept, with the topology of its `elem_type` if given, else `Hex8` (3-D) / `Quad4`
-//! (2-D). Every index is range-checked while reading, so a corrupt file gives an error
-//! naming the variable and entry, never a panic.
+//! element indices in `elem_ssN`, are 1-based *positions* (not the numbers of the maps);
+//! they become dense 0-based [`NodeId`]/[`ElemId`] here. Integer variables may be 8-,
+//! 16-, 32- or 64-bit. An empty ("NULL") block has no `num_el_in_blkN` dimension and no
+//! `connectN`; it is kept, with the topology of its `elem_type` if given, else `Hex8`
+//! (3-D) / `Quad4` (2-D). Every index is range-checked while reading, so a corrupt file
+//! gives an error naming the file and the variable, never a panic.
 
 use std::path::Path;
 
@@ -166,6 +174,132 @@ pub fn read_nodal_variable(path: &Path, name: &str, step: usize) -> Result<Vec<f
     Ok(values.iter().copied().collect())
 }
 
+/// The QA records (code name, version, date, time) and information lines of a file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Records {
+    /// `qa_records`: one `[code, version, date, time]` per record.
+    pub qa: Vec<[String; 4]>,
+    /// `info_records`: one line per record.
+    pub info: Vec<String>,
+}
+
+/// The QA records (`qa_records`, `num_qa_rec`) and information records (`info_records`,
+/// `num_info`) of an Exodus file; empty when it has none.
+pub fn read_records(path: &Path) -> Result<Records, MeshError> {
+    let ex = open(path)?;
+    let mut out = Records::default();
+    let nqa = ex.dim_opt("num_qa_rec").unwrap_or(0);
+    if nqa > 0 && ex.has_var("qa_records") {
+        let flat = ex.names("qa_records", 4 * nqa)?;
+        out.qa = flat
+            .chunks_exact(4)
+            .map(|c| [c[0].clone(), c[1].clone(), c[2].clone(), c[3].clone()])
+            .collect();
+    }
+    let ninfo = ex.dim_opt("num_info").unwrap_or(0);
+    if ninfo > 0 && ex.has_var("info_records") {
+        out.info = ex.names("info_records", ninfo)?;
+    }
+    Ok(out)
+}
+
+/// The values of global variable `name` (named by `name_glo_var`, stored in
+/// `vals_glo_var`), one per step.
+pub fn read_global_variable(path: &Path, name: &str) -> Result<Vec<f64>, MeshError> {
+    let ex = open(path)?;
+    let nvar = ex.dim_opt("num_glo_var").unwrap_or(0);
+    let k = ex.variable_index("name_glo_var", nvar, name, "global")?;
+    let steps = ex.dim_opt("time_step").unwrap_or(0);
+    let all = ex.floats("vals_glo_var", steps * nvar)?;
+    Ok(all.iter().skip(k).step_by(nvar).copied().collect())
+}
+
+/// The values of element variable `name` (named by `name_elem_var`, stored per block in
+/// `vals_elem_varVebB`) at step `step` (0-based), one per element in the order
+/// [`super::read`] numbers them; NaN in blocks where the truth table `elem_var_tab` says
+/// the variable is not stored.
+pub fn read_element_variable(path: &Path, name: &str, step: usize) -> Result<Vec<f64>, MeshError> {
+    let ex = open(path)?;
+    let nvar = ex.dim_opt("num_elem_var").unwrap_or(0);
+    let v = ex.variable_index("name_elem_var", nvar, name, "element")? + 1;
+    ex.check_step(step)?;
+    let nblk = ex.dim_opt("num_el_blk").unwrap_or(0);
+    let mut out = Vec::new();
+    for b in 1..=nblk {
+        let count = ex.dim_opt(&format!("num_el_in_blk{b}")).unwrap_or(0);
+        let var = format!("vals_elem_var{v}eb{b}");
+        if count == 0 {
+            continue;
+        }
+        if ex.has_var(&var) {
+            out.extend(ex.step_slice(&var, step, count)?);
+        } else {
+            out.extend(std::iter::repeat_n(f64::NAN, count));
+        }
+    }
+    Ok(out)
+}
+
+/// The values of side-set variable `name` (named by `name_sset_var`, stored per set in
+/// `vals_sset_varVssS`) on side set `id` (its `ss_prop1` id) at step `step` (0-based),
+/// one per side in the order of the set; `None` when the variable is not stored on that
+/// set (its `sset_var_tab` entry is 0).
+pub fn read_side_set_variable(
+    path: &Path,
+    name: &str,
+    id: i64,
+    step: usize,
+) -> Result<Option<Vec<f64>>, MeshError> {
+    open(path)?.set_variable(SetKind::Side, name, id, step)
+}
+
+/// As [`read_side_set_variable`], for node-set variables (`name_nset_var`,
+/// `vals_nset_varVnsS`, `nset_var_tab`) on node set `id` (its `ns_prop1` id), one value
+/// per node of the set.
+pub fn read_node_set_variable(
+    path: &Path,
+    name: &str,
+    id: i64,
+    step: usize,
+) -> Result<Option<Vec<f64>>, MeshError> {
+    open(path)?.set_variable(SetKind::Node, name, id, step)
+}
+
+#[derive(Clone, Copy)]
+enum SetKind {
+    Side,
+    Node,
+}
+
+impl SetKind {
+    /// (kind, set count, `num_*_var`, `name_*_var`, ids, `vals_*_var` stem, set tag,
+    /// set size stem)
+    fn names(self) -> [&'static str; 8] {
+        match self {
+            SetKind::Side => [
+                "side-set",
+                "num_side_sets",
+                "num_sset_var",
+                "name_sset_var",
+                "ss_prop1",
+                "vals_sset_var",
+                "ss",
+                "num_side_ss",
+            ],
+            SetKind::Node => [
+                "node-set",
+                "num_node_sets",
+                "num_nset_var",
+                "name_nset_var",
+                "ns_prop1",
+                "vals_nset_var",
+                "ns",
+                "num_nod_ns",
+            ],
+        }
+    }
+}
+
 struct ExoFile<'a> {
     path: &'a Path,
     file: NcFile,
@@ -197,6 +331,100 @@ impl ExoFile<'_> {
                 "the file may be corrupt; re-export it from Cubit/SEACAS",
             )
         }
+    }
+
+    /// The 0-based index of variable `name` in the name table `table` of `count` names;
+    /// exact match first, then ignoring case.
+    fn variable_index(
+        &self,
+        table: &str,
+        count: usize,
+        name: &str,
+        kind: &str,
+    ) -> Result<usize, MeshError> {
+        let names = self.names(table, count)?;
+        names
+            .iter()
+            .position(|n| n == name)
+            .or_else(|| names.iter().position(|n| n.eq_ignore_ascii_case(name)))
+            .ok_or_else(|| {
+                self.err(
+                    format!("no {kind} variable `{name}` (`{table}` holds {names:?})"),
+                    "use one of the names the file has",
+                )
+            })
+    }
+
+    fn check_step(&self, step: usize) -> Result<(), MeshError> {
+        let steps = self.dim_opt("time_step").unwrap_or(0);
+        if step >= steps {
+            return Err(self.err(
+                format!(
+                    "step {step} asked for, but the file holds {steps} step(s) (numbered from 0)"
+                ),
+                "ask for a step below the count; a run that stopped early holds fewer steps",
+            ));
+        }
+        Ok(())
+    }
+
+    /// Step `step` of the record variable `var(time_step, n)`.
+    fn step_slice(&self, var: &str, step: usize, n: usize) -> Result<Vec<f64>, MeshError> {
+        self.bound(var, n, 4)?;
+        let values = self
+            .file
+            .read_variable_slice_as_f64(
+                var,
+                &NcSliceInfo {
+                    selections: vec![
+                        NcSliceInfoElem::Index(step as u64),
+                        NcSliceInfoElem::Slice {
+                            start: 0,
+                            end: n as u64,
+                            step: 1,
+                        },
+                    ],
+                },
+            )
+            .map_err(|e| self.nc_err(var, e))?;
+        if values.len() != n {
+            return Err(self.err(
+                format!(
+                    "`{var}` gives {} values at step {step}, expected {n}",
+                    values.len()
+                ),
+                "the file's dimensions disagree with its data; re-export it",
+            ));
+        }
+        Ok(values.iter().copied().collect())
+    }
+
+    /// A set variable's values on set `id` at `step`; `None` where it is not stored.
+    fn set_variable(
+        &self,
+        kind: SetKind,
+        name: &str,
+        id: i64,
+        step: usize,
+    ) -> Result<Option<Vec<f64>>, MeshError> {
+        let [what, num_sets, num_var, table, prop, vals, tag, size] = kind.names();
+        let nvar = self.dim_opt(num_var).unwrap_or(0);
+        let v = self.variable_index(table, nvar, name, what)? + 1;
+        self.check_step(step)?;
+        let nsets = self.dim_opt(num_sets).unwrap_or(0);
+        let ids = self.ids(prop, nsets)?;
+        let Some(s) = ids.iter().position(|&i| i == id) else {
+            return Err(self.err(
+                format!("no {what} with id {id} (`{prop}` holds {ids:?})"),
+                "use the id of a set in the file",
+            ));
+        };
+        let var = format!("{vals}{v}{tag}{}", s + 1);
+        if !self.has_var(&var) {
+            return Ok(None);
+        }
+        let count = self.dim_opt(&format!("{size}{}", s + 1)).unwrap_or(0);
+        self.step_slice(&var, step, count).map(Some)
     }
 
     /// Refuse `n` entries of `size` bytes when the file cannot hold them.
@@ -538,7 +766,7 @@ impl ExoFile<'_> {
                         "{label}: element type `{elem_type}` with {npe} nodes is not supported"
                     ),
                     "seam supports HEX8, TETRA4, WEDGE6, PYRAMID5, QUAD4/TRI3 (2-D), \
-                     SHELL4/SHELL3 and BAR2; convert higher-order blocks to linear ones \
+                     SHELL4/TRISHELL3 and BAR2; convert higher-order blocks to linear ones \
                      (e.g. Cubit `block N element type hex8`)",
                 ));
             };
@@ -602,14 +830,16 @@ impl ExoFile<'_> {
             if count > 0 {
                 let label = set_label("side set", ids[i - 1], &names[i - 1]);
                 let describe = |k: usize| format!("{label}, entry {}", k + 1);
-                let elems = self.positions(
-                    &format!("ss_elem{i}"),
-                    count,
-                    num_elem,
-                    "element",
-                    &describe,
-                )?;
-                let side_name = format!("ss_side{i}");
+                // The Exodus II names are `elem_ssN`/`side_ssN`; `ss_elemN`/`ss_sideN`
+                // are read too: earlier seam versions wrote them.
+                let (elem_name, side_name) = if !self.has_var(&format!("elem_ss{i}"))
+                    && self.has_var(&format!("ss_elem{i}"))
+                {
+                    (format!("ss_elem{i}"), format!("ss_side{i}"))
+                } else {
+                    (format!("elem_ss{i}"), format!("side_ss{i}"))
+                };
+                let elems = self.positions(&elem_name, count, num_elem, "element", &describe)?;
                 let nums = self.ints(&side_name, count)?;
                 sides.reserve_exact(count);
                 for (k, (&e, &s)) in elems.iter().zip(&nums).enumerate() {

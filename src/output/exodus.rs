@@ -1,22 +1,29 @@
-//! Exodus II results writer, in pure Rust on netCDF classic 64-bit-offset files (CDF-2).
+//! Exodus II results writer, in pure Rust on netCDF classic 64-bit-offset files (CDF-2),
+//! with the names of the Exodus II format (the reference C library's `exodusII_int.h`;
+//! the full list, each with the test that checks it, is in `docs/exodus.md`).
 //!
-//! Entry point: [`ExodusWriter`]: [`ExodusWriter::create`] writes the mesh (title,
-//! coordinates `coordx/coordy[/coordz]`, number maps, element blocks `connectN` with
-//! `elem_type`, ids `eb_prop1` and names `eb_names`, shell thickness as `attribN`, node
-//! sets `node_nsN`/`ns_prop1`/`ns_names`, side sets `ss_elemN`/`ss_sideN`/`ss_prop1`/
-//! `ss_names`) and declares the result variables: nodal `vals_nod_varK` named by
-//! `name_nod_var`, element `vals_elem_varVebB` named by `name_elem_var` with the truth
-//! table `elem_var_tab`, optional global variables `vals_glo_var` named by
-//! `name_glo_var`, and `time_whole`. [`ExodusWriter::write_step`] appends one
-//! record (a time and every variable's values) and then bumps `numrecs` in the header,
-//! so the file is complete and readable after every step and a killed run keeps the
-//! steps written so far. Nothing of a step is kept in memory after it is written.
+//! Entry point: [`ExodusWriter`]: [`ExodusWriter::create`] writes the mesh (title and
+//! the global attributes `api_version`, `version`, `floating_point_word_size`,
+//! `file_size`, `maximum_name_length`, `int64_status`; one QA record `qa_records` and one
+//! information record `info_records`; coordinates `coordx/coordy[/coordz]` named by
+//! `coor_names`; number maps `node_num_map`, `elem_num_map`; element blocks `connectN`
+//! with `elem_type`, `eb_status`, ids `eb_prop1` and names `eb_names`, shell thickness as
+//! `attribN` named by `attrib_nameN`; node sets `node_nsN`, `ns_status`, `ns_prop1`,
+//! `ns_names`; side sets `elem_ssN`/`side_ssN`, `ss_status`, `ss_prop1`, `ss_names`) and
+//! declares the result variables: nodal `vals_nod_varK` named by `name_nod_var`, element
+//! `vals_elem_varVebB` named by `name_elem_var` with the truth table `elem_var_tab`,
+//! optional global variables `vals_glo_var` named by `name_glo_var`, and `time_whole`.
+//! [`ExodusWriter::write_step`] appends one record (a time and every variable's values)
+//! and then bumps `numrecs` in the header, so the file is complete and readable after
+//! every step and a killed run keeps the steps written so far. Nothing of a step is kept
+//! in memory after it is written.
 //!
 //! Conventions, as [`crate::mesh::exodus`] reads them back: indices in `connectN`,
-//! `node_nsN` and `ss_elemN` are 1-based positions; ids and numbers are 32-bit (CDF-2
+//! `node_nsN` and `elem_ssN` are 1-based positions; ids and numbers are 32-bit (CDF-2
 //! has no 64-bit integers), so a larger id is an input error. Empty blocks and sets get
 //! no size dimension (a zero-length dimension would be the record dimension), as the
-//! Exodus library writes "NULL" entities. Assemblies are not written.
+//! Exodus library writes "NULL" entities. Sets carry no distribution factors.
+//! Assemblies are not written.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
@@ -54,6 +61,42 @@ enum Fill {
     NodeSet(usize),
     SideElems(usize),
     SideNumbers(usize),
+}
+
+/// `len_string`: QA record entries hold 32 characters and a NUL.
+const LEN_STRING: u64 = 33;
+/// `len_line`: information records hold 80 characters and a NUL.
+const LEN_LINE: u64 = 81;
+
+/// The QA record: code name, code version, and the date (`MM/DD/YY`) and time
+/// (`HH:MM:SS`, UTC) the file was written.
+fn qa_record() -> Vec<String> {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (days, rest) = (secs / 86_400, secs % 86_400);
+    let (y, m, d) = civil_from_days(days as i64);
+    vec![
+        "seam".to_string(),
+        env!("CARGO_PKG_VERSION").to_string(),
+        format!("{m:02}/{d:02}/{:02}", y.rem_euclid(100)),
+        format!("{:02}:{:02}:{:02}", rest / 3600, rest / 60 % 60, rest % 60),
+    ]
+}
+
+/// The proleptic Gregorian date of `days` since 1970-01-01 (H. Hinnant's
+/// `civil_from_days`, "chrono-Compatible Low-Level Date Algorithms").
+fn civil_from_days(days: i64) -> (i64, u32, u32) {
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (y, m, d)
 }
 
 fn invalid(message: String) -> io::Error {
@@ -191,6 +234,9 @@ impl ExodusWriter {
         s.global("int64_status", AttrValue::Ints(vec![0]));
         s.global("title", AttrValue::Text(title));
 
+        let len_string = s.dim("len_string", LEN_STRING);
+        let len_line = s.dim("len_line", LEN_LINE);
+        let four = s.dim("four", 4);
         let len_name = s.dim("len_name", name_len);
         let time = s.dim("time_step", 0);
         let num_dim = s.dim("num_dim", mesh.dim as u64);
@@ -212,6 +258,25 @@ impl ExodusWriter {
         };
 
         add(&mut s, "time_whole", &[time], NcType::Double, None);
+        // One QA record (code name, version, date, time) and one information record, as
+        // `ex_put_qa` and `ex_put_info` store them: NUL-padded char arrays.
+        let num_qa = s.dim("num_qa_rec", 1);
+        add(
+            &mut s,
+            "qa_records",
+            &[num_qa, four, len_string],
+            NcType::Char,
+            Some(Fill::Chars(name_table(&qa_record(), LEN_STRING))),
+        );
+        let num_info = s.dim("num_info", 1);
+        let info = format!("seam {} results", env!("CARGO_PKG_VERSION"));
+        add(
+            &mut s,
+            "info_records",
+            &[num_info, len_line],
+            NcType::Char,
+            Some(Fill::Chars(name_table(&[info], LEN_LINE))),
+        );
         if !global.is_empty() {
             let num_glo_var = s.dim("num_glo_var", global.len() as u64);
             let names: Vec<String> = global.iter().map(|n| n.to_string()).collect();
@@ -398,14 +463,14 @@ impl ExodusWriter {
                 let d = s.dim(&format!("num_side_ss{}", i + 1), ss.sides.len() as u64);
                 add(
                     &mut s,
-                    &format!("ss_elem{}", i + 1),
+                    &format!("elem_ss{}", i + 1),
                     &[d],
                     NcType::Int,
                     Some(Fill::SideElems(i)),
                 );
                 add(
                     &mut s,
-                    &format!("ss_side{}", i + 1),
+                    &format!("side_ss{}", i + 1),
                     &[d],
                     NcType::Int,
                     Some(Fill::SideNumbers(i)),
@@ -642,12 +707,14 @@ fn check_indices(mesh: &Mesh) -> io::Result<()> {
 }
 
 /// The `elem_type` attribute: the bare shape names that Cubit writes and every reader
-/// knows (meshio, for one, maps `TETRA4` to no cell type but reads `TETRA`).
+/// knows (meshio, for one, maps `TETRA4` to no cell type but reads `TETRA`). A 3-node
+/// shell is a `TRISHELL3` in Exodus (`SHELL3` would be a 3-node 2-D line shell).
 fn elem_type(t: Topology) -> &'static str {
     match t {
         Topology::Tet4 => "TETRA",
         Topology::Wedge6 => "WEDGE",
         Topology::Pyramid5 => "PYRAMID",
+        Topology::Shell3 => "TRISHELL3",
         other => other.exodus_name(),
     }
 }
@@ -796,5 +863,18 @@ impl<W: Write> Write for Counter<'_, W> {
 
     fn flush(&mut self) -> io::Result<()> {
         self.out.flush()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::civil_from_days;
+
+    #[test]
+    fn civil_dates_of_known_days() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert_eq!(civil_from_days(19_723), (2024, 1, 1));
+        assert_eq!(civil_from_days(-1), (1969, 12, 31));
     }
 }

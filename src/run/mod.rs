@@ -1059,6 +1059,13 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             .collect()
     };
     let mut split_history: Vec<Vec<Vec<f64>>> = Vec::new();
+    // The global variables of results.exo: the heat leaving each side of every term.
+    let heat_names = steps::interface_heat_names(
+        &term_choice
+            .iter()
+            .map(|&k| (pairings[k].side_a.as_str(), pairings[k].side_b.as_str()))
+            .collect::<Vec<_>>(),
+    );
     // One state's fields as step `step` of the results (temperature, heat flux, contact
     // faces), from its derived values when they were made with the faces.
     let write_state = |writer: &mut steps::StepWriter<'_>,
@@ -1066,7 +1073,8 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                        dofs: &DofMap,
                        step: usize,
                        time: f64,
-                       derived: Option<Derived>|
+                       derived: Option<Derived>,
+                       heat: &[(f64, f64)]|
      -> Result<(), String> {
         let derived = match derived {
             Some(d) => d,
@@ -1079,6 +1087,8 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             temperature: &t,
             heat_flux: &q,
             contact: contact.as_ref(),
+            heat_names: &heat_names,
+            heat,
         };
         writer
             .write_step(step, time, &fields)
@@ -1222,8 +1232,16 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             let derived = derive(&st.u, dofs, st.time, due).map_err(HeatError::Step)?;
             split_history.push(term_mechanisms(&derived));
             if due {
-                write_state(&mut writer, &st.u, dofs, st.step, st.time, Some(derived))
-                    .map_err(HeatError::Step)?;
+                write_state(
+                    &mut writer,
+                    &st.u,
+                    dofs,
+                    st.step,
+                    st.time,
+                    Some(derived),
+                    &r.heat,
+                )
+                .map_err(HeatError::Step)?;
             }
             writer
                 .checkpoint(st)
@@ -1246,6 +1264,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                 last.step,
                 last.time,
                 None,
+                history.last().map_or(&[][..], |r| &r.heat),
             )
             .map_err(RunError::Solve)?;
         }
@@ -1292,10 +1311,18 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             )
             .map_err(RunError::Solve)?;
             let contact = contact_of(&derived);
+            let steady_heat: Vec<(f64, f64)> = solution
+                .heat
+                .iter()
+                .chain(&solution.tie_heat)
+                .copied()
+                .collect();
             let state = steps::StepFields {
                 temperature: &solution.temperature,
                 heat_flux: &heat_flux,
                 contact: contact.as_ref(),
+                heat_names: &heat_names,
+                heat: &steady_heat,
             };
             let file = out_dir.join("temperature.vtu");
             let per_field: Vec<(String, Vec<f64>)> = if field_names.len() > 1 {

@@ -43,6 +43,29 @@ pub(super) struct StepFields<'a> {
     pub heat_flux: &'a [f64],
     /// The contact faces, when some interaction visualises contact.
     pub contact: Option<&'a ContactFields>,
+    /// The global variables of `results.exo`, from [`interface_heat_names`].
+    pub heat_names: &'a [String],
+    /// Per term (contact terms, then ties): the heat leaving side A and side B; empty
+    /// when the state has none (its globals are then written as NaN).
+    pub heat: &'a [(f64, f64)],
+}
+
+/// The names of the global variables of `results.exo`: per term (side A, side B
+/// surface names), `heat_side_a:A/B` and `heat_side_b:A/B`, the columns of
+/// `interface_heat.csv`; a pair that occurs again gets `:k` (its 1-based term) appended.
+pub(super) fn interface_heat_names(terms: &[(&str, &str)]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::with_capacity(2 * terms.len());
+    for (k, (a, b)) in terms.iter().enumerate() {
+        let again = terms[..k].contains(&(*a, *b));
+        for side in ["a", "b"] {
+            let mut name = format!("heat_side_{side}:{a}/{b}");
+            if again {
+                name.push_str(&format!(":{}", k + 1));
+            }
+            out.push(name);
+        }
+    }
+    out
 }
 
 /// Writes a run's steps into the output directory.
@@ -142,11 +165,13 @@ impl<'m> StepWriter<'m> {
             if fields.contact.is_some() {
                 nodal.extend(CONTACT_NODAL);
             }
-            self.exodus = Some(ExodusWriter::create(
+            let global: Vec<&str> = fields.heat_names.iter().map(String::as_str).collect();
+            self.exodus = Some(ExodusWriter::create_with_globals(
                 &dir.join("results.exo"),
                 self.mesh,
                 &nodal,
                 &HEAT_FLUX,
+                &global,
             )?);
         }
         // Nodes without a temperature (shells, bars) and elements without a flux hold 0
@@ -170,10 +195,15 @@ impl<'m> StepWriter<'m> {
             .collect();
         let nodal: Vec<&[f64]> = nodal.iter().map(Vec::as_slice).collect();
         let element: Vec<&[f64]> = element.iter().map(Vec::as_slice).collect();
+        let global: Vec<f64> = if fields.heat.len() * 2 == fields.heat_names.len() {
+            fields.heat.iter().flat_map(|&(a, b)| [a, b]).collect()
+        } else {
+            vec![f64::NAN; fields.heat_names.len()]
+        };
         self.exodus
             .as_mut()
             .expect("just made")
-            .write_step(time, &nodal, &element)?;
+            .write_step_with_globals(time, &nodal, &element, &global)?;
         self.last_written = Some(step);
         Ok(())
     }
@@ -630,4 +660,25 @@ fn line_samples(mesh: &Mesh, t: &[f64], origin: [f64; 3], axis: [f64; 3]) -> Vec
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::interface_heat_names;
+
+    #[test]
+    fn interface_heat_names_are_unique_per_term() {
+        let names = interface_heat_names(&[("a", "b"), ("c", "d"), ("a", "b")]);
+        assert_eq!(
+            names,
+            [
+                "heat_side_a:a/b",
+                "heat_side_b:a/b",
+                "heat_side_a:c/d",
+                "heat_side_b:c/d",
+                "heat_side_a:a/b:3",
+                "heat_side_b:a/b:3"
+            ]
+        );
+    }
 }

@@ -233,6 +233,14 @@ fn exodus_flavours_read_identically_and_match_the_sidecar() {
 }
 
 #[test]
+fn exodus_side_sets_under_the_names_of_earlier_seam_versions_still_read() {
+    // ss_elemN/ss_sideN instead of elem_ssN/side_ssN; nothing else differs.
+    let legacy = read("legacy_side_set_names.exo");
+    check_against_sidecar(&legacy, &expected()["two_hex"]);
+    assert_same(&read("two_hex_offset64.exo"), &legacy, "legacy names", 0.0);
+}
+
+#[test]
 fn exodus_side_sets_lie_on_the_planes_they_were_written_on() {
     // Both side sets were written on the interface z = 1.
     let m = read("two_hex_nc4.exo");
@@ -257,10 +265,349 @@ fn exodus_other_topologies_match_the_sidecar() {
     assert_eq!(shell.blocks[1].topology, Topology::Shell4);
     assert_eq!(shell.blocks[1].thickness, Some(0.1));
     assert!(shell.blocks[2].is_empty(), "the NULL block is kept");
+    // The assembly (assembly_entity100 with _id, _type = element blocks, _name).
+    assert_eq!(shell.assemblies.len(), 1);
+    let a = &shell.assemblies[0];
+    assert_eq!((a.id, a.name.as_str()), (100, "everything"));
+    assert!(matches!(a.kind, seam::mesh::AssemblyKind::Blocks));
+    assert_eq!(a.members, [1, 2, 3]);
     let tw = read("tet_wedge.exo");
     assert_eq!(tw.blocks[0].topology, Topology::Wedge6);
     assert_eq!(tw.blocks[1].topology, Topology::Tet4);
     assert_eq!(read("quad2d.exo").blocks[0].topology, Topology::Quad4);
+}
+
+// ------------------------------------------------------------------------------------
+// Exodus files written by the reference Exodus II C library (libexodus), by
+// tests/exodus/write_fixtures.c, with reference.json printed from the C program's own
+// arrays. `SEAM_EXODUS_REFERENCE_DIR` points the tests at freshly written files (CI
+// regenerates them), else the committed copies in tests/fixtures/reference are read.
+
+fn reference_dir() -> PathBuf {
+    match std::env::var_os("SEAM_EXODUS_REFERENCE_DIR") {
+        Some(d) if !d.is_empty() => PathBuf::from(d),
+        _ => fixture("reference"),
+    }
+}
+
+fn reference() -> Value {
+    let path = reference_dir().join("reference.json");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).expect("reference.json parses")
+}
+
+const FLAVOURS: [&str; 3] = ["classic", "offset64", "nc4"];
+
+/// Every count, id, name, coordinate, connectivity entry and side of a mesh against
+/// what the C program wrote (positions in the JSON are 1-based, as in the file).
+fn check_against_reference(m: &Mesh, e: &Value, file: &str) {
+    assert_eq!(m.dim as i64, e["dim"].as_i64().unwrap(), "{file}");
+    assert_eq!(
+        m.num_nodes() as i64,
+        e["num_nodes"].as_i64().unwrap(),
+        "{file}"
+    );
+    assert_eq!(
+        m.num_elems() as i64,
+        e["num_elems"].as_i64().unwrap(),
+        "{file}"
+    );
+    assert_eq!(
+        m.node_numbers,
+        ints(&e["node_numbers"]),
+        "{file} node_num_map"
+    );
+    assert_eq!(
+        m.elem_numbers,
+        ints(&e["elem_numbers"]),
+        "{file} elem_num_map"
+    );
+    let coords = e["coords"].as_array().unwrap();
+    for (k, xyz) in coords.iter().enumerate() {
+        for d in 0..3 {
+            assert_eq!(
+                m.coords[k][d],
+                xyz[d].as_f64().unwrap(),
+                "{file} node {k} axis {d}"
+            );
+        }
+    }
+    let blocks = e["blocks"].as_array().unwrap();
+    assert_eq!(m.blocks.len(), blocks.len(), "{file}");
+    for (b, eb) in m.blocks.iter().zip(blocks) {
+        let what = format!("{file} block {}", b.id);
+        assert_eq!(b.id, eb["id"].as_i64().unwrap(), "{what}");
+        assert_eq!(b.name, eb["name"].as_str().unwrap(), "{what}");
+        assert_eq!(b.len() as i64, eb["count"].as_i64().unwrap(), "{what}");
+        if !b.is_empty() {
+            assert_eq!(
+                Topology::from_exodus_name(
+                    eb["type"].as_str().unwrap(),
+                    eb["nodes_per_elem"].as_u64().unwrap() as usize,
+                    m.dim
+                ),
+                Some(b.topology),
+                "{what}"
+            );
+        }
+        let conn: Vec<i64> = b.connectivity.iter().map(|n| n.0 as i64 + 1).collect();
+        assert_eq!(conn, ints(&eb["connectivity"]), "{what} connect");
+        assert_eq!(b.thickness, eb["thickness"].as_f64(), "{what} attrib");
+    }
+    let sets = e["side_sets"].as_array().unwrap();
+    assert_eq!(m.side_sets.len(), sets.len(), "{file}");
+    for (s, es) in m.side_sets.iter().zip(sets) {
+        let what = format!("{file} side set {}", s.id);
+        assert_eq!(s.id, es["id"].as_i64().unwrap(), "{what}");
+        assert_eq!(s.name, es["name"].as_str().unwrap(), "{what}");
+        let elems: Vec<i64> = s.sides.iter().map(|x| x.elem.0 as i64 + 1).collect();
+        let sides: Vec<i64> = s.sides.iter().map(|x| i64::from(x.side)).collect();
+        assert_eq!(elems, ints(&es["elems"]), "{what} elem_ss");
+        assert_eq!(sides, ints(&es["sides"]), "{what} side_ss");
+    }
+    let sets = e["node_sets"].as_array().unwrap();
+    assert_eq!(m.node_sets.len(), sets.len(), "{file}");
+    for (s, es) in m.node_sets.iter().zip(sets) {
+        let what = format!("{file} node set {}", s.id);
+        assert_eq!(s.id, es["id"].as_i64().unwrap(), "{what}");
+        assert_eq!(s.name, es["name"].as_str().unwrap(), "{what}");
+        let nodes: Vec<i64> = s.nodes.iter().map(|n| n.0 as i64 + 1).collect();
+        assert_eq!(nodes, ints(&es["nodes"]), "{what} node_ns");
+    }
+}
+
+#[test]
+fn exodus_reference_library_files_read_in_every_flavour_2d_and_3d() {
+    let r = reference();
+    for key in ["ref3d", "ref2d"] {
+        for flavour in FLAVOURS {
+            let file = format!("{key}_{flavour}.exo");
+            let path = reference_dir().join(&file);
+            let m = mesh::read(&path).unwrap_or_else(|e| panic!("{file}: {e}"));
+            check_against_reference(&m, &r[key], &file);
+        }
+    }
+    let m = mesh::read(&reference_dir().join("ref3d_classic.exo")).unwrap();
+    let topologies: Vec<Topology> = m.blocks.iter().map(|b| b.topology).collect();
+    for t in [
+        Topology::Hex8,
+        Topology::Tet4,
+        Topology::Wedge6,
+        Topology::Pyramid5,
+        Topology::Shell4,
+        Topology::Shell3,
+        Topology::Bar2,
+    ] {
+        assert!(
+            topologies.contains(&t),
+            "{t:?} is in the 3-D reference mesh"
+        );
+    }
+    assert!(
+        m.blocks.last().unwrap().is_empty(),
+        "the NULL block is kept"
+    );
+    let m = mesh::read(&reference_dir().join("ref2d_nc4.exo")).unwrap();
+    assert_eq!(m.blocks[0].topology, Topology::Quad4);
+    assert_eq!(m.blocks[1].topology, Topology::Tri3);
+}
+
+#[test]
+fn exodus_reference_library_records_and_variables_read_in_every_flavour() {
+    let r = reference();
+    for key in ["ref3d", "ref2d"] {
+        let e = &r[key];
+        for flavour in FLAVOURS {
+            let file = format!("{key}_{flavour}.exo");
+            let path = reference_dir().join(&file);
+            let rec = mesh::exodus::read_records(&path).unwrap();
+            let qa: Vec<Vec<String>> = rec.qa.iter().map(|q| q.to_vec()).collect();
+            let want: Vec<Vec<String>> = e["qa_records"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|q| {
+                    q.as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|s| s.as_str().unwrap().to_string())
+                        .collect()
+                })
+                .collect();
+            assert_eq!(qa, want, "{file} qa_records");
+            let info: Vec<&str> = e["info_records"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|s| s.as_str().unwrap())
+                .collect();
+            assert_eq!(rec.info, info, "{file} info_records");
+
+            let times: Vec<f64> = e["times"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|t| t.as_f64().unwrap())
+                .collect();
+            assert_eq!(mesh::exodus::read_times(&path).unwrap(), times, "{file}");
+            let heat = mesh::exodus::read_global_variable(&path, "total_heat").unwrap();
+            let want: Vec<f64> = e["global_variables"]["total_heat"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            assert_eq!(heat, want, "{file} vals_glo_var");
+            for (step, want) in e["nodal_variables"]["temperature"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .enumerate()
+            {
+                let got = mesh::exodus::read_nodal_variable(&path, "temperature", step).unwrap();
+                let want: Vec<f64> = want
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|v| v.as_f64().unwrap())
+                    .collect();
+                assert_eq!(got, want, "{file} temperature at step {step}");
+            }
+            // `node_index` holds the 1-based node position, the second nodal variable.
+            let idx = mesh::exodus::read_nodal_variable(&path, "node_index", 1).unwrap();
+            let n = e["num_nodes"].as_u64().unwrap() as usize;
+            assert_eq!(idx, (1..=n).map(|k| k as f64).collect::<Vec<_>>(), "{file}");
+            // Element variable: id + k/2 + step (1-based step) where stored; the C
+            // program leaves the second block out of the truth table.
+            let m = mesh::read(&path).unwrap();
+            let flux = mesh::exodus::read_element_variable(&path, "heat_flux_x", 1).unwrap();
+            assert_eq!(flux.len(), m.num_elems(), "{file}");
+            for (i, b) in m.blocks.iter().enumerate() {
+                for k in 0..b.len() {
+                    let got = flux[b.first_elem.index() + k];
+                    if i == 1 {
+                        assert!(got.is_nan(), "{file} block {} is out of elem_var_tab", b.id);
+                    } else {
+                        assert_eq!(
+                            got,
+                            b.id as f64 + 0.5 * k as f64 + 2.0,
+                            "{file} block {}",
+                            b.id
+                        );
+                    }
+                }
+            }
+            // Side-set variable: -(k + step).
+            let first = &e["side_sets"][0];
+            let id = first["id"].as_i64().unwrap();
+            let count = first["elems"].as_array().unwrap().len();
+            let v = mesh::exodus::read_side_set_variable(&path, "side_flux", id, 0)
+                .unwrap()
+                .expect("stored on the first side set");
+            let want: Vec<f64> = (0..count).map(|k| -((k + 1) as f64)).collect();
+            assert_eq!(v, want, "{file} vals_sset_var");
+            // Node-set variable: 7 (k + step).
+            let first = &e["node_sets"][0];
+            let id = first["id"].as_i64().unwrap();
+            let count = first["nodes"].as_array().unwrap().len();
+            let v = mesh::exodus::read_node_set_variable(&path, "node_set_value", id, 1)
+                .unwrap()
+                .expect("stored on the first node set");
+            let want: Vec<f64> = (0..count).map(|k| 7.0 * (k + 2) as f64).collect();
+            assert_eq!(v, want, "{file} vals_nset_var");
+        }
+    }
+}
+
+/// seam's writer on the reference meshes (every topology, 2-D and 3-D, empty block and
+/// sets, shell thickness): read back by seam, the mesh is still what the C program wrote.
+/// With `SEAM_EXODUS_CHECKER` naming the compiled tests/exodus/check_results.c (CI sets
+/// it), the Exodus II C library reads each written file too and compares it with the
+/// reference file.
+#[test]
+fn exodus_writer_round_trips_the_reference_meshes() {
+    let r = reference();
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("exodus-writer");
+    std::fs::create_dir_all(&dir).unwrap();
+    for key in ["ref3d", "ref2d"] {
+        let input = reference_dir().join(format!("{key}_offset64.exo"));
+        let m = mesh::read(&input).unwrap();
+        let out = dir.join(format!("{key}_written.exo"));
+        let mut w = seam::output::exodus::ExodusWriter::create_with_globals(
+            &out,
+            &m,
+            &["temperature"],
+            &["heat_flux_x", "heat_flux_y", "heat_flux_z"],
+            &["heat_side_a:one/two", "heat_side_b:one/two"],
+        )
+        .unwrap();
+        let t: Vec<f64> = (0..m.num_nodes()).map(|k| 300.0 + k as f64).collect();
+        let q: Vec<f64> = (0..m.num_elems()).map(|k| k as f64).collect();
+        for step in 0..2 {
+            w.write_step_with_globals(step as f64, &[&t], &[&q, &q, &q], &[-1.5, 1.5])
+                .unwrap();
+        }
+        w.finish().unwrap();
+        let back = mesh::read(&out).unwrap();
+        check_against_reference(&back, &r[key], &out.display().to_string());
+        assert_eq!(mesh::exodus::read_times(&out).unwrap(), [0.0, 1.0]);
+        let rec = mesh::exodus::read_records(&out).unwrap();
+        assert_eq!(rec.qa.len(), 1);
+        assert_eq!(rec.qa[0][0], "seam");
+        assert_eq!(
+            mesh::exodus::read_global_variable(&out, "heat_side_b:one/two").unwrap(),
+            [1.5, 1.5]
+        );
+        assert_eq!(
+            mesh::exodus::read_element_variable(&out, "heat_flux_y", 1).unwrap(),
+            q
+        );
+        if let Some(checker) = std::env::var_os("SEAM_EXODUS_CHECKER") {
+            let o = std::process::Command::new(checker)
+                .arg(&input)
+                .arg(&out)
+                .arg(dir.join(format!("{key}.dump")))
+                .output()
+                .unwrap();
+            assert!(
+                o.status.success(),
+                "{key}: the Exodus II library disagrees:\n{}{}",
+                String::from_utf8_lossy(&o.stdout),
+                String::from_utf8_lossy(&o.stderr)
+            );
+            eprintln!("{}", String::from_utf8_lossy(&o.stdout).trim());
+        }
+    }
+}
+
+/// docs/exodus.md names, for every Exodus name, the tests that check it: each must exist.
+#[test]
+fn exodus_doc_names_tests_that_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/exodus.md")).unwrap();
+    let mut named = 0;
+    for part in doc.split('`') {
+        let Some((module, name)) = part.split_once("::") else {
+            continue;
+        };
+        if name.is_empty() || !module.chars().all(|c| c.is_ascii_lowercase() || c == '_') {
+            continue;
+        }
+        let src = std::fs::read_to_string(root.join(format!("tests/it/{module}.rs")))
+            .unwrap_or_else(|e| panic!("docs/exodus.md names `{part}`: tests/it/{module}.rs: {e}"));
+        assert!(
+            src.contains(&format!("fn {name}(")),
+            "docs/exodus.md names `{part}`, which is not a test in tests/it/{module}.rs"
+        );
+        named += 1;
+    }
+    assert!(named >= 6, "{named} tests named");
+    for c in [
+        "tests/exodus/write_fixtures.c",
+        "tests/exodus/check_results.c",
+    ] {
+        assert!(doc.contains(c) && root.join(c).is_file(), "{c}");
+    }
 }
 
 // ------------------------------------------------------------------------------------

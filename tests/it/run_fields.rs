@@ -201,6 +201,13 @@ fn run_contact_flux_sums_to_the_interface_heat() {
     assert!(gap.iter().all(|g| g.abs() < 1e-12), "{gap:?}");
 
     let exo = out.join("results.exo");
+    // The interface heat per side is a global variable of results.exo, one value per step.
+    let i = &r.summary.interactions[0];
+    for (side, want) in [("a", i.heat_side_a), ("b", i.heat_side_b)] {
+        let name = format!("heat_side_{side}:{}/{}", i.side_a, i.side_b);
+        let got = mesh::exodus::read_global_variable(&exo, &name).unwrap();
+        assert_eq!(got, vec![want], "{name}");
+    }
     let nodal = |name: &str| mesh::exodus::read_nodal_variable(&exo, name, 0).unwrap();
     let (f, q) = (nodal("contact_fraction"), nodal("interface_flux"));
     let m = &r.mesh;

@@ -2,7 +2,8 @@
 """Check the result files of a `seam run` output directory with meshio.
 
 Usage:
-    python check_results.py [--expect-heat-flux] [--expect-contact] OUTPUT_DIR
+    python check_results.py [--expect-heat-flux] [--expect-contact]
+                            [--libexodus-dump DUMP] OUTPUT_DIR
 
 Opens every `.vtu` in OUTPUT_DIR, every file listed by a `.pvd` there, and every Exodus
 file (`.exo`, `.e`), and checks that each has point data `temperature`, one value per
@@ -22,11 +23,22 @@ Wherever they are present (required with the flags):
   and the nodal variables `contact_gap`, `contact_fraction`, `interface_flux` in every
   Exodus file, finite at every step. `contact_points.vtu` is checked when present.
 
+Every mesh `.vtu` is also read by VTK's own reader (vtkXMLUnstructuredGridReader),
+which must find the same points, the point data `temperature` (equal to meshio's) and,
+with `--expect-heat-flux`, the cell data `heat_flux`.
+
+`--libexodus-dump DUMP`: DUMP was written by tests/exodus/check_results.c from
+`results.exo` as the Exodus II C library reads it; its times must be those of the
+`.pvd` series (transient runs), its last step's nodal temperature that of the last
+`.vtu` as VTK reads it (on every node where the `.vtu` value is finite), and its global
+variables `heat_side_a:A/B`, `heat_side_b:A/B` at each step the interface heat that
+`interface_heat.csv` gives for that time and pair (a term's last row: its total).
+
 The contact files have their own points, so they are left out of the node-count check.
 Prints one summary line; exits 0 when all is well, 1 when a check fails, 2 on bad
 usage.
 
-Needs meshio, netCDF4 and numpy (pinned in requirements.txt beside this file):
+Needs meshio, netCDF4, numpy and vtk (pinned in requirements.txt beside this file):
 
     python3 -m venv venv && venv/bin/pip install -r tests/python/requirements.txt
 
@@ -239,6 +251,110 @@ def exodus_steps(path, nodes, npoints, np):
         return var.shape[0]
 
 
+def vtk_read(path, np):
+    """Points, point data `temperature` and cell data `heat_flux` (or None) of a `.vtu`
+    as VTK's own XML reader sees them."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+    r = vtkXMLUnstructuredGridReader()
+    r.SetFileName(str(path))
+    r.Update()
+    grid = r.GetOutput()
+    if grid is None or grid.GetNumberOfPoints() == 0:
+        raise CheckError(f"{path}: VTK's reader finds no points")
+    points = vtk_to_numpy(grid.GetPoints().GetData())
+    t = grid.GetPointData().GetArray("temperature")
+    if t is None:
+        raise CheckError(f"{path}: VTK's reader finds no point data `temperature`")
+    q = grid.GetCellData().GetArray("heat_flux")
+    return points, vtk_to_numpy(t), None if q is None else vtk_to_numpy(q)
+
+
+def check_vtk(path, meshio, np, expect_heat_flux):
+    """VTK reads the same points and temperature as meshio; return the temperature."""
+    points, t, q = vtk_read(path, np)
+    mesh = read(path, meshio)
+    if points.shape != mesh.points.shape or not np.array_equal(points, mesh.points):
+        raise CheckError(f"{path}: VTK and meshio read different points")
+    tm = np.asarray(mesh.point_data["temperature"], dtype=float).ravel()
+    same = (t == tm) | (np.isnan(t) & np.isnan(tm))
+    if not np.all(same):
+        raise CheckError(f"{path}: VTK and meshio read different temperatures")
+    if expect_heat_flux and (q is None or q.shape != (len(solid_cells(mesh)), 3)):
+        raise CheckError(f"{path}: VTK's reader finds no 3-component cell data `heat_flux`")
+    return t
+
+
+def read_dump(path):
+    times, temperature, glob = {}, {}, {}
+    for line in Path(path).read_text().splitlines():
+        f = line.split(" ")
+        if f[0] == "time":
+            times[int(f[1])] = float(f[2])
+        elif f[0] == "temperature":
+            temperature[int(f[1])] = float(f[2])
+        elif f[0] == "global":
+            glob[(int(f[1]), " ".join(f[2:-1]))] = float(f[-1])
+        else:
+            raise CheckError(f"{path}: unexpected line {line!r}")
+    return times, temperature, glob
+
+
+def interface_heat_rows(path):
+    """interface_heat.csv: (time, side_a, side_b) -> (heat_side_a, heat_side_b) of the
+    term's last row (its total when split by mechanism)."""
+    import csv
+
+    out = {}
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            key = (float(row["time"]), row["side_a"], row["side_b"])
+            out[key] = (float(row["heat_side_a"]), float(row["heat_side_b"]))
+    return out
+
+
+def check_dump(dump, out, last_vtu, np):
+    """Compare what libexodus read from results.exo with VTK and interface_heat.csv."""
+    times, temperature, glob = read_dump(dump)
+    if not times:
+        raise CheckError(f"{dump}: no steps")
+    compared = 0
+    if last_vtu is not None:
+        _, t, _ = vtk_read(last_vtu, np)
+        if len(t) != len(temperature):
+            raise CheckError(f"{dump}: {len(temperature)} nodes, {last_vtu.name} has {len(t)}")
+        for k in range(len(t)):
+            if np.isfinite(t[k]):
+                exo = temperature[k + 1]
+                if abs(exo - t[k]) > 1e-12 * max(1.0, abs(t[k])):
+                    raise CheckError(
+                        f"node {k + 1}: temperature {exo!r} in results.exo (libexodus), "
+                        f"{float(t[k])!r} in {last_vtu.name} (VTK)")
+                compared += 1
+    csv = out / "interface_heat.csv"
+    pairs = 0
+    if glob:
+        if not csv.exists():
+            raise CheckError(f"{out}: results.exo has global variables but no interface_heat.csv")
+        rows = interface_heat_rows(csv)
+        for (step, name), value in glob.items():
+            side, pair = name.split(":", 1)
+            a, b = pair.split("/", 1)
+            if ":" in b:  # a repeated pair: its term index, not in the csv key
+                continue
+            key = (times[step], a, b)
+            if key not in rows:
+                raise CheckError(f"{csv.name}: no row at time {times[step]} for {a}/{b}")
+            want = rows[key][0 if side == "heat_side_a" else 1]
+            if abs(value - want) > 1e-12 * max(1.0, abs(want)):
+                raise CheckError(
+                    f"step {step}: global {name} = {value!r} in results.exo (libexodus), "
+                    f"{want!r} in {csv.name}")
+            pairs += 1
+    return len(times), compared, pairs
+
+
 def pvd_files(path):
     """The files a .pvd lists, with their times, checked for order."""
     try:
@@ -263,10 +379,20 @@ def pvd_files(path):
 def main(argv):
     flags = {a for a in argv[1:] if a.startswith("--")}
     args = [a for a in argv[1:] if not a.startswith("--")]
+    dump = None
+    if "--libexodus-dump" in argv[1:]:
+        k = argv.index("--libexodus-dump")
+        if k + 1 >= len(argv):
+            args = []
+        else:
+            dump = argv[k + 1]
+            args = [a for a in args if a != dump]
+        flags.discard("--libexodus-dump")
     known = {"--expect-heat-flux", "--expect-contact"}
     if len(args) != 1 or not Path(args[0]).is_dir() or flags - known:
         print(
-            "usage: check_results.py [--expect-heat-flux] [--expect-contact] OUTPUT_DIR",
+            "usage: check_results.py [--expect-heat-flux] [--expect-contact] "
+            "[--libexodus-dump DUMP] OUTPUT_DIR",
             file=sys.stderr,
         )
         print("error: give one existing output directory", file=sys.stderr)
@@ -309,6 +435,20 @@ def main(argv):
         solid = None
         for f in sorted(vtus):
             counts[f], solid = check_mesh_file(f, meshio, np, expect_heat_flux, True)
+            check_vtk(f, meshio, np, expect_heat_flux)
+        dumped = ""
+        if dump is not None:
+            series = [f for pvd in pvds if pvd.name == "temperature.pvd" for _, f in pvd_files(pvd)]
+            last = series[-1] if series else (out / "temperature.vtu")
+            steps, nodes, pairs = check_dump(dump, out, last if last.exists() else None, np)
+            pvd_times = [t for pvd in pvds if pvd.name == "temperature.pvd"
+                         for t, _ in pvd_files(pvd)]
+            exo_times = list(read_dump(dump)[0].values())
+            if pvd_times and pvd_times != exo_times:
+                raise CheckError(f"times differ: results.exo (libexodus) {exo_times}, "
+                                 f"temperature.pvd {pvd_times}")
+            dumped = (f"; libexodus: {steps} steps, temperature equal to VTK's on {nodes} nodes, "
+                      f"{pairs} interface heats equal to interface_heat.csv")
         exo_steps = 0
         for f in exos:
             counts[f], nodes = check_mesh_file(f, meshio, np, expect_heat_flux, False)
@@ -326,6 +466,7 @@ def main(argv):
         f"ok: {len(vtus)} vtu, {len(pvds)} pvd ({pvd_steps} steps), "
         f"{len(exos)} exodus ({exo_steps} steps); {n} nodes, temperature finite on "
         f"{len(solid)} solid nodes; {len(contact)} contact file(s), {faces} contact faces"
+        f"{dumped}"
     )
     return 0
 
