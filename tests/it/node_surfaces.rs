@@ -507,3 +507,97 @@ fn node_points_meet_the_normal_angle_check() {
         r.stats
     );
 }
+
+/// `seam run` end to end, from a problem file, a contact deck and an Exodus mesh (the
+/// matching slabs written out, node set `a_top` included): a contact node set and a
+/// `Contact Type = node` surface carry the heat of the face surface to 1e-10 relative,
+/// and the exact q = 1/(1/k_A + 1/h + 1/k_B), for a resistance, a gap conductance, a
+/// Nitsche tie and a multiplier tie — nonzero heat, not the 0 W of a dropped surface.
+#[test]
+fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
+    use seam::output::exodus::ExodusWriter;
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("node-surfaces-run");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = slabs(3, 3, SolidKind::Hex8);
+    ExodusWriter::create(&dir.join("slabs.exo"), &mesh, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    let k = [1.0, 5.0];
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = \"slabs.exo\"\n\
+             [[material]]\nblocks = [\"block_1\"]\nconductivity = {}\n\
+             [[material]]\nblocks = [\"block_2\"]\nconductivity = {}\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_3\"]\nvalue = 0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 1\n\
+             [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-12\n",
+            k[0], k[1]
+        ),
+    )
+    .unwrap();
+    let side_a = [
+        ("faces", "contact surface a contains surface_1"),
+        ("contact node set", "contact node set a contains a_top"),
+        (
+            "contact type = node",
+            "begin contact surface a\n  surface = surface_1\n  contact type = node\n end",
+        ),
+    ];
+    let models = [
+        ("enforcement for energy = contact_resistance h = 10", 10.0),
+        (
+            "enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = 10",
+            10.0,
+        ),
+        ("enforcement for energy = tied_temperature", f64::INFINITY),
+        (
+            "enforcement for energy = tied\n  side b variable temperature to temperature",
+            f64::INFINITY,
+        ),
+    ];
+    for (model, h) in models {
+        let q = 1.0 / (1.0 / k[0] + 1.0 / h + 1.0 / k[1]);
+        let mut face_heat = None;
+        for (what, a) in side_a {
+            std::fs::write(
+                dir.join("contact.i"),
+                format!(
+                    "begin contact definition\n visualize contact\n {a}\n contact surface b contains surface_2\n\
+                     begin interaction\n  side a a\n  side b b\n end\n\
+                     begin enforcement\n  {model}\n end\nend\n"
+                ),
+            )
+            .unwrap();
+            let r = match seam::run::run(&dir.join("problem.toml")) {
+                Ok(r) => r,
+                Err(seam::run::RunError::Input(d, s)) => panic!("{what}: {}", d.render(&s)),
+                Err(seam::run::RunError::Solve(e)) => panic!("{what}: {e}"),
+            };
+            assert!(r.summary.converged, "{what} / {model}");
+            let i = &r.summary.interactions[0];
+            let heat = i.heat_side_a;
+            let reference = *face_heat.get_or_insert(heat);
+            let diff = (heat - reference).abs() / reference.abs();
+            eprintln!(
+                "seam run, {what}, {}: heat {heat:.15}, exact {:.15}, against faces {diff:.1e}",
+                model.lines().next().unwrap(),
+                -q
+            );
+            assert!(
+                (heat + q).abs() <= 1e-10 * q,
+                "{what} / {model}: {heat} vs {}",
+                -q
+            );
+            assert!(diff <= 1e-10, "{what} / {model}: {diff:e}");
+            assert!(
+                i.imbalance.abs() <= 1e-12 * q,
+                "{what}: imbalance {}",
+                i.imbalance
+            );
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
