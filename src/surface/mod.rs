@@ -11,7 +11,9 @@
 //!    element shares (see the `skin` module). Shells contribute top and bottom, lofted by half
 //!    their thickness; a solid side under an equivalenced shell is sandwiched.
 //! 3. *Side sets* contribute their sides, exterior or not (a dead element's sides drop
-//!    out). *Node sets* make node surfaces.
+//!    out). *Node sets* make node surfaces, whose nodes take their tributary area from
+//!    the exterior faces of the mesh that lie wholly in the sets (`Contact Type = node`:
+//!    from the surface's own faces); a node on no such face is reported (W0308).
 //! 4. *Ownership.* A face (or node) belongs to at most one surface: the first command in
 //!    the deck that includes it. Later commands skip it with a warning naming both
 //!    surfaces and the count. `Skin All Blocks` makes one surface per block, named after
@@ -79,15 +81,16 @@ pub struct ContactSurface {
 }
 
 impl ContactSurface {
-    /// Total area (length in 2-D) of the faces, evaluated on the unlofted geometry.
+    /// Total area (length in 2-D) of the faces, evaluated on the unlofted geometry; for a
+    /// node surface, of its tributary faces (the sum of its nodes' tributary areas when it
+    /// owns every node of those faces).
     pub fn area(&self, mesh: &Mesh) -> f64 {
-        self.faces
-            .iter()
-            .map(|f| {
-                let nodes: Vec<NodeId> = mesh.side_nodes(f.side).collect();
-                measure_and_normal(mesh, &nodes).0
-            })
-            .sum()
+        let measure = |side: Side| {
+            let nodes: Vec<NodeId> = mesh.side_nodes(side).collect();
+            measure_and_normal(mesh, &nodes).0
+        };
+        self.faces.iter().map(|f| measure(f.side)).sum::<f64>()
+            + self.tributary.iter().map(|&s| measure(s)).sum::<f64>()
     }
 }
 

@@ -426,6 +426,8 @@ fn tributary_areas_sum_to_the_surface_area() {
             eprintln!("{kind:?} {side_a:?}: Σ A_i − 1 = {:.1e}", total - 1.0);
             assert!((total - 1.0).abs() < 1e-14, "{kind:?}: {total}");
             assert!((g.area() - 1.0).abs() < 1e-14);
+            // `seam surfaces` reports the same area.
+            assert!((set.get("a").unwrap().area(&mesh) - 1.0).abs() < 1e-14);
             for (k, &(_, x)) in g.nodes.iter().enumerate() {
                 let n = g.node_normal[k];
                 assert!((n[2] - 1.0).abs() < 1e-14 && n[0].abs() < 1e-14 && n[1].abs() < 1e-14);
