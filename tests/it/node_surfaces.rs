@@ -603,3 +603,66 @@ fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Aria's masking reaches node surfaces: a convection condition on the faces under a
+/// contact node set (its tributary faces, which the nodes cover) is masked like one under
+/// a face surface (W0701), so it changes nothing — unless `no_coverage_flux = true`.
+#[test]
+fn face_conditions_under_a_contact_node_set_are_masked() {
+    use seam::output::exodus::ExodusWriter;
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("node-surfaces-mask");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = slabs(3, 3, SolidKind::Hex8);
+    ExodusWriter::create(&dir.join("slabs.exo"), &mesh, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        "begin contact definition\n contact node set a contains a_top\n contact surface b contains surface_2\n\
+         begin interaction\n  side a a\n  side b b\n end\n\
+         begin enforcement\n  enforcement for energy = contact_resistance h = 10\n end\nend\n",
+    )
+    .unwrap();
+    let run = |extra: &str| {
+        std::fs::write(
+            dir.join("problem.toml"),
+            format!(
+                "[mesh]\nfile = \"slabs.exo\"\n\
+                 [[material]]\nblocks = [\"block_1\", \"block_2\"]\nconductivity = 1.0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_3\"]\nvalue = 0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 1\n{extra}\
+                 [contact]\nfile = \"contact.i\"\n"
+            ),
+        )
+        .unwrap();
+        match seam::run::run(&dir.join("problem.toml")) {
+            Ok(r) => (
+                r.solution.temperature,
+                r.warnings.0.iter().map(|d| d.code).collect::<Vec<_>>(),
+            ),
+            Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+            Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
+        }
+    };
+    let convection =
+        "[[bc]]\nkind = \"convection\"\nsurfaces = [\"surface_1\"]\nvalue = 50.0\nambient = 5.0\n";
+    let (plain, _) = run("");
+    let (masked, codes) = run(convection);
+    let (kept, _) = run(&format!("{convection}no_coverage_flux = true\n"));
+    let diff = |a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+    };
+    // Round-off apart (a parallel factorisation may sum in another order).
+    assert!(diff(&plain, &masked) < 1e-12, "{}", diff(&plain, &masked));
+    assert!(codes.contains(&"W0701"), "{codes:?}");
+    assert!(
+        diff(&plain, &kept) > 0.1,
+        "an unmasked hot convection heats the interface"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
