@@ -514,7 +514,8 @@ fn node_points_meet_the_normal_angle_check() {
 /// matching slabs written out, node set `a_top` included): a contact node set and a
 /// `Contact Type = node` surface carry the heat of the face surface to 1e-10 relative,
 /// and the exact q = 1/(1/k_A + 1/h + 1/k_B), for a resistance, a gap conductance, a
-/// Nitsche tie and a multiplier tie — nonzero heat, not the 0 W of a dropped surface.
+/// Nitsche tie and standard and dual multiplier ties — nonzero heat, not the 0 W of a
+/// dropped surface.
 #[test]
 fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
     use seam::output::exodus::ExodusWriter;
@@ -557,6 +558,10 @@ fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
         ("enforcement for energy = tied_temperature", f64::INFINITY),
         (
             "enforcement for energy = tied\n  side b variable temperature to temperature",
+            f64::INFINITY,
+        ),
+        (
+            "enforcement for energy = tied multipliers = dual\n  side b variable temperature to temperature",
             f64::INFINITY,
         ),
     ];
