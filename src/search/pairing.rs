@@ -7,6 +7,10 @@
 //! segment point) with its side-B face, parametric coordinates, gap and normals, and
 //! the statistics an analyst needs to trust it.
 //!
+//! A node surface (contact node set, `Contact Type = node`) gives one point per node,
+//! weighted by its tributary area and carrying its normal
+//! ([`SurfaceGeometry::tributary_of_nodes`]), whatever the integration mode.
+//!
 //! Two integration modes ([`Integration`]): `Quadrature` places Gauss points on each
 //! side-A face and projects each onto side B (fast; not exact on non-matching meshes);
 //! `Segments` clips every side-A face against the side-B faces projected onto it and
@@ -359,7 +363,8 @@ pub struct SearchStats {
     pub rejected_distance: usize,
     pub rejected_angle: usize,
     pub rejected_subdomain: usize,
-    /// Area of side A covered by side B (clipped overlap polygons of matched pairs).
+    /// Area of side A covered by side B (clipped overlap polygons of matched pairs; for
+    /// a node surface, the tributary areas of its matched nodes).
     pub overlap_area: f64,
     pub side_a_area: f64,
     /// Over matched points; `None` when nothing matched.
@@ -525,7 +530,12 @@ impl Searcher {
             }
         }
         for k in 0..a.nodes.len() {
-            result.points.push(ctx.pair_node(a, k));
+            let p = ctx.pair_node(a, k);
+            if overlap && p.status == PointStatus::Matched {
+                // A node surface's covered area: its matched nodes' tributary areas.
+                result.stats.overlap_area += p.weight;
+            }
+            result.points.push(p);
         }
         result.stats.side_a_area = a.area();
         tally(&mut result);

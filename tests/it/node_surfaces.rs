@@ -485,7 +485,8 @@ fn isolated_nodes_are_reported_and_carry_nothing() {
 }
 
 /// A point of a node surface pairs with its normal: a side-B face whose normal is not
-/// opposed to the node's is rejected by the angle check, as for faces.
+/// opposed to the node's is rejected by the angle check, as for faces; the search's
+/// statistics count the matched nodes' tributary areas as the covered area.
 #[test]
 fn node_points_meet_the_normal_angle_check() {
     let s = setup(3, 3, SolidKind::Hex8, SideA::NodeSet);
@@ -517,6 +518,18 @@ fn node_points_meet_the_normal_angle_check() {
         "{:?}",
         r.stats
     );
+    assert_eq!(r.stats.overlap_area, 0.0);
+    // Paired with the facing side B, the whole unit face is covered, as `seam search`
+    // reports: side-A area and overlap are the tributary areas' sum.
+    let r = Searcher::new(&s.b, &settings).search(
+        &s.a,
+        &s.b,
+        &settings,
+        Integration::Quadrature { order: 1 },
+        None,
+    );
+    assert!((r.stats.overlap_area - 1.0).abs() < 1e-14, "{:?}", r.stats);
+    assert!((r.stats.side_a_area - 1.0).abs() < 1e-14, "{:?}", r.stats);
 }
 
 /// `seam run` end to end, from a problem file, a contact deck and an Exodus mesh (the
