@@ -765,3 +765,69 @@ fn node_point_jacobian_matches_finite_differences() {
         );
     }
 }
+
+/// A transient `seam run` (backward Euler, the general Newton solver) through a contact
+/// node set: the slabs start at 0 and the top is held at 1. The solution stays uniform
+/// in x and y, so with a constant conductance the node-to-face and face forms are the
+/// same discrete equations (∫ h [u] N_i = h [u] A_i when [u] is uniform): the final
+/// temperatures and heat agree to round-off, and the heat is not zero.
+#[test]
+fn transient_run_through_a_contact_node_set_matches_the_face_surface() {
+    use seam::output::exodus::ExodusWriter;
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("node-surfaces-transient");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mesh = slabs(3, 3, SolidKind::Hex8);
+    ExodusWriter::create(&dir.join("slabs.exo"), &mesh, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    std::fs::write(
+        dir.join("problem.toml"),
+        "[mesh]\nfile = \"slabs.exo\"\n[initial]\ntemperature = 0.0\n\
+         [[material]]\nblocks = [\"block_1\"]\nconductivity = 1.0\nrho_c = 1.0\n\
+         [[material]]\nblocks = [\"block_2\"]\nconductivity = 5.0\nrho_c = 2.0\n\
+         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_3\"]\nvalue = 0\n\
+         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 1\n\
+         [contact]\nfile = \"contact.i\"\n\
+         [solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 0.05\nend_time = 0.5\n",
+    )
+    .unwrap();
+    let run = |side_a: &str| {
+        std::fs::write(
+            dir.join("contact.i"),
+            format!(
+                "begin contact definition\n {side_a}\n contact surface b contains surface_2\n\
+                 begin interaction\n  side a a\n  side b b\n end\n\
+                 begin enforcement\n  enforcement for energy = contact_resistance h = 10\n end\nend\n"
+            ),
+        )
+        .unwrap();
+        match seam::run::run(&dir.join("problem.toml")) {
+            Ok(r) => {
+                assert!(r.summary.converged);
+                (
+                    r.solution.temperature,
+                    r.summary.interactions[0].heat_side_a,
+                )
+            }
+            Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+            Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
+        }
+    };
+    let (t_face, q_face) = run("contact surface a contains surface_1");
+    let (t_node, q_node) = run("contact node set a contains a_top");
+    let worst = t_face
+        .iter()
+        .zip(&t_node)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let diff = (q_node - q_face).abs() / q_face.abs();
+    eprintln!(
+        "transient: worst nodal difference {worst:.1e}, heat {q_node:.15} against faces {q_face:.15} ({diff:.1e})"
+    );
+    assert!(q_face.abs() > 0.1, "heat crosses: {q_face}");
+    assert!(worst < 1e-12, "{worst:e}");
+    assert!(diff <= 1e-10, "{diff:e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
