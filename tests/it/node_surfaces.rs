@@ -535,9 +535,9 @@ fn node_points_meet_the_normal_angle_check() {
 /// `seam run` end to end, from a problem file, a contact deck and an Exodus mesh (the
 /// matching slabs written out, node set `a_top` included): a contact node set and a
 /// `Contact Type = node` surface carry the heat of the face surface to 1e-10 relative,
-/// and the exact q = 1/(1/k_A + 1/h + 1/k_B), for a resistance, a gap conductance, a
-/// Nitsche tie and standard and dual multiplier ties — nonzero heat, not the 0 W of a
-/// dropped surface.
+/// and the exact q = 1/(1/k_A + 1/h + 1/k_B), for a resistance, a gap conductance (also
+/// a temperature-dependent one written in Lua), a Nitsche tie and standard and dual
+/// multiplier ties — nonzero heat, not the 0 W of a dropped surface.
 #[test]
 fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
     use seam::output::exodus::ExodusWriter;
@@ -586,9 +586,28 @@ fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
             "enforcement for energy = tied multipliers = dual\n  side b variable temperature to temperature",
             f64::INFINITY,
         ),
+        // NaN: h = 10 + (T_A + T_B)/2 from Lua, solved by Newton; the exact q below.
+        (
+            "enforcement for energy = gap_conductance\n  gap conductance coefficient = lua \"10 + 0.5*(temp_a + temp_b)\"",
+            f64::NAN,
+        ),
     ];
+    // The Lua case: T_A = q/k_A and T_B = 1 − q/k_B either side of z = 1, so q is the
+    // fixed point of q = 1/(1/k_A + 1/h(q) + 1/k_B), a contraction (|dq/dh| q/h² < 1e-2).
+    let lua_q = {
+        let mut q = 0.5;
+        for _ in 0..200 {
+            let h = 10.0 + 0.5 * (q / k[0] + 1.0 - q / k[1]);
+            q = 1.0 / (1.0 / k[0] + 1.0 / h + 1.0 / k[1]);
+        }
+        q
+    };
     for (model, h) in models {
-        let q = 1.0 / (1.0 / k[0] + 1.0 / h + 1.0 / k[1]);
+        let q = if h.is_nan() {
+            lua_q
+        } else {
+            1.0 / (1.0 / k[0] + 1.0 / h + 1.0 / k[1])
+        };
         let mut face_heat = None;
         for (what, a) in side_a {
             std::fs::write(
