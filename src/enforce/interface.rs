@@ -523,8 +523,8 @@ struct CachedPoint {
 
 impl InterfacePoints {
     /// Evaluate the geometry of every matched point of a pairing: face points with the
-    /// face-to-face form, node points (node surfaces) with the node-to-face form (see
-    /// [`local_node`]), each node weighted by its tributary area.
+    /// face-to-face form, node points (node surfaces) with the node-to-face form (module
+    /// docs), each node weighted by its tributary area.
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
