@@ -816,6 +816,7 @@ impl Embedding {
                     origin: 0,
                 })
                 .collect(),
+            tributary: Vec::new(),
             nodes: Vec::new(),
             origins: vec![(format!("surface {}", ss.name), ss.sides.len())],
             parent: None,

@@ -31,6 +31,18 @@
 //!
 //! An `Offset Temperature` ΔT replaces `[u]` by `[u] − ΔT` (a prescribed jump).
 //!
+//! **Node-to-face form** (node surfaces: contact node sets, `Contact Type = node`). A
+//! side-A node i paired with side-B face coordinates ξ_B is one point of weight A_i, its
+//! tributary area `∫ N_i dA` over the faces around it: the same form with the jump
+//! `[u] = u_i − u_B(ξ_B)` (side A's basis is the node's own dof, value 1), the flux
+//! average side B's alone (`w_A = 0`, `w_B = 1`) and the penalty `α = β k_B / h_e,B`. The
+//! P, θ, S of every model above apply unchanged. Since `Σ_i A_i = |Γ_A|`, a constant flux
+//! crosses with exactly the heat of the face form; conservation holds as below (side A's
+//! row is `A_i q`, side B's rows sum to `−A_i q`). It is a collocation of the jump at side
+//! A's nodes, so a linear field with a normal flux crosses exactly when side B's traces
+//! are linear on side A's faces (matching or nested meshes), not on arbitrary
+//! non-matching ones: the one-pass node-to-segment limitation.
+//!
 //! Heat accounting: with `v = 1` on all of side A (0 on B), the form gives the heat
 //! leaving side A, `∫ P([u] − ΔT) − θ{k∂u}`; with `v = 1` on side B, minus the same. So
 //! the heat through each side is read off the assembled interface residual, and their
@@ -154,6 +166,18 @@ pub enum InterfaceError {
         elem: i64,
         side: u8,
         message: String,
+    },
+    #[error("conductance at side-A node {node} ({x:.6}, {y:.6}, {z:.6}): {message}", x = at[0], y = at[1], z = at[2])]
+    ConductanceAtNode {
+        at: [f64; 3],
+        node: i64,
+        message: String,
+    },
+    #[error("node {number} of node surface `{surface}` has no `{field}` dof")]
+    NoNodeDof {
+        number: i64,
+        surface: String,
+        field: String,
     },
     #[error(transparent)]
     Assembly(#[from] AssemblyError),
@@ -359,6 +383,30 @@ fn local(a: &SideEval, b: &SideEval, form: Form, beta: f64) -> Local {
     l
 }
 
+/// The local vectors of a node point (node-to-face form): side A is the node's single
+/// dof with value 1, so `[u] = u_node − u_B(ξ_B)`; the flux average is side B's flux
+/// alone (`w_A = 0`, `w_B = 1`: the flux is continuous and side A has no face at the
+/// point), and the penalty length is side B's, `α = β k_B / h_e,B` (`Tied_Ip`: the same;
+/// there is no side-A element to average with).
+fn local_node(dof: u32, b: &SideEval, beta: f64) -> Local {
+    let mut l = Local {
+        dofs: Vec::with_capacity(1 + b.len),
+        jump: Vec::with_capacity(1 + b.len),
+        flux: Vec::with_capacity(1 + b.len),
+        na: 1,
+        alpha: beta * b.k / b.h_e.max(f64::MIN_POSITIVE),
+    };
+    l.dofs.push(dof);
+    l.jump.push(1.0);
+    l.flux.push(0.0);
+    for i in 0..b.len {
+        l.dofs.push(b.dofs[i]);
+        l.jump.push(-b.n[i]);
+        l.flux.push(-b.k * dot(b.grad[i], b.normal));
+    }
+    l
+}
+
 /// One point's values at a field: see [`InterfacePoints::at_point`].
 struct PointEval<'a> {
     jump: &'a [f64],
@@ -401,7 +449,8 @@ fn push_couplings(dofs: &[u32], out: &mut Vec<(usize, usize)>) {
 /// (A, B) met by some point, a dense block over their dofs, and a right-hand side.
 #[derive(Clone, Debug, Default)]
 pub struct InterfaceSystem {
-    /// Dense blocks keyed by (element A, element B): (dofs, row-major matrix).
+    /// Dense blocks keyed by (element A, element B), or (node A, element B) for node
+    /// points: (dofs, row-major matrix).
     pub blocks: Vec<(Vec<u32>, Vec<f64>)>,
     /// (dof, value) right-hand-side contributions.
     pub rhs: Vec<(u32, f64)>,
@@ -435,9 +484,10 @@ pub fn interface_terms(
 /// the weight and the penalty. What changes between evaluations — the field, and h
 /// through it — is applied by [`InterfacePoints::evaluate`] in a few flops per entry.
 ///
-/// Points are grouped by their element pair (side A, side B) — the dense blocks of
-/// [`InterfaceSystem`] — in element-pair order; within a group they keep the pairing's
-/// order, so sums run in the same order at every evaluation.
+/// Points are grouped by their element pair (side A, side B) — or, for node points, by
+/// (side-A node, side-B element) — the dense blocks of [`InterfaceSystem`], face groups
+/// first, each kind in key order; within a group they keep the pairing's order, so sums
+/// run in the same order at every evaluation.
 #[derive(Clone, Debug, Default)]
 pub struct InterfacePoints {
     /// The groups' dof lists, concatenated (`group_dofs[g]..group_dofs[g+1]`).
@@ -459,7 +509,8 @@ pub struct InterfacePoints {
 struct CachedPoint {
     /// Index in the pairing's point list.
     index: u32,
-    /// Side-A element (its number) and side, for messages.
+    /// Side-A element (its number) and side, for messages; for a node point (`side` 0)
+    /// `elem` is the node's number.
     elem: i64,
     side: u8,
     na: u32,
@@ -471,7 +522,9 @@ struct CachedPoint {
 }
 
 impl InterfacePoints {
-    /// Evaluate the geometry of every matched face point of a pairing.
+    /// Evaluate the geometry of every matched point of a pairing: face points with the
+    /// face-to-face form, node points (node surfaces) with the node-to-face form (module
+    /// docs), each node weighted by its tributary area.
     pub fn new(
         mesh: &Mesh,
         dofs: &DofMap,
@@ -482,21 +535,43 @@ impl InterfacePoints {
         form: &InterfaceForm<'_>,
     ) -> Result<InterfacePoints, InterfaceError> {
         let fields = fields.into();
-        // (element pair, point order, point, its dofs, jump and flux values)
+        // (group key, point, its dofs, jump and flux values). The key keeps face points
+        // (0, element A, element B) apart from node points (1, node, element B).
         let mut evaluated = Vec::new();
         for (index, p) in points.iter().enumerate() {
-            if p.status != PointStatus::Matched || p.a_face == u32::MAX {
-                continue; // node points carry no face to integrate over
+            if p.status != PointStatus::Matched {
+                continue;
             }
-            let fa = &a.faces[p.a_face as usize];
             let fb = &b.faces[p.b_face as usize];
-            let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
             let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, form.conductivity)?;
-            let l = local(&ea, &eb, form.form, form.beta);
+            let (key, l, elem, side) = if p.a_face == u32::MAX {
+                let Some(&(node, _)) = a.nodes.get(p.a_node as usize) else {
+                    continue;
+                };
+                if p.weight == 0.0 {
+                    continue; // no tributary face: reported when the surface was built
+                }
+                let dof = dofs
+                    .dof(fields.a, node)
+                    .ok_or_else(|| InterfaceError::NoNodeDof {
+                        number: mesh.node_number(node),
+                        surface: a.name.clone(),
+                        field: dofs.field_name(fields.a).to_string(),
+                    })?
+                    .0;
+                let l = local_node(dof, &eb, form.beta);
+                ((1u8, node.0, eb.elem.0), l, mesh.node_number(node), 0)
+            } else {
+                let fa = &a.faces[p.a_face as usize];
+                let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
+                let l = local(&ea, &eb, form.form, form.beta);
+                let key = (0u8, ea.elem.0, eb.elem.0);
+                (key, l, mesh.elem_number(fa.side.elem), fa.side.side)
+            };
             let point = CachedPoint {
                 index: index as u32,
-                elem: mesh.elem_number(fa.side.elem),
-                side: fa.side.side,
+                elem,
+                side,
                 na: l.na as u32,
                 at: 0,
                 weight: p.weight,
@@ -504,7 +579,7 @@ impl InterfacePoints {
                 x: p.x,
                 alpha: l.alpha,
             };
-            evaluated.push(((ea.elem.0, eb.elem.0), point, l));
+            evaluated.push((key, point, l));
         }
         // Stable: points of a group keep their order.
         evaluated.sort_by_key(|e| e.0);
@@ -554,7 +629,7 @@ impl InterfacePoints {
         self.group_points.len().saturating_sub(1)
     }
 
-    /// Number of matched face points.
+    /// Number of matched points with a weight (face points and node points).
     pub fn len(&self) -> usize {
         self.points.len()
     }
@@ -637,11 +712,18 @@ impl InterfacePoints {
                 x: p.x,
                 point: p.index as usize,
             })
-            .map_err(|message| InterfaceError::Conductance {
-                at: p.x,
-                elem: p.elem,
-                side: p.side,
-                message,
+            .map_err(|message| match p.side {
+                0 => InterfaceError::ConductanceAtNode {
+                    at: p.x,
+                    node: p.elem,
+                    message,
+                },
+                side => InterfaceError::Conductance {
+                    at: p.x,
+                    elem: p.elem,
+                    side,
+                    message,
+                },
             })?,
             _ => HValue::default(),
         };
@@ -657,8 +739,8 @@ impl InterfacePoints {
     }
 
     /// The heat flux from side A to side B at every point of the pairing the cache was
-    /// made from (`count` points; `None` where a point is not matched or is a node
-    /// point): `q = P([u] − ΔT) − θ{k∂u}`.
+    /// made from (`count` points; `None` where a point is not matched, or is a node point
+    /// without tributary area): `q = P([u] − ΔT) − θ{k∂u}`.
     pub fn point_flux(
         &self,
         form: &InterfaceForm<'_>,
@@ -817,7 +899,7 @@ pub struct PointFlux {
 }
 
 /// The heat flux from side A to side B at each of `points` (`None` for points that are
-/// not matched and for node points, which carry no face): `q = P([u] − ΔT) − θ{k∂u}`
+/// not matched and for node points without tributary area): `q = P([u] − ΔT) − θ{k∂u}`
 /// with the coefficients of [`InterfaceForm::form`] at the point's h.
 ///
 /// This is the integrand of the heat leaving side A (module docs, "Heat accounting"):

@@ -22,6 +22,14 @@
 //! basis function is shared equally among the kept nodes of each face it touches, so
 //! the multiplier space still holds the constants (Wohlmuth's crosspoint modification)
 //! and the patch test stays exact.
+//!
+//! **Node surfaces.** On a node surface (contact node set, `Contact Type = node`) the
+//! multipliers are collocated: one per matched side-A node k with tributary area w_k,
+//! `C_k· = w_k (e_k − Σ_j N_B,j(ξ_B) e_j)`, ψ_k = 1 at its own point. The side-A block of
+//! C is then diagonal, so standard and dual multipliers coincide, and the constraint
+//! holds at every node: `u_k = u_B(x_k)`. A Dirichlet node (or one tied earlier) gets no
+//! multiplier, as above; a node without tributary area gets none either (its row would
+//! be zero).
 
 use std::collections::{BTreeMap, HashSet};
 
@@ -52,9 +60,10 @@ pub struct MortarTie {
 
 impl MortarTie {
     /// The multiplier field `λ_h = Σ_k ψ_k λ_k` at each of the pairing's `count` points
-    /// (`None` where the tie has no multiplier: unmatched and node points). It is the
-    /// heat flux from side A to side B: the heat leaving side A is
-    /// `Σ_{d∈A} (Cᵀλ)_d = Σ_points w λ_h`, since side A's shape functions sum to one.
+    /// (`None` where the tie has no multiplier: unmatched points, crosspoint nodes). It is
+    /// the heat flux from side A to side B: the heat leaving side A is
+    /// `Σ_{d∈A} (Cᵀλ)_d = Σ_points w λ_h`, since side A's shape functions sum to one (at a
+    /// node point ψ = 1 and side A's entry is w).
     pub fn point_flux(&self, lambda: &[f64], count: usize) -> Vec<Option<f64>> {
         let mut out = vec![None; count];
         for &(p, k, psi) in &self.point_psi {
@@ -93,6 +102,9 @@ pub fn mortar_tie(
     multipliers: Multipliers,
 ) -> Result<MortarTie, InterfaceError> {
     let fields = fields.into();
+    if !a.nodes.is_empty() {
+        return node_tie(mesh, dofs, fields, a, b, points, conductivity, constrained);
+    }
     let mut index: BTreeMap<NodeId, u32> = BTreeMap::new();
     let mut crosspoints = Vec::new();
     // Multipliers on the side-A faces' nodes, in node order (deterministic).
@@ -230,6 +242,76 @@ pub fn mortar_tie(
         side_b_dofs: side_b,
         point_psi,
     })
+}
+
+/// The collocated tie of a node surface (module docs, "Node surfaces").
+#[allow(clippy::too_many_arguments)]
+fn node_tie(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    fields: FieldPair,
+    a: &SurfaceGeometry,
+    b: &SurfaceGeometry,
+    points: &[ContactPoint],
+    conductivity: &[f64],
+    constrained: &mut HashSet<NodeId>,
+) -> Result<MortarTie, InterfaceError> {
+    let mut tie = MortarTie::default();
+    let mut side_a = Vec::new();
+    let mut side_b = Vec::new();
+    // Points in node order (a surface's nodes ascend), so multipliers do too.
+    let mut node_points: Vec<(usize, &ContactPoint)> = points
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.status == PointStatus::Matched && p.a_face == u32::MAX && p.weight > 0.0)
+        .collect();
+    node_points.sort_by_key(|(_, p)| p.a_node);
+    for (at, p) in node_points {
+        let Some(&(node, _)) = a.nodes.get(p.a_node as usize) else {
+            continue;
+        };
+        if constrained.contains(&node) {
+            tie.crosspoints.push(node);
+            continue;
+        }
+        if tie.nodes.last() == Some(&node) {
+            continue; // one multiplier per node
+        }
+        let own = dofs
+            .dof(fields.a, node)
+            .ok_or_else(|| InterfaceError::NoNodeDof {
+                number: mesh.node_number(node),
+                surface: a.name.clone(),
+                field: dofs.field_name(fields.a).to_string(),
+            })?
+            .0;
+        let fb = &b.faces[p.b_face as usize];
+        let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, conductivity)?;
+        let k = tie.nodes.len() as u32;
+        tie.nodes.push(node);
+        tie.psi_integral.push(p.weight);
+        tie.point_psi.push((at as u32, k, 1.0));
+        let mut row: BTreeMap<u32, f64> = BTreeMap::new();
+        *row.entry(own).or_default() += p.weight;
+        for j in 0..eb.len {
+            *row.entry(eb.dofs[j]).or_default() -= p.weight * eb.n[j];
+        }
+        tie.entries.extend(
+            row.into_iter()
+                .filter(|(_, v)| *v != 0.0)
+                .map(|(d, v)| (k, d, v)),
+        );
+        side_a.push(own);
+        side_b.extend_from_slice(&eb.dofs[..eb.len]);
+    }
+    side_a.sort_unstable();
+    side_a.dedup();
+    side_b.sort_unstable();
+    side_b.dedup();
+    tie.side_a_dofs = side_a;
+    tie.side_b_dofs = side_b;
+    constrained.extend(tie.nodes.iter().copied());
+    Ok(tie)
 }
 
 /// `A = D M⁻¹` for a face mass matrix `M` (n × n, n ≤ 4), by Gauss–Jordan elimination;

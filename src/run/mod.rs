@@ -689,13 +689,15 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     }
 
     // Aria masks ordinary flux and convection conditions on faces in contact: a side-A
-    // face with matched points, or a side-B face some point paired with. A condition
-    // with `no_coverage_flux = true` stays.
+    // face with matched points (for a node surface, a tributary face with a matched
+    // node), or a side-B face some point paired with. A condition with
+    // `no_coverage_flux = true` stays.
     let mut in_contact: HashSet<Side> = HashSet::new();
     for p in &pairings {
         if p.periodic {
             continue;
         }
+        let mut matched_nodes = HashSet::new();
         for q in p
             .result
             .points
@@ -704,8 +706,18 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         {
             if q.a_face != u32::MAX {
                 in_contact.insert(p.side_a_geometry.faces[q.a_face as usize].side);
+            } else if let Some(&(node, _)) = p.side_a_geometry.nodes.get(q.a_node as usize) {
+                matched_nodes.insert(node);
             }
             in_contact.insert(p.side_b_geometry.faces[q.b_face as usize].side);
+        }
+        for f in &p.side_a_geometry.tributary {
+            if f.nodes[..f.len as usize]
+                .iter()
+                .any(|n| matched_nodes.contains(n))
+            {
+                in_contact.insert(f.side);
+            }
         }
     }
     let before = face_sites.len();

@@ -7,6 +7,10 @@
 //! segment point) with its side-B face, parametric coordinates, gap and normals, and
 //! the statistics an analyst needs to trust it.
 //!
+//! A node surface (contact node set, `Contact Type = node`) gives one point per node,
+//! weighted by its tributary area and carrying its normal
+//! ([`SurfaceGeometry::tributary_of_nodes`]), whatever the integration mode.
+//!
 //! Two integration modes ([`Integration`]): `Quadrature` places Gauss points on each
 //! side-A face and projects each onto side B (fast; not exact on non-matching meshes);
 //! `Segments` clips every side-A face against the side-B faces projected onto it and
@@ -112,6 +116,14 @@ pub struct SurfaceGeometry {
     pub faces: Vec<FaceGeom>,
     /// For node surfaces: the nodes and their coordinates.
     pub nodes: Vec<(NodeId, V3)>,
+    /// For node surfaces, per node (parallel to `nodes`): its tributary area
+    /// `A_i = Σ_f ∫_f N_i dA` and unit normal `n_i ∝ Σ_f ∫_f N_i n dA` over the tributary
+    /// faces around it (zero area and normal for a node on none). See
+    /// [`SurfaceGeometry::tributary_of_nodes`].
+    pub node_area: Vec<f64>,
+    pub node_normal: Vec<V3>,
+    /// For node surfaces: the faces the areas and normals come from (not searched).
+    pub tributary: Vec<FaceGeom>,
 }
 
 /// Why a surface cannot be searched.
@@ -145,21 +157,19 @@ impl SurfaceGeometry {
                 .iter()
                 .map(|&n| (n, coords[n.index()]))
                 .collect();
+            for &side in &surface.tributary {
+                let g = face_geom(mesh, side, coords);
+                // Edges (2-D meshes) are not searched; as tributaries they give nothing.
+                if g.len >= 3 {
+                    out.tributary.push(g);
+                }
+            }
+            out.tributary_of_nodes();
             return Ok(out);
         }
         out.faces.reserve(surface.faces.len());
         for f in &surface.faces {
-            let mut g = FaceGeom {
-                side: f.side,
-                len: 0,
-                nodes: [NodeId(0); 4],
-                x: [[0.0; 3]; 4],
-            };
-            for (k, n) in mesh.side_nodes(f.side).enumerate() {
-                g.nodes[k] = n;
-                g.x[k] = coords[n.index()];
-                g.len += 1;
-            }
+            let mut g = face_geom(mesh, f.side, coords);
             if g.len == 2 {
                 return Err(SearchError::TwoDimensional(surface.name.clone()));
             }
@@ -172,6 +182,59 @@ impl SurfaceGeometry {
             out.faces.push(g);
         }
         Ok(out)
+    }
+
+    /// Each node's tributary area and normal from the tributary faces (module docs of
+    /// `enforce::interface`, node-to-face form): `A_i = Σ_f ∫_f N_i dA`, the row sum of the
+    /// face mass matrix, so `Σ_i A_i` is the faces' area and a constant flux q gives
+    /// `Σ_i A_i q = q A` exactly; `n_i = Σ_f ∫_f N_i n dA`, normalised. Tri3 faces are
+    /// flat (`∫ N_i = A/3`); Quad4 faces use the 2×2 Gauss rule of the bilinear map, exact
+    /// for `N_i |J|` on flat faces (N_i bilinear, |J| bilinear) and for `N_i J` on warped
+    /// ones (both of degree ≤ 2 in each coordinate).
+    pub fn tributary_of_nodes(&mut self) {
+        let index: std::collections::HashMap<NodeId, usize> = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(k, &(n, _))| (n, k))
+            .collect();
+        let mut area = vec![0.0; self.nodes.len()];
+        let mut vector = vec![[0.0; 3]; self.nodes.len()];
+        for f in &self.tributary {
+            let len = f.len as usize;
+            // A triangle's N_i is linear and its Jacobian constant: the centroid rule is
+            // exact.
+            let rule: &[([f64; 2], f64)] = if len == 3 {
+                &[([1.0 / 3.0, 1.0 / 3.0], 0.5)]
+            } else {
+                &[
+                    ([-GAUSS2, -GAUSS2], 1.0),
+                    ([GAUSS2, -GAUSS2], 1.0),
+                    ([GAUSS2, GAUSS2], 1.0),
+                    ([-GAUSS2, GAUSS2], 1.0),
+                ]
+            };
+            for &(xi, w) in rule {
+                let j = face_normal_jacobian(f, xi);
+                let shapes = face_shapes(len, xi);
+                for (node, shape) in f.nodes.iter().zip(shapes).take(len) {
+                    let Some(&i) = index.get(node) else {
+                        continue;
+                    };
+                    let wn = w * shape;
+                    area[i] += wn * norm(j);
+                    vector[i] = add(vector[i], scale(j, wn));
+                }
+            }
+        }
+        self.node_normal = vector
+            .iter()
+            .map(|&v| {
+                let l = norm(v);
+                if l > 0.0 { scale(v, 1.0 / l) } else { [0.0; 3] }
+            })
+            .collect();
+        self.node_area = area;
     }
 
     /// The geometry of side set `set` of the mesh taken whole as a surface, on the
@@ -190,6 +253,7 @@ impl SurfaceGeometry {
                     origin: 0,
                 })
                 .collect(),
+            tributary: Vec::new(),
             nodes: Vec::new(),
             origins: Vec::new(),
             parent: None,
@@ -213,11 +277,20 @@ impl SurfaceGeometry {
         for (_, p) in &mut out.nodes {
             *p = map.map_point(*p).map_err(fail)?;
         }
+        for f in &mut out.tributary {
+            for p in &mut f.x[..f.len as usize] {
+                *p = map.map_point(*p).map_err(fail)?;
+            }
+        }
+        if !out.nodes.is_empty() {
+            out.tributary_of_nodes();
+        }
         Ok(out)
     }
 
+    /// The area of the faces, or for a node surface the sum of its nodes' tributary areas.
     pub fn area(&self) -> f64 {
-        self.faces.iter().map(FaceGeom::area).sum()
+        self.faces.iter().map(FaceGeom::area).sum::<f64>() + self.node_area.iter().sum::<f64>()
     }
 
     /// Mean face size (√area), the length scale of the search tolerances.
@@ -266,7 +339,7 @@ pub struct ContactPoint {
     pub xi_a: [f64; 2],
     /// The point on side A.
     pub x: V3,
-    /// Integration weight (area); 1 for a node point.
+    /// Integration weight (area); a node point's tributary area.
     pub weight: f64,
     pub status: PointStatus,
     /// Index of the side-B face (`u32::MAX` when unmatched).
@@ -290,7 +363,8 @@ pub struct SearchStats {
     pub rejected_distance: usize,
     pub rejected_angle: usize,
     pub rejected_subdomain: usize,
-    /// Area of side A covered by side B (clipped overlap polygons of matched pairs).
+    /// Area of side A covered by side B (clipped overlap polygons of matched pairs; for
+    /// a node surface, the tributary areas of its matched nodes).
     pub overlap_area: f64,
     pub side_a_area: f64,
     /// Over matched points; `None` when nothing matched.
@@ -455,8 +529,13 @@ impl Searcher {
                 result.stats.overlap_area += overlap;
             }
         }
-        for (k, &(_, x)) in a.nodes.iter().enumerate() {
-            result.points.push(ctx.pair_node(k as u32, x));
+        for k in 0..a.nodes.len() {
+            let p = ctx.pair_node(a, k);
+            if overlap && p.status == PointStatus::Matched {
+                // A node surface's covered area: its matched nodes' tributary areas.
+                result.stats.overlap_area += p.weight;
+            }
+            result.points.push(p);
         }
         result.stats.side_a_area = a.area();
         tally(&mut result);
@@ -524,7 +603,10 @@ impl SearchResult {
                 p.x = fa.map(p.xi_a);
                 p.normal_a = fa.normal();
             } else if let Some((_, x)) = a.nodes.get(p.a_node as usize) {
+                let k = p.a_node as usize;
                 p.x = *x;
+                p.weight = a.node_area.get(k).copied().unwrap_or(0.0);
+                p.normal_a = a.node_normal.get(k).copied().unwrap_or([0.0; 3]);
             }
             if p.status != PointStatus::Matched {
                 continue;
@@ -755,8 +837,13 @@ impl Ctx<'_> {
         p
     }
 
-    fn pair_node(&self, k: u32, x: V3) -> ContactPoint {
-        self.point(u32::MAX, k, [0.0; 2], x, 1.0, [0.0; 3])
+    /// A node point: its tributary area is its weight, its normal that of the faces
+    /// around it (zero for a node on none, which skips the angle test).
+    fn pair_node(&self, a: &SurfaceGeometry, k: usize) -> ContactPoint {
+        let x = a.nodes[k].1;
+        let w = a.node_area.get(k).copied().unwrap_or(0.0);
+        let n = a.node_normal.get(k).copied().unwrap_or([0.0; 3]);
+        self.point(u32::MAX, k as u32, [0.0; 2], x, w, n)
     }
 
     fn quadrature_points(
@@ -866,6 +953,58 @@ impl Ctx<'_> {
     }
 }
 
+/// One face of the mesh as coordinates (unlofted).
+fn face_geom(mesh: &Mesh, side: Side, coords: &[V3]) -> FaceGeom {
+    let mut g = FaceGeom {
+        side,
+        len: 0,
+        nodes: [NodeId(0); 4],
+        x: [[0.0; 3]; 4],
+    };
+    for (k, n) in mesh.side_nodes(side).enumerate().take(4) {
+        g.nodes[k] = n;
+        g.x[k] = coords[n.index()];
+        g.len += 1;
+    }
+    g
+}
+
+/// Shape functions of a Tri3 (`len` 3) or Quad4 face at `xi`, Exodus node order.
+fn face_shapes(len: usize, xi: [f64; 2]) -> [f64; 4] {
+    let (s, t) = (xi[0], xi[1]);
+    if len == 3 {
+        [1.0 - s - t, s, t, 0.0]
+    } else {
+        [
+            0.25 * (1.0 - s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 + t),
+            0.25 * (1.0 - s) * (1.0 + t),
+        ]
+    }
+}
+
+/// ∂x/∂ξ × ∂x/∂η at ξ: the face's area Jacobian times its unit normal.
+fn face_normal_jacobian(face: &FaceGeom, xi: [f64; 2]) -> V3 {
+    let x = &face.x;
+    match face.len {
+        3 => cross(sub(x[1], x[0]), sub(x[2], x[0])),
+        _ => {
+            let (s, t) = (xi[0], xi[1]);
+            let d_xi: V3 = std::array::from_fn(|d| {
+                0.25 * (-(1.0 - t) * x[0][d] + (1.0 - t) * x[1][d] + (1.0 + t) * x[2][d]
+                    - (1.0 + t) * x[3][d])
+            });
+            let d_eta: V3 = std::array::from_fn(|d| {
+                0.25 * (-(1.0 - s) * x[0][d] - (1.0 + s) * x[1][d]
+                    + (1.0 + s) * x[2][d]
+                    + (1.0 - s) * x[3][d])
+            });
+            cross(d_xi, d_eta)
+        }
+    }
+}
+
 /// Gauss rule on a face's reference element: (ξ, weight on the reference element).
 fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
     match face.len {
@@ -902,19 +1041,6 @@ const GAUSS3: f64 = 0.774_596_669_241_483_4;
 fn face_jacobian(face: &FaceGeom, xi: [f64; 2]) -> f64 {
     match face.len {
         3 => 2.0 * face.area(),
-        _ => {
-            let x = &face.x;
-            let (s, t) = (xi[0], xi[1]);
-            let d_xi: V3 = std::array::from_fn(|d| {
-                0.25 * (-(1.0 - t) * x[0][d] + (1.0 - t) * x[1][d] + (1.0 + t) * x[2][d]
-                    - (1.0 + t) * x[3][d])
-            });
-            let d_eta: V3 = std::array::from_fn(|d| {
-                0.25 * (-(1.0 - s) * x[0][d] - (1.0 + s) * x[1][d]
-                    + (1.0 + s) * x[2][d]
-                    + (1.0 - s) * x[3][d])
-            });
-            norm(cross(d_xi, d_eta))
-        }
+        _ => norm(face_normal_jacobian(face, xi)),
     }
 }

@@ -11,7 +11,9 @@
 //!    element shares (see the `skin` module). Shells contribute top and bottom, lofted by half
 //!    their thickness; a solid side under an equivalenced shell is sandwiched.
 //! 3. *Side sets* contribute their sides, exterior or not (a dead element's sides drop
-//!    out). *Node sets* make node surfaces.
+//!    out). *Node sets* make node surfaces, whose nodes take their tributary area from
+//!    the exterior faces of the mesh that lie wholly in the sets (`Contact Type = node`:
+//!    from the surface's own faces); a node on no such face is reported (W0308).
 //! 4. *Ownership.* A face (or node) belongs to at most one surface: the first command in
 //!    the deck that includes it. Later commands skip it with a warning naming both
 //!    surfaces and the count. `Skin All Blocks` makes one surface per block, named after
@@ -64,6 +66,11 @@ pub struct ContactSurface {
     pub kind: SurfaceKind,
     /// Faces in (element, side) order; empty for node surfaces.
     pub faces: Vec<SurfaceFace>,
+    /// For node surfaces: the faces that give each node its tributary area and normal,
+    /// in (element, side) order — the surface's own faces for `Contact Type = node`, the
+    /// exterior faces of the mesh whose nodes all lie in the node sets for a contact node
+    /// set. They are not searched and not owned. Empty for face surfaces.
+    pub tributary: Vec<Side>,
     /// The nodes this surface owns, ascending: for a face surface the nodes of its faces
     /// not owned by an earlier surface; for a node surface its nodes.
     pub nodes: Vec<NodeId>,
@@ -74,15 +81,16 @@ pub struct ContactSurface {
 }
 
 impl ContactSurface {
-    /// Total area (length in 2-D) of the faces, evaluated on the unlofted geometry.
+    /// Total area (length in 2-D) of the faces, evaluated on the unlofted geometry; for a
+    /// node surface, of its tributary faces (the sum of its nodes' tributary areas when it
+    /// owns every node of those faces).
     pub fn area(&self, mesh: &Mesh) -> f64 {
-        self.faces
-            .iter()
-            .map(|f| {
-                let nodes: Vec<NodeId> = mesh.side_nodes(f.side).collect();
-                measure_and_normal(mesh, &nodes).0
-            })
-            .sum()
+        let measure = |side: Side| {
+            let nodes: Vec<NodeId> = mesh.side_nodes(side).collect();
+            measure_and_normal(mesh, &nodes).0
+        };
+        self.faces.iter().map(|f| measure(f.side)).sum::<f64>()
+            + self.tributary.iter().map(|&s| measure(s)).sum::<f64>()
     }
 }
 
@@ -122,6 +130,7 @@ pub fn build_with_dead(
         node_owner: vec![u32::MAX; mesh.num_nodes()],
         surfaces: Vec::new(),
         exterior_by_elem: Vec::new(),
+        mesh_skin: None,
     };
     b.run(def);
     SurfaceSet {
@@ -142,6 +151,9 @@ struct Builder<'a> {
     surfaces: Vec<ContactSurface>,
     /// Exterior sides grouped by element: `exterior_by_elem[e]` is a bit mask of sides.
     exterior_by_elem: Vec<u8>,
+    /// The exterior sides of the whole mesh (every live element), made on first need by
+    /// a contact node set.
+    mesh_skin: Option<Vec<Side>>,
 }
 
 /// Faces gathered for one surface, with where each came from.
@@ -172,7 +184,13 @@ impl<'a> Builder<'a> {
                     let before = self.error_count();
                     let g = self.gather_node_sets(contains, at);
                     let named_wrong = self.error_count() > before;
+                    let members: HashSet<NodeId> = g.nodes.iter().map(|n| n.0).collect();
+                    let first = self.surfaces.len();
                     self.claim(name, SurfaceKind::Nodes, g, at, &mut names, named_wrong);
+                    if first < self.surfaces.len() {
+                        self.surfaces[first].tributary = self.tributary_faces(&members);
+                        self.warn_isolated_nodes(first, at);
+                    }
                 }
                 SurfaceDef::SkinAllBlocks { exclude, at } => {
                     let excluded = self.resolve_blocks(exclude, at);
@@ -209,8 +227,9 @@ impl<'a> Builder<'a> {
                         &mut names,
                         named_wrong,
                     );
-                    if sb.contact_type == ContactType::Node {
+                    if sb.contact_type == ContactType::Node && first < self.surfaces.len() {
                         self.make_node_surface(first);
+                        self.warn_isolated_nodes(first, &sb.at);
                     }
                     if let Some(parent) = self.surfaces.get(first).cloned() {
                         subset::apply(self, parent, first, sb, &mut names);
@@ -222,6 +241,64 @@ impl<'a> Builder<'a> {
             self.restrict(sphere.point, sphere.radius, &def.at);
         }
         self.assign_nodes();
+    }
+
+    /// The exterior faces of the whole mesh (less dead elements) whose nodes all lie in
+    /// `members`: the faces a contact node set's nodes take their area and normal from.
+    /// Of coincident faces (a shell's top and bottom) the first is kept, so an area is
+    /// never counted twice.
+    fn tributary_faces(&mut self, members: &HashSet<NodeId>) -> Vec<Side> {
+        if self.mesh_skin.is_none() {
+            let alive: Vec<bool> = (0..self.mesh.num_elems())
+                .map(|e| !self.dead.contains(&ElemId(e as u32)))
+                .collect();
+            self.mesh_skin = Some(skin::exterior_sides(self.mesh, &alive));
+        }
+        let mut seen = HashSet::new();
+        let mut out = Vec::new();
+        for &side in self.mesh_skin.as_deref().unwrap_or_default() {
+            let mut key: Vec<NodeId> = self.mesh.side_nodes(side).collect();
+            if key.len() < 3 || !key.iter().all(|n| members.contains(n)) {
+                continue;
+            }
+            key.sort_unstable();
+            if seen.insert(key) {
+                out.push(side);
+            }
+        }
+        out
+    }
+
+    /// Warn about the nodes of node surface `i` that lie on no tributary face: they have
+    /// no area and carry no heat, which an analyst should hear about rather than find out.
+    fn warn_isolated_nodes(&mut self, i: usize, at: &Loc) {
+        let s = &self.surfaces[i];
+        let on_face: HashSet<NodeId> = s
+            .tributary
+            .iter()
+            .flat_map(|&side| self.mesh.side_nodes(side))
+            .collect();
+        let isolated: Vec<NodeId> = s
+            .nodes
+            .iter()
+            .copied()
+            .filter(|n| !on_face.contains(n))
+            .collect();
+        let Some(&first) = isolated.first() else {
+            return;
+        };
+        let message = format!(
+            "{} of the {} nodes of node surface `{}` (node {} first) lie on no exterior face whose nodes all belong to the surface: they have no tributary area and carry no heat",
+            isolated.len(),
+            s.nodes.len(),
+            s.name,
+            self.mesh.node_number(first)
+        );
+        self.diags.push(
+            Diagnostic::warning("W0308", message)
+                .at(Some(at.clone()))
+                .help("a node takes its area from the faces around it; name the node set of whole faces, or use a face surface"),
+        );
     }
 
     /// Elements included in the definition: blocks named anywhere, all blocks for
@@ -706,6 +783,7 @@ impl<'a> Builder<'a> {
             name,
             kind,
             faces,
+            tributary: Vec::new(),
             nodes,
             origins,
             parent: None,
@@ -735,6 +813,7 @@ impl<'a> Builder<'a> {
         nodes.dedup();
         for f in s.faces.drain(..) {
             self.face_owner.remove(&f.side);
+            s.tributary.push(f.side);
         }
         let index = i as u32;
         nodes.retain(|n| {

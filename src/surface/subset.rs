@@ -149,6 +149,7 @@ pub(super) fn apply(
             name,
             kind: super::SurfaceKind::Faces,
             faces,
+            tributary: Vec::new(),
             nodes: Vec::new(),
             origins: vec![(origin, count)],
             parent: Some(parent.name.clone()),

@@ -12,6 +12,7 @@ mod examples;
 mod fem;
 mod interactions;
 mod mesh_io;
+mod node_surfaces;
 mod output;
 mod plugin;
 mod preflight;
