@@ -272,9 +272,12 @@ pub enum PeriodicTransform {
         #[serde(default = "default_true")]
         invert_normals: bool,
     },
-    /// Each map is a Lua expression in x, y, z or the name of a function in a Lua file.
+    /// Each map is a Lua expression in x, y, z or the name of a function in a Lua file;
+    /// a map left out is the identity (`x_map = x`, `y_map = y`, no `z_map`: z kept).
     Mapped {
+        #[serde(default = "identity_x")]
         x_map: String,
+        #[serde(default = "identity_y")]
         y_map: String,
         #[serde(default)]
         z_map: Option<String>,
@@ -283,6 +286,14 @@ pub enum PeriodicTransform {
 
 fn default_true() -> bool {
     true
+}
+
+fn identity_x() -> String {
+    "x".to_string()
+}
+
+fn identity_y() -> String {
+    "y".to_string()
 }
 
 /// `begin Enforcement [name]` … `end`.
@@ -320,8 +331,27 @@ pub struct Enforcement {
     pub quarantine_faulty_points: bool,
     #[serde(default)]
     pub use_toggle_block: Option<String>,
+    /// The element blocks listed after the toggle's name in `Use Toggle Block T b…`
+    /// (needed by Aria at region level only; in an enforcement the toggle switches the
+    /// whole enforcement).
+    #[serde(default)]
+    pub toggle_element_blocks: Vec<String>,
+    /// `Contact Gap Temperature = side_a | side_b | mean`: the temperature a
+    /// temperature-dependent conductance sees at a contact point.
+    #[serde(default)]
+    pub contact_gap_temperature: Option<GapTemperature>,
     #[serde(skip)]
     pub at: Loc,
+}
+
+/// Which temperature a temperature-dependent conductance sees at a contact point:
+/// side A's, side B's (interpolated at the projection), or their mean.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GapTemperature {
+    SideA,
+    SideB,
+    Mean,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -226,6 +226,8 @@ fn full_expected() -> Deck {
             contact_pressure: None,
             quarantine_faulty_points: false,
             use_toggle_block: Some("tog".into()),
+            toggle_element_blocks: vec![],
+            contact_gap_temperature: None,
             contact_pressure_variable: None,
             at: Default::default(),
         }],
@@ -451,14 +453,17 @@ fn gap_conductance_property_as_written_in_aria() {
 }
 
 #[test]
-fn property_may_start_with_another_blocks_keyword() {
-    // `surface` is a contact-surface command, but `surface emissivity = …` is a property.
-    let def = one_def(
+fn unknown_property_starting_with_another_blocks_keyword_is_unknown() {
+    // `surface` is a contact-surface command; `surface emissivity = …` is no material
+    // model of Aria's list, so it is an unknown keyword, not a misplaced `surface`.
+    let (deck, d) = sierra(
         "begin contact definition\n begin enforcement\n  Surface Emissivity = Constant E = 0.5\n end\nend\n",
     );
-    assert_eq!(
-        def.enforcements[0].properties[0].property,
-        "surface_emissivity"
+    assert_eq!(codes_of(&d), [codes::UNKNOWN_KEYWORD]);
+    assert!(
+        deck.contact_definitions[0].enforcements[0]
+            .properties
+            .is_empty()
     );
 }
 
@@ -565,10 +570,10 @@ fn periodicity_parts_are_checked() {
 
 #[test]
 fn missing_words_are_reported_past_the_line_end() {
-    let (_, d) = sierra("begin contact definition\n contact surface top\nend\n");
+    let (_, d) = sierra("begin contact definition\n contact surface top contains\nend\n");
     assert_eq!(codes_of(&d), [codes::MISSING_ARGUMENT]);
     let loc = d.0[0].loc.clone().unwrap_or_default();
-    assert_eq!((loc.line, loc.col), (2, 22));
+    assert_eq!((loc.line, loc.col), (2, 31));
 }
 
 #[test]
