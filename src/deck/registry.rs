@@ -416,14 +416,14 @@ pub static COMMANDS: &[CommandSpec] = &[
         "general contact",
         "general_contact",
         [DEF],
-        "= on|off",
+        "[= on|off]",
         "Every listed surface interacts with every other."
     ),
     cmd!(
         "self contact",
         "self_contact",
         [DEF, SO],
-        "= on|off",
+        "[= on|off]",
         "A surface may interact with itself (ELFEN: `Self_contact_flag = 0|1`)."
     ),
     // Search Options.
@@ -531,8 +531,8 @@ pub static COMMANDS: &[CommandSpec] = &[
         "contact type",
         "contact_type",
         [CS],
-        "= face|node",
-        "Whether the surface is made of faces or of their nodes."
+        "= face|node|standard",
+        "Whether the surface is made of faces or of their nodes; Sierra/SM's `standard` is `face`, its `smooth` is refused (seam does not smooth surfaces)."
     ),
 ];
 
@@ -804,7 +804,9 @@ pub fn reference_markdown() -> String {
          `[[contact_definition.periodicity]]` with a `transform` table tagged by `kind`; \
          `enforcement for` lines are `model` entries and `gap conductance coefficient` lines \
          `property` entries of an enforcement. `_` inside a keyword reads as a space \
-         (`Buffer_factor` is `buffer factor`). The `status` column says what seam does: \
+         (`Buffer_factor` is `buffer factor`). An `=` shown as `[=]` may be left out, as \
+         the manuals' syntax lines do; a switch shown as `[= on|off]` alone means on. The \
+         `status` column says what seam does: \
          *implemented*; *warns* (kept in the spec, but without effect where the reason \
          says, and a warning says so); *refused* (an error says why). Generated from the \
          keyword registry (`src/deck/registry.rs`).\n"

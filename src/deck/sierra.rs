@@ -695,6 +695,15 @@ impl Lower {
         }
     }
 
+    /// An on/off switch that may be left out, as the manual's syntax lines do: alone
+    /// it means on.
+    fn flag(&mut self, c: &mut Cur) -> Option<bool> {
+        match c.peek() {
+            None => Some(true),
+            Some(_) => self.switch(c),
+        }
+    }
+
     /// Report anything left on the line.
     fn finish(&mut self, c: &Cur) {
         let rest = c.rest();
@@ -1632,11 +1641,11 @@ impl Lower {
             match c.cmd.key {
                 "general_contact" => {
                     self.once(&mut seen, &c);
-                    x.general_contact = self.switch(&mut c);
+                    x.general_contact = self.flag(&mut c);
                 }
                 "self_contact" => {
                     self.once(&mut seen, &c);
-                    x.self_contact = self.switch(&mut c);
+                    x.self_contact = self.flag(&mut c);
                 }
                 "surfaces" => x.surfaces.extend(self.names(&mut c, "surface names")),
                 "enforcement" => {
@@ -1666,7 +1675,7 @@ impl Lower {
             self.once(&mut seen, &c);
             let key = c.cmd.key;
             match key {
-                "self_contact" => x.self_contact = self.switch(&mut c),
+                "self_contact" => x.self_contact = self.flag(&mut c),
                 "search_update_frequency" => {
                     x.search_update_frequency = self
                         .count(&mut c, "a whole number of steps")
@@ -1849,8 +1858,17 @@ impl Lower {
                     c.skip_sep();
                     if let Some(t) = c.bump() {
                         match t.lower.as_str() {
-                            "face" => x.contact_type = ContactType::Face,
+                            // Sierra/SM's `standard` (its default) is seam's face contact.
+                            "face" | "standard" => x.contact_type = ContactType::Face,
                             "node" => x.contact_type = ContactType::Node,
+                            "smooth" => self.push(
+                                Diagnostic::error(
+                                    codes::CONTACT_TYPE,
+                                    "seam does not smooth contact surfaces (`contact type = smooth`)",
+                                )
+                                .at(Some(t.loc(&self.file)))
+                                .help("write `contact type = standard` (or `face`): seam pairs the mesh's own faces"),
+                            ),
                             other => {
                                 let hint = did_you_mean(other, ["face", "node"])
                                     .map(|s| format!("did you mean `{s}`? "))
