@@ -573,7 +573,7 @@ pub static ELFEN_REFUSED: &[(&str, &str)] = &[
     ),
     (
         "Print_search",
-        "printing of the search; in seam write `output rule = summary|verbose`",
+        "printing of the search; in seam write `output rule = summary` or `verbose`",
     ),
     (
         "Edge_search_frequency",
@@ -888,7 +888,8 @@ pub fn reference_markdown() -> String {
                 "ELFEN contact-set parameters: `Buffer_factor`, `Field_factor` are `buffer \
                  factor`, `field factor`; `Normal_dir_chk_angle` is `normal check angle`; \
                  `Global_update_frequency` is `search update frequency`; `Self_contact_flag` \
-                 is `self contact`. These have no counterpart in seam and are refused (E0224):\n"
+                 is `self contact`. The ELFEN parameters below have no counterpart in seam and are \
+                 refused (E0224):\n"
             );
             let _ = writeln!(out, "| ELFEN parameter | status |");
             let _ = writeln!(out, "|---|---|");

@@ -483,7 +483,7 @@ impl Lower {
                     ),
                 )
                 .at(Some(first.loc(&self.file)))
-                .help(format!("it controls {why}; remove the line")),
+                .help(format!("in ELFEN it sets {why}; remove the line")),
             );
             return Matched::Reported;
         }
