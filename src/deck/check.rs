@@ -444,9 +444,11 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
             continue;
         }
         let at = (!p.at.is_unknown()).then(|| p.at.clone());
-        let spec = registry::COMMANDS
-            .iter()
-            .find(|c| c.key == name && c.blocks.contains(&"enforcement"));
+        // By key, or by the phrase in snake_case (`contact_surface_pressure`).
+        let spec = registry::COMMANDS.iter().find(|c| {
+            c.blocks.contains(&"enforcement")
+                && (c.key == name || c.phrase.replace(' ', "_") == name)
+        });
         match spec {
             Some(c) if matches!(c.status, Status::Refused(_)) => {
                 let Status::Refused(why) = c.status else {

@@ -11,6 +11,12 @@
 //! checks of [`check`], which the TOML front end shares. Every keyword comes from the
 //! [`registry`]; [`reference_markdown`] generates the deck reference from it. The
 //! diagnostic codes are listed in [`codes`].
+//!
+//! A Sierra-syntax file is either a contact deck (only `begin contact definition`
+//! blocks at the top level, anything else an error) or a whole Sierra input file
+//! (`begin sierra … begin procedure … begin aria region … begin contact definition`):
+//! from the latter every contact definition is read wherever it sits, and the other
+//! blocks are named in one W0103 warning.
 
 pub mod check;
 pub mod codes;

@@ -7,7 +7,20 @@
 //! in a [`Locs`] table so those checks can point at the offending token.
 //!
 //! Conventions: bare words are stored lower case, quoted strings as written; numbers
-//! accept a Fortran `d` exponent (`1.5d3`); names after a command are single tokens.
+//! accept a Fortran `d` exponent (`1.5d3`); names after a command are single tokens;
+//! a command's phrase may be spelled with `_` for spaces (ELFEN's `Buffer_factor`);
+//! the `=` that Aria's syntax lines leave out is optional.
+//!
+//! A whole Sierra input file is recognised by its top level (see `is_sierra_file`):
+//! its contact definitions are lowered as in a contact deck, its other blocks and lines
+//! skipped and named in one W0103 warning. A region-level `begin toggle block` is
+//! refused (E0226) when an enforcement uses it, and in a contact deck.
+//!
+//! Enforcement material-model lines: `gap conductance coefficient` stays a property
+//! line (read by the conductance module); `contact surface pressure`, `offset
+//! temperature` and `contact gap temperature` are lowered into their own fields; the
+//! other models of Aria's list are kept as property lines that [`super::check`]
+//! refuses, so the TOML form is refused the same way.
 
 use std::collections::HashSet;
 use std::sync::Arc;

@@ -753,3 +753,28 @@ fn invert_normals_takes_zero_or_one_and_points_at_the_value() {
     let loc = d.0[0].loc.clone().unwrap_or_default();
     assert_eq!((loc.line, loc.col, loc.len), (2, 69, 5));
 }
+
+#[test]
+fn a_deck_inside_a_sierra_input_file_gives_the_same_spec() {
+    let base = clean(RESPELL);
+    let wrapped = format!(
+        "Begin Sierra job\n Begin Procedure p\n  Begin Aria Region r\n{RESPELL}  End Aria Region r\n End\nEnd Sierra job\n"
+    );
+    let (deck, d) = sierra(&wrapped);
+    // Nothing but contact input: nothing skipped, so no note either.
+    assert!(d.is_empty(), "{d:?}");
+    assert_eq!(deck.without_locations(), base);
+}
+
+#[test]
+fn underscores_spell_spaces_in_keywords() {
+    let spaced = clean(
+        "begin contact definition\n skin all blocks\n begin search options\n  normal check angle = 70\n  buffer factor = 2\n end\nend\n",
+    );
+    let underscored = clean(
+        "begin contact definition\n Skin_All_Blocks\n begin search options\n  Normal_Check_Angle = 70\n  Buffer_Factor = 2\n end\nend\n",
+    );
+    assert_eq!(underscored, spaced);
+    let so = spaced.contact_definitions[0].search_options.clone();
+    assert_eq!(so.and_then(|s| s.normal_check_angle), Some(70.0));
+}
