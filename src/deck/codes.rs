@@ -41,7 +41,7 @@
 //! | E0223 | error    | argument key the enforcement model does not take (with did-you-mean) |
 //! | E0224 | error    | ELFEN contact-set parameter with no counterpart in seam |
 //! | E0225 | error    | unknown material property of an enforcement (TOML `property`), or one with its own field |
-//! | E0226 | error    | toggle block of a Sierra input file used by an enforcement: its schedule cannot be read |
+//! | E0226 | error    | `begin toggle block`: in a contact deck, or used by an enforcement of a Sierra input file (its schedule cannot be read) |
 //! | W0101 | warning  | deprecated alias (`Slave Variable`) |
 //! | W0102 | warning  | single-valued command given twice; the last one wins |
 //! | W0103 | warning  | blocks and lines of a Sierra input file skipped (not contact input) |

@@ -783,7 +783,11 @@ impl Lower {
 
     fn definition_block(&mut self, d: usize, cd: &mut ContactDefinition, sub: &Block) {
         let Some(spec) = sub.spec else {
-            self.unknown_tree(sub);
+            if is_toggle_block(sub) {
+                self.toggle_block(sub, None);
+            } else {
+                self.unknown_tree(sub);
+            }
             return;
         };
         if spec.parent != CD {

@@ -778,3 +778,14 @@ fn underscores_spell_spaces_in_keywords() {
     let so = spaced.contact_definitions[0].search_options.clone();
     assert_eq!(so.and_then(|s| s.normal_check_angle), Some(70.0));
 }
+
+#[test]
+fn a_toggle_block_in_a_contact_deck_is_refused_not_unknown() {
+    for text in [
+        "begin toggle block tog\nend\n",
+        "begin contact definition\n begin toggle block tog\n end\nend\n",
+    ] {
+        let (_, d) = sierra(text);
+        assert_eq!(codes_of(&d), [codes::TOGGLE_BLOCK], "{text}");
+    }
+}
