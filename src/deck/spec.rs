@@ -34,6 +34,8 @@ pub struct ContactDefinition {
     pub visualize_contact: bool,
     #[serde(default)]
     pub output_rule: Option<OutputRule>,
+    /// `Update Search Every n Steps`: kept, though seam's meshes do not move in a run, so
+    /// a re-search finds the same pairs.
     #[serde(default)]
     pub update_search_every_n_steps: Option<u32>,
     #[serde(default)]
@@ -302,10 +304,13 @@ fn identity_y() -> String {
 pub struct Enforcement {
     #[serde(default)]
     pub name: Option<String>,
-    /// `Enforcement for EQ = MODEL args…`, one per equation.
+    /// `Enforcement for EQ = MODEL args…`, one per equation. Any equation name is
+    /// carried; the deck's checks refuse those seam does not solve.
     #[serde(default, rename = "model")]
     pub models: Vec<EnforcementModel>,
-    /// `[Material Property] = [Model] [args…]` lines, e.g. `Gap Conductance Coefficient = Constant H = 10`.
+    /// Material-model lines kept as written: `Gap Conductance Coefficient = Constant H = 10`
+    /// (the ones with their own field, such as `Contact Surface Pressure`, are lowered
+    /// into it; the others of Aria's list are refused by the deck's checks).
     #[serde(default, rename = "property")]
     pub properties: Vec<PropertyModel>,
     #[serde(default)]
@@ -453,6 +458,8 @@ pub struct SearchOptions {
     pub normal_check_angle: Option<f64>,
     #[serde(default)]
     pub self_contact: Option<bool>,
+    /// `Search Update Frequency` (ELFEN `Global_update_frequency`): as
+    /// [`ContactDefinition::update_search_every_n_steps`].
     #[serde(default)]
     pub search_update_frequency: Option<u32>,
     #[serde(skip)]
