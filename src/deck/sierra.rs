@@ -41,9 +41,13 @@ const DEF: &str = "interaction_defaults";
 const SO: &str = "search_options";
 const CS: &str = "contact_surface";
 
+/// The lines a deck's contact input spans: `None` for a contact deck (all of it), the
+/// `begin … end` line ranges of its contact definitions for a Sierra input file.
+pub type ContactLines = Option<Vec<(u32, u32)>>;
+
 /// Lower the top level of a file: a contact deck, or a whole Sierra input file (see
 /// [`is_sierra_file`]) from which only the contact definitions are read.
-pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics) {
+pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics, ContactLines) {
     let mut l = Lower {
         file: file.clone(),
         diags: Diagnostics::default(),
@@ -54,7 +58,7 @@ pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics) {
         let mut skipped = Skipped::default();
         l.sierra_items(items, &mut deck, &mut skipped);
         l.report_skipped(items, &deck, &skipped);
-        return (deck, l.locs, l.diags);
+        return (deck, l.locs, l.diags, Some(skipped.read));
     }
     for item in items {
         match item {
@@ -71,7 +75,7 @@ pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics) {
             Item::Line(line) => l.top_line(line),
         }
     }
-    (deck, l.locs, l.diags)
+    (deck, l.locs, l.diags, None)
 }
 
 /// A whole Sierra input file rather than a contact deck: it has a top-level block of a
@@ -118,6 +122,8 @@ struct Skipped {
     lines: usize,
     /// Toggle blocks: name (lower case) and `begin` line.
     toggles: Vec<(String, Loc)>,
+    /// The `begin` and `end` lines of the contact definitions read.
+    read: Vec<(u32, u32)>,
 }
 
 /// What a line turned out to be.
@@ -271,6 +277,7 @@ impl Lower {
                     let d = deck.contact_definitions.len();
                     let def = self.definition(d, b);
                     deck.contact_definitions.push(def);
+                    skipped.read.push((b.head.line, b.end_line));
                 }
                 Some(_) => skipped.blocks.push(block_title(b)),
                 None if is_toggle_block(b) => self.toggle_block(b, Some(skipped)),

@@ -34,6 +34,8 @@ pub struct Block {
     pub items: Vec<Item>,
     /// For a block of unknown type, the diagnostic to report if it is in contact input.
     pub unknown: Option<Diagnostic>,
+    /// The line of its `end` (`u32::MAX` if it is never closed).
+    pub end_line: u32,
 }
 
 impl Block {
@@ -65,8 +67,9 @@ pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
                 stack.push(open(file, line));
             }
             Some("end") if line.tokens.first().is_some_and(Token::is_word) => match stack.pop() {
-                Some(block) => {
+                Some(mut block) => {
                     check_end(file, &block, &line, &mut diags);
+                    block.end_line = line.line;
                     push(&mut stack, &mut top, Item::Block(block));
                 }
                 None => diags.push(
@@ -165,6 +168,7 @@ fn open(file: &Arc<str>, head: Line) -> Block {
         name,
         items: Vec::new(),
         unknown,
+        end_line: u32::MAX,
     }
 }
 

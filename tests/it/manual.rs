@@ -1029,6 +1029,20 @@ fn a_sierra_input_file_keeps_contact_definitions_strict() {
 }
 
 #[test]
+fn a_sierra_input_file_may_hold_what_a_contact_deck_may_not() {
+    // An unclosed quote on a skipped line ends at its line; block structure still counts.
+    let text = SIERRA_FILE.replace(
+        "Database Name = two_blocks.exo",
+        "Database Name = \"two_blocks.exo",
+    );
+    let codes: Vec<&str> = parse(&text).1.0.iter().map(|x| x.code).collect();
+    assert_eq!(codes, ["W0103"]);
+    let text = SIERRA_FILE.replace("  End Procedure AriaProcedure\n", "");
+    let codes: Vec<&str> = parse(&text).1.0.iter().map(|x| x.code).collect();
+    assert_eq!(codes, ["E0101", "W0103"]);
+}
+
+#[test]
 fn a_toggle_block_that_an_enforcement_uses_is_refused() {
     let text = SIERRA_FILE
         .replace(
