@@ -61,7 +61,12 @@ pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
     let mut top: Vec<Item> = Vec::new();
     let mut stack: Vec<Block> = Vec::new();
     for line in lines {
-        let first = line.tokens.first().map(|t| t.lower.as_str());
+        // `end time = 10` is a line of a Sierra input file, not the end of a block.
+        let first = line
+            .tokens
+            .first()
+            .filter(|_| !line.tokens.iter().any(Token::is_sep))
+            .map(|t| t.lower.as_str());
         match first {
             Some("begin") if line.tokens.first().is_some_and(Token::is_word) => {
                 stack.push(open(file, line));
@@ -236,6 +241,17 @@ mod tests {
         assert_eq!(cs.spec.map(|s| s.key), Some("contact_surface"));
         assert_eq!(cs.name_lower().as_deref(), Some("top"));
         assert_eq!(cs.items.len(), 1);
+    }
+
+    #[test]
+    fn begin_and_end_with_a_separator_are_lines() {
+        let (top, d) = tree("begin time control\n end time = 10\n begin = 0\nend\n");
+        assert!(d.is_empty(), "{d:?}");
+        let [Item::Block(b)] = top.as_slice() else {
+            panic!("expected one block, got {top:?}")
+        };
+        assert_eq!(b.items.len(), 2);
+        assert!(b.items.iter().all(|i| matches!(i, Item::Line(_))));
     }
 
     #[test]
