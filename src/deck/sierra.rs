@@ -508,7 +508,16 @@ impl Lower {
             return Matched::Reported;
         }
         let allowed = registry::phrases_in(block);
-        let suggestion = registry::suggest(&words, &allowed);
+        let mut suggestion = registry::suggest(&words, &allowed);
+        // `Buffer_factr = 2`: compare the words of the first token, blame the token.
+        if suggestion.is_none()
+            && let Some(first) = words.first().filter(|w| w.contains('_'))
+        {
+            let split: Vec<&str> = first.split('_').filter(|w| !w.is_empty()).collect();
+            suggestion = registry::suggest(&split, &allowed)
+                .filter(|&(_, k)| k == split.len())
+                .map(|(p, _)| (p, 1));
+        }
         let n_words = match suggestion {
             Some((_, k)) => k,
             None => words.len().max(1),

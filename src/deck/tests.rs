@@ -789,3 +789,20 @@ fn a_toggle_block_in_a_contact_deck_is_refused_not_unknown() {
         assert_eq!(codes_of(&d), [codes::TOGGLE_BLOCK], "{text}");
     }
 }
+
+#[test]
+fn a_misspelt_underscored_keyword_gets_a_suggestion() {
+    let (_, d) =
+        sierra("begin contact definition\n begin search options\n  Buffer_factr = 2\n end\nend\n");
+    assert_eq!(codes_of(&d), [codes::UNKNOWN_KEYWORD]);
+    assert_eq!(
+        d.0[0].message,
+        "unknown keyword `buffer_factr` in `begin search options`"
+    );
+    assert!(
+        d.0[0]
+            .help
+            .as_deref()
+            .is_some_and(|h| h.starts_with("did you mean `buffer factor`?"))
+    );
+}
