@@ -787,6 +787,16 @@ fn auto_subset_example_and_its_forbidden_mix() {
         (a.name.as_str(), a.number_of_subsets, a.angle),
         ("sub1", Some(6), Some(45.0))
     );
+    // `AUTO SUBSET <string>subname [NUMBER OF SUBSETS <integer>] [ANGLE <real>(60)]`:
+    // left out, both stay unset (the surface module applies 60 degrees and 360/angle).
+    let def =
+        definition_line("BEGIN CONTACT SURFACE surf1\n  BLOCK = block_1\n  AUTO SUBSET sub1\nEND");
+    let s = surfaces(&def);
+    let [SurfaceDef::Block(b)] = s.as_slice() else {
+        panic!("expected one contact surface block")
+    };
+    let a = b.auto_subset.clone().expect("auto subset");
+    assert_eq!((a.number_of_subsets, a.angle), (None, None));
     // "the following is not permitted"
     assert_eq!(
         refusal(&in_definition(
@@ -872,6 +882,36 @@ fn surface_order_examples_keep_deck_order() {
             },
             contains("surfd", &["surface_4"]),
         ]
+    );
+    // 8.4.6 example 1
+    let def = definition_line(
+        "contact surface surfB contains surface_2\ncontact surface surfA contains block_1",
+    );
+    assert_eq!(
+        surfaces(&def),
+        [
+            contains("surfb", &["surface_2"]),
+            contains("surfa", &["block_1"]),
+        ]
+    );
+    // 8.4.8.1, 8.4.8.2 and 8.4.8.5
+    let def = definition_line("CONTACT SURFACE block_1 CONTAINS block_1");
+    assert_eq!(surfaces(&def), [contains("block_1", &["block_1"])]);
+    let def = definition_line(
+        "CONTACT SURFACE block_1 CONTAINS block_1\nCONTACT SURFACE block_2 CONTAINS block_2",
+    );
+    assert_eq!(
+        surfaces(&def),
+        [
+            contains("block_1", &["block_1"]),
+            contains("block_2", &["block_2"]),
+        ]
+    );
+    let def =
+        definition_line("CONTACT SURFACE c1 CONTAINS block_1\nCONTACT SURFACE c2 CONTAINS block_2");
+    assert_eq!(
+        surfaces(&def),
+        [contains("c1", &["block_1"]), contains("c2", &["block_2"])]
     );
     // 8.4.8.4
     let def = definition_line(
