@@ -818,9 +818,10 @@ pub fn reference_markdown() -> String {
          … `end`, or any file whose contact definitions sit inside other blocks such as \
          `begin procedure` and `begin aria region`). From a Sierra input file seam reads \
          every `begin contact definition` wherever it sits, and skips the other blocks and \
-         lines, naming the skipped blocks in one warning (W0103). A region-level \
-         `begin toggle block` that an enforcement's `use toggle block` names is refused \
-         (E0226): seam cannot read its schedule; give it as a `[[toggle]]` of the problem \
+         lines, naming the skipped blocks in one warning (W0103). Aria's \
+         `begin toggle block` is refused (E0226) in a contact deck, and in a Sierra input \
+         file when an enforcement's `use toggle block` names it (an unused one is only \
+         skipped): seam cannot read its schedule; give it as a `[[toggle]]` of the problem \
          file instead.\n"
     );
     for b in BLOCKS {
