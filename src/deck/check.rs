@@ -11,14 +11,23 @@
 //! `"{d}.surface.{s}.name"`, `"{d}.surface.{s}.subset.{k}.normal"`,
 //! `"{d}.surface.{s}.auto_subset.{angle|number_of_subsets}"`,
 //! `"{d}.periodicity.{p}.{offset|axis|center|angle}"`,
-//! `"{d}.control_assignment.{k}.factor"`, with `d`, `i`, `s`, `k`, `p`
+//! `"{d}.control_assignment.{k}.factor"`,
+//! `"{d}.enforcement.{k}.model.{m}.equation"`, `"{d}.enforcement.{k}.model.{m}.arg.{a}"`,
+//! `"{d}.enforcement.{k}.use_toggle_block"`, with `d`, `i`, `s`, `k`, `p`, `m`, `a`
 //! 0-based indices into the spec's vectors.
+//!
+//! Enforcements: every `Enforcement For` equation must be in Aria's list and one seam
+//! solves (the spec carries any), once per block; model arguments are checked where the
+//! deck knows the model's keys; property lines must be `gap conductance coefficient`
+//! (the material models seam lowers into their own fields never reach the list, and the
+//! others are refused here, for both front ends).
 
 use std::collections::HashMap;
 
 use crate::diag::{Diagnostic, Diagnostics, Loc, did_you_mean};
 
 use super::codes;
+use super::registry::{self, Status};
 use super::spec::*;
 
 /// Locations of individual values, by the keys listed in the module docs.
@@ -235,6 +244,9 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
             out,
         );
     }
+    for (k, e) in def.enforcements.iter().enumerate() {
+        check_enforcement(d, k, e, locs, out);
+    }
     for (k, c) in def.control_assignments.iter().enumerate() {
         if let Control::ScalePenalty { factor } = c.control
             && !(factor > 0.0 && factor.is_finite())
@@ -310,6 +322,175 @@ fn check_surface_block(d: usize, s: usize, b: &SurfaceBlock, locs: &Locs, out: &
                 ))
                 .help("ask for at least one subset, or leave `number of subsets` out"),
             );
+        }
+    }
+}
+
+/// Keys of the models whose arguments the deck knows; other models' arguments are
+/// checked by the code that reads them.
+const MODEL_KEYS: &[(&str, &[&str], &str)] = &[
+    (
+        "contact_resistance",
+        &["h"],
+        "`h = <conductance>` (or a `gap conductance coefficient` line)",
+    ),
+    (
+        "conductance",
+        &["h"],
+        "`h = <conductance>` (or a `gap conductance coefficient` line)",
+    ),
+    (
+        "gap_conductance",
+        &["h"],
+        "`h = <conductance>` (or a `gap conductance coefficient` line)",
+    ),
+    ("tied", &["multipliers"], "`multipliers = standard|dual`"),
+];
+
+/// The material properties seam supports, as a help line lists them.
+const SUPPORTED_PROPERTIES: &str = "seam supports `gap conductance coefficient`, `contact surface pressure` (or `contact pressure`), `offset temperature` and `contact gap temperature`";
+
+fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut Diagnostics) {
+    let who = match &e.name {
+        Some(n) => format!("enforcement `{n}`"),
+        None => format!("enforcement #{}", k + 1),
+    };
+    let mut first: HashMap<&str, usize> = HashMap::new();
+    for (m, model) in e.models.iter().enumerate() {
+        let eq = model.equation.as_str();
+        let at = locs.or(
+            &format!("{d}.enforcement.{k}.model.{m}.equation"),
+            &model.at,
+        );
+        match registry::equation(eq) {
+            Some(Status::Implemented) | Some(Status::Warns(_)) => {}
+            Some(Status::Refused(why)) => out.push(
+                Diagnostic::error(
+                    codes::REFUSED_EQUATION,
+                    format!("{who}: `enforcement for {eq}`: seam does not solve the {eq} equation"),
+                )
+                .at(at.clone())
+                .help(format!(
+                    "{why}; write `enforcement for energy = <model>` (contact_resistance, conductance, gap_conductance, tied_temperature, dash, plugin, …)"
+                )),
+            ),
+            None => {
+                let names = registry::EQUATIONS.iter().map(|(n, _)| *n);
+                let hint = did_you_mean(eq, names)
+                    .map(|s| format!("did you mean `{s}`? "))
+                    .unwrap_or_default();
+                out.push(
+                    Diagnostic::error(
+                        codes::UNKNOWN_EQUATION,
+                        format!("{who}: unknown equation `{eq}` in `enforcement for`"),
+                    )
+                    .at(at.clone())
+                    .help(format!(
+                        "{hint}Aria's equations are {}; seam solves `energy`",
+                        registry::EQUATIONS
+                            .iter()
+                            .map(|(n, _)| format!("`{n}`"))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )),
+                );
+            }
+        }
+        if let Some(&prev) = first.get(eq) {
+            let prev_at = e.models.get(prev).map(|p| &p.at);
+            let where_prev = prev_at
+                .filter(|l| !l.is_unknown())
+                .map(|l| format!(" on line {}", l.line))
+                .unwrap_or_default();
+            out.push(
+                Diagnostic::error(
+                    codes::DUPLICATE_EQUATION,
+                    format!("{who}: a second `enforcement for {eq}` line in one block"),
+                )
+                .at(at)
+                .help(format!(
+                    "the first is{where_prev}; one equation has one model per enforcement block: keep one, or put the other in its own `begin enforcement` block"
+                )),
+            );
+        } else {
+            first.insert(eq, m);
+        }
+        let name = model.model.as_str();
+        if let Some((_, keys, usage)) = MODEL_KEYS.iter().find(|(n, _, _)| *n == name) {
+            for (a, arg) in model.args.iter().enumerate() {
+                if arg.key.is_empty() || keys.contains(&arg.key.as_str()) {
+                    continue;
+                }
+                let hint = did_you_mean(&arg.key, keys.iter().copied())
+                    .map(|s| format!("did you mean `{s}`? "))
+                    .unwrap_or_default();
+                out.push(
+                    Diagnostic::error(
+                        codes::UNKNOWN_MODEL_KEY,
+                        format!(
+                            "{who}: `{}` is not an argument of the `{name}` model",
+                            arg.key
+                        ),
+                    )
+                    .at(locs.or(&format!("{d}.enforcement.{k}.model.{m}.arg.{a}"), &model.at))
+                    .help(format!("{hint}`{name}` takes {usage}")),
+                );
+            }
+        }
+    }
+    for p in &e.properties {
+        let name = p.property.as_str();
+        if name == "gap_conductance_coefficient" {
+            continue;
+        }
+        let at = (!p.at.is_unknown()).then(|| p.at.clone());
+        // By key, or by the phrase in snake_case (`contact_surface_pressure`).
+        let spec = registry::COMMANDS.iter().find(|c| {
+            c.blocks.contains(&"enforcement")
+                && (c.key == name || c.phrase.replace(' ', "_") == name)
+        });
+        match spec {
+            Some(c) if matches!(c.status, Status::Refused(_)) => {
+                let Status::Refused(why) = c.status else {
+                    continue;
+                };
+                out.push(
+                    Diagnostic::error(
+                        codes::REFUSED_MATERIAL_MODEL,
+                        format!("{who}: seam cannot use the material model `{}`: it {why}", c.phrase),
+                    )
+                    .at(at)
+                    .help(format!("remove the line; {SUPPORTED_PROPERTIES}")),
+                );
+            }
+            Some(c) => out.push(
+                Diagnostic::error(
+                    codes::UNKNOWN_PROPERTY,
+                    format!("{who}: `{}` is not a property line but a field of the enforcement", c.phrase),
+                )
+                .at(at)
+                .help(format!(
+                    "in TOML write `{} = …` in the enforcement table; `property` entries are `gap_conductance_coefficient` lines",
+                    c.key
+                )),
+            ),
+            None => {
+                let known = registry::COMMANDS
+                    .iter()
+                    .filter(|c| c.blocks.contains(&"enforcement"))
+                    .map(|c| c.key);
+                let hint = did_you_mean(name, known)
+                    .map(|s| format!("did you mean `{s}`? "))
+                    .unwrap_or_default();
+                out.push(
+                    Diagnostic::error(
+                        codes::UNKNOWN_PROPERTY,
+                        format!("{who}: unknown material property `{name}`"),
+                    )
+                    .at(at)
+                    .help(format!("{hint}{SUPPORTED_PROPERTIES}")),
+                );
+            }
         }
     }
 }

@@ -33,8 +33,18 @@
 //! | E0215 | error    | interaction names an enforcement that is not defined |
 //! | E0216 | error    | a value that must be positive is not (penalty scale factor) |
 //! | E0217 | error    | a word outside the command's list of choices (overclosure treatment) |
+//! | E0218 | error    | material-model line seam recognises but cannot use (needs an equation it does not solve) |
+//! | E0219 | error    | `Enforcement For` an equation of Aria's list that seam does not solve |
+//! | E0220 | error    | `Enforcement For` an equation name not in Aria's list (with did-you-mean) |
+//! | E0221 | error    | the same equation twice in one enforcement block |
+//! | E0222 | error    | `Contact Pressure` and `Contact Surface Pressure` in one enforcement block |
+//! | E0223 | error    | argument key the enforcement model does not take (with did-you-mean) |
+//! | E0224 | error    | ELFEN contact-set parameter with no counterpart in seam |
+//! | E0225 | error    | unknown material property of an enforcement (TOML `property`), or one with its own field |
+//! | E0226 | error    | `begin toggle block`: in a contact deck, or used by an enforcement of a Sierra input file (its schedule cannot be read) |
 //! | W0101 | warning  | deprecated alias (`Slave Variable`) |
 //! | W0102 | warning  | single-valued command given twice; the last one wins |
+//! | W0103 | warning  | blocks and lines of a Sierra input file skipped (not contact input) |
 
 pub const UNCLOSED_BLOCK: &str = "E0101";
 pub const MISMATCHED_END: &str = "E0102";
@@ -67,8 +77,18 @@ pub const PERIODICITY: &str = "E0214";
 pub const UNKNOWN_ENFORCEMENT: &str = "E0215";
 pub const NOT_POSITIVE: &str = "E0216";
 pub const BAD_CHOICE: &str = "E0217";
+pub const REFUSED_MATERIAL_MODEL: &str = "E0218";
+pub const REFUSED_EQUATION: &str = "E0219";
+pub const UNKNOWN_EQUATION: &str = "E0220";
+pub const DUPLICATE_EQUATION: &str = "E0221";
+pub const TWO_PRESSURES: &str = "E0222";
+pub const UNKNOWN_MODEL_KEY: &str = "E0223";
+pub const ELFEN_REFUSED: &str = "E0224";
+pub const UNKNOWN_PROPERTY: &str = "E0225";
+pub const TOGGLE_BLOCK: &str = "E0226";
 pub const DEPRECATED_ALIAS: &str = "W0101";
 pub const REPEATED_COMMAND: &str = "W0102";
+pub const SKIPPED_BLOCKS: &str = "W0103";
 
 /// Every code above, for tests and tools that list them.
 pub const ALL: &[&str] = &[
@@ -103,8 +123,18 @@ pub const ALL: &[&str] = &[
     UNKNOWN_ENFORCEMENT,
     NOT_POSITIVE,
     BAD_CHOICE,
+    REFUSED_MATERIAL_MODEL,
+    REFUSED_EQUATION,
+    UNKNOWN_EQUATION,
+    DUPLICATE_EQUATION,
+    TWO_PRESSURES,
+    UNKNOWN_MODEL_KEY,
+    ELFEN_REFUSED,
+    UNKNOWN_PROPERTY,
+    TOGGLE_BLOCK,
     DEPRECATED_ALIAS,
     REPEATED_COMMAND,
+    SKIPPED_BLOCKS,
 ];
 
 #[cfg(test)]

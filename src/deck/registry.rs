@@ -38,8 +38,35 @@ pub struct CommandSpec {
     /// What follows the phrase, `<…>` for values, `[…]` optional, `a|b` choices.
     pub args: &'static str,
     pub description: &'static str,
-    /// False for commands read into the spec but not yet acted on downstream.
-    pub implemented: bool,
+    /// What seam does with the command.
+    pub status: Status,
+}
+
+/// What seam does with a keyword, as the reference reports it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// Read into the spec and acted on.
+    Implemented,
+    /// Read into the spec, but it has no effect in some uses and a warning says so; the
+    /// text says when.
+    Warns(&'static str),
+    /// Recognised and refused with an error that says why (the text).
+    Refused(&'static str),
+}
+
+impl Status {
+    /// The reference's status cell.
+    pub fn describe(self) -> String {
+        match self {
+            Status::Implemented => "implemented".to_string(),
+            Status::Warns(why) => format!("warns: {why}"),
+            Status::Refused(why) => format!("refused: {why}"),
+        }
+    }
+
+    pub fn is_implemented(self) -> bool {
+        !matches!(self, Status::Refused(_))
+    }
 }
 
 const CD: &str = "contact_definition";
@@ -94,12 +121,27 @@ pub static BLOCKS: &[BlockSpec] = &[
     },
 ];
 
+/// A material-model line of an enforcement that seam recognises and refuses; the text
+/// says what it would need.
+macro_rules! refused {
+    ($phrase:literal, $key:literal, $why:literal) => {
+        CommandSpec {
+            phrase: $phrase,
+            key: $key,
+            blocks: &[ENF],
+            args: "= <model> [<key> = <value> | <word>]...",
+            description: "Aria material model.",
+            status: Status::Refused(concat!("needs ", $why)),
+        }
+    };
+}
+
 macro_rules! cmd {
     ($phrase:literal, $key:literal, [$($b:expr),+], $args:literal, $desc:literal) => {
-        CommandSpec { phrase: $phrase, key: $key, blocks: &[$($b),+], args: $args, description: $desc, implemented: true }
+        CommandSpec { phrase: $phrase, key: $key, blocks: &[$($b),+], args: $args, description: $desc, status: Status::Implemented }
     };
-    ($phrase:literal, $key:literal, [$($b:expr),+], $args:literal, $desc:literal, planned) => {
-        CommandSpec { phrase: $phrase, key: $key, blocks: &[$($b),+], args: $args, description: $desc, implemented: false }
+    ($phrase:literal, $key:literal, [$($b:expr),+], $args:literal, $desc:literal, warns $why:literal) => {
+        CommandSpec { phrase: $phrase, key: $key, blocks: &[$($b),+], args: $args, description: $desc, status: Status::Warns($why) }
     };
 }
 
@@ -109,8 +151,8 @@ pub static COMMANDS: &[CommandSpec] = &[
         "contact surface",
         "contact_surface",
         [CD],
-        "<name> contains <block|side set|assembly>...",
-        "Surface from the exterior faces of blocks, or from side sets or assemblies, by name."
+        "<name> [contains <block|side set|assembly>...]",
+        "Surface from the exterior faces of blocks, or from side sets or assemblies, by name; without `contains`, the mesh entity of the surface's own name (`contact surface s` is `contact surface s contains s`)."
     ),
     cmd!(
         "contact node set",
@@ -123,8 +165,8 @@ pub static COMMANDS: &[CommandSpec] = &[
         "skin all blocks",
         "skin_all_blocks",
         [CD],
-        "= on|off [exclude <block>...]",
-        "One surface per element block, named after the block, from its exterior faces."
+        "[= on|off] [exclude <block>...]",
+        "One surface per element block, named after the block, from its exterior faces (alone or with `exclude` only: on)."
     ),
     cmd!(
         "restrict contact to subdomain",
@@ -151,8 +193,9 @@ pub static COMMANDS: &[CommandSpec] = &[
         "update search every",
         "update_search_every_n_steps",
         [CD],
-        "<n> steps",
-        "Redo the search every n steps (1: every step)."
+        "[=] <n> [steps]",
+        "Redo the search every n steps (1: every step); the value is kept in the spec.",
+        warns "seam's meshes do not move in `seam run`, so re-searching has no effect; a warning says so"
     ),
     cmd!(
         "opposed normal threshold angle",
@@ -186,16 +229,16 @@ pub static COMMANDS: &[CommandSpec] = &[
         "periodicity for",
         "periodicity",
         [CD],
-        "<surface> = rectangular offset = <dx> <dy> [<dz>] | cylindrical axis = <a>... center = <c>... angle = <deg> | align_surface destination = <surface> [invert_normals = 0|1] | mapped x_map = <f> y_map = <g> [z_map = <h>]",
-        "Tie a surface to the image of another under a periodic transform."
+        "<surface> [=] rectangular offset = <dx> <dy> [<dz>] | cylindrical axis = <a>... center = <c>... angle = <deg> | align_surface destination = <surface> [invert_normals = 0|1] | mapped [x_map = <f>] [y_map = <g>] [z_map = <h>]",
+        "Tie a surface to the image of another under a periodic transform. Defaults: `invert_normals = 1` (the image faces the destination); a map left out is the identity (`x_map = x`, `y_map = y`, z kept). `cylindrical` needs all of `axis`, `center` and `angle`: the manual gives no default for them."
     ),
     // Enforcement.
     cmd!(
         "enforcement for",
         "model",
         [ENF],
-        "<equation> = <model> [<key> = <value> | <word>]...",
-        "The enforcement model for one equation, with its arguments."
+        "<equation> [=] <model> [<key> = <value> | <word>]...",
+        "The enforcement model for one equation, with its arguments; one line per equation. Equations: see the table below."
     ),
     cmd!(
         "integer data",
@@ -236,8 +279,8 @@ pub static COMMANDS: &[CommandSpec] = &[
         "offset temperature",
         "offset_temperature",
         [ENF],
-        "= <t>",
-        "Temperature offset added across the interface."
+        "= [constant [value =]] <t>",
+        "Temperature offset added across the interface (material model `Offset Temperature = Constant Value = <t>`)."
     ),
     cmd!(
         "quarantine faulty points",
@@ -254,6 +297,72 @@ pub static COMMANDS: &[CommandSpec] = &[
         "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins)."
     ),
     cmd!(
+        "contact surface pressure",
+        "contact_pressure",
+        [ENF],
+        "= [constant [value =]] <p>",
+        "Material model form of `contact pressure` (the same spec field); giving both in one block is an error."
+    ),
+    cmd!(
+        "gap conductance coefficient",
+        "gap_conductance_coefficient",
+        [ENF],
+        "= <model> [<key> = <value> | <word>]...",
+        "The conductance law of the interface: `constant h = …`, `gas_gap`, `radiation`, `cmy`, `table`, `lua`, `plugin` (several lines add up). In TOML a `property` entry with `property = \"gap_conductance_coefficient\"`."
+    ),
+    cmd!(
+        "contact gap temperature",
+        "contact_gap_temperature",
+        [ENF],
+        "= side_a|side_b|mean",
+        "The temperature a temperature-dependent conductance sees at a contact point: side A's, side B's, or their mean (`average`)."
+    ),
+    refused!(
+        "contact gap voltage",
+        "contact_gap_voltage",
+        "the voltage equation, which seam does not solve (seam solves energy only)"
+    ),
+    refused!(
+        "offset darcy potential",
+        "offset_darcy_potential",
+        "porous flow (Darcy potential), which seam does not solve (seam solves energy only)"
+    ),
+    refused!(
+        "offset mesh displacements",
+        "offset_mesh_displacements",
+        "mesh motion, which seam does not solve (its meshes do not move)"
+    ),
+    refused!(
+        "offset pressure",
+        "offset_pressure",
+        "fluid flow (pressure), which seam does not solve (seam solves energy only)"
+    ),
+    refused!(
+        "offset solid displacements",
+        "offset_solid_displacements",
+        "solid mechanics (displacements), which seam does not solve (its meshes do not move)"
+    ),
+    refused!(
+        "offset species",
+        "offset_species",
+        "species transport, which seam does not solve (seam solves energy only)"
+    ),
+    refused!(
+        "offset velocity",
+        "offset_velocity",
+        "fluid flow (velocity), which seam does not solve (seam solves energy only)"
+    ),
+    refused!(
+        "offset voltage",
+        "offset_voltage",
+        "the voltage equation, which seam does not solve (seam solves energy only)"
+    ),
+    refused!(
+        "user expression",
+        "user_expression",
+        "Aria's expression system, which seam does not have; a conductance given by an expression is `gap conductance coefficient = lua \"…\"`"
+    ),
+    cmd!(
         "contact pressure variable",
         "contact_pressure_variable",
         [ENF],
@@ -264,8 +373,8 @@ pub static COMMANDS: &[CommandSpec] = &[
         "use toggle block",
         "use_toggle_block",
         [ENF],
-        "= <name>",
-        "Switch the enforcement on and off in time with this toggle block (a `[[toggle]]` of the problem file)."
+        "[=] <name> [<element block>...]",
+        "Switch the enforcement on and off in time with this toggle block (a `[[toggle]]` of the problem file). The element blocks, which Aria needs at region level only, are kept in the spec (`toggle_element_blocks`); in an enforcement the toggle switches the whole enforcement."
     ),
     // Interaction, Interaction Defaults.
     cmd!(
@@ -307,15 +416,15 @@ pub static COMMANDS: &[CommandSpec] = &[
         "general contact",
         "general_contact",
         [DEF],
-        "= on|off",
+        "[= on|off]",
         "Every listed surface interacts with every other."
     ),
     cmd!(
         "self contact",
         "self_contact",
         [DEF, SO],
-        "= on|off",
-        "A surface may interact with itself."
+        "[= on|off]",
+        "A surface may interact with itself (ELFEN: `Self_contact_flag = 0|1`)."
     ),
     // Search Options.
     cmd!(
@@ -330,28 +439,29 @@ pub static COMMANDS: &[CommandSpec] = &[
         "buffer_factor",
         [SO],
         "[=] <f>",
-        "Growth of the search boxes, relative to the face size."
+        "Growth of the search boxes, relative to the face size (ELFEN: `Buffer_factor`)."
     ),
     cmd!(
         "field factor",
         "field_factor",
         [SO],
         "[=] <f>",
-        "Scale of the search field around each face."
+        "Scale of the search field around each face (ELFEN: `Field_factor`)."
     ),
     cmd!(
         "normal check angle",
         "normal_check_angle",
         [SO],
         "[=] <degrees>",
-        "Largest angle between normals of a pair."
+        "Largest angle between normals of a pair (ELFEN: `Normal_dir_chk_angle`)."
     ),
     cmd!(
         "search update frequency",
         "search_update_frequency",
         [SO],
         "[=] <n>",
-        "Redo the search every n steps."
+        "Redo the search every n steps (ELFEN: `Global_update_frequency`); the value is kept in the spec.",
+        warns "seam's meshes do not move in `seam run`, so re-searching has no effect; a warning says so"
     ),
     // Contact Surface block (Sierra/SM).
     cmd!(
@@ -421,10 +531,182 @@ pub static COMMANDS: &[CommandSpec] = &[
         "contact type",
         "contact_type",
         [CS],
-        "= face|node",
-        "Whether the surface is made of faces or of their nodes."
+        "= face|node|standard",
+        "Whether the surface is made of faces or of their nodes; Sierra/SM's `standard` is `face`, its `smooth` is refused (seam does not smooth surfaces)."
     ),
 ];
+
+/// Other programs' names for seam's commands: `(alias, canonical phrase)`. Matching also
+/// reads `_` as a space, so ELFEN's `Buffer_factor` is `buffer factor` without an entry.
+pub static ALIASES: &[(&str, &str)] = &[
+    ("normal dir chk angle", "normal check angle"),
+    ("global update frequency", "search update frequency"),
+    ("self contact flag", "self contact"),
+];
+
+/// ELFEN contact-set parameters that seam has no counterpart for: `(name as ELFEN
+/// spells it, what it does in ELFEN and what seam offers instead)`.
+pub static ELFEN_REFUSED: &[(&str, &str)] = &[
+    (
+        "Corner_projection_size",
+        "a corner model of dense explicit contact; seam's implicit thermal contact has no corner treatment",
+    ),
+    (
+        "Corner_region_size",
+        "a corner model of dense explicit contact; seam's implicit thermal contact has no corner treatment",
+    ),
+    (
+        "Corner_angle_tolerance",
+        "a corner model of dense explicit contact; seam's implicit thermal contact has no corner treatment",
+    ),
+    (
+        "Contactor_corner_model",
+        "a corner model of dense explicit contact; seam's implicit thermal contact has no corner treatment",
+    ),
+    (
+        "Trigger_search_velocity",
+        "a search triggered by node velocity; seam's meshes do not move",
+    ),
+    (
+        "All_geometry_flag",
+        "contact on every external surface; in seam write `skin all blocks`",
+    ),
+    (
+        "Print_search",
+        "printing of the search; in seam write `output rule = summary` or `verbose`",
+    ),
+    (
+        "Edge_search_frequency",
+        "an edge-node search frequency; seam searches all points together",
+    ),
+    (
+        "Thermal_advection_flag",
+        "advection terms of the contact heat flux; seam's interfaces do not move",
+    ),
+    (
+        "Memory_optimisation_flag",
+        "freeing of global search data; seam keeps its search structures",
+    ),
+    (
+        "Slip_update_model",
+        "fault slip, a mechanics quantity seam does not compute",
+    ),
+    (
+        "Slip_update_frequency",
+        "fault slip, a mechanics quantity seam does not compute",
+    ),
+    (
+        "Slip_ref_update_frequency",
+        "fault slip, a mechanics quantity seam does not compute",
+    ),
+    (
+        "Slip_rate_update_frequency",
+        "fault slip, a mechanics quantity seam does not compute",
+    ),
+    (
+        "Pore_force_no_contact_update",
+        "pore-pressure forces, which seam does not compute",
+    ),
+    (
+        "Geometry_sets",
+        "ELFEN geometry sets; in seam name the surfaces with `contact surface`",
+    ),
+    (
+        "Property_name",
+        "an ELFEN contact property set; in seam give the law in `begin enforcement`",
+    ),
+    (
+        "Property_number",
+        "an ELFEN contact property set; in seam give the law in `begin enforcement`",
+    ),
+];
+
+/// The equations of `Enforcement For <equation>` in Aria's list, with what seam does.
+pub static EQUATIONS: &[(&str, Status)] = &[
+    ("energy", Status::Implemented),
+    ("continuity", Status::Refused(NOT_ENERGY)),
+    ("current", Status::Refused(NOT_ENERGY)),
+    ("cvfem_continuity", Status::Refused(NOT_ENERGY)),
+    ("cvfem_energy", Status::Refused(CVFEM)),
+    ("cvfem_lumped_projection", Status::Refused(NOT_ENERGY)),
+    ("cvfem_momentum", Status::Refused(NOT_ENERGY)),
+    ("cvfem_projection", Status::Refused(NOT_ENERGY)),
+    (
+        "cvfem_specific_dissipation_rate",
+        Status::Refused(NOT_ENERGY),
+    ),
+    (
+        "cvfem_turbulent_kinetic_energy",
+        Status::Refused(NOT_ENERGY),
+    ),
+    ("mass_balance", Status::Refused(NOT_ENERGY)),
+    ("mesh", Status::Refused(NOT_ENERGY)),
+    ("momentum", Status::Refused(NOT_ENERGY)),
+    ("porous_enthalpy", Status::Refused(NOT_ENERGY)),
+    ("porous_species", Status::Refused(NOT_ENERGY)),
+    ("species", Status::Refused(NOT_ENERGY)),
+    ("voltage", Status::Refused(NOT_ENERGY)),
+];
+
+const NOT_ENERGY: &str = "seam solves Energy only";
+const CVFEM: &str = "seam solves Energy only, with finite elements (no control-volume form)";
+
+/// The status of equation `name` (lower case), `None` if it is not in Aria's list.
+pub fn equation(name: &str) -> Option<Status> {
+    EQUATIONS.iter().find(|(e, _)| *e == name).map(|(_, s)| *s)
+}
+
+/// The command that the first tokens of a line spell, and how many tokens it took:
+/// the longest command phrase or alias, with `_` inside a token read as a space.
+///
+/// Commands allowed in block `key` win over longer ones that are not (so
+/// `contact surface pressure contains b` is a surface named `pressure` in a contact
+/// definition); with none allowed, the longest of all is returned, for a wrong-block
+/// message.
+pub fn match_tokens(tokens: &[&str], key: &str) -> Option<(&'static CommandSpec, usize)> {
+    let here = match_tokens_where(tokens, |c| c.blocks.contains(&key));
+    here.or_else(|| match_tokens_where(tokens, |_| true))
+}
+
+fn match_tokens_where(
+    tokens: &[&str],
+    keep: impl Fn(&CommandSpec) -> bool,
+) -> Option<(&'static CommandSpec, usize)> {
+    let mut best: Option<(&'static CommandSpec, usize, usize)> = None;
+    let mut spelled = String::new();
+    for (k, t) in tokens.iter().enumerate() {
+        if k > 0 {
+            spelled.push(' ');
+        }
+        spelled.push_str(&t.replace('_', " "));
+        let words = word_count(&spelled);
+        let hit = COMMANDS
+            .iter()
+            .find(|c| c.phrase == spelled)
+            .or_else(|| {
+                ALIASES
+                    .iter()
+                    .find(|(a, _)| *a == spelled)
+                    .and_then(|(_, canon)| COMMANDS.iter().find(|c| c.phrase == *canon))
+            })
+            .filter(|c| keep(c));
+        if let Some(c) = hit
+            && best.is_none_or(|(_, _, w)| words > w)
+        {
+            best = Some((c, k + 1, words));
+        }
+    }
+    best.map(|(c, n, _)| (c, n))
+}
+
+/// The ELFEN parameter (with its reason) that `token` names, `_` and case ignored.
+pub fn elfen_refused(token: &str) -> Option<(&'static str, &'static str)> {
+    let t = token.replace('_', " ");
+    ELFEN_REFUSED
+        .iter()
+        .find(|(n, _)| n.replace('_', " ").eq_ignore_ascii_case(&t))
+        .copied()
+}
 
 /// The words `begin`, `end`: reserved, listed in the reference only.
 pub fn block(key: &str) -> Option<&'static BlockSpec> {
@@ -520,9 +802,27 @@ pub fn reference_markdown() -> String {
          `[[contact_definition.surface]]` with `kind = \"contains\" | \"node_set\" | \
          \"skin_all_blocks\" | \"block\"`; `periodicity for` is an entry of \
          `[[contact_definition.periodicity]]` with a `transform` table tagged by `kind`; \
-         `enforcement for` lines are `model` entries and material property lines `property` \
-         entries of an enforcement. Generated from the keyword registry \
-         (`src/deck/registry.rs`).\n"
+         `enforcement for` lines are `model` entries and `gap conductance coefficient` lines \
+         `property` entries of an enforcement. `_` inside a keyword reads as a space \
+         (`Buffer_factor` is `buffer factor`). An `=` shown as `[=]` may be left out, as \
+         the manuals' syntax lines do; a switch shown as `[= on|off]` alone means on. The \
+         `status` column says what seam does: \
+         *implemented*; *warns* (kept in the spec, but without effect where the reason \
+         says, and a warning says so); *refused* (an error says why). Generated from the \
+         keyword registry (`src/deck/registry.rs`).\n"
+    );
+    let _ = writeln!(
+        out,
+        "A deck file is either a contact deck (only `begin contact definition` blocks at the \
+         top level; any other line is an error) or a whole Sierra input file (`begin sierra` \
+         … `end`, or any file whose contact definitions sit inside other blocks such as \
+         `begin procedure` and `begin aria region`). From a Sierra input file seam reads \
+         every `begin contact definition` wherever it sits, and skips the other blocks and \
+         lines, naming the skipped blocks in one warning (W0103). Aria's \
+         `begin toggle block` is refused (E0226) in a contact deck, and in a Sierra input \
+         file when an enforcement's `use toggle block` names it (an unused one is only \
+         skipped): seam cannot read its schedule; give it as a `[[toggle]]` of the problem \
+         file instead.\n"
     );
     for b in BLOCKS {
         let name = match b.naming {
@@ -536,23 +836,20 @@ pub fn reference_markdown() -> String {
             None => "at the top level".to_string(),
         };
         let _ = writeln!(out, "{} Key `{}`; appears {place}.\n", b.description, b.key);
-        let _ = writeln!(
-            out,
-            "| command | key | arguments | description | implemented |"
-        );
+        let _ = writeln!(out, "| command | key | arguments | description | status |");
         let _ = writeln!(out, "|---|---|---|---|---|");
         for sub in BLOCKS.iter().filter(|s| s.parent == b.key) {
             // A block is carried out when any of its commands is.
             let done = COMMANDS
                 .iter()
-                .any(|c| c.implemented && c.blocks.contains(&sub.key));
+                .any(|c| c.status.is_implemented() && c.blocks.contains(&sub.key));
             let _ = writeln!(
                 out,
                 "| `begin {}` | `{}` | block | {} | {} |",
                 sub.phrase,
                 sub.key,
                 sub.description,
-                if done { "yes" } else { "parsed only" }
+                if done { "implemented" } else { "refused" }
             );
         }
         for c in COMMANDS.iter().filter(|c| c.blocks.contains(&b.key)) {
@@ -568,16 +865,40 @@ pub fn reference_markdown() -> String {
                 c.key,
                 args,
                 c.description,
-                if c.implemented { "yes" } else { "parsed only" }
-            );
-        }
-        if b.key == ENF {
-            let _ = writeln!(
-                out,
-                "| `<material property>` | `property` | `= <model> [<key> = <value> \\| <word>]...` | Any other `words = model args` line, e.g. `gap conductance coefficient = constant h = 10`. | parsed only |"
+                c.status.describe()
             );
         }
         let _ = writeln!(out);
+        if b.key == ENF {
+            let _ = writeln!(
+                out,
+                "Equations of `enforcement for` (Aria's list; any other name is an error, and \
+                 one equation may appear once per block). The spec carries every equation; \
+                 the deck refuses those seam does not solve.\n"
+            );
+            let _ = writeln!(out, "| equation | status |");
+            let _ = writeln!(out, "|---|---|");
+            for (e, st) in EQUATIONS {
+                let _ = writeln!(out, "| `{e}` | {} |", st.describe());
+            }
+            let _ = writeln!(out);
+        }
+        if b.key == SO {
+            let _ = writeln!(
+                out,
+                "ELFEN contact-set parameters: `Buffer_factor`, `Field_factor` are `buffer \
+                 factor`, `field factor`; `Normal_dir_chk_angle` is `normal check angle`; \
+                 `Global_update_frequency` is `search update frequency`; `Self_contact_flag` \
+                 is `self contact`. The ELFEN parameters below have no counterpart in seam and are \
+                 refused (E0224):\n"
+            );
+            let _ = writeln!(out, "| ELFEN parameter | status |");
+            let _ = writeln!(out, "|---|---|");
+            for (n, why) in ELFEN_REFUSED {
+                let _ = writeln!(out, "| `{n}` | refused: {why} |");
+            }
+            let _ = writeln!(out);
+        }
     }
     out
 }
@@ -614,6 +935,35 @@ mod tests {
                 assert!(block(b).is_some(), "{} in unknown block {b}", c.phrase);
             }
         }
+    }
+
+    #[test]
+    fn underscores_and_aliases_match() {
+        let m = |s: &str, b: &str| {
+            match_tokens(&s.split(' ').collect::<Vec<_>>(), b).map(|(c, n)| (c.key, n))
+        };
+        assert_eq!(m("buffer_factor = 2", SO), Some(("buffer_factor", 1)));
+        assert_eq!(
+            m("normal_dir_chk_angle = 80", SO),
+            Some(("normal_check_angle", 1))
+        );
+        assert_eq!(
+            m("global_update_frequency = 10", SO),
+            Some(("search_update_frequency", 1))
+        );
+        assert_eq!(m("self_contact_flag = 1", SO), Some(("self_contact", 1)));
+        assert_eq!(
+            m("contact surface pressure contains b", CD),
+            Some(("contact_surface", 2))
+        );
+        assert_eq!(
+            m("contact surface pressure = 5", ENF),
+            Some(("contact_pressure", 3))
+        );
+        assert!(elfen_refused("corner_REGION_size").is_some());
+        assert_eq!(equation("voltage"), Some(Status::Refused(NOT_ENERGY)));
+        assert_eq!(equation("energy"), Some(Status::Implemented));
+        assert_eq!(equation("enrgy"), None);
     }
 
     #[test]

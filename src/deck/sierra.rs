@@ -7,7 +7,20 @@
 //! in a [`Locs`] table so those checks can point at the offending token.
 //!
 //! Conventions: bare words are stored lower case, quoted strings as written; numbers
-//! accept a Fortran `d` exponent (`1.5d3`); names after a command are single tokens.
+//! accept a Fortran `d` exponent (`1.5d3`); names after a command are single tokens;
+//! a command's phrase may be spelled with `_` for spaces (ELFEN's `Buffer_factor`);
+//! the `=` that Aria's syntax lines leave out is optional.
+//!
+//! A whole Sierra input file is recognised by its top level (see `is_sierra_file`):
+//! its contact definitions are lowered as in a contact deck, its other blocks and lines
+//! skipped and named in one W0103 warning. A region-level `begin toggle block` is
+//! refused (E0226) when an enforcement uses it, and in a contact deck.
+//!
+//! Enforcement material-model lines: `gap conductance coefficient` stays a property
+//! line (read by the conductance module); `contact surface pressure`, `offset
+//! temperature` and `contact gap temperature` are lowered into their own fields; the
+//! other models of Aria's list are kept as property lines that [`super::check`]
+//! refuses, so the TOML form is refused the same way.
 
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -28,18 +41,30 @@ const DEF: &str = "interaction_defaults";
 const SO: &str = "search_options";
 const CS: &str = "contact_surface";
 
-/// Lower the top level of a file.
-pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics) {
+/// The lines a deck's contact input spans: `None` for a contact deck (all of it), the
+/// `begin … end` line ranges of its contact definitions for a Sierra input file.
+pub type ContactLines = Option<Vec<(u32, u32)>>;
+
+/// Lower the top level of a file: a contact deck, or a whole Sierra input file (see
+/// [`is_sierra_file`]) from which only the contact definitions are read.
+pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics, ContactLines) {
     let mut l = Lower {
         file: file.clone(),
         diags: Diagnostics::default(),
         locs: Locs::default(),
     };
     let mut deck = Deck::default();
+    if is_sierra_file(items) {
+        let mut skipped = Skipped::default();
+        l.sierra_items(items, &mut deck, &mut skipped);
+        l.report_skipped(items, &deck, &skipped);
+        return (deck, l.locs, l.diags, Some(skipped.read));
+    }
     for item in items {
         match item {
             Item::Block(b) => match b.spec {
-                None => {}
+                None if is_toggle_block(b) => l.toggle_block(b, None),
+                None => l.unknown_tree(b),
                 Some(s) if s.key == CD => {
                     let d = deck.contact_definitions.len();
                     let def = l.definition(d, b);
@@ -50,14 +75,60 @@ pub fn lower(file: &Arc<str>, items: &[Item]) -> (Deck, Locs, Diagnostics) {
             Item::Line(line) => l.top_line(line),
         }
     }
-    (deck, l.locs, l.diags)
+    (deck, l.locs, l.diags, None)
+}
+
+/// A whole Sierra input file rather than a contact deck: it has a top-level block of a
+/// type seam does not know that is `begin sierra` or holds a contact definition
+/// (`begin procedure … begin aria region … begin contact definition`).
+fn is_sierra_file(items: &[Item]) -> bool {
+    items.iter().any(|i| match i {
+        Item::Block(b) if b.spec.is_none() => {
+            b.type_tokens().first().is_some_and(|t| t.lower == "sierra") || holds_definition(b)
+        }
+        _ => false,
+    })
+}
+
+/// Does a contact definition sit in `b`, directly or inside blocks of unknown type?
+fn holds_definition(b: &Block) -> bool {
+    b.items.iter().any(|i| match i {
+        Item::Block(s) => match s.spec {
+            Some(spec) => spec.key == CD,
+            None => holds_definition(s),
+        },
+        Item::Line(_) => false,
+    })
+}
+
+/// `begin toggle block <name>`: Aria's region-level toggle.
+fn is_toggle_block(b: &Block) -> bool {
+    let words: Vec<&str> = b.type_tokens().iter().map(|t| t.lower.as_str()).collect();
+    words.starts_with(&["toggle", "block"])
+}
+
+/// `begin` and the words after it, lower case: `finite element model mesh1`.
+fn block_title(b: &Block) -> String {
+    let words: Vec<String> = b.head.tokens.iter().skip(1).map(value_text).collect();
+    words.join(" ")
+}
+
+/// What a Sierra input file held besides contact definitions.
+#[derive(Default)]
+struct Skipped {
+    /// Titles of the skipped blocks (outermost only), in file order.
+    blocks: Vec<String>,
+    /// Lines outside every contact definition.
+    lines: usize,
+    /// Toggle blocks: name (lower case) and `begin` line.
+    toggles: Vec<(String, Loc)>,
+    /// The `begin` and `end` lines of the contact definitions read.
+    read: Vec<(u32, u32)>,
 }
 
 /// What a line turned out to be.
 enum Matched<'a> {
     Command(Cur<'a>),
-    /// `words = model args` in an enforcement.
-    Property,
     /// Not usable here; a diagnostic has been pushed.
     Reported,
 }
@@ -68,6 +139,8 @@ struct Cur<'a> {
     line: &'a Line,
     /// Index of the next unread token.
     pos: usize,
+    /// Number of tokens the command phrase took.
+    n: usize,
 }
 
 impl<'a> Cur<'a> {
@@ -154,6 +227,144 @@ impl Lower {
 
     // ----- structure -----
 
+    /// Report the unknown block types in `b` and below (a block that is not read).
+    fn unknown_tree(&mut self, b: &Block) {
+        if let Some(d) = &b.unknown {
+            self.push(d.clone());
+        }
+        for item in &b.items {
+            if let Item::Block(sub) = item {
+                self.unknown_tree(sub);
+            }
+        }
+    }
+
+    /// A `begin toggle block`: in a contact deck an error; in a Sierra input file noted,
+    /// and an error only if an enforcement uses it (see [`Self::report_skipped`]).
+    fn toggle_block(&mut self, b: &Block, skipped: Option<&mut Skipped>) {
+        let name = b.head.tokens.get(3).map(value_text).unwrap_or_default();
+        match skipped {
+            Some(s) => {
+                s.blocks.push(block_title(b));
+                s.toggles.push((name, self.line_loc(&b.head)));
+            }
+            None => self.push(
+                Diagnostic::error(
+                    codes::TOGGLE_BLOCK,
+                    format!("seam cannot read the schedule of `begin toggle block {name}`"),
+                )
+                .at(self.span(b.type_tokens()))
+                .help(format!(
+                    "remove the block and give the schedule in the problem file: `[[toggle]]` with `name = \"{name}\"` and `on = [[t0, t1]]`; `use toggle block {name}` in an enforcement then follows it"
+                )),
+            ),
+        }
+    }
+
+    /// The items of a Sierra input file (or of a block in it): contact definitions are
+    /// read, blocks holding one are entered, everything else is skipped.
+    fn sierra_items(&mut self, items: &[Item], deck: &mut Deck, skipped: &mut Skipped) {
+        for item in items {
+            let b = match item {
+                Item::Line(_) => {
+                    skipped.lines += 1;
+                    continue;
+                }
+                Item::Block(b) => b,
+            };
+            match b.spec {
+                Some(s) if s.key == CD => {
+                    let d = deck.contact_definitions.len();
+                    let def = self.definition(d, b);
+                    deck.contact_definitions.push(def);
+                    skipped.read.push((b.head.line, b.end_line));
+                }
+                Some(_) => skipped.blocks.push(block_title(b)),
+                None if is_toggle_block(b) => self.toggle_block(b, Some(skipped)),
+                None if holds_definition(b) => self.sierra_items(&b.items, deck, skipped),
+                None => {
+                    // A misspelt contact definition is reported, not skipped.
+                    let words: Vec<&str> = b
+                        .type_tokens()
+                        .iter()
+                        .take(2)
+                        .map(|t| t.lower.as_str())
+                        .collect();
+                    if did_you_mean(&words.join(" "), ["contact definition"]).is_some() {
+                        self.unknown_tree(b);
+                    } else {
+                        skipped.blocks.push(block_title(b));
+                    }
+                }
+            }
+        }
+    }
+
+    /// The one note on what a Sierra input file held besides contact input, and the
+    /// toggle blocks that enforcements use but seam cannot read.
+    fn report_skipped(&mut self, items: &[Item], deck: &Deck, skipped: &Skipped) {
+        for (d, def) in deck.contact_definitions.iter().enumerate() {
+            for (k, e) in def.enforcements.iter().enumerate() {
+                let Some(name) = &e.use_toggle_block else {
+                    continue;
+                };
+                let Some((_, at)) = skipped.toggles.iter().find(|(t, _)| t == name) else {
+                    continue;
+                };
+                let used = self
+                    .locs
+                    .get(&format!("{d}.enforcement.{k}.use_toggle_block"))
+                    .or_else(|| Some(e.at.clone()));
+                self.push(
+                    Diagnostic::error(
+                        codes::TOGGLE_BLOCK,
+                        format!(
+                            "toggle block `{name}` (line {}) is used here, but seam cannot read a toggle block's schedule",
+                            at.line
+                        ),
+                    )
+                    .at(used)
+                    .help(format!(
+                        "give the schedule in the problem file (`[[toggle]]` with `name = \"{name}\"` and `on = [[t0, t1]]`) and remove `begin toggle block {name}` from the file given to seam"
+                    )),
+                );
+            }
+        }
+        if skipped.blocks.is_empty() && skipped.lines == 0 {
+            return;
+        }
+        let n = deck.contact_definitions.len();
+        let mut message = format!(
+            "read {n} contact definition{} from a Sierra input file; skipped ",
+            if n == 1 { "" } else { "s" }
+        );
+        let b = skipped.blocks.len();
+        if b > 0 {
+            message.push_str(&format!(
+                "{b} block{}: {}",
+                if b == 1 { "" } else { "s" },
+                skipped.blocks.join(", ")
+            ));
+        }
+        if skipped.lines > 0 {
+            message.push_str(&format!(
+                "{}{} line{} outside them",
+                if b > 0 { ", and " } else { "" },
+                skipped.lines,
+                if skipped.lines == 1 { "" } else { "s" }
+            ));
+        }
+        let at = items.iter().find_map(|i| match i {
+            Item::Block(b) => self.span(&b.head.tokens),
+            Item::Line(l) => self.span(&l.tokens),
+        });
+        self.push(
+            Diagnostic::warning(codes::SKIPPED_BLOCKS, message)
+                .at(at)
+                .help("seam reads the `begin contact definition` blocks only; the rest is other input of the Sierra run"),
+        );
+    }
+
     fn top_line(&mut self, line: &Line) {
         let words = leading_words(line);
         if let Some(cmd) = registry::match_command(&words) {
@@ -181,7 +392,15 @@ impl Lower {
     }
 
     fn misplaced(&mut self, b: &Block, parent: &str) {
-        let Some(spec) = b.spec else { return };
+        let Some(spec) = b.spec else {
+            self.unknown_tree(b);
+            return;
+        };
+        for item in &b.items {
+            if let Item::Block(sub) = item {
+                self.unknown_tree(sub);
+            }
+        }
         let here = match registry::block(parent) {
             Some(p) => format!("inside `begin {}`", p.phrase),
             None => "at the top level".to_string(),
@@ -246,34 +465,58 @@ impl Lower {
     /// Match a line to a command allowed in `block`; report it otherwise.
     fn command<'a>(&mut self, block: &str, line: &'a Line) -> Matched<'a> {
         let words = leading_words(line);
-        let found = registry::match_command(&words);
-        if let Some(cmd) = found {
-            let n = registry::word_count(cmd.phrase);
+        // Another block's command is misplaced only if it is the whole of what comes
+        // before the first separator (`surface emissivity = …` is no `surface` line).
+        let before_sep = line.tokens.iter().position(Token::is_sep);
+        let found = registry::match_tokens(&words, block)
+            .filter(|(cmd, n)| cmd.blocks.contains(&block) || before_sep.is_none_or(|p| *n >= p));
+        if let Some((cmd, n)) = found {
             if cmd.blocks.contains(&block) {
-                return Matched::Command(Cur { cmd, line, pos: n });
+                return Matched::Command(Cur {
+                    cmd,
+                    line,
+                    pos: n,
+                    n,
+                });
             }
-            // In an enforcement, `some words = model` is a material property unless the
-            // words are exactly another block's command.
-            let before_sep = line.tokens.iter().position(Token::is_sep);
-            let property = block == ENF && before_sep.is_some_and(|p| p > n);
-            if !property {
-                let at = self.span(line.tokens.get(..n).unwrap_or_default());
-                let here = registry::describe_block(block);
-                self.push(
-                    Diagnostic::error(
-                        codes::WRONG_BLOCK,
-                        format!("`{}` is not allowed in {here}", cmd.phrase),
-                    )
-                    .at(at)
-                    .help(format!("it belongs in {}", homes(cmd))),
-                );
-                return Matched::Reported;
-            }
+            let at = self.span(line.tokens.get(..n).unwrap_or_default());
+            let here = registry::describe_block(block);
+            self.push(
+                Diagnostic::error(
+                    codes::WRONG_BLOCK,
+                    format!("`{}` is not allowed in {here}", cmd.phrase),
+                )
+                .at(at)
+                .help(format!("it belongs in {}", homes(cmd))),
+            );
+            return Matched::Reported;
+        }
+        if let Some(first) = line.tokens.first().filter(|t| t.is_word())
+            && let Some((_, why)) = registry::elfen_refused(&first.lower)
+        {
+            self.push(
+                Diagnostic::error(
+                    codes::ELFEN_REFUSED,
+                    format!(
+                        "`{}` is an ELFEN contact-set parameter with no counterpart in seam",
+                        first.text
+                    ),
+                )
+                .at(Some(first.loc(&self.file)))
+                .help(format!("in ELFEN it sets {why}; remove the line")),
+            );
+            return Matched::Reported;
         }
         let allowed = registry::phrases_in(block);
-        let suggestion = registry::suggest(&words, &allowed);
-        if block == ENF && suggestion.is_none() && is_property_line(line) {
-            return Matched::Property;
+        let mut suggestion = registry::suggest(&words, &allowed);
+        // `Buffer_factr = 2`: compare the words of the first token, blame the token.
+        if suggestion.is_none()
+            && let Some(first) = words.first().filter(|w| w.contains('_'))
+        {
+            let split: Vec<&str> = first.split('_').filter(|w| !w.is_empty()).collect();
+            suggestion = registry::suggest(&split, &allowed)
+                .filter(|&(_, k)| k == split.len())
+                .map(|(p, _)| (p, 1));
         }
         let n_words = match suggestion {
             Some((_, k)) => k,
@@ -298,9 +541,6 @@ impl Lower {
             registry::describe_block(block),
             registry::accepted_in(block)
         ));
-        if block == ENF {
-            help.push_str(", and `<material property> = <model> [args]` lines");
-        }
         self.push(
             Diagnostic::error(
                 codes::UNKNOWN_KEYWORD,
@@ -484,6 +724,15 @@ impl Lower {
         }
     }
 
+    /// An on/off switch that may be left out, as the manual's syntax lines do: alone
+    /// it means on.
+    fn flag(&mut self, c: &mut Cur) -> Option<bool> {
+        match c.peek() {
+            None => Some(true),
+            Some(_) => self.switch(c),
+        }
+    }
+
     /// Report anything left on the line.
     fn finish(&mut self, c: &Cur) {
         let rest = c.rest();
@@ -514,13 +763,12 @@ impl Lower {
     /// count as the same command).
     fn once_as(&mut self, seen: &mut HashSet<&'static str>, key: &'static str, c: &Cur) {
         if !seen.insert(key) {
-            let n = registry::word_count(c.cmd.phrase);
             self.push(
                 Diagnostic::warning(
                     codes::REPEATED_COMMAND,
                     format!("`{}` is given more than once in this block", c.phrase()),
                 )
-                .at(self.span(c.line.tokens.get(..n).unwrap_or_default()))
+                .at(self.span(c.line.tokens.get(..c.n).unwrap_or_default()))
                 .help("only the last one counts; remove the others"),
             );
         }
@@ -550,7 +798,14 @@ impl Lower {
     }
 
     fn definition_block(&mut self, d: usize, cd: &mut ContactDefinition, sub: &Block) {
-        let Some(spec) = sub.spec else { return };
+        let Some(spec) = sub.spec else {
+            if is_toggle_block(sub) {
+                self.toggle_block(sub, None);
+            } else {
+                self.unknown_tree(sub);
+            }
+            return;
+        };
         if spec.parent != CD {
             self.misplaced(sub, CD);
             return;
@@ -567,7 +822,8 @@ impl Lower {
         };
         match spec.key {
             ENF => {
-                let e = self.enforcement(sub);
+                let k = cd.enforcements.len();
+                let e = self.enforcement(d, k, sub);
                 cd.enforcements.push(e);
             }
             INT => {
@@ -613,11 +869,16 @@ impl Lower {
                 let Some((name, name_at)) = self.name(c, "a surface name") else {
                     return;
                 };
-                if !self.keyword(c, "contains") {
-                    return;
-                }
-                c.skip_sep();
-                let contains = self.names(c, "the names it contains");
+                // Without `contains`, the mesh entity of the surface's own name.
+                let contains = if c.peek().is_none() {
+                    vec![name.clone()]
+                } else {
+                    if !self.keyword(c, "contains") {
+                        return;
+                    }
+                    c.skip_sep();
+                    self.names(c, "the names it contains")
+                };
                 self.locs
                     .set(format!("{d}.surface.{}.name", cd.surfaces.len()), name_at);
                 cd.surfaces.push(if c.cmd.key == "contact_surface" {
@@ -628,7 +889,15 @@ impl Lower {
             }
             "skin_all_blocks" => {
                 c.skip_sep();
-                let Some(on) = self.switch(c) else { return };
+                // Alone, or with `exclude` only, as the Aria manual writes it: on.
+                let on = match c.peek() {
+                    None => true,
+                    Some(t) if t.is_word() && t.lower == "exclude" => true,
+                    Some(_) => match self.switch(c) {
+                        Some(on) => on,
+                        None => return,
+                    },
+                };
                 let mut exclude = Vec::new();
                 if c.peek().is_some_and(|t| t.lower == "exclude") {
                     c.pos += 1;
@@ -826,10 +1095,6 @@ impl Lower {
     fn periodicity(&mut self, d: usize, p: usize, c: &mut Cur) -> Option<Periodicity> {
         let at = self.line_loc(c.line);
         let (surface, _) = self.name(c, "a surface name")?;
-        if !c.peek().is_some_and(Token::is_sep) {
-            self.missing(c, "`=` and a transform");
-            return None;
-        }
         c.skip_sep();
         let kinds = ["rectangular", "cylindrical", "align_surface", "mapped"];
         let Some(kind_tok) = c.peek().filter(|t| !t.is_sep()) else {
@@ -847,9 +1112,9 @@ impl Lower {
                 "cylindrical axis = <a1> <a2> [<a3>] center = <c1> <c2> [<c3>] angle = <degrees>"
             }
             "align_surface" => "align_surface destination = <surface> [invert_normals = 0|1]",
-            _ => "mapped x_map = <f> y_map = <g> [z_map = <h>]",
+            _ => "mapped [x_map = <f>] [y_map = <g>] [z_map = <h>]",
         };
-        let usage = format!("write `periodicity for {surface} = {usage}`");
+        let usage = format!("write `periodicity for {surface} {usage}`");
         let allowed: &[&str] = match kind {
             "rectangular" => &["offset"],
             "cylindrical" => &["axis", "center", "angle"],
@@ -1023,17 +1288,13 @@ impl Lower {
                     invert_normals: invert,
                 }
             }
-            _ => {
-                let x = text("x_map");
-                let y = text("y_map");
-                let both = need(self, "x_map", x.is_some()) & need(self, "y_map", y.is_some());
-                both.then_some(())?;
-                PeriodicTransform::Mapped {
-                    x_map: x.unwrap_or_default(),
-                    y_map: y.unwrap_or_default(),
-                    z_map: text("z_map"),
-                }
-            }
+            _ => PeriodicTransform::Mapped {
+                // A map left out is the identity (Aria manual: "functions that are not
+                // specified default to a trivial mapping").
+                x_map: text("x_map").unwrap_or_else(|| "x".to_string()),
+                y_map: text("y_map").unwrap_or_else(|| "y".to_string()),
+                z_map: text("z_map"),
+            },
         };
         ok.then_some(Periodicity {
             surface,
@@ -1042,13 +1303,16 @@ impl Lower {
         })
     }
 
-    fn enforcement(&mut self, b: &Block) -> Enforcement {
+    fn enforcement(&mut self, d: usize, k: usize, b: &Block) -> Enforcement {
         let mut e = Enforcement {
             name: self.block_name(b),
             at: self.line_loc(&b.head),
             ..Default::default()
         };
         let mut seen = HashSet::new();
+        // The first pressure line: its phrase and line, for `contact pressure` and
+        // `contact surface pressure` in one block.
+        let mut pressure_from: Option<(&'static str, u32)> = None;
         for item in &b.items {
             let line = match item {
                 Item::Block(sub) => {
@@ -1059,36 +1323,44 @@ impl Lower {
             };
             let mut c = match self.command(ENF, line) {
                 Matched::Command(c) => c,
-                Matched::Property => {
-                    if let Some(p) = self.property(line) {
-                        e.properties.push(p);
-                    }
-                    continue;
-                }
                 Matched::Reported => continue,
             };
             let at = self.line_loc(line);
+            if let registry::Status::Refused(_) = c.cmd.status {
+                // Kept as a property line: the semantic check refuses it, for both forms.
+                let p = self.property(&mut c);
+                e.properties.push(p);
+                continue;
+            }
             match c.cmd.key {
                 "model" => {
                     let eq = self.name(&mut c, "an equation name");
-                    if !c.peek().is_some_and(Token::is_sep) {
-                        if eq.is_some() {
-                            self.missing(&c, "`=` and a model");
-                        }
+                    let Some((equation, eq_at)) = eq else {
                         continue;
-                    }
+                    };
                     c.skip_sep();
-                    let model = self.name(&mut c, "a model name");
-                    let args = self.args(&c, c.rest());
-                    c.pos = line.tokens.len();
-                    if let (Some((equation, _)), Some((model, _))) = (eq, model) {
-                        e.models.push(EnforcementModel {
-                            equation,
-                            model,
-                            args,
-                            at,
-                        });
+                    let Some((model, _)) = self.name(&mut c, "a model name") else {
+                        continue;
+                    };
+                    let m = e.models.len();
+                    self.locs
+                        .set(format!("{d}.enforcement.{k}.model.{m}.equation"), eq_at);
+                    let (args, arg_locs) = self.args(&c, c.rest());
+                    for (a, l) in arg_locs.into_iter().enumerate() {
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.model.{m}.arg.{a}"), l);
                     }
+                    c.pos = line.tokens.len();
+                    e.models.push(EnforcementModel {
+                        equation,
+                        model,
+                        args,
+                        at,
+                    });
+                }
+                "gap_conductance_coefficient" => {
+                    let p = self.property(&mut c);
+                    e.properties.push(p);
                 }
                 "integer_data" => {
                     c.skip_sep();
@@ -1113,7 +1385,7 @@ impl Lower {
                                 codes::DEPRECATED_ALIAS,
                                 "`slave variable` is a deprecated name for `side b variable`",
                             )
-                            .at(self.span(line.tokens.get(..2).unwrap_or_default()))
+                            .at(self.span(line.tokens.get(..c.n).unwrap_or_default()))
                             .help("write `side b variable <side B variable> to <side A variable>`"),
                         );
                     }
@@ -1139,14 +1411,80 @@ impl Lower {
                         true
                     };
                 }
-                "dash_penalty_factor" | "offset_temperature" | "contact_pressure" => {
+                "dash_penalty_factor" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();
                     if let Some((v, _)) = self.number(&mut c, "a number") {
-                        match c.cmd.key {
-                            "dash_penalty_factor" => e.dash_penalty_factor = Some(v),
-                            "offset_temperature" => e.offset_temperature = Some(v),
-                            _ => e.contact_pressure = Some(v),
+                        e.dash_penalty_factor = Some(v);
+                    }
+                }
+                "offset_temperature" => {
+                    self.once(&mut seen, &c);
+                    if let Some(v) = self.constant_value(&mut c, "a temperature difference") {
+                        e.offset_temperature = Some(v);
+                    }
+                }
+                "contact_pressure" => {
+                    let phrase = c.cmd.phrase;
+                    match pressure_from {
+                        Some((first, first_line)) if first != phrase => {
+                            self.push(
+                                Diagnostic::error(
+                                    codes::TWO_PRESSURES,
+                                    format!(
+                                        "`{phrase}` and `{first}` in one enforcement block"
+                                    ),
+                                )
+                                .at(self.span(line.tokens.get(..c.n).unwrap_or_default()))
+                                .help(format!(
+                                    "both set the contact pressure; `{first}` is on line {first_line}: keep one"
+                                )),
+                            );
+                            continue;
+                        }
+                        Some(_) => {
+                            self.once_as(&mut seen, "contact_pressure", &c);
+                        }
+                        None => {
+                            seen.insert("contact_pressure");
+                            pressure_from = Some((phrase, line.line));
+                        }
+                    }
+                    if let Some(v) = self.constant_value(&mut c, "a pressure") {
+                        e.contact_pressure = Some(v);
+                    }
+                }
+                "contact_gap_temperature" => {
+                    self.once(&mut seen, &c);
+                    c.skip_sep();
+                    let rest = c.rest();
+                    c.pos = line.tokens.len();
+                    let words: Vec<String> =
+                        rest.iter().map(|t| t.lower.replace('_', " ")).collect();
+                    let value = words.join(" ");
+                    let choice = match value.as_str() {
+                        "side a" => Some(GapTemperature::SideA),
+                        "side b" => Some(GapTemperature::SideB),
+                        "mean" | "average" | "avg" => Some(GapTemperature::Mean),
+                        _ => None,
+                    };
+                    match choice {
+                        Some(g) => e.contact_gap_temperature = Some(g),
+                        None if rest.is_empty() => self.missing(&c, "`side_a`, `side_b` or `mean`"),
+                        None => {
+                            let hint = did_you_mean(&value, ["side a", "side b", "mean"])
+                                .map(|s| format!("did you mean `{}`? ", s.replace(' ', "_")))
+                                .unwrap_or_default();
+                            self.push(
+                                Diagnostic::error(
+                                    codes::BAD_CHOICE,
+                                    format!("unknown contact gap temperature `{value}`"),
+                                )
+                                .at(self.span(rest))
+                                .help(format!(
+                                    "{hint}the choices are `side_a`, `side_b` and `mean` (the temperature a temperature-dependent conductance sees)"
+                                )),
+                            );
                         }
                     }
                 }
@@ -1160,8 +1498,13 @@ impl Lower {
                 "use_toggle_block" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();
-                    if let Some((v, _)) = self.name(&mut c, "a toggle block name") {
+                    if let Some((v, at)) = self.name(&mut c, "a toggle block name") {
                         e.use_toggle_block = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.use_toggle_block"), at);
+                        if c.peek().is_some() {
+                            e.toggle_element_blocks = self.names(&mut c, "element block names");
+                        }
                     }
                 }
                 _ => {}
@@ -1171,45 +1514,54 @@ impl Lower {
         e
     }
 
-    fn property(&mut self, line: &Line) -> Option<PropertyModel> {
-        let sep = line.tokens.iter().position(Token::is_sep)?;
-        let words: Vec<&str> = line
-            .tokens
-            .get(..sep)
-            .unwrap_or_default()
-            .iter()
-            .map(|t| t.lower.as_str())
-            .collect();
-        let property = words.join("_");
-        let rest = line.tokens.get(sep + 1..).unwrap_or_default();
-        let Some(model_tok) = rest.first().filter(|t| !t.is_sep()) else {
-            self.push(
-                Diagnostic::error(
-                    codes::MISSING_ARGUMENT,
-                    format!("property `{}` expects a model after `=`", words.join(" ")),
-                )
-                .at(self.end_of(line))
-                .help("write `<material property> = <model> [args]`, e.g. `gap conductance coefficient = constant h = 10`"),
-            );
-            return None;
-        };
-        let fake = Cur {
-            cmd: &PROPERTY,
-            line,
-            pos: 0,
-        };
-        let args = self.args(&fake, rest.get(1..).unwrap_or_default());
-        Some(PropertyModel {
-            property,
-            model: model_tok.lower.clone(),
-            args,
-            at: self.line_loc(line),
-        })
+    /// `= [constant [value =]] <number>`: the material-model form `Constant Value = v`
+    /// and the plain `= v`.
+    fn constant_value(&mut self, c: &mut Cur, what: &str) -> Option<f64> {
+        c.skip_sep();
+        if c.peek()
+            .is_some_and(|t| t.is_word() && t.lower == "constant")
+        {
+            c.pos += 1;
+            if c.peek().is_some_and(|t| t.is_word() && t.lower == "value") {
+                c.pos += 1;
+            }
+            c.skip_sep();
+        }
+        self.number(c, what).map(|(v, _)| v)
     }
 
-    /// Model arguments: `key = value` pairs and bare words.
-    fn args(&mut self, c: &Cur, toks: &[Token]) -> Vec<Arg> {
+    /// A material-model line: `<property> [=] <model> [args…]`, the property named by
+    /// the command's key.
+    fn property(&mut self, c: &mut Cur) -> PropertyModel {
+        let line = c.line;
+        c.skip_sep();
+        let model = match c.peek().filter(|t| !t.is_sep()) {
+            Some(t) => {
+                c.pos += 1;
+                t.lower.clone()
+            }
+            None => {
+                if c.cmd.status == registry::Status::Implemented {
+                    self.missing(c, "a model after `=`");
+                }
+                String::new()
+            }
+        };
+        let (args, _) = self.args(c, c.rest());
+        c.pos = line.tokens.len();
+        PropertyModel {
+            property: c.cmd.key.to_string(),
+            model,
+            args,
+            at: self.line_loc(line),
+        }
+    }
+
+    /// Model arguments: `key = value` pairs and bare words, with where each was written
+    /// (its key, or the bare word).
+    fn args(&mut self, c: &Cur, toks: &[Token]) -> (Vec<Arg>, Vec<Loc>) {
         let mut out = Vec::new();
+        let mut locs = Vec::new();
         let mut i = 0;
         while let Some(t) = toks.get(i) {
             if t.is_sep() {
@@ -1229,6 +1581,7 @@ impl Lower {
                             key: t.lower.clone(),
                             value: value_text(v),
                         });
+                        locs.push(t.loc(&self.file));
                         i += 3;
                     }
                     None => {
@@ -1249,10 +1602,11 @@ impl Lower {
                     key: String::new(),
                     value: value_text(t),
                 });
+                locs.push(t.loc(&self.file));
                 i += 1;
             }
         }
-        out
+        (out, locs)
     }
 
     /// The recognised line commands of block `b` (of type `key`), in order; sub-blocks
@@ -1320,11 +1674,11 @@ impl Lower {
             match c.cmd.key {
                 "general_contact" => {
                     self.once(&mut seen, &c);
-                    x.general_contact = self.switch(&mut c);
+                    x.general_contact = self.flag(&mut c);
                 }
                 "self_contact" => {
                     self.once(&mut seen, &c);
-                    x.self_contact = self.switch(&mut c);
+                    x.self_contact = self.flag(&mut c);
                 }
                 "surfaces" => x.surfaces.extend(self.names(&mut c, "surface names")),
                 "enforcement" => {
@@ -1354,7 +1708,7 @@ impl Lower {
             self.once(&mut seen, &c);
             let key = c.cmd.key;
             match key {
-                "self_contact" => x.self_contact = self.switch(&mut c),
+                "self_contact" => x.self_contact = self.flag(&mut c),
                 "search_update_frequency" => {
                     x.search_update_frequency = self
                         .count(&mut c, "a whole number of steps")
@@ -1473,7 +1827,7 @@ impl Lower {
                 }
                 "auto_subset" => {
                     if x.auto_subset.is_some() {
-                        let n = registry::word_count(c.cmd.phrase);
+                        let n = c.n;
                         self.push(
                             Diagnostic::error(
                                 codes::SECOND_AUTO_SUBSET,
@@ -1537,8 +1891,17 @@ impl Lower {
                     c.skip_sep();
                     if let Some(t) = c.bump() {
                         match t.lower.as_str() {
-                            "face" => x.contact_type = ContactType::Face,
+                            // Sierra/SM's `standard` (its default) is seam's face contact.
+                            "face" | "standard" => x.contact_type = ContactType::Face,
                             "node" => x.contact_type = ContactType::Node,
+                            "smooth" => self.push(
+                                Diagnostic::error(
+                                    codes::CONTACT_TYPE,
+                                    "seam does not smooth contact surfaces (`contact type = smooth`)",
+                                )
+                                .at(Some(t.loc(&self.file)))
+                                .help("write `contact type = standard` (or `face`): seam pairs the mesh's own faces"),
+                            ),
                             other => {
                                 let hint = did_you_mean(other, ["face", "node"])
                                     .map(|s| format!("did you mean `{s}`? "))
@@ -1567,15 +1930,6 @@ impl Lower {
     }
 }
 
-static PROPERTY: CommandSpec = CommandSpec {
-    phrase: "material property",
-    key: "property",
-    blocks: &[ENF],
-    args: "= <model> [<key> = <value> | <word>]...",
-    description: "",
-    implemented: true,
-};
-
 /// The lower-case words at the start of a line, up to the first non-word token.
 fn leading_words(line: &Line) -> Vec<&str> {
     line.tokens
@@ -1583,17 +1937,6 @@ fn leading_words(line: &Line) -> Vec<&str> {
         .take_while(|t| t.is_word())
         .map(|t| t.lower.as_str())
         .collect()
-}
-
-/// `words … = model …`: at least one word, then a separator, then something.
-fn is_property_line(line: &Line) -> bool {
-    line.tokens.iter().position(Token::is_sep).is_some_and(|p| {
-        p > 0
-            && line
-                .tokens
-                .get(..p)
-                .is_some_and(|w| w.iter().all(Token::is_word))
-    })
 }
 
 /// `begin interaction`, `begin search options` for a command's blocks.

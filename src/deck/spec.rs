@@ -34,6 +34,8 @@ pub struct ContactDefinition {
     pub visualize_contact: bool,
     #[serde(default)]
     pub output_rule: Option<OutputRule>,
+    /// `Update Search Every n Steps`: kept, though seam's meshes do not move in a run, so
+    /// a re-search finds the same pairs.
     #[serde(default)]
     pub update_search_every_n_steps: Option<u32>,
     #[serde(default)]
@@ -272,9 +274,12 @@ pub enum PeriodicTransform {
         #[serde(default = "default_true")]
         invert_normals: bool,
     },
-    /// Each map is a Lua expression in x, y, z or the name of a function in a Lua file.
+    /// Each map is a Lua expression in x, y, z or the name of a function in a Lua file;
+    /// a map left out is the identity (`x_map = x`, `y_map = y`, no `z_map`: z kept).
     Mapped {
+        #[serde(default = "identity_x")]
         x_map: String,
+        #[serde(default = "identity_y")]
         y_map: String,
         #[serde(default)]
         z_map: Option<String>,
@@ -285,16 +290,27 @@ fn default_true() -> bool {
     true
 }
 
+fn identity_x() -> String {
+    "x".to_string()
+}
+
+fn identity_y() -> String {
+    "y".to_string()
+}
+
 /// `begin Enforcement [name]` … `end`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Enforcement {
     #[serde(default)]
     pub name: Option<String>,
-    /// `Enforcement for EQ = MODEL args…`, one per equation.
+    /// `Enforcement for EQ = MODEL args…`, one per equation. Any equation name is
+    /// carried; the deck's checks refuse those seam does not solve.
     #[serde(default, rename = "model")]
     pub models: Vec<EnforcementModel>,
-    /// `[Material Property] = [Model] [args…]` lines, e.g. `Gap Conductance Coefficient = Constant H = 10`.
+    /// Material-model lines kept as written: `Gap Conductance Coefficient = Constant H = 10`
+    /// (the ones with their own field, such as `Contact Surface Pressure`, are lowered
+    /// into it; the others of Aria's list are refused by the deck's checks).
     #[serde(default, rename = "property")]
     pub properties: Vec<PropertyModel>,
     #[serde(default)]
@@ -320,8 +336,27 @@ pub struct Enforcement {
     pub quarantine_faulty_points: bool,
     #[serde(default)]
     pub use_toggle_block: Option<String>,
+    /// The element blocks listed after the toggle's name in `Use Toggle Block T b…`
+    /// (needed by Aria at region level only; in an enforcement the toggle switches the
+    /// whole enforcement).
+    #[serde(default)]
+    pub toggle_element_blocks: Vec<String>,
+    /// `Contact Gap Temperature = side_a | side_b | mean`: the temperature a
+    /// temperature-dependent conductance sees at a contact point.
+    #[serde(default)]
+    pub contact_gap_temperature: Option<GapTemperature>,
     #[serde(skip)]
     pub at: Loc,
+}
+
+/// Which temperature a temperature-dependent conductance sees at a contact point:
+/// side A's, side B's (interpolated at the projection), or their mean.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GapTemperature {
+    SideA,
+    SideB,
+    Mean,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -423,6 +458,8 @@ pub struct SearchOptions {
     pub normal_check_angle: Option<f64>,
     #[serde(default)]
     pub self_contact: Option<bool>,
+    /// `Search Update Frequency` (ELFEN `Global_update_frequency`): as
+    /// [`ContactDefinition::update_search_every_n_steps`].
     #[serde(default)]
     pub search_update_frequency: Option<u32>,
     #[serde(skip)]

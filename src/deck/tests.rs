@@ -226,6 +226,8 @@ fn full_expected() -> Deck {
             contact_pressure: None,
             quarantine_faulty_points: false,
             use_toggle_block: Some("tog".into()),
+            toggle_element_blocks: vec![],
+            contact_gap_temperature: None,
             contact_pressure_variable: None,
             at: Default::default(),
         }],
@@ -451,14 +453,17 @@ fn gap_conductance_property_as_written_in_aria() {
 }
 
 #[test]
-fn property_may_start_with_another_blocks_keyword() {
-    // `surface` is a contact-surface command, but `surface emissivity = …` is a property.
-    let def = one_def(
+fn unknown_property_starting_with_another_blocks_keyword_is_unknown() {
+    // `surface` is a contact-surface command; `surface emissivity = …` is no material
+    // model of Aria's list, so it is an unknown keyword, not a misplaced `surface`.
+    let (deck, d) = sierra(
         "begin contact definition\n begin enforcement\n  Surface Emissivity = Constant E = 0.5\n end\nend\n",
     );
-    assert_eq!(
-        def.enforcements[0].properties[0].property,
-        "surface_emissivity"
+    assert_eq!(codes_of(&d), [codes::UNKNOWN_KEYWORD]);
+    assert!(
+        deck.contact_definitions[0].enforcements[0]
+            .properties
+            .is_empty()
     );
 }
 
@@ -565,10 +570,10 @@ fn periodicity_parts_are_checked() {
 
 #[test]
 fn missing_words_are_reported_past_the_line_end() {
-    let (_, d) = sierra("begin contact definition\n contact surface top\nend\n");
+    let (_, d) = sierra("begin contact definition\n contact surface top contains\nend\n");
     assert_eq!(codes_of(&d), [codes::MISSING_ARGUMENT]);
     let loc = d.0[0].loc.clone().unwrap_or_default();
-    assert_eq!((loc.line, loc.col), (2, 22));
+    assert_eq!((loc.line, loc.col), (2, 31));
 }
 
 #[test]
@@ -747,4 +752,57 @@ fn invert_normals_takes_zero_or_one_and_points_at_the_value() {
     assert_eq!(codes_of(&d), [codes::ON_OFF]);
     let loc = d.0[0].loc.clone().unwrap_or_default();
     assert_eq!((loc.line, loc.col, loc.len), (2, 69, 5));
+}
+
+#[test]
+fn a_deck_inside_a_sierra_input_file_gives_the_same_spec() {
+    let base = clean(RESPELL);
+    let wrapped = format!(
+        "Begin Sierra job\n Begin Procedure p\n  Begin Aria Region r\n{RESPELL}  End Aria Region r\n End\nEnd Sierra job\n"
+    );
+    let (deck, d) = sierra(&wrapped);
+    // Nothing but contact input: nothing skipped, so no note either.
+    assert!(d.is_empty(), "{d:?}");
+    assert_eq!(deck.without_locations(), base);
+}
+
+#[test]
+fn underscores_spell_spaces_in_keywords() {
+    let spaced = clean(
+        "begin contact definition\n skin all blocks\n begin search options\n  normal check angle = 70\n  buffer factor = 2\n end\nend\n",
+    );
+    let underscored = clean(
+        "begin contact definition\n Skin_All_Blocks\n begin search options\n  Normal_Check_Angle = 70\n  Buffer_Factor = 2\n end\nend\n",
+    );
+    assert_eq!(underscored, spaced);
+    let so = spaced.contact_definitions[0].search_options.clone();
+    assert_eq!(so.and_then(|s| s.normal_check_angle), Some(70.0));
+}
+
+#[test]
+fn a_toggle_block_in_a_contact_deck_is_refused_not_unknown() {
+    for text in [
+        "begin toggle block tog\nend\n",
+        "begin contact definition\n begin toggle block tog\n end\nend\n",
+    ] {
+        let (_, d) = sierra(text);
+        assert_eq!(codes_of(&d), [codes::TOGGLE_BLOCK], "{text}");
+    }
+}
+
+#[test]
+fn a_misspelt_underscored_keyword_gets_a_suggestion() {
+    let (_, d) =
+        sierra("begin contact definition\n begin search options\n  Buffer_factr = 2\n end\nend\n");
+    assert_eq!(codes_of(&d), [codes::UNKNOWN_KEYWORD]);
+    assert_eq!(
+        d.0[0].message,
+        "unknown keyword `buffer_factr` in `begin search options`"
+    );
+    assert!(
+        d.0[0]
+            .help
+            .as_deref()
+            .is_some_and(|h| h.starts_with("did you mean `buffer factor`?"))
+    );
 }

@@ -89,15 +89,29 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
                 }
             }
         }
-        for (e, n) in def.enforcements.iter_mut().zip(items(t, "enforcement")) {
+        for (k, (e, n)) in def
+            .enforcements
+            .iter_mut()
+            .zip(items(t, "enforcement"))
+            .enumerate()
+        {
             e.at = at(n.span());
+            put(
+                format!("{d}.enforcement.{k}.use_toggle_block"),
+                sub(n, "use_toggle_block"),
+            );
             let table = n.get_ref().as_table();
-            for (m, mn) in e
+            for (j, (m, mn)) in e
                 .models
                 .iter_mut()
                 .zip(table.map(|t| items(t, "model")).unwrap_or_default())
+                .enumerate()
             {
                 m.at = at(mn.span());
+                put(
+                    format!("{d}.enforcement.{k}.model.{j}.equation"),
+                    sub(mn, "equation"),
+                );
             }
             for (m, mn) in e
                 .properties

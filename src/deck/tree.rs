@@ -5,7 +5,9 @@
 //! block phrases (longest match); the rest of the line is the block's name. An `end` line
 //! may repeat the type and/or the name, and must then match (else E0102, and the block
 //! is closed all the same). Blocks still open at the end of the file are reported at
-//! their `begin` line (E0101).
+//! their `begin` line (E0101). A block of unknown type keeps its E0105 diagnostic in
+//! [`Block::unknown`] instead of reporting it: whether it is an error depends on where it
+//! sits (in a whole Sierra input file, blocks outside contact definitions are skipped).
 
 use std::sync::Arc;
 
@@ -30,6 +32,10 @@ pub struct Block {
     /// Tokens of the `begin` line after the type phrase.
     pub name: Vec<Token>,
     pub items: Vec<Item>,
+    /// For a block of unknown type, the diagnostic to report if it is in contact input.
+    pub unknown: Option<Diagnostic>,
+    /// The line of its `end` (`u32::MAX` if it is never closed).
+    pub end_line: u32,
 }
 
 impl Block {
@@ -55,14 +61,20 @@ pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
     let mut top: Vec<Item> = Vec::new();
     let mut stack: Vec<Block> = Vec::new();
     for line in lines {
-        let first = line.tokens.first().map(|t| t.lower.as_str());
+        // `end time = 10` is a line of a Sierra input file, not the end of a block.
+        let first = line
+            .tokens
+            .first()
+            .filter(|_| !line.tokens.iter().any(Token::is_sep))
+            .map(|t| t.lower.as_str());
         match first {
             Some("begin") if line.tokens.first().is_some_and(Token::is_word) => {
-                stack.push(open(file, line, &mut diags));
+                stack.push(open(file, line));
             }
             Some("end") if line.tokens.first().is_some_and(Token::is_word) => match stack.pop() {
-                Some(block) => {
+                Some(mut block) => {
                     check_end(file, &block, &line, &mut diags);
+                    block.end_line = line.line;
                     push(&mut stack, &mut top, Item::Block(block));
                 }
                 None => diags.push(
@@ -105,7 +117,8 @@ fn describe(block: &Block) -> String {
     words.join(" ")
 }
 
-fn open(file: &Arc<str>, head: Line, diags: &mut Diagnostics) -> Block {
+fn open(file: &Arc<str>, head: Line) -> Block {
+    let mut unknown = None;
     let rest = head.tokens.get(1..).unwrap_or_default();
     let words: Vec<&str> = rest
         .iter()
@@ -139,7 +152,7 @@ fn open(file: &Arc<str>, head: Line, diags: &mut Diagnostics) -> Block {
             } else {
                 format!("unknown block type `{written}`")
             };
-            diags.push(
+            unknown = Some(
                 Diagnostic::error(codes::UNKNOWN_BLOCK, message)
                     .at(span(
                         file,
@@ -159,6 +172,8 @@ fn open(file: &Arc<str>, head: Line, diags: &mut Diagnostics) -> Block {
         head,
         name,
         items: Vec::new(),
+        unknown,
+        end_line: u32::MAX,
     }
 }
 
@@ -229,6 +244,17 @@ mod tests {
     }
 
     #[test]
+    fn begin_and_end_with_a_separator_are_lines() {
+        let (top, d) = tree("begin time control\n end time = 10\n begin = 0\nend\n");
+        assert!(d.is_empty(), "{d:?}");
+        let [Item::Block(b)] = top.as_slice() else {
+            panic!("expected one block, got {top:?}")
+        };
+        assert_eq!(b.items.len(), 2);
+        assert!(b.items.iter().all(|i| matches!(i, Item::Line(_))));
+    }
+
+    #[test]
     fn mismatched_end_points_at_end_line() {
         let (_, d) = tree("begin interaction a\nend interaction b\n");
         assert_eq!(d.len(), 1);
@@ -251,12 +277,17 @@ mod tests {
 
     #[test]
     fn stray_end_and_unknown_block() {
-        let (_, d) = tree("end\nbegin contact defnition\nend\n");
+        let (top, d) = tree("end\nbegin contact defnition\nend\n");
         let codes: Vec<&str> = d.0.iter().map(|x| x.code).collect();
-        assert_eq!(codes, [codes::STRAY_END, codes::UNKNOWN_BLOCK]);
+        assert_eq!(codes, [codes::STRAY_END]);
+        let [Item::Block(b)] = top.as_slice() else {
+            panic!("expected one block, got {top:?}")
+        };
+        let unknown = b.unknown.as_ref().map(|x| (x.code, x.help.clone()));
+        assert_eq!(unknown.as_ref().map(|x| x.0), Some(codes::UNKNOWN_BLOCK));
         assert!(
-            d.0[1]
-                .help
+            unknown
+                .and_then(|x| x.1)
                 .as_deref()
                 .unwrap_or("")
                 .contains("did you mean `begin contact definition`")

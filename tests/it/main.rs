@@ -11,6 +11,7 @@ mod enforce;
 mod examples;
 mod fem;
 mod interactions;
+mod manual;
 mod mesh_io;
 mod node_surfaces;
 mod output;
