@@ -15,7 +15,7 @@
 //! `Offset Temperature = ΔT` prescribes the jump; `Integer Data`/`Real Data` are kept for
 //! plugin models.
 
-use crate::deck::spec::{Enforcement, EnforcementModel};
+use crate::deck::spec::{Enforcement, EnforcementModel, GapTemperature};
 use crate::diag::{Diagnostic, did_you_mean};
 
 use super::conductance::SeenTemperature;
@@ -240,6 +240,10 @@ fn conductance(e: &Enforcement, m: &EnforcementModel) -> Result<ConductanceLaw, 
 
 /// The temperature the block's conductance models see (`Contact Gap Temperature`).
 pub fn seen_temperature(e: &Enforcement) -> SeenTemperature {
-    let _ = e;
-    SeenTemperature::Both
+    match e.contact_gap_temperature {
+        None => SeenTemperature::Both,
+        Some(GapTemperature::SideA) => SeenTemperature::SideA,
+        Some(GapTemperature::SideB) => SeenTemperature::SideB,
+        Some(GapTemperature::Mean) => SeenTemperature::Mean,
+    }
 }

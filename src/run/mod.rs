@@ -649,11 +649,15 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                     .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
                 );
             }
-            if let Some(n) = def.update_search_every_n_steps {
+            let every = def.update_search_every_n_steps.or(def
+                .search_options
+                .as_ref()
+                .and_then(|o| o.search_update_frequency));
+            if let Some(n) = every {
                 diags.push(
                     Diagnostic::warning(
                         "W0703",
-                        format!("`Update Search Every {n} Steps` has no effect in this run: the mesh does not move, so the first search holds for every step"),
+                        format!("`Update Search Every {n} Steps` (or `Search Update Frequency`) has no effect in this run: the mesh does not move, so the first search holds for every step"),
                     )
                     .at(Some(def.at.clone()))
                     .help("remove the line, or keep it for a run coupled to a code that moves the mesh"),

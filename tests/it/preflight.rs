@@ -192,15 +192,21 @@ fn update_search_on_a_fixed_mesh_warns_that_it_does_nothing() {
         "begin contact definition\n",
         "begin contact definition\n  update search every 3 steps\n",
     );
-    let p = problem(&dir, &d, "400.0");
-    let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
-    let w: Vec<_> = r
-        .warnings
-        .warnings()
-        .filter(|w| w.code == "W0703")
-        .collect();
-    assert_eq!(w.len(), 1, "{:?}", r.warnings);
-    assert!(w[0].message.contains("no effect"), "{}", w[0].message);
+    let elfen = d.replace(
+        "  update search every 3 steps\n",
+        "  begin search options\n    Global_update_frequency = 3\n  end\n",
+    );
+    for text in [d, elfen] {
+        let p = problem(&dir, &text, "400.0");
+        let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
+        let w: Vec<_> = r
+            .warnings
+            .warnings()
+            .filter(|w| w.code == "W0703")
+            .collect();
+        assert_eq!(w.len(), 1, "{text}\n{:?}", r.warnings);
+        assert!(w[0].message.contains("no effect"), "{}", w[0].message);
+    }
 }
 
 #[test]
@@ -399,4 +405,104 @@ fn a_steady_problem_with_a_floating_part_is_named_before_the_solve() {
         "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 16.0\nrho_c = 1e6\n[initial]\ntemperature = 300.0\n[solve]\nkind = \"transient\"\ndt = 1.0\nend_time = 2.0\n",
     );
     assert_eq!(code, Some(0), "{text}");
+}
+
+/// The heat from the lid into the base with these enforcement lines.
+fn heat_with(name: &str, enforcement: &str) -> f64 {
+    let dir = scratch(name);
+    let p = problem(
+        &dir,
+        &deck(&format!("  begin enforcement\n{enforcement}  end\n"), ""),
+        "400.0",
+    );
+    let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    assert!(r.summary.converged, "{name}");
+    -r.summary.interactions[0].heat_side_a
+}
+
+const CMY: &str = "    enforcement for energy = gap_conductance\n    gap conductance coefficient = CMY K_A = 16 K_B = 200 Slope = 0.1 Roughness = 1e-6 Hardness = 3e9\n";
+
+#[test]
+fn contact_surface_pressure_reaches_a_pressure_dependent_conductance() {
+    // CMY: h = 1.25 k_s (m/σ)(p/H)^0.95, k_s = 2·16·200/216; the field is linear, so the
+    // Robin–Nitsche form gives the series heat exactly.
+    let k_s = 2.0 * 16.0 * 200.0 / 216.0;
+    let h = 1.25 * k_s * (0.1 / 1e-6) * (5e5f64 / 3e9).powf(0.95);
+    let exact = series_heat(h);
+    for (name, line) in [
+        ("contact_pressure", "    contact pressure = 5e5\n"),
+        (
+            "surface_pressure_value",
+            "    contact surface pressure = constant value = 5e5\n",
+        ),
+        (
+            "surface_pressure_constant",
+            "    Contact Surface Pressure = Constant 5e5\n",
+        ),
+    ] {
+        let heat = heat_with(name, &format!("{CMY}{line}"));
+        assert!(
+            (heat - exact).abs() <= 1e-9 * exact,
+            "{name}: heat {heat}, exact {exact}"
+        );
+    }
+    // No pressure: CMY gives h = 0, and nothing crosses.
+    let none = heat_with("no_pressure", CMY);
+    assert!(none.abs() <= 1e-9 * exact, "{none}");
+}
+
+#[test]
+fn offset_temperature_takes_effect_in_both_forms() {
+    // T_A − T_B = ΔT + q/h at the interface: the heat from the lid is (100 + ΔT)/R.
+    let r = 1.0 / 16.0 + 1.0 / 5.0 + 0.5 / 200.0;
+    for (name, line) in [
+        ("offset_number", "    offset temperature = 20\n"),
+        (
+            "offset_model",
+            "    Offset Temperature = Constant Value = 20\n",
+        ),
+    ] {
+        let heat = heat_with(
+            name,
+            &format!("    enforcement for energy = contact_resistance h = 5\n{line}"),
+        );
+        let exact = 120.0 / r;
+        assert!(
+            (heat - exact).abs() <= 1e-9 * exact,
+            "{name}: heat {heat}, exact {exact}"
+        );
+    }
+}
+
+#[test]
+fn contact_gap_temperature_decides_what_a_conductance_sees() {
+    let gap = |expr: &str, seen: &str| {
+        format!(
+            "    enforcement for energy = gap_conductance\n    gap conductance coefficient = lua \"{expr}\"\n{seen}"
+        )
+    };
+    let side_a = "    contact gap temperature = side_a\n";
+    // h(T_B) seeing side A is h(T_A); seeing the mean, h(T_A) is h((T_A + T_B)/2).
+    let pairs = [
+        ("b_as_a", gap("0.05*temp_b", side_a), gap("0.05*temp_a", "")),
+        (
+            "a_as_b",
+            gap("0.05*temp_a", "    Contact Gap Temperature = Side B\n"),
+            gap("0.05*temp_b", ""),
+        ),
+        (
+            "mean",
+            gap("0.05*temp_a", "    contact gap temperature = mean\n"),
+            gap("0.025*(temp_a + temp_b)", ""),
+        ),
+    ];
+    for (name, seen, plain) in pairs {
+        let a = heat_with(&format!("{name}_seen"), &seen);
+        let b = heat_with(&format!("{name}_plain"), &plain);
+        assert!((a - b).abs() <= 1e-9 * b, "{name}: {a} vs {b}");
+    }
+    // And it changes the answer: T_A and T_B differ by tens of kelvin at this h.
+    let a = heat_with("differs_a", &gap("0.05*temp_a", ""));
+    let b = heat_with("differs_b", &gap("0.05*temp_b", ""));
+    assert!((a - b).abs() > 1e-3 * a, "{a} vs {b}");
 }
