@@ -206,14 +206,15 @@ pub fn resolve_for(
 fn conductance(e: &Enforcement, m: &EnforcementModel) -> Result<ConductanceLaw, Vec<Diagnostic>> {
     if let Some(a) = m.args.iter().find(|a| a.key.eq_ignore_ascii_case("h")) {
         return match a.value.parse::<f64>() {
-            Ok(h) if h >= 0.0 && h.is_finite() => Ok(ConductanceLaw::Constant(h)),
+            // +∞ is a perfect joint: the forms take their tied limit.
+            Ok(h) if h >= 0.0 => Ok(ConductanceLaw::Constant(h)),
             Ok(h) => Err(vec![
                 Diagnostic::error(
                     "E0424",
-                    format!("conductance must be non-negative and finite, found {h}"),
+                    format!("conductance must be ≥ 0 (or inf), found {h}"),
                 )
                 .at(Some(m.at.clone()))
-                .help("a conductance h ≥ 0 (W/m²K); h = 0 means no heat crosses"),
+                .help("a conductance h ≥ 0 (W/m²K); h = 0 means no heat crosses, h = inf a perfect joint"),
             ]),
             Err(_) => Err(vec![
                 Diagnostic::error("E0425", format!("`{}` is not a number", a.value))

@@ -250,7 +250,11 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()))
             .max(f64::MIN_POSITIVE);
-        if rn <= goal
+        // A problem solved by Newton (a conductance that may depend on T) takes a
+        // second step even when the first meets the goal: the goal is relative to the
+        // first residual, which the Dirichlet lifting can make huge (k = 1e8), and the
+        // second step refines the LU solution to round-off (heat to ~1e-12, not 1e-7).
+        if (rn <= goal && (symmetric || it != 1))
             || (it > 0 && last_step <= 1e-13 * u_max)
             || (it > 0 && symmetric && rn <= 1e-8 * scale)
         {

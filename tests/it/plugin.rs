@@ -1272,3 +1272,17 @@ fn plugin_that_kills_the_process_is_reported_with_exit_code_3() {
         assert!(err.contains("E0503") && err.contains(what), "{err}");
     }
 }
+
+/// The interface heat through a plugin conductance (the C table plugin with a flat
+/// table h) is exact for every finite h from 0 to 1e300 and 1e8 contrasts, as the
+/// built-in models are (see `hard_cases`).
+#[test]
+fn plugin_conductance_heat_is_exact_for_every_finite_h() {
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    let worst = crate::hard_cases::sweep(
+        "plugin",
+        &format!("  enforcement for energy = plugin library = \"{table}\"\n  real data 0 H 1e6 H"),
+        &crate::hard_cases::H_SWEEP,
+    );
+    assert!(worst <= 1e-9, "worst relative error {worst:e}");
+}

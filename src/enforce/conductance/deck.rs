@@ -306,6 +306,13 @@ impl Cx<'_> {
 
     fn constant(&mut self, l: &Line) -> Option<Box<dyn ConductanceModel>> {
         let args = self.keyed(l, &["h"])?;
+        // `h = inf`: a perfect joint (the interface forms take their tied limit).
+        if args
+            .iter()
+            .any(|(k, v)| *k == "h" && v.parse::<f64>() == Ok(f64::INFINITY))
+        {
+            return self.built(l, Constant::new(f64::INFINITY));
+        }
         let h = self
             .number(
                 l,
@@ -313,7 +320,7 @@ impl Cx<'_> {
                 "h",
                 None,
                 |h| h >= 0.0,
-                "≥ 0 (a conductance in W/m²K)",
+                "≥ 0 (a conductance in W/m²K; inf for a perfect joint)",
             )
             .ok()?;
         self.built(l, Constant::new(h))

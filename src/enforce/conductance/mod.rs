@@ -321,8 +321,18 @@ pub struct Constant {
 }
 
 impl Constant {
+    /// h ≥ 0, or +∞ for a perfect joint (the interface forms take the tied limit).
     pub fn new(h: f64) -> Result<Constant, ConductanceError> {
-        require("constant", "h", h, h >= 0.0, "finite and ≥ 0")?;
+        if h == f64::INFINITY {
+            return Ok(Constant { h });
+        }
+        require(
+            "constant",
+            "h",
+            h,
+            h >= 0.0,
+            "≥ 0 (or inf for a perfect joint)",
+        )?;
         Ok(Constant { h })
     }
 }

@@ -1,0 +1,146 @@
+//! Hard cases: the interface heat as accurate as the temperatures for every conductance
+//! from 0 to ∞, at conductivity contrasts to 1e8.
+//!
+//! The case: the bundled two-block mesh (base k_A on z ∈ [0, 1], 6×6×6 hexes; lid k_B on
+//! z ∈ [1, 1.5], 4×4×3 hexes, non-matching at z = 1), 300 K below, 400 K on top, sides
+//! insulated. The exact field is piecewise linear in z, which the elements hold, so the
+//! discrete heat must be the series value 100 / (1/k_A + 1/h + 0.5/k_B) to round-off,
+//! on both sides of the interface.
+
+use std::path::{Path, PathBuf};
+
+/// The conductances swept: every few decades from 0 to ∞.
+pub(crate) const H_SWEEP: [f64; 16] = [
+    0.0, 1e-12, 1e-8, 1e-4, 1.0, 1e2, 1e4, 1e6, 1e8, 1e12, 1e16, 1e20, 1e50, 1e100, 1e200, 1e300,
+];
+
+/// Conductivity pairs (k_A, k_B): the bundled scene's, and contrasts of 1e8 both ways.
+const CONTRASTS: [(f64, f64); 3] = [(16.0, 200.0), (1.0, 1e8), (1e8, 1.0)];
+
+/// The exact heat from the lid into the base.
+pub(crate) fn exact_heat(h: f64, k_a: f64, k_b: f64) -> f64 {
+    if h == 0.0 {
+        return 0.0;
+    }
+    100.0 / (1.0 / k_a + 1.0 / h + 0.5 / k_b)
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("hard-{name}"));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Solve the two-block case with `enforcement` (the lines inside `begin enforcement`);
+/// returns the heat into side A (the base) and out of side B (the lid), both positive
+/// when heat flows down.
+pub(crate) fn two_block_heat(name: &str, k_a: f64, k_b: f64, enforcement: &str) -> (f64, f64) {
+    let dir = scratch(name);
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = {mesh:?}\n\
+             [[material]]\nblocks = [\"base\"]\nconductivity = {k_a:e}\n\
+             [[material]]\nblocks = [\"lid\"]\nconductivity = {k_b:e}\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n\
+             [contact]\nfile = \"contact.i\"\n",
+            mesh = mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition\n  contact surface base_face contains base_top\n  contact surface lid_face contains lid_bottom\n\
+             begin interaction\n  side a base_face\n  side b lid_face\n end\n begin enforcement\n{enforcement}\n end\nend\n"
+        ),
+    )
+    .unwrap();
+    match seam::run::run(&dir.join("problem.toml")) {
+        Ok(r) => {
+            assert!(r.summary.converged, "{name}: not converged");
+            let i = &r.summary.interactions[0];
+            (-i.heat_side_a, i.heat_side_b)
+        }
+        Err(seam::run::RunError::Input(d, s)) => panic!("{name}: {}", d.render(&s)),
+        Err(seam::run::RunError::Solve(e)) => panic!("{name}: {e}"),
+    }
+}
+
+/// Sweep `h` for one model (`lines` with `H` standing for the conductance) at every
+/// contrast; returns the worst relative error of either side's heat, and prints each.
+pub(crate) fn sweep(model: &str, lines: &str, hs: &[f64]) -> f64 {
+    let mut worst = 0.0f64;
+    for (c, &(k_a, k_b)) in CONTRASTS.iter().enumerate() {
+        for &h in hs {
+            let text = if h.is_infinite() {
+                "inf".to_string()
+            } else {
+                format!("{h:e}")
+            };
+            let (a, b) = two_block_heat(
+                &format!("{model}-{c}-{text}"),
+                k_a,
+                k_b,
+                &lines.replace('H', &text),
+            );
+            let exact = exact_heat(h, k_a, k_b);
+            // At h = 0 nothing crosses: judge against the heat at h = 1 instead.
+            let scale = if exact == 0.0 {
+                exact_heat(1.0, k_a, k_b)
+            } else {
+                exact
+            };
+            let err = ((a - exact).abs()).max((b - exact).abs()) / scale;
+            println!(
+                "{model:<20} k_A {k_a:>6e} k_B {k_b:>6e} h {text:>7}: side A {a:.15e}, side B {b:.15e}, exact {exact:.15e}, rel err {err:.1e}"
+            );
+            worst = worst.max(err);
+        }
+    }
+    println!("{model}: worst relative error {worst:.1e}");
+    worst
+}
+
+/// Relative error allowed: the temperatures of this case are exact to about 1e-13 of
+/// their range; the heat through a 1e8 contrast sums element fluxes of size k ΔT/L with
+/// k up to 1e8, so a few more digits go to round-off there.
+const TOLERANCE: f64 = 1e-9;
+
+#[test]
+fn contact_resistance_heat_is_exact_for_every_h() {
+    let mut hs = H_SWEEP.to_vec();
+    hs.push(f64::INFINITY);
+    let worst = sweep(
+        "contact_resistance",
+        "  enforcement for energy = contact_resistance h = H",
+        &hs,
+    );
+    assert!(worst <= TOLERANCE, "worst relative error {worst:e}");
+}
+
+#[test]
+fn gap_conductance_heat_is_exact_for_every_h() {
+    let mut hs = H_SWEEP.to_vec();
+    hs.push(f64::INFINITY);
+    let worst = sweep(
+        "gap_conductance",
+        "  enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = H",
+        &hs,
+    );
+    assert!(worst <= TOLERANCE, "worst relative error {worst:e}");
+}
+
+#[test]
+fn lua_conductance_heat_is_exact_for_every_finite_h() {
+    // A Lua model returns a number; ∞ is not one (refused as not finite).
+    let worst = sweep(
+        "lua",
+        "  enforcement for energy = contact_resistance\n  gap conductance coefficient = lua \"H\"",
+        &H_SWEEP,
+    );
+    assert!(worst <= TOLERANCE, "worst relative error {worst:e}");
+}
