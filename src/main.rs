@@ -562,6 +562,16 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
             use std::io::Write as _;
             let _ = std::io::stdout().flush();
             eprint!("{}", r.warnings.render(&r.sources));
+            if let Some(d) = &s.diagnosis {
+                eprintln!("error[E0800]: {d}");
+                if let Some(o) = &s.output {
+                    eprintln!(
+                        "  = note: the last iterate is written to {}, marked by the file {}",
+                        o.display(),
+                        seam::run::NOT_CONVERGED
+                    );
+                }
+            }
             if s.converged {
                 ExitCode::SUCCESS
             } else {

@@ -176,6 +176,9 @@ pub struct StepReport {
     pub assembly_s: f64,
     pub factor_s: f64,
     pub solve_s: f64,
+    /// `None` when Newton converged; for a steady solve that did not, what happened
+    /// (the residual history and the likely cause): the state is the last iterate.
+    pub diagnosis: Option<String>,
 }
 
 /// What [`solve`] hands back at the end.
@@ -493,6 +496,7 @@ pub fn solve(
         scatters: &scatters,
         element_matrices: RefCell::new(None),
         tie_first: &tie_first,
+        unconverged: RefCell::new(None),
     };
 
     let mut steps = 0;
@@ -503,7 +507,8 @@ pub fn solve(
             let r = ctx.newton(&mut asm, &mut solver, &mut guess, time, None)?;
             let r = match r {
                 Ok(r) => r,
-                Err(msg) => return Err(HeatError::Step(msg)),
+                // Out of iterations: the last iterate goes on, marked not converged.
+                Err(msg) => ctx.unconverged.take().ok_or(HeatError::Step(msg))?,
             };
             state.u = guess;
             state.time = time;
@@ -741,6 +746,28 @@ struct Context<'c, 'a> {
     /// computed for a linear problem (None: not kept).
     element_matrices: RefCell<Option<Vec<(u32, u8, f64)>>>,
     tie_first: &'c [usize],
+    /// The report of the last Newton attempt that ran out of iterations (its
+    /// `diagnosis` set), for a steady solve to hand on with its last iterate.
+    unconverged: RefCell<Option<StepReport>>,
+}
+
+/// Why Newton ran out of iterations, from its residual history: the history itself and
+/// the likely cause.
+fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String {
+    let shown: Vec<String> = history.iter().map(|r| format!("{r:.3e}")).collect();
+    let (first, last) = (history[0], history[history.len() - 1]);
+    let falling = history.len() >= 2 && last < 0.5 * history[history.len() - 2];
+    let cause = if last > first {
+        "the residual grew: the iterates move away from the answer, as a strongly nonlinear law (radiation, k(T), a temperature-dependent conductance) does from a guess far from it; give an [initial] temperature nearer the expected one, or reach the steady state through a transient run".to_string()
+    } else if falling {
+        format!("the residual is still falling: raise [solve] max_iterations (now {iterations})")
+    } else {
+        "the residual stalls: the Jacobian does not match the residual (a plugin whose derivatives are wrong, a law that is not smooth), or the tolerance asks for more than round-off allows; `seam check-plugin` checks a plugin's derivatives".to_string()
+    };
+    format!(
+        "Newton did not converge in {iterations} iterations at t = {t}: ‖R‖ = {}; {cause}",
+        shown.join(" → ")
+    )
 }
 
 impl Context<'_, '_> {
@@ -781,6 +808,7 @@ impl Context<'_, '_> {
             assembly_s: 0.0,
             factor_s: 0.0,
             solve_s: 0.0,
+            diagnosis: None,
         };
         let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
         // The last Newton update relative to max|u|.
@@ -809,10 +837,11 @@ impl Context<'_, '_> {
             let done = it > 0 && (linear || last_update <= p.tolerance);
             if done || it == p.max_iterations {
                 if !done {
-                    return Ok(Err(format!(
-                        "Newton did not converge in {} iterations at t = {t} (‖R‖ went {:.3e} → {:.3e})",
-                        p.max_iterations, report.residual_history[0], rn
-                    )));
+                    let message = unconverged(p.max_iterations, t, &report.residual_history);
+                    report.heat = self.heat(&terms, u);
+                    report.diagnosis = Some(message.clone());
+                    *self.unconverged.borrow_mut() = Some(report);
+                    return Ok(Err(message));
                 }
                 report.heat = self.heat(&terms, u);
                 return Ok(Ok(report));

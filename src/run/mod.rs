@@ -193,6 +193,10 @@ pub enum BcKind {
     Radiation,
 }
 
+/// The file a run that did not converge leaves in its output folder, holding the
+/// residual history and the likely cause.
+pub const NOT_CONVERGED: &str = "NOT_CONVERGED";
+
 /// Largest temperature (K) a problem file may give: far beyond any physical one, and
 /// small enough that radiation's T⁴ and the squares of residuals stay finite.
 pub const MAX_TEMPERATURE: f64 = 1e12;
@@ -393,6 +397,9 @@ pub struct Summary {
     /// system reports it (Linux: `VmHWM` in `/proc/self/status`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub peak_memory_mib: Option<f64>,
+    /// When `converged` is false: the residual history and the likely cause.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diagnosis: Option<String>,
 }
 
 /// Peak resident memory of this process in MiB (Linux only; None elsewhere).
@@ -1119,6 +1126,8 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             std::fs::create_dir_all(&out_dir).map_err(|e| {
                 RunError::Solve(format!("cannot create {}: {e}", out_dir.display()))
             })?;
+            // A mark left by an earlier run that did not converge.
+            let _ = std::fs::remove_file(out_dir.join(NOT_CONVERGED));
             Some(out_dir)
         }
         None => None,
@@ -1513,7 +1522,17 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         output,
         transient: transient_summary,
         peak_memory_mib: peak_memory_mib(),
+        diagnosis: history.last().and_then(|r| r.diagnosis.clone()),
     };
+    // A result that did not converge says so next to its files.
+    if let (Some(dir), Some(d)) = (&out_dir, &summary.diagnosis) {
+        std::fs::write(dir.join(NOT_CONVERGED), format!("{d}\n")).map_err(|e| {
+            RunError::Solve(format!(
+                "cannot write {}: {e}",
+                dir.join(NOT_CONVERGED).display()
+            ))
+        })?;
+    }
     Ok(Outcome::Ran(Box::new(RunResult {
         summary,
         mesh,

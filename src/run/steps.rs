@@ -543,7 +543,7 @@ pub(super) fn final_solution(
         u: outcome.state.u,
         dofs: outcome.dofs,
         newton_iterations: history.iter().map(|r| r.newton_iterations).sum(),
-        converged: true,
+        converged: last.is_none_or(|r| r.diagnosis.is_none()),
         residual_history: last.map(|r| r.residual_history.clone()).unwrap_or_default(),
         heat: flux.to_vec(),
         tie_heat: ties.to_vec(),

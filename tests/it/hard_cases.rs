@@ -144,3 +144,58 @@ fn lua_conductance_heat_is_exact_for_every_finite_h() {
     );
     assert!(worst <= TOLERANCE, "worst relative error {worst:e}");
 }
+
+/// A run that does not converge exits 1, leaves its last iterate marked by a
+/// `NOT_CONVERGED` file and says why: the residual history and the likely cause. A run
+/// that converges in the same folder removes the mark.
+#[test]
+fn a_run_that_does_not_converge_says_so_and_why() {
+    let dir = scratch("not_converged");
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
+    let problem = |iterations: usize| {
+        format!(
+            "[mesh]\nfile = {mesh:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = \"16 + 0.5*T\"\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n\
+             [[bc]]\nkind = \"radiation\"\nsurfaces = [\"lid_top\"]\nvalue = 0.8\nambient = 2000.0\n\
+             [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\nmax_iterations = {iterations}\n[output]\ndir = \"out\"\n",
+            mesh = mesh.to_str().unwrap()
+        )
+    };
+    std::fs::write(
+        dir.join("contact.i"),
+        "begin contact definition\n  contact surface a contains base_top\n  contact surface b contains lid_bottom\n  begin interaction\n    side a a\n    side b b\n  end\n  begin enforcement\n    enforcement for energy = contact_resistance h = 500\n  end\nend\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("problem.toml"), problem(2)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seam"))
+        .args(["run", "problem.toml", "--json"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary["converged"], false);
+    let why = summary["diagnosis"].as_str().unwrap();
+    // Three residuals (the guess and two iterates), growing from a guess far away.
+    assert_eq!(why.matches('→').count(), 2, "{why}");
+    assert!(why.contains("the residual grew"), "{why}");
+    let mark = std::fs::read_to_string(dir.join("out").join(seam::run::NOT_CONVERGED)).unwrap();
+    assert_eq!(mark.trim(), why);
+    assert!(dir.join("out/temperature.vtu").exists());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("error[E0800]") && err.contains(why), "{err}");
+
+    std::fs::write(dir.join("problem.toml"), problem(50)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_seam"))
+        .args(["run", "problem.toml", "--json"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(!dir.join("out").join(seam::run::NOT_CONVERGED).exists());
+}
