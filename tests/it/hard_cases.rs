@@ -199,3 +199,70 @@ fn a_run_that_does_not_converge_says_so_and_why() {
     );
     assert!(!dir.join("out").join(seam::run::NOT_CONVERGED).exists());
 }
+
+/// Gaps of 1e-12, 0 and slightly negative (the lid shifted by δ along z) under a gas-gap
+/// conductance h = k_gas / max(g, g_min): the heat is the series value with the gap the
+/// mesh holds, on both sides.
+#[test]
+fn gas_gap_heat_is_exact_for_tiny_zero_and_negative_gaps() {
+    use seam::output::exodus::ExodusWriter;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let base = seam::mesh::read(&root.join("examples/two_blocks/two_blocks.exo")).unwrap();
+    let lid = base
+        .blocks
+        .iter()
+        .position(|b| b.name == "lid")
+        .expect("the lid block");
+    let (k_gas, g_min) = (0.026, 1e-14);
+    let mut worst = 0.0f64;
+    for delta in [1e-12, 0.0, -1e-12] {
+        let mut mesh = base.clone();
+        let mut moved = vec![false; mesh.num_nodes()];
+        for e in mesh.blocks[lid].elems() {
+            for n in mesh.elem_nodes(e) {
+                moved[n.index()] = true;
+            }
+        }
+        for (x, m) in mesh.coords.iter_mut().zip(&moved) {
+            if *m {
+                x[2] += delta;
+            }
+        }
+        let dir = scratch(&format!("gap-{delta:e}"));
+        let path = dir.join("shifted.exo");
+        ExodusWriter::create(&path, &mesh, &[], &[])
+            .unwrap()
+            .finish()
+            .unwrap();
+        std::fs::write(
+            dir.join("problem.toml"),
+            "[mesh]\nfile = \"shifted.exo\"\n[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n\
+             [[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n[contact]\nfile = \"contact.i\"\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("contact.i"),
+            format!(
+                "begin contact definition\n  contact surface a contains base_top\n  contact surface b contains lid_bottom\n  begin interaction\n    side a a\n    side b b\n  end\n  begin enforcement\n    enforcement for energy = gap_conductance\n    gap conductance coefficient = gas_gap k = {k_gas} min_gap = {g_min:e}\n  end\nend\n"
+            ),
+        )
+        .unwrap();
+        let r = seam::run::run(&dir.join("problem.toml")).unwrap_or_else(|e| panic!("{e:?}"));
+        let i = &r.summary.interactions[0];
+        // The gap the mesh holds: fl(1 + δ) − 1.
+        let g = (1.0 + delta) - 1.0;
+        let exact = exact_heat(k_gas / f64::max(g, g_min), 16.0, 200.0);
+        let err = (-i.heat_side_a - exact)
+            .abs()
+            .max((i.heat_side_b - exact).abs())
+            / exact;
+        println!(
+            "gap {delta:e}: heat {} / {}, exact {exact}, rel err {err:.1e}",
+            -i.heat_side_a, i.heat_side_b
+        );
+        worst = worst.max(err);
+    }
+    assert!(worst <= TOLERANCE, "{worst:e}");
+}
