@@ -218,6 +218,23 @@ pub(crate) fn face_shape_values(len: usize, xi: [f64; 2]) -> [f64; 4] {
     }
 }
 
+/// The dof of `field` at side-A node `node` of surface `surface` (node-to-face points).
+pub(crate) fn node_dof(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    field: FieldId,
+    node: crate::mesh::NodeId,
+    surface: &str,
+) -> Result<u32, InterfaceError> {
+    dofs.dof(field, node)
+        .map(|d| d.0)
+        .ok_or_else(|| InterfaceError::NoNodeDof {
+            number: mesh.node_number(node),
+            surface: surface.to_string(),
+            field: dofs.field_name(field).to_string(),
+        })
+}
+
 /// Evaluate one side at a point of face `side`, face coordinates `xi`.
 pub fn side_eval(
     mesh: &Mesh,
@@ -567,14 +584,7 @@ impl InterfacePoints {
                 if p.weight == 0.0 {
                     continue; // no tributary face: reported when the surface was built
                 }
-                let dof = dofs
-                    .dof(fields.a, node)
-                    .ok_or_else(|| InterfaceError::NoNodeDof {
-                        number: mesh.node_number(node),
-                        surface: a.name.clone(),
-                        field: dofs.field_name(fields.a).to_string(),
-                    })?
-                    .0;
+                let dof = node_dof(mesh, dofs, fields.a, node, &a.name)?;
                 let l = local_node(dof, &eb, form.beta);
                 ((1u8, node.0, eb.elem.0), l, mesh.node_number(node), 0)
             } else {

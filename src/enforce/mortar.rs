@@ -37,7 +37,7 @@ use crate::assembly::DofMap;
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
 
-use super::interface::{FieldPair, InterfaceError, face_shape_values, side_eval};
+use super::interface::{FieldPair, InterfaceError, face_shape_values, node_dof, side_eval};
 
 /// The constraint rows of one mortar tie.
 #[derive(Clone, Debug, Default)]
@@ -277,14 +277,7 @@ fn node_tie(
         if tie.nodes.last() == Some(&node) {
             continue; // one multiplier per node
         }
-        let own = dofs
-            .dof(fields.a, node)
-            .ok_or_else(|| InterfaceError::NoNodeDof {
-                number: mesh.node_number(node),
-                surface: a.name.clone(),
-                field: dofs.field_name(fields.a).to_string(),
-            })?
-            .0;
+        let own = node_dof(mesh, dofs, fields.a, node, &a.name)?;
         let fb = &b.faces[p.b_face as usize];
         let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, conductivity)?;
         let k = tie.nodes.len() as u32;
