@@ -917,14 +917,24 @@ impl Lower {
                     return;
                 }
                 c.skip_sep();
-                let Some((radius, _)) = self.number(c, "a radius") else {
+                let Some((radius, radius_at)) = self.number(c, "a radius") else {
                     return;
                 };
+                self.locs.set(
+                    format!("{d}.restrict_contact_to_subdomain.radius"),
+                    radius_at,
+                );
                 if !(self.keyword(c, "and") && self.keyword(c, "point")) {
                     return;
                 }
                 c.skip_sep();
                 let (p, p_at) = self.numbers(c, "a coordinate");
+                if let Some(l) = &p_at {
+                    self.locs.set(
+                        format!("{d}.restrict_contact_to_subdomain.point"),
+                        l.clone(),
+                    );
+                }
                 match <[f64; 3]>::try_from(p.as_slice()) {
                     Ok(point) => {
                         cd.restrict_contact_to_subdomain = Some(Subdomain { radius, point })
@@ -987,8 +997,10 @@ impl Lower {
             "update_search_every_n_steps" => {
                 self.once(seen, c);
                 c.skip_sep();
-                if let Some((n, _)) = self.count(c, "a whole number of steps") {
+                if let Some((n, n_at)) = self.count(c, "a whole number of steps") {
                     cd.update_search_every_n_steps = Some(n);
+                    self.locs
+                        .set(format!("{d}.update_search_every_n_steps"), n_at);
                 }
                 if c.peek()
                     .is_some_and(|t| t.lower == "steps" || t.lower == "step")
@@ -1414,8 +1426,10 @@ impl Lower {
                 "dash_penalty_factor" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();
-                    if let Some((v, _)) = self.number(&mut c, "a number") {
+                    if let Some((v, v_at)) = self.number(&mut c, "a number") {
                         e.dash_penalty_factor = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.dash_penalty_factor"), v_at);
                     }
                 }
                 "offset_temperature" => {
@@ -1710,9 +1724,12 @@ impl Lower {
             match key {
                 "self_contact" => x.self_contact = self.flag(&mut c),
                 "search_update_frequency" => {
-                    x.search_update_frequency = self
-                        .count(&mut c, "a whole number of steps")
-                        .map(|(n, _)| n);
+                    x.search_update_frequency =
+                        self.count(&mut c, "a whole number of steps")
+                            .map(|(n, at)| {
+                                self.locs.set(format!("{d}.search_options.{key}"), at);
+                                n
+                            });
                 }
                 _ => {
                     let what = if key.ends_with("angle") {
