@@ -10,6 +10,7 @@ mod embed;
 mod enforce;
 mod examples;
 mod fem;
+mod hard_input;
 mod interactions;
 mod manual;
 mod mesh_io;
