@@ -206,6 +206,10 @@ impl Diagnostics {
 /// usually the cause of the others.
 pub const MAX_RENDERED: usize = 50;
 
+/// The most characters of a source line a diagnostic shows; a longer line is cut to a
+/// window around the caret.
+const LINE_SHOWN: usize = 160;
+
 fn plural(n: usize, what: &str) -> String {
     format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
@@ -222,18 +226,35 @@ fn render_one(d: &Diagnostic, sources: &SourceMap, out: &mut String) {
             let num = loc.line.to_string();
             let pad = " ".repeat(num.len());
             let text = text.replace('\t', " ");
-            let caret_at = text
-                .char_indices()
-                .nth(loc.col.saturating_sub(1) as usize)
-                .map(|(i, _)| text[..i].chars().count())
-                .unwrap_or(text.chars().count());
+            let count = text.chars().count();
+            let caret_at = (loc.col.saturating_sub(1) as usize).min(count);
+            let mut caret_len = (loc.len.max(1) as usize).min(LINE_SHOWN);
+            // A long line (minified, or a binary file read as text) is shown as a
+            // window around the caret, not in full.
+            let (text, caret_at) = if count <= LINE_SHOWN {
+                (text, caret_at)
+            } else {
+                let start = caret_at.saturating_sub(LINE_SHOWN / 3);
+                let window: String = text.chars().skip(start).take(LINE_SHOWN).collect();
+                let lead = if start > 0 { "…" } else { "" };
+                let tail = if start + LINE_SHOWN < count {
+                    "…"
+                } else {
+                    ""
+                };
+                caret_len = caret_len.min(LINE_SHOWN - (caret_at - start)).max(1);
+                (
+                    format!("{lead}{window}{tail}"),
+                    caret_at - start + usize::from(start > 0),
+                )
+            };
             let _ = writeln!(out, " {pad} |");
             let _ = writeln!(out, " {num} | {text}");
             let _ = writeln!(
                 out,
                 " {pad} | {}{}",
                 " ".repeat(caret_at),
-                "^".repeat(loc.len.max(1) as usize)
+                "^".repeat(caret_len)
             );
         }
     }
@@ -521,6 +542,23 @@ mod tests {
         assert_eq!(lines[1], "  --> deck.i:2:3");
         assert_eq!(lines[3], " 2 |   Contact Surfce top");
         assert_eq!(lines[4], "   |   ^^^^^^^^^^^^^^");
+    }
+
+    #[test]
+    fn long_lines_are_shown_around_the_caret() {
+        let file: Arc<str> = Arc::from("deck.i");
+        let mut sources = SourceMap::default();
+        let line = format!("{}BAD{}", "x".repeat(1000), "y".repeat(1000));
+        sources.add(&file, &line);
+        let ds = Diagnostics(vec![
+            Diagnostic::error("E0103", "bad").at(Some(Loc::new(&file, 1, 1001, 3))),
+        ]);
+        let text = ds.render(&sources);
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines[3].chars().count() < LINE_SHOWN + 10, "{}", lines[3]);
+        let at = lines[3].find("BAD").map(|b| lines[3][..b].chars().count());
+        assert_eq!(lines[4].find('^'), at);
+        assert_eq!(lines[4].matches('^').count(), 3);
     }
 
     #[test]
