@@ -291,7 +291,7 @@ pub enum ReadError {
         path: String,
         message: String,
     },
-    #[error("{what} {path} is {}; seam reads at most {} from a {what}", size_text(*.size, *.limit), bytes_text(*.limit))]
+    #[error("{what} {path} {}; seam reads at most {} from a {what}", size_text(*.size, *.limit), bytes_text(*.limit))]
     TooLarge {
         what: &'static str,
         path: String,
@@ -362,8 +362,10 @@ fn bytes_text(n: u64) -> String {
 
 fn size_text(size: Option<u64>, limit: u64) -> String {
     match size {
-        Some(n) => bytes_text(n),
-        None => format!("larger than that: it gave more than {limit} bytes"),
+        Some(n) => format!("is {}", bytes_text(n)),
+        None => {
+            format!("gave more than {limit} bytes (it has no size on disk, or grew while read)")
+        }
     }
 }
 
@@ -621,7 +623,7 @@ mod tests {
         assert!(matches!(e, ReadError::TooLarge { size: None, .. }), "{e}");
         assert!(
             e.to_string()
-                .contains("/dev/zero is larger than that: it gave more than 1048576 bytes"),
+                .contains("/dev/zero gave more than 1048576 bytes (it has no size"),
             "{e}"
         );
         assert!(t.elapsed().as_secs() < 10);
