@@ -13,7 +13,7 @@
 //! `"{d}.periodicity.{p}.{offset|axis|center|angle}"`,
 //! `"{d}.control_assignment.{k}.factor"`, `"{d}.update_search_every_n_steps"`,
 //! `"{d}.restrict_contact_to_subdomain.{radius|point}"`,
-//! `"{d}.enforcement.{k}.dash_penalty_factor"`,
+//! `"{d}.enforcement.{k}.{dash_penalty_factor|offset_temperature|contact_pressure}"`,
 //! `"{d}.enforcement.{k}.model.{m}.equation"`, `"{d}.enforcement.{k}.model.{m}.arg.{a}"`,
 //! `"{d}.enforcement.{k}.use_toggle_block"`, with `d`, `i`, `s`, `k`, `p`, `m`, `a`
 //! 0-based indices into the spec's vectors.
@@ -441,6 +441,17 @@ fn check_search_options(d: usize, so: &SearchOptions, locs: &Locs, out: &mut Dia
 fn check_surface_block(d: usize, s: usize, b: &SurfaceBlock, locs: &Locs, out: &mut Diagnostics) {
     let name = &b.name;
     for (k, sub) in b.subsets.iter().enumerate() {
+        let [x, y, z] = sub.normal;
+        range(
+            out,
+            sub.normal.iter().all(|c| c.is_finite()),
+            &format!("subset `{}` of contact surface `{name}`", sub.name),
+            "with normal",
+            format!("{x} {y} {z}"),
+            "three finite components",
+            locs.or(&format!("{d}.surface.{s}.subset.{k}.normal"), &sub.at),
+            "give the outward direction of the faces to pick, e.g. `with normal 0 0 1`",
+        );
         if sub.normal.iter().all(|&c| c == 0.0) {
             out.push(
                 Diagnostic::error(
@@ -540,6 +551,30 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
             "a finite number greater than 0",
             locs.or(&format!("{d}.enforcement.{k}.dash_penalty_factor"), &e.at),
             "it scales the Dash model's penalty: 0 ties nothing, a negative penalty pushes the sides apart",
+        );
+    }
+    if let Some(p) = e.contact_pressure {
+        range(
+            out,
+            non_negative(p),
+            &who,
+            "contact pressure",
+            p,
+            "a finite pressure of at least 0",
+            locs.or(&format!("{d}.enforcement.{k}.contact_pressure"), &e.at),
+            "the contact pressure presses the two sides together (Pa); a negative value is tension, under which the sides are not in contact",
+        );
+    }
+    if let Some(t) = e.offset_temperature {
+        range(
+            out,
+            t.is_finite(),
+            &who,
+            "offset temperature",
+            t,
+            "finite",
+            locs.or(&format!("{d}.enforcement.{k}.offset_temperature"), &e.at),
+            "the offset is a temperature difference added across the interface (K)",
         );
     }
     let mut first: HashMap<&str, usize> = HashMap::new();

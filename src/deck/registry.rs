@@ -280,7 +280,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "offset_temperature",
         [ENF],
         "= [constant [value =]] <t>",
-        "Temperature offset added across the interface (material model `Offset Temperature = Constant Value = <t>`)."
+        "Temperature offset added across the interface (material model `Offset Temperature = Constant Value = <t>`). Range: finite (else E0227)."
     ),
     cmd!(
         "quarantine faulty points",
@@ -294,7 +294,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "contact_pressure",
         [ENF],
         "= <p>",
-        "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins)."
+        "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins). Range: finite and >= 0, a compressive pressure (else E0227)."
     ),
     cmd!(
         "contact surface pressure",
@@ -518,7 +518,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "subset",
         [CS],
         "<name> with normal <nx> <ny> <nz>",
-        "Split off the faces whose normal is closest to this direction."
+        "Split off the faces whose normal is closest to this direction. Range: finite (else E0227) and not zero (else E0206)."
     ),
     cmd!(
         "auto subset",

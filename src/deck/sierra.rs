@@ -1434,8 +1434,11 @@ impl Lower {
                 }
                 "offset_temperature" => {
                     self.once(&mut seen, &c);
-                    if let Some(v) = self.constant_value(&mut c, "a temperature difference") {
+                    if let Some((v, v_at)) = self.constant_value(&mut c, "a temperature difference")
+                    {
                         e.offset_temperature = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.offset_temperature"), v_at);
                     }
                 }
                 "contact_pressure" => {
@@ -1464,8 +1467,10 @@ impl Lower {
                             pressure_from = Some((phrase, line.line));
                         }
                     }
-                    if let Some(v) = self.constant_value(&mut c, "a pressure") {
+                    if let Some((v, v_at)) = self.constant_value(&mut c, "a pressure") {
                         e.contact_pressure = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.contact_pressure"), v_at);
                     }
                 }
                 "contact_gap_temperature" => {
@@ -1530,7 +1535,7 @@ impl Lower {
 
     /// `= [constant [value =]] <number>`: the material-model form `Constant Value = v`
     /// and the plain `= v`.
-    fn constant_value(&mut self, c: &mut Cur, what: &str) -> Option<f64> {
+    fn constant_value(&mut self, c: &mut Cur, what: &str) -> Option<(f64, Loc)> {
         c.skip_sep();
         if c.peek()
             .is_some_and(|t| t.is_word() && t.lower == "constant")
@@ -1541,7 +1546,7 @@ impl Lower {
             }
             c.skip_sep();
         }
-        self.number(c, what).map(|(v, _)| v)
+        self.number(c, what)
     }
 
     /// A material-model line: `<property> [=] <model> [args…]`, the property named by

@@ -120,7 +120,12 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
             .enumerate()
         {
             e.at = at(n.span());
-            for key in ["use_toggle_block", "dash_penalty_factor"] {
+            for key in [
+                "use_toggle_block",
+                "dash_penalty_factor",
+                "offset_temperature",
+                "contact_pressure",
+            ] {
                 put(format!("{d}.enforcement.{k}.{key}"), sub(n, key));
             }
             let table = n.get_ref().as_table();
