@@ -340,6 +340,16 @@ fn definition_and_enforcement_numbers_are_checked() {
             ),
             None,
         ),
+        (
+            def("begin enforcement e\n enforcement for energy = dash\n contact pressure = 0\n end"),
+            None,
+        ),
+        (
+            def(
+                "begin enforcement e\n enforcement for energy = dash\n contact pressure = -1\n end",
+            ),
+            Some(codes::OUT_OF_RANGE),
+        ),
     ] {
         let got = codes_of(&text);
         assert_eq!(got, code.into_iter().collect::<Vec<_>>(), "{text}");
