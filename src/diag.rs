@@ -5,9 +5,18 @@
 //! a help line. [`Diagnostics::render`] prints them rustc-style with the source line and
 //! a caret, from the sources registered in a [`SourceMap`]. Codes are an interface:
 //! tests and users match on them, so a code is never reused for another meaning.
+//! A render prints at most [`MAX_RENDERED`] diagnostics and then one line counting the
+//! rest: past that many, the first ones are what to fix.
+//!
+//! Input text is read through [`read_text`]: bounded in size (so a device such as
+//! `/dev/zero`, a FIFO or a mesh given by mistake cannot make seam read without end),
+//! UTF-8 or an error at the line and column of the first bad byte, a leading byte-order
+//! mark dropped. The bounds are [`MAX_DECK_BYTES`] (decks, whole Sierra input files,
+//! problem files) and [`MAX_LUA_BYTES`] (Lua files).
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
+use std::io::Read as _;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -146,7 +155,8 @@ impl Diagnostics {
         self.0.len()
     }
 
-    /// Render every diagnostic, rustc-style:
+    /// Render the diagnostics, rustc-style, the first [`MAX_RENDERED`] of them and then
+    /// one line counting the rest (see [`Diagnostics::render_at_most`]):
     ///
     /// ```text
     /// error[E0103]: unknown keyword `contact surfce` in `begin contact definition`
@@ -157,12 +167,51 @@ impl Diagnostics {
     ///    = help: did you mean `contact surface`?
     /// ```
     pub fn render(&self, sources: &SourceMap) -> String {
+        self.render_at_most(sources, MAX_RENDERED)
+    }
+
+    /// Render the first `max` diagnostics, then, if some are left, one line:
+    /// `note: 9950 more diagnostics not shown (9950 errors); the first 50 are above`.
+    pub fn render_at_most(&self, sources: &SourceMap, max: usize) -> String {
         let mut out = String::new();
-        for d in &self.0 {
+        for d in self.0.iter().take(max) {
             render_one(d, sources, &mut out);
+        }
+        let rest = self.0.get(max..).unwrap_or_default();
+        if !rest.is_empty() {
+            let errors = rest.iter().filter(|d| d.is_error()).count();
+            let warnings = rest.len() - errors;
+            let mut kinds = Vec::new();
+            if errors > 0 {
+                kinds.push(plural(errors, "error"));
+            }
+            if warnings > 0 {
+                kinds.push(plural(warnings, "warning"));
+            }
+            let _ = writeln!(
+                out,
+                "note: {} more diagnostic{} not shown ({}); the first {max} are above",
+                rest.len(),
+                if rest.len() == 1 { "" } else { "s" },
+                kinds.join(", ")
+            );
         }
         out
     }
+}
+
+/// How many diagnostics one render prints before it only counts the rest: enough for
+/// every problem of a real deck (the bad-deck snapshots hold at most a dozen), few
+/// enough that a runaway input (10 000 bad lines) does not bury the first, which is
+/// usually the cause of the others.
+pub const MAX_RENDERED: usize = 50;
+
+/// The most characters of a source line a diagnostic shows; a longer line is cut to a
+/// window around the caret.
+const LINE_SHOWN: usize = 160;
+
+fn plural(n: usize, what: &str) -> String {
+    format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
 
 fn render_one(d: &Diagnostic, sources: &SourceMap, out: &mut String) {
@@ -177,18 +226,35 @@ fn render_one(d: &Diagnostic, sources: &SourceMap, out: &mut String) {
             let num = loc.line.to_string();
             let pad = " ".repeat(num.len());
             let text = text.replace('\t', " ");
-            let caret_at = text
-                .char_indices()
-                .nth(loc.col.saturating_sub(1) as usize)
-                .map(|(i, _)| text[..i].chars().count())
-                .unwrap_or(text.chars().count());
+            let count = text.chars().count();
+            let caret_at = (loc.col.saturating_sub(1) as usize).min(count);
+            let mut caret_len = (loc.len.max(1) as usize).min(LINE_SHOWN);
+            // A long line (minified, or a binary file read as text) is shown as a
+            // window around the caret, not in full.
+            let (text, caret_at) = if count <= LINE_SHOWN {
+                (text, caret_at)
+            } else {
+                let start = caret_at.saturating_sub(LINE_SHOWN / 3);
+                let window: String = text.chars().skip(start).take(LINE_SHOWN).collect();
+                let lead = if start > 0 { "…" } else { "" };
+                let tail = if start + LINE_SHOWN < count {
+                    "…"
+                } else {
+                    ""
+                };
+                caret_len = caret_len.min(LINE_SHOWN - (caret_at - start)).max(1);
+                (
+                    format!("{lead}{window}{tail}"),
+                    caret_at - start + usize::from(start > 0),
+                )
+            };
             let _ = writeln!(out, " {pad} |");
             let _ = writeln!(out, " {num} | {text}");
             let _ = writeln!(
                 out,
                 " {pad} | {}{}",
                 " ".repeat(caret_at),
-                "^".repeat(loc.len.max(1) as usize)
+                "^".repeat(caret_len)
             );
         }
     }
@@ -200,6 +266,179 @@ fn render_one(d: &Diagnostic, sources: &SourceMap, out: &mut String) {
 /// The display name of a file in messages: as given by the user, so it can be pasted.
 pub fn file_label(path: &Path) -> Arc<str> {
     Arc::from(path.to_string_lossy().as_ref())
+}
+
+/// The most bytes seam reads from a contact deck, a whole Sierra input file or a problem
+/// file: 64 MiB. A contact deck is a few kilobytes and a whole Sierra input file of a
+/// large model a few megabytes; 64 MiB is ten times the largest of those and still
+/// parses in seconds, while a mesh, a results file or a device given by mistake is
+/// refused before seam holds it in memory.
+pub const MAX_DECK_BYTES: u64 = 64 << 20;
+
+/// The most bytes seam reads from a Lua file (`file.lua:function` maps and
+/// expressions): 16 MiB, the Lua sandbox's own memory limit — a larger file could not be
+/// loaded by it anyway. A map or conductance function is a few hundred bytes; a file
+/// holding a large table of data stays well under this.
+pub const MAX_LUA_BYTES: u64 = 16 << 20;
+
+/// Why an input file could not be read as text.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReadError {
+    #[error("cannot read {what} {path}: {message}")]
+    Io {
+        what: &'static str,
+        path: String,
+        message: String,
+    },
+    #[error("{what} {path} {}; seam reads at most {} from a {what}", size_text(*.size, *.limit), bytes_text(*.limit))]
+    TooLarge {
+        what: &'static str,
+        path: String,
+        /// The size on disk; `None` when the file has none (a device, a FIFO) or grew
+        /// while read: it then gave more than `limit` bytes.
+        size: Option<u64>,
+        limit: u64,
+    },
+    #[error("{what} {path} is not UTF-8 text: byte 0x{byte:02x} at line {}, column {}", .at.line, .at.col)]
+    NotUtf8 {
+        what: &'static str,
+        path: String,
+        byte: u8,
+        /// Where the first byte that is not UTF-8 sits (the column counts the
+        /// characters before it on its line).
+        at: Loc,
+        /// The text with bad bytes replaced by U+FFFD, to show the line.
+        lossy: String,
+    },
+}
+
+impl ReadError {
+    /// What to do about it, for a help line.
+    pub fn help(&self) -> String {
+        match self {
+            ReadError::Io { .. } => "check the path and that the file is readable".into(),
+            ReadError::TooLarge { what, limit, .. } => {
+                let usual = if *limit >= MAX_DECK_BYTES {
+                    "a contact deck is a few kilobytes, a whole Sierra input file a few megabytes"
+                } else {
+                    "a Lua map or conductance function is a few hundred bytes"
+                };
+                format!(
+                    "{usual}: check that the path names the {what} and not a mesh, a results file or a device; the limit keeps a wrong path from making seam read without end"
+                )
+            }
+            ReadError::NotUtf8 { .. } => "save the file as UTF-8 (plain ASCII is UTF-8); a file in Latin-1 or UTF-16, or a binary file, is not".into(),
+        }
+    }
+
+    /// The place to point at (for text that is not UTF-8).
+    pub fn loc(&self) -> Option<Loc> {
+        match self {
+            ReadError::NotUtf8 { at, .. } => Some(at.clone()),
+            _ => None,
+        }
+    }
+
+    /// The text to show the place in (for text that is not UTF-8).
+    pub fn lossy_text(&self) -> Option<&str> {
+        match self {
+            ReadError::NotUtf8 { lossy, .. } => Some(lossy),
+            _ => None,
+        }
+    }
+}
+
+fn bytes_text(n: u64) -> String {
+    const MIB: u64 = 1 << 20;
+    if n >= MIB && n.is_multiple_of(MIB) {
+        format!("{} MiB ({n} bytes)", n / MIB)
+    } else if n >= MIB {
+        format!("{:.1} MiB ({n} bytes)", n as f64 / MIB as f64)
+    } else {
+        format!("{n} bytes")
+    }
+}
+
+fn size_text(size: Option<u64>, limit: u64) -> String {
+    match size {
+        Some(n) => format!("is {}", bytes_text(n)),
+        None => {
+            format!("gave more than {limit} bytes (it has no size on disk, or grew while read)")
+        }
+    }
+}
+
+/// Read the file `path` as text, at most `limit` bytes: its size on disk is checked
+/// first, and the read itself stops one byte past `limit`, so a device or a FIFO that
+/// never ends is refused as well. A leading UTF-8 byte-order mark is dropped. `what`
+/// names the kind of file in messages (`deck file`, `problem file`, `Lua file`).
+pub fn read_text(path: &Path, what: &'static str, limit: u64) -> Result<String, ReadError> {
+    let label = path.display().to_string();
+    let io = |e: std::io::Error| ReadError::Io {
+        what,
+        path: label.clone(),
+        message: e.to_string(),
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let meta = file.metadata().map_err(io)?;
+    if meta.is_dir() {
+        return Err(ReadError::Io {
+            what,
+            path: label,
+            message: "it is a directory".into(),
+        });
+    }
+    if meta.is_file() && meta.len() > limit {
+        return Err(ReadError::TooLarge {
+            what,
+            path: label,
+            size: Some(meta.len()),
+            limit,
+        });
+    }
+    let mut bytes = Vec::new();
+    file.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(ReadError::TooLarge {
+            what,
+            path: label,
+            size: None,
+            limit,
+        });
+    }
+    text_from_bytes(bytes, &label, what)
+}
+
+/// `bytes` as text: UTF-8 with a leading byte-order mark dropped, else the error at the
+/// line and column of the first bad byte.
+pub fn text_from_bytes(
+    mut bytes: Vec<u8>,
+    path: &str,
+    what: &'static str,
+) -> Result<String, ReadError> {
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let good = e.utf8_error().valid_up_to();
+        let before = std::str::from_utf8(&bytes[..good]).unwrap_or_default();
+        let line = before.matches('\n').count() + 1;
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let col = before[line_start..].chars().count() + 1;
+        let n = |x: usize| u32::try_from(x).unwrap_or(u32::MAX);
+        let file: Arc<str> = Arc::from(path);
+        ReadError::NotUtf8 {
+            what,
+            path: path.to_string(),
+            byte: bytes.get(good).copied().unwrap_or_default(),
+            at: Loc::new(&file, n(line), n(col), 1),
+            lossy: String::from_utf8_lossy(bytes).into_owned(),
+        }
+    })
 }
 
 /// Levenshtein distance, for did-you-mean suggestions.
@@ -305,6 +544,113 @@ mod tests {
         assert_eq!(lines[1], "  --> deck.i:2:3");
         assert_eq!(lines[3], " 2 |   Contact Surfce top");
         assert_eq!(lines[4], "   |   ^^^^^^^^^^^^^^");
+    }
+
+    #[test]
+    fn long_lines_are_shown_around_the_caret() {
+        let file: Arc<str> = Arc::from("deck.i");
+        let mut sources = SourceMap::default();
+        let line = format!("{}BAD{}", "x".repeat(1000), "y".repeat(1000));
+        sources.add(&file, &line);
+        let ds = Diagnostics(vec![
+            Diagnostic::error("E0103", "bad").at(Some(Loc::new(&file, 1, 1001, 3))),
+        ]);
+        let text = ds.render(&sources);
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines[3].chars().count() < LINE_SHOWN + 10, "{}", lines[3]);
+        let at = lines[3].find("BAD").map(|b| lines[3][..b].chars().count());
+        assert_eq!(lines[4].find('^'), at);
+        assert_eq!(lines[4].matches('^').count(), 3);
+    }
+
+    #[test]
+    fn renders_are_capped_with_a_count_of_the_rest() {
+        let mut ds = Diagnostics::default();
+        for i in 0..60 {
+            ds.push(Diagnostic::error("E0103", format!("problem {i}")));
+        }
+        ds.push(Diagnostic::warning("W0102", "late"));
+        let text = ds.render(&SourceMap::default());
+        let heads = text.lines().filter(|l| l.starts_with("error[")).count();
+        assert_eq!(heads, MAX_RENDERED);
+        assert!(!text.contains("problem 50"), "{text}");
+        let last = text.lines().last().unwrap_or_default();
+        assert_eq!(
+            last,
+            "note: 11 more diagnostics not shown (10 errors, 1 warning); the first 50 are above"
+        );
+        // At the cap exactly: no count line.
+        ds.0.truncate(MAX_RENDERED);
+        assert!(!ds.render(&SourceMap::default()).contains("note:"));
+    }
+
+    fn scratch(name: &str, bytes: &[u8]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("seam-diag-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+
+    #[test]
+    fn reads_are_bounded() {
+        let path = scratch("big.i", &[b'x'; 1000]);
+        let e = read_text(&path, "deck file", 999).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                ReadError::TooLarge {
+                    size: Some(1000),
+                    limit: 999,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        let msg = e.to_string();
+        assert!(
+            msg.ends_with("is 1000 bytes; seam reads at most 999 bytes from a deck file"),
+            "{msg}"
+        );
+        assert_eq!(read_text(&path, "deck file", 1000).unwrap().len(), 1000);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_device_that_never_ends_is_refused() {
+        let t = std::time::Instant::now();
+        let e = read_text(Path::new("/dev/zero"), "deck file", 1 << 20).unwrap_err();
+        assert!(matches!(e, ReadError::TooLarge { size: None, .. }), "{e}");
+        assert!(
+            e.to_string()
+                .contains("/dev/zero gave more than 1048576 bytes (it has no size"),
+            "{e}"
+        );
+        assert!(t.elapsed().as_secs() < 10);
+    }
+
+    #[test]
+    fn byte_order_mark_is_dropped_and_bad_bytes_located() {
+        let path = scratch("bom.i", "\u{feff}begin x\nend\n".as_bytes());
+        assert_eq!(
+            read_text(&path, "deck file", 100).unwrap(),
+            "begin x\nend\n"
+        );
+        let path = scratch("latin1.i", b"begin x\n  name = caf\xe9\nend\n");
+        let e = read_text(&path, "deck file", 100).unwrap_err();
+        let at = e.loc().unwrap();
+        assert_eq!((at.line, at.col), (2, 13));
+        assert!(
+            e.to_string()
+                .ends_with("is not UTF-8 text: byte 0xe9 at line 2, column 13"),
+            "{e}"
+        );
+        assert_eq!(
+            e.lossy_text().and_then(|t| t.lines().nth(1)),
+            Some("  name = caf\u{fffd}")
+        );
+        let e = read_text(&path.with_file_name("absent.i"), "deck file", 100).unwrap_err();
+        assert!(matches!(e, ReadError::Io { .. }), "{e}");
     }
 
     #[test]

@@ -11,10 +11,19 @@
 //! `"{d}.surface.{s}.name"`, `"{d}.surface.{s}.subset.{k}.normal"`,
 //! `"{d}.surface.{s}.auto_subset.{angle|number_of_subsets}"`,
 //! `"{d}.periodicity.{p}.{offset|axis|center|angle}"`,
-//! `"{d}.control_assignment.{k}.factor"`,
+//! `"{d}.control_assignment.{k}.factor"`, `"{d}.update_search_every_n_steps"`,
+//! `"{d}.restrict_contact_to_subdomain.{radius|point}"`,
+//! `"{d}.enforcement.{k}.{dash_penalty_factor|offset_temperature|contact_pressure}"`,
 //! `"{d}.enforcement.{k}.model.{m}.equation"`, `"{d}.enforcement.{k}.model.{m}.arg.{a}"`,
 //! `"{d}.enforcement.{k}.use_toggle_block"`, with `d`, `i`, `s`, `k`, `p`, `m`, `a`
 //! 0-based indices into the spec's vectors.
+//!
+//! Ranges: every number the search or an enforcement reads is checked against the range
+//! in which it means something, and refused outside it with the range in the message
+//! (E0227, or the older codes E0202, E0203, E0207, E0208, E0216 for the values they
+//! always covered): a value out of range does not fail later, it silently changes the
+//! answer (`normal check angle = 720` is cos 720° = 1: only exactly opposed faces pair).
+//! The ranges are listed in the deck reference, from the registry's descriptions.
 //!
 //! Enforcements: every `Enforcement For` equation must be in Aria's list and one seam
 //! solves (the spec carries any), once per block; model arguments are checked where the
@@ -48,6 +57,42 @@ impl Locs {
         self.get(key)
             .or_else(|| (!fallback.is_unknown()).then(|| fallback.clone()))
     }
+}
+
+/// Report `value` of `what` (as written in the deck) unless `ok`: E0227, with `range`
+/// (e.g. `greater than 0`) in the message and `help` saying what the value means.
+#[allow(clippy::too_many_arguments)]
+fn range(
+    out: &mut Diagnostics,
+    ok: bool,
+    who: &str,
+    what: &str,
+    value: impl std::fmt::Display,
+    range: &str,
+    at: Option<Loc>,
+    help: &str,
+) {
+    if ok {
+        return;
+    }
+    out.push(
+        Diagnostic::error(
+            codes::OUT_OF_RANGE,
+            format!("{who}: `{what}` is {value}; it must be {range}"),
+        )
+        .at(at)
+        .help(help),
+    );
+}
+
+/// True for a finite number greater than 0.
+fn positive(v: f64) -> bool {
+    v > 0.0 && v.is_finite()
+}
+
+/// True for a finite number at least 0.
+fn non_negative(v: f64) -> bool {
+    v >= 0.0 && v.is_finite()
 }
 
 /// Every semantic problem in `deck`.
@@ -86,6 +131,45 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
             );
     }
 
+    if let Some(n) = def.update_search_every_n_steps {
+        range(
+            out,
+            n >= 1,
+            "contact definition",
+            "update search every",
+            n,
+            "a whole number of steps of at least 1",
+            locs.or(&format!("{d}.update_search_every_n_steps"), &def.at),
+            "1 searches again every step; leave the line out to search once",
+        );
+    }
+    if let Some(sd) = &def.restrict_contact_to_subdomain {
+        range(
+            out,
+            positive(sd.radius),
+            "contact definition",
+            "restrict contact to subdomain … radius",
+            sd.radius,
+            "a finite length greater than 0",
+            locs.or(
+                &format!("{d}.restrict_contact_to_subdomain.radius"),
+                &def.at,
+            ),
+            "the search keeps only the points inside this sphere: a radius of 0 or less keeps none",
+        );
+        let [x, y, z] = sd.point;
+        range(
+            out,
+            sd.point.iter().all(|c| c.is_finite()),
+            "contact definition",
+            "restrict contact to subdomain … point",
+            format!("{x} {y} {z}"),
+            "three finite coordinates",
+            locs.or(&format!("{d}.restrict_contact_to_subdomain.point"), &def.at),
+            "the point is the centre of the sphere the search is restricted to",
+        );
+    }
+
     // Surface names: each defined once.
     let mut first: HashMap<&str, usize> = HashMap::new();
     for (s, surf) in def.surfaces.iter().enumerate() {
@@ -122,7 +206,7 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
 
     for (p, per) in def.periodicity.iter().enumerate() {
         let key = |k: &str| format!("{d}.periodicity.{p}.{k}");
-        let mut count = |what: &str, v: &[f64]| {
+        let count = |out: &mut Diagnostics, what: &str, v: &[f64]| {
             if !(2..=3).contains(&v.len()) {
                 out.push(
                     Diagnostic::error(
@@ -138,11 +222,35 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
                 );
             }
         };
+        let who = format!("periodicity for `{}`", per.surface);
+        let finite = |out: &mut Diagnostics, what: &str, v: &[f64]| {
+            let words: Vec<String> = v.iter().map(f64::to_string).collect();
+            range(
+                out,
+                v.iter().all(|x| x.is_finite()),
+                &who,
+                what,
+                words.join(" "),
+                "finite",
+                locs.or(&key(what), &per.at),
+                "a periodic transform with an infinite or NaN part maps every node to no point",
+            );
+        };
         match &per.transform {
-            PeriodicTransform::Rectangular { offset } => count("offset", offset),
-            PeriodicTransform::Cylindrical { axis, center, .. } => {
-                count("axis", axis);
-                count("center", center);
+            PeriodicTransform::Rectangular { offset } => {
+                finite(out, "offset", offset);
+                count(out, "offset", offset);
+            }
+            PeriodicTransform::Cylindrical {
+                axis,
+                center,
+                angle,
+            } => {
+                finite(out, "axis", axis);
+                finite(out, "center", center);
+                finite(out, "angle", std::slice::from_ref(angle));
+                count(out, "axis", axis);
+                count(out, "center", center);
                 if axis.iter().all(|&a| a == 0.0) && !axis.is_empty() {
                     out.push(
                         Diagnostic::error(
@@ -211,11 +319,11 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
     }
 
     let tolerance = |v: Option<f64>, key: String, at: &Loc, who: &str, out: &mut Diagnostics| {
-        if let Some(t) = v.filter(|t| t.is_nan() || *t <= 0.0) {
+        if let Some(t) = v.filter(|t| !positive(*t)) {
             out.push(
                 Diagnostic::error(
                     codes::NORMAL_TOLERANCE,
-                    format!("{who}: normal tolerance is {t}; it must be positive"),
+                    format!("{who}: normal tolerance is {t}; it must be a finite distance greater than 0"),
                 )
                 .at(locs.or(&key, at))
                 .help("the normal tolerance is the largest gap (a length) at which faces are paired; use a small positive distance"),
@@ -243,6 +351,7 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
             "search options",
             out,
         );
+        check_search_options(d, so, locs, out);
     }
     for (k, e) in def.enforcements.iter().enumerate() {
         check_enforcement(d, k, e, locs, out);
@@ -254,7 +363,7 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
             out.push(
                 Diagnostic::error(
                     codes::NOT_POSITIVE,
-                    format!("the penalty scale factor must be positive, found {factor}"),
+                    format!("the penalty scale factor must be a finite number greater than 0, found {factor}"),
                 )
                 .at(locs.or(&format!("{d}.control_assignment.{k}.factor"), &c.at))
                 .help("a factor of 1 keeps the enforcement's own penalty"),
@@ -263,9 +372,86 @@ fn check_definition(d: usize, def: &ContactDefinition, locs: &Locs, out: &mut Di
     }
 }
 
+/// The ranges of the search options other than the normal tolerance.
+fn check_search_options(d: usize, so: &SearchOptions, locs: &Locs, out: &mut Diagnostics) {
+    let at = |key: &str| locs.or(&format!("{d}.search_options.{key}"), &so.at);
+    let who = "search options";
+    if let Some(a) = so.normal_check_angle {
+        range(
+            out,
+            a > 0.0 && a <= 180.0,
+            who,
+            "normal check angle",
+            a,
+            "greater than 0 and at most 180 degrees",
+            at("normal_check_angle"),
+            "it is the largest angle between a side-B normal and the reversed side-A normal of a pair: an angle between two directions lies in [0, 180]; 0 would pair only exactly opposed faces, 180 pairs whatever the normals",
+        );
+    }
+    if let Some(f) = so.field_factor {
+        range(
+            out,
+            positive(f),
+            who,
+            "field factor",
+            f,
+            "a finite number greater than 0",
+            at("field_factor"),
+            "it sets the largest gap considered, as a multiple of the face size, when no normal tolerance is given (default 0.2): 0 or less accepts no gap at all",
+        );
+    }
+    if let Some(f) = so.buffer_factor {
+        range(
+            out,
+            non_negative(f),
+            who,
+            "buffer factor",
+            f,
+            "a finite number of at least 0",
+            at("buffer_factor"),
+            "the search boxes grow by the mean face size times this factor (default 1 in 3-D, 5 in 2-D): 0 adds no margin beyond the gap accepted, less would shrink the boxes",
+        );
+    }
+    if let Some(t) = so.tangential_tolerance {
+        range(
+            out,
+            non_negative(t),
+            who,
+            "tangential tolerance",
+            t,
+            "a finite number of at least 0",
+            at("tangential_tolerance"),
+            "it is how far outside a face, relative to the face size, a projection still counts (default 0.001): 0 is the face's own edge, less would cut points off inside the face",
+        );
+    }
+    if let Some(n) = so.search_update_frequency {
+        range(
+            out,
+            n >= 1,
+            who,
+            "search update frequency",
+            n,
+            "a whole number of steps of at least 1",
+            at("search_update_frequency"),
+            "1 searches again every step; leave the line out to search once",
+        );
+    }
+}
+
 fn check_surface_block(d: usize, s: usize, b: &SurfaceBlock, locs: &Locs, out: &mut Diagnostics) {
     let name = &b.name;
     for (k, sub) in b.subsets.iter().enumerate() {
+        let [x, y, z] = sub.normal;
+        range(
+            out,
+            sub.normal.iter().all(|c| c.is_finite()),
+            &format!("subset `{}` of contact surface `{name}`", sub.name),
+            "with normal",
+            format!("{x} {y} {z}"),
+            "three finite components",
+            locs.or(&format!("{d}.surface.{s}.subset.{k}.normal"), &sub.at),
+            "give the outward direction of the faces to pick, e.g. `with normal 0 0 1`",
+        );
         if sub.normal.iter().all(|&c| c == 0.0) {
             out.push(
                 Diagnostic::error(
@@ -297,11 +483,11 @@ fn check_surface_block(d: usize, s: usize, b: &SurfaceBlock, locs: &Locs, out: &
                 .help("split the surface either by explicit normals (`subset`) or automatically (`auto subset`), not both"),
             );
         }
-        if let Some(a) = auto.angle.filter(|a| a.is_nan() || *a <= 0.0) {
+        if let Some(a) = auto.angle.filter(|a| !positive(*a)) {
             out.push(
                 Diagnostic::error(
                     codes::NONPOSITIVE_ANGLE,
-                    format!("auto subset `{}` of contact surface `{name}` has angle {a}; it must be positive", auto.name),
+                    format!("auto subset `{}` of contact surface `{name}` has angle {a}; it must be positive (and finite)", auto.name),
                 )
                 .at(locs.or(&format!("{d}.surface.{s}.auto_subset.angle"), &auto.at))
                 .help("the angle (degrees) is how far face normals may turn within one subset; the default is 60"),
@@ -355,6 +541,42 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
         Some(n) => format!("enforcement `{n}`"),
         None => format!("enforcement #{}", k + 1),
     };
+    if let Some(f) = e.dash_penalty_factor {
+        range(
+            out,
+            positive(f),
+            &who,
+            "dash penalty factor",
+            f,
+            "a finite number greater than 0",
+            locs.or(&format!("{d}.enforcement.{k}.dash_penalty_factor"), &e.at),
+            "it scales the Dash model's penalty: 0 ties nothing, a negative penalty pushes the sides apart",
+        );
+    }
+    if let Some(p) = e.contact_pressure {
+        range(
+            out,
+            non_negative(p),
+            &who,
+            "contact pressure",
+            p,
+            "a finite pressure of at least 0",
+            locs.or(&format!("{d}.enforcement.{k}.contact_pressure"), &e.at),
+            "the contact pressure presses the two sides together (Pa); a negative value is tension, under which the sides are not in contact",
+        );
+    }
+    if let Some(t) = e.offset_temperature {
+        range(
+            out,
+            t.is_finite(),
+            &who,
+            "offset temperature",
+            t,
+            "finite",
+            locs.or(&format!("{d}.enforcement.{k}.offset_temperature"), &e.at),
+            "the offset is a temperature difference added across the interface (K)",
+        );
+    }
     let mut first: HashMap<&str, usize> = HashMap::new();
     for (m, model) in e.models.iter().enumerate() {
         let eq = model.equation.as_str();

@@ -1,7 +1,11 @@
-//! The deck's diagnostic codes: one constant per meaning, never reused.
+//! The deck's diagnostic codes, and those of reading any input file (E000x): one
+//! constant per meaning, never reused.
 //!
 //! | code  | severity | meaning |
 //! |-------|----------|---------|
+//! | E0001 | error    | an input file cannot be read (missing, unreadable, a directory) |
+//! | E0003 | error    | an input file (deck, problem file, Lua file) larger than seam reads |
+//! | E0004 | error    | an input file that is not UTF-8 text (points at the first bad byte) |
 //! | E0101 | error    | `begin` block not closed before the end of the file |
 //! | E0102 | error    | `end` line names a block type or name other than the open block |
 //! | E0103 | error    | unknown line command in this block (with did-you-mean) |
@@ -15,6 +19,7 @@
 //! | E0111 | error    | block needs a name, or has a name it may not have |
 //! | E0112 | error    | unexpected extra words at the end of a command |
 //! | E0113 | error    | a block that may appear once per definition appears twice |
+//! | E0114 | error    | blocks nested deeper than seam reads ([`super::MAX_NESTING`]) |
 //! | E0150 | error    | TOML syntax or type error |
 //! | E0201 | error    | value should be a (finite) number or integer but is not |
 //! | E0202 | error    | `Auto Subset … Angle` not positive |
@@ -42,10 +47,14 @@
 //! | E0224 | error    | ELFEN contact-set parameter with no counterpart in seam |
 //! | E0225 | error    | unknown material property of an enforcement (TOML `property`), or one with its own field |
 //! | E0226 | error    | `begin toggle block`: in a contact deck, or used by an enforcement of a Sierra input file (its schedule cannot be read) |
+//! | E0227 | error    | a number outside its documented range (the range is in the message) |
 //! | W0101 | warning  | deprecated alias (`Slave Variable`) |
 //! | W0102 | warning  | single-valued command given twice; the last one wins |
 //! | W0103 | warning  | blocks and lines of a Sierra input file skipped (not contact input) |
 
+pub const CANNOT_READ: &str = "E0001";
+pub const TOO_LARGE: &str = "E0003";
+pub const NOT_UTF8: &str = "E0004";
 pub const UNCLOSED_BLOCK: &str = "E0101";
 pub const MISMATCHED_END: &str = "E0102";
 pub const UNKNOWN_KEYWORD: &str = "E0103";
@@ -59,6 +68,7 @@ pub const MISSING_ARGUMENT: &str = "E0110";
 pub const BLOCK_NAME: &str = "E0111";
 pub const EXTRA_WORDS: &str = "E0112";
 pub const DUPLICATE_BLOCK: &str = "E0113";
+pub const TOO_DEEP: &str = "E0114";
 pub const TOML_ERROR: &str = "E0150";
 pub const NOT_A_NUMBER: &str = "E0201";
 pub const NONPOSITIVE_ANGLE: &str = "E0202";
@@ -86,12 +96,16 @@ pub const UNKNOWN_MODEL_KEY: &str = "E0223";
 pub const ELFEN_REFUSED: &str = "E0224";
 pub const UNKNOWN_PROPERTY: &str = "E0225";
 pub const TOGGLE_BLOCK: &str = "E0226";
+pub const OUT_OF_RANGE: &str = "E0227";
 pub const DEPRECATED_ALIAS: &str = "W0101";
 pub const REPEATED_COMMAND: &str = "W0102";
 pub const SKIPPED_BLOCKS: &str = "W0103";
 
 /// Every code above, for tests and tools that list them.
 pub const ALL: &[&str] = &[
+    CANNOT_READ,
+    TOO_LARGE,
+    NOT_UTF8,
     UNCLOSED_BLOCK,
     MISMATCHED_END,
     UNKNOWN_KEYWORD,
@@ -105,6 +119,7 @@ pub const ALL: &[&str] = &[
     BLOCK_NAME,
     EXTRA_WORDS,
     DUPLICATE_BLOCK,
+    TOO_DEEP,
     TOML_ERROR,
     NOT_A_NUMBER,
     NONPOSITIVE_ANGLE,
@@ -132,6 +147,7 @@ pub const ALL: &[&str] = &[
     ELFEN_REFUSED,
     UNKNOWN_PROPERTY,
     TOGGLE_BLOCK,
+    OUT_OF_RANGE,
     DEPRECATED_ALIAS,
     REPEATED_COMMAND,
     SKIPPED_BLOCKS,

@@ -31,11 +31,14 @@ mod tree;
 mod tests;
 
 pub use registry::reference_markdown;
+pub use tree::{MAX_NESTING, UNCLOSED_SHOWN};
 
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap, file_label};
+use crate::diag::{
+    Diagnostic, Diagnostics, Loc, MAX_DECK_BYTES, ReadError, SourceMap, file_label, read_text,
+};
 
 pub use spec::Deck;
 
@@ -48,17 +51,21 @@ pub struct LoadedDeck {
     pub sources: SourceMap,
 }
 
-/// Read a deck file: `.toml` is TOML, anything else Sierra syntax.
+/// Read a deck file: `.toml` is TOML, anything else Sierra syntax. At most
+/// [`MAX_DECK_BYTES`] are read (a contact deck or a whole Sierra input file alike).
 pub fn load(path: &Path) -> LoadedDeck {
+    load_at_most(path, MAX_DECK_BYTES)
+}
+
+/// As [`load`], reading at most `limit` bytes: a larger file (or a device that does not
+/// end) is error E0003, text that is not UTF-8 error E0004 at its line and column.
+pub fn load_at_most(path: &Path, limit: u64) -> LoadedDeck {
     let file = file_label(path);
     let mut out = LoadedDeck::default();
-    let text = match std::fs::read_to_string(path) {
+    let text = match read_text(path, "deck file", limit) {
         Ok(t) => t,
         Err(e) => {
-            out.diagnostics.push(
-                Diagnostic::error("E0001", format!("cannot read deck file {file}: {e}"))
-                    .help("check the path and that the file is readable UTF-8 text"),
-            );
+            out.diagnostics.push(read_error(&e, &mut out.sources));
             return out;
         }
     };
@@ -74,6 +81,23 @@ pub fn load(path: &Path) -> LoadedDeck {
     out.deck = deck;
     out.diagnostics.extend(diags);
     out
+}
+
+/// The diagnostic of an input file that could not be read (E0001, E0003, E0004); for
+/// text that is not UTF-8 the text (bad bytes replaced) goes to `sources`, so the caret
+/// shows the line.
+pub fn read_error(e: &ReadError, sources: &mut SourceMap) -> Diagnostic {
+    let code = match e {
+        ReadError::TooLarge { .. } => codes::TOO_LARGE,
+        ReadError::NotUtf8 { .. } => codes::NOT_UTF8,
+        _ => codes::CANNOT_READ,
+    };
+    if let (Some(at), Some(text)) = (e.loc(), e.lossy_text()) {
+        sources.add(&at.file, text);
+    }
+    Diagnostic::error(code, e.to_string())
+        .at(e.loc())
+        .help(e.help())
 }
 
 /// Parse Sierra-syntax text. `file` is the name used in diagnostics.

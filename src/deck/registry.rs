@@ -173,7 +173,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "restrict_contact_to_subdomain",
         [CD],
         "defined by radius <r> and point <x> <y> <z>",
-        "Search only inside this sphere."
+        "Search only inside this sphere. Range: r finite and > 0, the point finite (else E0227)."
     ),
     cmd!(
         "visualize contact",
@@ -194,7 +194,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "update_search_every_n_steps",
         [CD],
         "[=] <n> [steps]",
-        "Redo the search every n steps (1: every step); the value is kept in the spec.",
+        "Redo the search every n steps (1: every step); the value is kept in the spec. Range: n >= 1 (else E0227).",
         warns "seam's meshes do not move in `seam run`, so re-searching has no effect; a warning says so"
     ),
     cmd!(
@@ -202,7 +202,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "opposed_normal_threshold_angle",
         [CD],
         "= <degrees>",
-        "Faces interact only if their normals are at least this far apart (>= 90)."
+        "Faces interact only if their normals are at least this far apart. Range: 90 <= degrees <= 180 (else E0207)."
     ),
     cmd!(
         "disable opposed normal interaction culling",
@@ -216,7 +216,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "scale_penalty",
         [CD],
         "[for <surface> [with <surface>]] = <factor>",
-        "Penalty scale factor for the whole domain, one surface's self-contact, or one pair (Abaqus control assignment; the last that applies wins)."
+        "Penalty scale factor for the whole domain, one surface's self-contact, or one pair (Abaqus control assignment; the last that applies wins). Range: factor finite and > 0 (else E0216)."
     ),
     cmd!(
         "initial overclosure",
@@ -230,7 +230,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "periodicity",
         [CD],
         "<surface> [=] rectangular offset = <dx> <dy> [<dz>] | cylindrical axis = <a>... center = <c>... angle = <deg> | align_surface destination = <surface> [invert_normals = 0|1] | mapped [x_map = <f>] [y_map = <g>] [z_map = <h>]",
-        "Tie a surface to the image of another under a periodic transform. Defaults: `invert_normals = 1` (the image faces the destination); a map left out is the identity (`x_map = x`, `y_map = y`, z kept). `cylindrical` needs all of `axis`, `center` and `angle`: the manual gives no default for them."
+        "Tie a surface to the image of another under a periodic transform. Defaults: `invert_normals = 1` (the image faces the destination); a map left out is the identity (`x_map = x`, `y_map = y`, z kept). `cylindrical` needs all of `axis`, `center` and `angle`: the manual gives no default for them. Range: every number finite (else E0227), the axis not zero (E0206); a map that sends two distinct nodes of the surface onto one point is refused when the image is made (E0326)."
     ),
     // Enforcement.
     cmd!(
@@ -273,14 +273,14 @@ pub static COMMANDS: &[CommandSpec] = &[
         "dash_penalty_factor",
         [ENF],
         "= <f>",
-        "Penalty factor of the Dash (mortar penalty) model."
+        "Penalty factor of the Dash (mortar penalty) model. Range: finite and > 0 (else E0227)."
     ),
     cmd!(
         "offset temperature",
         "offset_temperature",
         [ENF],
         "= [constant [value =]] <t>",
-        "Temperature offset added across the interface (material model `Offset Temperature = Constant Value = <t>`)."
+        "Temperature offset added across the interface (material model `Offset Temperature = Constant Value = <t>`). Range: finite (else E0227)."
     ),
     cmd!(
         "quarantine faulty points",
@@ -294,7 +294,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "contact_pressure",
         [ENF],
         "= <p>",
-        "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins)."
+        "Contact pressure (Pa) seen by pressure-dependent conductance models (CMY, tables of pressure, plugins). Range: finite and >= 0, a compressive pressure (else E0227)."
     ),
     cmd!(
         "contact surface pressure",
@@ -403,7 +403,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "normal_tolerance",
         [INT, SO],
         "[=] <distance>",
-        "Largest normal gap at which a pair is found (> 0)."
+        "Largest normal gap at which a pair is found. Range: a finite distance > 0 (else E0208)."
     ),
     cmd!(
         "enforcement",
@@ -432,35 +432,35 @@ pub static COMMANDS: &[CommandSpec] = &[
         "tangential_tolerance",
         [SO],
         "[=] <distance>",
-        "How far outside a face a projection still counts."
+        "How far outside a face a projection still counts, relative to the face size (default 0.001). Range: finite and >= 0 (else E0227)."
     ),
     cmd!(
         "buffer factor",
         "buffer_factor",
         [SO],
         "[=] <f>",
-        "Growth of the search boxes, relative to the face size (ELFEN: `Buffer_factor`)."
+        "Growth of the search boxes, relative to the mean face size (ELFEN: `Buffer_factor`; default 1 in 3-D, 5 in 2-D). Range: finite and >= 0 (else E0227)."
     ),
     cmd!(
         "field factor",
         "field_factor",
         [SO],
         "[=] <f>",
-        "Scale of the search field around each face (ELFEN: `Field_factor`)."
+        "Largest gap considered without a normal tolerance, relative to the face size (ELFEN: `Field_factor`; default 0.2). Range: finite and > 0 (else E0227)."
     ),
     cmd!(
         "normal check angle",
         "normal_check_angle",
         [SO],
         "[=] <degrees>",
-        "Largest angle between normals of a pair (ELFEN: `Normal_dir_chk_angle`)."
+        "Largest angle between the side-B normal and the reversed side-A normal of a pair (ELFEN: `Normal_dir_chk_angle`; default 80). Range: 0 < degrees <= 180, an angle between two directions (else E0227)."
     ),
     cmd!(
         "search update frequency",
         "search_update_frequency",
         [SO],
         "[=] <n>",
-        "Redo the search every n steps (ELFEN: `Global_update_frequency`); the value is kept in the spec.",
+        "Redo the search every n steps (ELFEN: `Global_update_frequency`); the value is kept in the spec. Range: n >= 1 (else E0227).",
         warns "seam's meshes do not move in `seam run`, so re-searching has no effect; a warning says so"
     ),
     // Contact Surface block (Sierra/SM).
@@ -518,14 +518,14 @@ pub static COMMANDS: &[CommandSpec] = &[
         "subset",
         [CS],
         "<name> with normal <nx> <ny> <nz>",
-        "Split off the faces whose normal is closest to this direction."
+        "Split off the faces whose normal is closest to this direction. Range: finite (else E0227) and not zero (else E0206)."
     ),
     cmd!(
         "auto subset",
         "auto_subset",
         [CS],
         "<name> [number of subsets <n>] [angle <degrees>]",
-        "Split the surface into subsets by normal direction."
+        "Split the surface into subsets by normal direction. Range: n >= 1 (else E0203), the angle finite and > 0 (else E0202)."
     ),
     cmd!(
         "contact type",
@@ -823,6 +823,24 @@ pub fn reference_markdown() -> String {
          file when an enforcement's `use toggle block` names it (an unused one is only \
          skipped): seam cannot read its schedule; give it as a `[[toggle]]` of the problem \
          file instead.\n"
+    );
+    let _ = writeln!(
+        out,
+        "Limits: a deck file (contact deck, whole Sierra input file or TOML) is read up to \
+         {} MiB and a Lua file up to {} MiB; a larger file, or a device such as \
+         `/dev/zero` that never ends, is refused (E0003) without being read to its end. A \
+         deck is UTF-8 text (a leading byte-order mark is accepted); another encoding is \
+         refused at the line and column of the first byte that is not UTF-8 (E0004). Blocks \
+         nest at most {} deep (E0114). Of the blocks left open at the end of the file, the \
+         {} outermost are reported one by one and the rest counted in one more E0101; any \
+         run prints at most {} diagnostics, then one line counting the others. Every number \
+         has the range given with its command: a value outside it is refused with the range \
+         in the message, since it would not fail but change the answer.\n",
+        crate::diag::MAX_DECK_BYTES >> 20,
+        crate::diag::MAX_LUA_BYTES >> 20,
+        super::tree::MAX_NESTING,
+        super::tree::UNCLOSED_SHOWN,
+        crate::diag::MAX_RENDERED,
     );
     for b in BLOCKS {
         let name = match b.naming {

@@ -917,14 +917,24 @@ impl Lower {
                     return;
                 }
                 c.skip_sep();
-                let Some((radius, _)) = self.number(c, "a radius") else {
+                let Some((radius, radius_at)) = self.number(c, "a radius") else {
                     return;
                 };
+                self.locs.set(
+                    format!("{d}.restrict_contact_to_subdomain.radius"),
+                    radius_at,
+                );
                 if !(self.keyword(c, "and") && self.keyword(c, "point")) {
                     return;
                 }
                 c.skip_sep();
                 let (p, p_at) = self.numbers(c, "a coordinate");
+                if let Some(l) = &p_at {
+                    self.locs.set(
+                        format!("{d}.restrict_contact_to_subdomain.point"),
+                        l.clone(),
+                    );
+                }
                 match <[f64; 3]>::try_from(p.as_slice()) {
                     Ok(point) => {
                         cd.restrict_contact_to_subdomain = Some(Subdomain { radius, point })
@@ -987,8 +997,10 @@ impl Lower {
             "update_search_every_n_steps" => {
                 self.once(seen, c);
                 c.skip_sep();
-                if let Some((n, _)) = self.count(c, "a whole number of steps") {
+                if let Some((n, n_at)) = self.count(c, "a whole number of steps") {
                     cd.update_search_every_n_steps = Some(n);
+                    self.locs
+                        .set(format!("{d}.update_search_every_n_steps"), n_at);
                 }
                 if c.peek()
                     .is_some_and(|t| t.lower == "steps" || t.lower == "step")
@@ -1414,14 +1426,19 @@ impl Lower {
                 "dash_penalty_factor" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();
-                    if let Some((v, _)) = self.number(&mut c, "a number") {
+                    if let Some((v, v_at)) = self.number(&mut c, "a number") {
                         e.dash_penalty_factor = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.dash_penalty_factor"), v_at);
                     }
                 }
                 "offset_temperature" => {
                     self.once(&mut seen, &c);
-                    if let Some(v) = self.constant_value(&mut c, "a temperature difference") {
+                    if let Some((v, v_at)) = self.constant_value(&mut c, "a temperature difference")
+                    {
                         e.offset_temperature = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.offset_temperature"), v_at);
                     }
                 }
                 "contact_pressure" => {
@@ -1450,8 +1467,10 @@ impl Lower {
                             pressure_from = Some((phrase, line.line));
                         }
                     }
-                    if let Some(v) = self.constant_value(&mut c, "a pressure") {
+                    if let Some((v, v_at)) = self.constant_value(&mut c, "a pressure") {
                         e.contact_pressure = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.contact_pressure"), v_at);
                     }
                 }
                 "contact_gap_temperature" => {
@@ -1516,7 +1535,7 @@ impl Lower {
 
     /// `= [constant [value =]] <number>`: the material-model form `Constant Value = v`
     /// and the plain `= v`.
-    fn constant_value(&mut self, c: &mut Cur, what: &str) -> Option<f64> {
+    fn constant_value(&mut self, c: &mut Cur, what: &str) -> Option<(f64, Loc)> {
         c.skip_sep();
         if c.peek()
             .is_some_and(|t| t.is_word() && t.lower == "constant")
@@ -1527,7 +1546,7 @@ impl Lower {
             }
             c.skip_sep();
         }
-        self.number(c, what).map(|(v, _)| v)
+        self.number(c, what)
     }
 
     /// A material-model line: `<property> [=] <model> [args…]`, the property named by
@@ -1710,9 +1729,12 @@ impl Lower {
             match key {
                 "self_contact" => x.self_contact = self.flag(&mut c),
                 "search_update_frequency" => {
-                    x.search_update_frequency = self
-                        .count(&mut c, "a whole number of steps")
-                        .map(|(n, _)| n);
+                    x.search_update_frequency =
+                        self.count(&mut c, "a whole number of steps")
+                            .map(|(n, at)| {
+                                self.locs.set(format!("{d}.search_options.{key}"), at);
+                                n
+                            });
                 }
                 _ => {
                     let what = if key.ends_with("angle") {

@@ -41,10 +41,34 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
                 locs.set(key, at(v.span()));
             }
         };
-        put(
-            format!("{d}.opposed_normal_threshold_angle"),
-            field(t, "opposed_normal_threshold_angle"),
-        );
+        for key in [
+            "opposed_normal_threshold_angle",
+            "update_search_every_n_steps",
+        ] {
+            put(format!("{d}.{key}"), field(t, key));
+        }
+        if let Some(n) = field(t, "restrict_contact_to_subdomain") {
+            for key in ["radius", "point"] {
+                put(
+                    format!("{d}.restrict_contact_to_subdomain.{key}"),
+                    sub(n, key),
+                );
+            }
+        }
+        for (k, (c, n)) in def
+            .control_assignments
+            .iter_mut()
+            .zip(items(t, "control_assignment"))
+            .enumerate()
+        {
+            c.at = at(n.span());
+            if let Some(control) = sub(n, "control") {
+                put(
+                    format!("{d}.control_assignment.{k}.factor"),
+                    sub(control, "factor"),
+                );
+            }
+        }
         for (s, (surf, n)) in def.surfaces.iter_mut().zip(items(t, "surface")).enumerate() {
             put(format!("{d}.surface.{s}.name"), sub(n, "name"));
             let loc = at(n.span());
@@ -96,10 +120,14 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
             .enumerate()
         {
             e.at = at(n.span());
-            put(
-                format!("{d}.enforcement.{k}.use_toggle_block"),
-                sub(n, "use_toggle_block"),
-            );
+            for key in [
+                "use_toggle_block",
+                "dash_penalty_factor",
+                "offset_temperature",
+                "contact_pressure",
+            ] {
+                put(format!("{d}.enforcement.{k}.{key}"), sub(n, key));
+            }
             let table = n.get_ref().as_table();
             for (j, (m, mn)) in e
                 .models
@@ -155,6 +183,7 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
                 "buffer_factor",
                 "field_factor",
                 "normal_check_angle",
+                "search_update_frequency",
             ] {
                 put(format!("{d}.search_options.{key}"), sub(n, key));
             }

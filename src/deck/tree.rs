@@ -5,7 +5,11 @@
 //! block phrases (longest match); the rest of the line is the block's name. An `end` line
 //! may repeat the type and/or the name, and must then match (else E0102, and the block
 //! is closed all the same). Blocks still open at the end of the file are reported at
-//! their `begin` line (E0101). A block of unknown type keeps its E0105 diagnostic in
+//! their `begin` line (E0101): the outermost [`UNCLOSED_SHOWN`] one by one, the others in
+//! one diagnostic at the innermost. Blocks nest at most [`MAX_NESTING`] deep: a `begin`
+//! deeper than that is E0114, and it and everything up to its `end` are skipped (so a
+//! file of 100 000 `begin` lines neither overflows the stack nor reports 100 000
+//! errors). A block of unknown type keeps its E0105 diagnostic in
 //! [`Block::unknown`] instead of reporting it: whether it is an error depends on where it
 //! sits (in a whole Sierra input file, blocks outside contact definitions are skipped).
 
@@ -55,11 +59,26 @@ impl Block {
     }
 }
 
+/// How deep blocks may nest. A contact deck nests three deep (`contact definition`,
+/// `contact surface`, a toggle block), a whole Sierra input file about eight (`sierra`,
+/// `procedure`, `region`, …); 64 leaves room for any real file and bounds the recursion
+/// of the stages after this one.
+pub const MAX_NESTING: usize = 64;
+
+/// How many unclosed blocks are reported one by one (outermost first); the rest are
+/// counted in one more diagnostic. One missing `end` leaves the outermost open blocks
+/// unclosed, so those are the ones to show.
+pub const UNCLOSED_SHOWN: usize = 3;
+
 /// The file's top level.
 pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
     let mut diags = Diagnostics::default();
     let mut top: Vec<Item> = Vec::new();
     let mut stack: Vec<Block> = Vec::new();
+    // `begin` lines open inside a block nested too deep: skipped with all they hold.
+    let mut skipped = 0usize;
+    // Blocks skipped that were never closed.
+    let mut skipped_total = 0usize;
     for line in lines {
         // `end time = 10` is a line of a Sierra input file, not the end of a block.
         let first = line
@@ -67,11 +86,35 @@ pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
             .first()
             .filter(|_| !line.tokens.iter().any(Token::is_sep))
             .map(|t| t.lower.as_str());
+        let keyword = line.tokens.first().is_some_and(Token::is_word);
         match first {
-            Some("begin") if line.tokens.first().is_some_and(Token::is_word) => {
+            Some("begin") if keyword && (skipped > 0 || stack.len() >= MAX_NESTING) => {
+                if skipped == 0 {
+                    diags.push(
+                        Diagnostic::error(
+                            codes::TOO_DEEP,
+                            format!(
+                                "blocks nested more than {MAX_NESTING} deep: this block and everything in it is skipped"
+                            ),
+                        )
+                        .at(span(file, &line.tokens))
+                        .help(format!(
+                            "a contact deck nests blocks three deep and a whole Sierra input file about eight; check that every `begin` has its `end` (seam reads at most {MAX_NESTING} levels)"
+                        )),
+                    );
+                }
+                skipped += 1;
+                skipped_total += 1;
+            }
+            Some("end") if keyword && skipped > 0 => {
+                skipped -= 1;
+                skipped_total -= 1;
+            }
+            _ if skipped > 0 => {}
+            Some("begin") if keyword => {
                 stack.push(open(file, line));
             }
-            Some("end") if line.tokens.first().is_some_and(Token::is_word) => match stack.pop() {
+            Some("end") if keyword => match stack.pop() {
                 Some(mut block) => {
                     check_end(file, &block, &line, &mut diags);
                     block.end_line = line.line;
@@ -87,7 +130,12 @@ pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
         }
     }
     // Report unclosed blocks outermost first, and keep their contents.
-    for block in &stack {
+    let unclosed = stack.len() + skipped_total;
+    for block in stack.iter().take(if unclosed > UNCLOSED_SHOWN + 1 {
+        UNCLOSED_SHOWN
+    } else {
+        unclosed
+    }) {
         let what = describe(block);
         diags.push(
             Diagnostic::error(codes::UNCLOSED_BLOCK, format!("`{what}` is never closed"))
@@ -96,6 +144,28 @@ pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
                     "add `end` (or `end {}`) after the last line of this block",
                     block.spec.map_or("", |s| s.phrase)
                 )),
+        );
+    }
+    if let (Some(last), true) = (stack.last(), unclosed > UNCLOSED_SHOWN + 1) {
+        let rest = unclosed - UNCLOSED_SHOWN;
+        let from = stack
+            .get(UNCLOSED_SHOWN)
+            .map_or(last.head.line, |b| b.head.line);
+        let deeper = if skipped_total > 0 {
+            format!(" ({skipped_total} of them nested too deep to read)")
+        } else {
+            String::new()
+        };
+        diags.push(
+            Diagnostic::error(
+                codes::UNCLOSED_BLOCK,
+                format!(
+                    "{rest} more blocks opened from line {from} on are never closed{deeper}; the innermost read is `{}`",
+                    describe(last)
+                ),
+            )
+            .at(span(file, &last.head.tokens))
+            .help("every `begin` needs its `end`; a file of `begin` lines with no `end` is probably not a deck"),
         );
     }
     while let Some(block) = stack.pop() {
@@ -273,6 +343,59 @@ mod tests {
         assert_eq!(lines, [1, 2]);
         assert!(d.0.iter().all(|x| x.code == codes::UNCLOSED_BLOCK));
         assert_eq!(top.len(), 1);
+    }
+
+    #[test]
+    fn many_unclosed_blocks_are_reported_in_a_few_lines() {
+        let src = "begin contact definition\n".repeat(10_000);
+        let (top, d) = tree(&src);
+        let codes: Vec<&str> = d.0.iter().map(|x| x.code).collect();
+        // One E0114 at the first block too deep, the three outermost unclosed blocks,
+        // one count of the rest.
+        assert_eq!(codes.iter().filter(|&&c| c == codes::TOO_DEEP).count(), 1);
+        assert_eq!(
+            codes
+                .iter()
+                .filter(|&&c| c == codes::UNCLOSED_BLOCK)
+                .count(),
+            UNCLOSED_SHOWN + 1
+        );
+        let last = d.0.iter().rfind(|x| x.code == codes::UNCLOSED_BLOCK);
+        let message = last.map(|x| x.message.clone()).unwrap_or_default();
+        assert!(
+            message.starts_with("9997 more blocks opened from line 4 on are never closed"),
+            "{message}"
+        );
+        assert_eq!(top.len(), 1);
+    }
+
+    #[test]
+    fn nesting_is_bounded_and_the_deep_part_skipped() {
+        let deep = MAX_NESTING + 5;
+        let mut src = "begin contact definition\n".repeat(deep);
+        src += &"end\n".repeat(deep);
+        src += "begin contact definition after\nend\n";
+        let (top, d) = tree(&src);
+        let codes: Vec<&str> = d.0.iter().map(|x| x.code).collect();
+        assert_eq!(codes, [codes::TOO_DEEP]);
+        let at = d.0[0].loc.as_ref().map(|l| l.line);
+        assert_eq!(at, Some(MAX_NESTING as u32 + 1));
+        // The deep part is gone, the rest of the file is read.
+        assert_eq!(top.len(), 2);
+        let mut depth = 0;
+        let mut items = &top;
+        while let Some(Item::Block(b)) = items.first() {
+            depth += 1;
+            items = &b.items;
+        }
+        assert_eq!(depth, MAX_NESTING);
+    }
+
+    #[test]
+    fn four_unclosed_blocks_are_each_reported() {
+        let (_, d) = tree(&"begin contact definition\n".repeat(UNCLOSED_SHOWN + 1));
+        assert_eq!(d.len(), UNCLOSED_SHOWN + 1);
+        assert!(d.0.iter().all(|x| x.message.ends_with("is never closed")));
     }
 
     #[test]

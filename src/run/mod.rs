@@ -514,13 +514,16 @@ enum Outcome {
 fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, RunError> {
     let start = Instant::now();
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        input_error(
-            "E0700",
-            format!("cannot read problem file {}: {e}", path.display()),
-            "check the path",
-        )
-    })?;
+    // Bounded (a device or a mesh given by mistake is refused), UTF-8, BOM dropped.
+    let text =
+        crate::diag::read_text(path, "problem file", crate::diag::MAX_DECK_BYTES).map_err(|e| {
+            let mut sources = SourceMap::default();
+            let mut d = crate::deck::read_error(&e, &mut sources);
+            if d.code == crate::deck::codes::CANNOT_READ {
+                d.code = "E0700";
+            }
+            RunError::Input(Diagnostics(vec![d]), sources)
+        })?;
     let problem: Problem = toml::from_str(&text).map_err(|e| {
         let file = crate::diag::file_label(path);
         let mut sources = SourceMap::default();

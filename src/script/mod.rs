@@ -58,6 +58,11 @@ pub enum ScriptError {
     NotANumber { name: String, got: String },
     #[error("cannot read Lua file {path}: {message}")]
     Io { path: String, message: String },
+    /// A Lua file too large ([`crate::diag::MAX_LUA_BYTES`]) or not UTF-8.
+    #[error(transparent)]
+    Read(Box<crate::diag::ReadError>),
+    #[error("Lua function {name} returned {got}; it must return exactly one finite number")]
+    NotOneValue { name: String, got: String },
 }
 
 /// A compiled Lua function with the name used in messages.
@@ -171,12 +176,9 @@ impl Sandbox {
             .map_err(|e| self.classify(chunk, e))
     }
 
-    /// Run a Lua file.
+    /// Run a Lua file, read with [`read_lua_file`].
     pub fn run_file(&self, path: &Path) -> Result<(), ScriptError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScriptError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = read_lua_file(path)?;
         self.run_source(&path.display().to_string(), &text)
     }
 
@@ -202,7 +204,11 @@ impl Sandbox {
         expr: &str,
         params: &[&str],
     ) -> Result<ScriptFn, ScriptError> {
-        let source = format!("return function({}) return ({expr}) end", params.join(", "));
+        // No parentheses around `expr`: they would keep the first of several values and
+        // hide an expression that returns two (`math.modf(x)`, `x, y`), which
+        // [`Sandbox::call`] refuses. The newline keeps a trailing `--` comment from
+        // swallowing the `end`.
+        let source = format!("return function({}) return {expr}\nend", params.join(", "));
         self.reset_budget();
         let f: mlua::Function = self
             .lua
@@ -227,11 +233,25 @@ impl Sandbox {
         self.compiled.insert(text.to_string(), f);
     }
 
-    /// Call a function with numeric arguments; it must return one finite number.
+    /// Call a function with numeric arguments; it must return exactly one finite number
+    /// (none, two or more are [`ScriptError::NotOneValue`], naming what came back).
     pub fn call(&self, f: &ScriptFn, args: &[f64]) -> Result<f64, ScriptError> {
         self.reset_budget();
         let args = mlua::Variadic::from_iter(args.iter().copied());
-        let v: Value = f.f.call(args).map_err(|e| self.classify(&f.name, e))?;
+        let values: mlua::MultiValue = f.f.call(args).map_err(|e| self.classify(&f.name, e))?;
+        if values.len() != 1 {
+            let shown: Vec<String> = values.iter().take(4).map(describe).collect();
+            let more = if values.len() > 4 { ", …" } else { "" };
+            let got = match values.len() {
+                0 => "no value".to_string(),
+                n => format!("{n} values ({}{more})", shown.join(", ")),
+            };
+            return Err(ScriptError::NotOneValue {
+                name: f.name.clone(),
+                got,
+            });
+        }
+        let v = values.into_iter().next().unwrap_or(Value::Nil);
         match v {
             Value::Number(x) if x.is_finite() => Ok(x),
             Value::Integer(i) => Ok(i as f64),
@@ -243,9 +263,20 @@ impl Sandbox {
     }
 }
 
+/// The text of a Lua file: at most [`crate::diag::MAX_LUA_BYTES`], UTF-8, a leading
+/// byte-order mark dropped. For every reader of Lua files, so all share the bound.
+pub fn read_lua_file(path: &Path) -> Result<String, ScriptError> {
+    crate::diag::read_text(path, "Lua file", crate::diag::MAX_LUA_BYTES).map_err(|e| match e {
+        crate::diag::ReadError::Io { path, message, .. } => ScriptError::Io { path, message },
+        other => ScriptError::Read(Box::new(other)),
+    })
+}
+
 fn describe(v: &Value) -> String {
     match v {
         Value::Number(x) => format!("{x}"),
+        Value::Integer(i) => format!("{i}"),
+        Value::String(s) => format!("the string {:?}", s.to_string_lossy()),
         Value::Nil => "nil".into(),
         other => other.type_name().to_string(),
     }
@@ -345,6 +376,60 @@ mod tests {
         let s = sandbox();
         let err = s.run_source("bin.lua", "\x1bLua\x54\x00").unwrap_err();
         assert!(err.to_string().contains("binary"), "{err}");
+    }
+
+    #[test]
+    fn one_value_exactly() {
+        let s = sandbox();
+        for (expr, want) in [
+            ("x, y", "returned 2 values (1, 2)"),
+            ("math.modf(x + 0.5)", "returned 2 values (1, 0.5)"),
+            ("x -- a comment", ""),
+        ] {
+            let f = s.expression("deck.i:3", expr, &["x", "y"]).unwrap();
+            match s.call(&f, &[1.0, 2.0]) {
+                Ok(v) => assert!(want.is_empty() && v == 1.0, "{expr}: {v}"),
+                Err(e) => {
+                    let msg = e.to_string();
+                    assert!(matches!(e, ScriptError::NotOneValue { .. }), "{msg}");
+                    assert!(msg.contains(want) && msg.contains(expr), "{expr}: {msg}");
+                }
+            }
+        }
+        s.run_source(
+            "maps.lua",
+            "function two(x) return x, x end function none(x) end",
+        )
+        .unwrap();
+        let f = s.function("two", "maps.lua").unwrap();
+        let msg = s.call(&f, &[3.0]).unwrap_err().to_string();
+        assert!(
+            msg.contains("two (maps.lua) returned 2 values (3, 3)"),
+            "{msg}"
+        );
+        let f = s.function("none", "maps.lua").unwrap();
+        let msg = s.call(&f, &[3.0]).unwrap_err().to_string();
+        assert!(msg.contains("none (maps.lua) returned no value"), "{msg}");
+    }
+
+    #[test]
+    fn lua_files_are_bounded() {
+        let dir = std::env::temp_dir().join(format!("seam-lua-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bom = dir.join("bom.lua");
+        std::fs::write(&bom, "\u{feff}function f(x) return 2*x end\n").unwrap();
+        let s = sandbox();
+        s.run_file(&bom).unwrap();
+        let f = s.function("f", "bom.lua").unwrap();
+        assert_eq!(s.call(&f, &[2.0]).unwrap(), 4.0);
+        let bad = dir.join("latin1.lua");
+        std::fs::write(&bad, b"-- caf\xe9\nfunction f(x) return x end\n").unwrap();
+        let msg = s.run_file(&bad).unwrap_err().to_string();
+        assert!(
+            msg.contains("not UTF-8") && msg.contains("line 1, column 7"),
+            "{msg}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -14,6 +14,11 @@
 //! - the image must land on its destination: the worst distance from an image node to
 //!   the destination is reported, and must be below 5 % of the destination's mean face
 //!   size ([`LANDING_TOLERANCE`]);
+//! - the map must be one-to-one on the surface's nodes ([`check_one_to_one`]): two nodes
+//!   at least [`FOLD_SOURCE_FRACTION`] of a face apart must not land within
+//!   [`FOLD_IMAGE_FRACTION`] of a face of each other — a map that collapses the surface
+//!   onto a point or folds it onto itself would otherwise land "on" its destination
+//!   and pass every other check (error E0326, before the search);
 //! - an N-fold cylindrical rotation (`360/θ` an integer N) must close up: the map applied
 //!   N times returns every node within 1e-12 × model size; an angle that does not divide
 //!   360° is a warning.
@@ -29,7 +34,7 @@ use super::pairing::{
 use crate::deck::spec::{ContactDefinition, PeriodicTransform, Periodicity};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap};
 use crate::interaction::{Interaction, SearchSettings};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, NodeId};
 use crate::periodic::{
     LuaMap, MapError, MapSource, PeriodicMap, Rigid, Rotation, Translation, align_surface,
     closure_error, fold_count,
@@ -208,6 +213,12 @@ pub enum PeriodicError {
     #[error("{n} rotations by {angle}° miss the start by {miss:.3e}")]
     NotClosed { n: usize, angle: f64, miss: f64 },
     #[error(
+        "the map is not one-to-one: nodes {} at {} and {} at {} land at {} and {}, {:.3e} apart (the surface's faces are {:.3e} across)",
+        .0.numbers[0], point(.0.source[0]), .0.numbers[1], point(.0.source[1]),
+        point(.0.image[0]), point(.0.image[1]), .0.image_distance(), .0.face_size
+    )]
+    Folds(Box<Fold>),
+    #[error(
         "its image does not land on `{destination}`: the worst image node is {worst:.3e} away (accepted: {limit:.3e})"
     )]
     Landing {
@@ -215,6 +226,110 @@ pub enum PeriodicError {
         worst: f64,
         limit: f64,
     },
+}
+
+/// Two distinct nodes of a surface that a periodic map sends (nearly) onto one point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fold {
+    pub nodes: [NodeId; 2],
+    /// Their user-visible numbers (as [`Mesh::node_number`]); the dense ids plus one when
+    /// the caller has no mesh.
+    pub numbers: [i64; 2],
+    pub source: [[f64; 3]; 2],
+    pub image: [[f64; 3]; 2],
+    /// The source's mean face size, the scale of the test.
+    pub face_size: f64,
+}
+
+impl Fold {
+    pub fn image_distance(&self) -> f64 {
+        crate::vec3::norm(crate::vec3::sub(self.image[0], self.image[1]))
+    }
+}
+
+fn point(p: [f64; 3]) -> String {
+    format!("({}, {}, {})", short(p[0]), short(p[1]), short(p[2]))
+}
+
+/// A coordinate in a message: 6 significant digits, no trailing zeros.
+fn short(x: f64) -> String {
+    let t = format!("{x:.6}");
+    let t = t.trim_end_matches('0').trim_end_matches('.');
+    if t == "-0" { "0".into() } else { t.into() }
+}
+
+/// Two images closer than this fraction of the source's mean face size count as one
+/// point. A periodic map is a rigid motion or close to one, so images of distinct nodes
+/// stay about as far apart as the nodes; 1 % of a face is far below any node spacing of
+/// a usable mesh and far above round-off.
+pub const FOLD_IMAGE_FRACTION: f64 = 0.01;
+
+/// Nodes closer than this fraction of the mean face size are taken as one place (a
+/// duplicated node), whose images may coincide: only nodes at least this far apart
+/// whose images coincide are a fold.
+pub const FOLD_SOURCE_FRACTION: f64 = 0.1;
+
+/// Check that `map` (which made `image` from `source`, face by face) keeps distinct nodes
+/// distinct: the first two nodes at least [`FOLD_SOURCE_FRACTION`] of a face apart whose
+/// images lie within [`FOLD_IMAGE_FRACTION`] of a face, or `None`. Images are hashed
+/// into cells of that size and each is compared with the few kept in the 27 cells
+/// around it; a kept image has no other within the distance, so a cell keeps at most
+/// eight and the check is linear in the number of nodes. `numbers` gives the nodes'
+/// user-visible numbers.
+pub fn check_one_to_one(
+    source: &SurfaceGeometry,
+    image: &SurfaceGeometry,
+    numbers: impl Fn(NodeId) -> i64,
+) -> Option<Fold> {
+    use std::collections::{HashMap, HashSet};
+    let h = source.mean_face_size();
+    if !(h > 0.0 && h.is_finite()) {
+        return None;
+    }
+    let (near, far) = (FOLD_IMAGE_FRACTION * h, FOLD_SOURCE_FRACTION * h);
+    let dist = |a: [f64; 3], b: [f64; 3]| crate::vec3::norm(crate::vec3::sub(a, b));
+    let cell = |p: [f64; 3]| p.map(|x| (x / near).floor() as i64);
+    let mut seen: HashSet<NodeId> = HashSet::new();
+    let mut kept: Vec<(NodeId, [f64; 3], [f64; 3])> = Vec::new();
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    for (f, g) in source.faces.iter().zip(&image.faces) {
+        for k in 0..f.len as usize {
+            let (node, x, y) = (f.nodes[k], f.x[k], g.x[k]);
+            if !seen.insert(node) || !y.iter().all(|c| c.is_finite()) {
+                continue;
+            }
+            let c = cell(y);
+            let mut duplicate = false;
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        let key = [c[0] + dx, c[1] + dy, c[2] + dz];
+                        for &j in grid.get(&key).map_or(&[][..], Vec::as_slice) {
+                            let (other, ox, oy) = kept[j];
+                            if dist(y, oy) >= near {
+                                continue;
+                            }
+                            if dist(x, ox) >= far {
+                                return Some(Fold {
+                                    nodes: [other, node],
+                                    numbers: [numbers(other), numbers(node)],
+                                    source: [ox, x],
+                                    image: [oy, y],
+                                    face_size: h,
+                                });
+                            }
+                            duplicate = true;
+                        }
+                    }
+                }
+            }
+            if !duplicate {
+                grid.entry(c).or_default().push(kept.len());
+                kept.push((node, x, y));
+            }
+        }
+    }
+    None
 }
 
 /// The map of a periodic transform from `source` (and, for `Align_Surface`, onto
@@ -365,7 +480,7 @@ pub fn landing(image: &SurfaceGeometry, destination: &SurfaceGeometry) -> Landin
 /// Search one `Periodicity For S = …` of `def`: the image of `S` paired with its
 /// destination (given by `Align_Surface`, else the face surface other than `S` on which
 /// most image points land), and the map. `geometry` is [`surface_geometries`] of
-/// `surfaces`. Diagnostics (E0320–E0325, W0320) and timing go to `out`; `None` when the
+/// `surfaces`. Diagnostics (E0320–E0326, W0320) and timing go to `out`; `None` when the
 /// condition cannot be searched.
 #[allow(clippy::too_many_arguments)]
 pub fn search_periodicity(
@@ -499,6 +614,15 @@ pub fn search_periodicity(
         }
     };
     out.timing.build_s += t.elapsed().as_secs_f64();
+    if let Some(fold) = check_one_to_one(source, &image, |n| mesh.node_number(n)) {
+        let e = PeriodicError::Folds(Box::new(fold));
+        out.diagnostics.push(
+            Diagnostic::error("E0326", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(at))
+                .help("a periodic map carries each node to its own place on the partner surface (a rigid motion or close to one); check the map: a constant (`x_map = 0`) or a folding formula (`x_map = math.abs(x)`) sends several nodes to one point"),
+        );
+        return None;
+    }
 
     // The destination: given, or the face surface that takes most image points.
     let candidates: Vec<usize> = match destination {

@@ -11,6 +11,7 @@ mod enforce;
 mod examples;
 mod fem;
 mod hard_cases;
+mod hard_input;
 mod interactions;
 mod manual;
 mod mesh_io;

@@ -1,0 +1,3 @@
+function centre(x, y, z)
+  return 0.5
+end
