@@ -13,6 +13,7 @@
 use std::cell::Cell;
 use std::fmt::Write as _;
 use std::sync::Once;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use seam_plugin_abi::SeamPointIn;
 
@@ -43,10 +44,21 @@ const SIGNALS: [libc::c_int; 5] = [
 static mut PREVIOUS: [std::mem::MaybeUninit<libc::sigaction>; 5] =
     [const { std::mem::MaybeUninit::uninit() }; 5];
 static INSTALL: Once = Once::new();
+/// Set in a plugin worker process: there a crash must kill the process, so that the
+/// parent sees how it died (see [`super::isolate`]).
+static DISABLED: AtomicBool = AtomicBool::new(false);
+
+/// No reports and no handlers from here on (a plugin worker).
+pub(super) fn disable() {
+    DISABLED.store(true, Ordering::Relaxed);
+}
 
 /// Run `f` (a call into a plugin) with `site` on record, so that a crash or an `exit`
 /// during it is reported.
 pub(super) fn guarded<R>(site: &CallSite<'_>, f: impl FnOnce() -> R) -> R {
+    if DISABLED.load(Ordering::Relaxed) {
+        return f();
+    }
     install();
     // SAFETY: the pointer is cleared before `site` goes out of scope (below, also on
     // unwind via the reset guard); the handlers only read it while it is set.
