@@ -207,7 +207,7 @@ enum Backend {
         serial: Mutex<()>,
     },
     /// In a worker process; one call at a time.
-    Process(Mutex<Worker>),
+    Process(Box<Mutex<Worker>>),
 }
 
 // SAFETY: the instance pointer is only used through the plugin's functions; calls are
@@ -414,7 +414,7 @@ impl Plugin {
         Ok(Plugin {
             label: format!("`{}` ({})", info.name, path.display()),
             info,
-            backend: Backend::Process(Mutex::new(worker)),
+            backend: Backend::Process(Box::new(Mutex::new(worker))),
             data: data.clone(),
             fd_notice_given: AtomicBool::new(false),
         })

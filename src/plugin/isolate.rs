@@ -24,7 +24,7 @@
 //! call faults at once. No timeout: a plugin that hangs, hangs the call.
 
 use std::ffi::CString;
-use std::io::Read;
+use std::io::{BufReader, Read};
 use std::os::fd::{AsRawFd, FromRawFd, OwnedFd};
 use std::os::unix::net::UnixStream;
 use std::os::unix::process::ExitStatusExt;
@@ -113,10 +113,22 @@ pub fn worker_program() -> Result<PathBuf, String> {
 
 // --- wire format -------------------------------------------------------------------------
 
-#[derive(Default)]
+/// A frame being written: 4 bytes kept for the length, then the payload.
 struct Wire(Vec<u8>);
 
+impl Default for Wire {
+    fn default() -> Self {
+        Wire::with_capacity(64)
+    }
+}
+
 impl Wire {
+    fn with_capacity(n: usize) -> Self {
+        let mut v = Vec::with_capacity(n + 4);
+        v.extend_from_slice(&[0; 4]);
+        Wire(v)
+    }
+
     fn u8(&mut self, v: u8) {
         self.0.push(v);
     }
@@ -263,11 +275,12 @@ fn send_all(fd: libc::c_int, mut bytes: &[u8], socket: bool) -> std::io::Result<
     Ok(())
 }
 
-fn send_frame(fd: libc::c_int, payload: &[u8], socket: bool) -> std::io::Result<()> {
-    let mut framed = Vec::with_capacity(payload.len() + 4);
-    framed.extend_from_slice(&(payload.len() as u32).to_le_bytes());
-    framed.extend_from_slice(payload);
-    send_all(fd, &framed, socket)
+/// Send `w`'s frame (its length written into the 4 bytes kept for it).
+fn send_frame(fd: libc::c_int, w: &mut Wire, socket: bool) -> std::io::Result<()> {
+    let len = u32::try_from(w.0.len() - 4)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidInput, "a frame over 4 GiB"))?;
+    w.0[..4].copy_from_slice(&len.to_le_bytes());
+    send_all(fd, &w.0, socket)
 }
 
 fn read_frame(r: &mut impl Read, buf: &mut Vec<u8>) -> std::io::Result<()> {
@@ -435,7 +448,8 @@ pub(super) struct Death {
 
 struct Live {
     child: Child,
-    stream: UnixStream,
+    /// Buffered: a frame's length and payload in one read.
+    stream: BufReader<UnixStream>,
 }
 
 /// A plugin instance in a worker process, started again after it dies.
@@ -452,7 +466,7 @@ impl Drop for Worker {
     fn drop(&mut self) {
         if let Some(mut live) = self.live.take() {
             // End of input: the worker finalises the instance and exits.
-            let _ = live.stream.shutdown(std::net::Shutdown::Both);
+            let _ = live.stream.get_ref().shutdown(std::net::Shutdown::Both);
             drop(live.stream);
             let _ = reap(&mut live.child, Duration::from_secs(2));
         }
@@ -539,7 +553,7 @@ impl Worker {
             .map_err(|e| worker_error(format!("could not be started: {e}")))?;
         let mut live = Live {
             child,
-            stream: mine,
+            stream: BufReader::new(mine),
         };
         let mut w = Wire::default();
         w.0.extend_from_slice(MAGIC);
@@ -554,9 +568,9 @@ impl Worker {
         }
         w.list_i64(&self.data.integer_data);
         w.list_f64(&self.data.real_data);
-        let fd = live.stream.as_raw_fd();
+        let fd = live.stream.get_ref().as_raw_fd();
         let answer =
-            send_frame(fd, &w.0, true).and_then(|()| read_frame(&mut live.stream, &mut self.buf));
+            send_frame(fd, &mut w, true).and_then(|()| read_frame(&mut live.stream, &mut self.buf));
         // Not a worker, or it died while loading (a library initialiser that crashes).
         let fail = |mut live: Live, kill: bool| {
             if kill {
@@ -596,7 +610,7 @@ impl Worker {
 
     /// Send `request`, read the answer into `self.buf`; on any failure, reap the child
     /// and say how it died.
-    fn request(&mut self, request: &[u8]) -> Result<(), Death> {
+    fn request(&mut self, request: &mut Wire) -> Result<(), Death> {
         if self.live.is_none() {
             if self.deaths >= MAX_DEATHS {
                 return Err(Death {
@@ -612,7 +626,7 @@ impl Worker {
                 how: "is not running".into(),
             });
         };
-        let fd = live.stream.as_raw_fd();
+        let fd = live.stream.get_ref().as_raw_fd();
         let result = send_frame(fd, request, true)
             .and_then(|()| read_frame(&mut live.stream, &mut self.buf));
         match result {
@@ -656,10 +670,10 @@ impl Worker {
         outs: &mut [SeamPointOut],
         batch: bool,
     ) -> Result<(), Death> {
-        let mut w = Wire(Vec::with_capacity(64 + ins.len() * 200));
+        let mut w = Wire::with_capacity(64 + ins.len() * 200);
         // SAFETY: by the caller's contract.
         unsafe { write_points(&mut w, ins, batch) };
-        self.request(&w.0)?;
+        self.request(&mut w)?;
         let ns = ins.first().map_or(0, |s| s.n_state);
         let mut p = Parse {
             buf: &self.buf[1..],
@@ -701,7 +715,7 @@ impl Worker {
         let mut w = Wire::default();
         w.u8(CONFORMANCE);
         write_config(&mut w, config);
-        self.request(&w.0)?;
+        self.request(&mut w)?;
         read_report(&mut Parse {
             buf: &self.buf[1..],
         })
@@ -735,7 +749,7 @@ pub fn serve_worker() -> i32 {
         return 2;
     }
     // SAFETY: `chan` was just duplicated and is owned here.
-    let mut input = unsafe { std::fs::File::from_raw_fd(chan) };
+    let mut input = BufReader::new(unsafe { std::fs::File::from_raw_fd(chan) });
     let mut buf = Vec::new();
     if read_frame(&mut input, &mut buf).is_err() {
         return 2;
@@ -772,11 +786,11 @@ pub fn serve_worker() -> i32 {
         Err(e) => {
             w.u8(ERR);
             w.str(&e.to_string());
-            let _ = send_frame(chan, &w.0, false);
+            let _ = send_frame(chan, &mut w, false);
             return 0;
         }
     };
-    if send_frame(chan, &w.0, false).is_err() {
+    if send_frame(chan, &mut w, false).is_err() {
         return 2;
     }
     let mut scratch = Scratch::default();
@@ -786,7 +800,7 @@ pub fn serve_worker() -> i32 {
             return 0;
         }
         let mut p = Parse { buf: &buf };
-        let mut w = Wire(Vec::with_capacity(buf.len()));
+        let mut w = Wire::with_capacity(buf.len());
         w.u8(OK);
         let served = match p.u8() {
             Some(EVALUATE) => scratch.evaluate(&plugin, &mut p, &mut w),
@@ -799,7 +813,7 @@ pub fn serve_worker() -> i32 {
             eprintln!("seam plugin-worker: a request out of protocol");
             return 2;
         }
-        if send_frame(chan, &w.0, false).is_err() {
+        if send_frame(chan, &mut w, false).is_err() {
             return 0;
         }
     }
