@@ -12,8 +12,9 @@
 //! modes give bit-identical results.
 //!
 //! Wire format: frames of a `u32` length and a payload, numbers little-endian, `f64` as
-//! their bits. The parent opens with [`MAGIC`] and a load request; the child answers with
-//! [`MAGIC`] and the plugin's descriptor or the load error. The child writes the protocol
+//! their bits. The parent opens with [`MAGIC`] and a load request; the child greets with
+//! [`MAGIC`] (so a program that is not a worker is told from a worker that died while
+//! loading), then answers with the plugin's descriptor or the load error. The child writes the protocol
 //! on a duplicate of its standard input and sends its standard output to standard error,
 //! so a plugin's `printf` cannot corrupt the channel. The parent writes with
 //! `MSG_NOSIGNAL`: a dead child is an error, not a `SIGPIPE` for an embedding host.
@@ -488,8 +489,9 @@ fn reap(child: &mut Child, patience: Duration) -> std::io::Result<ExitStatus> {
     }
 }
 
-/// `killed by SIGSEGV (invalid memory access)`, `ended with exit status 0 (…)`.
-fn describe(status: &ExitStatus) -> String {
+/// `was killed by SIGSEGV (invalid memory access)`, `ended with exit status 0`; with
+/// `in_plugin` (it died in a plugin call) an exit says what ends a process there.
+fn describe(status: &ExitStatus, in_plugin: bool) -> String {
     if let Some(sig) = status.signal() {
         let name = match sig {
             libc::SIGSEGV => "SIGSEGV (invalid memory access)",
@@ -504,9 +506,10 @@ fn describe(status: &ExitStatus) -> String {
         return format!("was killed by {name}");
     }
     match status.code() {
-        Some(code) => format!(
+        Some(code) if in_plugin => format!(
             "ended with exit status {code} (the plugin called exit, as a Fortran STOP does)"
         ),
+        Some(code) => format!("ended with exit status {code}"),
         None => format!("ended ({status})"),
     }
 }
@@ -569,42 +572,42 @@ impl Worker {
         w.list_i64(&self.data.integer_data);
         w.list_f64(&self.data.real_data);
         let fd = live.stream.get_ref().as_raw_fd();
-        let answer =
+        // The worker greets before it loads, then answers the load.
+        let hello =
             send_frame(fd, &mut w, true).and_then(|()| read_frame(&mut live.stream, &mut self.buf));
-        // Not a worker, or it died while loading (a library initialiser that crashes).
-        let fail = |mut live: Live, kill: bool| {
-            if kill {
-                let _ = live.child.kill();
-            }
+        let fail = |mut live: Live, what: &str| {
+            let _ = live.child.kill();
             let how = reap(&mut live.child, Duration::from_secs(2)).map_or_else(
                 |e| format!("could not be waited for: {e}"),
-                |s| describe(&s),
+                |s| describe(&s, false),
             );
-            worker_error(format!(
-                "did not answer as a seam plugin worker while loading the plugin: it {how}"
-            ))
+            worker_error(format!("{what}: it {how}"))
         };
-        if answer.is_err() {
-            return Err(fail(live, false));
+        if hello.is_err() || self.buf != MAGIC {
+            return Err(fail(live, "is not a seam plugin worker (no greeting)"));
+        }
+        if read_frame(&mut live.stream, &mut self.buf).is_err() {
+            return Err(fail(
+                live,
+                "died while loading the plugin (its initialisers, entry point or init)",
+            ));
         }
         let mut p = Parse { buf: &self.buf };
-        if p.take(MAGIC.len()) != Some(MAGIC.as_slice()) {
-            return Err(fail(live, true));
-        }
+        let fail = |live: Live| fail(live, "answered the load out of protocol");
         match p.u8() {
             Some(OK) => match read_info(&mut p, &path) {
                 Some(info) => {
                     self.live = Some(live);
                     Ok(info)
                 }
-                None => Err(fail(live, true)),
+                None => Err(fail(live)),
             },
             Some(ERR) => {
                 let message = p.string().unwrap_or_default();
                 let _ = reap(&mut live.child, Duration::from_secs(2));
                 Err(PluginError::Isolated { message })
             }
-            _ => Err(fail(live, true)),
+            _ => Err(fail(live)),
         }
     }
 
@@ -617,9 +620,13 @@ impl Worker {
                     how: format!("has died {} times; it is not started again", self.deaths),
                 });
             }
-            self.spawn().map_err(|e| Death {
-                how: format!("could not be started again: {e}"),
-            })?;
+            if let Err(e) = self.spawn() {
+                // A failed start counts as a death: no endless restarts.
+                self.deaths += 1;
+                return Err(Death {
+                    how: format!("could not be started again: {e}"),
+                });
+            }
         }
         let Some(live) = self.live.as_mut() else {
             return Err(Death {
@@ -645,7 +652,7 @@ impl Worker {
                 let status = reap(&mut live.child, Duration::from_secs(2));
                 let mut how = status.map_or_else(
                     |e| format!("could not be waited for: {e}"),
-                    |s| describe(&s),
+                    |s| describe(&s, true),
                 );
                 if protocol {
                     how = format!("answered out of protocol and {how}");
@@ -777,6 +784,10 @@ pub fn serve_worker() -> i32 {
     };
     let mut w = Wire::default();
     w.0.extend_from_slice(MAGIC);
+    if send_frame(chan, &mut w, false).is_err() {
+        return 2;
+    }
+    let mut w = Wire::default();
     let plugin = match Plugin::load_with(&path, &data) {
         Ok(plugin) => {
             w.u8(OK);

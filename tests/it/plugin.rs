@@ -1614,3 +1614,32 @@ fn plugin_isolation_line_in_sierra_and_toml() {
     let text = format!("{e:?}");
     assert!(text.contains("did you mean `process`"), "{text}");
 }
+
+/// A worker that cannot be found, or a program that is not a worker, is a clear load
+/// error naming the plugin and what was tried (`SEAM_PLUGIN_WORKER` overrides the
+/// lookup), and `seam check-plugin --isolate` exits 3 with it.
+#[test]
+fn a_missing_or_wrong_plugin_worker_is_a_clear_error() {
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    for (worker, needle) in [
+        (
+            "/nonexistent/seam",
+            "SEAM_PLUGIN_WORKER=/nonexistent/seam: no such file",
+        ),
+        (
+            "/bin/false",
+            "is not a seam plugin worker (no greeting): it ended with exit status 1",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["check-plugin", "--isolate", &table])
+            .env("SEAM_PLUGIN_WORKER", worker)
+            .output()
+            .expect("seam runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{err}");
+        assert!(err.contains("error[E0500]: plugin"), "{err}");
+        assert!(err.contains("seam_c_table"), "{err}");
+        assert!(err.contains(needle), "{worker}: no `{needle}` in {err}");
+    }
+}
