@@ -840,6 +840,8 @@ struct Scratch {
     real: Vec<f64>,
     old: Vec<f64>,
     new: Vec<f64>,
+    surface_a: CString,
+    surface_b: CString,
     ins: Vec<SeamPointIn>,
     outs: Vec<SeamPointOut>,
 }
@@ -847,6 +849,40 @@ struct Scratch {
 impl Scratch {
     /// One evaluate request: re-create the points, call the plugin, write the outputs.
     fn evaluate(&mut self, plugin: &Plugin, p: &mut Parse<'_>, w: &mut Wire) -> Option<()> {
+        let batch = self.decode(p)?;
+        let s = self;
+        let ns = s.ins.first().map_or(0, |q| q.n_state);
+        s.outs.clear();
+        s.outs.resize(s.ins.len(), SeamPointOut::new());
+        plugin.call_in_process(&s.ins, &mut s.outs, batch);
+        for (i, o) in s.outs.iter().enumerate() {
+            w.i32(o.status);
+            w.f64s(&[
+                o.value,
+                o.d_temp_a,
+                o.d_temp_b,
+                o.d_gap,
+                o.d_pressure,
+                o.cutback_factor,
+            ]);
+            let message: Vec<u8> = if o.status == SEAM_STATUS_OK {
+                Vec::new()
+            } else {
+                o.message
+                    .iter()
+                    .take_while(|&&c| c != 0)
+                    .map(|&c| c as u8)
+                    .collect()
+            };
+            w.bytes(&message);
+            w.f64s(&s.new[i * ns..(i + 1) * ns]);
+        }
+        Some(())
+    }
+
+    /// Re-create the points of an evaluate request (after its tag) in `self.ins`; whether
+    /// to use the batch entry. `None`: out of protocol (sizes and length disagree).
+    fn decode(&mut self, p: &mut Parse<'_>) -> Option<bool> {
         let batch = p.u8()? != 0;
         let n = p.usize()?;
         let (nf, ni, nr, ns) = (p.usize()?, p.usize()?, p.usize()?, p.usize()?);
@@ -857,8 +893,8 @@ impl Scratch {
             .checked_add(nr)?
             .checked_add(ns.checked_mul(2)?)?
             .checked_mul(8)?;
-        let surface_a = CString::new(p.bytes()?).ok()?;
-        let surface_b = CString::new(p.bytes()?).ok()?;
+        self.surface_a = CString::new(p.bytes()?).ok()?;
+        self.surface_b = CString::new(p.bytes()?).ok()?;
         if n.checked_mul(per_point)? != p.buf.len() {
             return None;
         }
@@ -894,8 +930,8 @@ impl Scratch {
             q.normal_b = [v[10], v[11], v[12]];
             (q.weight, q.time, q.dt) = (v[13], v[14], v[15]);
             (q.step, q.iteration) = (s.steps[2 * i], s.steps[2 * i + 1]);
-            q.surface_a = surface_a.as_ptr();
-            q.surface_b = surface_b.as_ptr();
+            q.surface_a = s.surface_a.as_ptr();
+            q.surface_b = s.surface_b.as_ptr();
             if nf > 0 {
                 q.fields = s.fields[i * nf..].as_ptr();
                 q.n_fields = nf;
@@ -911,31 +947,115 @@ impl Scratch {
             }
             s.ins.push(q);
         }
-        s.outs.clear();
-        s.outs.resize(n, SeamPointOut::new());
-        plugin.call_in_process(&s.ins, &mut s.outs, batch);
-        for (i, o) in s.outs.iter().enumerate() {
-            w.i32(o.status);
-            w.f64s(&[
-                o.value,
-                o.d_temp_a,
-                o.d_temp_b,
-                o.d_gap,
-                o.d_pressure,
-                o.cutback_factor,
-            ]);
-            let message: Vec<u8> = if o.status == SEAM_STATUS_OK {
-                Vec::new()
-            } else {
-                o.message
-                    .iter()
-                    .take_while(|&&c| c != 0)
-                    .map(|&c| c as u8)
-                    .collect()
-            };
-            w.bytes(&message);
-            w.f64s(&s.new[i * ns..(i + 1) * ns]);
+        Some(batch)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn report_and_config_survive_the_wire() {
+        let report = Report {
+            name: "m".into(),
+            model_version: "1.2".into(),
+            capabilities: 5,
+            points: 54,
+            derivatives_checked: 216,
+            max_derivative_error: 3.5e-9,
+            batch_checked: true,
+            threads_checked: false,
+            failures: vec!["a".into(), "b é".into()],
+            failure_count: 7,
+        };
+        let mut w = Wire::default();
+        write_report(&mut w, &report);
+        assert_eq!(read_report(&mut Parse { buf: &w.0[4..] }), Some(report));
+        let config = Config {
+            integer_data: vec![-1, 2],
+            real_data: vec![f64::MIN_POSITIVE, -0.0],
+            ..Config::default()
+        };
+        let mut w = Wire::default();
+        write_config(&mut w, &config);
+        let back = read_config(&mut Parse { buf: &w.0[4..] }).unwrap();
+        assert_eq!(back, config);
+        assert!(back.real_data[1].is_sign_negative(), "bits, not values");
+    }
+
+    /// Every cut of a valid payload, and a count larger than the payload, is refused
+    /// without a panic or a huge allocation.
+    #[test]
+    fn short_or_lying_payloads_are_refused() {
+        let mut w = Wire::default();
+        write_report(
+            &mut w,
+            &Report {
+                failures: vec!["x".into()],
+                failure_count: 1,
+                ..Report::default()
+            },
+        );
+        let payload = &w.0[4..];
+        for cut in 0..payload.len() {
+            assert_eq!(
+                read_report(&mut Parse {
+                    buf: &payload[..cut]
+                }),
+                None,
+                "{cut}"
+            );
         }
-        Some(())
+        let mut lying = Wire::default();
+        lying.u64(u64::MAX);
+        assert_eq!(Parse { buf: &lying.0[4..] }.list_f64(), None);
+        assert_eq!(Parse { buf: &lying.0[4..] }.string(), None);
+    }
+
+    /// A request whose sizes disagree with its length is refused by the worker before
+    /// any call; a consistent one is re-created with the sender's numbers.
+    #[test]
+    fn evaluate_requests_are_checked_and_recreated() {
+        let data = [1.5, 2.5];
+        let mut state_new = [0.0; 1];
+        let old = [7.0];
+        let mut q = SeamPointIn::new();
+        (q.gap, q.pressure, q.x, q.step) = (1e-6, 3e5, [1.0, 2.0, 3.0], 4);
+        q.surface_a = c"top".as_ptr();
+        q.surface_b = c"bottom".as_ptr();
+        (q.real_data, q.n_real) = (data.as_ptr(), 2);
+        (q.state_old, q.state_new, q.n_state) = (old.as_ptr(), state_new.as_mut_ptr(), 1);
+        let mut w = Wire::default();
+        // SAFETY: the pointers above are valid for their counts.
+        unsafe { write_points(&mut w, &[q, q], true) };
+        let payload = &w.0[5..]; // after the length and the request tag
+        let mut scratch = Scratch::default();
+        let batch = scratch.decode(&mut Parse { buf: payload });
+        assert_eq!(batch, Some(true));
+        assert_eq!(scratch.ins.len(), 2);
+        let r = scratch.ins[1];
+        assert_eq!(
+            (r.gap, r.pressure, r.x, r.step),
+            (q.gap, q.pressure, q.x, q.step)
+        );
+        // SAFETY: re-created by `decode`, alive in `scratch`.
+        unsafe {
+            assert_eq!(std::ffi::CStr::from_ptr(r.surface_b), c"bottom");
+            assert_eq!(*r.real_data.add(1), 2.5);
+            assert_eq!(*r.state_old, 7.0);
+        }
+        for cut in [0, 1, payload.len() - 1] {
+            let mut short = Scratch::default();
+            assert_eq!(
+                short.decode(&mut Parse {
+                    buf: &payload[..cut]
+                }),
+                None
+            );
+        }
+        let mut long = payload.to_vec();
+        long.push(0);
+        assert_eq!(Scratch::default().decode(&mut Parse { buf: &long }), None);
     }
 }
