@@ -1528,10 +1528,12 @@ fn isolated_plugin_that_kills_its_process_stops_the_run_or_is_quarantined() {
     assert!(text.contains("PASS"), "{text}");
 }
 
-/// The C table plugin in a run gives the same temperatures in a worker process as in
-/// seam's own process. Both runs see bit-identical conductances (the test above); the
-/// solve itself may add in another order from run to run (the parallel factorisation),
-/// so the temperatures are compared with the tolerance two in-process runs meet.
+/// The C table plugin (linear problem) and the Rust CMY plugin with radiation (nonlinear,
+/// several Newton iterations) give the same temperatures in a run in a worker process as
+/// in seam's own process. Both modes see bit-identical conductances (the tests above);
+/// the solve itself may add in another order from run to run (the parallel
+/// factorisation), so the temperatures are compared with what two in-process runs meet:
+/// bit for bit when those agree to the bit.
 #[test]
 fn isolated_plugin_in_a_run_gives_the_in_process_temperatures() {
     seam::plugin::set_worker_program(env!("CARGO_BIN_EXE_seam"));
@@ -1541,28 +1543,41 @@ fn isolated_plugin_in_a_run_gives_the_in_process_temperatures() {
         .map(|v| format!("{v:e}"))
         .collect::<Vec<_>>()
         .join(" ");
-    let line = format!(
-        "  enforcement for energy = plugin library = \"{table}\"\n  contact pressure = 2e5\n  real data {real}"
-    );
-    let a = run_with(&line, 300.0, 900.0, "iso-none");
-    let b = run_with(
-        &format!("{line}\n  plugin isolation = process"),
-        300.0,
-        900.0,
-        "iso-process",
-    );
-    let again = run_with(&line, 300.0, 900.0, "iso-none-again");
-    let floor = max_diff(&a, &again);
-    assert!(
-        max_diff(&a, &b) <= floor.max(1e-12),
-        "{} (floor {floor:e})",
-        max_diff(&a, &b)
-    );
-    if floor == 0.0 {
-        assert!(
-            a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
-            "a deterministic solve gives bit-identical temperatures"
+    let cmy = rust_plugins().cmy.to_str().unwrap().to_string();
+    for (tag, line) in [
+        (
+            "table",
+            format!(
+                "  enforcement for energy = plugin library = \"{table}\"\n  contact pressure = 2e5\n  real data {real}"
+            ),
+        ),
+        (
+            "cmy",
+            format!(
+                "  enforcement for energy = plugin library = \"{cmy}\"\n  real data 16 0.1 1e-6 3e9 0 1e-6 0.8 0.6"
+            ),
+        ),
+    ] {
+        let a = run_with(&line, 300.0, 1300.0, &format!("iso-{tag}-none"));
+        let b = run_with(
+            &format!("{line}\n  plugin isolation = process"),
+            300.0,
+            1300.0,
+            &format!("iso-{tag}-process"),
         );
+        let again = run_with(&line, 300.0, 1300.0, &format!("iso-{tag}-none-again"));
+        let floor = max_diff(&a, &again);
+        assert!(
+            max_diff(&a, &b) <= floor.max(1e-12),
+            "{tag}: {} (floor {floor:e})",
+            max_diff(&a, &b)
+        );
+        if floor == 0.0 {
+            assert!(
+                a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{tag}: a deterministic solve gives bit-identical temperatures"
+            );
+        }
     }
 }
 
