@@ -2,27 +2,32 @@
 //! `exit` inside it is an ordinary [`PluginFault`](super::PluginFault) and the host goes
 //! on.
 //!
-//! The child is a *plugin worker*: the `seam` executable started as `seam plugin-worker`
-//! (see [`worker_program`] for how it is found). It loads the library and the instance in
-//! process (the checks of [`Plugin::load_with`], its errors word for word), then serves
-//! requests on its standard input, a Unix socket shared with the parent: evaluate a call's
-//! points (the `SeamPointIn` / `SeamPointOut` data, pointers' contents sent with them and
-//! re-created in the child), or run the conformance kit. The parent builds the points,
-//! validates the outputs and forms finite differences exactly as in process, so both
-//! modes give bit-identical results.
+//! Entry points: [`Plugin::load_isolated`](super::Plugin::load_isolated) (the parent's
+//! side, through `Worker`); [`serve_worker`] (the child's side, what `seam plugin-worker`
+//! runs); [`worker_program`] / [`set_worker_program`] (which executable is the worker).
+//!
+//! The child is a *plugin worker*: the `seam` executable started as `seam plugin-worker`.
+//! It loads the library and the instance in process (the checks of
+//! [`Plugin::load_with`], its errors word for word), then serves requests on its standard
+//! input, a Unix socket shared with the parent: evaluate a call's points (the
+//! `SeamPointIn` / `SeamPointOut` data, pointers' contents sent with them and re-created
+//! in the child), or run the conformance kit. The parent builds the points, validates the
+//! outputs and forms finite differences exactly as in process, so both modes give
+//! bit-identical results.
 //!
 //! Wire format: frames of a `u32` length and a payload, numbers little-endian, `f64` as
 //! their bits. The parent opens with [`MAGIC`] and a load request; the child greets with
 //! [`MAGIC`] (so a program that is not a worker is told from a worker that died while
-//! loading), then answers with the plugin's descriptor or the load error. The child writes the protocol
-//! on a duplicate of its standard input and sends its standard output to standard error,
-//! so a plugin's `printf` cannot corrupt the channel. The parent writes with
+//! loading), then answers with the plugin's descriptor or the load error. The child
+//! speaks on a duplicate of its standard input and sends its standard output to standard
+//! error, so a plugin's `printf` cannot corrupt the channel. The parent writes with
 //! `MSG_NOSIGNAL`: a dead child is an error, not a `SIGPIPE` for an embedding host.
 //!
-//! A child that dies (signal or exit) during a request is reaped and described (`killed
-//! by SIGSEGV (invalid memory access)`, `ended with exit status 0`). It is started again
-//! on the next call, up to [`MAX_DEATHS`] deaths; after that the plugin is dead and every
-//! call faults at once. No timeout: a plugin that hangs, hangs the call.
+//! A child that dies (signal or exit) during a request is reaped and described (`was
+//! killed by SIGSEGV (invalid memory access)`, `ended with exit status 0`). It is started
+//! again on the next call, up to [`MAX_DEATHS`] deaths (failed starts included); after
+//! that the plugin is dead and every call faults at once. No timeout: a plugin that
+//! hangs, hangs the call.
 
 use std::ffi::CString;
 use std::io::{BufReader, Read};
