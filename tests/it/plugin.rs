@@ -1658,3 +1658,32 @@ fn a_missing_or_wrong_plugin_worker_is_a_clear_error() {
         assert!(err.contains(needle), "{worker}: no `{needle}` in {err}");
     }
 }
+
+/// The faults a plugin reports or seam's checks find (NaN, negative, an error with its
+/// message, a cutback with its factor, an unknown status) are the same, field for field,
+/// when the plugin runs in a worker, and the worker goes on serving.
+#[test]
+fn isolated_plugin_faults_are_the_in_process_ones() {
+    let points = [
+        point(0.0, 1.0, 300.0, 300.0),
+        point(0.0, 2.0, 300.0, 300.0),
+        point(0.0, 150.0, 300.0, 300.0),
+    ];
+    for fault in [
+        "NAN",
+        "NAN_DERIVATIVE",
+        "NEGATIVE",
+        "ERROR",
+        "CUTBACK",
+        "BAD_STATUS",
+    ] {
+        let here = Plugin::load(&faulty(fault)).unwrap();
+        let there = isolated(&faulty(fault), &data(&[], &[])).unwrap();
+        let a = eval(&here, &points).unwrap_err();
+        let b = eval(&there, &points).unwrap_err();
+        // (Debug, not ==: a NaN value is not equal to itself.)
+        assert_eq!(format!("{a:?}"), format!("{b:?}"), "{fault}");
+        assert_eq!(a.point(), Some(2));
+        assert_eq!(eval(&there, &points[..2]).unwrap()[1].value, 1.0);
+    }
+}
