@@ -698,7 +698,12 @@ impl Plugin {
                 interaction: ins
                     .first()
                     .map(|p| format!("{} / {}", names(p.surface_a), names(p.surface_b))),
-                points: first..first + ins.len(),
+                // The point the worker was at, when it knew (point by point), else the
+                // points of the request.
+                points: match d.point.filter(|&k| k < ins.len()) {
+                    Some(k) => first + k..first + k + 1,
+                    None => first..first + ins.len(),
+                },
                 how: d.how,
             }
         })

@@ -42,6 +42,7 @@ use std::time::{Duration, Instant};
 use seam_plugin_abi::{SEAM_MESSAGE_LEN, SEAM_STATUS_OK, SeamPointIn, SeamPointOut};
 use seam_plugin_testkit::{Config, Grid, Report};
 
+use super::guard::DIED_TAG;
 use super::{Plugin, PluginData, PluginError, PluginInfo};
 
 /// Opens both directions of the conversation; the digits are the protocol's version.
@@ -450,6 +451,8 @@ unsafe fn write_points(w: &mut Wire, ins: &[SeamPointIn], batch: bool) {
 /// How a request to the worker failed: the child died, or could not be (re)started.
 pub(super) struct Death {
     pub how: String,
+    /// The point of the request being evaluated when it died, when the worker knew it.
+    pub point: Option<usize>,
 }
 
 struct Live {
@@ -580,8 +583,12 @@ impl Worker {
         // The worker greets before it loads, then answers the load.
         let hello =
             send_frame(fd, &mut w, true).and_then(|()| read_frame(&mut live.stream, &mut self.buf));
-        let fail = |mut live: Live, what: &str| {
-            let _ = live.child.kill();
+        // Killed when it may still be running (it said something else); else reaped as it
+        // ends (`reap` kills it after a while all the same).
+        let fail = |mut live: Live, what: &str, kill: bool| {
+            if kill {
+                let _ = live.child.kill();
+            }
             let how = reap(&mut live.child, Duration::from_secs(2)).map_or_else(
                 |e| format!("could not be waited for: {e}"),
                 |s| describe(&s, false),
@@ -589,16 +596,22 @@ impl Worker {
             worker_error(format!("{what}: it {how}"))
         };
         if hello.is_err() || self.buf != MAGIC {
-            return Err(fail(live, "is not a seam plugin worker (no greeting)"));
+            return Err(fail(
+                live,
+                "is not a seam plugin worker (no greeting)",
+                hello.is_ok(),
+            ));
         }
-        if read_frame(&mut live.stream, &mut self.buf).is_err() {
+        let loaded = read_frame(&mut live.stream, &mut self.buf);
+        if loaded.is_err() || self.buf.first() == Some(&DIED_TAG) {
             return Err(fail(
                 live,
                 "died while loading the plugin (its initialisers, entry point or init)",
+                false,
             ));
         }
         let mut p = Parse { buf: &self.buf };
-        let fail = |live: Live| fail(live, "answered the load out of protocol");
+        let fail = |live: Live| fail(live, "answered the load out of protocol", true);
         match p.u8() {
             Some(OK) => match read_info(&mut p, &path) {
                 Some(info) => {
@@ -623,6 +636,7 @@ impl Worker {
             if self.deaths >= MAX_DEATHS {
                 return Err(Death {
                     how: format!("has died {} times; it is not started again", self.deaths),
+                    point: None,
                 });
             }
             if let Err(e) = self.spawn() {
@@ -630,23 +644,39 @@ impl Worker {
                 self.deaths += 1;
                 return Err(Death {
                     how: format!("could not be started again: {e}"),
+                    point: None,
                 });
             }
         }
         let Some(live) = self.live.as_mut() else {
             return Err(Death {
                 how: "is not running".into(),
+                point: None,
             });
         };
         let fd = live.stream.get_ref().as_raw_fd();
         let result = send_frame(fd, request, true)
             .and_then(|()| read_frame(&mut live.stream, &mut self.buf));
+        // A worker dying in the plugin leaves a note first: the point it was at.
+        let mut point = None;
+        let result = match result {
+            Ok(()) if self.buf.first() == Some(&DIED_TAG) => {
+                let mut p = Parse {
+                    buf: &self.buf[1..],
+                };
+                point = p.u64().and_then(|k| usize::try_from(k).ok());
+                // Then the end of the channel, when the process is gone.
+                read_frame(&mut live.stream, &mut self.buf)
+            }
+            other => other,
+        };
         match result {
-            Ok(()) if self.buf.first() == Some(&OK) => Ok(()),
+            Ok(()) if self.buf.first() == Some(&OK) && point.is_none() => Ok(()),
             other => {
                 let Some(mut live) = self.live.take() else {
                     return Err(Death {
                         how: "is not running".into(),
+                        point,
                     });
                 };
                 let protocol = other.is_ok();
@@ -667,7 +697,7 @@ impl Worker {
                 } else {
                     "; a new process serves the next call"
                 });
-                Err(Death { how })
+                Err(Death { how, point })
             }
         }
     }
@@ -712,6 +742,7 @@ impl Worker {
             if ok.is_none() {
                 return Err(Death {
                     how: "answered out of protocol (a short reply)".into(),
+                    point: None,
                 });
             }
             if ns > 0 && !s.state_new.is_null() {
@@ -733,6 +764,7 @@ impl Worker {
         })
         .ok_or_else(|| Death {
             how: "answered out of protocol (a short report)".into(),
+            point: None,
         })
     }
 }
@@ -743,7 +775,6 @@ impl Worker {
 /// exit code. What `seam plugin-worker` runs. Crashes inside the plugin are not caught
 /// here: the process dies and the parent reports how.
 pub fn serve_worker() -> i32 {
-    super::guard::disable();
     // The protocol on a duplicate of stdin; stdout to stderr, stdin from /dev/null.
     // SAFETY: plain descriptor calls on the process's own standard descriptors.
     let chan = unsafe {
@@ -760,6 +791,8 @@ pub fn serve_worker() -> i32 {
         eprintln!("seam plugin-worker: no protocol channel on standard input");
         return 2;
     }
+    // A crash or an exit in the plugin leaves a note with the point on the channel.
+    super::guard::report_to_worker(chan);
     // SAFETY: `chan` was just duplicated and is owned here.
     let mut input = BufReader::new(unsafe { std::fs::File::from_raw_fd(chan) });
     let mut buf = Vec::new();

@@ -1338,8 +1338,10 @@ fn isolated_plugins_give_the_in_process_results_to_the_last_bit() {
 }
 
 /// A worker that crashes (SIGSEGV) or calls `exit(0)` at the points with pressure ≥ 100
-/// is an ordinary fault naming the plugin, the interaction, the points and how the
-/// worker died; the host is alive, and the next call is served by a new worker.
+/// is an ordinary fault naming the plugin, the interaction, the point and how the worker
+/// died; the host is alive, and the next call is served by a new worker. (The faulty
+/// plugin has no batch entry: the worker calls it point by point and knows the point; a
+/// batch entry's crash names the points of the call.)
 #[test]
 fn a_crashing_isolated_plugin_is_an_ordinary_fault_and_the_host_goes_on() {
     for (fault, how) in [
@@ -1362,7 +1364,7 @@ fn a_crashing_isolated_plugin_is_an_ordinary_fault_and_the_host_goes_on() {
         for needle in [
             "`faulty`",
             &format!("faulty_{}", fault.to_lowercase()),
-            "points 256–299",
+            "point 280 on interaction block_1_top / block_2_bottom",
             "on interaction block_1_top / block_2_bottom",
             "isolated plugin process",
             how,
@@ -1372,20 +1374,19 @@ fn a_crashing_isolated_plugin_is_an_ordinary_fault_and_the_host_goes_on() {
             assert!(msg.contains(needle), "{fault}: no `{needle}` in {msg}");
         }
         assert!(
-            matches!(err, PluginFault::ProcessDied { ref points, .. } if *points == (256..300)),
+            matches!(err, PluginFault::ProcessDied { ref points, .. } if *points == (280..281)),
             "{err:?}"
         );
-        assert_eq!(err.point(), Some(256));
+        assert_eq!(err.point(), Some(280));
         // The first chunk was served before the death; a new worker serves the next call.
         assert_eq!(r[0].value, 1.0);
         let good = eval(&plugin, &points[..10]).unwrap();
         assert!(good.iter().all(|r| r.value == 1.0));
-        // A call names the range of its points; one point at a time (as `seam run`
-        // calls a conductance), the point itself.
+        // The point is counted in the caller's call.
         let err = plugin
             .evaluate_per_point(&ctx(), &points[275..285], &mut r[..10], None)
             .unwrap_err();
-        assert!(err.to_string().contains("points 0–9 "), "{err}");
+        assert!(err.to_string().contains("point 5 on"), "{err}");
         let err = plugin
             .evaluate(&ctx(), &points[280..281], &mut r[..1], None)
             .unwrap_err();
