@@ -6,8 +6,12 @@
 //! `atexit` hook print that and end the process with exit code 3 (plugin fault).
 //! A crash outside a plugin call goes to the handler that was there before.
 //!
-//! Entry point: [`guarded`]. The handlers are installed once, when the first plugin is
-//! loaded. What they do is async-signal-safe in practice: read a thread-local pointer,
+//! In a plugin worker process (`Plugin Isolation = Process`, see [`super::isolate`]) the
+//! report is instead a short note to the parent — the point being evaluated — and the
+//! process then dies as it would have, so that the parent can say how.
+//!
+//! Entry points: [`guarded`]; [`report_to_worker`] in a worker. The handlers are
+//! installed once, when the first plugin is loaded. What they do is async-signal-safe in practice: read a thread-local pointer,
 //! format into a stack buffer (no allocation), `write(2)`, `_exit(2)`.
 
 use std::cell::Cell;
