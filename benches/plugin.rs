@@ -11,6 +11,9 @@
 //! form whose h comes from: the built-in constant model, the C table plugin (flat at
 //! h = 10) called per point, the same plugin evaluated in one batch before the assembly,
 //! and a Lua expression `10`; time per point for evaluation plus assembly, best of 3.
+//! Last, `Plugin Isolation = Process` against in process (both plugins, 256 points per
+//! call and one point per call, medians of 11; the worker's start-up time; results
+//! compared bit for bit); `cargo bench --bench plugin -- isolation` runs that part alone.
 //! Nothing here gates CI.
 
 use std::hint::black_box;
@@ -201,6 +204,11 @@ fn raw_batch(d: &'static SeamPluginDescriptor, real: &[f64], points: &[ContactPo
 
 fn main() {
     let (table_path, cmy_path) = build_plugins();
+    // `cargo bench --bench plugin -- isolation`: only the in-process / isolated table.
+    if std::env::args().skip(1).any(|a| a == "isolation") {
+        isolation(&table_path, &cmy_path);
+        return;
+    }
     let points: Vec<ContactPoint> = (0..N)
         .map(|i| {
             let t = i as f64 / N as f64;
@@ -266,7 +274,11 @@ fn main() {
         });
         // Raw: the ABI batch call alone, on inputs marshalled once, 4096 points per call,
         // with an instance of our own (no host copies, chunking or validation).
-        let t_raw = raw_batch(plugin.descriptor(), &data.real_data, &points);
+        let t_raw = raw_batch(
+            plugin.descriptor().expect("loaded in process"),
+            &data.real_data,
+            &points,
+        );
         let err = max_diff(&native_out, &batch_out).max(max_diff(&native_out, &point_out));
         println!(
             "{:<8} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>8.2} {:>8.2} {:>11.1e}",
@@ -282,6 +294,128 @@ fn main() {
     }
 
     assembly(&table_path);
+    isolation(&table_path, &cmy_path);
+}
+
+/// Median of `reps` timings of `f`, each over `points` points, in ns per point.
+fn median_ns(reps: usize, points: usize, mut f: impl FnMut()) -> f64 {
+    let mut t: Vec<f64> = (0..reps)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64() * 1e9 / points as f64
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[reps / 2]
+}
+
+/// `Plugin Isolation = Process` against in process: ns per point with 256 points per call
+/// (a batch, as the host's chunks) and with one point per call (as `seam run` calls a
+/// conductance), medians of 11 timings; and the cost of starting a worker (what a crash
+/// costs before the next call). The results of both modes are compared bit for bit.
+fn isolation(table_path: &Path, cmy_path: &Path) {
+    seam::plugin::set_worker_program(env!("CARGO_BIN_EXE_seam"));
+    const REPS: usize = 11;
+    const BATCH: usize = 256;
+    const CALLS_BATCH: usize = 400;
+    const CALLS_POINT: usize = 20_000;
+    let points: Vec<ContactPoint> = (0..BATCH)
+        .map(|i| {
+            let t = i as f64 / BATCH as f64;
+            ContactPoint {
+                gap: 1e-4 * t,
+                pressure: 1.2e7 * t,
+                temp_a: 300.0 + 600.0 * t,
+                temp_b: 350.0 + 100.0 * t,
+                normal_a: [0.0, 0.0, 1.0],
+                normal_b: [0.0, 0.0, -1.0],
+                weight: 1.0,
+                ..ContactPoint::default()
+            }
+        })
+        .collect();
+    let ctx = StepContext {
+        surface_a: "side_a",
+        surface_b: "side_b",
+        time: 1.0,
+        dt: 1.0,
+        step: 1,
+        ..StepContext::default()
+    };
+    println!();
+    println!(
+        "plugin isolation: ns per point, median of {REPS} (batch: {CALLS_BATCH} calls of {BATCH} points; point: {CALLS_POINT} calls of 1)"
+    );
+    println!(
+        "{:<8} {:>11} {:>11} {:>8} {:>11} {:>11} {:>8} {:>10} {:>9}",
+        "model",
+        "batch none",
+        "batch proc",
+        "ratio",
+        "point none",
+        "point proc",
+        "ratio",
+        "start ms",
+        "bitwise"
+    );
+    let table_real: Vec<f64> = TABLE.iter().flat_map(|&(p, h)| [p, h]).collect();
+    for (name, path, real) in [
+        ("c_table", table_path, table_real),
+        ("cmy", cmy_path, CMY.to_vec()),
+    ] {
+        let data = PluginData {
+            model: None,
+            integer_data: vec![],
+            real_data: real,
+        };
+        let here = Plugin::load_with(path, &data).expect("load in process");
+        let there = Plugin::load_isolated(path, &data).expect("load in a worker");
+        let mut out = vec![PointResult::default(); BATCH];
+        let batch = |p: &Plugin, out: &mut [PointResult]| {
+            median_ns(REPS, CALLS_BATCH * BATCH, || {
+                for _ in 0..CALLS_BATCH {
+                    p.evaluate(&ctx, &points, out, None).expect("batch");
+                }
+                black_box(&*out);
+            })
+        };
+        let single = |p: &Plugin, out: &mut [PointResult]| {
+            median_ns(REPS, CALLS_POINT, || {
+                for k in 0..CALLS_POINT {
+                    let i = k % BATCH;
+                    p.evaluate(&ctx, &points[i..=i], &mut out[i..=i], None)
+                        .expect("point");
+                }
+                black_box(&*out);
+            })
+        };
+        let (b_none, b_proc) = (batch(&here, &mut out), batch(&there, &mut out));
+        let (p_none, p_proc) = (single(&here, &mut out), single(&there, &mut out));
+        let start_ms = median_ns(REPS, 1, || {
+            black_box(Plugin::load_isolated(path, &data).expect("load in a worker"));
+        }) * 1e-6;
+        let mut a = vec![PointResult::default(); BATCH];
+        let mut b = vec![PointResult::default(); BATCH];
+        here.evaluate(&ctx, &points, &mut a, None).expect("batch");
+        there.evaluate(&ctx, &points, &mut b, None).expect("batch");
+        let same = a.iter().zip(&b).all(|(x, y)| {
+            [x.value, x.d_temp_a, x.d_temp_b, x.d_gap, x.d_pressure].map(f64::to_bits)
+                == [y.value, y.d_temp_a, y.d_temp_b, y.d_gap, y.d_pressure].map(f64::to_bits)
+        });
+        println!(
+            "{:<8} {:>11.1} {:>11.1} {:>8.1} {:>11.1} {:>11.1} {:>8.1} {:>10.2} {:>9}",
+            name,
+            b_none,
+            b_proc,
+            b_proc / b_none,
+            p_none,
+            p_proc,
+            p_proc / p_none,
+            start_ms,
+            if same { "yes" } else { "NO" }
+        );
+    }
 }
 
 /// Time per point of assembling the interface terms with each conductance source.

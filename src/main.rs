@@ -87,7 +87,15 @@ enum Command {
         /// Integer Data handed to the plugin (`--integer 1 2 3`).
         #[arg(long, num_args = 1.., allow_negative_numbers = true)]
         integer: Vec<i64>,
+        /// Run the plugin in a worker process (`Plugin Isolation = Process`): a crash or
+        /// an `exit` in it is a FAILED check (exit 3) instead of the end of seam.
+        #[arg(long)]
+        isolate: bool,
     },
+    /// Serve one plugin on standard input for an isolated host (`Plugin Isolation =
+    /// Process`); not for direct use.
+    #[command(name = "plugin-worker", hide = true)]
+    PluginWorker,
     /// Validate a deck and print every diagnostic: everything `seam run` checks before
     /// it solves (enforcement models made, Lua compiled, plugins loaded). With --mesh its
     /// surfaces, interactions and search too; with --problem the whole problem file.
@@ -126,7 +134,9 @@ fn main() -> ExitCode {
             path,
             real,
             integer,
-        } => check_plugin(&path, &real, &integer),
+            isolate,
+        } => check_plugin(&path, &real, &integer, isolate),
+        Command::PluginWorker => ExitCode::from(seam::plugin::serve_worker().clamp(0, 255) as u8),
         Command::Check {
             deck,
             mesh,
@@ -584,7 +594,12 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
         }
         Err(seam::run::RunError::Solve(e)) => {
             eprintln!("error[E0800]: {e}");
-            ExitCode::from(1)
+            // A plugin whose worker process died stopped the run: a plugin fault.
+            if e.contains(seam::plugin::isolate::PROCESS_DEATH) {
+                ExitCode::from(EXIT_PLUGIN_FAULT)
+            } else {
+                ExitCode::from(1)
+            }
         }
     }
 }
@@ -637,9 +652,14 @@ fn progress_printer(json: bool) -> Progress {
     (Box::new(steps), Box::new(phase))
 }
 
-fn check_plugin(path: &Path, real: &[f64], integer: &[i64]) -> ExitCode {
+fn check_plugin(path: &Path, real: &[f64], integer: &[i64], isolate: bool) -> ExitCode {
     let mut stdout = std::io::stdout();
-    match seam::plugin::check_plugin(path, real, integer, &mut stdout) {
+    let isolation = if isolate {
+        seam::plugin::Isolation::Process
+    } else {
+        seam::plugin::Isolation::None
+    };
+    match seam::plugin::check_plugin_with(path, real, integer, isolation, &mut stdout) {
         Ok(report) if report.exit_code() == 0 => ExitCode::SUCCESS,
         Ok(_) => ExitCode::from(EXIT_PLUGIN_FAULT),
         Err(e) => {

@@ -290,6 +290,13 @@ pub static COMMANDS: &[CommandSpec] = &[
         "A point where the conductance model (plugin, Lua) fails contributes nothing and is reported, instead of stopping the run."
     ),
     cmd!(
+        "plugin isolation",
+        "plugin_isolation",
+        [ENF],
+        "= process|none",
+        "Where the enforcement's plugin runs: `process`, in a worker process, so that a crash or an `exit` in the plugin is an ordinary fault naming the plugin, the interaction and the points (stopping the run with exit code 3, or quarantined); `none` (the default), in seam's own process, the fastest."
+    ),
+    cmd!(
         "contact pressure",
         "contact_pressure",
         [ENF],

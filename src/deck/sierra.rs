@@ -1507,6 +1507,37 @@ impl Lower {
                         }
                     }
                 }
+                "plugin_isolation" => {
+                    self.once(&mut seen, &c);
+                    c.skip_sep();
+                    let rest = c.rest();
+                    c.pos = line.tokens.len();
+                    let value = rest
+                        .iter()
+                        .map(|t| t.lower.as_str())
+                        .collect::<Vec<_>>()
+                        .join(" ");
+                    match value.as_str() {
+                        "process" => e.plugin_isolation = PluginIsolation::Process,
+                        "none" => e.plugin_isolation = PluginIsolation::None,
+                        _ if rest.is_empty() => self.missing(&c, "`process` or `none`"),
+                        _ => {
+                            let hint = did_you_mean(&value, ["process", "none"])
+                                .map(|s| format!("did you mean `{s}`? "))
+                                .unwrap_or_default();
+                            self.push(
+                                Diagnostic::error(
+                                    codes::BAD_CHOICE,
+                                    format!("unknown plugin isolation `{value}`"),
+                                )
+                                .at(self.span(rest))
+                                .help(format!(
+                                    "{hint}the choices are `process` (the plugin in a worker process) and `none` (in seam's process)"
+                                )),
+                            );
+                        }
+                    }
+                }
                 "contact_pressure_variable" => {
                     self.once(&mut seen, &c);
                     c.skip_sep();

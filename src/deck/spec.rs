@@ -345,8 +345,23 @@ pub struct Enforcement {
     /// temperature-dependent conductance sees at a contact point.
     #[serde(default)]
     pub contact_gap_temperature: Option<GapTemperature>,
+    /// `Plugin Isolation = Process | None`: run the enforcement's plugin in a worker
+    /// process (a crash is an ordinary fault) or in seam's own process (the default).
+    #[serde(default)]
+    pub plugin_isolation: PluginIsolation,
     #[serde(skip)]
     pub at: Loc,
+}
+
+/// Where an enforcement's plugin runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PluginIsolation {
+    /// In seam's own process: fastest; a crash in the plugin ends the run (exit 3).
+    #[default]
+    None,
+    /// In a worker process: a crash or an `exit` in the plugin is an ordinary fault.
+    Process,
 }
 
 /// Which temperature a temperature-dependent conductance sees at a contact point:

@@ -1,13 +1,11 @@
-//! `seam check-plugin PATH [--real …] [--integer …]`: load, describe, probe.
+//! `seam check-plugin PATH [--real …] [--integer …] [--isolate]`: load, describe, probe.
 
 use std::io::Write;
 use std::path::Path;
 
-use seam_plugin_testkit::{Config, Loaded, Report};
+use seam_plugin_testkit::{Config, Report};
 
-use super::guard::{CallSite, guarded};
-
-use super::{ContactPoint, Plugin, PluginData, PluginError, PointResult, StepContext};
+use super::{ContactPoint, Isolation, Plugin, PluginData, PluginError, PointResult, StepContext};
 
 /// What [`check_plugin`] found.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,11 +33,25 @@ impl CheckReport {
 /// Load the plugin at `path` with `real` / `integer` as its Real / Integer Data, print
 /// its descriptor, run the conformance checks (grid: gaps 1e-6–1e-4, pressures 1e5–1e7,
 /// T_A 300–900, T_B 350–700, SI units) and seam's own output validation, and print the
-/// findings to `out`. Write errors on `out` are ignored.
+/// findings to `out`. Write errors on `out` are ignored. In process: a plugin that
+/// crashes ends the process (exit 3, see [`check_plugin_with`] for the isolated check).
 pub fn check_plugin(
     path: &Path,
     real: &[f64],
     integer: &[i64],
+    out: &mut impl Write,
+) -> Result<CheckReport, PluginError> {
+    check_plugin_with(path, real, integer, Isolation::None, out)
+}
+
+/// As [`check_plugin`], with the plugin in this process or in a worker process. Isolated,
+/// a crash or an `exit` during the conformance checks is a failed check (the message
+/// names how the worker died), and the host validation runs in a new worker.
+pub fn check_plugin_with(
+    path: &Path,
+    real: &[f64],
+    integer: &[i64],
+    isolation: Isolation,
     out: &mut impl Write,
 ) -> Result<CheckReport, PluginError> {
     let data = PluginData {
@@ -47,7 +59,7 @@ pub fn check_plugin(
         integer_data: integer.to_vec(),
         real_data: real.to_vec(),
     };
-    let plugin = Plugin::load_with(path, &data)?;
+    let plugin = Plugin::load_with_isolation(path, &data, isolation)?;
     let info = plugin.info();
     let _ = writeln!(out, "plugin        {}", info.path.display());
     let _ = writeln!(out, "model         {} {}", info.name, info.model_version);
@@ -63,6 +75,9 @@ pub fn check_plugin(
             ""
         }
     );
+    if isolation == Isolation::Process {
+        let _ = writeln!(out, "isolation     a worker process");
+    }
     if let Some(notice) = plugin.derivative_notice() {
         let _ = writeln!(out, "note          {notice}");
     }
@@ -71,19 +86,17 @@ pub fn check_plugin(
         real_data: data.real_data.clone(),
         ..Config::default()
     };
-    // SAFETY: the descriptor comes from a library seam never unloads, and `load_with`
-    // checked its versions, size and evaluate_point.
-    let loaded = unsafe { Loaded::from_descriptor(plugin.descriptor()) };
-    // The conformance kit calls the plugin itself: a crash or an `exit` there is
-    // reported like one in the host's own calls.
-    let label = format!("`{}` ({})", plugin.info().name, path.display());
-    let site = CallSite {
-        plugin: &label,
-        entry: "the conformance checks",
-        points: &[],
-        current: std::cell::Cell::new(None),
-    };
-    let conformance = guarded(&site, || seam_plugin_testkit::run(&loaded, &config));
+    let conformance = plugin.conformance(&config).unwrap_or_else(|fault| {
+        let message = fault.to_string();
+        Report {
+            name: info.name.clone(),
+            model_version: info.model_version.clone(),
+            capabilities: info.capabilities,
+            failures: vec![message],
+            failure_count: 1,
+            ..Report::default()
+        }
+    });
     let states = config.grid.states();
     let points: Vec<ContactPoint> = states
         .iter()

@@ -6,13 +6,18 @@
 //! `atexit` hook print that and end the process with exit code 3 (plugin fault).
 //! A crash outside a plugin call goes to the handler that was there before.
 //!
-//! Entry point: [`guarded`]. The handlers are installed once, when the first plugin is
-//! loaded. What they do is async-signal-safe in practice: read a thread-local pointer,
+//! In a plugin worker process (`Plugin Isolation = Process`, see [`super::isolate`]) the
+//! report is instead a short note to the parent — the point being evaluated — and the
+//! process then dies as it would have, so that the parent can say how.
+//!
+//! Entry points: [`guarded`]; [`report_to_worker`] in a worker. The handlers are
+//! installed once, when the first plugin is loaded. What they do is async-signal-safe in practice: read a thread-local pointer,
 //! format into a stack buffer (no allocation), `write(2)`, `_exit(2)`.
 
 use std::cell::Cell;
 use std::fmt::Write as _;
 use std::sync::Once;
+use std::sync::atomic::{AtomicI32, Ordering};
 
 use seam_plugin_abi::SeamPointIn;
 
@@ -43,6 +48,20 @@ const SIGNALS: [libc::c_int; 5] = [
 static mut PREVIOUS: [std::mem::MaybeUninit<libc::sigaction>; 5] =
     [const { std::mem::MaybeUninit::uninit() }; 5];
 static INSTALL: Once = Once::new();
+/// In a plugin worker process (see [`super::isolate`]): the protocol channel. There the
+/// report is a note to the parent on that channel — the point being evaluated — and the
+/// process then dies as it would have (the signal's default action, or the `exit`), so
+/// that the parent sees how.
+static WORKER_CHANNEL: AtomicI32 = AtomicI32::new(-1);
+
+/// Report faults as notes on `fd` (a plugin worker's channel) from here on.
+pub(super) fn report_to_worker(fd: libc::c_int) {
+    WORKER_CHANNEL.store(fd, Ordering::Relaxed);
+}
+
+/// The note a worker leaves before it dies: a frame of [`DIED_TAG`] and the point of the
+/// call being evaluated (`u64::MAX` when not known: a batch entry, the conformance kit).
+pub(super) const DIED_TAG: u8 = 9;
 
 /// Run `f` (a call into a plugin) with `site` on record, so that a crash or an `exit`
 /// during it is reported.
@@ -93,8 +112,16 @@ extern "C" fn on_signal(sig: libc::c_int, info: *mut libc::siginfo_t, context: *
         _ => "a fatal signal",
     };
     if report(name, "crashed with") {
-        // SAFETY: ending the process without running anything else.
-        unsafe { libc::_exit(3) };
+        // SAFETY: ending the process without running anything else; in a worker, by the
+        // signal itself (delivered with its default action when the handler returns).
+        unsafe {
+            if WORKER_CHANNEL.load(Ordering::Relaxed) >= 0 {
+                libc::signal(sig, libc::SIG_DFL);
+                libc::raise(sig);
+                return;
+            }
+            libc::_exit(3)
+        };
     }
     // Not in a plugin call: hand the signal to whoever had it before.
     // SAFETY: PREVIOUS was filled before this handler was installed.
@@ -123,8 +150,9 @@ extern "C" fn on_exit() {
     if report(
         "exit (a Fortran STOP or a call to exit)",
         "ended the process by",
-    ) {
-        // SAFETY: as in on_signal.
+    ) && WORKER_CHANNEL.load(Ordering::Relaxed) < 0
+    {
+        // SAFETY: as in on_signal. (A worker lets the exit go on with its status.)
         unsafe { libc::_exit(3) };
     }
 }
@@ -153,6 +181,19 @@ fn report(what: &str, verb: &str) -> bool {
     }
     // SAFETY: set by `guarded` for the duration of the call that faulted.
     let site = unsafe { &*site };
+    let channel = WORKER_CHANNEL.load(Ordering::Relaxed);
+    if channel >= 0 {
+        let point = site.current.get().map_or(u64::MAX, |k| k as u64);
+        let mut note = [0u8; 13];
+        note[..4].copy_from_slice(&9u32.to_le_bytes());
+        note[4] = DIED_TAG;
+        note[5..].copy_from_slice(&point.to_le_bytes());
+        // SAFETY: write(2) of a valid buffer to the worker's channel.
+        unsafe {
+            libc::write(channel, note.as_ptr().cast(), note.len());
+        }
+        return true;
+    }
     let mut b = Buffer {
         bytes: [0; 1024],
         len: 0,

@@ -14,8 +14,11 @@ use seam_plugin_abi::{
 
 use std::cell::Cell;
 
+use seam_plugin_testkit::{Config, Loaded, Report};
+
 use super::guard::{CallSite, guarded};
-use super::{PluginError, PluginFault};
+use super::isolate::Worker;
+use super::{Isolation, PluginError, PluginFault};
 
 /// Finite-difference step floors for plugins without derivatives: the host perturbs x
 /// by δ = ε^{1/3} max(|x|, floor) and takes central differences (truncation O(δ²),
@@ -184,17 +187,27 @@ impl StateStore {
     }
 }
 
-/// A loaded plugin with one instance of its model.
+/// A loaded plugin with one instance of its model, in this process or in a worker
+/// process ([`Isolation::Process`]).
 pub struct Plugin {
     info: PluginInfo,
     /// `name (path)`, for fault messages.
     label: String,
-    descriptor: &'static SeamPluginDescriptor,
-    instance: *mut c_void,
+    backend: Backend,
     data: PluginData,
-    /// Held around every call unless the plugin is THREAD_SAFE.
-    serial: Mutex<()>,
     fd_notice_given: AtomicBool,
+}
+
+/// Where the instance lives.
+enum Backend {
+    InProcess {
+        descriptor: &'static SeamPluginDescriptor,
+        instance: *mut c_void,
+        /// Held around every call unless the plugin is THREAD_SAFE.
+        serial: Mutex<()>,
+    },
+    /// In a worker process; one call at a time.
+    Process(Box<Mutex<Worker>>),
 }
 
 // SAFETY: the instance pointer is only used through the plugin's functions; calls are
@@ -214,10 +227,19 @@ impl std::fmt::Debug for Plugin {
 
 impl Drop for Plugin {
     fn drop(&mut self) {
-        if let Some(finalize) = self.descriptor.finalize {
+        // A worker finalises its instance when its input ends (`Worker`'s drop).
+        let finalize = match &self.backend {
+            Backend::InProcess {
+                descriptor,
+                instance,
+                ..
+            } => descriptor.finalize.map(|f| (f, *instance)),
+            Backend::Process(_) => None,
+        };
+        if let Some((finalize, instance)) = finalize {
             // SAFETY: the instance came from this descriptor's init and is released once;
             // the library is never unloaded.
-            unsafe { finalize(self.instance) };
+            unsafe { finalize(instance) };
         }
     }
 }
@@ -355,10 +377,45 @@ impl Plugin {
         Ok(Plugin {
             label: format!("`{}` ({})", info.name, path.display()),
             info,
-            descriptor: d,
-            instance,
+            backend: Backend::InProcess {
+                descriptor: d,
+                instance,
+                serial: Mutex::new(()),
+            },
             data: data.clone(),
-            serial: Mutex::new(()),
+            fd_notice_given: AtomicBool::new(false),
+        })
+    }
+
+    /// Load in this process ([`Isolation::None`], as [`Plugin::load_with`]) or in a
+    /// worker process ([`Isolation::Process`], as [`Plugin::load_isolated`]).
+    pub fn load_with_isolation(
+        path: &Path,
+        data: &PluginData,
+        isolation: Isolation,
+    ) -> Result<Plugin, PluginError> {
+        match isolation {
+            Isolation::None => Plugin::load_with(path, data),
+            Isolation::Process => Plugin::load_isolated(path, data),
+        }
+    }
+
+    /// Start a worker process (see [`super::isolate`]) that loads the library and creates
+    /// the instance with `data`; this process never maps the library. Load errors are
+    /// those of [`Plugin::load_with`], word for word; a worker that cannot be found or
+    /// dies while loading is a [`PluginError::Worker`] / [`PluginError::NoWorker`].
+    pub fn load_isolated(path: &Path, data: &PluginData) -> Result<Plugin, PluginError> {
+        if !path.exists() {
+            return Err(PluginError::NotFound {
+                path: path.to_owned(),
+            });
+        }
+        let (worker, info) = Worker::start(path, data)?;
+        Ok(Plugin {
+            label: format!("`{}` ({})", info.name, path.display()),
+            info,
+            backend: Backend::Process(Box::new(Mutex::new(worker))),
+            data: data.clone(),
             fd_notice_given: AtomicBool::new(false),
         })
     }
@@ -367,9 +424,59 @@ impl Plugin {
         &self.info
     }
 
-    /// The plugin's static descriptor (valid for the life of the process).
-    pub fn descriptor(&self) -> &'static SeamPluginDescriptor {
-        self.descriptor
+    /// How this plugin runs.
+    pub fn isolation(&self) -> Isolation {
+        match self.backend {
+            Backend::InProcess { .. } => Isolation::None,
+            Backend::Process(_) => Isolation::Process,
+        }
+    }
+
+    /// The plugin's static descriptor (valid for the life of the process); `None` for an
+    /// isolated plugin, whose library is mapped in the worker only.
+    pub fn descriptor(&self) -> Option<&'static SeamPluginDescriptor> {
+        match self.backend {
+            Backend::InProcess { descriptor, .. } => Some(descriptor),
+            Backend::Process(_) => None,
+        }
+    }
+
+    /// Run the conformance kit on this plugin (in its worker when isolated). A crash
+    /// during the kit is a [`PluginFault::ProcessDied`] when isolated; in process it ends
+    /// the process with the guard's report.
+    pub fn conformance(&self, config: &Config) -> Result<Report, PluginFault> {
+        match &self.backend {
+            Backend::InProcess { .. } => Ok(self.conformance_in_process(config)),
+            Backend::Process(worker) => worker
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .conformance(config)
+                .map_err(|d| PluginFault::ProcessDied {
+                    plugin: self.label.clone(),
+                    entry: "the conformance checks",
+                    interaction: None,
+                    points: 0..0,
+                    how: d.how,
+                }),
+        }
+    }
+
+    pub(super) fn conformance_in_process(&self, config: &Config) -> Report {
+        let Some(descriptor) = self.descriptor() else {
+            return Report::default();
+        };
+        // SAFETY: the descriptor comes from a library seam never unloads, and `load_with`
+        // checked its versions, size and evaluate_point.
+        let loaded = unsafe { Loaded::from_descriptor(descriptor) };
+        // The conformance kit calls the plugin itself: a crash or an `exit` there is
+        // reported like one in the host's own calls.
+        let site = CallSite {
+            plugin: &self.label,
+            entry: "the conformance checks",
+            points: &[],
+            current: Cell::new(None),
+        };
+        guarded(&site, || seam_plugin_testkit::run(&loaded, config))
     }
 
     /// True when seam forms the derivatives by finite differences (the plugin does not
@@ -529,7 +636,7 @@ impl Plugin {
                 o.cutback_factor = 0.0;
                 o.message[0] = 0;
             }
-            self.call(&ins, &mut outs, batch);
+            self.call(&ins, &mut outs, batch, start)?;
             for (k, o) in outs.iter().enumerate() {
                 let point = start + k;
                 self.validate(point, o, "value", conductance)?;
@@ -558,12 +665,69 @@ impl Plugin {
         Ok(())
     }
 
-    /// Call the plugin on `ins`, serialised unless it is thread-safe. A crash or an
-    /// `exit` inside the call is reported with the point (see [`super::guard`]).
-    fn call(&self, ins: &[SeamPointIn], outs: &mut [SeamPointOut], batch: bool) {
-        let _guard = (!self.info.thread_safe())
-            .then(|| self.serial.lock().unwrap_or_else(|e| e.into_inner()));
-        let batched = batch && self.descriptor.evaluate_batch.is_some();
+    /// Call the plugin on `ins` (points `first…` of the caller's call), in process or in
+    /// the worker. In process, a crash or an `exit` inside the call is reported with the
+    /// point and ends the process (see [`super::guard`]); in a worker it is a
+    /// [`PluginFault::ProcessDied`].
+    fn call(
+        &self,
+        ins: &[SeamPointIn],
+        outs: &mut [SeamPointOut],
+        batch: bool,
+        first: usize,
+    ) -> Result<(), PluginFault> {
+        let Backend::Process(worker) = &self.backend else {
+            self.call_in_process(ins, outs, batch);
+            return Ok(());
+        };
+        let mut worker = worker.lock().unwrap_or_else(|e| e.into_inner());
+        // SAFETY: the inputs are built by `evaluate_mode` / `finite_differences`, their
+        // pointers valid for the call and `state_new` writable.
+        unsafe { worker.evaluate(ins, outs, batch) }.map_err(|d| {
+            let names = |p: *const std::ffi::c_char| {
+                // SAFETY: the host's surface names are NUL-terminated and live for the call.
+                unsafe { c_text(p) }.unwrap_or_default()
+            };
+            PluginFault::ProcessDied {
+                plugin: self.label.clone(),
+                entry: if batch && self.info.has_batch {
+                    "evaluate_batch"
+                } else {
+                    "evaluate_point"
+                },
+                interaction: ins
+                    .first()
+                    .map(|p| format!("{} / {}", names(p.surface_a), names(p.surface_b))),
+                // The point the worker was at, when it knew (point by point), else the
+                // points of the request.
+                points: match d.point.filter(|&k| k < ins.len()) {
+                    Some(k) => first + k..first + k + 1,
+                    None => first..first + ins.len(),
+                },
+                how: d.how,
+            }
+        })
+    }
+
+    /// Call the plugin in this process, serialised unless it is thread-safe.
+    pub(super) fn call_in_process(
+        &self,
+        ins: &[SeamPointIn],
+        outs: &mut [SeamPointOut],
+        batch: bool,
+    ) {
+        let Backend::InProcess {
+            descriptor,
+            instance,
+            serial,
+        } = &self.backend
+        else {
+            return;
+        };
+        let (descriptor, instance) = (*descriptor, *instance);
+        let _guard =
+            (!self.info.thread_safe()).then(|| serial.lock().unwrap_or_else(|e| e.into_inner()));
+        let batched = batch && descriptor.evaluate_batch.is_some();
         let site = CallSite {
             plugin: &self.label,
             entry: if batched {
@@ -575,21 +739,17 @@ impl Plugin {
             current: Cell::new(None),
         };
         guarded(&site, || {
-            match (
-                batch,
-                self.descriptor.evaluate_batch,
-                self.descriptor.evaluate_point,
-            ) {
+            match (batch, descriptor.evaluate_batch, descriptor.evaluate_point) {
                 (true, Some(f), _) => {
                     // SAFETY: ins.len() valid inputs whose pointers live for the call and
                     // as many writable outputs; the instance is this plugin's.
-                    unsafe { f(self.instance, ins.as_ptr(), outs.as_mut_ptr(), ins.len()) }
+                    unsafe { f(instance, ins.as_ptr(), outs.as_mut_ptr(), ins.len()) }
                 }
                 (_, _, Some(f)) => {
                     for (k, (i, o)) in ins.iter().zip(outs.iter_mut()).enumerate() {
                         site.current.set(Some(k));
                         // SAFETY: as above, one point.
-                        unsafe { f(self.instance, i, o) }
+                        unsafe { f(instance, i, o) }
                     }
                 }
                 // Checked non-NULL at load.
@@ -702,8 +862,8 @@ impl Plugin {
             }
             let mut outs = [SeamPointOut::new(), SeamPointOut::new()];
             // One point at a time: the two calls share the scratch state.
-            self.call(&ins[..1], &mut outs[..1], false);
-            self.call(&ins[1..], &mut outs[1..], false);
+            self.call(&ins[..1], &mut outs[..1], false, point)?;
+            self.call(&ins[1..], &mut outs[1..], false, point)?;
             for o in &outs {
                 // The sign is not checked here: x ± δ may leave the model's range.
                 self.validate(point, o, what, false)?;

@@ -9,7 +9,10 @@
 //!   else point by point; serialised behind a mutex unless the plugin is `THREAD_SAFE`),
 //!   then validate every output. A [`PluginFault`] names the plugin and the point index;
 //!   the caller adds the interaction and face;
-//! - [`check_plugin`]: what `seam check-plugin` runs;
+//! - [`Plugin::load_isolated`] / [`Plugin::load_with_isolation`]: the same, in a worker
+//!   process (`Plugin Isolation = Process`): a crash or an `exit` in the plugin is a
+//!   [`PluginFault::ProcessDied`] and the host goes on (see [`isolate`]);
+//! - [`check_plugin`] / [`check_plugin_with`]: what `seam check-plugin [--isolate]` runs;
 //! - [`PluginSpec::from_enforcement`]: the deck's `Enforcement for Energy = Plugin
 //!   Library = "…" Model = …` resolved against the deck's directory.
 //!
@@ -21,17 +24,23 @@
 mod check;
 mod guard;
 mod host;
+pub mod isolate;
 mod spec;
 
 use std::path::PathBuf;
 
-pub use check::{CheckReport, check_plugin};
+pub use check::{CheckReport, check_plugin, check_plugin_with};
 pub use host::{
     ContactPoint, FD_FLOOR_GAP, FD_FLOOR_PRESSURE, FD_FLOOR_TEMPERATURE, Plugin, PluginData,
     PluginInfo, PointResult, StateStore, StepContext,
 };
+pub use isolate::{serve_worker, set_worker_program, worker_program};
 pub use seam_plugin_abi as abi;
 pub use spec::PluginSpec;
+
+/// Where a plugin runs: `Plugin Isolation = None` (in process, the default) or
+/// `Process` (in a worker process).
+pub use crate::deck::spec::PluginIsolation as Isolation;
 
 /// Why a plugin could not be loaded or set up. Every message names the library path.
 #[derive(Debug, thiserror::Error)]
@@ -105,6 +114,24 @@ pub enum PluginError {
     },
     #[error("{0}")]
     Spec(String),
+    /// A load error met by the worker of an isolated plugin: the in-process message.
+    #[error("{message}")]
+    Isolated { message: String },
+    #[error(
+        "plugin {}: no plugin worker for `Plugin Isolation = Process` ({tried}): set SEAM_PLUGIN_WORKER to the seam executable, or call seam::plugin::set_worker_program",
+        path.display()
+    )]
+    NoWorker { path: PathBuf, tried: String },
+    #[error(
+        "plugin {}: the plugin worker {} {how}",
+        path.display(),
+        program.display()
+    )]
+    Worker {
+        path: PathBuf,
+        program: PathBuf,
+        how: String,
+    },
 }
 
 /// A fault while evaluating: which plugin (`name (path)`), which point of the call, what.
@@ -148,6 +175,23 @@ pub enum PluginFault {
         point: usize,
         status: i32,
     },
+    /// The worker process of an isolated plugin died (a crash, an `exit`) or could not be
+    /// started again during a call: an ordinary fault, the host goes on.
+    #[error(
+        "plugin {plugin}: {}in `{entry}`, the isolated plugin process {how}",
+        place(points, interaction.as_deref())
+    )]
+    ProcessDied {
+        plugin: String,
+        /// The entry point running when it died.
+        entry: &'static str,
+        /// `side A / side B`, when the call was about points.
+        interaction: Option<String>,
+        /// The points of the caller's call that were being evaluated.
+        points: std::ops::Range<usize>,
+        /// `was killed by SIGSEGV (…); a new process serves the next call`.
+        how: String,
+    },
     /// The caller passed inconsistent arrays (a bug in the caller, reported, not panicked).
     #[error("plugin {plugin}: bad call: {message}")]
     Usage { plugin: String, message: String },
@@ -162,11 +206,26 @@ impl PluginFault {
             | PluginFault::NotFinite { point, .. }
             | PluginFault::Negative { point, .. }
             | PluginFault::BadStatus { point, .. } => Some(*point),
+            PluginFault::ProcessDied { points, .. } => (!points.is_empty()).then_some(points.start),
             PluginFault::Usage { .. } => None,
         }
     }
 
     pub fn is_cutback(&self) -> bool {
         matches!(self, PluginFault::Cutback { .. })
+    }
+}
+
+/// `point 3 on interaction A / B: `, `points 0–255 …: `, or nothing for a call without
+/// points.
+fn place(points: &std::ops::Range<usize>, interaction: Option<&str>) -> String {
+    let points = match points.len() {
+        0 => return String::new(),
+        1 => format!("point {}", points.start),
+        _ => format!("points {}–{}", points.start, points.end - 1),
+    };
+    match interaction {
+        Some(i) => format!("{points} on interaction {i}: "),
+        None => format!("{points}: "),
     }
 }

@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::{Plugin, PluginData, PluginError};
+use super::{Isolation, Plugin, PluginData, PluginError};
 use crate::deck::spec::Enforcement;
 
 /// `Enforcement for Energy = Plugin Library = "path/libmodel.so" Model = name` with the
@@ -12,6 +12,8 @@ pub struct PluginSpec {
     /// The library, resolved against the deck's directory if relative.
     pub path: PathBuf,
     pub data: PluginData,
+    /// `Plugin Isolation`: in seam's process (default) or in a worker process.
+    pub isolation: Isolation,
 }
 
 impl PluginSpec {
@@ -56,12 +58,13 @@ impl PluginSpec {
                 integer_data: enforcement.integer_data.clone(),
                 real_data: enforcement.real_data.clone(),
             },
+            isolation: enforcement.plugin_isolation,
         })
     }
 
-    /// Load the library and create the instance.
+    /// Load the library and create the instance, in this process or in a worker.
     pub fn load(&self) -> Result<Plugin, PluginError> {
-        Plugin::load_with(&self.path, &self.data)
+        Plugin::load_with_isolation(&self.path, &self.data, self.isolation)
     }
 }
 

@@ -1273,6 +1273,422 @@ fn plugin_that_kills_the_process_is_reported_with_exit_code_3() {
     }
 }
 
+// --- isolation: the plugin in a worker process --------------------------------------------
+
+/// The worker for in-process library calls: this test binary is not `seam`.
+fn isolated(path: &Path, data: &PluginData) -> Result<Plugin, PluginError> {
+    seam::plugin::set_worker_program(env!("CARGO_BIN_EXE_seam"));
+    Plugin::load_isolated(path, data)
+}
+
+fn bits(r: &[PointResult]) -> Vec<[u64; 5]> {
+    r.iter()
+        .map(|r| [r.value, r.d_temp_a, r.d_temp_b, r.d_gap, r.d_pressure].map(f64::to_bits))
+        .collect()
+}
+
+/// In a worker process the C table plugin (batch entry, exact derivatives), the smooth
+/// plugin (derivatives by finite differences, 9 calls a point) and the echo plugin (state
+/// and data) give the in-process results to the last bit, over more than one chunk of
+/// 256 points, batched and point by point; the state a stateful plugin writes comes back.
+#[test]
+fn isolated_plugins_give_the_in_process_results_to_the_last_bit() {
+    let c = c_plugins();
+    let points: Vec<_> = (0..600)
+        .map(|i| {
+            point(
+                1e-7 * i as f64,
+                1.7e4 * i as f64,
+                300.0 + 0.5 * i as f64,
+                410.0,
+            )
+        })
+        .collect();
+    let cases = [
+        (&c.table, data(&table_real(), &[])),
+        (&c.smooth, data(&[], &[])),
+        (&c.echo, data(&[1.5, -2.0], &[3, 4])),
+    ];
+    for (path, d) in cases {
+        let here = Plugin::load_with(path, &d).unwrap();
+        let there = isolated(path, &d).unwrap();
+        assert_eq!(here.info(), there.info());
+        assert_eq!(there.isolation(), seam::plugin::Isolation::Process);
+        assert!(there.descriptor().is_none());
+        let ns = here.info().state_size;
+        let run = |p: &Plugin, per_point: bool| {
+            let mut r = vec![PointResult::default(); points.len()];
+            let mut s = StateStore::new(points.len(), ns);
+            if per_point {
+                p.evaluate_per_point(&ctx(), &points, &mut r, Some(&mut s))
+            } else {
+                p.evaluate(&ctx(), &points, &mut r, Some(&mut s))
+            }
+            .unwrap();
+            s.commit();
+            (bits(&r), s)
+        };
+        for per_point in [false, true] {
+            let (a, sa) = run(&here, per_point);
+            let (b, sb) = run(&there, per_point);
+            assert!(a == b, "{}: results differ", path.display());
+            assert_eq!(sa, sb, "{}: states differ", path.display());
+        }
+    }
+}
+
+/// A worker that crashes (SIGSEGV) or calls `exit(0)` at the points with pressure ≥ 100
+/// is an ordinary fault naming the plugin, the interaction, the point and how the worker
+/// died; the host is alive, and the next call is served by a new worker. (The faulty
+/// plugin has no batch entry: the worker calls it point by point and knows the point; a
+/// batch entry's crash names the points of the call.)
+#[test]
+fn a_crashing_isolated_plugin_is_an_ordinary_fault_and_the_host_goes_on() {
+    for (fault, how) in [
+        ("SEGFAULT", "killed by SIGSEGV"),
+        ("EXIT", "ended with exit status 0"),
+    ] {
+        let lib = cc_shared(
+            "plugins/tests/faulty/faulty.c",
+            &[&format!("-DFAULT_{fault}")],
+            &format!("faulty_{}", fault.to_lowercase()),
+        );
+        let plugin = isolated(&lib, &data(&[], &[])).unwrap();
+        let mut points: Vec<_> = (0..300).map(|_| point(0.0, 1.0, 300.0, 300.0)).collect();
+        points[280].pressure = 150.0;
+        let mut r = vec![PointResult::default(); points.len()];
+        let err = plugin
+            .evaluate(&ctx(), &points, &mut r, None)
+            .expect_err("the worker dies");
+        let msg = err.to_string();
+        for needle in [
+            "`faulty`",
+            &format!("faulty_{}", fault.to_lowercase()),
+            "point 280 on interaction block_1_top / block_2_bottom",
+            "on interaction block_1_top / block_2_bottom",
+            "isolated plugin process",
+            how,
+            "evaluate_point",
+            "a new process serves the next call",
+        ] {
+            assert!(msg.contains(needle), "{fault}: no `{needle}` in {msg}");
+        }
+        assert!(
+            matches!(err, PluginFault::ProcessDied { ref points, .. } if *points == (280..281)),
+            "{err:?}"
+        );
+        assert_eq!(err.point(), Some(280));
+        // The first chunk was served before the death; a new worker serves the next call.
+        assert_eq!(r[0].value, 1.0);
+        let good = eval(&plugin, &points[..10]).unwrap();
+        assert!(good.iter().all(|r| r.value == 1.0));
+        // The point is counted in the caller's call.
+        let err = plugin
+            .evaluate_per_point(&ctx(), &points[275..285], &mut r[..10], None)
+            .unwrap_err();
+        assert!(err.to_string().contains("point 5 on"), "{err}");
+        let err = plugin
+            .evaluate(&ctx(), &points[280..281], &mut r[..1], None)
+            .unwrap_err();
+        assert!(err.to_string().contains("point 0 on interaction"), "{err}");
+    }
+}
+
+/// Load errors met in the worker are the in-process messages, word for word; a worker
+/// executable that does not speak the protocol is a clear error.
+#[test]
+fn isolated_load_errors_are_the_in_process_ones() {
+    for fault in ["MAJOR", "NO_ENTRY", "NULL_EVALUATE"] {
+        let here = load_err(&faulty(fault));
+        let there = match isolated(&faulty(fault), &data(&[], &[])) {
+            Ok(_) => panic!("{fault} loaded in the worker"),
+            Err(e) => e.to_string(),
+        };
+        assert_eq!(here, there);
+    }
+    let missing = tmp().join("no-such-plugin.so");
+    let err = isolated(&missing, &data(&[], &[])).unwrap_err();
+    assert!(matches!(err, PluginError::NotFound { .. }), "{err}");
+}
+
+/// Write the two-block problem whose enforcement uses `lib` at contact pressure 1000
+/// plus `extra` lines; the directory.
+fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
+    let mesh = root().join("examples/two_blocks/two_blocks.exo");
+    let dir = tmp().join(format!("run-isolated-{tag}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = {:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 1\n[contact]\nfile = \"contact.i\"\n[output]\ndir = \"out\"\n",
+            mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
+             begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{}\"\n  contact pressure = 1000\n  plugin isolation = process\n{extra} end\nend\n",
+            lib.display()
+        ),
+    )
+    .unwrap();
+    dir
+}
+
+/// `Plugin Isolation = Process` in `seam run`: a plugin that segfaults or calls `exit(0)`
+/// stops the run with an ordinary error naming the plugin, the interaction, the point and
+/// how its worker died, exit code 3; with `Quarantine Faulty Points` the run completes
+/// and reports the points. `seam check-plugin --isolate` gives a FAILED report, exit 3.
+#[test]
+fn isolated_plugin_that_kills_its_process_stops_the_run_or_is_quarantined() {
+    for (fault, how) in [
+        ("SEGFAULT", "killed by SIGSEGV"),
+        ("EXIT", "ended with exit status 0"),
+    ] {
+        let lib = cc_shared(
+            "plugins/tests/faulty/faulty.c",
+            &[&format!("-DFAULT_{fault}")],
+            &format!("faulty_{}", fault.to_lowercase()),
+        );
+        let tag = fault.to_lowercase();
+        let dir = kill_problem(&lib, &tag, "");
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["run", "problem.toml"])
+            .current_dir(&dir)
+            .output()
+            .expect("seam runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{fault}: {err}");
+        for needle in [
+            "error[E0800]",
+            "plugin `faulty`",
+            "interaction base_face / lid_face",
+            "at (gap",
+            "isolated plugin process",
+            how,
+            "Quarantine Faulty Points",
+        ] {
+            assert!(err.contains(needle), "{fault}: no `{needle}` in\n{err}");
+        }
+        assert!(!err.contains("E0503"), "not the in-process report: {err}");
+
+        let dir = kill_problem(
+            &lib,
+            &format!("{tag}-quarantine"),
+            "  quarantine faulty points\n",
+        );
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["run", "problem.toml"])
+            .current_dir(&dir)
+            .output()
+            .expect("seam runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(0), "{fault}: {text}\n{err}");
+        for needle in ["W0501", "quarantined", how] {
+            assert!(err.contains(needle), "{fault}: no `{needle}` in\n{err}");
+        }
+        assert!(text.contains("heat out of A 0.0"), "{text}");
+
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["check-plugin", "--isolate", lib.to_str().unwrap()])
+            .output()
+            .expect("seam runs");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(out.status.code(), Some(3), "{fault}: {text}");
+        for needle in [
+            "isolation     a worker process",
+            "the conformance checks",
+            how,
+            "FAIL",
+            "host validation FAILED",
+        ] {
+            assert!(text.contains(needle), "{fault}: no `{needle}` in\n{text}");
+        }
+    }
+    // A good plugin passes the isolated check.
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    let mut args = vec![
+        "check-plugin".to_string(),
+        "--isolate".into(),
+        table,
+        "--real".into(),
+    ];
+    args.extend(table_real().iter().map(|v| v.to_string()));
+    let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+        .args(&args)
+        .output()
+        .expect("seam runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("PASS"), "{text}");
+}
+
+/// The C table plugin (linear problem) and the Rust CMY plugin with radiation (nonlinear,
+/// several Newton iterations) give the same temperatures in a run in a worker process as
+/// in seam's own process. Both modes see bit-identical conductances (the tests above);
+/// the solve itself may add in another order from run to run (the parallel
+/// factorisation), so the temperatures are compared with what two in-process runs meet:
+/// bit for bit when those agree to the bit.
+#[test]
+fn isolated_plugin_in_a_run_gives_the_in_process_temperatures() {
+    seam::plugin::set_worker_program(env!("CARGO_BIN_EXE_seam"));
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    let real = table_real()
+        .iter()
+        .map(|v| format!("{v:e}"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let cmy = rust_plugins().cmy.to_str().unwrap().to_string();
+    for (tag, line) in [
+        (
+            "table",
+            format!(
+                "  enforcement for energy = plugin library = \"{table}\"\n  contact pressure = 2e5\n  real data {real}"
+            ),
+        ),
+        (
+            "cmy",
+            format!(
+                "  enforcement for energy = plugin library = \"{cmy}\"\n  real data 16 0.1 1e-6 3e9 0 1e-6 0.8 0.6"
+            ),
+        ),
+    ] {
+        let a = run_with(&line, 300.0, 1300.0, &format!("iso-{tag}-none"));
+        let b = run_with(
+            &format!("{line}\n  plugin isolation = process"),
+            300.0,
+            1300.0,
+            &format!("iso-{tag}-process"),
+        );
+        let again = run_with(&line, 300.0, 1300.0, &format!("iso-{tag}-none-again"));
+        let floor = max_diff(&a, &again);
+        assert!(
+            max_diff(&a, &b) <= floor.max(1e-12),
+            "{tag}: {} (floor {floor:e})",
+            max_diff(&a, &b)
+        );
+        if floor == 0.0 {
+            assert!(
+                a.iter().zip(&b).all(|(x, y)| x.to_bits() == y.to_bits()),
+                "{tag}: a deterministic solve gives bit-identical temperatures"
+            );
+        }
+    }
+}
+
+/// `Plugin Isolation = Process` in Sierra and `plugin_isolation = "process"` in TOML give
+/// the same plugin spec; the default is in process; a misspelt choice is an error with a
+/// did-you-mean.
+#[test]
+fn plugin_isolation_line_in_sierra_and_toml() {
+    let sierra = |extra: &str| {
+        format!(
+            "begin contact definition\n begin enforcement\n  enforcement for energy = plugin library = \"lib/m.so\"\n{extra} end\nend\n"
+        )
+    };
+    let toml = |extra: &str| {
+        format!(
+            "[[contact_definition]]\n[[contact_definition.enforcement]]\n{extra}model = [{{ equation = \"energy\", model = \"plugin\", args = [{{ key = \"library\", value = \"lib/m.so\" }}] }}]\n"
+        )
+    };
+    let file = std::sync::Arc::from("d");
+    let spec = |d: &seam::deck::spec::Deck| {
+        seam::plugin::PluginSpec::from_enforcement(
+            &d.contact_definitions[0].enforcements[0],
+            Path::new("/decks"),
+        )
+        .unwrap()
+    };
+    for (line, key, isolation) in [
+        ("", "", seam::plugin::Isolation::None),
+        (
+            "  Plugin Isolation = Process\n",
+            "plugin_isolation = \"process\"\n",
+            seam::plugin::Isolation::Process,
+        ),
+        (
+            "  plugin isolation none\n",
+            "plugin_isolation = \"none\"\n",
+            seam::plugin::Isolation::None,
+        ),
+    ] {
+        let (a, da) = seam::deck::parse_sierra(&file, &sierra(line));
+        let (b, db) = seam::deck::parse_toml(&file, &toml(key));
+        assert!(!da.has_errors() && !db.has_errors(), "{da:?} {db:?}");
+        assert_eq!(spec(&a), spec(&b));
+        assert_eq!(spec(&a).isolation, isolation, "{line}");
+    }
+    let (_, d) = seam::deck::parse_sierra(&file, &sierra("  plugin isolation = proces\n"));
+    let e = d.errors().next().expect("a bad choice is an error");
+    assert_eq!(e.code, "E0217");
+    let text = format!("{e:?}");
+    assert!(text.contains("did you mean `process`"), "{text}");
+}
+
+/// A worker that cannot be found, or a program that is not a worker, is a clear load
+/// error naming the plugin and what was tried (`SEAM_PLUGIN_WORKER` overrides the
+/// lookup), and `seam check-plugin --isolate` exits 3 with it.
+#[test]
+fn a_missing_or_wrong_plugin_worker_is_a_clear_error() {
+    let table = c_plugins().table.to_str().unwrap().to_string();
+    for (worker, needle) in [
+        (
+            "/nonexistent/seam",
+            "SEAM_PLUGIN_WORKER=/nonexistent/seam: no such file",
+        ),
+        (
+            "/bin/false",
+            "is not a seam plugin worker (no greeting): it ended with exit status 1",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(["check-plugin", "--isolate", &table])
+            .env("SEAM_PLUGIN_WORKER", worker)
+            .output()
+            .expect("seam runs");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{err}");
+        assert!(err.contains("error[E0500]: plugin"), "{err}");
+        assert!(err.contains("seam_c_table"), "{err}");
+        assert!(err.contains(needle), "{worker}: no `{needle}` in {err}");
+    }
+}
+
+/// The faults a plugin reports or seam's checks find (NaN, negative, an error with its
+/// message, a cutback with its factor, an unknown status) are the same, field for field,
+/// when the plugin runs in a worker, and the worker goes on serving.
+#[test]
+fn isolated_plugin_faults_are_the_in_process_ones() {
+    let points = [
+        point(0.0, 1.0, 300.0, 300.0),
+        point(0.0, 2.0, 300.0, 300.0),
+        point(0.0, 150.0, 300.0, 300.0),
+    ];
+    for fault in [
+        "NAN",
+        "NAN_DERIVATIVE",
+        "NEGATIVE",
+        "ERROR",
+        "CUTBACK",
+        "BAD_STATUS",
+    ] {
+        let here = Plugin::load(&faulty(fault)).unwrap();
+        let there = isolated(&faulty(fault), &data(&[], &[])).unwrap();
+        let a = eval(&here, &points).unwrap_err();
+        let b = eval(&there, &points).unwrap_err();
+        // (Debug, not ==: a NaN value is not equal to itself.)
+        assert_eq!(format!("{a:?}"), format!("{b:?}"), "{fault}");
+        assert_eq!(a.point(), Some(2));
+        assert_eq!(eval(&there, &points[..2]).unwrap()[1].value, 1.0);
+    }
+}
+
 /// The interface heat through a plugin conductance (the C table plugin with a flat
 /// table h) is exact for every finite h from 0 to 1e300 and 1e8 contrasts, as the
 /// built-in models are (see `hard_cases`).
