@@ -898,6 +898,14 @@ impl Embedding {
         let a = source
             .mapped(map.as_mut(), &name)
             .map_err(|e| fail(&e, "the map failed while mapping side A's nodes"))?;
+        if let Some(fold) =
+            crate::search::scene::check_one_to_one(&source, &a, |n| self.mesh.node_number(n))
+        {
+            return Err(fail(
+                &PeriodicError::Folds(Box::new(fold)),
+                "a periodic map carries each node to its own place on side B; check the map",
+            ));
+        }
         landing(&a, &b).check(&side_b.name).map_err(|e| {
             fail(
                 &e,

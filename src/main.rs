@@ -719,14 +719,15 @@ fn check(deck_path: &Path, mesh_path: Option<&Path>, problem: Option<&Path>) -> 
             }
         };
         // The problem's deck is usually DECK itself: say each thing once.
+        let mut extra = Diagnostics::default();
         for d in found.0 {
-            if seen.contains(&d) {
-                continue;
+            if !seen.contains(&d) {
+                errors += usize::from(d.is_error());
+                seen.push(d.clone());
+                extra.push(d);
             }
-            errors += usize::from(d.is_error());
-            text += &Diagnostics(vec![d.clone()]).render(&sources);
-            seen.push(d);
         }
+        text += &extra.render(&sources);
     }
     eprint!("{text}");
     if errors > 0 {

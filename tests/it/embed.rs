@@ -927,6 +927,25 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
             .contains("its image does not land on `cut_end`"),
         "{err}"
     );
+
+    // A map that collapses the cut onto one point is refused before any landing check.
+    let mut collapsing = builder();
+    let err = collapsing
+        .add_interaction(
+            Interaction::new("cut_start", "cut_end", Model::TiedNitsche).periodic(
+                Periodic::Mapped {
+                    x: "0".into(),
+                    y: "0".into(),
+                    z: Some("0".into()),
+                },
+            ),
+        )
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("the map is not one-to-one"),
+        "{err}"
+    );
+    assert!(!err.to_string().contains("does not land"), "{err}");
 }
 
 /// The plugin-conductance scene through the embedding API: the deck's C table plugin

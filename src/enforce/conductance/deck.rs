@@ -552,7 +552,8 @@ impl Cx<'_> {
             return None;
         };
         let path = self.deck_dir.join(file);
-        let text = match std::fs::read_to_string(&path) {
+        // Bounded and BOM-aware, like every Lua file seam reads.
+        let text = match crate::script::read_lua_file(&path) {
             Ok(t) => t,
             Err(e) => {
                 self.error(

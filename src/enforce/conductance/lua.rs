@@ -109,10 +109,7 @@ impl LuaConductance {
         function: &str,
         limits: Limits,
     ) -> Result<LuaConductance, ScriptError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScriptError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = crate::script::read_lua_file(path)?;
         LuaConductance::source_with(&path.display().to_string(), &text, function, limits)
     }
 
