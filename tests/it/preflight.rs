@@ -441,6 +441,10 @@ fn contact_surface_pressure_reaches_a_pressure_dependent_conductance() {
         ),
     ] {
         let heat = heat_with(name, &format!("{CMY}{line}"));
+        println!(
+            "{name}: heat {heat}, exact {exact}, rel err {:.1e}",
+            (heat - exact).abs() / exact
+        );
         assert!(
             (heat - exact).abs() <= 1e-9 * exact,
             "{name}: heat {heat}, exact {exact}"
@@ -467,6 +471,10 @@ fn offset_temperature_takes_effect_in_both_forms() {
             &format!("    enforcement for energy = contact_resistance h = 5\n{line}"),
         );
         let exact = 120.0 / r;
+        println!(
+            "{name}: heat {heat}, exact {exact}, rel err {:.1e}",
+            (heat - exact).abs() / exact
+        );
         assert!(
             (heat - exact).abs() <= 1e-9 * exact,
             "{name}: heat {heat}, exact {exact}"
@@ -499,10 +507,15 @@ fn contact_gap_temperature_decides_what_a_conductance_sees() {
     for (name, seen, plain) in pairs {
         let a = heat_with(&format!("{name}_seen"), &seen);
         let b = heat_with(&format!("{name}_plain"), &plain);
+        println!(
+            "{name}: seen {a}, plain {b}, rel diff {:.1e}",
+            (a - b).abs() / b
+        );
         assert!((a - b).abs() <= 1e-9 * b, "{name}: {a} vs {b}");
     }
     // And it changes the answer: T_A and T_B differ by tens of kelvin at this h.
     let a = heat_with("differs_a", &gap("0.05*temp_a", ""));
     let b = heat_with("differs_b", &gap("0.05*temp_b", ""));
+    println!("h(T_A) {a} against h(T_B) {b}");
     assert!((a - b).abs() > 1e-3 * a, "{a} vs {b}");
 }
