@@ -266,3 +266,48 @@ fn gas_gap_heat_is_exact_for_tiny_zero_and_negative_gaps() {
     }
     assert!(worst <= TOLERANCE, "{worst:e}");
 }
+
+/// The per-face interface flux that `Visualize Contact` writes is as exact as the heat
+/// for huge and infinite conductances: uniform, and equal to the series flux, on every
+/// face of side A.
+#[test]
+fn contact_flux_per_face_is_exact_for_huge_h() {
+    for h in ["1e8", "1e20", "1e300", "inf"] {
+        let dir = scratch(&format!("faces-{h}"));
+        let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
+        std::fs::write(
+            dir.join("problem.toml"),
+            format!(
+                "[mesh]\nfile = {mesh:?}\n[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n\
+                 [[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n\
+                 [contact]\nfile = \"contact.i\"\n[output]\ndir = \"out\"\n",
+                mesh = mesh.to_str().unwrap()
+            ),
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("contact.i"),
+            format!(
+                "begin contact definition\n  contact surface a contains base_top\n  contact surface b contains lid_bottom\n  visualize contact\n  begin interaction\n    side a a\n    side b b\n  end\n  begin enforcement\n    enforcement for energy = contact_resistance h = {h}\n  end\nend\n"
+            ),
+        )
+        .unwrap();
+        seam::run::run(&dir.join("problem.toml")).unwrap_or_else(|e| panic!("{e:?}"));
+        let xml = std::fs::read_to_string(dir.join("out/contact.vtu")).unwrap();
+        let flux = crate::run_fields::vtu_array(&xml, "interface_flux");
+        // Heat flows from the lid (B) into the base (A): the flux from A to B is −q.
+        let exact = -exact_heat(h.parse().unwrap(), 16.0, 200.0);
+        let worst = flux
+            .iter()
+            .map(|q| (q - exact).abs() / exact.abs())
+            .fold(0.0, f64::max);
+        println!(
+            "h = {h}: {} faces, worst relative error of the face flux {worst:.1e}",
+            flux.len()
+        );
+        assert_eq!(flux.len(), 36);
+        assert!(worst <= 1e-9, "h = {h}: {worst:e}");
+    }
+}

@@ -34,7 +34,7 @@ fn run(problem: &Path) -> RunResult {
 }
 
 /// The values of the ASCII `DataArray` called `name` in a `.vtu` `seam run` wrote.
-fn vtu_array(xml: &str, name: &str) -> Vec<f64> {
+pub(crate) fn vtu_array(xml: &str, name: &str) -> Vec<f64> {
     let tag = format!("Name=\"{name}\"");
     let at = xml
         .find(&tag)
