@@ -5,7 +5,9 @@
 //! block phrases (longest match); the rest of the line is the block's name. An `end` line
 //! may repeat the type and/or the name, and must then match (else E0102, and the block
 //! is closed all the same). Blocks still open at the end of the file are reported at
-//! their `begin` line (E0101).
+//! their `begin` line (E0101). Blocks nest at most [`MAX_DEPTH`] deep: a deeper `begin`
+//! is E0106 and is skipped with everything up to its `end`, so no input can make the
+//! later stages recurse without bound.
 
 use std::sync::Arc;
 
@@ -49,18 +51,44 @@ impl Block {
     }
 }
 
+/// How deep blocks may nest. Sierra's contact blocks nest three deep; the bound keeps
+/// the recursive lowering (and dropping) of the tree within any thread's stack.
+pub const MAX_DEPTH: usize = 32;
+
 /// The file's top level.
 pub fn build(file: &Arc<str>, lines: Vec<Line>) -> (Vec<Item>, Diagnostics) {
     let mut diags = Diagnostics::default();
     let mut top: Vec<Item> = Vec::new();
     let mut stack: Vec<Block> = Vec::new();
+    // `begin` lines past MAX_DEPTH still open, whose contents are skipped.
+    let mut too_deep = 0usize;
     for line in lines {
         let first = line.tokens.first().map(|t| t.lower.as_str());
+        let keyword = line.tokens.first().is_some_and(Token::is_word);
+        if too_deep > 0 {
+            match first {
+                Some("begin") if keyword => too_deep += 1,
+                Some("end") if keyword => too_deep -= 1,
+                _ => {}
+            }
+            continue;
+        }
         match first {
-            Some("begin") if line.tokens.first().is_some_and(Token::is_word) => {
+            Some("begin") if keyword && stack.len() >= MAX_DEPTH => {
+                too_deep = 1;
+                diags.push(
+                    Diagnostic::error(
+                        codes::MISPLACED_BLOCK,
+                        format!("block nested more than {MAX_DEPTH} deep"),
+                    )
+                    .at(span(file, &line.tokens))
+                    .help("close the blocks above with `end`; this block and everything in it up to its `end` are skipped"),
+                );
+            }
+            Some("begin") if keyword => {
                 stack.push(open(file, line, &mut diags));
             }
-            Some("end") if line.tokens.first().is_some_and(Token::is_word) => match stack.pop() {
+            Some("end") if keyword => match stack.pop() {
                 Some(block) => {
                     check_end(file, &block, &line, &mut diags);
                     push(&mut stack, &mut top, Item::Block(block));
@@ -260,6 +288,41 @@ mod tests {
                 .as_deref()
                 .unwrap_or("")
                 .contains("did you mean `begin contact definition`")
+        );
+    }
+
+    #[test]
+    fn nesting_past_the_bound_is_one_error_and_skipped() {
+        let n = 100_000;
+        let src = format!(
+            "begin contact definition\n{}{}begin contact surface top\nend\nend\n",
+            "begin interaction a\n".repeat(n),
+            "end\n".repeat(n),
+        );
+        let (top, d) = tree(&src);
+        assert_eq!(d.len(), 1, "{d:?}");
+        assert_eq!(d.0[0].code, codes::MISPLACED_BLOCK);
+        assert_eq!(
+            d.0[0].loc.as_ref().map(|l| l.line),
+            Some(MAX_DEPTH as u32 + 1)
+        );
+        fn depth(items: &[Item]) -> usize {
+            items
+                .iter()
+                .map(|i| match i {
+                    Item::Block(b) => 1 + depth(&b.items),
+                    Item::Line(_) => 0,
+                })
+                .max()
+                .unwrap_or(0)
+        }
+        assert_eq!(depth(&top), MAX_DEPTH);
+        // The block after the skipped ones is read again.
+        let [Item::Block(cd)] = top.as_slice() else {
+            panic!("expected one block")
+        };
+        assert!(
+            matches!(cd.items.last(), Some(Item::Block(b)) if b.name_lower().as_deref() == Some("top"))
         );
     }
 }
