@@ -10,6 +10,7 @@ mod embed;
 mod enforce;
 mod examples;
 mod fem;
+mod fuzz_regressions;
 mod interactions;
 mod mesh_io;
 mod output;
