@@ -9,9 +9,18 @@ use std::sync::Once;
 use libfuzzer_sys::fuzz_target;
 
 const BESIDE: [(&str, &[u8]); 3] = [
-    ("two_blocks.exo", include_bytes!("../../examples/two_blocks/two_blocks.exo")),
-    ("contact_run.i", include_bytes!("../../examples/two_blocks/contact_run.i")),
-    ("contact.i", include_bytes!("../../examples/two_blocks/contact.i")),
+    (
+        "two_blocks.exo",
+        include_bytes!("../../examples/two_blocks/two_blocks.exo"),
+    ),
+    (
+        "contact_run.i",
+        include_bytes!("../../examples/two_blocks/contact_run.i"),
+    ),
+    (
+        "contact.i",
+        include_bytes!("../../examples/two_blocks/contact.i"),
+    ),
 ];
 
 fuzz_target!(|data: &[u8]| {
