@@ -52,7 +52,7 @@ for t in "${targets[@]}"; do
     cargo fuzz run "${flags[@]}" "$t" "corpus/$t" -- \
         -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -max_len=65536 \
         -print_final_stats=1 >"$log" 2>&1 || rc=$?
-    grep -E '^(#[0-9]+ *(INITED|DONE)|stat::number_of_executed_units|==[0-9]+== *ERROR|SUMMARY|thread .* panicked)' "$log" || true
+    grep -E '^(#[0-9]+[[:space:]]+(INITED|DONE)|stat::number_of_executed_units|==[0-9]+== *ERROR|SUMMARY|thread .* panicked)' "$log" || true
     if [ "$rc" -ne 0 ]; then
         tail -n 30 "$log"
         failed+=("$t")
