@@ -93,6 +93,7 @@ int seam_builder_add_face_set(seam_builder *builder, const char *name,
 int seam_builder_set_dofs(seam_builder *builder, const int64_t *dofs, size_t n_nodes);
 /* Nodes the host prescribes (Dirichlet): mortar ties give them no multiplier. */
 int seam_builder_set_fixed_nodes(seam_builder *builder, const int64_t *nodes, size_t n);
+/* `order` 1 to 20. */
 int seam_builder_set_integration(seam_builder *builder, int kind, int order);
 
 /* --- the embedding ---------------------------------------------------------------- */

@@ -433,7 +433,8 @@ pub unsafe extern "C" fn seam_builder_set_fixed_nodes(
     })
 }
 
-/// `kind` 0: mortar segments, 1: Gauss quadrature on side A; `order` the rule's order.
+/// `kind` 0: mortar segments, 1: Gauss quadrature on side A; `order` the rule's order,
+/// 1 to [`crate::search::pairing::MAX_ORDER`].
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_builder_set_integration(
     builder: *mut SeamBuilder,
@@ -444,8 +445,8 @@ pub unsafe extern "C" fn seam_builder_set_integration(
         let b = unsafe { handle(builder, "builder") }?;
         let order = usize::try_from(order)
             .ok()
-            .filter(|&o| o >= 1)
-            .ok_or_else(|| bad(format!("order {order}"), "give an order of 1 or more"))?;
+            .filter(|o| (1..=crate::search::pairing::MAX_ORDER).contains(o))
+            .ok_or_else(|| bad(format!("order {order}"), "give an order of 1 to 20"))?;
         let integration = match kind {
             0 => Integration::Segments { order },
             1 => Integration::Quadrature { order },

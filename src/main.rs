@@ -59,9 +59,9 @@ enum Command {
         /// Integrate on mortar segments (exact overlap) instead of side-A Gauss points.
         #[arg(long)]
         segments: bool,
-        /// Quadrature order (Gauss points per face direction, or segment rule degree).
-        #[arg(long, default_value_t = 2)]
-        order: usize,
+        /// Quadrature order (Gauss points per face direction, or segment rule degree), 1 to 20.
+        #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=seam::search::pairing::MAX_ORDER as i64))]
+        order: u16,
     },
     /// Solve a heat-transfer problem with contact (a TOML problem file) and write the
     /// temperature as VTK XML. Exit 1 if Newton does not converge.
@@ -124,7 +124,7 @@ fn main() -> ExitCode {
             json,
             segments,
             order,
-        } => search(&deck, &mesh, json, segments, order),
+        } => search(&deck, &mesh, json, segments, order as usize),
         Command::Run {
             problem,
             json,

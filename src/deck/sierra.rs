@@ -162,6 +162,14 @@ impl<'a> Cur<'a> {
         }
     }
 
+    /// In a list of values: a token the reader refused without consuming (a stray
+    /// separator, already reported) is passed over, so the list's loop always ends.
+    fn pass_reported(&mut self, before: usize) {
+        if self.pos == before {
+            self.pos += 1;
+        }
+    }
+
     fn rest(&self) -> &'a [Token] {
         self.line.tokens.get(self.pos..).unwrap_or_default()
     }
@@ -1377,17 +1385,21 @@ impl Lower {
                 "integer_data" => {
                     c.skip_sep();
                     while c.peek().is_some() {
+                        let before = c.pos;
                         if let Some((v, _)) = self.integer(&mut c, "integers") {
                             e.integer_data.push(v);
                         }
+                        c.pass_reported(before);
                     }
                 }
                 "real_data" => {
                     c.skip_sep();
                     while c.peek().is_some() {
+                        let before = c.pos;
                         if let Some((v, _)) = self.number(&mut c, "numbers") {
                             e.real_data.push(v);
                         }
+                        c.pass_reported(before);
                     }
                 }
                 "side_b_variable" | "slave_variable" => {
@@ -1843,10 +1855,12 @@ impl Lower {
                         self.missing(&c, "element numbers");
                     }
                     while c.peek().is_some() {
+                        let before = c.pos;
                         if let Some((v, l)) = self.integer(&mut c, "element numbers (integers)") {
                             x.elements.push(v);
                             x.name_locs.push((v.to_string(), l));
                         }
+                        c.pass_reported(before);
                     }
                 }
                 "subset" => {

@@ -589,6 +589,31 @@ fn extra_words_and_repeats() {
     );
 }
 
+#[test]
+fn a_separator_inside_a_list_of_values_is_reported_and_passed_over() {
+    // Each of these looped forever, pushing one diagnostic per turn.
+    let text = "begin contact definition
+  begin contact surface top
+    element = 1 = 2
+  end
+  begin enforcement e
+    real data = real data = 1 2
+    integer data = 3 is 4
+  end
+end
+";
+    let (deck, d) = sierra(text);
+    let def = &deck.contact_definitions[0];
+    let SurfaceDef::Block(top) = &def.surfaces[0] else {
+        panic!("a surface block: {:?}", def.surfaces)
+    };
+    assert_eq!(top.elements, [1, 2], "{d:?}");
+    assert_eq!(def.enforcements[0].integer_data, [3, 4], "{d:?}");
+    assert_eq!(def.enforcements[0].real_data, [1.0, 2.0], "{d:?}");
+    // `element`'s `=`, `real`, `data`, `=` and `is`: one diagnostic each.
+    assert_eq!(d.len(), 5, "{d:?}");
+}
+
 // ----- properties -----
 
 /// A deck whose only case-sensitive text is inside quotes, so any re-spelling outside

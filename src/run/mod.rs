@@ -647,6 +647,18 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                 ));
             }
         };
+        if let Some(order) = c.order
+            && !(1..=crate::search::pairing::MAX_ORDER).contains(&order)
+        {
+            return Err(input_error(
+                "E0716",
+                format!(
+                    "[contact] order = {order}: the integration order must be 1 to {}",
+                    crate::search::pairing::MAX_ORDER
+                ),
+                "orders 2 (quadrature) and 5 (segments) are the defaults; higher ones only cost time",
+            ));
+        }
         let deck_dir = deck_path.parent().unwrap_or(Path::new(".")).to_path_buf();
         for def in &loaded.deck.contact_definitions {
             if ContactView::of(def).silenced {

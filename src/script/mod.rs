@@ -3,7 +3,10 @@
 //! Entry point: [`Sandbox`]. One sandbox per definition and thread (Lua states are not
 //! shared between threads). A sandbox offers only the `math`, `string` and `table`
 //! libraries: no `io`, `os`, `package`/`require`, `debug`, `load`, `loadstring`,
-//! `dofile`, `loadfile`, `collectgarbage`, `string.dump` or `print`. Chunks are loaded
+//! `dofile`, `loadfile`, `collectgarbage`, `string.dump` or `print`, and none of the
+//! pattern functions `string.find`, `match`, `gmatch`, `gsub`: they run in C, out of the
+//! instruction budget's reach, and a backtracking pattern such as `('a*'):rep(8)..'b'`
+//! against a few hundred characters runs for hours. Chunks are loaded
 //! as text only (precompiled bytecode is refused). Memory is capped, and every call runs
 //! under an instruction budget, so a runaway loop or a memory bomb ends with a clear
 //! error instead of hanging or exhausting the host.
@@ -106,7 +109,10 @@ impl Sandbox {
             globals.set(name, Value::Nil).map_err(setup)?;
         }
         let string: mlua::Table = globals.get("string").map_err(setup)?;
-        string.set("dump", Value::Nil).map_err(setup)?;
+        // Pattern matching runs in C, where the instruction hook never fires.
+        for name in ["dump", "find", "match", "gmatch", "gsub"] {
+            string.set(name, Value::Nil).map_err(setup)?;
+        }
         lua.set_memory_limit(limits.memory_bytes).map_err(setup)?;
         let used = Arc::new(AtomicU64::new(0));
         let exceeded = Arc::new(AtomicBool::new(false));
@@ -324,6 +330,31 @@ mod tests {
             assert!(matches!(err, ScriptError::Runtime { .. }), "{code}: {msg}");
             assert!(msg.contains(needle), "{code}: {msg}");
         }
+    }
+
+    #[test]
+    fn pattern_matching_is_not_offered() {
+        // With `string.find` this backtracks for hours inside one C call.
+        let s = sandbox();
+        let code = "return string.find(string.rep('a', 400), string.rep('a*', 8) .. 'b')";
+        let start = std::time::Instant::now();
+        for (code, needle) in [
+            (code, "find"),
+            ("return ('x'):match('x')", "match"),
+            ("return ('x'):gsub('x', 'y')", "gsub"),
+            ("return string.gmatch('x', 'x')", "gmatch"),
+        ] {
+            let err = s.run_source("pattern.lua", code).unwrap_err();
+            let msg = err.to_string();
+            assert!(matches!(err, ScriptError::Runtime { .. }), "{code}: {msg}");
+            assert!(msg.contains(needle), "{code}: {msg}");
+        }
+        assert!(start.elapsed() < std::time::Duration::from_secs(5));
+        // The rest of the string library stays.
+        let f = s
+            .expression("len", "string.len(string.rep('ab', 3))", &[])
+            .unwrap();
+        assert_eq!(s.call(&f, &[]).unwrap(), 6.0);
     }
 
     #[test]

@@ -302,6 +302,12 @@ impl SurfaceGeometry {
     }
 }
 
+/// The highest integration order accepted from input. A segment rule of order p on a
+/// triangle has ((p + 2)/2)² points built in O(p³) work, so an order in the thousands
+/// would run for hours per segment; 20 integrates polynomials far beyond any contact
+/// law's.
+pub const MAX_ORDER: usize = 20;
+
 /// How side-A points are placed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -10,6 +10,7 @@ mod embed;
 mod enforce;
 mod examples;
 mod fem;
+mod fuzz_regressions;
 mod hard_cases;
 mod hard_input;
 mod interactions;
