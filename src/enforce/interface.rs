@@ -203,20 +203,8 @@ fn reference_point(topology: Topology, side: u8, xi: [f64; 2]) -> Option<[f64; 3
 }
 
 /// Trace shape functions of a Tri3 (`len` 3) or Quad4 face at face coordinates `xi`,
-/// Exodus node order (the fourth value is 0 for a triangle).
-pub(crate) fn face_shape_values(len: usize, xi: [f64; 2]) -> [f64; 4] {
-    let (s, t) = (xi[0], xi[1]);
-    if len == 3 {
-        [1.0 - s - t, s, t, 0.0]
-    } else {
-        [
-            0.25 * (1.0 - s) * (1.0 - t),
-            0.25 * (1.0 + s) * (1.0 - t),
-            0.25 * (1.0 + s) * (1.0 + t),
-            0.25 * (1.0 - s) * (1.0 + t),
-        ]
-    }
-}
+/// Exodus node order (the fourth value is 0 for a triangle): the search's own.
+pub(crate) use crate::search::pairing::face_shapes as face_shape_values;
 
 /// The dof of `field` at side-A node `node` of surface `surface` (node-to-face points).
 pub(crate) fn node_dof(

@@ -102,15 +102,22 @@ fn install() {
     });
 }
 
-extern "C" fn on_signal(sig: libc::c_int, info: *mut libc::siginfo_t, context: *mut libc::c_void) {
-    let name = match sig {
+/// The name of a signal that ends a process, with what it means.
+pub(super) fn signal_name(sig: libc::c_int) -> Option<&'static str> {
+    Some(match sig {
         libc::SIGSEGV => "SIGSEGV (invalid memory access)",
         libc::SIGBUS => "SIGBUS (bus error)",
         libc::SIGFPE => "SIGFPE (arithmetic fault)",
         libc::SIGILL => "SIGILL (illegal instruction)",
         libc::SIGABRT => "SIGABRT (abort)",
-        _ => "a fatal signal",
-    };
+        libc::SIGKILL => "SIGKILL (killed, e.g. out of memory)",
+        libc::SIGTERM => "SIGTERM (terminated)",
+        _ => return None,
+    })
+}
+
+extern "C" fn on_signal(sig: libc::c_int, info: *mut libc::siginfo_t, context: *mut libc::c_void) {
+    let name = signal_name(sig).unwrap_or("a fatal signal");
     if report(name, "crashed with") {
         // SAFETY: ending the process without running anything else; in a worker, by the
         // signal itself (delivered with its default action when the handler returns).

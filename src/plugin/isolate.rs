@@ -501,15 +501,8 @@ fn reap(child: &mut Child, patience: Duration) -> std::io::Result<ExitStatus> {
 /// `in_plugin` (it died in a plugin call) an exit says what ends a process there.
 fn describe(status: &ExitStatus, in_plugin: bool) -> String {
     if let Some(sig) = status.signal() {
-        let name = match sig {
-            libc::SIGSEGV => "SIGSEGV (invalid memory access)",
-            libc::SIGBUS => "SIGBUS (bus error)",
-            libc::SIGFPE => "SIGFPE (arithmetic fault)",
-            libc::SIGILL => "SIGILL (illegal instruction)",
-            libc::SIGABRT => "SIGABRT (abort)",
-            libc::SIGKILL => "SIGKILL (killed, e.g. out of memory)",
-            libc::SIGTERM => "SIGTERM (terminated)",
-            _ => return format!("was killed by signal {sig}"),
+        let Some(name) = super::guard::signal_name(sig) else {
+            return format!("was killed by signal {sig}");
         };
         return format!("was killed by {name}");
     }

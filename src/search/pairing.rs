@@ -975,8 +975,9 @@ fn face_geom(mesh: &Mesh, side: Side, coords: &[V3]) -> FaceGeom {
     g
 }
 
-/// Shape functions of a Tri3 (`len` 3) or Quad4 face at `xi`, Exodus node order.
-fn face_shapes(len: usize, xi: [f64; 2]) -> [f64; 4] {
+/// Shape functions of a Tri3 (`len` 3) or Quad4 face at `xi`, Exodus node order (the
+/// fourth value is 0 for a triangle).
+pub(crate) fn face_shapes(len: usize, xi: [f64; 2]) -> [f64; 4] {
     let (s, t) = (xi[0], xi[1]);
     if len == 3 {
         [1.0 - s - t, s, t, 0.0]
