@@ -206,6 +206,62 @@ fn assembly_rows(
     (a, f)
 }
 
+/// Where AMG-CG overtakes Cholesky: the Q1 conduction matrix of a `c³`-cell cube with
+/// T = 0 on its boundary, solved by METIS Cholesky (factor + solve) and by AMG-CG at the
+/// tolerance `seam run` uses (set-up + solve), for `c` from 8 to 40 cells. The crossover
+/// sets `seam::heat::steady::AUTO_AMG_THRESHOLD`.
+fn crossover(reps: usize) {
+    println!("| cells | unknowns | Cholesky s | AMG-CG s | CG iterations | max |x_chol − x_amg| |");
+    println!("|---:|---:|---:|---:|---:|---:|");
+    for cells in [8, 12, 16, 20, 24, 28, 32, 40] {
+        let (mut a, mut f) = assembly_rows(&mut Vec::new(), cells, 1);
+        let c = cells + 1;
+        let bcs: Vec<(usize, f64)> = (0..c * c * c)
+            .filter(|&d| {
+                let (i, j, k) = (d % c, (d / c) % c, d / (c * c));
+                [i, j, k].iter().any(|&v| v == 0 || v == c - 1)
+            })
+            .map(|d| (d, 0.0))
+            .collect();
+        apply_dirichlet(&mut a, &mut f, &bcs).unwrap();
+        let (mut tc, mut ta) = (Vec::new(), Vec::new());
+        let (mut xc, mut xa, mut its) = (f.clone(), f.clone(), 0);
+        for _ in 0..reps {
+            tc.push(
+                time(|| {
+                    let mut chol = Cholesky::new(Ordering::Metis);
+                    chol.factor(&a).unwrap();
+                    xc = f.clone();
+                    chol.solve(&mut xc).unwrap();
+                })
+                .1,
+            );
+            ta.push(
+                time(|| {
+                    let mut amg = AmgCg::new(AmgOptions {
+                        tolerance: seam::heat::steady::AMG_TOLERANCE,
+                        ..AmgOptions::default()
+                    });
+                    amg.factor(&a).unwrap();
+                    xa = f.clone();
+                    its = amg.solve(&mut xa).unwrap().iterations;
+                })
+                .1,
+            );
+        }
+        let diff = xc
+            .iter()
+            .zip(&xa)
+            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+        println!(
+            "| {cells} | {} | {:.4} | {:.4} | {its} | {diff:.1e} |",
+            a.nrows(),
+            median(tc),
+            median(ta)
+        );
+    }
+}
+
 fn main() {
     let quick = std::env::var("SEAM_BENCH_QUICK").is_ok();
     let reps_env = std::env::var("SEAM_BENCH_REPS")
@@ -222,6 +278,11 @@ fn main() {
         rayon::current_num_threads(),
         faer::get_global_parallelism()
     );
+    // `SEAM_BENCH_ONLY=crossover`: only the Cholesky / AMG-CG crossover on Q1 hexes.
+    if std::env::var("SEAM_BENCH_ONLY").is_ok_and(|s| s == "crossover") {
+        crossover(reps);
+        return;
+    }
     // `SEAM_BENCH_ONLY=assembly` skips the Laplacian cases (for profiling assembly).
     let only_assembly = std::env::var("SEAM_BENCH_ONLY").is_ok_and(|s| s == "assembly");
     let mut rows = Vec::new();

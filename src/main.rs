@@ -540,6 +540,21 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                         "NOT converged"
                     }
                 );
+                let ls = &s.linear_solver;
+                let cg = match ls.iterations_per_solve.len() {
+                    0 => String::new(),
+                    1 => format!(", {} CG iterations", ls.iterations),
+                    _ => format!(
+                        ", {} CG iterations ({})",
+                        ls.iterations,
+                        ls.iterations_per_solve
+                            .iter()
+                            .map(usize::to_string)
+                            .collect::<Vec<_>>()
+                            .join(" + ")
+                    ),
+                };
+                println!("  linear solver: {} ({}){cg}", ls.name, ls.reason);
                 for i in &s.interactions {
                     println!(
                         "  {} / {} ({}): heat out of A {:.6e}, out of B {:.6e}, imbalance {:.3e}",

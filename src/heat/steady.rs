@@ -46,6 +46,65 @@ pub struct TieTerm<'a> {
     pub multipliers: Multipliers,
 }
 
+/// Relative residual at which AMG-preconditioned CG stops, ‖b − Ax‖ ≤ 1e-11 ‖b‖: three
+/// orders below the default Newton tolerance (1e-10), so one CG solve finishes a linear
+/// problem, and tight enough that temperatures and interface heat agree with a
+/// factorisation's to about 1e-10 relative (4e-14 absolute on the crossover benchmark,
+/// 1e-8 relative asserted on the two-block scene), the accuracy the verification cases
+/// assert.
+pub const AMG_TOLERANCE: f64 = 1e-11;
+
+/// Size (unknowns) from which `seam run`'s `linear_solver = "auto"` solves a symmetric
+/// positive definite system by AMG-preconditioned CG instead of sparse Cholesky.
+///
+/// Measured (`SEAM_BENCH_ONLY=crossover cargo bench --bench solvers`, release, 2 threads,
+/// medians of 3): the Q1 conduction matrix of a c³-cell cube, T = 0 on its boundary,
+/// METIS Cholesky (factor + solve) against AMG-CG to 1e-11 (set-up + solve):
+/// 729 unknowns 4.9 ms vs 5.1 ms, 2 197: 22 vs 8.7 ms, 9 261: 0.12 vs 0.033 s,
+/// 24 389: 0.47 vs 0.078 s, 68 921: 2.4 vs 0.29 s (Cholesky grows as n^1.6, AMG-CG as
+/// n^1.3, 11–13 CG iterations; answers agree to 4e-14). The time crossover is about
+/// 1 000 unknowns, but below 20 000 a factorisation costs under 0.3 s, is exact to
+/// round-off and does not mind the stiff interface conductances and penalties
+/// (h = 1e8) that double CG's iterations on tied systems; from 20 000 on its growth
+/// makes it the slow path (6–8× AMG-CG at 25 000–70 000 unknowns).
+pub const AUTO_AMG_THRESHOLD: usize = 20_000;
+
+/// The linear solver a steady solve used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinearMethod {
+    /// Sparse LLᵀ (METIS ordering): symmetric positive definite systems.
+    Cholesky,
+    /// Sparse LU: unsymmetric Newton Jacobians (a conductance that depends on T), or
+    /// a symmetric system Cholesky rejected.
+    Lu,
+    /// Saddle-point LDLᵀ: standard Lagrange-multiplier ties.
+    SaddleLdlt,
+    /// CG preconditioned by smoothed-aggregation AMG.
+    AmgCg,
+}
+
+impl LinearMethod {
+    /// The name `seam run` prints.
+    pub fn name(self) -> &'static str {
+        match self {
+            LinearMethod::Cholesky => "Cholesky",
+            LinearMethod::Lu => "LU",
+            LinearMethod::SaddleLdlt => "LDLᵀ",
+            LinearMethod::AmgCg => "AMG-CG",
+        }
+    }
+}
+
+/// What the linear solves of a steady solve did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LinearSolves {
+    /// The solver of the last solve (`None` when nothing was solved, e.g. the initial
+    /// state already met the tolerance, or a transient run).
+    pub method: Option<LinearMethod>,
+    /// CG iterations of each AMG-CG solve (empty for factorisations).
+    pub cg_iterations: Vec<usize>,
+}
+
 /// A steady problem on a mesh.
 pub struct SteadyProblem<'a> {
     pub mesh: &'a Mesh,
@@ -92,6 +151,8 @@ pub struct SteadySolution {
     /// constrained (Dirichlet data or an earlier tie).
     pub crosspoints: Vec<Vec<NodeId>>,
     pub timing: SolveTiming,
+    /// Which linear solver ran, and its CG iterations.
+    pub linear: LinearSolves,
 }
 
 /// Solve the steady problem.
@@ -186,11 +247,12 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let symmetric = p.contact.iter().all(|c| c.linear);
     let mut chol = Cholesky::new(Ordering::Metis);
     let mut amg = AmgCg::new(AmgOptions {
-        tolerance: 1e-11,
+        tolerance: AMG_TOLERANCE,
         ..AmgOptions::default()
     });
     let mut saddle = SaddleLdlt::with_primal(n_primal, n, Ordering::Metis);
     let mut lu = Lu::new();
+    let mut linear = LinearSolves::default();
     let mut history = Vec::new();
     let mut converged = false;
     let mut iterations = 0;
@@ -285,7 +347,9 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             amg.factor(&jac)?;
             timing.factor_s += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            amg.solve(&mut rhs)?;
+            let report = amg.solve(&mut rhs)?;
+            linear.method = Some(LinearMethod::AmgCg);
+            linear.cg_iterations.push(report.iterations);
             timing.solve_s += t.elapsed().as_secs_f64();
             last_step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for (ui, d) in u.iter_mut().zip(&rhs) {
@@ -302,10 +366,13 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         let t = Instant::now();
         if saddle_ok {
             saddle.solve(&mut rhs)?;
+            linear.method = Some(LinearMethod::SaddleLdlt);
         } else if use_chol {
             chol.solve(&mut rhs)?;
+            linear.method = Some(LinearMethod::Cholesky);
         } else {
             lu.solve(&mut rhs)?;
+            linear.method = Some(LinearMethod::Lu);
         }
         timing.solve_s += t.elapsed().as_secs_f64();
         last_step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -344,6 +411,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         tie_heat,
         crosspoints,
         timing,
+        linear,
     })
 }
 
@@ -565,6 +633,10 @@ fn solve_dual(
         heat,
         tie_heat,
         timing,
+        linear: LinearSolves {
+            method: Some(LinearMethod::Cholesky),
+            cg_iterations: Vec::new(),
+        },
     })
 }
 

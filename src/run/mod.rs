@@ -307,10 +307,16 @@ pub struct SolveSpec {
     pub tolerance: f64,
     #[serde(default = "default_iterations")]
     pub max_iterations: usize,
-    /// `direct` (sparse Cholesky/LU, default) or `amg` (CG with algebraic multigrid, for
-    /// large symmetric problems).
+    /// `auto` (the default: AMG-preconditioned CG for symmetric positive definite systems
+    /// of at least `auto_threshold` unknowns, a direct factorisation otherwise), `direct`
+    /// (sparse Cholesky, LDLᵀ or LU) or `amg` (CG with algebraic multigrid).
     #[serde(default)]
     pub linear_solver: Option<String>,
+    /// The size from which `auto` picks AMG-CG (default
+    /// [`AUTO_AMG_THRESHOLD`](crate::heat::steady::AUTO_AMG_THRESHOLD)); for tests and
+    /// for machines where the crossover lies elsewhere.
+    #[serde(default)]
+    pub auto_threshold: Option<usize>,
 }
 
 impl Default for SolveSpec {
@@ -330,6 +336,7 @@ impl Default for SolveSpec {
             tolerance: default_tolerance(),
             max_iterations: default_iterations(),
             linear_solver: None,
+            auto_threshold: None,
         }
     }
 }
@@ -400,6 +407,63 @@ pub struct Summary {
     /// When `converged` is false: the residual history and the likely cause.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub diagnosis: Option<String>,
+    /// Which linear solver ran and why.
+    pub linear_solver: LinearSolverSummary,
+}
+
+/// The linear solver of a run, the reason it was chosen, and its CG iterations.
+#[derive(Clone, Debug, Serialize)]
+pub struct LinearSolverSummary {
+    /// `Cholesky`, `LDLᵀ`, `LU`, `AMG-CG`, or `direct` (transient and nonlinear runs,
+    /// which factor each step's system with the solver its kind needs).
+    pub name: String,
+    /// Why: `requested by linear_solver`, or `auto: …` with the size and kind.
+    pub reason: String,
+    /// CG iterations in total (0 for factorisations).
+    pub iterations: usize,
+    /// CG iterations of each solve.
+    pub iterations_per_solve: Vec<usize>,
+}
+
+/// The summary of a linear steady solve's solver: `requested` is the `linear_solver`
+/// field (`None` or `auto` for the automatic choice), `n` the unknowns.
+fn linear_solver_summary(
+    requested: Option<&str>,
+    threshold: usize,
+    n: usize,
+    ties: bool,
+    linear: &crate::heat::steady::LinearSolves,
+) -> LinearSolverSummary {
+    use crate::heat::steady::LinearMethod;
+    let auto = matches!(requested, None | Some("auto"));
+    let why = match linear.method {
+        Some(LinearMethod::AmgCg) => {
+            format!("{n:.1e} unknowns, symmetric positive definite → AMG-CG")
+        }
+        Some(LinearMethod::SaddleLdlt) => "multipliers make the system indefinite → LDLᵀ".into(),
+        Some(LinearMethod::Lu) => {
+            "a temperature-dependent conductance makes the Jacobian unsymmetric → LU".into()
+        }
+        Some(LinearMethod::Cholesky) if ties => {
+            "dual mortar ties condensed to a symmetric positive definite system → Cholesky".into()
+        }
+        Some(LinearMethod::Cholesky) => format!("{n} unknowns (< {threshold}) → Cholesky"),
+        None => "no linear solve was needed".into(),
+    };
+    let asked_amg = requested == Some("amg");
+    let reason = if auto {
+        format!("auto: {why}")
+    } else if asked_amg && linear.method.is_some_and(|m| m != LinearMethod::AmgCg) {
+        format!("linear_solver = \"amg\" requested, but {why}")
+    } else {
+        "requested by linear_solver".into()
+    };
+    LinearSolverSummary {
+        name: linear.method.map_or("none", LinearMethod::name).into(),
+        reason,
+        iterations: linear.cg_iterations.iter().sum(),
+        iterations_per_solve: linear.cg_iterations.clone(),
+    }
 }
 
 /// Peak resident memory of this process in MiB (Linux only; None elsewhere).
@@ -543,13 +607,14 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         RunError::Input(d, sources)
     })?;
     if let Some(ls) = problem.solve.linear_solver.as_deref()
+        && ls != "auto"
         && ls != "direct"
         && ls != "amg"
     {
         return Err(input_error(
             "E0708",
             format!("unknown linear solver `{ls}`"),
-            "use linear_solver = \"direct\" or \"amg\"",
+            "use linear_solver = \"auto\" (the default), \"direct\" or \"amg\"",
         ));
     }
     let transient = match problem.solve.kind.as_str() {
@@ -1156,8 +1221,35 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         && problem.bc.iter().all(|b| b.kind != BcKind::Radiation);
     let mut history = Vec::new();
     let mut writer = steps::StepWriter::new(out_dir.as_deref(), &mesh, &problem.output, transient);
+    let requested = problem.solve.linear_solver.as_deref();
+    let threshold = problem
+        .solve
+        .auto_threshold
+        .unwrap_or(crate::heat::steady::AUTO_AMG_THRESHOLD);
+    let mut linear_summary = LinearSolverSummary {
+        name: "direct".into(),
+        reason: if matches!(requested, None | Some("auto")) {
+            "auto: transient and nonlinear problems are factored step by step (Cholesky, LDLᵀ or LU by the system's kind)".into()
+        } else {
+            "requested by linear_solver".into()
+        },
+        iterations: 0,
+        iterations_per_solve: Vec::new(),
+    };
     let solution = if linear_steady {
         let materials = materials.constant().expect("checked constant");
+        // The temperature unknowns (multipliers aside) decide the automatic choice.
+        let solid: Vec<usize> = (0..mesh.blocks.len())
+            .filter(|&b| mesh.blocks[b].topology.is_solid())
+            .collect();
+        let unknowns = DofMap::new(&mesh, &[(TEMPERATURE, &solid)])
+            .map_err(|e| RunError::Solve(e.to_string()))?
+            .len();
+        let iterative = match requested {
+            Some("amg") => true,
+            Some("direct") => false,
+            _ => unknowns >= threshold,
+        };
         let loads = loads_at(
             &problem,
             &mesh,
@@ -1175,7 +1267,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             face_bcs: &loads.faces,
             contact: contact_terms(),
             ties: tie_terms(),
-            iterative: problem.solve.linear_solver.as_deref() == Some("amg"),
+            iterative,
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
         };
@@ -1184,6 +1276,13 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             mesh.num_nodes()
         ));
         let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+        linear_summary = linear_solver_summary(
+            requested,
+            threshold,
+            unknowns,
+            !steady.ties.is_empty(),
+            &solved.linear,
+        );
         if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
             return Err(RunError::Solve(format!("[[source]]: {e}")));
         }
@@ -1538,6 +1637,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         transient: transient_summary,
         peak_memory_mib: peak_memory_mib(),
         diagnosis: history.last().and_then(|r| r.diagnosis.clone()),
+        linear_solver: linear_summary,
     };
     // A result that did not converge says so next to its files.
     if let (Some(dir), Some(d)) = (&out_dir, &summary.diagnosis) {

@@ -6,7 +6,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::assembly::DofMap;
-use crate::heat::steady::{SolveTiming, SteadySolution};
+use crate::heat::steady::{LinearSolves, SolveTiming, SteadySolution};
 use crate::heat::transient::{Outcome, State, StepReport};
 use crate::mesh::Mesh;
 use crate::output::exodus::ExodusWriter;
@@ -549,6 +549,7 @@ pub(super) fn final_solution(
         tie_heat: ties.to_vec(),
         crosspoints: outcome.crosspoints,
         timing,
+        linear: LinearSolves::default(),
     }
 }
 

@@ -14,6 +14,7 @@ mod fuzz_regressions;
 mod hard_cases;
 mod hard_input;
 mod interactions;
+mod linear_solver;
 mod manual;
 mod mesh_io;
 mod node_surfaces;

@@ -1,0 +1,218 @@
+//! The linear solver `seam run` picks by itself (`[solve] linear_solver = "auto"`, the
+//! default) and the reason it reports: Cholesky below the size threshold, AMG-CG at or
+//! above it for a symmetric positive definite system, LDLᵀ whenever multipliers make the
+//! system indefinite; `direct` and `amg` still override. The threshold is lowered with
+//! the `[solve] auto_threshold` field so that a small scene crosses it.
+//!
+//! AMG-CG stops at ‖b − Ax‖ ≤ 1e-11 ‖b‖ (`seam::heat::steady::AMG_TOLERANCE`); on the
+//! electronics scene (1 043 unknowns, several AMG levels, about 30 CG iterations; a
+//! silicon die under an aluminium sink through a pressure-dependent contact conductance,
+//! convection outside) that leaves the temperature and the interface heat
+//! within 1e-8 relative of the Cholesky answer: they agree to about 1e-13, so the bound
+//! keeps five orders of margin for other machines' round-off while still failing if CG
+//! stopped at a loose tolerance.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use seam::run::{RunError, RunResult};
+
+/// Agreement of AMG-CG and Cholesky answers (see the module comment).
+const AGREE: f64 = 1e-8;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A copy of `examples/two_blocks` whose `[solve]` table gets `extra` (TOML lines).
+fn two_blocks_with(tag: &str, extra: &str) -> PathBuf {
+    scene_with("two_blocks", tag, extra)
+}
+
+/// A copy of `examples/<scene>` whose `[solve]` table gets `extra` (TOML lines).
+fn scene_with(scene: &str, tag: &str, extra: &str) -> PathBuf {
+    let dir = crate::examples::copy_scene_as(scene, tag);
+    let path = dir.join("problem.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("[solve]\n"), "the scene has a [solve] table");
+    std::fs::write(
+        &path,
+        text.replace("[solve]\n", &format!("[solve]\n{extra}\n")),
+    )
+    .unwrap();
+    path
+}
+
+fn run(problem: &Path) -> RunResult {
+    match seam::run::run(problem) {
+        Ok(r) => {
+            assert!(
+                r.summary.converged,
+                "{} did not converge",
+                problem.display()
+            );
+            r
+        }
+        Err(RunError::Input(d, s)) => panic!("{}: {}", problem.display(), d.render(&s)),
+        Err(RunError::Solve(e)) => panic!("{}: {e}", problem.display()),
+    }
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter()
+        .filter(|x| x.is_finite())
+        .fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+#[test]
+fn auto_factors_a_small_problem() {
+    let r = run(&two_blocks_with("auto-small", ""));
+    let ls = &r.summary.linear_solver;
+    assert_eq!(ls.name, "Cholesky");
+    assert!(
+        ls.reason.starts_with("auto: ")
+            && ls.reason.contains("unknowns")
+            && ls.reason.contains("Cholesky"),
+        "{}",
+        ls.reason
+    );
+    assert_eq!(ls.iterations, 0);
+    assert!(ls.iterations_per_solve.is_empty());
+}
+
+#[test]
+fn auto_uses_amg_above_the_threshold_and_agrees_with_cholesky() {
+    let direct = run(&scene_with(
+        "electronics",
+        "auto-direct",
+        "linear_solver = \"direct\"\nauto_threshold = 1",
+    ));
+    let d = &direct.summary.linear_solver;
+    assert_eq!(d.name, "Cholesky");
+    assert_eq!(d.reason, "requested by linear_solver");
+
+    let amg = run(&scene_with("electronics", "auto-amg", "auto_threshold = 1"));
+    let a = &amg.summary.linear_solver;
+    assert_eq!(a.name, "AMG-CG");
+    assert!(
+        a.reason.starts_with("auto: ") && a.reason.contains("symmetric positive definite"),
+        "{}",
+        a.reason
+    );
+    // More than one CG iteration: the hierarchy has several levels (one iteration would
+    // mean the coarse direct solve did all the work).
+    assert!(a.iterations > 1, "{a:?}");
+    assert_eq!(a.iterations, a.iterations_per_solve.iter().sum::<usize>());
+
+    // Same answer to AGREE, relative to the largest temperature and interface heat.
+    let (ta, td) = (&amg.solution.temperature, &direct.solution.temperature);
+    assert_eq!(ta.len(), td.len());
+    let scale = max_abs(td);
+    for (k, (x, y)) in ta.iter().zip(td).enumerate() {
+        if y.is_finite() {
+            assert!(
+                (x - y).abs() <= AGREE * scale,
+                "node {k}: AMG {x} vs Cholesky {y}"
+            );
+        }
+    }
+    let (ia, id) = (&amg.summary.interactions, &direct.summary.interactions);
+    assert_eq!(ia.len(), id.len());
+    assert!(!id.is_empty());
+    for (x, y) in ia.iter().zip(id) {
+        let q = y.heat_side_a.abs().max(y.heat_side_b.abs());
+        assert!(q > 0.0);
+        assert!(
+            (x.heat_side_a - y.heat_side_a).abs() <= AGREE * q,
+            "{} vs {}",
+            x.heat_side_a,
+            y.heat_side_a
+        );
+        assert!(
+            (x.heat_side_b - y.heat_side_b).abs() <= AGREE * q,
+            "{} vs {}",
+            x.heat_side_b,
+            y.heat_side_b
+        );
+    }
+}
+
+#[test]
+fn amg_can_be_requested_on_a_small_problem() {
+    let r = run(&two_blocks_with("request-amg", "linear_solver = \"amg\""));
+    let ls = &r.summary.linear_solver;
+    assert_eq!(ls.name, "AMG-CG");
+    assert_eq!(ls.reason, "requested by linear_solver");
+    assert!(ls.iterations > 0);
+}
+
+#[test]
+fn multipliers_keep_the_direct_saddle_point_solver() {
+    // The standard Lagrange-multiplier tie of the verification case, its paths made
+    // absolute, above a threshold of one unknown: still LDLᵀ.
+    let case = root().join("tests/cases/two_slab_mortar_lagrange");
+    let mut table: toml::Table =
+        toml::from_str(&std::fs::read_to_string(case.join("problem.toml")).unwrap()).unwrap();
+    let abs =
+        |p: &toml::Value| toml::Value::String(case.join(p.as_str().unwrap()).display().to_string());
+    let mesh = table["mesh"].as_table_mut().unwrap();
+    mesh["file"] = abs(&mesh["file"]);
+    let contact = table["contact"].as_table_mut().unwrap();
+    contact["file"] = abs(&contact["file"]);
+    table["solve"]
+        .as_table_mut()
+        .unwrap()
+        .insert("auto_threshold".into(), toml::Value::Integer(1));
+    table.remove("output");
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("auto-lagrange-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("problem.toml");
+    std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
+    let r = run(&path);
+    let ls = &r.summary.linear_solver;
+    assert_eq!(ls.name, "LDLᵀ");
+    assert!(
+        ls.reason.starts_with("auto: ") && ls.reason.contains("indefinite"),
+        "{}",
+        ls.reason
+    );
+}
+
+#[test]
+fn the_json_summary_and_the_text_name_the_solver() {
+    let path = two_blocks_with("auto-json", "auto_threshold = 1");
+    let seam = |json: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_seam"));
+        c.arg("run").arg(&path);
+        if json {
+            c.arg("--json");
+        }
+        let out = c.output().expect("seam runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let v: serde_json::Value = serde_json::from_str(&seam(true)).expect("one JSON object");
+    let ls = &v["linear_solver"];
+    assert_eq!(ls["name"], "AMG-CG");
+    assert!(ls["reason"].as_str().unwrap().starts_with("auto: "));
+    assert!(ls["iterations"].as_u64().unwrap() > 0);
+    assert!(ls["iterations_per_solve"].is_array());
+    // The keys that were there before stay.
+    for key in [
+        "dofs",
+        "newton_iterations",
+        "converged",
+        "interactions",
+        "timing",
+    ] {
+        assert!(v.get(key).is_some(), "{key} missing");
+    }
+    let text = seam(false);
+    assert!(text.contains("linear solver: AMG-CG (auto: "), "{text}");
+    assert!(text.contains("CG iterations"), "{text}");
+}
