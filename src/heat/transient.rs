@@ -43,7 +43,9 @@ use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
 use crate::enforce::interface::{FieldPair, InterfacePoints, InterfaceSystem, Scatter};
 use crate::enforce::mortar::{MortarTie, mortar_tie};
 use crate::mesh::{Mesh, NodeId};
-use crate::solve::{Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv};
+use crate::solve::{
+    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
+};
 
 use super::law::Law;
 use super::steady::{ContactTerm, TieTerm};
@@ -120,6 +122,11 @@ pub struct TransientProblem<'a> {
     pub max_iterations: usize,
     /// Sequential factorisations: bit-for-bit reproducible runs and restarts.
     pub reproducible: bool,
+    /// Solve a linear step's system by AMG-preconditioned CG (to
+    /// [`AMG_TOLERANCE`](super::steady::AMG_TOLERANCE)) when it is symmetric positive
+    /// definite (no multipliers) and has at least this many unknowns, keeping the
+    /// hierarchy while the matrix is unchanged; `None`: always factor.
+    pub amg_threshold: Option<usize>,
 }
 
 /// Step-size control.
@@ -176,6 +183,8 @@ pub struct StepReport {
     pub assembly_s: f64,
     pub factor_s: f64,
     pub solve_s: f64,
+    /// CG iterations of the step's AMG-CG solves (0 when it factored).
+    pub cg_iterations: usize,
     /// `None` when Newton converged; for a steady solve that did not, what happened
     /// (the residual history and the likely cause): the state is the last iterate.
     pub diagnosis: Option<String>,
@@ -708,6 +717,7 @@ struct Solvers {
     chol: Cholesky,
     saddle: SaddleLdlt,
     lu: Lu,
+    amg: AmgCg,
     /// The values of the matrix factored last and which solver holds it: a linear
     /// problem stepping with a fixed step reuses the factorisation (bit for bit the
     /// same as factoring again).
@@ -719,6 +729,7 @@ enum Which {
     Saddle,
     Cholesky,
     Lu,
+    Amg,
 }
 
 impl Solvers {
@@ -731,6 +742,10 @@ impl Solvers {
             chol,
             saddle,
             lu: Lu::new(),
+            amg: AmgCg::new(AmgOptions {
+                tolerance: super::steady::AMG_TOLERANCE,
+                ..AmgOptions::default()
+            }),
             factored: None,
         }
     }
@@ -808,6 +823,7 @@ impl Context<'_, '_> {
             assembly_s: 0.0,
             factor_s: 0.0,
             solve_s: 0.0,
+            cg_iterations: 0,
             diagnosis: None,
         };
         let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
@@ -852,7 +868,10 @@ impl Context<'_, '_> {
             apply_dirichlet(&mut jac, &mut rhs, &zero)?;
             report.assembly_s += clock.elapsed().as_secs_f64();
             let symmetric = linear;
-            let solved = (|| -> Result<(f64, f64), HeatError> {
+            // AMG-CG for a symmetric positive definite step system from the threshold on.
+            let amg =
+                setup.ties.is_empty() && symmetric && p.amg_threshold.is_some_and(|k| setup.n >= k);
+            let solved = (|| -> Result<(f64, f64, usize), HeatError> {
                 let t0 = std::time::Instant::now();
                 let same = solvers
                     .factored
@@ -864,7 +883,10 @@ impl Context<'_, '_> {
                     None => {
                         solvers.factored = None;
                         let tied = !setup.ties.is_empty();
-                        let w = if tied && symmetric && solvers.saddle.factor(&jac).is_ok() {
+                        let w = if amg {
+                            solvers.amg.factor(&jac)?;
+                            Which::Amg
+                        } else if tied && symmetric && solvers.saddle.factor(&jac).is_ok() {
                             Which::Saddle
                         } else if !tied && symmetric && solvers.chol.factor(&jac).is_ok() {
                             Which::Cholesky
@@ -880,14 +902,24 @@ impl Context<'_, '_> {
                 };
                 let factor_s = t0.elapsed().as_secs_f64();
                 let t1 = std::time::Instant::now();
-                match which {
-                    Which::Saddle => solvers.saddle.solve(&mut rhs)?,
-                    Which::Cholesky => solvers.chol.solve(&mut rhs)?,
-                    Which::Lu => solvers.lu.solve(&mut rhs)?,
+                let cg = match which {
+                    Which::Saddle => {
+                        solvers.saddle.solve(&mut rhs)?;
+                        0
+                    }
+                    Which::Cholesky => {
+                        solvers.chol.solve(&mut rhs)?;
+                        0
+                    }
+                    Which::Lu => {
+                        solvers.lu.solve(&mut rhs)?;
+                        0
+                    }
+                    Which::Amg => solvers.amg.solve(&mut rhs)?.iterations,
                 };
-                Ok((factor_s, t1.elapsed().as_secs_f64()))
+                Ok((factor_s, t1.elapsed().as_secs_f64(), cg))
             })();
-            let (factor_s, solve_s) = match solved {
+            let (factor_s, solve_s, cg) = match solved {
                 Ok(x) => x,
                 Err(HeatError::Solve(e)) => {
                     return Ok(Err(format!("the linear solve failed at t = {t}: {e}")));
@@ -896,6 +928,7 @@ impl Context<'_, '_> {
             };
             report.factor_s += factor_s;
             report.solve_s += solve_s;
+            report.cg_iterations += cg;
             report.newton_iterations += 1;
             let step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             for (ui, d) in u.iter_mut().zip(&rhs) {

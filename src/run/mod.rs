@@ -1229,7 +1229,9 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let mut linear_summary = LinearSolverSummary {
         name: "direct".into(),
         reason: if matches!(requested, None | Some("auto")) {
-            "auto: transient and nonlinear problems are factored step by step (Cholesky, LDLᵀ or LU by the system's kind)".into()
+            format!(
+                "auto: step systems below {threshold} unknowns or not symmetric positive definite are factored (Cholesky, LDLᵀ or LU by their kind)"
+            )
         } else {
             "requested by linear_solver".into()
         },
@@ -1288,13 +1290,6 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         }
         solved
     } else {
-        if problem.solve.linear_solver.as_deref() == Some("amg") {
-            return Err(input_error(
-                "E0708",
-                "linear_solver = \"amg\" is for linear steady problems".into(),
-                "drop it: transient and nonlinear problems are solved with sparse direct factorisations",
-            ));
-        }
         let loads = |t: f64| -> Result<Loads, HeatError> {
             clock.set(t);
             loads_at(&problem, &mesh, &dirichlet, &face_sites, &sandbox, t).map_err(HeatError::Step)
@@ -1329,6 +1324,11 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
             reproducible: problem.solve.reproducible.unwrap_or(true),
+            amg_threshold: match requested {
+                Some("direct") => None,
+                Some("amg") => Some(0),
+                _ => Some(threshold),
+            },
         };
         let restart = match (&problem.restart, options.restart.as_ref()) {
             (_, Some(file)) => Some(steps::read_checkpoint(file)?),
@@ -1410,6 +1410,23 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         writer
             .finish(last)
             .map_err(|e| RunError::Solve(e.to_string()))?;
+        // CG iterations per accepted step, when the steps were solved by AMG-CG.
+        let per_step: Vec<usize> = history.iter().map(|r| r.cg_iterations).collect();
+        if per_step.iter().any(|&k| k > 0) {
+            let n = outcome.dofs.len();
+            linear_summary = LinearSolverSummary {
+                name: "AMG-CG".into(),
+                reason: if matches!(requested, None | Some("auto")) {
+                    format!(
+                        "auto: {n:.1e} unknowns, symmetric positive definite steps → AMG-CG (hierarchy kept while the matrix is unchanged)"
+                    )
+                } else {
+                    "requested by linear_solver".into()
+                },
+                iterations: per_step.iter().sum(),
+                iterations_per_solve: per_step,
+            };
+        }
         steps::final_solution(outcome, &history, &field_names, tp.contact.len())
     };
     for ((p, (c, _, _)), log) in pairings.iter().zip(&choices).zip(&quarantined) {

@@ -31,8 +31,13 @@ fn two_blocks_with(tag: &str, extra: &str) -> PathBuf {
 
 /// A copy of `examples/<scene>` whose `[solve]` table gets `extra` (TOML lines).
 fn scene_with(scene: &str, tag: &str, extra: &str) -> PathBuf {
+    scene_file_with(scene, "problem.toml", tag, extra)
+}
+
+/// As [`scene_with`], for the scene's problem file `file`.
+fn scene_file_with(scene: &str, file: &str, tag: &str, extra: &str) -> PathBuf {
     let dir = crate::examples::copy_scene_as(scene, tag);
-    let path = dir.join("problem.toml");
+    let path = dir.join(file);
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("[solve]\n"), "the scene has a [solve] table");
     std::fs::write(
@@ -215,4 +220,51 @@ fn the_json_summary_and_the_text_name_the_solver() {
     let text = seam(false);
     assert!(text.contains("linear solver: AMG-CG (auto: "), "{text}");
     assert!(text.contains("CG iterations"), "{text}");
+}
+
+#[test]
+fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
+    // The electronics warm-up (80 BDF2 steps, linear): every step system is symmetric
+    // positive definite, so above the threshold each step is one AMG-CG solve, the
+    // hierarchy set up again only when the matrix changes (the first two steps).
+    let file = "transient.toml";
+    let direct = run(&scene_file_with(
+        "electronics",
+        file,
+        "transient-direct",
+        "linear_solver = \"direct\"\nauto_threshold = 1",
+    ));
+    assert_eq!(direct.summary.linear_solver.name, "direct");
+    let amg = run(&scene_file_with(
+        "electronics",
+        file,
+        "transient-amg",
+        "auto_threshold = 1",
+    ));
+    let a = &amg.summary.linear_solver;
+    assert_eq!(a.name, "AMG-CG");
+    assert!(a.reason.starts_with("auto: "), "{}", a.reason);
+    let steps = amg.summary.transient.as_ref().unwrap().steps;
+    assert_eq!(a.iterations_per_solve.len(), steps);
+    assert!(a.iterations_per_solve.iter().all(|&k| k > 0), "{a:?}");
+    let (ta, td) = (&amg.solution.temperature, &direct.solution.temperature);
+    let scale = max_abs(td);
+    for (k, (x, y)) in ta.iter().zip(td).enumerate() {
+        if y.is_finite() {
+            assert!(
+                (x - y).abs() <= AGREE * scale,
+                "node {k}: AMG {x} vs Cholesky {y}"
+            );
+        }
+    }
+    for (x, y) in amg
+        .summary
+        .interactions
+        .iter()
+        .zip(&direct.summary.interactions)
+    {
+        let q = y.heat_side_a.abs().max(y.heat_side_b.abs());
+        assert!((x.heat_side_a - y.heat_side_a).abs() <= AGREE * q);
+        assert!((x.heat_side_b - y.heat_side_b).abs() <= AGREE * q);
+    }
 }
