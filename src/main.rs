@@ -544,7 +544,7 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                 let cg = match ls.iterations_per_solve.len() {
                     0 => String::new(),
                     1 => format!(", {} CG iterations", ls.iterations),
-                    _ => format!(
+                    k if k <= 6 => format!(
                         ", {} CG iterations ({})",
                         ls.iterations,
                         ls.iterations_per_solve
@@ -552,6 +552,13 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                             .map(usize::to_string)
                             .collect::<Vec<_>>()
                             .join(" + ")
+                    ),
+                    // Many solves (time steps): the range per solve, not every count.
+                    k => format!(
+                        ", {} CG iterations ({}–{} per solve over {k} solves)",
+                        ls.iterations,
+                        ls.iterations_per_solve.iter().min().unwrap_or(&0),
+                        ls.iterations_per_solve.iter().max().unwrap_or(&0)
                     ),
                 };
                 println!("  linear solver: {} ({}){cg}", ls.name, ls.reason);
