@@ -1219,35 +1219,13 @@ fn plugin_without_derivatives_in_a_run_is_noted_once() {
 /// in `seam run` and in `seam check-plugin`.
 #[test]
 fn plugin_that_kills_the_process_is_reported_with_exit_code_3() {
-    let mesh = root().join("examples/two_blocks/two_blocks.exo");
     for (fault, what) in [("SEGFAULT", "SIGSEGV"), ("EXIT", "exit")] {
         let lib = cc_shared(
             "plugins/tests/faulty/faulty.c",
             &[&format!("-DFAULT_{fault}")],
             &format!("faulty_{}", fault.to_lowercase()),
         );
-        let dir = tmp().join(format!("run-kill-{}", fault.to_lowercase()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(
-            dir.join("problem.toml"),
-            format!(
-                "[mesh]\nfile = {:?}\n[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n\
-                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 0\n\
-                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 1\n[contact]\nfile = \"contact.i\"\n[output]\ndir = \"out\"\n",
-                mesh.to_str().unwrap()
-            ),
-        )
-        .unwrap();
-        std::fs::write(
-            dir.join("contact.i"),
-            format!(
-                "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
-                 begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{}\"\n  contact pressure = 1000\n end\nend\n",
-                lib.display()
-            ),
-        )
-        .unwrap();
+        let dir = kill_problem(&lib, &format!("in-process-{}", fault.to_lowercase()), "");
         let out = Command::new(env!("CARGO_BIN_EXE_seam"))
             .args(["run", "problem.toml"])
             .current_dir(&dir)
@@ -1412,7 +1390,9 @@ fn isolated_load_errors_are_the_in_process_ones() {
 }
 
 /// Write the two-block problem whose enforcement uses `lib` at contact pressure 1000
-/// plus `extra` lines; the directory.
+/// plus `extra` lines (e.g. `plugin isolation = process`); the directory.
+const ISOLATED: &str = "  plugin isolation = process\n";
+
 fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
     let mesh = root().join("examples/two_blocks/two_blocks.exo");
     let dir = tmp().join(format!("run-isolated-{tag}"));
@@ -1432,7 +1412,7 @@ fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
         dir.join("contact.i"),
         format!(
             "begin contact definition\n contact surface lid_face contains lid_bottom\n contact surface base_face contains base_top\n\
-             begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{}\"\n  contact pressure = 1000\n  plugin isolation = process\n{extra} end\nend\n",
+             begin interaction\n side a base_face\n side b lid_face\n end\n begin enforcement\n  enforcement for energy = plugin library = \"{}\"\n  contact pressure = 1000\n{extra} end\nend\n",
             lib.display()
         ),
     )
@@ -1456,7 +1436,7 @@ fn isolated_plugin_that_kills_its_process_stops_the_run_or_is_quarantined() {
             &format!("faulty_{}", fault.to_lowercase()),
         );
         let tag = fault.to_lowercase();
-        let dir = kill_problem(&lib, &tag, "");
+        let dir = kill_problem(&lib, &tag, ISOLATED);
         let out = Command::new(env!("CARGO_BIN_EXE_seam"))
             .args(["run", "problem.toml"])
             .current_dir(&dir)
@@ -1480,7 +1460,7 @@ fn isolated_plugin_that_kills_its_process_stops_the_run_or_is_quarantined() {
         let dir = kill_problem(
             &lib,
             &format!("{tag}-quarantine"),
-            "  quarantine faulty points\n",
+            &format!("{ISOLATED}  quarantine faulty points\n"),
         );
         let out = Command::new(env!("CARGO_BIN_EXE_seam"))
             .args(["run", "problem.toml"])
