@@ -1,0 +1,364 @@
+//! Embedding seam in a host code that owns its mesh, its unknowns and its matrix.
+//!
+//! Entry point: [`Embedding::builder`]. The host hands over its node coordinates, its
+//! element blocks (topology, connectivity, conductivity), the faces its interfaces are
+//! made of — as (element, local side) pairs or as face node lists — and its own DOF
+//! number of each node. It then adds interactions, either in code ([`Interaction`]) or
+//! from a Sierra contact deck ([`Embedding::add_deck`]), searches them
+//! ([`Embedding::search`]), and at each Newton step asks for the interface terms at its
+//! current field ([`Embedding::contributions`]): residual entries `(dof, value)` and
+//! Jacobian triplets `(row, col, value)` in the host's own numbering, plus the heat
+//! through each side. Mortar ties give constraint rows instead
+//! ([`Embedding::constraints`]); dual multipliers give them in the condensed form
+//! `u_A = g + Σ c_j u_j`, for hosts that carry no multipliers.
+//!
+//! Periodic conditions pair the image of a surface under a map with its partner, from a
+//! deck's `Periodicity For S = …` or in code ([`Interaction::periodic`]); the terms
+//! couple each side-A node with the side-B nodes its image lands between, in host dof
+//! numbers, like any other interaction. Plugin enforcements (`Enforcement for Energy =
+//! Plugin Library = …`) load their library when the deck is added; a plugin that fails
+//! at a point is [`EmbedError::Plugin`], one that asks for a smaller step is
+//! [`EmbedError::Cutback`].
+//!
+//! ```no_run
+//! use seam::embed::{Embedding, Interaction, Model, Topology};
+//! # fn host() -> Result<(), seam::embed::EmbedError> {
+//! # let (coords, conn, top, bottom, dof_of_node, u): (Vec<[f64; 3]>, Vec<usize>,
+//! #   Vec<(usize, u8)>, Vec<[usize; 4]>, Vec<usize>, Vec<f64>) = Default::default();
+//! let mut seam = Embedding::builder(&coords)
+//!     .block("solid", Topology::Hex8, &conn, 16.0)
+//!     .side_set("top", &top)        // (element, 1-based Exodus side)
+//!     .face_set("bottom", &bottom)  // face node lists
+//!     .dofs(&dof_of_node)
+//!     .build()?;
+//! seam.add_interaction(Interaction::new("top", "bottom", Model::GapConductance { h: 500.0 }))?;
+//! seam.search()?;
+//! let c = seam.contributions(&u)?;
+//! for &(row, col, v) in &c.jacobian { /* K[row][col] += v */ }
+//! # Ok(()) }
+//! ```
+//!
+//! Conventions:
+//! - Node and element indices are the host's, 0-based: nodes index `coords`, elements
+//!   are numbered block after block in the order the blocks were given. Messages use
+//!   these numbers. Local sides are 1-based, Exodus II order ([`crate::mesh::topology`]).
+//! - Residual and Jacobian: the host adds `residual` to its residual `R(u) = K u − F`
+//!   and `jacobian` to `∂R/∂u`. For a linear model `residual = J_Γ u − load`, so a host
+//!   that assembles `K u = F` once adds `jacobian` to `K` and `load` to `F`.
+//! - Heat: W leaving side A and leaving side B through the interface (their sum is zero
+//!   to round-off); positive side A means heat flows from A to B.
+//! - Nothing here panics on host input: every check returns an [`EmbedError`] that says
+//!   what is wrong, where, and how to fix it.
+
+use std::sync::OnceLock;
+
+use crate::assembly::{DofMap, FieldId};
+use crate::deck::spec::PeriodicTransform;
+use crate::enforce::conductance::{ConductanceModel, PluginConductance};
+use crate::enforce::interface::{DEFAULT_BETA, Form, InterfaceError, InterfacePoints};
+use crate::interaction::SearchSettings;
+use crate::mesh::{Mesh, NodeId, ValidationError};
+use crate::periodic::PeriodicMap;
+use crate::search::pairing::{SearchResult, Searcher, Sphere, SurfaceGeometry};
+use crate::surface::ContactSurface;
+
+pub use crate::deck::spec::Overclosure;
+pub use crate::enforce::mortar::Multipliers;
+pub use crate::mesh::Topology;
+pub use crate::search::pairing::Integration;
+
+/// Everything that can go wrong between a host and seam.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum EmbedError {
+    /// The host's mesh arrays are inconsistent.
+    #[error("host mesh: {what}\n  help: {help}")]
+    Mesh { what: String, help: String },
+    /// The mesh is well formed but fails seam's checks (inverted element, …).
+    #[error("host mesh: {0}")]
+    Invalid(#[from] ValidationError),
+    #[error("unknown surface `{name}`\n  help: {help}")]
+    UnknownSurface { name: String, help: String },
+    /// A contact deck with errors: the rendered diagnostics.
+    #[error("contact deck:\n{0}")]
+    Deck(String),
+    /// An argument out of range (a model parameter, a field vector too short, …).
+    #[error("{what}\n  help: {help}")]
+    Argument { what: String, help: String },
+    /// A call out of order, e.g. contributions before the first search.
+    #[error("{what}\n  help: {help}")]
+    Order { what: String, help: String },
+    /// An enforcement failed at a contact point (bad element, failing conductance model).
+    #[error("interaction {side_a} / {side_b}: {source}")]
+    Enforcement {
+        side_a: String,
+        side_b: String,
+        source: InterfaceError,
+    },
+    /// A plugin enforcement could not be loaded (`add_deck`), or its plugin failed at a
+    /// contact point (`contributions`): an error status, a non-finite or negative value.
+    /// The message names the plugin's library and, at a point, where it is.
+    #[error(
+        "interaction {side_a} / {side_b}: {message}\n  help: `seam check-plugin LIB` loads and probes a plugin on its own"
+    )]
+    Plugin {
+        side_a: String,
+        side_b: String,
+        message: String,
+    },
+    /// A plugin asks for a smaller step (`SEAM_STATUS_CUTBACK`): not a failure of the
+    /// model, a request to the host to retry its time (or load) step with a smaller one.
+    #[error(
+        "interaction {side_a} / {side_b}: {message}\n  help: retry the step with a smaller one (suggested new/old step {factor}; 0: the host decides)"
+    )]
+    Cutback {
+        side_a: String,
+        side_b: String,
+        /// The plugin's suggested new/old step in (0, 1), or 0: the host decides.
+        factor: f64,
+        message: String,
+    },
+}
+
+fn mesh_error(what: String, help: &str) -> EmbedError {
+    EmbedError::Mesh {
+        what,
+        help: help.into(),
+    }
+}
+
+fn argument(what: String, help: &str) -> EmbedError {
+    EmbedError::Argument {
+        what,
+        help: help.into(),
+    }
+}
+
+/// How an interaction enforces the energy equation (see [`crate::enforce::interface`]
+/// for the forms).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Model {
+    /// `q = h [u]`, integrated on side A (contact resistance).
+    Conductance { h: f64 },
+    /// Robin–Nitsche gap conductance: stable for every `h` in `[0, ∞]`.
+    GapConductance { h: f64 },
+    /// Weighted symmetric Nitsche tie `[u] = 0` (no extra unknowns).
+    TiedNitsche,
+    /// Mortar tie with Lagrange multipliers on side A: constraint rows
+    /// ([`Embedding::constraints`]) instead of residual terms.
+    TiedMortar { multipliers: Multipliers },
+}
+
+/// A periodic map of an interaction built in code: side A's image under the map is
+/// paired with side B, as `Periodicity For A = …` pairs it with its destination in a deck
+/// ([`crate::periodic`]). Side A keeps its own nodes and dofs: the interaction couples
+/// each point of A with the point of B its image lands on.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Periodic {
+    /// `Rectangular Offset`: `x ↦ x + offset`.
+    Rectangular { offset: [f64; 3] },
+    /// `Cylindrical`: a turn by `angle` degrees (counter-clockwise, right-hand rule)
+    /// about the line through `center` along `axis`. An N-fold turn (`360/angle` an
+    /// integer N) must come back to the start after N turns.
+    Cylindrical {
+        axis: [f64; 3],
+        center: [f64; 3],
+        angle: f64,
+    },
+    /// `Align_Surface`: the rigid map taking A's centroid and mean normal onto B's,
+    /// normals opposed when `invert_normals` (two sides of an interface face each other).
+    AlignSurface { invert_normals: bool },
+    /// `Mapped`: each component a Lua expression in `x`, `y`, `z` or
+    /// `file.lua:function` (a file under the working directory); without `z`, z is kept.
+    Mapped {
+        x: String,
+        y: String,
+        z: Option<String>,
+    },
+}
+
+impl Periodic {
+    /// The deck's transform, with `side_b` as the destination.
+    fn transform(&self, side_b: &str) -> PeriodicTransform {
+        match self {
+            Periodic::Rectangular { offset } => PeriodicTransform::Rectangular {
+                offset: offset.to_vec(),
+            },
+            Periodic::Cylindrical {
+                axis,
+                center,
+                angle,
+            } => PeriodicTransform::Cylindrical {
+                axis: axis.to_vec(),
+                center: center.to_vec(),
+                angle: *angle,
+            },
+            Periodic::AlignSurface { invert_normals } => PeriodicTransform::AlignSurface {
+                destination: side_b.to_string(),
+                invert_normals: *invert_normals,
+            },
+            Periodic::Mapped { x, y, z } => PeriodicTransform::Mapped {
+                x_map: x.clone(),
+                y_map: y.clone(),
+                z_map: z.clone(),
+            },
+        }
+    }
+}
+
+/// One interaction built in code: two surfaces and a model.
+#[derive(Clone, Debug)]
+pub struct Interaction {
+    side_a: String,
+    side_b: String,
+    model: Model,
+    offset: f64,
+    beta: f64,
+    settings: Option<SearchSettings>,
+    periodic: Option<Periodic>,
+}
+
+impl Interaction {
+    /// Side A carries the integration points; side B is projected onto.
+    pub fn new(side_a: &str, side_b: &str, model: Model) -> Self {
+        Interaction {
+            side_a: side_a.to_string(),
+            side_b: side_b.to_string(),
+            model,
+            offset: 0.0,
+            beta: DEFAULT_BETA,
+            settings: None,
+            periodic: None,
+        }
+    }
+
+    /// Pair the image of side A under `map` with side B (a periodic condition).
+    pub fn periodic(mut self, map: Periodic) -> Self {
+        self.periodic = Some(map);
+        self
+    }
+
+    /// A prescribed jump `u_A − u_B = ΔT` (`Offset Temperature`).
+    pub fn offset(mut self, delta_t: f64) -> Self {
+        self.offset = delta_t;
+        self
+    }
+
+    /// The Nitsche penalty factor β (default [`DEFAULT_BETA`]).
+    pub fn penalty_factor(mut self, beta: f64) -> Self {
+        self.beta = beta;
+        self
+    }
+
+    /// Search tolerances other than the defaults of [`SearchSettings::defaults`].
+    pub fn search_settings(mut self, settings: SearchSettings) -> Self {
+        self.settings = Some(settings);
+        self
+    }
+}
+
+/// Heat through one interaction, W.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Heat {
+    pub side_a: f64,
+    pub side_b: f64,
+}
+
+/// The interface terms at one field, in the host's numbering.
+#[derive(Clone, Debug, Default)]
+pub struct Contributions {
+    /// `(dof, value)`, to add to the host's residual; a dof may repeat.
+    pub residual: Vec<(usize, f64)>,
+    /// `(row, col, value)`, to add to the host's Jacobian; pairs may repeat.
+    pub jacobian: Vec<(usize, usize, f64)>,
+    /// `(dof, value)`, the right-hand side of linear models (offset terms).
+    pub load: Vec<(usize, f64)>,
+    /// Per interaction, in the order they were added; `None` for mortar ties (see
+    /// [`TieConstraints::heat`]).
+    pub heat: Vec<Option<Heat>>,
+}
+
+/// One side-A dof of a dual mortar tie in condensed form: `u[dof] = constant + Σ c u[j]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Condensed {
+    pub dof: usize,
+    pub constant: f64,
+    pub terms: Vec<(usize, f64)>,
+}
+
+/// The conductance of a flux-type interaction.
+enum Law {
+    Constant(f64),
+    /// A model from the deck (`Gap Conductance Coefficient = …`) and the contact
+    /// pressure it sees.
+    Model(Box<dyn ConductanceModel>, f64),
+    /// A plugin (`Enforcement for Energy = Plugin …`) and the contact pressure it sees:
+    /// its faults and cutback requests become [`EmbedError::Plugin`] and
+    /// [`EmbedError::Cutback`].
+    Plugin(Box<PluginConductance>, f64),
+}
+
+enum Enforcement {
+    Flux {
+        form: Form,
+        law: Law,
+        offset: f64,
+        beta: f64,
+    },
+    Tie {
+        multipliers: Multipliers,
+        offset: f64,
+    },
+}
+
+/// The map of a periodic pair: side A is the image of its surface under it.
+struct Image {
+    map: Box<dyn PeriodicMap>,
+    name: String,
+}
+
+/// One interaction and its search state.
+struct Pair {
+    side_a: ContactSurface,
+    side_b: ContactSurface,
+    /// Side A's geometry as searched (for a periodic pair: the image).
+    a: SurfaceGeometry,
+    b: SurfaceGeometry,
+    settings: SearchSettings,
+    /// `None` for periodic pairs, which keep their gaps as found (as `seam run`).
+    overclosure: Option<Overclosure>,
+    /// `Restrict Contact To Subdomain` of the deck's definition.
+    subdomain: Option<Sphere>,
+    image: Option<Image>,
+    enforcement: Enforcement,
+    searcher: Option<Searcher>,
+    result: Option<SearchResult>,
+    /// The interface geometry at the points of `result`, made at the first
+    /// `contributions` after a search or a move and reused until the next.
+    points: OnceLock<InterfacePoints>,
+}
+
+/// seam inside a host: the host's mesh and numbering, its interactions and their search.
+pub struct Embedding {
+    mesh: Mesh,
+    dofs: DofMap,
+    field: FieldId,
+    /// The host's dof of each of seam's dofs.
+    host_dof: Vec<usize>,
+    conductivity: Vec<f64>,
+    fixed: Vec<NodeId>,
+    integration: Integration,
+    pairs: Vec<Pair>,
+    /// The host's time, passed to conductance models and plugins (0 until set).
+    time: f64,
+}
+
+mod add;
+mod builder;
+mod from_deck;
+mod search;
+mod terms;
+mod ties;
+
+pub use builder::EmbeddingBuilder;
+pub use ties::TieConstraints;

@@ -1,0 +1,147 @@
+use super::{EmbedError, Embedding, Enforcement, Pair, argument};
+use std::sync::OnceLock;
+
+use crate::enforce::interface::Form;
+use crate::search::pairing::{SearchResult, SearchStats, Searcher, SurfaceGeometry};
+
+impl Embedding {
+    /// Number of interactions.
+    pub fn len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.pairs.is_empty()
+    }
+
+    /// The surface names (side A, side B) of interaction `i`.
+    pub fn surfaces(&self, i: usize) -> Option<(&str, &str)> {
+        self.pairs
+            .get(i)
+            .map(|p| (p.side_a.name.as_str(), p.side_b.name.as_str()))
+    }
+
+    /// Pair every interaction's side-A points with side-B faces anew (a full search).
+    pub fn search(&mut self) -> Result<(), EmbedError> {
+        for p in &mut self.pairs {
+            if p.b.faces.is_empty() {
+                return Err(argument(
+                    format!("side B `{}` has no faces", p.side_b.name),
+                    "check the surface's faces",
+                ));
+            }
+            let searcher = Searcher::new(&p.b, &p.settings);
+            let mut result =
+                searcher.search(&p.a, &p.b, &p.settings, self.integration, p.subdomain);
+            if let Some(treatment) = p.overclosure {
+                result.treat_overclosure(treatment);
+            }
+            let tie = match &p.enforcement {
+                Enforcement::Tie { .. } => true,
+                Enforcement::Flux { form, .. } => matches!(
+                    form,
+                    Form::TiedNitsche | Form::TiedInteriorPenalty | Form::Penalty
+                ),
+            };
+            if tie && result.stats.matched == 0 {
+                return Err(argument(
+                    format!(
+                        "interaction {} / {} ties two surfaces that do not overlap anywhere ({} points, none paired)",
+                        p.side_a.name, p.side_b.name, result.stats.points
+                    ),
+                    "check the surfaces' faces and the search tolerances (normal tolerance, field factor)",
+                ));
+            }
+            p.searcher = Some(searcher);
+            p.result = Some(result);
+            p.points = OnceLock::new();
+        }
+        Ok(())
+    }
+
+    /// The host's time for the next [`Self::contributions`]: conductance models and
+    /// plugins that depend on t (a Lua expression of `t`, a plugin's time argument)
+    /// see it. Must be finite.
+    pub fn set_time(&mut self, time: f64) -> Result<(), EmbedError> {
+        if !time.is_finite() {
+            return Err(argument(
+                format!("the time {time} is not finite"),
+                "pass the host's current time in seconds",
+            ));
+        }
+        self.time = time;
+        Ok(())
+    }
+
+    /// The time set by [`Self::set_time`] (0 until then).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// The nodes moved: keep every pairing, place its points again on the moved faces
+    /// and measure gaps anew (`Update Search Every n Steps` between full searches).
+    /// Call [`Self::search`] to pair anew.
+    pub fn move_nodes(&mut self, coords: &[[f64; 3]]) -> Result<(), EmbedError> {
+        if coords.len() != self.mesh.coords.len() {
+            return Err(argument(
+                format!(
+                    "{} coordinates for {} nodes",
+                    coords.len(),
+                    self.mesh.coords.len()
+                ),
+                "pass every node's new coordinates, in node order",
+            ));
+        }
+        if let Some(k) = coords.iter().position(|x| x.iter().any(|c| !c.is_finite())) {
+            return Err(argument(
+                format!("node {k} moved to a non-finite position {:?}", coords[k]),
+                "check the host's displacement field",
+            ));
+        }
+        self.mesh.coords = coords.to_vec();
+        for p in &mut self.pairs {
+            for (surface, geometry) in [(&p.side_a, &mut p.a), (&p.side_b, &mut p.b)] {
+                *geometry = SurfaceGeometry::from_surface(&self.mesh, surface, coords)
+                    .map_err(|e| argument(e.to_string(), "interfaces are searched in 3-D"))?;
+            }
+            // A periodic pair's side A is the image of the moved surface.
+            if let Some(image) = &mut p.image {
+                p.a = p.a.mapped(image.map.as_mut(), &image.name).map_err(|e| {
+                    argument(
+                        format!(
+                            "periodic interaction {} / {}: {e}",
+                            p.side_a.name, p.side_b.name
+                        ),
+                        "the map failed on the moved nodes of side A",
+                    )
+                })?;
+            }
+            if let Some(r) = &mut p.result {
+                r.update_geometry(&p.a, &p.b);
+            }
+            p.points = OnceLock::new();
+            if let Some(s) = &mut p.searcher {
+                s.refit(&p.b);
+            }
+        }
+        Ok(())
+    }
+
+    /// The search statistics of interaction `i` (after a search).
+    pub fn search_stats(&self, i: usize) -> Option<&SearchStats> {
+        self.pairs
+            .get(i)
+            .and_then(|p| p.result.as_ref())
+            .map(|r| &r.stats)
+    }
+
+    pub(super) fn searched(p: &Pair) -> Result<&SearchResult, EmbedError> {
+        p.result.as_ref().ok_or_else(|| EmbedError::Order {
+            what: format!(
+                "interaction {} / {} has not been searched",
+                p.side_a.name, p.side_b.name
+            ),
+            help: "call search() after adding interactions".into(),
+        })
+    }
+}

@@ -1,0 +1,195 @@
+use super::{Condensed, EmbedError, Embedding, Enforcement, Heat, Multipliers, argument};
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+use crate::enforce::mortar::mortar_tie;
+use crate::mesh::NodeId;
+
+/// The constraint rows of one mortar tie, in the host's numbering.
+#[derive(Clone, Debug, Default)]
+pub struct TieConstraints {
+    /// Index of the interaction.
+    pub interaction: usize,
+    /// The host dof of each multiplier's side-A node, in multiplier order.
+    pub multiplier_dofs: Vec<usize>,
+    /// `(multiplier k, dof j, C_kj)`: the rows of `C u = g`.
+    pub entries: Vec<(usize, usize, f64)>,
+    /// `g_k = ΔT ∫ψ_k`.
+    pub rhs: Vec<f64>,
+    /// Dual multipliers only: each multiplier's side-A dof in condensed form (a host
+    /// without multipliers substitutes these rows; the system stays SPD).
+    pub condensed: Vec<Condensed>,
+    /// `C_kk` of each multiplier's own dof (dual: the diagonal `D`).
+    diagonal: Vec<f64>,
+    side_a_dofs: Vec<usize>,
+    side_b_dofs: Vec<usize>,
+}
+
+impl TieConstraints {
+    /// Heat leaving each side for multipliers `lambda` (the flux from A to B), one per
+    /// multiplier: `Σ_{i ∈ side} (Cᵀλ)_i`.
+    pub fn heat(&self, lambda: &[f64]) -> Result<Heat, EmbedError> {
+        if lambda.len() != self.multiplier_dofs.len() {
+            return Err(argument(
+                format!(
+                    "{} multipliers given, the tie has {}",
+                    lambda.len(),
+                    self.multiplier_dofs.len()
+                ),
+                "pass one value per entry of `multiplier_dofs`",
+            ));
+        }
+        let mut ct: HashMap<usize, f64> = HashMap::new();
+        for &(k, j, c) in &self.entries {
+            *ct.entry(j).or_default() += c * lambda[k];
+        }
+        let sum = |set: &[usize]| set.iter().filter_map(|d| ct.get(d)).sum::<f64>();
+        Ok(Heat {
+            side_a: sum(&self.side_a_dofs),
+            side_b: sum(&self.side_b_dofs),
+        })
+    }
+
+    /// Dual multipliers of a host that condensed the tie: `λ_k = −r_k / D_k`, with `r`
+    /// the host's own residual `K u − F` (without the tie) at its solution, by host dof.
+    pub fn dual_multipliers(&self, residual: &[f64]) -> Result<Vec<f64>, EmbedError> {
+        if self.condensed.is_empty() && !self.multiplier_dofs.is_empty() {
+            return Err(argument(
+                "this tie has standard multipliers; they are unknowns of the host's system".into(),
+                "read λ from the host's solution, or build the tie with Multipliers::Dual",
+            ));
+        }
+        self.multiplier_dofs
+            .iter()
+            .zip(&self.diagonal)
+            .map(|(&d, &diag)| {
+                let r = residual.get(d).ok_or_else(|| {
+                    argument(
+                        format!("residual has {} entries, dof {d} is needed", residual.len()),
+                        "pass the host's whole residual vector",
+                    )
+                })?;
+                Ok(if diag == 0.0 { 0.0 } else { -r / diag })
+            })
+            .collect()
+    }
+}
+
+impl Embedding {
+    /// The constraint rows of every mortar tie, in interaction order. Fixed nodes and
+    /// nodes of an earlier tie get no multiplier (crosspoints).
+    pub fn constraints(&self) -> Result<Vec<TieConstraints>, EmbedError> {
+        let mut constrained: HashSet<NodeId> = self.fixed.iter().copied().collect();
+        let mut out = Vec::new();
+        for (index, p) in self.pairs.iter().enumerate() {
+            let result = Self::searched(p)?;
+            let Enforcement::Tie {
+                multipliers,
+                offset,
+            } = &p.enforcement
+            else {
+                continue;
+            };
+            let tie = mortar_tie(
+                &self.mesh,
+                &self.dofs,
+                self.field,
+                &p.a,
+                &p.b,
+                &result.points,
+                &self.conductivity,
+                &mut constrained,
+                *multipliers,
+            )
+            .map_err(|source| EmbedError::Enforcement {
+                side_a: p.side_a.name.clone(),
+                side_b: p.side_b.name.clone(),
+                source,
+            })?;
+            let host = |d: u32| self.host_dof[d as usize];
+            let own: Vec<u32> = tie
+                .nodes
+                .iter()
+                .map(|&n| self.dofs.dof(self.field, n).map_or(u32::MAX, |d| d.0))
+                .collect();
+            let mut rows: Vec<BTreeMap<u32, f64>> = vec![BTreeMap::new(); tie.nodes.len()];
+            for &(k, d, c) in &tie.entries {
+                *rows[k as usize].entry(d).or_default() += c;
+            }
+            let diagonal: Vec<f64> = rows
+                .iter()
+                .zip(&own)
+                .map(|(row, d)| row.get(d).copied().unwrap_or(0.0))
+                .collect();
+            let mut t = TieConstraints {
+                interaction: index,
+                multiplier_dofs: own.iter().map(|&d| host(d)).collect(),
+                entries: tie
+                    .entries
+                    .iter()
+                    .map(|&(k, d, c)| (k as usize, host(d), c))
+                    .collect(),
+                rhs: tie.psi_integral.iter().map(|psi| offset * psi).collect(),
+                condensed: Vec::new(),
+                diagonal,
+                side_a_dofs: tie.side_a_dofs.iter().map(|&d| host(d)).collect(),
+                side_b_dofs: tie.side_b_dofs.iter().map(|&d| host(d)).collect(),
+            };
+            if *multipliers == Multipliers::Dual {
+                t.condensed = condense(&t, &rows, &own, &host, &p.side_a.name)?;
+            }
+            out.push(t);
+        }
+        Ok(out)
+    }
+}
+
+/// The dual rows solved for their own dof: `u_k = (g_k − Σ_{j≠k} C_kj u_j) / D_k`.
+fn condense(
+    t: &TieConstraints,
+    rows: &[BTreeMap<u32, f64>],
+    own: &[u32],
+    host: &dyn Fn(u32) -> usize,
+    side_a: &str,
+) -> Result<Vec<Condensed>, EmbedError> {
+    let condensed: HashSet<u32> = own
+        .iter()
+        .zip(&t.diagonal)
+        .filter(|(_, d)| **d != 0.0)
+        .map(|(o, _)| *o)
+        .collect();
+    let mut out = Vec::new();
+    for (k, row) in rows.iter().enumerate() {
+        let d = t.diagonal[k];
+        if d == 0.0 {
+            continue; // a node no point reached: left free
+        }
+        let mut terms = Vec::new();
+        for (&j, &c) in row {
+            if j == own[k] {
+                continue;
+            }
+            let coefficient = -c / d;
+            // Biorthogonality keeps side-A rows apart; a coupling means a side-A face
+            // only partly covered by side B.
+            if condensed.contains(&j) && coefficient.abs() > 1e-9 {
+                return Err(argument(
+                    format!(
+                        "dual mortar on side A `{side_a}`: the rows of dofs {} and {} are coupled ({coefficient:.3e}); a side-A face is only partly covered by side B",
+                        host(own[k]),
+                        host(j)
+                    ),
+                    "use standard multipliers (Multipliers::Standard) for this tie",
+                ));
+            }
+            if !condensed.contains(&j) {
+                terms.push((host(j), coefficient));
+            }
+        }
+        out.push(Condensed {
+            dof: host(own[k]),
+            constant: t.rhs[k] / d,
+            terms,
+        });
+    }
+    Ok(out)
+}
