@@ -17,12 +17,47 @@
  *   seam_embedding_free(e);
  *
  * Conventions: indices (nodes, elements, dofs) are 0-based int64_t; elements are
- * numbered block after block; local sides are 1-based in Exodus II order. Every
- * function returns a status (SEAM_OK = 0); on failure seam_last_error() says what went
- * wrong, where, and how to fix it (per thread). No function aborts or unwinds into the
- * caller. Arrays returned through `const T **` belong to the handle and stay valid
- * until the next call that recomputes them or the handle is freed. A handle must be
- * used by one thread at a time.
+ * numbered block after block; local sides are 1-based in Exodus II order (table below).
+ * Every function returns a status (SEAM_OK = 0); on failure seam_last_error() says what
+ * went wrong, where, and how to fix it (per thread). No function aborts or unwinds into
+ * the caller. A handle must be used by one thread at a time.
+ *
+ * Ownership and lifetimes:
+ *   - Input arrays (`const T *` with a count) are read during the call only and copied
+ *     where kept; the caller may free or reuse them as soon as the call returns. A null
+ *     array is accepted only with a count of 0.
+ *   - Strings (`const char *`) are read during the call only (UTF-8, NUL-terminated).
+ *   - Handles (seam_builder *, seam_embedding *) are owned by the caller from the
+ *     function that makes them until the matching _free; _free accepts NULL. An
+ *     embedding does not keep its builder: free the builder after seam_embedding_new.
+ *   - Arrays returned through `const T **` belong to the handle: never free them. They
+ *     stay valid until the next call on the same handle that recomputes the same
+ *     results (named at each function), a search, a move, an added interaction, or the
+ *     handle's _free — copy what must outlive that.
+ *   - seam_last_error()'s string belongs to the library (per thread) and stays valid
+ *     until the next failing call on that thread.
+ *   - A conductance callback and its user_data must stay valid until the embedding is
+ *     freed; seam never frees user_data. The callback is called on the thread that
+ *     called seam_evaluate / seam_evaluate_csr / a field query, during that call, one
+ *     point at a time, and must not call back into the same embedding.
+ *
+ * Element node order and sides (the Exodus II convention; docs/embedding.md has the
+ * same). Reference coordinates of the local nodes (0-based), then each side's local
+ * nodes in the order whose right-hand normal points out of the element:
+ *   SEAM_HEX8     nodes 0 (-1,-1,-1) 1 (1,-1,-1) 2 (1,1,-1) 3 (-1,1,-1)
+ *                       4 (-1,-1,1)  5 (1,-1,1)  6 (1,1,1)  7 (-1,1,1)
+ *                 side 1: 0 1 5 4 | side 2: 1 2 6 5 | side 3: 2 3 7 6 |
+ *                 side 4: 0 4 7 3 | side 5: 0 3 2 1 | side 6: 4 5 6 7
+ *   SEAM_TET4     nodes 0 (0,0,0) 1 (1,0,0) 2 (0,1,0) 3 (0,0,1)
+ *                 side 1: 0 1 3 | side 2: 1 2 3 | side 3: 0 3 2 | side 4: 0 2 1
+ *   SEAM_WEDGE6   nodes 0 (0,0,-1) 1 (1,0,-1) 2 (0,1,-1) 3 (0,0,1) 4 (1,0,1) 5 (0,1,1)
+ *                 side 1: 0 1 4 3 | side 2: 1 2 5 4 | side 3: 0 3 5 2 |
+ *                 side 4: 0 2 1 | side 5: 3 4 5
+ *   SEAM_PYRAMID5 nodes 0 (-1,-1,0) 1 (1,-1,0) 2 (1,1,0) 3 (-1,1,0) 4 (0,0,1)
+ *                 side 1: 0 1 4 | side 2: 1 2 4 | side 3: 2 3 4 | side 4: 0 4 3 |
+ *                 side 5: 0 3 2 1
+ * An element whose nodes come in another order is inverted or tangled: seam_embedding_new
+ * refuses it with SEAM_ERR_MESH and names it, before any face is looked up.
  *
  * Build: link with -lseam (target/<profile>/libseam.so of `cargo build`).
  */
@@ -47,6 +82,7 @@ extern "C" {
 #define SEAM_ERR_INTERNAL 7      /* a bug in seam (a caught panic) */
 #define SEAM_ERR_PLUGIN 8        /* a plugin could not be loaded, or failed at a contact point */
 #define SEAM_CUTBACK 9           /* a plugin asks for a smaller step (seam_cutback_factor) */
+#define SEAM_ERR_NOTHING_PAIRED 10 /* a flux interaction's search paired no point (seam_allow_unpaired) */
 
 /* Element topologies (3-D solids). */
 #define SEAM_HEX8 1
@@ -133,7 +169,9 @@ int seam_move_nodes(seam_embedding *embedding, const double *coords, size_t n_no
 int seam_evaluate(seam_embedding *embedding, const double *u, size_t n);
 /* After SEAM_CUTBACK: the plugin's suggested new/old step in (0, 1), or 0 (host decides). */
 int seam_cutback_factor(const seam_embedding *embedding, double *out_factor);
-/* Residual entries to add to R(u) = K u - F; dofs may repeat. */
+/* Residual entries to add to R(u) = K u - F; dofs may repeat. The arrays of
+ * seam_residual, seam_jacobian and seam_load stay valid until the next seam_evaluate,
+ * seam_evaluate_csr, search, move or added interaction. */
 int seam_residual(const seam_embedding *embedding, size_t *out_n, const int64_t **out_dofs,
                   const double **out_values);
 /* Jacobian triplets to add to dR/du; (row, col) pairs may repeat. */
@@ -142,9 +180,117 @@ int seam_jacobian(const seam_embedding *embedding, size_t *out_n, const int64_t 
 /* Right-hand side of linear models (offset terms): residual = J u - load. */
 int seam_load(const seam_embedding *embedding, size_t *out_n, const int64_t **out_dofs,
               const double **out_values);
-/* Heat (W) leaving side A and side B of a flux-type interaction. */
+/* Heat (W) leaving side A and side B of a flux-type interaction, at the field of the
+ * last seam_evaluate or seam_evaluate_csr (SEAM_ERR_ORDER before any); for another
+ * state use seam_heat_at. */
 int seam_heat(const seam_embedding *embedding, size_t index, double *out_side_a,
               double *out_side_b);
+
+/* --- coverage and fields ------------------------------------------------------------ */
+/* Why a side-A point found no partner (seam_unpaired_points). */
+#define SEAM_UNPAIRED_NO_FACE 1            /* no side-B face within reach */
+#define SEAM_UNPAIRED_TOO_FAR 2            /* farther along the normal than the tolerance */
+#define SEAM_UNPAIRED_NORMALS_NOT_OPPOSED 3
+#define SEAM_UNPAIRED_OUTSIDE_SUBDOMAIN 4
+
+typedef struct {
+    size_t points;        /* side-A points (nodes, for a node surface) */
+    size_t paired_points;
+    double area;          /* side A's area, m^2 */
+    double paired_area;   /* the part of it paired with side B */
+    size_t unpaired;      /* points not paired (seam_unpaired_points lists them) */
+    int has_gap;          /* 1 when something paired: gap_min and gap_max hold */
+    double gap_min, gap_max; /* m, positive open */
+} seam_coverage_info;
+
+typedef struct {
+    double x[3];
+    double weight;          /* the point's share of side A's area, m^2 */
+    int paired;
+    int64_t side_a_element; /* side-A face (element, 1-based side); -1 for a node point */
+    int side_a_side;
+    int64_t side_b_element; /* side-B face it paired with; -1 when not paired */
+    int side_b_side;
+    double gap;             /* m, positive open; 0 when not paired */
+    double flux;            /* W/m^2 from side A to side B; 0 when not paired */
+    double temp_a, temp_b;  /* side A's and side B's temperature there (NaN for ties) */
+    int has_multiplier;     /* ties: 1 where the point has a multiplier */
+    double multiplier;      /* ties: lambda_h there (= flux) */
+} seam_point_values;
+
+typedef struct {
+    int64_t element;        /* the face: element and 1-based side */
+    int side;
+    int surface_side;       /* 0 side A, 1 side B */
+    double area, paired_area, fraction; /* m^2, m^2, paired/area in [0, 1] */
+    double gap, flux;       /* means over the paired area (0 with none) */
+} seam_face_values;
+
+/* What the last search of interaction `index` paired. */
+int seam_coverage(const seam_embedding *embedding, size_t index,
+                  seam_coverage_info *out_coverage);
+/* Its unpaired points: point indices, xyz (3 per point) and SEAM_UNPAIRED_* reasons.
+ * Arrays valid until the next seam_unpaired_points on this handle. */
+int seam_unpaired_points(seam_embedding *embedding, size_t index, size_t *out_n,
+                         const size_t **out_points, const double **out_xyz,
+                         const int **out_reasons);
+/* By default seam_search fails with SEAM_ERR_NOTHING_PAIRED when a flux interaction
+ * pairs nothing (wrong surfaces or sides, surfaces apart). allow != 0 lets interaction
+ * `index` (every one with SIZE_MAX) stand with zero terms; 0 refuses it again. */
+int seam_allow_unpaired(seam_embedding *embedding, size_t index, int allow);
+/* Values at every side-A point of flux interaction `index` at the host's field u (n
+ * entries, by host dof), in point order. Array valid until the next point-field call. */
+int seam_point_fields(seam_embedding *embedding, size_t index, const double *u, size_t n,
+                      size_t *out_n, const seam_point_values **out_values);
+/* Per face of flux interaction `index` at u: side A's faces, then side B's if side_b.
+ * Array valid until the next face-field call. */
+int seam_face_fields(seam_embedding *embedding, size_t index, const double *u, size_t n,
+                     int side_b, size_t *out_n, const seam_face_values **out_values);
+/* Heat (W) leaving side A and side B of flux interaction `index` at the field u the
+ * host passes (not the last evaluation's). */
+int seam_heat_at(const seam_embedding *embedding, size_t index, const double *u, size_t n,
+                 double *out_side_a, double *out_side_b);
+
+/* --- CSR: a Jacobian of fixed pattern, refreshed in place ----------------------------- */
+/* Evaluate at u (n entries, by host dof; n is the matrix size) into a CSR Jacobian
+ * whose pattern is built at the first call after a search or move and only refreshed
+ * after, and dense residual and load vectors; seam_heat then gives this evaluation's
+ * heat. Arrays of the three getters below stay valid (same pointers) until the next
+ * seam_evaluate_csr, search, move or added interaction; their contents change only at
+ * the next seam_evaluate_csr. */
+int seam_evaluate_csr(seam_embedding *embedding, const double *u, size_t n);
+/* row_offsets: n_rows + 1 entries; columns (sorted within a row) and values: nnz.
+ * pattern changes only when a search or move made a new pattern (out_pattern may be
+ * NULL): while it stays, offsets and columns hold the same contents. */
+int seam_jacobian_csr(const seam_embedding *embedding, size_t *out_n_rows, size_t *out_nnz,
+                      const size_t **out_row_offsets, const size_t **out_columns,
+                      const double **out_values, uint64_t *out_pattern);
+int seam_residual_dense(const seam_embedding *embedding, size_t *out_n, const double **out_values);
+int seam_load_dense(const seam_embedding *embedding, size_t *out_n, const double **out_values);
+
+/* --- conductance callbacks ------------------------------------------------------------ */
+typedef struct {
+    double gap;       /* m, positive open */
+    double pressure;  /* Pa (0: the host gives no pressure) */
+    double temp_a;    /* K, side A at the point */
+    double temp_b;    /* K, side B at its projection */
+    double x[3];      /* the point */
+    double time;      /* seam_set_time's */
+} seam_point_state;
+/* Return 0 and h >= 0 with its derivatives (finite), or non-zero: the evaluation then
+ * fails with SEAM_ERR_ENFORCEMENT naming the point. */
+typedef int (*seam_conductance_fn)(const seam_point_state *state, void *user_data,
+                                   double *out_h, double *out_dh_dtemp_a,
+                                   double *out_dh_dtemp_b);
+/* As seam_add_interaction with model SEAM_CONDUCTANCE or SEAM_GAP_CONDUCTANCE, h from
+ * callback(state, user_data, ...) at every point. depends_on_temperature = 0 promises
+ * h does not change with T (the host may keep a linear solve). See "Ownership" above
+ * for the callback's lifetime and threading. */
+int seam_add_interaction_with_conductance(seam_embedding *embedding, const char *side_a,
+                                          const char *side_b, int model,
+                                          seam_conductance_fn callback, void *user_data,
+                                          int depends_on_temperature, double offset,
+                                          size_t *out_index);
 
 /* --- mortar ties ------------------------------------------------------------------ */
 /* Compute every tie's rows (after seam_search). Returns the condensed rows of the dual
@@ -171,6 +317,15 @@ int seam_tie_heat(const seam_embedding *embedding, size_t tie, const double *lam
  * the tie (n entries, by host dof) at its solution. */
 int seam_dual_tie_heat(const seam_embedding *embedding, size_t tie, const double *residual,
                        size_t n, double *out_side_a, double *out_side_b);
+/* A condensed dual tie's multipliers from the host's residual K u - F without the tie
+ * (n entries): written into out_lambda, which holds `capacity` >= n_multipliers values. */
+int seam_dual_multipliers(seam_embedding *embedding, size_t tie, const double *residual,
+                          size_t n, double *out_lambda, size_t capacity);
+/* Values at every side-A point of tie `tie` for its multipliers lambda (n = its number
+ * of multipliers; standard: the host's unknowns, dual: seam_dual_multipliers): flux and
+ * multiplier are lambda_h = sum psi_k lambda_k. Array valid until the next point-field call. */
+int seam_tie_point_fields(seam_embedding *embedding, size_t tie, const double *lambda, size_t n,
+                          size_t *out_n, const seam_point_values **out_values);
 
 #ifdef __cplusplus
 }

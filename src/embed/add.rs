@@ -79,6 +79,7 @@ impl Embedding {
             searcher: None,
             result: None,
             points: OnceLock::new(),
+            allow_unpaired: false,
         })
     }
 
@@ -153,6 +154,7 @@ impl Embedding {
             searcher: None,
             result: None,
             points: OnceLock::new(),
+            allow_unpaired: false,
         })
     }
 
@@ -180,10 +182,22 @@ impl Embedding {
                     } else {
                         Form::Conductance
                     },
-                    law: Law::Constant(h),
+                    law: match &i.conductance {
+                        Some(m) => Law::Host(m.clone()),
+                        None => Law::Constant(h),
+                    },
                     offset: i.offset,
                     beta: i.beta,
                 }
+            }
+            Model::TiedMortar { .. } | Model::TiedNitsche if i.conductance.is_some() => {
+                return Err(argument(
+                    format!(
+                        "interaction {} / {}: a conductance model on a tie",
+                        i.side_a, i.side_b
+                    ),
+                    "give the model to Model::Conductance or Model::GapConductance",
+                ));
             }
             Model::TiedNitsche => {
                 check("penalty factor", i.beta, false)?;
@@ -210,10 +224,11 @@ impl Embedding {
         }
         let (a, b) = (self.surface(&i.side_a)?, self.surface(&i.side_b)?);
         let settings = i.settings.unwrap_or_else(|| SearchSettings::defaults(3));
-        let pair = match &i.periodic {
+        let mut pair = match &i.periodic {
             None => self.pair(a, b, settings, Overclosure::StoreOffsets, None, enforcement)?,
             Some(periodic) => self.periodic_pair(a, b, settings, periodic, enforcement)?,
         };
+        pair.allow_unpaired = i.allow_unpaired;
         self.pairs.push(pair);
         Ok(self.pairs.len() - 1)
     }

@@ -180,6 +180,10 @@ impl EmbeddingBuilder {
                 "seam numbers nodes and elements with 32-bit indices",
             ));
         }
+        // The elements first: a host whose node order differs from seam's gets
+        // inverted or tangled elements, and that — not the faces it then fails to find —
+        // is what it must be told.
+        mesh.validate()?;
         let mut by_nodes: Option<HashMap<[u32; 4], Vec<Side>>> = None;
         let mut names = HashSet::new();
         for (s, (name, faces)) in self.surfaces.iter().enumerate() {
@@ -202,7 +206,6 @@ impl EmbeddingBuilder {
                 sides,
             });
         }
-        mesh.validate()?;
         // Seam's own numbering of the temperature dofs, mapped to the host's.
         let solid: Vec<usize> = (0..mesh.blocks.len()).collect();
         let dofs = DofMap::new(&mesh, &[("temperature", &solid)])
@@ -247,6 +250,7 @@ impl EmbeddingBuilder {
             integration: self.integration,
             pairs: Vec::new(),
             time: 0.0,
+            evaluation: None,
         })
     }
 }
@@ -264,7 +268,13 @@ fn sides_by_number(mesh: &Mesh, name: &str, list: &[(usize, u8)]) -> Result<Vec<
             }
             let topology = mesh.topology(ElemId(elem as u32));
             let count = topology.face_side_count();
-            if side == 0 || usize::from(side) > count {
+            if side == 0 {
+                return Err(mesh_error(
+                    format!("surface `{name}`, face {k}: element {elem} has no side 0: local sides are 1-based"),
+                    &format!("add 1 to 0-based side numbers: sides of a {topology:?} run 1 to {count}, Exodus order (docs/embedding.md, \"Element node order and sides\")"),
+                ));
+            }
+            if usize::from(side) > count {
                 return Err(mesh_error(
                     format!("surface `{name}`, face {k}: element {elem} ({topology:?}) has no side {side}"),
                     &format!("local sides are 1-based, Exodus order: 1 to {count}"),

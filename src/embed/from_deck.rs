@@ -131,6 +131,7 @@ impl Embedding {
                     searcher: None,
                     result: None,
                     points: OnceLock::new(),
+                    allow_unpaired: false,
                 });
             }
         }

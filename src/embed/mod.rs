@@ -50,11 +50,11 @@
 //! - Nothing here panics on host input: every check returns an [`EmbedError`] that says
 //!   what is wrong, where, and how to fix it.
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
 use crate::deck::spec::PeriodicTransform;
-use crate::enforce::conductance::{ConductanceModel, PluginConductance};
+use crate::enforce::conductance::PluginConductance;
 use crate::enforce::interface::{DEFAULT_BETA, Form, InterfaceError, InterfacePoints};
 use crate::interaction::SearchSettings;
 use crate::mesh::{Mesh, NodeId, ValidationError};
@@ -88,6 +88,18 @@ pub enum EmbedError {
     /// A call out of order, e.g. contributions before the first search.
     #[error("{what}\n  help: {help}")]
     Order { what: String, help: String },
+    /// A flux interaction's search paired no point: wrong surfaces or side numbers, or
+    /// surfaces apart, would otherwise pass as an interface that carries no heat.
+    /// [`Interaction::allow_unpaired`] (or [`Embedding::allow_unpaired`]) lets it stand.
+    #[error(
+        "interaction {side_a} / {side_b} paired nothing: {why}\n  help: check the surfaces' faces (element numbers, 1-based sides) and the search tolerances; allow_unpaired() if the surfaces may really be apart"
+    )]
+    NothingPaired {
+        side_a: String,
+        side_b: String,
+        /// What the search saw, from its counts.
+        why: String,
+    },
     /// An enforcement failed at a contact point (bad element, failing conductance model).
     #[error("interaction {side_a} / {side_b}: {source}")]
     Enforcement {
@@ -207,7 +219,7 @@ impl Periodic {
 }
 
 /// One interaction built in code: two surfaces and a model.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Interaction {
     side_a: String,
     side_b: String,
@@ -216,6 +228,23 @@ pub struct Interaction {
     beta: f64,
     settings: Option<SearchSettings>,
     periodic: Option<Periodic>,
+    conductance: Option<Arc<dyn ConductanceModel>>,
+    allow_unpaired: bool,
+}
+
+impl std::fmt::Debug for Interaction {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Interaction")
+            .field("side_a", &self.side_a)
+            .field("side_b", &self.side_b)
+            .field("model", &self.model)
+            .field("offset", &self.offset)
+            .field("beta", &self.beta)
+            .field("periodic", &self.periodic)
+            .field("conductance", &self.conductance.as_ref().map(|m| m.name()))
+            .field("allow_unpaired", &self.allow_unpaired)
+            .finish()
+    }
 }
 
 impl Interaction {
@@ -229,6 +258,8 @@ impl Interaction {
             beta: DEFAULT_BETA,
             settings: None,
             periodic: None,
+            conductance: None,
+            allow_unpaired: false,
         }
     }
 
@@ -250,10 +281,73 @@ impl Interaction {
         self
     }
 
+    /// h from the host's own model instead of the constant of [`Model::Conductance`] or
+    /// [`Model::GapConductance`] (whose `h` is then ignored): h and its derivatives at
+    /// each point, from its gap, temperatures, position and the host's time. See
+    /// [`FnConductance`] for a closure, and the C API's `seam_add_interaction_with_conductance`.
+    pub fn conductance(mut self, model: Arc<dyn ConductanceModel>) -> Self {
+        self.conductance = Some(model);
+        self
+    }
+
+    /// Let a flux interaction whose search pairs nothing stand (its terms are then 0):
+    /// by default [`Embedding::search`] refuses it, since wrong side numbers or surfaces
+    /// that are apart otherwise look like an interface that carries no heat.
+    pub fn allow_unpaired(mut self) -> Self {
+        self.allow_unpaired = true;
+        self
+    }
+
     /// Search tolerances other than the defaults of [`SearchSettings::defaults`].
     pub fn search_settings(mut self, settings: SearchSettings) -> Self {
         self.settings = Some(settings);
         self
+    }
+}
+
+/// A conductance given by a closure: `f(state)` returns h and its derivatives with
+/// respect to the two temperatures (`Conductance { h, dh_dtemp_a, dh_dtemp_b, .. }`),
+/// or a message saying why it cannot.
+pub struct FnConductance<F> {
+    name: String,
+    f: F,
+    depends_on_temperature: bool,
+}
+
+impl<F> FnConductance<F>
+where
+    F: Fn(&PointState) -> Result<Conductance, String>,
+{
+    /// `name` labels messages; `depends_on_temperature` false keeps the host's problem
+    /// linear (say so only when h does not change with T).
+    pub fn new(name: &str, depends_on_temperature: bool, f: F) -> Self {
+        FnConductance {
+            name: name.to_string(),
+            f,
+            depends_on_temperature,
+        }
+    }
+}
+
+impl<F> ConductanceModel for FnConductance<F>
+where
+    F: Fn(&PointState) -> Result<Conductance, String>,
+{
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn evaluate(&self, state: &PointState) -> Result<Conductance, ConductanceError> {
+        let c = (self.f)(state).map_err(|message| ConductanceError::Evaluation {
+            model: self.name.clone(),
+            state: *state,
+            message,
+        })?;
+        crate::enforce::conductance::check(self, state, c)
+    }
+
+    fn depends_on_temperature(&self) -> bool {
+        self.depends_on_temperature
     }
 }
 
@@ -296,6 +390,8 @@ enum Law {
     /// its faults and cutback requests become [`EmbedError::Plugin`] and
     /// [`EmbedError::Cutback`].
     Plugin(Box<PluginConductance>, f64),
+    /// A model the host gave in code (a Rust model or closure, a C callback).
+    Host(Arc<dyn ConductanceModel>),
 }
 
 enum Enforcement {
@@ -336,6 +432,8 @@ struct Pair {
     /// The interface geometry at the points of `result`, made at the first
     /// `contributions` after a search or a move and reused until the next.
     points: OnceLock<InterfacePoints>,
+    /// A flux interaction whose search pairs nothing is an error unless this is set.
+    allow_unpaired: bool,
 }
 
 /// seam inside a host: the host's mesh and numbering, its interactions and their search.
@@ -351,14 +449,24 @@ pub struct Embedding {
     pairs: Vec<Pair>,
     /// The host's time, passed to conductance models and plugins (0 until set).
     time: f64,
+    /// The last [`Embedding::evaluate`]: its CSR pattern is kept until the next search
+    /// or move, its values are refreshed in place.
+    evaluation: Option<Evaluation>,
 }
 
 mod add;
 mod builder;
+mod csr;
+mod fields;
 mod from_deck;
 mod search;
 mod terms;
 mod ties;
 
+pub use crate::enforce::conductance::{
+    Conductance, ConductanceError, ConductanceModel, PointState,
+};
 pub use builder::EmbeddingBuilder;
+pub use csr::{CsrMatrix, Evaluation};
+pub use fields::{Coverage, FaceValues, HostFace, PointValues, Unpaired, UnpairedReason};
 pub use ties::TieConstraints;

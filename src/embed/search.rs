@@ -52,9 +52,38 @@ impl Embedding {
                     "check the surfaces' faces and the search tolerances (normal tolerance, field factor)",
                 ));
             }
+            if !tie && !p.allow_unpaired && result.stats.matched == 0 {
+                return Err(EmbedError::NothingPaired {
+                    side_a: p.side_a.name.clone(),
+                    side_b: p.side_b.name.clone(),
+                    why: crate::scene::why_nothing_paired(&result.stats),
+                });
+            }
             p.searcher = Some(searcher);
             p.result = Some(result);
             p.points = OnceLock::new();
+        }
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
+        }
+        Ok(())
+    }
+
+    /// Let interaction `i` (or every interaction, with `None`) pair nothing without
+    /// [`EmbedError::NothingPaired`]; see [`super::Interaction::allow_unpaired`].
+    pub fn allow_unpaired(&mut self, i: Option<usize>, allow: bool) -> Result<(), EmbedError> {
+        match i {
+            None => self.pairs.iter_mut().for_each(|p| p.allow_unpaired = allow),
+            Some(i) => {
+                let count = self.pairs.len();
+                let p = self.pairs.get_mut(i).ok_or_else(|| {
+                    argument(
+                        format!("no interaction {i}, there are {count}"),
+                        "interaction indices are 0-based, in the order they were added",
+                    )
+                })?;
+                p.allow_unpaired = allow;
+            }
         }
         Ok(())
     }
@@ -120,6 +149,9 @@ impl Embedding {
                 r.update_geometry(&p.a, &p.b);
             }
             p.points = OnceLock::new();
+            if let Some(e) = &mut self.evaluation {
+                e.outdate();
+            }
             if let Some(s) = &mut p.searcher {
                 s.refit(&p.b);
             }

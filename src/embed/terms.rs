@@ -1,13 +1,21 @@
-use super::{Contributions, EmbedError, Embedding, Enforcement, Heat, Law, argument};
+//! The interface terms of flux-type interactions at a host field: residual, Jacobian and
+//! heat, as triplets ([`Embedding::contributions`]) or for a state the host names
+//! ([`Embedding::heat`]). Every entry point goes through [`Embedding::with_form`], which
+//! turns the interaction's law into the h the interface form sees and a model's fault
+//! into the matching [`EmbedError`].
+
+use super::{Contributions, EmbedError, Embedding, Enforcement, Heat, Law, Pair, argument};
 use std::cell::Cell;
 
 use crate::enforce::conductance::{ConductanceError, ConductanceModel, PointState};
-use crate::enforce::interface::{HInput, HValue, InterfaceForm, InterfacePoints};
+use crate::enforce::interface::{
+    HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints, InterfaceSystem,
+};
 
 impl Embedding {
-    /// The interface terms of every flux-type interaction at the host's field `u` (by
-    /// host dof): residual, Jacobian (exact, including dh/dT) and heat.
-    pub fn contributions(&self, u: &[f64]) -> Result<Contributions, EmbedError> {
+    /// The host's field `u` (by host dof) in seam's numbering, checked: long enough and
+    /// finite.
+    pub(super) fn local_field(&self, u: &[f64]) -> Result<Vec<f64>, EmbedError> {
         let mut local = vec![0.0; self.dofs.len()];
         for (d, &h) in self.host_dof.iter().enumerate() {
             local[d] = *u.get(h).ok_or_else(|| {
@@ -23,105 +31,135 @@ impl Embedding {
                 "check the host's solve",
             ));
         }
+        Ok(local)
+    }
+
+    /// Run `f` with the interface form of flux interaction `p` and its points (made at
+    /// the first call after a search or move): `None` for a tie. A conductance model's
+    /// failure becomes [`EmbedError::Plugin`] or [`EmbedError::Cutback`] for plugins,
+    /// [`EmbedError::Enforcement`] otherwise.
+    pub(super) fn with_form<R>(
+        &self,
+        p: &Pair,
+        f: impl FnOnce(&InterfacePoints, &InterfaceForm<'_>) -> Result<R, InterfaceError>,
+    ) -> Result<Option<R>, EmbedError> {
+        let result = Self::searched(p)?;
+        let Enforcement::Flux {
+            form,
+            law,
+            offset,
+            beta,
+        } = &p.enforcement
+        else {
+            return Ok(None);
+        };
+        // A plugin's fault, kept to tell a plugin failure or cutback request from the
+        // other failures once the interface terms stop at it.
+        let fault: Cell<Option<ConductanceError>> = Cell::new(None);
+        let h = |x: &HInput| -> Result<HValue, String> {
+            let (model, pressure): (&dyn ConductanceModel, f64) = match law {
+                Law::Constant(h) => {
+                    return Ok(HValue {
+                        h: *h,
+                        ..HValue::default()
+                    });
+                }
+                Law::Model(m, pressure) => (m.as_ref(), *pressure),
+                Law::Plugin(m, pressure) => (m.as_ref(), *pressure),
+                Law::Host(m) => (m.as_ref(), 0.0),
+            };
+            let state = PointState {
+                gap: x.gap,
+                pressure,
+                temp_a: x.temp_a,
+                temp_b: x.temp_b,
+                x: x.x,
+                time: self.time,
+            };
+            match model.evaluate(&state) {
+                Ok(c) => Ok(HValue {
+                    h: c.h,
+                    dh_dtemp_a: c.dh_dtemp_a,
+                    dh_dtemp_b: c.dh_dtemp_b,
+                }),
+                Err(e) => {
+                    let message = e.to_string();
+                    if matches!(law, Law::Plugin(..)) {
+                        fault.set(Some(e));
+                    }
+                    Err(message)
+                }
+            }
+        };
+        let form = InterfaceForm {
+            form: *form,
+            h: &h,
+            offset: *offset,
+            beta: *beta,
+            conductivity: &self.conductivity,
+        };
+        let named = |source| EmbedError::Enforcement {
+            side_a: p.side_a.name.clone(),
+            side_b: p.side_b.name.clone(),
+            source,
+        };
+        let points = match p.points.get() {
+            Some(points) => points,
+            None => {
+                let made = InterfacePoints::new(
+                    &self.mesh,
+                    &self.dofs,
+                    self.field,
+                    &p.a,
+                    &p.b,
+                    &result.points,
+                    &form,
+                )
+                .map_err(named)?;
+                p.points.get_or_init(|| made)
+            }
+        };
+        f(points, &form).map(Some).map_err(|source| {
+            let (side_a, side_b) = (p.side_a.name.clone(), p.side_b.name.clone());
+            match fault.take() {
+                Some(ConductanceError::Cutback { factor, .. }) => EmbedError::Cutback {
+                    side_a,
+                    side_b,
+                    factor,
+                    message: source.to_string(),
+                },
+                Some(_) => EmbedError::Plugin {
+                    side_a,
+                    side_b,
+                    message: source.to_string(),
+                },
+                None => named(source),
+            }
+        })
+    }
+
+    /// The interface system of flux interaction `p` at seam's field `local`.
+    pub(super) fn system(
+        &self,
+        p: &Pair,
+        local: &[f64],
+    ) -> Result<Option<InterfaceSystem>, EmbedError> {
+        self.with_form(p, |points, form| points.evaluate(form, local))
+    }
+
+    /// The interface terms of every flux-type interaction at the host's field `u` (by
+    /// host dof): residual, Jacobian (exact, including dh/dT) and heat, as triplets. A
+    /// host that assembles at every Newton step into a matrix of fixed pattern is better
+    /// served by [`Self::evaluate`] (CSR, refreshed in place).
+    pub fn contributions(&self, u: &[f64]) -> Result<Contributions, EmbedError> {
+        let local = self.local_field(u)?;
         let mut out = Contributions::default();
+        let host = |d: u32| self.host_dof[d as usize];
         for p in &self.pairs {
-            let result = Self::searched(p)?;
-            let Enforcement::Flux {
-                form,
-                law,
-                offset,
-                beta,
-            } = &p.enforcement
-            else {
+            let Some(s) = self.system(p, &local)? else {
                 out.heat.push(None);
                 continue;
             };
-            // A plugin's fault, kept to tell a plugin failure or cutback request from
-            // the other failures once the interface terms stop at it.
-            let fault: Cell<Option<ConductanceError>> = Cell::new(None);
-            let h = |x: &HInput| -> Result<HValue, String> {
-                let (model, pressure): (&dyn ConductanceModel, f64) = match law {
-                    Law::Constant(h) => {
-                        return Ok(HValue {
-                            h: *h,
-                            ..HValue::default()
-                        });
-                    }
-                    Law::Model(m, pressure) => (m.as_ref(), *pressure),
-                    Law::Plugin(m, pressure) => (m.as_ref(), *pressure),
-                };
-                let state = PointState {
-                    gap: x.gap,
-                    pressure,
-                    temp_a: x.temp_a,
-                    temp_b: x.temp_b,
-                    x: x.x,
-                    time: self.time,
-                };
-                match model.evaluate(&state) {
-                    Ok(c) => Ok(HValue {
-                        h: c.h,
-                        dh_dtemp_a: c.dh_dtemp_a,
-                        dh_dtemp_b: c.dh_dtemp_b,
-                    }),
-                    Err(e) => {
-                        let message = e.to_string();
-                        if matches!(law, Law::Plugin(..)) {
-                            fault.set(Some(e));
-                        }
-                        Err(message)
-                    }
-                }
-            };
-            let form = InterfaceForm {
-                form: *form,
-                h: &h,
-                offset: *offset,
-                beta: *beta,
-                conductivity: &self.conductivity,
-            };
-            let points = match p.points.get() {
-                Some(points) => points,
-                None => {
-                    let made = InterfacePoints::new(
-                        &self.mesh,
-                        &self.dofs,
-                        self.field,
-                        &p.a,
-                        &p.b,
-                        &result.points,
-                        &form,
-                    )
-                    .map_err(|source| EmbedError::Enforcement {
-                        side_a: p.side_a.name.clone(),
-                        side_b: p.side_b.name.clone(),
-                        source,
-                    })?;
-                    p.points.get_or_init(|| made)
-                }
-            };
-            let s = points.evaluate(&form, &local).map_err(|source| {
-                let (side_a, side_b) = (p.side_a.name.clone(), p.side_b.name.clone());
-                match fault.take() {
-                    Some(ConductanceError::Cutback { factor, .. }) => EmbedError::Cutback {
-                        side_a,
-                        side_b,
-                        factor,
-                        message: source.to_string(),
-                    },
-                    Some(_) => EmbedError::Plugin {
-                        side_a,
-                        side_b,
-                        message: source.to_string(),
-                    },
-                    None => EmbedError::Enforcement {
-                        side_a,
-                        side_b,
-                        source,
-                    },
-                }
-            })?;
-            let host = |d: u32| self.host_dof[d as usize];
             for (dofs, m) in &s.blocks {
                 let n = dofs.len();
                 for (r, &i) in dofs.iter().enumerate() {
@@ -148,5 +186,21 @@ impl Embedding {
             }));
         }
         Ok(out)
+    }
+
+    /// Heat (W) leaving each side of every interaction at the host's field `u` (by host
+    /// dof), whatever was evaluated before: `None` for mortar ties (their heat comes
+    /// from the multipliers, [`super::TieConstraints::heat`]).
+    pub fn heat(&self, u: &[f64]) -> Result<Vec<Option<Heat>>, EmbedError> {
+        let local = self.local_field(u)?;
+        self.pairs
+            .iter()
+            .map(|p| {
+                Ok(self.system(p, &local)?.map(|s| {
+                    let (side_a, side_b) = s.heat();
+                    Heat { side_a, side_b }
+                }))
+            })
+            .collect()
     }
 }

@@ -22,12 +22,12 @@ pub struct TieConstraints {
     diagonal: Vec<f64>,
     side_a_dofs: Vec<usize>,
     side_b_dofs: Vec<usize>,
+    /// `(point, multiplier, ψ)`: the multiplier basis at the pairing's points.
+    point_psi: Vec<(u32, u32, f64)>,
 }
 
 impl TieConstraints {
-    /// Heat leaving each side for multipliers `lambda` (the flux from A to B), one per
-    /// multiplier: `Σ_{i ∈ side} (Cᵀλ)_i`.
-    pub fn heat(&self, lambda: &[f64]) -> Result<Heat, EmbedError> {
+    fn check_lambda(&self, lambda: &[f64]) -> Result<(), EmbedError> {
         if lambda.len() != self.multiplier_dofs.len() {
             return Err(argument(
                 format!(
@@ -38,6 +38,36 @@ impl TieConstraints {
                 "pass one value per entry of `multiplier_dofs`",
             ));
         }
+        if let Some(k) = lambda.iter().position(|v| !v.is_finite()) {
+            return Err(argument(
+                format!("multiplier {k} is not finite ({})", lambda[k]),
+                "check the host's solve",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The multiplier field `λ_h = Σ ψ_k λ_k` at each of the pairing's `count` points
+    /// (`None` where the tie has no multiplier): the heat flux from side A to side B.
+    pub(super) fn multiplier_field(
+        &self,
+        lambda: &[f64],
+        count: usize,
+    ) -> Result<Vec<Option<f64>>, EmbedError> {
+        self.check_lambda(lambda)?;
+        let mut out = vec![None; count];
+        for &(p, k, psi) in &self.point_psi {
+            if let Some(q) = out.get_mut(p as usize) {
+                *q.get_or_insert(0.0) += psi * lambda[k as usize];
+            }
+        }
+        Ok(out)
+    }
+
+    /// Heat leaving each side for multipliers `lambda` (the flux from A to B), one per
+    /// multiplier: `Σ_{i ∈ side} (Cᵀλ)_i`.
+    pub fn heat(&self, lambda: &[f64]) -> Result<Heat, EmbedError> {
+        self.check_lambda(lambda)?;
         let mut ct: HashMap<usize, f64> = HashMap::new();
         for &(k, j, c) in &self.entries {
             *ct.entry(j).or_default() += c * lambda[k];
@@ -133,6 +163,7 @@ impl Embedding {
                 diagonal,
                 side_a_dofs: tie.side_a_dofs.iter().map(|&d| host(d)).collect(),
                 side_b_dofs: tie.side_b_dofs.iter().map(|&d| host(d)).collect(),
+                point_psi: tie.point_psi.clone(),
             };
             if *multipliers == Multipliers::Dual {
                 t.condensed = condense(&t, &rows, &own, &host, &p.side_a.name)?;

@@ -16,7 +16,7 @@ use seam::embed::{EmbedError, Embedding, Interaction, Model, Multipliers, Period
 
 #[path = "../../examples/embed.rs"]
 #[allow(dead_code)]
-mod example;
+pub(crate) mod example;
 
 const TOLERANCE: f64 = 1e-9;
 
@@ -614,7 +614,13 @@ fn embed_bad_input_is_an_error_that_says_where() {
         Model::Conductance { h: 1.0 },
     ))
     .unwrap();
+    // A flux interaction that pairs nothing is an error that says why, unless allowed.
+    let err = e.search().unwrap_err();
+    assert!(matches!(err, EmbedError::NothingPaired { .. }), "{err}");
+    assert!(err.to_string().contains("surfaces are apart"), "{err}");
+    e.allow_unpaired(Some(0), true).unwrap();
     e.search().unwrap();
+    assert_eq!(e.coverage(0).unwrap().paired_points, 0);
     let err = e.contributions(&[0.0; 3]).unwrap_err();
     assert!(err.to_string().contains("dof 3 is needed"), "{err}");
     let err = e.add_deck("bad.i", "begin contact definition\n  frobnicate\nend\n");
@@ -664,7 +670,15 @@ fn embed_c_api_reports_errors_by_code() {
 #[test]
 fn embed_header_declares_the_exported_functions() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(root.join("src/capi.rs")).unwrap();
+    let mut files: Vec<_> = std::fs::read_dir(root.join("src/capi"))
+        .unwrap()
+        .map(|f| f.unwrap().path())
+        .collect();
+    files.sort();
+    let source: String = files
+        .iter()
+        .map(|f| std::fs::read_to_string(f).unwrap())
+        .collect();
     let text = std::fs::read_to_string(root.join("include/seam.h")).unwrap();
     // Declarations only: drop the comments (their usage lines name the functions too).
     let mut header = String::new();

@@ -7,6 +7,7 @@ mod cli;
 mod conductance;
 mod docs;
 mod embed;
+mod embed_api;
 mod enforce;
 mod examples;
 mod fem;

@@ -1,0 +1,452 @@
+//! The embedding API a host lives with, tested as a host uses it (only `seam::embed`):
+//! point and face fields against `seam run`'s contact output on the same scene, the
+//! coverage calls and the pairs-nothing error, the CSR Jacobian against the triplets
+//! and finite differences with its pattern kept, conductances from host closures, the
+//! heat of a state the host names, and the validator naming the real cause.
+//!
+//! Tolerances: fields and heats compare the same discrete quantities computed through
+//! two paths (the host's dense Newton vs `seam run`'s sparse solve), so they agree to
+//! the solves' round-off times the condition number (~1e-12 relative here); 1e-9 leaves
+//! room and still catches a wrong point order, face or form. Finite differences: central,
+//! step 1e-4 K on a quadratic-in-T conductance, truncation ~1e-8 relative; 1e-6 asserted.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use seam::embed::{
+    Conductance, EmbedError, Embedding, FnConductance, Interaction, Model, PointState, Topology,
+    UnpairedReason,
+};
+
+use crate::embed::example;
+
+fn scene() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks")
+}
+
+/// `seam run` on the two-block problem with `deck`, output into a scratch folder;
+/// returns that folder.
+fn seam_run_with_output(name: &str, deck: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("seam-embed-api-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let problem = std::fs::read_to_string(scene().join("problem.toml")).unwrap();
+    let mesh = scene().join("two_blocks.exo");
+    let problem = problem.replace(
+        "file = \"two_blocks.exo\"",
+        &format!("file = {:?}", mesh.display().to_string()),
+    );
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    std::fs::write(dir.join("contact_run.i"), deck).unwrap();
+    if let Err(e) = seam::run::run(&dir.join("problem.toml")) {
+        panic!("seam run failed: {e:?}");
+    }
+    dir.join("out")
+}
+
+fn vtu(path: &Path, name: &str) -> Vec<f64> {
+    crate::run_fields::vtu_array(&std::fs::read_to_string(path).unwrap(), name)
+}
+
+/// The two-block scene as a host solves it: the embedding (deck `contact_run.i`) and
+/// the converged field.
+fn host_solution(deck: &str) -> (Embedding, Vec<f64>) {
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_deck("contact_run.i", deck).unwrap();
+    seam.search().unwrap();
+    let k = example::conduction(&mesh, &dof).unwrap();
+    let fixed = example::dirichlet(&mesh, &dof).unwrap();
+    let (u, _) = example::newton(&seam, &k, &fixed).unwrap();
+    (seam, u)
+}
+
+fn largest_difference(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            if x.is_nan() && y.is_nan() {
+                0.0
+            } else {
+                (x - y).abs() / scale
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn embed_point_and_face_fields_match_seam_run() {
+    let deck = std::fs::read_to_string(scene().join("contact_run.i"))
+        .unwrap()
+        .replace("output rule = verbose", "output rule = more verbose");
+    let out = seam_run_with_output("fields", &deck);
+    let (seam, u) = host_solution(&deck);
+
+    // Per point, in the pairing's order: flux (NaN where unpaired in the file) and gap.
+    let points = seam.point_fields(0, &u).unwrap();
+    let file_flux = vtu(&out.join("contact_points.vtu"), "interface_flux");
+    let file_weight = vtu(&out.join("contact_points.vtu"), "weight");
+    let host_flux: Vec<f64> = points
+        .iter()
+        .map(|p| if p.paired { p.flux } else { f64::NAN })
+        .collect();
+    let host_weight: Vec<f64> = points.iter().map(|p| p.weight).collect();
+    let (df, dw) = (
+        largest_difference(&file_flux, &host_flux),
+        largest_difference(&file_weight, &host_weight),
+    );
+    println!(
+        "{} points: flux {df:.2e}, weight {dw:.2e} (relative to the largest)",
+        points.len()
+    );
+    assert!(df <= 1e-9 && dw <= 1e-12, "{df:.3e} {dw:.3e}");
+    // Σ w q is the heat leaving side A.
+    let heat = seam.heat(&u).unwrap()[0].unwrap();
+    let sum: f64 = points
+        .iter()
+        .filter(|p| p.paired)
+        .map(|p| p.weight * p.flux)
+        .sum();
+    assert!(
+        (sum - heat.side_a).abs() <= 1e-9 * heat.side_a.abs(),
+        "{sum} {}",
+        heat.side_a
+    );
+
+    // Per face, side A then side B (`Output Rule = more verbose` writes both).
+    let faces = seam.face_fields(0, &u, true).unwrap();
+    let contact = out.join("contact.vtu");
+    for (name, host) in [
+        (
+            "interface_flux",
+            faces.iter().map(|f| f.flux).collect::<Vec<_>>(),
+        ),
+        ("contact_gap", faces.iter().map(|f| f.gap).collect()),
+        (
+            "contact_fraction",
+            faces.iter().map(|f| f.fraction).collect(),
+        ),
+        (
+            "contact_area",
+            faces.iter().map(|f| f.paired_area).collect(),
+        ),
+    ] {
+        let d = largest_difference(&vtu(&contact, name), &host);
+        println!("faces {name}: {d:.2e}");
+        assert!(d <= 1e-9, "{name}: {d:.3e}");
+    }
+
+    // Coverage: the lid covers the base's top exactly, at zero gap.
+    let c = seam.coverage(0).unwrap();
+    assert_eq!(c.paired_points, c.points);
+    assert!(c.unpaired.is_empty());
+    assert!(
+        (c.area - 1.0).abs() < 1e-12 && (c.paired_area - 1.0).abs() < 1e-12,
+        "{c:?}"
+    );
+    let (lo, hi) = c.gap_range.unwrap();
+    assert!(lo.abs() < 1e-12 && hi.abs() < 1e-12, "{lo} {hi}");
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+}
+
+/// Side A is the base's bottom, side B the lid's top: half a metre apart, facing away.
+#[test]
+fn embed_nothing_paired_is_an_error_with_its_reasons() {
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_interaction(Interaction::new(
+        "base_top",
+        "lid_top",
+        Model::GapConductance { h: 500.0 },
+    ))
+    .unwrap();
+    let err = seam.search().unwrap_err();
+    assert!(matches!(err, EmbedError::NothingPaired { .. }), "{err}");
+    let text = err.to_string();
+    assert!(text.contains("base_top / lid_top paired nothing"), "{text}");
+    // Allowed: it stands, and the coverage says what happened point by point.
+    seam.allow_unpaired(Some(0), true).unwrap();
+    seam.search().unwrap();
+    let c = seam.coverage(0).unwrap();
+    assert_eq!(c.paired_points, 0);
+    assert_eq!(c.paired_area, 0.0);
+    assert_eq!(c.gap_range, None);
+    assert_eq!(c.unpaired.len(), c.points);
+    assert!(
+        c.unpaired
+            .iter()
+            .all(|u| u.reason != UnpairedReason::OutsideSubdomain)
+    );
+    let u = vec![300.0; mesh.num_nodes()];
+    assert_eq!(seam.heat(&u).unwrap()[0].unwrap().side_a, 0.0);
+    // Built in code with allow_unpaired() from the start, the same.
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_interaction(
+        Interaction::new("base_top", "lid_top", Model::GapConductance { h: 500.0 })
+            .allow_unpaired(),
+    )
+    .unwrap();
+    seam.search().unwrap();
+    // A deck interaction that pairs nothing is refused the same way.
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    let deck = std::fs::read_to_string(scene().join("contact_run.i"))
+        .unwrap()
+        .replace("contains base_top", "contains base_bottom");
+    seam.add_deck("apart.i", &deck).unwrap();
+    let err = seam.search().unwrap_err();
+    assert!(matches!(err, EmbedError::NothingPaired { .. }), "{err}");
+}
+
+/// h = 500 + 0.01 (T_A − 250)² + 0.02 (T_B − 250)²: depends on both temperatures.
+fn quadratic_h() -> Arc<FnConductance<impl Fn(&PointState) -> Result<Conductance, String>>> {
+    Arc::new(FnConductance::new("quadratic", true, |s: &PointState| {
+        let (a, b) = (s.temp_a - 250.0, s.temp_b - 250.0);
+        Ok(Conductance {
+            h: 500.0 + 0.01 * a * a + 0.02 * b * b,
+            dh_dtemp_a: 0.02 * a,
+            dh_dtemp_b: 0.04 * b,
+            ..Conductance::default()
+        })
+    }))
+}
+
+fn two_blocks(interaction: Interaction) -> (Embedding, usize) {
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_interaction(interaction).unwrap();
+    seam.search().unwrap();
+    (seam, mesh.num_nodes())
+}
+
+/// A field that varies over the interface (so every term and derivative is exercised).
+fn field(n: usize, shift: f64) -> Vec<f64> {
+    (0..n)
+        .map(|i| 300.0 + shift + 37.0 * ((i as f64) * 0.7).sin())
+        .collect()
+}
+
+#[test]
+fn embed_csr_jacobian_matches_triplets_and_differences_and_keeps_its_pattern() {
+    let (mut seam, n) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(quadratic_h()),
+    );
+    let u1 = field(n, 0.0);
+    let dense = |triplets: &[(usize, usize, f64)]| {
+        let mut m = vec![0.0; n * n];
+        for &(i, j, v) in triplets {
+            m[i * n + j] += v;
+        }
+        m
+    };
+    let reference = dense(&seam.contributions(&u1).unwrap().jacobian);
+    let residual_ref = {
+        let mut r = vec![0.0; n];
+        for (d, v) in seam.contributions(&u1).unwrap().residual {
+            r[d] += v;
+        }
+        r
+    };
+    let (pattern, columns_at, nnz) = {
+        let e = seam.evaluate(&u1).unwrap();
+        let j = &e.jacobian;
+        let mut worst = 0.0f64;
+        for i in 0..n {
+            for jj in 0..n {
+                worst = worst.max((j.get(i, jj) - reference[i * n + jj]).abs());
+            }
+        }
+        let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(worst <= 1e-13 * scale, "CSR vs triplets: {worst:.3e}");
+        assert!(largest_difference(&residual_ref, &e.residual) <= 1e-14);
+        // No duplicates, sorted rows.
+        for i in 0..n {
+            let row = &j.columns[j.row_offsets[i]..j.row_offsets[i + 1]];
+            assert!(row.windows(2).all(|w| w[0] < w[1]));
+        }
+        (e.pattern, j.columns.as_ptr(), j.columns.len())
+    };
+    // Refreshed in place at another state: same pattern, same arrays, new values.
+    let u2 = field(n, 40.0);
+    let before = seam.evaluation().unwrap().jacobian.values.clone();
+    let e = seam.evaluate(&u2).unwrap();
+    assert_eq!(e.pattern, pattern);
+    assert_eq!(e.jacobian.columns.as_ptr(), columns_at);
+    assert_eq!(e.jacobian.columns.len(), nnz);
+    assert_ne!(
+        e.jacobian.values, before,
+        "h depends on T: the values change"
+    );
+    // The Jacobian is the derivative of the residual (central differences).
+    let j2 = e.jacobian.clone();
+    let step = 1e-4;
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    let interface: Vec<usize> = (0..n).filter(|&c| j2.get(c, c) != 0.0).collect();
+    for &c in interface.iter().step_by(7) {
+        let mut plus = u2.clone();
+        plus[c] += step;
+        let mut minus = u2.clone();
+        minus[c] -= step;
+        let rp = seam.evaluate(&plus).unwrap().residual.clone();
+        let rm = seam.evaluate(&minus).unwrap().residual.clone();
+        for r in 0..n {
+            let fd = (rp[r] - rm[r]) / (2.0 * step);
+            worst = worst.max((fd - j2.get(r, c)).abs());
+            scale = scale.max(j2.get(r, c).abs());
+        }
+    }
+    println!(
+        "CSR Jacobian vs central differences: {:.2e} relative",
+        worst / scale
+    );
+    assert!(worst <= 1e-6 * scale, "{worst:.3e} of {scale:.3e}");
+    // A new search makes a new pattern.
+    seam.search().unwrap();
+    assert_eq!(seam.evaluate(&u1).unwrap().pattern, pattern + 1);
+}
+
+#[test]
+fn embed_closure_conductance_matches_the_constant_model() {
+    let (constant, n) = two_blocks(Interaction::new(
+        "base_top",
+        "lid_bottom",
+        Model::GapConductance { h: 500.0 },
+    ));
+    let closure = Arc::new(FnConductance::new("500", false, |_: &PointState| {
+        Ok(Conductance {
+            h: 500.0,
+            ..Conductance::default()
+        })
+    }));
+    let (with_closure, _) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(closure),
+    );
+    let u = field(n, 0.0);
+    let (a, b) = (
+        constant.heat(&u).unwrap()[0].unwrap(),
+        with_closure.heat(&u).unwrap()[0].unwrap(),
+    );
+    assert!(
+        (a.side_a - b.side_a).abs() <= 1e-12 * a.side_a.abs(),
+        "{a:?} {b:?}"
+    );
+    // A closure that fails names the point.
+    let failing = Arc::new(FnConductance::new("failing", true, |s: &PointState| {
+        if s.x[0] > 0.5 {
+            Err("no data past x = 0.5".into())
+        } else {
+            Ok(Conductance::default())
+        }
+    }));
+    let (broken, _) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::Conductance { h: 0.0 })
+            .conductance(failing),
+    );
+    let err = broken.heat(&u).unwrap_err().to_string();
+    assert!(
+        err.contains("no data past x = 0.5") && err.contains("element"),
+        "{err}"
+    );
+}
+
+/// `heat(u)` is the heat at the state passed, not at the last evaluation.
+#[test]
+fn embed_heat_is_for_the_state_passed() {
+    let (mut seam, n) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(quadratic_h()),
+    );
+    let (u1, u2) = (field(n, 0.0), field(n, 25.0));
+    let at_u1 = seam.evaluate(&u1).unwrap().heat[0].unwrap();
+    let at_u2 = seam.heat(&u2).unwrap()[0].unwrap();
+    assert_eq!(seam.contributions(&u2).unwrap().heat[0].unwrap(), at_u2);
+    assert_ne!(at_u1, at_u2);
+    assert_eq!(seam.evaluation().unwrap().heat[0].unwrap(), at_u1);
+}
+
+/// One hex with the host's own node order (the top face first): the element is
+/// inverted, and that is what the host is told — not that its faces are no sides.
+#[test]
+fn embed_validator_names_the_real_cause_first() {
+    let coords: Vec<[f64; 3]> = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ];
+    let host_order = [4, 5, 6, 7, 0, 1, 2, 3];
+    let dofs: Vec<usize> = (0..8).collect();
+    let err = Embedding::builder(&coords)
+        .block("b", Topology::Hex8, &host_order, 1.0)
+        .face_set("top", &[[4, 5, 6, 7]])
+        .face_set("odd", &[[0, 1, 6, 7]])
+        .dofs(&dofs)
+        .build()
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("inverted") && err.contains("element 0"),
+        "{err}"
+    );
+    // A node out of range is named as such.
+    let err = Embedding::builder(&coords)
+        .block("b", Topology::Hex8, &[0, 1, 2, 3, 4, 5, 6, 8], 1.0)
+        .dofs(&dofs)
+        .build()
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("node 8 does not exist"), "{err}");
+    // A 0-based side is told to be one.
+    let err = Embedding::builder(&coords)
+        .block("b", Topology::Hex8, &dofs, 1.0)
+        .side_set("s", &[(0, 0)])
+        .dofs(&dofs)
+        .build()
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("1-based"), "{err}");
+}
+
+/// The header's table of node order and sides is the one seam uses.
+#[test]
+fn embed_header_side_table_is_seams() {
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("include/seam.h"))
+            .unwrap();
+    for (name, topology) in [
+        ("SEAM_HEX8", Topology::Hex8),
+        ("SEAM_TET4", Topology::Tet4),
+        ("SEAM_WEDGE6", Topology::Wedge6),
+        ("SEAM_PYRAMID5", Topology::Pyramid5),
+    ] {
+        let at = text.find(&format!(" *   {name} ")).expect(name);
+        let block: String = text[at..]
+            .lines()
+            .skip(1)
+            .take_while(|l| !l.contains(" *   SEAM_") && !l.contains("An element whose"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let block = text[at..].lines().next().unwrap().to_string() + " " + &block;
+        for s in 1..=topology.face_side_count() {
+            let nodes: Vec<String> = topology.sides()[s - 1]
+                .iter()
+                .map(|n| n.to_string())
+                .collect();
+            let want = format!("side {s}: {}", nodes.join(" "));
+            assert!(block.contains(&want), "{name}: `{want}` not in `{block}`");
+        }
+    }
+}
