@@ -112,6 +112,119 @@ static void apply_dirichlet(double *k, double *f, size_t n, const double *fixed)
         if (!isnan(fixed[d])) f[d] = fixed[d];
 }
 
+/* What the search paired, and the fields at the host's solution u: every side-A point
+ * (position, paired, flux, gap) and every face (element, side, flux, fraction). */
+static void report_fields(seam_embedding *e, const double *u, size_t n) {
+    seam_coverage_info c;
+    CHECK(seam_coverage(e, 0, &c));
+    printf("coverage: %zu points, %zu paired, area %.17g, paired %.17g, gap %d %.17g %.17g\n",
+           c.points, c.paired_points, c.area, c.paired_area, c.has_gap, c.gap_min, c.gap_max);
+    size_t np, nf;
+    const seam_point_values *p;
+    const seam_face_values *f;
+    CHECK(seam_point_fields(e, 0, u, n, &np, &p));
+    double sum = 0.0;
+    for (size_t i = 0; i < np; i++) {
+        if (p[i].paired) sum += p[i].weight * p[i].flux;
+        printf("point %.17g %.17g %.17g %d %.17g %.17g\n", p[i].x[0], p[i].x[1], p[i].x[2],
+               p[i].paired, p[i].flux, p[i].gap);
+    }
+    printf("point flux sum: %.17g W\n", sum);
+    CHECK(seam_face_fields(e, 0, u, n, 1, &nf, &f));
+    for (size_t i = 0; i < nf; i++)
+        printf("face %d %.17g %.17g %.17g\n", f[i].surface_side, f[i].flux, f[i].fraction,
+               f[i].paired_area);
+    double a, b;
+    double *half = malloc(sizeof(double) * n);
+    for (size_t i = 0; i < n; i++) half[i] = 0.5 * u[i];
+    CHECK(seam_heat_at(e, 0, half, n, &a, &b));
+    printf("heat at u/2: %.17g W\n", a);
+    free(half);
+}
+
+/* The CSR Jacobian against the triplets at the same field, and its pattern kept. */
+static void check_csr(seam_embedding *e, const double *u, size_t n) {
+    size_t nt, n_rows, nnz;
+    const int64_t *rows, *cols;
+    const double *vals, *values;
+    const size_t *offsets, *columns;
+    uint64_t pattern, again;
+    CHECK(seam_evaluate(e, u, n));
+    CHECK(seam_jacobian(e, &nt, &rows, &cols, &vals));
+    double *dense = calloc(n * n, sizeof(double));
+    for (size_t t = 0; t < nt; t++) dense[rows[t] * n + cols[t]] += vals[t];
+    CHECK(seam_evaluate_csr(e, u, n));
+    CHECK(seam_jacobian_csr(e, &n_rows, &nnz, &offsets, &columns, &values, &pattern));
+    for (size_t r = 0; r < n_rows; r++)
+        for (size_t k = offsets[r]; k < offsets[r + 1]; k++) dense[r * n + columns[k]] -= values[k];
+    double worst = 0.0;
+    for (size_t i = 0; i < n * n; i++) worst = fmax(worst, fabs(dense[i]));
+    const size_t *columns_before = columns;
+    CHECK(seam_evaluate_csr(e, u, n));
+    CHECK(seam_jacobian_csr(e, &n_rows, &nnz, &offsets, &columns, &values, &again));
+    size_t nr;
+    const double *r;
+    CHECK(seam_residual_dense(e, &nr, &r));
+    printf("csr: rows %zu entries %zu triplets %zu largest difference %.3e pattern kept %d\n",
+           n_rows, nnz, nt, worst, pattern == again && columns == columns_before && nr == n);
+    free(dense);
+}
+
+/* A conductance from a C callback: h = 500 from user data, and one that fails. */
+static int constant_h(const seam_point_state *s, void *user, double *h, double *da, double *db) {
+    (void)s;
+    *h = *(const double *)user;
+    *da = *db = 0.0;
+    return 0;
+}
+
+static int failing_h(const seam_point_state *s, void *user, double *h, double *da, double *db) {
+    (void)user, (void)da, (void)db;
+    *h = 1.0;
+    return s->x[0] > 0.5 ? 7 : 0;
+}
+
+static void check_callbacks(const seam_builder *b, const double *u, size_t n, double q_a) {
+    seam_embedding *e = NULL;
+    double h = 500.0, a, side_b;
+    CHECK(seam_embedding_new(b, &e));
+    CHECK(seam_add_interaction_with_conductance(e, "base_top", "lid_bottom",
+                                                SEAM_GAP_CONDUCTANCE, constant_h, &h, 0, 0.0,
+                                                NULL));
+    CHECK(seam_add_interaction_with_conductance(e, "base_top", "lid_bottom", SEAM_CONDUCTANCE,
+                                                failing_h, NULL, 1, 0.0, NULL));
+    CHECK(seam_search(e));
+    CHECK(seam_heat_at(e, 0, u, n, &a, &side_b));
+    printf("callback heat: %.17g W (constant model %.17g W)\n", a, q_a);
+    int status = seam_heat_at(e, 1, u, n, &a, &side_b);
+    printf("expected callback failure %d: %s\n", status, seam_last_error());
+    seam_embedding_free(e);
+}
+
+/* The lid lifted half a metre: nothing pairs, which is an error until allowed. */
+static void check_nothing_paired(seam_embedding *e, const double *coords, size_t n_nodes,
+                                 size_t first_lid_node) {
+    double *moved = malloc(sizeof(double) * 3 * n_nodes);
+    memcpy(moved, coords, sizeof(double) * 3 * n_nodes);
+    for (size_t i = 0; i < n_nodes; i++)
+        if (i >= first_lid_node) moved[3 * i + 2] += 0.5;
+    CHECK(seam_move_nodes(e, moved, n_nodes));
+    int status = seam_search(e);
+    printf("expected nothing paired %d: %s\n", status, seam_last_error());
+    CHECK(seam_allow_unpaired(e, SIZE_MAX, 1));
+    CHECK(seam_search(e));
+    seam_coverage_info c;
+    size_t nu;
+    const size_t *which;
+    const double *xyz;
+    const int *reasons;
+    CHECK(seam_coverage(e, 0, &c));
+    CHECK(seam_unpaired_points(e, 0, &nu, &which, &xyz, &reasons));
+    printf("apart: %zu paired of %zu points, area %.17g paired %.17g, %zu unpaired, first reason %d\n",
+           c.paired_points, c.points, c.area, c.paired_area, nu, nu > 0 ? reasons[0] : -1);
+    free(moved);
+}
+
 int main(void) {
     Box base = {6, 6, 6, 0};
     Box lid = {4, 4, 3, 0};
@@ -197,6 +310,11 @@ int main(void) {
     CHECK(seam_heat(e, 0, &q_a, &q_b));
     printf("interface heat: side A %.17g W, side B %.17g W\n", q_a, q_b);
 
+    report_fields(e, u, n);
+    check_csr(e, u, n);
+    check_callbacks(b, u, n, q_a);
+    check_nothing_paired(e, coords, n_nodes, (size_t)lid.first);
+
     seam_embedding_free(e);
 
     /* The same blocks tied by dual mortar, which this host (no multipliers) condenses:
@@ -249,6 +367,22 @@ int main(void) {
     }
     CHECK(seam_dual_tie_heat(tie, 0, u, n, &q_a, &q_b));
     printf("dual tie heat: side A %.17g W, side B %.17g W\n", q_a, q_b);
+    /* Its multipliers from the same residual, and the multiplier field at its points. */
+    size_t n_mult, n_entries, n_points;
+    const int64_t *mult_dofs, *mults, *entry_dofs;
+    const double *g, *entry_values;
+    const seam_point_values *tp;
+    CHECK(seam_tie_rows(tie, 0, &n_mult, &mult_dofs, &g, &n_entries, &mults, &entry_dofs,
+                        &entry_values));
+    double *lambda = malloc(sizeof(double) * n_mult);
+    CHECK(seam_dual_multipliers(tie, 0, u, n, lambda, n_mult));
+    CHECK(seam_tie_point_fields(tie, 0, lambda, n_mult, &n_points, &tp));
+    double tie_sum = 0.0;
+    for (size_t i = 0; i < n_points; i++)
+        if (tp[i].has_multiplier) tie_sum += tp[i].weight * tp[i].multiplier;
+    printf("dual tie multiplier field: %zu points, sum of w lambda_h %.17g W\n", n_points,
+           tie_sum);
+    free(lambda);
 
     seam_embedding_free(tie);
     seam_builder_free(b);

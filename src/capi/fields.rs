@@ -324,22 +324,12 @@ pub unsafe extern "C" fn seam_heat_at(
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
         let u = unsafe { slice(u, n, "u") }?;
-        let heat = e.inner.heat(u)?;
-        let h = match heat.get(index) {
-            Some(Some(h)) => *h,
-            Some(None) => {
-                return Err(bad(
-                    format!("interaction {index} is a mortar tie"),
-                    "read its heat with seam_tie_heat or seam_dual_tie_heat",
-                ));
-            }
-            None => {
-                return Err(bad(
-                    format!("interaction {index} does not exist ({} in all)", heat.len()),
-                    "indices are 0-based, in the order interactions were added",
-                ));
-            }
-        };
+        let h = e.inner.heat_of(index, u)?.ok_or_else(|| {
+            bad(
+                format!("interaction {index} is a mortar tie"),
+                "read its heat with seam_tie_heat or seam_dual_tie_heat",
+            )
+        })?;
         unsafe {
             out(out_side_a, h.side_a, "out_side_a")?;
             out(out_side_b, h.side_b, "out_side_b")

@@ -188,6 +188,22 @@ impl Embedding {
         Ok(out)
     }
 
+    /// Heat (W) leaving each side of interaction `i` at the host's field `u` (by host
+    /// dof), whatever was evaluated before: `None` for a mortar tie.
+    pub fn heat_of(&self, i: usize, u: &[f64]) -> Result<Option<Heat>, EmbedError> {
+        let p = self.pairs.get(i).ok_or_else(|| {
+            argument(
+                format!("no interaction {i}, there are {}", self.pairs.len()),
+                "interaction indices are 0-based, in the order they were added",
+            )
+        })?;
+        let local = self.local_field(u)?;
+        Ok(self.system(p, &local)?.map(|s| {
+            let (side_a, side_b) = s.heat();
+            Heat { side_a, side_b }
+        }))
+    }
+
     /// Heat (W) leaving each side of every interaction at the host's field `u` (by host
     /// dof), whatever was evaluated before: `None` for mortar ties (their heat comes
     /// from the multipliers, [`super::TieConstraints::heat`]).

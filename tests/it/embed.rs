@@ -172,6 +172,7 @@ fn embed_c_host_matches_seam_run() {
         relative(b, reference_b) <= TOLERANCE,
         "{b} vs {reference_b}"
     );
+    c_host_fields(&stdout, a);
     // Its dual mortar tie, condensed in C, against seam run's dual solve.
     let dual = printed(&stdout, "dual tie heat: side A ");
     let (reference, _) = seam_run("c-dual", &tie_deck("dual"));
@@ -182,6 +183,145 @@ fn embed_c_host_matches_seam_run() {
     );
     assert!(relative(dual[0], reference) <= TOLERANCE);
     assert!(relative(-dual[1], reference) <= TOLERANCE);
+    let field = printed(&stdout, "dual tie multiplier field: ");
+    assert!(
+        field[0] > 0.0 && relative(field[1], dual[0]) <= TOLERANCE,
+        "{field:?}"
+    );
+}
+
+/// The C host's coverage, point and face fields, CSR, callbacks and pairs-nothing error
+/// (examples/c_host/main.c) at its solution, whose interface heat is `heat`.
+fn c_host_fields(stdout: &str, heat: f64) {
+    let coverage = printed(stdout, "coverage: ");
+    assert_eq!(coverage[0], coverage[1], "every point paired: {coverage:?}");
+    assert!((coverage[2] - 1.0).abs() < 1e-12 && (coverage[3] - 1.0).abs() < 1e-12);
+    // Per point: the Rust host on the Exodus mesh of the same scene (whose points match
+    // `seam run`'s, embed_api.rs) by position; the C mesh is generated in C.
+    let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
+    let (seam, u) = crate::embed_api::host_solution(&deck);
+    let key = |x: [f64; 3]| x.map(|v| (v * 1e9).round() as i64);
+    let rust: std::collections::HashMap<_, _> = seam
+        .point_fields(0, &u)
+        .unwrap()
+        .into_iter()
+        .map(|p| (key(p.x), p))
+        .collect();
+    let mut compared = 0;
+    let mut worst = 0.0f64;
+    for line in stdout
+        .lines()
+        .filter(|l| l.starts_with("point ") && !l.starts_with("point flux"))
+    {
+        let v: Vec<f64> = line[6..]
+            .split_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect();
+        let p = rust
+            .get(&key([v[0], v[1], v[2]]))
+            .unwrap_or_else(|| panic!("no Rust point at {v:?}"));
+        assert_eq!(v[3] != 0.0, p.paired);
+        worst = worst.max((v[4] - p.flux).abs() / heat.abs());
+        compared += 1;
+    }
+    println!("C point fields: {compared} points, largest flux difference {worst:.2e} of |Q|");
+    assert_eq!(compared, rust.len());
+    assert!(worst <= TOLERANCE, "{worst:.3e}");
+    let sum = printed(stdout, "point flux sum: ")[0];
+    assert!(relative(sum, heat) <= TOLERANCE, "{sum} {heat}");
+    // The scene is one-dimensional: every face carries heat/area over all of it.
+    let faces: Vec<Vec<f64>> = stdout
+        .lines()
+        .filter(|l| l.starts_with("face "))
+        .map(|l| {
+            l[5..]
+                .split_whitespace()
+                .map(|t| t.parse().unwrap())
+                .collect()
+        })
+        .collect();
+    assert_eq!(
+        faces.len(),
+        36 + 16,
+        "the base's 6 × 6 top faces and the lid's 4 × 4"
+    );
+    for f in &faces {
+        assert!(relative(f[1], heat) <= TOLERANCE, "{f:?}");
+        assert!((f[2] - 1.0).abs() < 1e-12, "{f:?}");
+    }
+    assert!(relative(printed(stdout, "heat at u/2: ")[0], 0.5 * heat) <= TOLERANCE);
+    let csr = printed(stdout, "csr: ");
+    assert!(
+        csr[3] == 0.0 && csr[4] == 1.0,
+        "CSR = triplets, pattern kept: {csr:?}"
+    );
+    assert!(relative(printed(stdout, "callback heat: ")[0], heat) <= 1e-12);
+    assert!(
+        stdout.contains("expected callback failure 6: ")
+            && stdout.contains("the callback returned 7"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains(
+            "expected nothing paired 10: interaction base_top / lid_bottom paired nothing"
+        ),
+        "{stdout}"
+    );
+    let apart = printed(stdout, "apart: ");
+    assert!(
+        apart[0] == 0.0 && apart[2] > 0.99 && apart[3] == 0.0,
+        "{apart:?}"
+    );
+}
+
+/// The multiplier field λ_h of a tie at every point, from the host's multipliers,
+/// against the per-point flux `seam run` writes for the same tie (`contact_points.vtu`,
+/// same mesh and deck, so the same points in the same order); Σ w λ_h is the heat.
+fn tie_fields_match_seam_run(
+    seam: &Embedding,
+    tie: &seam::embed::TieConstraints,
+    lambda: &[f64],
+    deck: &str,
+    name: &str,
+) {
+    let visual = deck.replacen(
+        "  begin interaction",
+        "  visualize contact\n  output rule = more verbose\n  begin interaction",
+        1,
+    );
+    let out = crate::embed_api::seam_run_with_output(name, &visual);
+    let xml = std::fs::read_to_string(out.join("contact_points.vtu")).unwrap();
+    let file = crate::run_fields::vtu_array(&xml, "interface_flux");
+    let points = seam.tie_point_fields(tie, lambda).unwrap();
+    assert_eq!(points.len(), file.len());
+    let scale = file
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut worst = 0.0f64;
+    for (p, f) in points.iter().zip(&file) {
+        assert_eq!(p.multiplier.is_some(), f.is_finite(), "{p:?} {f}");
+        if let Some(m) = p.multiplier {
+            assert_eq!(m, p.flux);
+            worst = worst.max((m - f).abs() / scale);
+        }
+    }
+    println!(
+        "{name} tie: λ_h at {} points, largest difference {worst:.2e}",
+        points.len()
+    );
+    assert!(worst <= TOLERANCE, "{worst:.3e}");
+    let heat = tie.heat(lambda).unwrap();
+    let sum: f64 = points
+        .iter()
+        .filter_map(|p| p.multiplier.map(|m| m * p.weight))
+        .sum();
+    assert!(
+        relative(sum, heat.side_a) <= TOLERANCE,
+        "{sum} {}",
+        heat.side_a
+    );
+    let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
 /// The two-block interface tied by mortar with `multipliers` (`dual` or `standard`).
@@ -285,6 +425,7 @@ fn embed_dual_mortar_rows_match_seam_run() {
         .collect();
     let lambda = ties[0].dual_multipliers(&residual).unwrap();
     let heat = ties[0].heat(&lambda).unwrap();
+    tie_fields_match_seam_run(&seam, &ties[0], &lambda, &deck, "dual");
     let err = relative(heat.side_a, reference);
     println!(
         "dual rows {:.15e} W, seam run {reference:.15e} W: {err:.2e}",
@@ -347,6 +488,7 @@ fn embed_standard_mortar_rows_match_seam_run() {
     }
     let x = example::solve_dense(a, f, size).unwrap();
     let heat = tie.heat(&x[n..]).unwrap();
+    tie_fields_match_seam_run(&seam, tie, &x[n..], &deck, "standard");
     let err = relative(heat.side_a, reference);
     println!(
         "standard rows {:.15e} W, seam run {reference:.15e} W: {err:.2e}",

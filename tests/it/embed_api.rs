@@ -26,7 +26,7 @@ fn scene() -> PathBuf {
 
 /// `seam run` on the two-block problem with `deck`, output into a scratch folder;
 /// returns that folder.
-fn seam_run_with_output(name: &str, deck: &str) -> PathBuf {
+pub(crate) fn seam_run_with_output(name: &str, deck: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("seam-embed-api-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let problem = std::fs::read_to_string(scene().join("problem.toml")).unwrap();
@@ -49,7 +49,7 @@ fn vtu(path: &Path, name: &str) -> Vec<f64> {
 
 /// The two-block scene as a host solves it: the embedding (deck `contact_run.i`) and
 /// the converged field.
-fn host_solution(deck: &str) -> (Embedding, Vec<f64>) {
+pub(crate) fn host_solution(deck: &str) -> (Embedding, Vec<f64>) {
     let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
     let dof = example::host_dofs(&mesh);
     let mut seam = example::embedding(&mesh, &dof).build().unwrap();
