@@ -10,6 +10,7 @@ pub mod deck;
 pub mod diag;
 pub mod embed;
 pub mod enforce;
+pub mod error;
 pub mod heat;
 pub mod interaction;
 pub mod mesh;
@@ -23,3 +24,5 @@ pub mod search;
 pub mod solve;
 pub mod surface;
 pub(crate) mod vec3;
+
+pub use error::{Error, Result};
