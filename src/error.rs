@@ -80,7 +80,9 @@ mod tests {
         let err = embed_fails().unwrap_err();
         assert!(matches!(err, Error::Embed(_)), "{err:?}");
         assert!(err.to_string().contains("no nodes"), "{err}");
-        let run = Error::from(crate::run::RunError::Solve("no convergence at t = 3".into()));
+        let run = Error::from(crate::run::RunError::Solve(
+            "no convergence at t = 3".into(),
+        ));
         assert_eq!(run.to_string(), "no convergence at t = 3");
     }
 }
