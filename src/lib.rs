@@ -10,6 +10,7 @@ pub mod deck;
 pub mod diag;
 pub mod embed;
 pub mod enforce;
+pub mod fem;
 pub mod heat;
 pub mod interaction;
 pub mod mesh;

@@ -42,6 +42,7 @@ use rayon::prelude::*;
 use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
 use crate::enforce::interface::{FieldPair, InterfacePoints, InterfaceSystem, Scatter};
 use crate::enforce::mortar::{MortarTie, mortar_tie};
+use crate::fem::{Basis, MAX_NODES};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{
     AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
@@ -255,7 +256,7 @@ struct Setup {
     lumped: Vec<LumpedWeight>,
     /// The blocks carrying a field, and the element basis of each.
     blocks: Vec<usize>,
-    rules: Vec<Option<kernel::Basis>>,
+    rules: Vec<Option<Basis>>,
 }
 
 impl Setup {
@@ -364,16 +365,15 @@ fn lumped_weights(mesh: &Mesh, dofs: &DofMap) -> Result<Vec<LumpedWeight>, HeatE
         if dofs.block_fields(b).is_empty() {
             continue;
         }
-        let basis =
-            kernel::Basis::standard(block.topology).ok_or(HeatError::UnsupportedTopology {
-                block: block.id,
-                topology: block.topology,
-            })?;
+        let basis = Basis::standard(block.topology).ok_or(HeatError::UnsupportedTopology {
+            block: block.id,
+            topology: block.topology,
+        })?;
         let nn = block.topology.node_count();
         let mut me = vec![0.0; nn * nn];
         for k in 0..block.len() {
             let e = crate::mesh::ElemId(block.first_elem.0 + k as u32);
-            let mut x = [[0.0; 3]; kernel::MAX_NODES];
+            let mut x = [[0.0; 3]; MAX_NODES];
             let m = elem_coords(mesh, e, &mut x);
             me.fill(0.0);
             kernel::capacity_lumped(&basis, &x[..m], 1.0, &mut me)
@@ -1012,16 +1012,16 @@ impl Context<'_, '_> {
             let b = mesh.block_of(e);
             let topo = mesh.blocks[b].topology;
             let rule = rules[b].as_ref().expect("rule of a field block");
-            let mut x = [[0.0; 3]; kernel::MAX_NODES];
+            let mut x = [[0.0; 3]; MAX_NODES];
             let nn = elem_coords(mesh, e, &mut x);
             let mut elem_dofs = Vec::with_capacity(nn);
             dofs.elem_dofs(mesh, e, &mut elem_dofs);
-            let mut te = [0.0; kernel::MAX_NODES];
+            let mut te = [0.0; MAX_NODES];
             for (k, d) in elem_dofs.iter().enumerate() {
                 te[k] = u[*d as usize];
             }
             // Linear: the matrix at T = 0, then the residual from it.
-            let t_eval = if linear { [0.0; kernel::MAX_NODES] } else { te };
+            let t_eval = if linear { [0.0; MAX_NODES] } else { te };
             let law = &laws[b].conductivity;
             let failed = Cell::new(None);
             let k = |temp: f64, xq: [f64; 3]| match law.eval(temp, xq, t) {
@@ -1066,7 +1066,7 @@ impl Context<'_, '_> {
                 return;
             }
             let start = faces.partition_point(|f| f.0 < e.0);
-            let mut scratch = [0.0; kernel::MAX_NODES * kernel::MAX_NODES];
+            let mut scratch = [0.0; MAX_NODES * MAX_NODES];
             for &(_, k) in faces[start..].iter().take_while(|f| f.0 == e.0) {
                 let bc = loads.faces[k];
                 // Kept matrices hold the faces' dg/dT already.
@@ -1092,8 +1092,8 @@ impl Context<'_, '_> {
             }
             // Sources at the element's temperatures (a linear problem's do not depend on
             // T, so their dQ/dT adds nothing to the kept matrices).
-            let mut f = [0.0; kernel::MAX_NODES];
-            let mut scratch = [0.0; kernel::MAX_NODES * kernel::MAX_NODES];
+            let mut f = [0.0; MAX_NODES];
+            let mut scratch = [0.0; MAX_NODES * MAX_NODES];
             let sourced = match (block_source, source) {
                 (Some(qb), _) if !matches!(qb[b], Law::Constant(v) if v == 0.0) => {
                     let js = if keep {

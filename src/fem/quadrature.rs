@@ -56,8 +56,8 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// Gauss–Legendre on [0, 1].
-fn gauss_unit(n: usize) -> (Vec<f64>, Vec<f64>) {
+/// [`gauss_legendre`] mapped to [0, 1]: nodes `(1 + x)/2`, weights `w/2`.
+pub fn gauss_legendre_01(n: usize) -> (Vec<f64>, Vec<f64>) {
     let (x, w) = gauss_legendre(n);
     (
         x.iter().map(|x| 0.5 * (x + 1.0)).collect(),
@@ -200,7 +200,7 @@ impl QuadratureRule {
 
     /// Collapsed rule on the unit triangle: ξ = u, η = v(1 − u), dξdη = (1 − u) du dv.
     fn triangle(n: usize) -> Self {
-        let (x, w) = gauss_unit(n);
+        let (x, w) = gauss_legendre_01(n);
         let mut r = Self::empty();
         for i in 0..n {
             for j in 0..n {
@@ -214,7 +214,7 @@ impl QuadratureRule {
     /// Collapsed rule on the unit tetrahedron: ξ = u, η = v(1 − u), ζ = w(1 − u)(1 − v),
     /// Jacobian (1 − u)²(1 − v).
     fn tetrahedron(n: usize) -> Self {
-        let (x, w) = gauss_unit(n);
+        let (x, w) = gauss_legendre_01(n);
         let mut r = Self::empty();
         for i in 0..n {
             for j in 0..n {
@@ -234,7 +234,7 @@ impl QuadratureRule {
     /// (1 − c)²; `n` Gauss points in a and b, `nc` in c.
     fn pyramid(n: usize, nc: usize) -> Self {
         let (x, w) = gauss_legendre(n);
-        let (c, wc) = gauss_unit(nc);
+        let (c, wc) = gauss_legendre_01(nc);
         let mut r = Self::empty();
         for k in 0..nc {
             let s = 1.0 - c[k];
