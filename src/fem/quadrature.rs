@@ -21,9 +21,26 @@ pub struct QuadratureRule {
 }
 
 /// Gauss–Legendre nodes and weights on [−1, 1] with `n` points (exact to degree
-/// 2n − 1), by Newton's method on the Legendre polynomial P_n from the Tricomi-type
-/// initial guess cos(π(i + ¾)/(n + ½)); converged to round-off in < 10 steps.
+/// 2n − 1), nodes ascending: the one Gauss rule of seam, which every other rule and
+/// every Gauss loop (element, face, mortar segment, tributary area) is built on.
+///
+/// Up to three points in closed form (0 and 2; ±1/√3 and 1; 0, ±√(3/5) and 5/9, 8/9),
+/// so the rules of the common low orders are exact to the last bit; above, by Newton's
+/// method on the Legendre polynomial P_n from the Tricomi-type initial guess
+/// cos(π(i + ¾)/(n + ½)), converged to round-off in < 10 steps.
 pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    match n {
+        1 => return (vec![0.0], vec![2.0]),
+        2 => {
+            let g = 1.0 / 3f64.sqrt();
+            return (vec![-g, g], vec![1.0, 1.0]);
+        }
+        3 => {
+            let g = 0.6f64.sqrt();
+            return (vec![-g, 0.0, g], vec![5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]);
+        }
+        _ => {}
+    }
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     for i in 0..n {
@@ -32,15 +49,10 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
         for _ in 0..100 {
             // Three-term recurrence for P_n(z) and P_{n−1}(z).
             let (mut p0, mut p1) = (1.0, z);
-            if n == 1 {
-                p1 = z;
-                p0 = 1.0;
-            } else {
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
             }
             // P_n'(z) = n (z P_n − P_{n−1}) / (z² − 1)
             dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);

@@ -40,6 +40,7 @@ use super::mortar::{overlap_area_face_face, rule_triangle, segments_face_face_in
 use super::project::{
     map_quad4, map_tri3, project_point_quad4, project_point_tri3, vector_area_quad4,
 };
+use crate::fem::quadrature::gauss_legendre;
 use crate::interaction::SearchSettings;
 use crate::mesh::{Mesh, NodeId, Side};
 use crate::periodic::PeriodicMap;
@@ -204,17 +205,15 @@ impl SurfaceGeometry {
             let len = f.len as usize;
             // A triangle's N_i is linear and its Jacobian constant: the centroid rule is
             // exact.
-            let rule: &[([f64; 2], f64)] = if len == 3 {
-                &[([1.0 / 3.0, 1.0 / 3.0], 0.5)]
+            let rule: Vec<([f64; 2], f64)> = if len == 3 {
+                vec![([1.0 / 3.0, 1.0 / 3.0], 0.5)]
             } else {
-                &[
-                    ([-GAUSS2, -GAUSS2], 1.0),
-                    ([GAUSS2, -GAUSS2], 1.0),
-                    ([GAUSS2, GAUSS2], 1.0),
-                    ([-GAUSS2, GAUSS2], 1.0),
-                ]
+                let (g, w) = gauss_legendre(2);
+                [(0, 0), (1, 0), (1, 1), (0, 1)]
+                    .map(|(i, j)| ([g[i], g[j]], w[i] * w[j]))
+                    .to_vec()
             };
-            for &(xi, w) in rule {
+            for &(xi, w) in &rule {
                 let j = face_normal_jacobian(f, xi);
                 let shapes = face_shapes(len, xi);
                 for (node, shape) in f.nodes.iter().zip(shapes).take(len) {
@@ -1024,11 +1023,7 @@ fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
                 .collect()
         }
         _ => {
-            let (xs, ws): (&[f64], &[f64]) = match order {
-                0 | 1 => (&[0.0], &[2.0]),
-                2 => (&[-GAUSS2, GAUSS2], &[1.0, 1.0]),
-                _ => (&[-GAUSS3, 0.0, GAUSS3], &[5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]),
-            };
+            let (xs, ws) = gauss_legendre(order.clamp(1, 3));
             let mut out = Vec::with_capacity(xs.len() * xs.len());
             for (j, &eta) in xs.iter().enumerate() {
                 for (i, &xi) in xs.iter().enumerate() {
@@ -1039,10 +1034,6 @@ fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
         }
     }
 }
-
-/// 1/√3 and √(3/5): the 2- and 3-point Gauss–Legendre abscissae on [−1, 1].
-const GAUSS2: f64 = 0.577_350_269_189_625_8;
-const GAUSS3: f64 = 0.774_596_669_241_483_4;
 
 /// |∂x/∂ξ × ∂x/∂η| at ξ: the area Jacobian of the face's map.
 fn face_jacobian(face: &FaceGeom, xi: [f64; 2]) -> f64 {
