@@ -56,7 +56,7 @@ use std::path::Path;
 use std::sync::{Arc, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
-use crate::deck::spec::{ContactDefinition, Enforcement as DeckEnforcement, PeriodicTransform};
+use crate::deck::spec::{ContactDefinition, Enforcement as DeckEnforcement};
 use crate::deck::{self, Deck};
 use crate::diag::{Diagnostics, SourceMap, did_you_mean};
 use crate::enforce::conductance::SeenTemperature;
@@ -66,21 +66,23 @@ use crate::enforce::conductance::{
 use crate::enforce::interface::{
     DEFAULT_BETA, Form, HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints,
 };
-use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
+use crate::enforce::model::ConductanceLaw;
 use crate::enforce::mortar::mortar_tie;
-use crate::interaction::SearchSettings;
 use crate::mesh::{ElemId, Mesh, NodeId, Side, SideSet, ValidationError};
 use crate::periodic::PeriodicMap;
+use crate::scene::enforcement::resolve as resolve_model;
+use crate::scene::search::search_periodicity;
+use crate::search::SearchSettings;
 use crate::search::pairing::{SearchResult, SearchStats, Searcher, Sphere, SurfaceGeometry};
-use crate::search::scene::{
-    PeriodicError, SceneSearch, check_closure, landing, periodic_map, search_periodicity,
-    surface_geometries,
+use crate::search::periodic::{
+    PeriodicError, PeriodicTransform, check_closure, landing, periodic_map,
 };
+use crate::search::scene::{SceneSearch, surface_geometries};
 use crate::surface::{ContactSurface, SurfaceFace, SurfaceKind};
 
-pub use crate::deck::spec::Overclosure;
 pub use crate::enforce::mortar::Multipliers;
 pub use crate::mesh::Topology;
+pub use crate::search::Overclosure;
 pub use crate::search::pairing::Integration;
 
 /// Everything that can go wrong between a host and seam.
@@ -899,7 +901,7 @@ impl Embedding {
             .mapped(map.as_mut(), &name)
             .map_err(|e| fail(&e, "the map failed while mapping side A's nodes"))?;
         if let Some(fold) =
-            crate::search::scene::check_one_to_one(&source, &a, |n| self.mesh.node_number(n))
+            crate::search::periodic::check_one_to_one(&source, &a, |n| self.mesh.node_number(n))
         {
             return Err(fail(
                 &PeriodicError::Folds(Box::new(fold)),
@@ -1027,12 +1029,12 @@ impl Embedding {
         for def in &deck.contact_definitions {
             let set = crate::surface::build(&self.mesh, def, &sources);
             diags.extend(set.diagnostics.clone());
-            let (list, d) = crate::interaction::resolve(def, &set, 3, &sources);
+            let (list, d) = crate::scene::interaction::resolve(def, &set, 3, &sources);
             diags.extend(d);
             if diags.has_errors() {
                 return Err(fail(&diags));
             }
-            let subdomain = crate::search::scene::subdomain(def);
+            let subdomain = crate::scene::search::subdomain(def);
             for i in &list {
                 let enforcement = self.deck_enforcement(
                     def,
@@ -1098,7 +1100,7 @@ impl Embedding {
                     side_b: set.surfaces[p.side_b_surface].clone(),
                     a: p.side_a_geometry,
                     b: p.side_b_geometry,
-                    settings: crate::search::scene::base_settings(def, 3),
+                    settings: crate::scene::search::base_settings(def, 3),
                     overclosure: None,
                     subdomain,
                     image: Some(Image {
@@ -1161,20 +1163,20 @@ impl Embedding {
             None => Law::Constant(0.0),
             Some(ConductanceLaw::Constant(h)) => Law::Constant(h),
             Some(ConductanceLaw::Coefficient) => {
-                let (m, d) = crate::enforce::conductance::from_properties(enf, dir, sources);
+                let (m, d) = crate::scene::conductance::from_properties(enf, dir, sources);
                 match m {
                     Some(m) => Law::Model(m, choice.pressure),
                     None => return Err(fail(&d)),
                 }
             }
             Some(ConductanceLaw::Plugin) => {
-                let plugin = PluginConductance::from_enforcement(enf, dir, side_a, side_b)
+                let plugin = crate::scene::plugin::plugin_conductance(enf, dir, side_a, side_b)
                     .map_err(|e| EmbedError::Plugin {
                         side_a: side_a.to_string(),
                         side_b: side_b.to_string(),
                         message: e.to_string(),
                     })?;
-                match crate::enforce::model::seen_temperature(enf) {
+                match crate::scene::enforcement::seen_temperature(enf) {
                     SeenTemperature::Both => Law::Plugin(Box::new(plugin), choice.pressure),
                     seen => Law::Model(seen.wrap(Box::new(plugin)), choice.pressure),
                 }

@@ -12,7 +12,6 @@ pub mod embed;
 pub mod enforce;
 pub mod fem;
 pub mod heat;
-pub mod interaction;
 pub mod mesh;
 pub mod output;
 pub mod periodic;

@@ -40,8 +40,8 @@ use super::mortar::{overlap_area_face_face, rule_triangle, segments_face_face_in
 use super::project::{
     map_quad4, map_tri3, project_point_quad4, project_point_tri3, vector_area_quad4,
 };
+use super::settings::{Overclosure, SearchSettings};
 use crate::fem::quadrature::gauss_legendre;
-use crate::interaction::SearchSettings;
 use crate::mesh::{Mesh, NodeId, Side};
 use crate::periodic::PeriodicMap;
 use crate::script::ScriptError;
@@ -579,17 +579,6 @@ impl SearchSchedule {
         }
     }
 
-    /// The schedule of a contact definition: `Update Search Every n Steps`, else the
-    /// search options' `Search Update Frequency` (ELFEN's name for the same), else 1.
-    pub fn for_definition(def: &crate::deck::spec::ContactDefinition) -> Self {
-        SearchSchedule::new(
-            def.update_search_every_n_steps.or(def
-                .search_options
-                .as_ref()
-                .and_then(|o| o.search_update_frequency)),
-        )
-    }
-
     /// Whether step `step` (0-based) does a full search.
     pub fn full_search(&self, step: u64) -> bool {
         step.is_multiple_of(u64::from(self.every))
@@ -634,8 +623,7 @@ impl SearchResult {
     /// `AdjustNodes` moves the side-A point onto side B along side B's normal (gap 0);
     /// `StoreOffsets` keeps the geometry and records the gap as the point's offset.
     /// Statistics are recomputed.
-    pub fn treat_overclosure(&mut self, treatment: crate::deck::spec::Overclosure) {
-        use crate::deck::spec::Overclosure;
+    pub fn treat_overclosure(&mut self, treatment: Overclosure) {
         for p in &mut self.points {
             if p.status != PointStatus::Matched || p.gap >= 0.0 {
                 continue;
