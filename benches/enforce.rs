@@ -15,9 +15,9 @@ use std::time::Instant;
 use seam::enforce::interface::{DEFAULT_BETA, Form, HInput, HValue, InterfaceForm};
 use seam::heat::steady::{ContactTerm, SteadyProblem, solve_steady};
 use seam::heat::{Material, error_norms};
-use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{Mesh, NodeId};
+use seam::search::SearchSettings;
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
 
 fn exact(p: [f64; 3]) -> f64 {

@@ -427,8 +427,8 @@ fn assembly(table_path: &Path) {
     use seam::enforce::interface::{
         DEFAULT_BETA, Form, HFn, HInput, HValue, InterfaceForm, interface_terms,
     };
-    use seam::interaction::SearchSettings;
     use seam::mesh::generate::{self, BoxSpec};
+    use seam::search::SearchSettings;
     use seam::search::pairing::{Integration, PointStatus, Searcher, SurfaceGeometry};
     use std::cell::Cell;
 

@@ -9,9 +9,9 @@
 
 use std::time::Instant;
 
-use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{ElemId, Mesh, NodeId, Side};
+use seam::search::SearchSettings;
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
 
 /// Planar: side A is the top of an n×n-cell slab, side B the bottom of an m×m slab

@@ -14,7 +14,8 @@ use std::error::Error;
 use std::path::{Path, PathBuf};
 
 use seam::embed::{Embedding, EmbeddingBuilder, Heat};
-use seam::heat::kernel::{Basis, conductivity};
+use seam::fem::Basis;
+use seam::heat::kernel::conductivity;
 use seam::mesh::Mesh;
 
 /// The host's answer: the interface heat, and how many Newton steps it took.

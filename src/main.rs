@@ -326,12 +326,13 @@ fn search(
     for def in &loaded.deck.contact_definitions {
         let set = surface::build(&mesh, def, &loaded.sources);
         diags.extend(set.diagnostics.clone());
-        let (interactions, d) = seam::interaction::resolve(def, &set, mesh.dim, &loaded.sources);
+        let (interactions, d) =
+            seam::scene::interaction::resolve(def, &set, mesh.dim, &loaded.sources);
         diags.extend(d);
         if diags.has_errors() {
             continue;
         }
-        let scene = seam::search::scene::search_definition(
+        let scene = seam::scene::search::search_definition(
             &mesh,
             def,
             &set,

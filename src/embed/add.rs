@@ -7,10 +7,10 @@ use std::sync::OnceLock;
 
 use crate::diag::did_you_mean;
 use crate::enforce::interface::Form;
-use crate::interaction::SearchSettings;
 use crate::mesh::Mesh;
+use crate::search::SearchSettings;
 use crate::search::pairing::{Sphere, SurfaceGeometry};
-use crate::search::scene::{PeriodicError, check_closure, landing, periodic_map};
+use crate::search::periodic::{PeriodicError, check_closure, landing, periodic_map};
 use crate::surface::{ContactSurface, SurfaceFace, SurfaceKind};
 
 impl Embedding {
@@ -128,7 +128,7 @@ impl Embedding {
             .mapped(map.as_mut(), &name)
             .map_err(|e| fail(&e, "the map failed while mapping side A's nodes"))?;
         if let Some(fold) =
-            crate::search::scene::check_one_to_one(&source, &a, |n| self.mesh.node_number(n))
+            crate::search::periodic::check_one_to_one(&source, &a, |n| self.mesh.node_number(n))
         {
             return Err(fail(
                 &PeriodicError::Folds(Box::new(fold)),

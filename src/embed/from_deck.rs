@@ -5,11 +5,12 @@ use std::sync::{Arc, OnceLock};
 use crate::deck::spec::{ContactDefinition, Enforcement as DeckEnforcement};
 use crate::deck::{self, Deck};
 use crate::diag::{Diagnostics, SourceMap};
-use crate::enforce::conductance::PluginConductance;
 use crate::enforce::conductance::SeenTemperature;
 use crate::enforce::interface::DEFAULT_BETA;
-use crate::enforce::model::{ConductanceLaw, resolve as resolve_model};
-use crate::search::scene::{SceneSearch, search_periodicity, surface_geometries};
+use crate::enforce::model::ConductanceLaw;
+use crate::scene::enforcement::resolve as resolve_model;
+use crate::scene::search::search_periodicity;
+use crate::search::scene::{SceneSearch, surface_geometries};
 
 impl Embedding {
     /// Add the interactions of a Sierra-syntax contact deck (`name` labels messages;
@@ -49,12 +50,12 @@ impl Embedding {
         for def in &deck.contact_definitions {
             let set = crate::surface::build(&self.mesh, def, &sources);
             diags.extend(set.diagnostics.clone());
-            let (list, d) = crate::interaction::resolve(def, &set, 3, &sources);
+            let (list, d) = crate::scene::interaction::resolve(def, &set, 3, &sources);
             diags.extend(d);
             if diags.has_errors() {
                 return Err(fail(&diags));
             }
-            let subdomain = crate::search::scene::subdomain(def);
+            let subdomain = crate::scene::search::subdomain(def);
             for i in &list {
                 let enforcement = self.deck_enforcement(
                     def,
@@ -120,7 +121,7 @@ impl Embedding {
                     side_b: set.surfaces[p.side_b_surface].clone(),
                     a: p.side_a_geometry,
                     b: p.side_b_geometry,
-                    settings: crate::search::scene::base_settings(def, 3),
+                    settings: crate::scene::search::base_settings(def, 3),
                     overclosure: None,
                     subdomain,
                     image: Some(Image {
@@ -184,20 +185,20 @@ impl Embedding {
             None => Law::Constant(0.0),
             Some(ConductanceLaw::Constant(h)) => Law::Constant(h),
             Some(ConductanceLaw::Coefficient) => {
-                let (m, d) = crate::enforce::conductance::from_properties(enf, dir, sources);
+                let (m, d) = crate::scene::conductance::from_properties(enf, dir, sources);
                 match m {
                     Some(m) => Law::Model(m, choice.pressure),
                     None => return Err(fail(&d)),
                 }
             }
             Some(ConductanceLaw::Plugin) => {
-                let plugin = PluginConductance::from_enforcement(enf, dir, side_a, side_b)
+                let plugin = crate::scene::plugin::plugin_conductance(enf, dir, side_a, side_b)
                     .map_err(|e| EmbedError::Plugin {
                         side_a: side_a.to_string(),
                         side_b: side_b.to_string(),
                         message: e.to_string(),
                     })?;
-                match crate::enforce::model::seen_temperature(enf) {
+                match crate::scene::enforcement::seen_temperature(enf) {
                     SeenTemperature::Both => Law::Plugin(Box::new(plugin), choice.pressure),
                     seen => Law::Model(seen.wrap(Box::new(plugin)), choice.pressure),
                 }

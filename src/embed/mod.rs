@@ -53,18 +53,18 @@
 use std::sync::{Arc, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
-use crate::deck::spec::PeriodicTransform;
 use crate::enforce::conductance::PluginConductance;
 use crate::enforce::interface::{DEFAULT_BETA, Form, InterfaceError, InterfacePoints};
-use crate::interaction::SearchSettings;
 use crate::mesh::{Mesh, NodeId, ValidationError};
 use crate::periodic::PeriodicMap;
+use crate::search::SearchSettings;
 use crate::search::pairing::{SearchResult, Searcher, Sphere, SurfaceGeometry};
+use crate::search::periodic::PeriodicTransform;
 use crate::surface::ContactSurface;
 
-pub use crate::deck::spec::Overclosure;
 pub use crate::enforce::mortar::Multipliers;
 pub use crate::mesh::Topology;
+pub use crate::search::Overclosure;
 pub use crate::search::pairing::Integration;
 
 /// Everything that can go wrong between a host and seam.

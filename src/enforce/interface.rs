@@ -51,8 +51,8 @@
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas' subscripts
 
 use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId};
-use crate::heat::kernel::{MAX_NODES, eval_point};
-use crate::heat::shape::reference_nodes;
+use crate::fem::shape::reference_nodes;
+use crate::fem::{MAX_NODES, eval_point};
 use crate::mesh::{ElemId, Mesh, Side, Topology};
 use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
 use crate::vec3::{cross, dot, norm, sub};

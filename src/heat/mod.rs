@@ -5,7 +5,8 @@
 //!
 //! Entry points: [`steady_conduction`] (K and F with Dirichlet conditions eliminated),
 //! [`error_norms`], [`nonlinear_residual_jacobian`], [`newton`]; the kernels in
-//! [`kernel`], shape functions in [`shape`], rules in [`quadrature`].
+//! [`kernel`]; shape functions, quadrature rules and the isoparametric map come from
+//! [`crate::fem`].
 //!
 //! Conventions: the temperature field is the [`DofMap`] field named
 //! [`TEMPERATURE`]; a prescribed face flux `q` is heat flowing *into* the body
@@ -18,8 +19,6 @@
 
 pub mod kernel;
 pub mod law;
-pub mod quadrature;
-pub mod shape;
 pub mod steady;
 pub mod transient;
 
@@ -32,8 +31,9 @@ use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId, Pattern};
 use crate::mesh::{ElemId, Mesh, NodeId, Side};
 use crate::solve::{LinearSolver, Lu, SolveError, apply_dirichlet};
 
-pub use kernel::Basis;
-pub use quadrature::QuadratureRule;
+use crate::fem::{BadJacobian, MAX_NODES};
+
+pub use crate::fem::{Basis, QuadratureRule};
 
 /// Name of the temperature field in a [`DofMap`].
 pub const TEMPERATURE: &str = "temperature";
@@ -150,7 +150,7 @@ fn temperature(dofs: &DofMap) -> Result<FieldId, HeatError> {
 }
 
 /// Coordinates of an element's nodes.
-fn elem_coords(mesh: &Mesh, elem: ElemId, out: &mut [[f64; 3]; kernel::MAX_NODES]) -> usize {
+fn elem_coords(mesh: &Mesh, elem: ElemId, out: &mut [[f64; 3]; MAX_NODES]) -> usize {
     let nodes = mesh.elem_nodes(elem);
     for (k, n) in nodes.iter().enumerate() {
         out[k] = mesh.coords[n.index()];
@@ -180,7 +180,7 @@ impl FirstError {
     }
 }
 
-fn bad_jacobian(mesh: &Mesh, elem: ElemId, b: kernel::BadJacobian) -> HeatError {
+fn bad_jacobian(mesh: &Mesh, elem: ElemId, b: BadJacobian) -> HeatError {
     let (block, _) = mesh.locate(elem);
     HeatError::BadJacobian {
         number: mesh.elem_number(elem),
@@ -280,7 +280,7 @@ pub fn assemble_conduction(
         let b = mesh.block_of(e);
         let topo = block.topology;
         let rule = rules[b].as_ref().expect("rule of a temperature block");
-        let mut x = [[0.0; 3]; kernel::MAX_NODES];
+        let mut x = [[0.0; 3]; MAX_NODES];
         let nn = elem_coords(mesh, e, &mut x);
         let x = &x[..nn];
         let k = materials[b].conductivity;
@@ -369,7 +369,7 @@ pub fn error_norms(
             .map(|k| {
                 let e = ElemId(block.first_elem.0 + k as u32);
                 let nodes = block.elem_nodes(k);
-                let mut x = [[0.0; 3]; kernel::MAX_NODES];
+                let mut x = [[0.0; 3]; MAX_NODES];
                 for (i, n) in nodes.iter().enumerate() {
                     x[i] = mesh.coords[n.index()];
                 }
@@ -430,9 +430,9 @@ pub fn nonlinear_residual_jacobian(
     asm.elements(mesh, Some(dofs.field_blocks(field)), |e, je, re| {
         let b = mesh.block_of(e);
         let rule = rules[b].as_ref().expect("rule of a temperature block");
-        let mut x = [[0.0; 3]; kernel::MAX_NODES];
+        let mut x = [[0.0; 3]; MAX_NODES];
         let nn = elem_coords(mesh, e, &mut x);
-        let mut te = [0.0; kernel::MAX_NODES];
+        let mut te = [0.0; MAX_NODES];
         for (k, n) in mesh.elem_nodes(e).iter().enumerate() {
             te[k] = t[dofs.dof(field, *n).expect("temperature dof").index()];
         }
@@ -440,7 +440,7 @@ pub fn nonlinear_residual_jacobian(
             kernel::conduction_residual_jacobian(rule, &x[..nn], &te[..nn], conductivity, re, je)
                 .and_then(|_| match source {
                     Some(q) => {
-                        let mut f = [0.0; kernel::MAX_NODES];
+                        let mut f = [0.0; MAX_NODES];
                         kernel::source(rule, &x[..nn], q, &mut f)?;
                         re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
                         Ok(())
@@ -576,7 +576,7 @@ mod tests {
             (Quad4, 4.0),
             (Tri3, 0.5),
         ] {
-            let x = shape::reference_nodes(t).unwrap();
+            let x = crate::fem::shape::reference_nodes(t).unwrap();
             let m = kernel::measure(&Basis::standard(t).unwrap(), x).unwrap();
             assert!((m - v).abs() < 1e-14, "{t:?}: {m}");
         }
@@ -590,7 +590,7 @@ mod tests {
         use crate::mesh::Topology::*;
         for t in [Hex8, Tet4, Wedge6, Pyramid5, Quad4, Tri3] {
             let nn = t.node_count();
-            let x: Vec<[f64; 3]> = shape::reference_nodes(t)
+            let x: Vec<[f64; 3]> = crate::fem::shape::reference_nodes(t)
                 .unwrap()
                 .iter()
                 .enumerate()
@@ -652,7 +652,7 @@ mod tests {
     /// and the convection matrix sums to h·area (partition of unity on the face).
     #[test]
     fn face_integrals_sum_to_area() {
-        let x = shape::reference_nodes(crate::mesh::Topology::Hex8).unwrap();
+        let x = crate::fem::shape::reference_nodes(crate::mesh::Topology::Hex8).unwrap();
         for side in 1..=6u8 {
             let mut fe = [0.0; 8];
             kernel::face_flux(crate::mesh::Topology::Hex8, x, side, |_| 2.5, &mut fe);

@@ -13,8 +13,8 @@
 //!   process (`Plugin Isolation = Process`): a crash or an `exit` in the plugin is a
 //!   [`PluginFault::ProcessDied`] and the host goes on (see [`isolate`]);
 //! - [`check_plugin`] / [`check_plugin_with`]: what `seam check-plugin [--isolate]` runs;
-//! - [`PluginSpec::from_enforcement`]: the deck's `Enforcement for Energy = Plugin
-//!   Library = "…" Model = …` resolved against the deck's directory.
+//! - [`PluginSpec`]: a plugin to load (library, data, isolation), as the scene makes it
+//!   from a deck's `Enforcement for Energy = Plugin Library = "…" Model = …`.
 //!
 //! Conventions: gap > 0 open; pressure ≥ 0 in compression; a conductance h must be ≥ 0
 //! and gives q = h (T_B − T_A) into side A; a plugin with `RETURNS_FLUX` returns q
@@ -38,9 +38,15 @@ pub use isolate::{serve_worker, set_worker_program, worker_program};
 pub use seam_plugin_abi as abi;
 pub use spec::PluginSpec;
 
-/// Where a plugin runs: `Plugin Isolation = None` (in process, the default) or
-/// `Process` (in a worker process).
-pub use crate::deck::spec::PluginIsolation as Isolation;
+/// Where a plugin runs (`Plugin Isolation = None | Process` in a deck).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Isolation {
+    /// In seam's own process: fastest; a crash in the plugin ends the run (exit 3).
+    #[default]
+    None,
+    /// In a worker process: a crash or an `exit` in the plugin is an ordinary fault.
+    Process,
+}
 
 /// Why a plugin could not be loaded or set up. Every message names the library path.
 #[derive(Debug, thiserror::Error)]

@@ -1,15 +1,15 @@
-//! From the deck's enforcement to a plugin to load.
+//! A plugin to load: its library, its data and where it runs.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::{Isolation, Plugin, PluginData, PluginError};
-use crate::deck::spec::Enforcement;
 
-/// `Enforcement for Energy = Plugin Library = "path/libmodel.so" Model = name` with the
-/// block's `Integer Data` / `Real Data`.
+/// A plugin to load: in a deck, `Enforcement for Energy = Plugin Library =
+/// "path/libmodel.so" Model = name` with the block's `Integer Data` / `Real Data`, which
+/// the scene makes into this.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PluginSpec {
-    /// The library, resolved against the deck's directory if relative.
+    /// The library (a deck's relative path is resolved against the deck's directory).
     pub path: PathBuf,
     pub data: PluginData,
     /// `Plugin Isolation`: in seam's process (default) or in a worker process.
@@ -17,93 +17,8 @@ pub struct PluginSpec {
 }
 
 impl PluginSpec {
-    /// The plugin of `enforcement`'s first `plugin` model, or an error saying what is
-    /// missing. A relative `Library` path is taken relative to `deck_dir`.
-    pub fn from_enforcement(
-        enforcement: &Enforcement,
-        deck_dir: &Path,
-    ) -> Result<Self, PluginError> {
-        let name = enforcement.name.as_deref().unwrap_or("(unnamed)");
-        let model = enforcement
-            .models
-            .iter()
-            .find(|m| m.model.eq_ignore_ascii_case("plugin"))
-            .ok_or_else(|| {
-                PluginError::Spec(format!("enforcement {name} has no `Plugin` model"))
-            })?;
-        let arg = |key: &str| {
-            model
-                .args
-                .iter()
-                .find(|a| a.key.eq_ignore_ascii_case(key))
-                .map(|a| a.value.trim().trim_matches('"').to_owned())
-                .filter(|v| !v.is_empty())
-        };
-        let library = arg("library").ok_or_else(|| {
-            PluginError::Spec(format!(
-                "enforcement {name}: `Enforcement for {} = Plugin` needs `Library = \"path/libmodel.so\"`",
-                model.equation
-            ))
-        })?;
-        let library = PathBuf::from(library);
-        let path = if library.is_absolute() {
-            library
-        } else {
-            deck_dir.join(library)
-        };
-        Ok(PluginSpec {
-            path,
-            data: PluginData {
-                model: arg("model"),
-                integer_data: enforcement.integer_data.clone(),
-                real_data: enforcement.real_data.clone(),
-            },
-            isolation: enforcement.plugin_isolation,
-        })
-    }
-
     /// Load the library and create the instance, in this process or in a worker.
     pub fn load(&self) -> Result<Plugin, PluginError> {
         Plugin::load_with_isolation(&self.path, &self.data, self.isolation)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::deck::spec::{Arg, EnforcementModel};
-
-    fn arg(key: &str, value: &str) -> Arg {
-        Arg {
-            key: key.into(),
-            value: value.into(),
-        }
-    }
-
-    #[test]
-    fn library_is_resolved_against_the_deck_directory() {
-        let e = Enforcement {
-            name: Some("gap".into()),
-            models: vec![EnforcementModel {
-                equation: "energy".into(),
-                model: "plugin".into(),
-                args: vec![arg("library", "lib/libm.so"), arg("model", "cmy")],
-                at: Default::default(),
-            }],
-            integer_data: vec![4],
-            real_data: vec![1.5],
-            ..Enforcement::default()
-        };
-        let s = PluginSpec::from_enforcement(&e, Path::new("/decks/a")).unwrap();
-        assert_eq!(s.path, PathBuf::from("/decks/a/lib/libm.so"));
-        assert_eq!(s.data.model.as_deref(), Some("cmy"));
-        assert_eq!(
-            (s.data.integer_data, s.data.real_data),
-            (vec![4], vec![1.5])
-        );
-        let mut no_lib = e.clone();
-        no_lib.models[0].args.remove(0);
-        let err = PluginSpec::from_enforcement(&no_lib, Path::new(".")).unwrap_err();
-        assert!(err.to_string().contains("needs `Library"), "{err}");
     }
 }

@@ -15,8 +15,8 @@
 use crate::deck::spec::{ContactDefinition, OutputRule};
 use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::PointFlux;
-use crate::heat::kernel::{MAX_NODES, eval_point};
-use crate::heat::shape::reference_nodes;
+use crate::fem::shape::reference_nodes;
+use crate::fem::{MAX_NODES, eval_point};
 use crate::heat::transient::BlockLaws;
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::{PointStatus, SurfaceGeometry};

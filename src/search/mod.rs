@@ -5,6 +5,11 @@
 //! The kernels take plain coordinates (`[f64; 3]`), not seam's mesh types, so they can be
 //! tested and used anywhere; they are stateless apart from the [`bvh::Bvh`] itself.
 //!
+//! Above the kernels: [`pairing`] (the searcher of one interaction, over the typed
+//! [`SearchSettings`]), [`periodic`] (periodic maps and their checks) and [`scene`] (the
+//! searched pairs of a contact definition). Nothing here reads a deck: the scene, above,
+//! lowers a deck to these settings; a host builds them in code.
+//!
 //! Conventions shared by all kernels:
 //! - Side A carries integration points; side B is projected onto.
 //! - A face's unit normal follows the right-hand rule of its node order (Exodus order,
@@ -51,4 +56,8 @@ pub mod mortar;
 pub mod project;
 
 pub mod pairing;
+pub mod periodic;
 pub mod scene;
+pub mod settings;
+
+pub use settings::{Overclosure, SearchSettings};

@@ -24,6 +24,7 @@
 //!   origin, Quad4 `(ξ, η) ∈ [-1, 1]²` in Exodus node order.
 
 use super::project::{map_quad4, map_tri3};
+use crate::fem::quadrature::gauss_legendre_01;
 use crate::vec3::{V3, axpy, cross, dot, norm, normalize, sub};
 
 type P2 = [f64; 2];
@@ -226,10 +227,10 @@ pub fn rule_triangle(order: usize) -> TriangleRule {
         }
         _ => {
             let n = (order + 2).div_ceil(2);
-            let gl = gauss_legendre_01(n);
+            let (x, w) = gauss_legendre_01(n);
             let mut points = Vec::with_capacity(n * n);
-            for &(s, ws) in &gl {
-                for &(t, wt) in &gl {
+            for (&s, &ws) in x.iter().zip(&w) {
+                for (&t, &wt) in x.iter().zip(&w) {
                     // ∫_T f = ∫₀¹∫₀¹ f(s, t(1−s)) (1−s) dt ds; weights relative to area ½.
                     points.push(([s, t * (1.0 - s)], 2.0 * ws * wt * (1.0 - s)));
                 }
@@ -240,36 +241,6 @@ pub fn rule_triangle(order: usize) -> TriangleRule {
             }
         }
     }
-}
-
-/// Gauss–Legendre points and weights on `[0, 1]`: the roots of the Legendre polynomial
-/// `Pₙ` by Newton from `cos(π (i − ¼)/(n + ½))` (Abramowitz & Stegun 22.16.6 asymptotics),
-/// `Pₙ` by the three-term recurrence, weights `2 / ((1 − x²) Pₙ'(x)²)`, halved for
-/// `[0, 1]`.
-fn gauss_legendre_01(n: usize) -> Vec<(f64, f64)> {
-    let mut out = Vec::with_capacity(n);
-    for i in 1..=n {
-        let mut x = (std::f64::consts::PI * (i as f64 - 0.25) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            // Pₙ' = n (x Pₙ − Pₙ₋₁) / (x² − 1); for n = 1 the loop leaves P₁ = x, P₀ = 1.
-            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-            let dx = p1 / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        let w = 2.0 / ((1.0 - x * x) * dp * dp);
-        out.push((0.5 * (1.0 - x), 0.5 * w));
-    }
-    out
 }
 
 /// The integration plane of a face: origin, unit normal, tangents.

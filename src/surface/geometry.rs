@@ -5,6 +5,7 @@
 //! plane) the normal is the edge direction turned clockwise by 90°, again outward for a
 //! counter-clockwise element.
 
+use crate::fem::quadrature::gauss_legendre;
 use crate::mesh::{Mesh, NodeId};
 
 pub(crate) use crate::vec3::{V3 as Vec3, cross, dot, norm, scale, sub};
@@ -33,9 +34,10 @@ pub(crate) fn measure_and_normal(mesh: &Mesh, nodes: &[NodeId]) -> (f64, Vec3) {
         _ => {
             let (p0, p1, p2, p3) = (x(0), x(1), x(2), x(3));
             let vector_area = scale(cross(sub(p2, p0), sub(p3, p1)), 0.5);
-            let g = 1.0 / 3f64.sqrt();
+            let (g, w) = gauss_legendre(2);
             let mut area = 0.0;
-            for (xi, eta) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
+            for (i, j) in [(0, 0), (1, 0), (1, 1), (0, 1)] {
+                let (xi, eta, weight) = (g[i], g[j], w[i] * w[j]);
                 // Tangents of the bilinear map on [-1,1]², each scaled by 4.
                 let t_xi: Vec3 = std::array::from_fn(|d| {
                     -(1.0 - eta) * p0[d] + (1.0 - eta) * p1[d] + (1.0 + eta) * p2[d]
@@ -46,7 +48,7 @@ pub(crate) fn measure_and_normal(mesh: &Mesh, nodes: &[NodeId]) -> (f64, Vec3) {
                         + (1.0 + xi) * p2[d]
                         + (1.0 - xi) * p3[d]
                 });
-                area += norm(cross(t_xi, t_eta)) / 16.0;
+                area += weight * norm(cross(t_xi, t_eta)) / 16.0;
             }
             let m = norm(vector_area);
             (

@@ -22,9 +22,9 @@ use seam::diag::SourceMap;
 use seam::enforce::conductance::{
     Cmy, Conductance, ConductanceModel, Constant, GasGap, LuaConductance, MinGapOrder,
     PluginConductance, PointState, Radiation, STEFAN_BOLTZMANN, Sum, Table, TableVariable,
-    from_properties,
 };
 use seam::plugin::{Plugin, PluginData};
+use seam::scene::conductance::from_properties;
 use seam::script::Limits;
 
 const SIGMA: f64 = 5.670374419e-8;

@@ -4,9 +4,9 @@
 use seam::enforce::interface::{DEFAULT_BETA, Form, HInput, HValue, InterfaceForm};
 use seam::heat::Material;
 use seam::heat::steady::{ContactTerm, SteadyProblem, solve_steady};
-use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec, SolidKind};
 use seam::mesh::{Mesh, NodeId};
+use seam::search::SearchSettings;
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
 
 /// Block 1 on [0,1]²×[0,1] (n1 cells a side), block 2 on [0,1]²×[1,2] (n2), meshed
@@ -862,8 +862,8 @@ fn crosspoints_of_a_tie_with_dirichlet_and_periodic_faces() {
     let def = &d.contact_definitions[0];
     let sources = seam::diag::SourceMap::default();
     let set = seam::surface::build(&mesh, def, &sources);
-    let (list, _) = seam::interaction::resolve(def, &set, 3, &sources);
-    let scene = seam::search::scene::search_definition(
+    let (list, _) = seam::scene::interaction::resolve(def, &set, 3, &sources);
+    let scene = seam::scene::search::search_definition(
         &mesh,
         def,
         &set,

@@ -4,10 +4,10 @@
 use std::sync::Arc;
 
 use seam::deck::parse_sierra;
-use seam::deck::spec::Overclosure;
 use seam::diag::SourceMap;
-use seam::interaction::{self, Interaction};
 use seam::mesh::generate::{self, BoxSpec};
+use seam::scene::interaction::{self, Interaction};
+use seam::search::Overclosure;
 use seam::surface;
 
 /// Three boxes meshed apart, blocks 1..3, and a node set on block 1's nodes.

@@ -9,9 +9,9 @@ use seam::enforce::interface::{DEFAULT_BETA, Form, HInput, HValue, InterfaceForm
 use seam::enforce::mortar::Multipliers;
 use seam::heat::Material;
 use seam::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
-use seam::interaction::SearchSettings;
 use seam::mesh::generate::{self, BoxSpec, SolidKind};
 use seam::mesh::{Mesh, NodeId, NodeSet};
+use seam::search::SearchSettings;
 use seam::search::pairing::{ContactPoint, Integration, PointStatus, Searcher, SurfaceGeometry};
 use seam::surface::{self, SurfaceKind, SurfaceSet};
 

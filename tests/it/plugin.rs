@@ -1075,7 +1075,7 @@ fn deck_data_arrives_at_the_plugin_as_written() {
     let (d, diags) = seam::deck::parse_sierra(&std::sync::Arc::from("deck.i"), &deck);
     assert!(!diags.has_errors(), "{diags:?}");
     let enf = &d.contact_definitions[0].enforcements[0];
-    let spec = seam::plugin::PluginSpec::from_enforcement(enf, echo.parent().unwrap()).unwrap();
+    let spec = seam::scene::plugin::plugin_spec(enf, echo.parent().unwrap()).unwrap();
     assert_eq!(spec.data.integer_data, [1, 2, 3]);
     assert_eq!(spec.data.real_data, [1.5, 2000.0, 100.0, -0.25]);
     let plugin = spec.load().unwrap();
@@ -1168,11 +1168,9 @@ model = [{ equation = "energy", model = "plugin", args = [{ key = "library", val
     assert!(!da.has_errors() && !db.has_errors(), "{da:?} {db:?}");
     let dir = std::path::Path::new("/decks");
     let sa =
-        seam::plugin::PluginSpec::from_enforcement(&a.contact_definitions[0].enforcements[0], dir)
-            .unwrap();
+        seam::scene::plugin::plugin_spec(&a.contact_definitions[0].enforcements[0], dir).unwrap();
     let sb =
-        seam::plugin::PluginSpec::from_enforcement(&b.contact_definitions[0].enforcements[0], dir)
-            .unwrap();
+        seam::scene::plugin::plugin_spec(&b.contact_definitions[0].enforcements[0], dir).unwrap();
     assert_eq!(sa, sb);
     assert_eq!(sa.path, dir.join("lib/libModel.so"));
 }
@@ -1579,7 +1577,7 @@ fn plugin_isolation_line_in_sierra_and_toml() {
     };
     let file = std::sync::Arc::from("d");
     let spec = |d: &seam::deck::spec::Deck| {
-        seam::plugin::PluginSpec::from_enforcement(
+        seam::scene::plugin::plugin_spec(
             &d.contact_definitions[0].enforcements[0],
             Path::new("/decks"),
         )

@@ -6,11 +6,12 @@ use std::sync::Arc;
 
 use seam::deck::parse_sierra;
 use seam::diag::SourceMap;
-use seam::interaction;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{Mesh, NodeSet};
+use seam::scene::interaction;
+use seam::scene::search::search_definition;
 use seam::search::pairing::{Integration, PointStatus, Searcher, SurfaceGeometry};
-use seam::search::scene::{SceneSearch, search_definition};
+use seam::search::scene::SceneSearch;
 use seam::surface;
 
 fn run(mesh: &Mesh, deck: &str, integration: Integration) -> SceneSearch {
@@ -344,7 +345,7 @@ fn refit_after_a_move_equals_a_rebuild() {
         &parse_sierra(&Arc::from("d"), PAIR).0.contact_definitions[0],
         &SourceMap::default(),
     );
-    let settings = interaction::SearchSettings::defaults(3);
+    let settings = seam::search::SearchSettings::defaults(3);
     let a = SurfaceGeometry::from_surface(&mesh, set.get("bottom").unwrap(), &mesh.coords).unwrap();
     let b0 = SurfaceGeometry::from_surface(&mesh, set.get("top").unwrap(), &mesh.coords).unwrap();
     let mut searcher = Searcher::new(&b0, &settings);
@@ -499,14 +500,14 @@ fn pairing_is_reused_between_search_updates() {
         "begin contact definition\n begin search options\n search update frequency 4\n end\nend\n",
     );
     assert_eq!(
-        SearchSchedule::for_definition(&elfen),
+        seam::scene::search::search_schedule(&elfen),
         SearchSchedule::new(Some(4))
     );
     let aria = deck(
         "begin contact definition\n update search every 2 steps\n begin search options\n search update frequency 4\n end\nend\n",
     );
     assert_eq!(
-        SearchSchedule::for_definition(&aria),
+        seam::scene::search::search_schedule(&aria),
         SearchSchedule::new(Some(2))
     );
 
@@ -516,7 +517,7 @@ fn pairing_is_reused_between_search_updates() {
         .contact_definitions
         .remove(0);
     let set = surface::build(&mesh, &def, &SourceMap::default());
-    let settings = interaction::SearchSettings::defaults(3);
+    let settings = seam::search::SearchSettings::defaults(3);
     let geo = |coords: &[[f64; 3]], name: &str| {
         SurfaceGeometry::from_surface(&mesh, set.get(name).unwrap(), coords).unwrap()
     };

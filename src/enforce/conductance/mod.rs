@@ -9,22 +9,21 @@
 //! - [`LuaConductance`]: a sandboxed Lua expression or file function (derivatives by
 //!   central finite differences);
 //! - [`PluginConductance`]: a user plugin (`seam::plugin::Plugin`) that returns
-//!   conductance;
-//! - [`from_properties`]: the deck's `Gap Conductance Coefficient = …` lines (several
-//!   lines add up) turned into one model, with diagnostics `E06xx`.
+//!   conductance.
+//!
+//! The deck's `Gap Conductance Coefficient = …` lines are turned into these models by
+//! the scene, above (several lines add up into a [`Sum`]).
 //!
 //! Units (SI, as the deck): h in W/(m²·K), gap g in m (g > 0 open, g ≤ 0 closed or
 //! penetrating), temperatures in K, pressure p in Pa (≥ 0 in compression), x in m,
 //! time in s. Every evaluation checks its result: a non-finite h or derivative, or a
 //! negative h, is a [`ConductanceError`] that names the model and the point.
 
-mod deck;
 mod lua;
 mod plugin;
 
 use std::fmt;
 
-pub use deck::{codes, from_properties};
 pub use lua::{FD_FLOOR_GAP, FD_FLOOR_PRESSURE, FD_FLOOR_TEMPERATURE, LuaConductance};
 pub use plugin::{PluginConductance, PluginLoadError};
 

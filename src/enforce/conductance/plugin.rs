@@ -1,15 +1,12 @@
 //! The plugin adapter: a loaded enforcement plugin that returns conductance, used as a
 //! conductance model.
 
-use std::path::Path;
-
 use super::{Conductance, ConductanceError, ConductanceModel, PointState, check};
-use crate::deck::spec::Enforcement;
 use crate::plugin::{
     ContactPoint, Plugin, PluginError, PluginFault, PluginSpec, PointResult, StepContext,
 };
 
-/// Why a deck's plugin enforcement could not be made a conductance model: the library
+/// Why a plugin enforcement could not be made a conductance model: the library
 /// (missing, not a plugin, refused its data) or the plugin's kind (returns flux, keeps
 /// state). Both messages name the plugin's library.
 #[derive(Debug, thiserror::Error)]
@@ -62,17 +59,13 @@ impl PluginConductance {
         })
     }
 
-    /// The plugin of the deck's `Enforcement for Energy = Plugin Library = "…" Model = …`
-    /// with the block's `Integer Data` / `Real Data` (a relative library path is taken
-    /// from `deck_dir`), loaded and told the interaction's surfaces.
-    pub fn from_enforcement(
-        enforcement: &Enforcement,
-        deck_dir: &Path,
+    /// Load `spec`'s plugin as a conductance model told the interaction's surfaces.
+    pub fn load(
+        spec: &PluginSpec,
         surface_a: &str,
         surface_b: &str,
     ) -> Result<PluginConductance, PluginLoadError> {
-        let plugin = PluginSpec::from_enforcement(enforcement, deck_dir)?.load()?;
-        Ok(PluginConductance::new(plugin)?.on_surfaces(surface_a, surface_b))
+        Ok(PluginConductance::new(spec.load()?)?.on_surfaces(surface_a, surface_b))
     }
 
     /// The surfaces the plugin is told about.

@@ -1,5 +1,6 @@
 //! `Gap Conductance Coefficient = <model> <args>` lines of an enforcement, turned into
-//! one conductance model (several lines add up into a [`Sum`]).
+//! one conductance model of [`crate::enforce::conductance`] (several lines add up into
+//! a [`Sum`]), with diagnostics `E06xx` that point into the line.
 //!
 //! Spellings (case-insensitive apart from quoted strings; `[…]` optional):
 //! - `Constant H = 10`
@@ -15,12 +16,13 @@
 
 use std::path::Path;
 
-use super::{
-    Cmy, ConductanceError, ConductanceModel, Constant, GasGap, LuaConductance, MinGapOrder,
-    PluginConductance, Radiation, Sum, Table, TableVariable,
-};
+use super::enforcement::seen_temperature;
 use crate::deck::spec::{Enforcement, PropertyModel};
 use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap, did_you_mean};
+use crate::enforce::conductance::{
+    Cmy, ConductanceError, ConductanceModel, Constant, DEFAULT_MAX_GAP, DEFAULT_MIN_GAP, GasGap,
+    LuaConductance, MinGapOrder, PluginConductance, Radiation, Sum, Table, TableVariable,
+};
 use crate::plugin::{Plugin, PluginData};
 use crate::script::{Limits, ScriptError};
 
@@ -75,7 +77,7 @@ pub fn from_properties(
         enforcement,
         diags: Diagnostics::default(),
     };
-    let seen = crate::enforce::model::seen_temperature(enforcement);
+    let seen = seen_temperature(enforcement);
     let mut parts = Vec::new();
     let mut failed = false;
     for p in enforcement
@@ -336,7 +338,7 @@ impl Cx<'_> {
             l,
             &args,
             "min_gap",
-            Some(super::DEFAULT_MIN_GAP),
+            Some(DEFAULT_MIN_GAP),
             |g| g > 0.0,
             "> 0 (m)",
         );
@@ -344,7 +346,7 @@ impl Cx<'_> {
             l,
             &args,
             "max_gap",
-            Some(super::DEFAULT_MAX_GAP),
+            Some(DEFAULT_MAX_GAP),
             |g| g > 0.0,
             "> 0 (m)",
         );

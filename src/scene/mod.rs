@@ -12,6 +12,21 @@
 //! names with `Enforcement = name`; otherwise the definition's blocks together, one per
 //! equation. Two blocks claiming the same equation on one pair, with no interaction
 //! naming one, is an error (which one was meant is not written anywhere).
+//!
+//! The scene is the one consumer of the typed deck spec: its parts lower the deck to
+//! the typed settings of the layers below it, which never see a deck —
+//! [`interaction`] (which surfaces pair, with the search's
+//! [`SearchSettings`](crate::search::SearchSettings)), [`search`] (the searches of a
+//! definition and its periodic conditions), [`enforcement`] (an enforcement block's
+//! [`ModelChoice`]), [`conductance`] (`Gap Conductance Coefficient` lines to conductance
+//! models) and [`plugin`] (a plugin enforcement to a
+//! [`PluginSpec`](crate::plugin::PluginSpec)).
+
+pub mod conductance;
+pub mod enforcement;
+pub mod interaction;
+pub mod plugin;
+pub mod search;
 
 use std::path::Path;
 use std::time::Instant;
@@ -19,14 +34,16 @@ use std::time::Instant;
 use crate::deck::LoadedDeck;
 use crate::deck::spec::{ContactDefinition, Enforcement};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap};
-use crate::enforce::conductance::{self, ConductanceModel, PluginConductance};
+use crate::enforce::conductance::{self as models, ConductanceModel};
 use crate::enforce::interface::Form;
-use crate::enforce::model::{ConductanceLaw, ModelChoice, resolve_for, seen_temperature};
-use crate::interaction;
+use crate::enforce::model::{ConductanceLaw, ModelChoice};
 use crate::mesh::Mesh;
 use crate::search::pairing::{Integration, SearchStats};
-use crate::search::scene::{Pairing, search_definition};
+use crate::search::scene::Pairing;
 use crate::surface;
+
+use enforcement::{resolve_for, seen_temperature};
+use search::search_definition;
 
 /// The equation every supported enforcement applies to.
 const ENERGY: &str = "energy";
@@ -328,7 +345,7 @@ pub fn conductance_model(
 ) -> Result<Option<Box<dyn ConductanceModel>>, Refused> {
     match &choice.conductance {
         None => Ok(None),
-        Some(ConductanceLaw::Constant(h)) => match conductance::Constant::new(*h) {
+        Some(ConductanceLaw::Constant(h)) => match models::Constant::new(*h) {
             Ok(c) => Ok(Some(Box::new(c))),
             Err(e) => {
                 diags.push(
@@ -345,7 +362,7 @@ pub fn conductance_model(
             m.map(Some).ok_or(Refused)
         }
         Some(ConductanceLaw::Plugin) => {
-            match PluginConductance::from_enforcement(enf, deck_dir, side_a, side_b) {
+            match plugin::plugin_conductance(enf, deck_dir, side_a, side_b) {
                 Ok(c) => {
                     if let Some(notice) = c.plugin().derivative_notice() {
                         diags.push(

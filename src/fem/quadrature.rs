@@ -21,9 +21,26 @@ pub struct QuadratureRule {
 }
 
 /// Gauss–Legendre nodes and weights on [−1, 1] with `n` points (exact to degree
-/// 2n − 1), by Newton's method on the Legendre polynomial P_n from the Tricomi-type
-/// initial guess cos(π(i + ¾)/(n + ½)); converged to round-off in < 10 steps.
+/// 2n − 1), nodes ascending: the one Gauss rule of seam, which every other rule and
+/// every Gauss loop (element, face, mortar segment, tributary area) is built on.
+///
+/// Up to three points in closed form (0 and 2; ±1/√3 and 1; 0, ±√(3/5) and 5/9, 8/9),
+/// so the rules of the common low orders are exact to the last bit; above, by Newton's
+/// method on the Legendre polynomial P_n from the Tricomi-type initial guess
+/// cos(π(i + ¾)/(n + ½)), converged to round-off in < 10 steps.
 pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    match n {
+        1 => return (vec![0.0], vec![2.0]),
+        2 => {
+            let g = 1.0 / 3f64.sqrt();
+            return (vec![-g, g], vec![1.0, 1.0]);
+        }
+        3 => {
+            let g = 0.6f64.sqrt();
+            return (vec![-g, 0.0, g], vec![5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0]);
+        }
+        _ => {}
+    }
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     for i in 0..n {
@@ -32,15 +49,10 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
         for _ in 0..100 {
             // Three-term recurrence for P_n(z) and P_{n−1}(z).
             let (mut p0, mut p1) = (1.0, z);
-            if n == 1 {
-                p1 = z;
-                p0 = 1.0;
-            } else {
-                for k in 2..=n {
-                    let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                    p0 = p1;
-                    p1 = p2;
-                }
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
             }
             // P_n'(z) = n (z P_n − P_{n−1}) / (z² − 1)
             dp = n as f64 * (z * p1 - p0) / (z * z - 1.0);
@@ -56,8 +68,8 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     (x, w)
 }
 
-/// Gauss–Legendre on [0, 1].
-fn gauss_unit(n: usize) -> (Vec<f64>, Vec<f64>) {
+/// [`gauss_legendre`] mapped to [0, 1]: nodes `(1 + x)/2`, weights `w/2`.
+pub fn gauss_legendre_01(n: usize) -> (Vec<f64>, Vec<f64>) {
     let (x, w) = gauss_legendre(n);
     (
         x.iter().map(|x| 0.5 * (x + 1.0)).collect(),
@@ -200,7 +212,7 @@ impl QuadratureRule {
 
     /// Collapsed rule on the unit triangle: ξ = u, η = v(1 − u), dξdη = (1 − u) du dv.
     fn triangle(n: usize) -> Self {
-        let (x, w) = gauss_unit(n);
+        let (x, w) = gauss_legendre_01(n);
         let mut r = Self::empty();
         for i in 0..n {
             for j in 0..n {
@@ -214,7 +226,7 @@ impl QuadratureRule {
     /// Collapsed rule on the unit tetrahedron: ξ = u, η = v(1 − u), ζ = w(1 − u)(1 − v),
     /// Jacobian (1 − u)²(1 − v).
     fn tetrahedron(n: usize) -> Self {
-        let (x, w) = gauss_unit(n);
+        let (x, w) = gauss_legendre_01(n);
         let mut r = Self::empty();
         for i in 0..n {
             for j in 0..n {
@@ -234,7 +246,7 @@ impl QuadratureRule {
     /// (1 − c)²; `n` Gauss points in a and b, `nc` in c.
     fn pyramid(n: usize, nc: usize) -> Self {
         let (x, w) = gauss_legendre(n);
-        let (c, wc) = gauss_unit(nc);
+        let (c, wc) = gauss_legendre_01(nc);
         let mut r = Self::empty();
         for k in 0..nc {
             let s = 1.0 - c[k];

@@ -13,50 +13,18 @@
 //! - A pair named twice keeps one interaction: the later definition's options apply.
 //!
 //! Search options come from `begin Search Options` (defaults for every interaction) and
-//! an interaction's own `Normal Tolerance`.
+//! an interaction's own `Normal Tolerance`; they are lowered here to the search's typed
+//! [`SearchSettings`], and `Initial Overclosure` control assignments to its
+//! [`Overclosure`].
 
 use serde::Serialize;
 
 use crate::deck::spec::{
-    ContactDefinition, Control, ControlAssignment, Interaction as InteractionSpec, Overclosure,
+    ContactDefinition, Control, ControlAssignment, Interaction as InteractionSpec,
 };
 use crate::diag::{Diagnostic, Diagnostics, Loc, SourceMap, did_you_mean};
+use crate::search::{Overclosure, SearchSettings};
 use crate::surface::{SurfaceKind, SurfaceSet};
-
-/// Search controls of one interaction, with their defaults resolved.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SearchSettings {
-    /// Largest |gap| accepted, absolute length; `None`: set by the field factor.
-    pub normal_tolerance: Option<f64>,
-    /// How far outside a face (relative to its size) a projection still counts.
-    pub tangential_tolerance: f64,
-    /// Search box = mean facet length × buffer factor (ELFEN; 1.0 in 3-D, 5.0 in 2-D).
-    pub buffer_factor: f64,
-    /// Largest penetration or separation considered = target facet length × field factor.
-    pub field_factor: f64,
-    /// A target whose normal makes more than this angle (degrees) with the opposite of
-    /// the contact point's normal is ignored.
-    pub normal_check_angle: f64,
-    /// Faces whose normals make less than this angle (degrees) are not opposed and are
-    /// culled, unless culling is disabled.
-    pub opposed_normal_threshold_angle: f64,
-    pub cull_opposed_normals: bool,
-}
-
-impl SearchSettings {
-    /// Defaults for a mesh of spatial dimension `dim`.
-    pub fn defaults(dim: usize) -> Self {
-        SearchSettings {
-            normal_tolerance: None,
-            tangential_tolerance: 1e-3,
-            buffer_factor: if dim == 2 { 5.0 } else { 1.0 },
-            field_factor: 0.2,
-            normal_check_angle: 80.0,
-            opposed_normal_threshold_angle: 90.0,
-            cull_opposed_normals: true,
-        }
-    }
-}
 
 /// One resolved interaction between two surfaces (indices into the [`SurfaceSet`]).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -270,7 +238,7 @@ fn apply_controls(
             if applies {
                 match c.control {
                     Control::ScalePenalty { factor } => i.penalty_scale = factor,
-                    Control::InitialOverclosure { treatment } => i.overclosure = treatment,
+                    Control::InitialOverclosure { treatment } => i.overclosure = treatment.into(),
                 }
             }
         }

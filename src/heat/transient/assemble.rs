@@ -1,0 +1,264 @@
+//! The residual and Jacobian of a step at `u` (elements, faces, sources, capacity,
+//! interface forms and mortar ties) and the heat through each interface.
+
+use std::cell::Cell;
+
+use rayon::prelude::*;
+
+use crate::assembly::Assembler;
+use crate::enforce::interface::InterfaceSystem;
+use crate::fem::MAX_NODES;
+use crate::heat::kernel;
+use crate::heat::law::Law;
+use crate::heat::{FirstError, HeatError, bad_jacobian, elem_coords};
+
+use super::newton::{Context, History};
+use super::{Failure, Loads};
+
+impl Context<'_, '_> {
+    /// Residual and Jacobian (left in `asm`) at `u`, and the interface systems.
+    pub(super) fn assemble(
+        &self,
+        asm: &mut Assembler<'_>,
+        u: &[f64],
+        t: f64,
+        loads: &Loads,
+        history: Option<&History<'_>>,
+        linear: bool,
+    ) -> Result<(Vec<f64>, Vec<Option<InterfaceSystem>>), Failure> {
+        let p = self.p;
+        let setup = self.setup;
+        let mesh = p.mesh;
+        let dofs = &setup.dofs;
+        let (blocks, rules) = (&setup.blocks, &setup.rules);
+        let mut faces: Vec<(u32, usize)> = loads
+            .faces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| (f.side().elem.0, k))
+            .collect();
+        faces.sort_unstable();
+        let errors = FirstError::new();
+        let (laws, source, block_source) = (p.laws, p.source, p.block_source);
+        // A linear problem's element matrices (conduction, and the faces' dg/dT) stay
+        // the same while the face conditions' derivatives do: then they are kept in
+        // their slots and only the vectors are computed. Either way a linear element's
+        // residual is `K_e T_e + g(0) − f`, so keeping or recomputing gives the same bits.
+        let signature: Option<Vec<(u32, u8, f64)>> = linear.then(|| {
+            loads
+                .faces
+                .iter()
+                .map(|f| (f.side().elem.0, f.side().side, f.outflow(0.0).1))
+                .collect()
+        });
+        let keep = signature.is_some() && *self.element_matrices.borrow() == signature;
+        asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
+            let b = mesh.block_of(e);
+            let topo = mesh.blocks[b].topology;
+            let rule = rules[b].as_ref().expect("rule of a field block");
+            let mut x = [[0.0; 3]; MAX_NODES];
+            let nn = elem_coords(mesh, e, &mut x);
+            let mut elem_dofs = Vec::with_capacity(nn);
+            dofs.elem_dofs(mesh, e, &mut elem_dofs);
+            let mut te = [0.0; MAX_NODES];
+            for (k, d) in elem_dofs.iter().enumerate() {
+                te[k] = u[*d as usize];
+            }
+            // Linear: the matrix at T = 0, then the residual from it.
+            let t_eval = if linear { [0.0; MAX_NODES] } else { te };
+            let law = &laws[b].conductivity;
+            let failed = Cell::new(None);
+            let k = |temp: f64, xq: [f64; 3]| match law.eval(temp, xq, t) {
+                Ok(v) => v,
+                Err(m) => {
+                    failed.set(Some(m));
+                    (0.0, 0.0)
+                }
+            };
+            // Q(T, x, t) and dQ/dT; a failure or a non-finite value stops the run there.
+            let q_failed = Cell::new(None);
+            let q = |temp: f64, xq: [f64; 3]| {
+                let v = block_source.map_or(Ok((0.0, 0.0)), |s| s[b].eval(temp, xq, t));
+                let what = match v {
+                    Ok((q, dq)) if q.is_finite() && dq.is_finite() => return (q, dq),
+                    Ok((q, dq)) => format!("Q = {q}, dQ/dT = {dq}"),
+                    Err(m) => m.lines().next().unwrap_or_default().to_string(),
+                };
+                let [x0, x1, x2] = xq;
+                q_failed.set(Some(format!(
+                    "{what} at ({x0:.6}, {x1:.6}, {x2:.6}), T = {temp}, t = {t}"
+                )));
+                (0.0, 0.0)
+            };
+            let conduction = if keep {
+                Ok(())
+            } else {
+                kernel::conduction_residual_jacobian(rule, &x[..nn], &t_eval[..nn], k, re, je)
+            };
+            if let Err(bad) = conduction {
+                errors.record(e, bad_jacobian(mesh, e, bad));
+                return;
+            }
+            if let Some(m) = failed.take() {
+                errors.record(
+                    e,
+                    HeatError::Material {
+                        block: mesh.blocks[b].id,
+                        message: m,
+                    },
+                );
+                return;
+            }
+            let start = faces.partition_point(|f| f.0 < e.0);
+            let mut scratch = [0.0; MAX_NODES * MAX_NODES];
+            for &(_, k) in faces[start..].iter().take_while(|f| f.0 == e.0) {
+                let bc = loads.faces[k];
+                // Kept matrices hold the faces' dg/dT already.
+                let jf = if keep {
+                    &mut scratch[..nn * nn]
+                } else {
+                    &mut *je
+                };
+                kernel::face_load(
+                    topo,
+                    &x[..nn],
+                    bc.side().side,
+                    &t_eval[..nn],
+                    |temp, _| bc.outflow(temp),
+                    re,
+                    jf,
+                );
+            }
+            if linear {
+                for a in 0..nn {
+                    re[a] += (0..nn).map(|c| je[a * nn + c] * te[c]).sum::<f64>();
+                }
+            }
+            // Sources at the element's temperatures (a linear problem's do not depend on
+            // T, so their dQ/dT adds nothing to the kept matrices).
+            let mut f = [0.0; MAX_NODES];
+            let mut scratch = [0.0; MAX_NODES * MAX_NODES];
+            let sourced = match (block_source, source) {
+                (Some(qb), _) if !matches!(qb[b], Law::Constant(v) if v == 0.0) => {
+                    let js = if keep {
+                        &mut scratch[..nn * nn]
+                    } else {
+                        &mut *je
+                    };
+                    kernel::source_residual_jacobian(rule, &x[..nn], &te[..nn], q, re, js)
+                }
+                (None, Some(q)) => kernel::source(rule, &x[..nn], q, &mut f),
+                _ => Ok(()),
+            };
+            if let Err(bad) = sourced {
+                errors.record(e, bad_jacobian(mesh, e, bad));
+                return;
+            }
+            if let Some(message) = q_failed.take() {
+                let block = mesh.blocks[b].id;
+                errors.record(e, HeatError::Source { block, message });
+                return;
+            }
+            re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
+        });
+        errors.into_result()?;
+        if !keep {
+            asm.check_finite(mesh).map_err(HeatError::from)?;
+        }
+        *self.element_matrices.borrow_mut() = signature;
+        asm.reset_couplings();
+        let mut r = asm.rhs();
+        // Capacity (lumped): M(u)(α₀u + α₁uⁿ + α₂uⁿ⁻¹)/Δt on the diagonal.
+        if let Some(h) = history {
+            let terms: Vec<Result<(usize, f64, f64), String>> = setup
+                .lumped
+                .par_iter()
+                .with_min_len(4096)
+                .map(|&(d, b, w, xn)| {
+                    let d = d as usize;
+                    let (c, dc) = p.laws[b as usize].capacity.eval(u[d], xn, t)?;
+                    let mut rate = h.alpha[0] * u[d] + h.alpha[1] * h.current[d];
+                    if let Some(prev) = h.previous {
+                        rate += h.alpha[2] * prev[d];
+                    }
+                    rate /= h.dt;
+                    Ok((d, w * c * rate, w * (c * h.alpha[0] / h.dt + dc * rate)))
+                })
+                .collect();
+            for term in terms {
+                let (d, rv, jv) = term.map_err(|m| Failure::Fatal(HeatError::Step(m)))?;
+                r[d] += rv;
+                asm.add_diagonal(d, jv);
+            }
+        }
+        // Interfaces.
+        let mut systems = Vec::with_capacity(p.contact.len());
+        for (k, c) in p.contact.iter().enumerate() {
+            if !p.is_active(k, t) {
+                systems.push(None);
+                continue;
+            }
+            let s = self.points[k].evaluate(&c.form, u);
+            let s = match s {
+                Ok(s) => s,
+                Err(e) => {
+                    if p.cutback.is_some_and(|c| c.replace(false)) {
+                        return Err(Failure::Retry(format!(
+                            "a conductance model asked for a smaller step ({e})"
+                        )));
+                    }
+                    return Err(Failure::Fatal(HeatError::Contact(e.to_string())));
+                }
+            };
+            for &(d, v) in &s.residual {
+                r[d as usize] += v;
+            }
+            s.add_scattered(asm, &self.scatters[k]);
+            systems.push(Some(s));
+        }
+        // Ties: Cᵀλ and C u − ΔT ∫ψ; a tie switched off keeps λ = 0.
+        for (ti, tie) in setup.ties.iter().enumerate() {
+            let l0 = setup.lambda_first[ti];
+            if !p.is_active(p.contact.len() + ti, t) {
+                for k in 0..tie.nodes.len() {
+                    r[l0 + k] = u[l0 + k];
+                    asm.add_diagonal(l0 + k, 1.0);
+                }
+                continue;
+            }
+            for (e, &(k, d, c)) in tie.entries.iter().enumerate() {
+                let l = l0 + k as usize;
+                r[d as usize] += c * u[l];
+                r[l] += c * u[d as usize];
+                asm.add_coupling(self.tie_first[ti] + e, c, c);
+            }
+            for (k, w) in tie.psi_integral.iter().enumerate() {
+                r[l0 + k] -= p.ties[ti].offset * w;
+            }
+        }
+        Ok((r, systems))
+    }
+
+    /// Heat through each interface at `u`: contact terms from their residuals, ties
+    /// from Cᵀλ.
+    pub(super) fn heat(&self, systems: &[Option<InterfaceSystem>], u: &[f64]) -> Vec<(f64, f64)> {
+        let mut out: Vec<(f64, f64)> = systems
+            .iter()
+            .map(|s| s.as_ref().map_or((0.0, 0.0), InterfaceSystem::heat))
+            .collect();
+        for (ti, tie) in self.setup.ties.iter().enumerate() {
+            let l0 = self.setup.lambda_first[ti];
+            let mut ct = std::collections::BTreeMap::<u32, f64>::new();
+            for &(k, d, c) in &tie.entries {
+                *ct.entry(d).or_default() += c * u[l0 + k as usize];
+            }
+            let sum = |set: &[u32]| {
+                set.iter()
+                    .map(|d| ct.get(d).copied().unwrap_or(0.0))
+                    .sum::<f64>()
+            };
+            out.push((sum(&tie.side_a_dofs), sum(&tie.side_b_dofs)));
+        }
+        out
+    }
+}

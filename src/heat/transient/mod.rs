@@ -1,0 +1,551 @@
+//! Transient (and nonlinear steady) conduction with contact: backward Euler or BDF2,
+//! fixed or adaptive steps, Newton with exact Jacobians at every step.
+//!
+//! Entry point: [`solve`]. The discrete problem at each step, for the dof vector `u`:
+//!
+//! ```text
+//! R(u) = M(u) (α₀ u + α₁ uⁿ + α₂ uⁿ⁻¹)/Δt + ∫ k(T) ∇N·∇T − ∫ Q(T) N + Σ_faces ∫ N g(T)
+//!        + Σ_Γ R_Γ(u) + Cᵀλ          (and C u = ΔT ∫ψ on the multiplier rows)
+//! ```
+//!
+//! with M the lumped capacity `∫ ρc(T_a) N_a` at each node, Q(T, x, t) the source of
+//! the element's block (its dQ/dT enters the Jacobian), g the heat leaving through a
+//! face (flux, convection, radiation; see [`FaceBc::outflow`]), R_Γ the interface forms
+//! of [`crate::enforce::interface`] and C the mortar ties. Backward Euler has
+//! `(α₀, α₁, α₂) = (1, −1, 0)`; BDF2 with step ratio ω = Δtₙ/Δtₙ₋₁ has
+//! `((1+2ω)/(1+ω), −(1+ω), ω²/(1+ω))` and starts with one backward-Euler step. A steady
+//! solve is the same Newton without the capacity term.
+//!
+//! A step is rejected and retried with half the step when Newton fails or a
+//! conductance model (a plugin) asks for a smaller step; with adaptive steps also when
+//! the local error estimate — the distance to the polynomial predictor, scaled by the
+//! scheme's error constant — exceeds the tolerance. Only accepted steps reach the
+//! caller's `on_step`, so contact state and output are committed on accepted steps
+//! only.
+//!
+//! A linear step (constant laws, conductances independent of T, linear faces and
+//! sources) costs one assembly: the element matrices are kept while the faces'
+//! derivatives do not change, the residual after the solve is `R + J du`, and a fixed
+//! step reuses its factorisation. The interface geometry at the contact points is
+//! evaluated once per run ([`InterfacePoints`]).
+//!
+//! Results are reproducible bit for bit: element loops write fixed slots, interface
+//! sums run in a fixed order, and the factorisations run sequentially when
+//! [`TransientProblem::reproducible`] is set — so a run restarted from a
+//! [`State`] continues exactly as the uninterrupted run.
+//!
+//! The parts: `setup` (what a run keeps: dofs, ties, lumped weights, bases), `newton`
+//! (one step's iteration and its solvers) and `assemble` (the residual and Jacobian at
+//! a state, the interface heat); this file holds the problem types and the time loop.
+
+mod assemble;
+mod newton;
+mod setup;
+
+use std::cell::{Cell, RefCell};
+
+use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
+use crate::enforce::interface::{FieldPair, InterfacePoints};
+use crate::mesh::{Mesh, NodeId};
+
+use super::TEMPERATURE;
+use super::law::Law;
+use super::steady::{ContactTerm, TieTerm};
+use super::{FaceBc, HeatError, SourceFn};
+
+use newton::{Context, History, Solvers};
+use setup::Setup;
+
+/// Time integration scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Scheme {
+    BackwardEuler,
+    Bdf2,
+}
+
+impl Scheme {
+    /// Order of accuracy.
+    pub fn order(self) -> u32 {
+        match self {
+            Scheme::BackwardEuler => 1,
+            Scheme::Bdf2 => 2,
+        }
+    }
+}
+
+/// The material laws of one block.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockLaws {
+    /// k(T), W/m/K.
+    pub conductivity: Law,
+    /// ρc(T), J/m³/K.
+    pub capacity: Law,
+}
+
+/// Boundary data at one time: nodal temperatures and face conditions. The set of
+/// Dirichlet nodes must not change over a run (their values may).
+#[derive(Clone, Debug, Default)]
+pub struct Loads {
+    pub dirichlet: Vec<(NodeId, f64)>,
+    pub faces: Vec<FaceBc>,
+}
+
+/// A field and the blocks it lives on (each block carries one field).
+#[derive(Clone, Debug)]
+pub struct FieldSpec {
+    pub name: String,
+    pub blocks: Vec<usize>,
+}
+
+/// The problem: mesh, fields, laws, source, interfaces.
+pub struct TransientProblem<'a> {
+    pub mesh: &'a Mesh,
+    /// The fields; `temperature` over every solid block when empty.
+    pub fields: Vec<FieldSpec>,
+    /// Laws per mesh block (entries of blocks without a field are not used).
+    pub laws: &'a [BlockLaws],
+    pub source: Option<SourceFn<'a>>,
+    /// The source per mesh block, Q(T, x, t) in W/m³ (a [`Law`]: a number, a Lua
+    /// expression, a table in time), used instead of `source` when given.
+    pub block_source: Option<&'a [Law]>,
+    /// Boundary data at time t.
+    pub loads: &'a dyn Fn(f64) -> Result<Loads, HeatError>,
+    pub contact: Vec<ContactTerm<'a>>,
+    pub ties: Vec<TieTerm<'a>>,
+    /// Per contact term, then per tie: indices into `fields` of side A's and side B's
+    /// field (both 0 when empty).
+    pub term_fields: Vec<(usize, usize)>,
+    /// Whether term `k` (contact terms, then ties) is switched on at time t
+    /// (`Use Toggle Block`); always on when `None`.
+    pub active: Option<&'a dyn Fn(usize, f64) -> bool>,
+    /// Set by a conductance model that asks for a smaller step; the step is retried.
+    pub cutback: Option<&'a Cell<bool>>,
+    /// Newton stops when the update is below `tolerance × max|u|`.
+    pub tolerance: f64,
+    pub max_iterations: usize,
+    /// Sequential factorisations: bit-for-bit reproducible runs and restarts.
+    pub reproducible: bool,
+    /// Solve a linear step's system by AMG-preconditioned CG (to
+    /// [`AMG_TOLERANCE`](crate::heat::steady::AMG_TOLERANCE)) when it is symmetric positive
+    /// definite (no multipliers) and has at least this many unknowns, keeping the
+    /// hierarchy while the matrix is unchanged; `None`: always factor.
+    pub amg_threshold: Option<usize>,
+}
+
+/// Step-size control.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// Largest local error accepted in a step (K, max norm).
+    pub tolerance: f64,
+    pub dt_min: f64,
+    pub dt_max: f64,
+}
+
+/// What to integrate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TimeMode {
+    /// One nonlinear steady solve at this time.
+    Steady { time: f64 },
+    Transient {
+        scheme: Scheme,
+        end: f64,
+        adaptive: Option<Adaptive>,
+        /// The least step a failing step may be cut to.
+        dt_min: f64,
+    },
+}
+
+/// The state of a run between steps: enough to continue it exactly.
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    pub step: usize,
+    pub time: f64,
+    /// The next step size to try.
+    pub dt: f64,
+    /// The dof vector (fields, then multipliers).
+    pub u: Vec<f64>,
+    /// Earlier accepted states, newest first (at most two): `(time, u)`.
+    pub past: Vec<(f64, Vec<f64>)>,
+}
+
+/// One accepted step (or the steady solve).
+#[derive(Clone, Debug)]
+pub struct StepReport {
+    pub step: usize,
+    pub time: f64,
+    pub dt: f64,
+    pub newton_iterations: usize,
+    /// ‖R‖₂ at every Newton iterate of the accepted attempt.
+    pub residual_history: Vec<f64>,
+    /// Attempts rejected before this one.
+    pub rejected: usize,
+    /// Local error estimate (adaptive steps), K.
+    pub error_estimate: Option<f64>,
+    /// Per contact term then per tie: heat leaving side A and side B through Γ (W).
+    pub heat: Vec<(f64, f64)>,
+    pub assembly_s: f64,
+    pub factor_s: f64,
+    pub solve_s: f64,
+    /// CG iterations of the step's AMG-CG solves (0 when it factored).
+    pub cg_iterations: usize,
+    /// `None` when Newton converged; for a steady solve that did not, what happened
+    /// (the residual history and the likely cause): the state is the last iterate.
+    pub diagnosis: Option<String>,
+}
+
+/// What [`solve`] hands back at the end.
+#[derive(Debug)]
+pub struct Outcome {
+    pub dofs: DofMap,
+    pub fields: Vec<FieldId>,
+    pub state: State,
+    pub steps: usize,
+    pub rejected: usize,
+    /// Per tie: side-A nodes left without a multiplier (crosspoints).
+    pub crosspoints: Vec<Vec<NodeId>>,
+}
+
+/// Where a run starts.
+pub enum Start<'s> {
+    /// At `time` with first step `dt`, every field at the nodal `initial` value and the
+    /// multipliers at 0.
+    Fresh {
+        time: f64,
+        dt: f64,
+        initial: &'s dyn Fn(NodeId) -> f64,
+    },
+    /// From a saved state (a checkpoint).
+    Restart(State),
+}
+
+impl TransientProblem<'_> {
+    fn fields_or_default(&self) -> Vec<FieldSpec> {
+        if self.fields.is_empty() {
+            vec![FieldSpec {
+                name: TEMPERATURE.into(),
+                blocks: (0..self.mesh.blocks.len())
+                    .filter(|&b| self.mesh.blocks[b].topology.is_solid())
+                    .collect(),
+            }]
+        } else {
+            self.fields.clone()
+        }
+    }
+
+    fn term_pair(&self, k: usize, fields: &[FieldId]) -> FieldPair {
+        let (a, b) = self.term_fields.get(k).copied().unwrap_or((0, 0));
+        FieldPair {
+            a: fields[a],
+            b: fields[b],
+        }
+    }
+
+    fn is_active(&self, k: usize, t: f64) -> bool {
+        self.active.is_none_or(|f| f(k, t))
+    }
+}
+
+/// The time-derivative weights `(α₀, α₁, α₂)` of a step of size `dt` after a step of
+/// size `dt_prev` (None: no history, backward Euler).
+fn weights(scheme: Scheme, dt: f64, dt_prev: Option<f64>) -> [f64; 3] {
+    match (scheme, dt_prev) {
+        (Scheme::Bdf2, Some(prev)) => {
+            let w = dt / prev;
+            [(1.0 + 2.0 * w) / (1.0 + w), -(1.0 + w), w * w / (1.0 + w)]
+        }
+        _ => [1.0, -1.0, 0.0],
+    }
+}
+
+/// Why an attempt did not give a step.
+enum Failure {
+    /// Retry with a smaller step.
+    Retry(String),
+    Fatal(HeatError),
+}
+
+impl From<HeatError> for Failure {
+    fn from(e: HeatError) -> Self {
+        Failure::Fatal(e)
+    }
+}
+
+/// Solve the problem from `state`: a steady solve, or time steps until `end`. Each
+/// accepted step is handed to `on_step` with the new state.
+pub fn solve(
+    p: &TransientProblem<'_>,
+    mode: TimeMode,
+    start: Start<'_>,
+    on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
+) -> Result<Outcome, HeatError> {
+    let time0 = match &start {
+        Start::Fresh { time, .. } => *time,
+        Start::Restart(s) => s.time,
+    };
+    let setup = Setup::new(p, time0)?;
+    let mut state = match start {
+        Start::Restart(s) => s,
+        Start::Fresh { time, dt, initial } => {
+            let mut u = vec![0.0; setup.n];
+            for &f in &setup.fields {
+                for node in (0..p.mesh.num_nodes()).map(|n| NodeId(n as u32)) {
+                    if let Some(d) = setup.dofs.dof(f, node) {
+                        u[d.index()] = initial(node);
+                    }
+                }
+            }
+            State {
+                step: 0,
+                time,
+                dt,
+                u,
+                past: Vec::new(),
+            }
+        }
+    };
+    if state.u.len() != setup.n {
+        return Err(HeatError::Step(format!(
+            "the state has {} values but the problem has {} dofs (a checkpoint of another problem?)",
+            state.u.len(),
+            setup.n
+        )));
+    }
+    let mesh = p.mesh;
+    // The pattern: elements, interface couplings (from a first evaluation), ties.
+    let mut pattern = Pattern::new(mesh, &setup.dofs);
+    let mut points = Vec::with_capacity(p.contact.len());
+    let mut scatters = Vec::with_capacity(p.contact.len());
+    for (k, c) in p.contact.iter().enumerate() {
+        let cache = InterfacePoints::new(
+            mesh,
+            &setup.dofs,
+            p.term_pair(k, &setup.fields),
+            c.side_a,
+            c.side_b,
+            c.points,
+            &c.form,
+        )
+        .map_err(|e| HeatError::Contact(e.to_string()))?;
+        let cp = cache.couplings();
+        let first = pattern.add_couplings(&cp)?.start;
+        scatters.push(cache.scatter(&cp, first));
+        points.push(cache);
+    }
+    let mut tie_first = Vec::with_capacity(setup.ties.len());
+    for (t, tie) in setup.ties.iter().enumerate() {
+        let pairs: Vec<(usize, usize)> = tie
+            .entries
+            .iter()
+            .map(|&(k, d, _)| (d as usize, setup.lambda_first[t] + k as usize))
+            .collect();
+        tie_first.push(pattern.add_couplings(&pairs)?.start);
+    }
+    pattern.build()?;
+    let mut solver = Solvers::new(&setup, p.reproducible);
+    let mut asm = Assembler::new(&pattern);
+    let ctx = Context {
+        p,
+        setup: &setup,
+        points: &points,
+        scatters: &scatters,
+        element_matrices: RefCell::new(None),
+        tie_first: &tie_first,
+        unconverged: RefCell::new(None),
+    };
+
+    let mut steps = 0;
+    let mut rejected_total = 0;
+    match mode {
+        TimeMode::Steady { time } => {
+            let mut guess = state.u.clone();
+            let r = ctx.newton(&mut asm, &mut solver, &mut guess, time, None)?;
+            let r = match r {
+                Ok(r) => r,
+                // Out of iterations: the last iterate goes on, marked not converged.
+                Err(msg) => ctx.unconverged.take().ok_or(HeatError::Step(msg))?,
+            };
+            state.u = guess;
+            state.time = time;
+            let report = StepReport {
+                step: 0,
+                time,
+                dt: 0.0,
+                rejected: 0,
+                error_estimate: None,
+                ..r
+            };
+            on_step(&report, &state, &setup.dofs)?;
+            steps = 1;
+        }
+        TimeMode::Transient {
+            scheme,
+            end,
+            adaptive,
+            dt_min,
+        } => {
+            let eps = 1e-12 * end.abs().max(state.dt);
+            while state.time < end - eps {
+                let mut rejected = 0;
+                loop {
+                    let mut dt = state.dt.min(end - state.time);
+                    if let Some(a) = adaptive {
+                        dt = dt.min(a.dt_max);
+                    }
+                    // Do not leave a sliver of a step before the end.
+                    if end - state.time - dt < 1e-6 * dt {
+                        dt = end - state.time;
+                    }
+                    let t_new = state.time + dt;
+                    let dt_prev = state.past.first().map(|(t, _)| state.time - t);
+                    let alpha = weights(scheme, dt, dt_prev);
+                    let mut u = predictor(&state, dt, 1);
+                    let history = Some(History {
+                        dt,
+                        alpha,
+                        current: &state.u,
+                        previous: state.past.first().map(|(_, u)| u.as_slice()),
+                    });
+                    let attempt = ctx.newton(&mut asm, &mut solver, &mut u, t_new, history)?;
+                    let failure = match attempt {
+                        Err(msg) => Some(msg),
+                        Ok(mut report) => {
+                            let estimate = adaptive
+                                .and_then(|_| error_estimate(scheme, &state, &u, dt, &setup));
+                            let too_big = match (adaptive, estimate) {
+                                (Some(a), Some(e)) => e > a.tolerance,
+                                _ => false,
+                            };
+                            if too_big {
+                                let (a, e) = (adaptive.unwrap(), estimate.unwrap());
+                                state.dt = dt * factor(a.tolerance, e, scheme).clamp(0.2, 0.9);
+                                rejected += 1;
+                                rejected_total += 1;
+                                if state.dt < a.dt_min {
+                                    return Err(HeatError::Step(format!(
+                                        "at t = {}: the local error {e:.3e} K stays above the tolerance {:.3e} K down to dt_min = {}",
+                                        state.time, a.tolerance, a.dt_min
+                                    )));
+                                }
+                                continue;
+                            }
+                            // Accept: shift the history and pick the next step.
+                            let old = std::mem::replace(&mut state.u, u);
+                            state.past.insert(0, (state.time, old));
+                            state.past.truncate(2);
+                            state.time = t_new;
+                            state.step += 1;
+                            state.dt = match (adaptive, estimate) {
+                                (Some(a), Some(e)) => (dt
+                                    * factor(a.tolerance, e, scheme).clamp(0.2, 2.0))
+                                .clamp(a.dt_min, a.dt_max),
+                                _ => state.dt,
+                            };
+                            report.step = state.step;
+                            report.time = t_new;
+                            report.dt = dt;
+                            report.rejected = rejected;
+                            report.error_estimate = estimate;
+                            on_step(&report, &state, &setup.dofs)?;
+                            steps += 1;
+                            None
+                        }
+                    };
+                    match failure {
+                        None => break,
+                        Some(msg) => {
+                            rejected += 1;
+                            rejected_total += 1;
+                            state.dt = dt * 0.5;
+                            let floor = adaptive.map_or(dt_min, |a| a.dt_min);
+                            if state.dt < floor {
+                                return Err(HeatError::Step(format!(
+                                    "at t = {}: {msg}; the step was cut to {} and may not go below {floor}",
+                                    state.time, state.dt
+                                )));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(Outcome {
+        crosspoints: setup.ties.iter().map(|t| t.crosspoints.clone()).collect(),
+        fields: setup.fields.clone(),
+        dofs: setup.dofs,
+        state,
+        steps,
+        rejected: rejected_total,
+    })
+}
+
+/// Step-size factor `(tol/err)^(1/(p+1))` with a safety factor 0.9.
+fn factor(tol: f64, err: f64, scheme: Scheme) -> f64 {
+    if err <= 0.0 {
+        return f64::INFINITY;
+    }
+    0.9 * (tol / err).powf(1.0 / (scheme.order() as f64 + 1.0))
+}
+
+/// The starting guess of a step: the last state, extrapolated linearly when `order` ≥ 1
+/// and a history exists.
+fn predictor(state: &State, dt: f64, order: usize) -> Vec<f64> {
+    match (order, state.past.first()) {
+        (1.., Some((t_prev, u_prev))) if state.time > *t_prev => {
+            let s = dt / (state.time - t_prev);
+            state
+                .u
+                .iter()
+                .zip(u_prev)
+                .map(|(u, v)| u + s * (u - v))
+                .collect()
+        }
+        _ => state.u.clone(),
+    }
+}
+
+/// The local error estimate of the step just solved: the distance from the
+/// solution to the predictor through the last `order + 1` states, times the scheme's
+/// error constant relative to that of the predictor (backward Euler: Δt/(Δt + Δtₙ₋₁);
+/// BDF2: 2/11 for equal steps). None while the history is too short.
+fn error_estimate(
+    scheme: Scheme,
+    state: &State,
+    u_new: &[f64],
+    dt: f64,
+    setup: &Setup,
+) -> Option<f64> {
+    let n = setup.n_primal;
+    match scheme {
+        Scheme::BackwardEuler => {
+            let (t1, _) = state.past.first()?;
+            let h1 = state.time - t1;
+            let pred = predictor(state, dt, 1);
+            let c = dt / (dt + h1);
+            Some(max_diff(&u_new[..n], &pred[..n]) * c)
+        }
+        Scheme::Bdf2 => {
+            let (t1, u1) = state.past.first()?;
+            let (t2, u2) = state.past.get(1)?;
+            // Quadratic extrapolation through (t2,u2), (t1,u1), (t0,u0) to t0 + dt.
+            let (x0, x1, x2) = (state.time, *t1, *t2);
+            let x = x0 + dt;
+            let l0 = (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2));
+            let l1 = (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2));
+            let l2 = (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1));
+            let mut worst = 0.0f64;
+            for i in 0..n {
+                let p = l0 * state.u[i] + l1 * u1[i] + l2 * u2[i];
+                worst = worst.max((u_new[i] - p).abs());
+            }
+            Some(worst * 2.0 / 11.0)
+        }
+    }
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}

@@ -1,0 +1,283 @@
+//! One step's Newton iteration: the time history it needs, the linear solvers kept
+//! between iterations and steps, and the test for a linear step.
+
+use std::cell::RefCell;
+
+use crate::assembly::Assembler;
+use crate::enforce::interface::{InterfacePoints, Scatter};
+use crate::heat::{FaceBc, HeatError};
+use crate::solve::{
+    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
+};
+
+use super::setup::{Setup, node_dofs};
+use super::{Failure, Loads, StepReport, TransientProblem};
+
+/// The time history a step needs.
+pub(super) struct History<'s> {
+    pub(super) dt: f64,
+    pub(super) alpha: [f64; 3],
+    pub(super) current: &'s [f64],
+    pub(super) previous: Option<&'s [f64]>,
+}
+
+/// The linear solvers, kept across steps (symbolic analyses are reused).
+pub(super) struct Solvers {
+    pub(super) chol: Cholesky,
+    pub(super) saddle: SaddleLdlt,
+    pub(super) lu: Lu,
+    pub(super) amg: AmgCg,
+    /// The values of the matrix factored last and which solver holds it: a linear
+    /// problem stepping with a fixed step reuses the factorisation (bit for bit the
+    /// same as factoring again).
+    pub(super) factored: Option<(Vec<f64>, Which)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Which {
+    Saddle,
+    Cholesky,
+    Lu,
+    Amg,
+}
+
+impl Solvers {
+    pub(super) fn new(setup: &Setup, sequential: bool) -> Self {
+        let mut chol = Cholesky::new(Ordering::Metis);
+        chol.sequential = sequential;
+        let mut saddle = SaddleLdlt::with_primal(setup.n_primal, setup.n, Ordering::Metis);
+        saddle.sequential = sequential;
+        Solvers {
+            chol,
+            saddle,
+            lu: Lu::new(),
+            amg: AmgCg::new(AmgOptions {
+                tolerance: crate::heat::steady::AMG_TOLERANCE,
+                ..AmgOptions::default()
+            }),
+            factored: None,
+        }
+    }
+}
+
+pub(super) struct Context<'c, 'a> {
+    pub(super) p: &'c TransientProblem<'a>,
+    pub(super) setup: &'c Setup,
+    /// Per contact term: its points' geometry and where its blocks go.
+    pub(super) points: &'c [InterfacePoints],
+    pub(super) scatters: &'c [Scatter],
+    /// The face-derivative signature under which the element matrix slots were last
+    /// computed for a linear problem (None: not kept).
+    pub(super) element_matrices: RefCell<Option<Vec<(u32, u8, f64)>>>,
+    pub(super) tie_first: &'c [usize],
+    /// The report of the last Newton attempt that ran out of iterations (its
+    /// `diagnosis` set), for a steady solve to hand on with its last iterate.
+    pub(super) unconverged: RefCell<Option<StepReport>>,
+}
+
+/// Why Newton ran out of iterations, from its residual history: the history itself and
+/// the likely cause.
+pub(super) fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String {
+    let shown: Vec<String> = history.iter().map(|r| format!("{r:.3e}")).collect();
+    let (first, last) = (history[0], history[history.len() - 1]);
+    let falling = history.len() >= 2 && last < 0.5 * history[history.len() - 2];
+    let cause = if last > first {
+        "the residual grew: the iterates move away from the answer, as a strongly nonlinear law (radiation, k(T), a temperature-dependent conductance) does from a guess far from it; give an [initial] temperature nearer the expected one, or reach the steady state through a transient run".to_string()
+    } else if falling {
+        format!("the residual is still falling: raise [solve] max_iterations (now {iterations})")
+    } else {
+        "the residual stalls: the Jacobian does not match the residual (a plugin whose derivatives are wrong, a law that is not smooth), or the tolerance asks for more than round-off allows; `seam check-plugin` checks a plugin's derivatives".to_string()
+    };
+    format!(
+        "Newton did not converge in {iterations} iterations at t = {t}: ‖R‖ = {}; {cause}",
+        shown.join(" → ")
+    )
+}
+
+impl Context<'_, '_> {
+    /// Newton at time `t` from the guess `u` (updated in place). `Ok(Err(msg))`: the
+    /// attempt failed and may be retried with a smaller step.
+    pub(super) fn newton(
+        &self,
+        asm: &mut Assembler<'_>,
+        solvers: &mut Solvers,
+        u: &mut [f64],
+        t: f64,
+        history: Option<History<'_>>,
+    ) -> Result<Result<StepReport, String>, HeatError> {
+        let p = self.p;
+        let setup = self.setup;
+        let loads = (p.loads)(t)?;
+        let bcs = node_dofs(p.mesh, &setup.dofs, &setup.fields, &loads.dirichlet)?;
+        if bcs.len() != setup.dirichlet_dofs.len() {
+            return Err(HeatError::Step(format!(
+                "the Dirichlet nodes changed at t = {t}: {} now against {} at the start",
+                bcs.len(),
+                setup.dirichlet_dofs.len()
+            )));
+        }
+        for &(d, g) in &bcs {
+            u[d] = g;
+        }
+        let linear = self.is_linear(&loads);
+        let mut report = StepReport {
+            step: 0,
+            time: t,
+            dt: history.as_ref().map_or(0.0, |h| h.dt),
+            newton_iterations: 0,
+            residual_history: Vec::new(),
+            rejected: 0,
+            error_estimate: None,
+            heat: Vec::new(),
+            assembly_s: 0.0,
+            factor_s: 0.0,
+            solve_s: 0.0,
+            cg_iterations: 0,
+            diagnosis: None,
+        };
+        let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
+        // The last Newton update relative to max|u|.
+        let mut last_update = f64::INFINITY;
+        // A linear step's residual after its solve, and its interface systems.
+        let mut carried = None;
+        for it in 0..=p.max_iterations {
+            let clock = std::time::Instant::now();
+            let (mut r, mut terms) = match carried.take() {
+                Some(x) => x,
+                None => match self.assemble(asm, u, t, &loads, history.as_ref(), linear) {
+                    Ok(x) => x,
+                    Err(Failure::Retry(msg)) => return Ok(Err(msg)),
+                    Err(Failure::Fatal(e)) => return Err(e),
+                },
+            };
+            for &(d, _) in &bcs {
+                r[d] = 0.0;
+            }
+            let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+            report.residual_history.push(rn);
+            report.assembly_s += clock.elapsed().as_secs_f64();
+            if !rn.is_finite() {
+                return Ok(Err(format!("the residual is not finite at t = {t}")));
+            }
+            let done = it > 0 && (linear || last_update <= p.tolerance);
+            if done || it == p.max_iterations {
+                if !done {
+                    let message = unconverged(p.max_iterations, t, &report.residual_history);
+                    report.heat = self.heat(&terms, u);
+                    report.diagnosis = Some(message.clone());
+                    *self.unconverged.borrow_mut() = Some(report);
+                    return Ok(Err(message));
+                }
+                report.heat = self.heat(&terms, u);
+                return Ok(Ok(report));
+            }
+            let clock = std::time::Instant::now();
+            let mut jac = asm.matrix()?;
+            let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
+            apply_dirichlet(&mut jac, &mut rhs, &zero)?;
+            report.assembly_s += clock.elapsed().as_secs_f64();
+            let symmetric = linear;
+            // AMG-CG for a symmetric positive definite step system from the threshold on.
+            let amg =
+                setup.ties.is_empty() && symmetric && p.amg_threshold.is_some_and(|k| setup.n >= k);
+            let solved = (|| -> Result<(f64, f64, usize), HeatError> {
+                let t0 = std::time::Instant::now();
+                let same = solvers
+                    .factored
+                    .as_ref()
+                    .filter(|(v, _)| v.as_slice() == jac.val())
+                    .map(|(_, w)| *w);
+                let which = match same {
+                    Some(w) => w,
+                    None => {
+                        solvers.factored = None;
+                        let tied = !setup.ties.is_empty();
+                        let w = if amg {
+                            solvers.amg.factor(&jac)?;
+                            Which::Amg
+                        } else if tied && symmetric && solvers.saddle.factor(&jac).is_ok() {
+                            Which::Saddle
+                        } else if !tied && symmetric && solvers.chol.factor(&jac).is_ok() {
+                            Which::Cholesky
+                        } else {
+                            solvers.lu.factor(&jac)?;
+                            Which::Lu
+                        };
+                        if linear {
+                            solvers.factored = Some((jac.val().to_vec(), w));
+                        }
+                        w
+                    }
+                };
+                let factor_s = t0.elapsed().as_secs_f64();
+                let t1 = std::time::Instant::now();
+                let cg = match which {
+                    Which::Saddle => {
+                        solvers.saddle.solve(&mut rhs)?;
+                        0
+                    }
+                    Which::Cholesky => {
+                        solvers.chol.solve(&mut rhs)?;
+                        0
+                    }
+                    Which::Lu => {
+                        solvers.lu.solve(&mut rhs)?;
+                        0
+                    }
+                    Which::Amg => solvers.amg.solve(&mut rhs)?.iterations,
+                };
+                Ok((factor_s, t1.elapsed().as_secs_f64(), cg))
+            })();
+            let (factor_s, solve_s, cg) = match solved {
+                Ok(x) => x,
+                Err(HeatError::Solve(e)) => {
+                    return Ok(Err(format!("the linear solve failed at t = {t}: {e}")));
+                }
+                Err(e) => return Err(e),
+            };
+            report.factor_s += factor_s;
+            report.solve_s += solve_s;
+            report.cg_iterations += cg;
+            report.newton_iterations += 1;
+            let step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (ui, d) in u.iter_mut().zip(&rhs) {
+                *ui += d;
+            }
+            if linear {
+                // The residual of a linear system at u + du is R + J du: no second
+                // assembly (J's Dirichlet rows and columns are the identity, and du
+                // vanishes there).
+                let clock = std::time::Instant::now();
+                let mut jdu = vec![0.0; r.len()];
+                spmv(&jac, &rhs, &mut jdu);
+                r.iter_mut().zip(&jdu).for_each(|(r, j)| *r += j);
+                for s in terms.iter_mut().flatten() {
+                    s.advance(&rhs);
+                }
+                carried = Some((r, terms));
+                report.assembly_s += clock.elapsed().as_secs_f64();
+            }
+            let u_max = u[..setup.n_primal]
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+                .max(f64::MIN_POSITIVE);
+            last_update = step / u_max;
+        }
+        unreachable!("the loop returns at its last iteration")
+    }
+
+    /// Is the step's system linear (constant laws, linear faces, constant conductances,
+    /// sources that do not depend on T)?
+    pub(super) fn is_linear(&self, loads: &Loads) -> bool {
+        self.p
+            .laws
+            .iter()
+            .all(|l| l.conductivity.is_constant() && l.capacity.is_constant())
+            && loads
+                .faces
+                .iter()
+                .all(|f| !matches!(f, FaceBc::Radiation { .. }))
+            && self.p.contact.iter().all(|c| c.linear)
+            && (self.p.block_source).is_none_or(|s| s.iter().all(|q| !q.uses_temperature()))
+    }
+}

@@ -1,0 +1,171 @@
+//! What does not change over a run: the dofs and fields, the mortar ties and their
+//! multiplier rows, the Dirichlet dofs, the lumped capacity weights and the element
+//! bases.
+
+use std::collections::HashSet;
+
+use crate::assembly::{DofMap, FieldId};
+use crate::enforce::mortar::{MortarTie, mortar_tie};
+use crate::fem::{Basis, MAX_NODES};
+use crate::heat::kernel;
+use crate::heat::{HeatError, bad_jacobian, block_rules, elem_coords};
+use crate::mesh::{Mesh, NodeId};
+
+use super::TransientProblem;
+
+/// What does not change over a run: dofs, ties, the pattern's couplings, the lumped
+/// capacity weights.
+pub(super) struct Setup {
+    pub(super) dofs: DofMap,
+    pub(super) fields: Vec<FieldId>,
+    pub(super) n_primal: usize,
+    pub(super) n: usize,
+    pub(super) ties: Vec<MortarTie>,
+    pub(super) lambda_first: Vec<usize>,
+    pub(super) dirichlet_dofs: Vec<usize>,
+    pub(super) lumped: Vec<LumpedWeight>,
+    /// The blocks carrying a field, and the element basis of each.
+    pub(super) blocks: Vec<usize>,
+    pub(super) rules: Vec<Option<Basis>>,
+}
+
+impl Setup {
+    pub(super) fn new(p: &TransientProblem<'_>, time: f64) -> Result<Setup, HeatError> {
+        let mesh = p.mesh;
+        let specs = p.fields_or_default();
+        let list: Vec<(&str, &[usize])> = specs
+            .iter()
+            .map(|f| (f.name.as_str(), f.blocks.as_slice()))
+            .collect();
+        let mut dofs = DofMap::new(mesh, &list)?;
+        let fields: Vec<FieldId> = specs
+            .iter()
+            .map(|f| dofs.field(&f.name).expect("field just made"))
+            .collect();
+        let n_primal = dofs.len();
+        let loads = (p.loads)(time)?;
+        let dirichlet_dofs = node_dofs(mesh, &dofs, &fields, &loads.dirichlet)?
+            .into_iter()
+            .map(|(d, _)| d)
+            .collect();
+        let conductivity: Vec<f64> = p
+            .laws
+            .iter()
+            .map(|l| l.conductivity.eval(300.0, [0.0; 3], time).map(|(k, _)| k))
+            .collect::<Result<_, _>>()
+            .map_err(HeatError::Step)?;
+        let mut constrained: HashSet<NodeId> = loads.dirichlet.iter().map(|d| d.0).collect();
+        let mut ties = Vec::with_capacity(p.ties.len());
+        for (t, tie) in p.ties.iter().enumerate() {
+            let pair = p.term_pair(p.contact.len() + t, &fields);
+            ties.push(
+                mortar_tie(
+                    mesh,
+                    &dofs,
+                    pair,
+                    tie.side_a,
+                    tie.side_b,
+                    tie.points,
+                    &conductivity,
+                    &mut constrained,
+                    tie.multipliers,
+                )
+                .map_err(|e| HeatError::Contact(e.to_string()))?,
+            );
+        }
+        let lambda_first = ties
+            .iter()
+            .map(|t| dofs.add_extra(t.nodes.len()).start)
+            .collect();
+        let lumped = lumped_weights(mesh, &dofs)?;
+        let mut blocks: Vec<usize> = Vec::new();
+        let mut rules = vec![None; mesh.blocks.len()];
+        for &f in &fields {
+            blocks.extend_from_slice(dofs.field_blocks(f));
+            for (b, r) in block_rules(mesh, &dofs, f)?.into_iter().enumerate() {
+                if r.is_some() {
+                    rules[b] = r;
+                }
+            }
+        }
+        let n = dofs.len();
+        Ok(Setup {
+            dofs,
+            fields,
+            n_primal,
+            n,
+            ties,
+            lambda_first,
+            dirichlet_dofs,
+            lumped,
+            blocks,
+            rules,
+        })
+    }
+}
+
+/// `(dof, value)` of nodal data on whichever field the node carries.
+pub(super) fn node_dofs(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    fields: &[FieldId],
+    data: &[(NodeId, f64)],
+) -> Result<Vec<(usize, f64)>, HeatError> {
+    data.iter()
+        .map(|&(n, v)| {
+            fields
+                .iter()
+                .find_map(|&f| dofs.dof(f, n))
+                .map(|d| (d.index(), v))
+                .ok_or(HeatError::DirichletOffField(
+                    mesh.node_numbers.get(n.index()).copied().unwrap_or(-1),
+                ))
+        })
+        .collect()
+}
+
+/// (dof, block, ∫N_a dV over that block's elements at the node, node coordinates).
+pub(super) type LumpedWeight = (u32, u32, f64, [f64; 3]);
+
+/// Lumped capacity weights `∫ N_a dV` per (dof, block), with the node's coordinates.
+pub(super) fn lumped_weights(mesh: &Mesh, dofs: &DofMap) -> Result<Vec<LumpedWeight>, HeatError> {
+    let mut out: std::collections::BTreeMap<(u32, u32), f64> = Default::default();
+    let mut elem_dofs = Vec::new();
+    for (b, block) in mesh.blocks.iter().enumerate() {
+        if dofs.block_fields(b).is_empty() {
+            continue;
+        }
+        let basis = Basis::standard(block.topology).ok_or(HeatError::UnsupportedTopology {
+            block: block.id,
+            topology: block.topology,
+        })?;
+        let nn = block.topology.node_count();
+        let mut me = vec![0.0; nn * nn];
+        for k in 0..block.len() {
+            let e = crate::mesh::ElemId(block.first_elem.0 + k as u32);
+            let mut x = [[0.0; 3]; MAX_NODES];
+            let m = elem_coords(mesh, e, &mut x);
+            me.fill(0.0);
+            kernel::capacity_lumped(&basis, &x[..m], 1.0, &mut me)
+                .map_err(|bad| bad_jacobian(mesh, e, bad))?;
+            dofs.elem_dofs(mesh, e, &mut elem_dofs);
+            for a in 0..nn {
+                *out.entry((elem_dofs[a], b as u32)).or_default() += me[a * nn + a];
+            }
+        }
+    }
+    // Coordinates of each dof's node.
+    let mut coords = vec![[0.0; 3]; dofs.len()];
+    for f in 0..dofs.field_count() {
+        let f = FieldId(f as u32);
+        for node in 0..mesh.num_nodes() {
+            if let Some(d) = dofs.dof(f, NodeId(node as u32)) {
+                coords[d.index()] = mesh.coords[node];
+            }
+        }
+    }
+    Ok(out
+        .into_iter()
+        .map(|((d, b), w)| (d, b, w, coords[d as usize]))
+        .collect())
+}

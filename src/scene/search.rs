@@ -1,0 +1,394 @@
+//! The search of a whole contact definition: every interaction, and every periodic
+//! image paired with its destination.
+//!
+//! Entry point: [`search_definition`]; [`search_periodicity`] searches one periodic
+//! condition and keeps its map (for callers that move nodes and search again). Periodic
+//! conditions (`Periodicity For S = …`) are interactions between the image of `S` (side
+//! A) and a destination surface (side B): `Align_Surface` names it; for the other
+//! transforms it is the face surface, other than `S`, on which most of the image's points
+//! land. The inverse map is never asked of the user: the destination's side of the
+//! pairing is found by the search itself.
+//!
+//! The checks of a periodic map ([`crate::search::periodic`]) are reported here with
+//! their deck location: E0320 (unknown surface), E0321 (the map cannot be made or
+//! fails), E0322 (no mean normal), E0323 (the image lands nowhere), E0324 (the image
+//! misses its destination), E0325 (a rotation that does not close), E0326 (a map that is
+//! not one-to-one, before the search), W0320 (an angle that does not divide 360°).
+//!
+//! This is also where the deck's search options become the typed
+//! [`SearchSettings`] of periodic pairs ([`base_settings`]), its subdomain a
+//! [`Sphere`] ([`subdomain`]), its update frequency a [`SearchSchedule`]
+//! ([`search_schedule`]) and its transforms [`PeriodicTransform`]s.
+
+use std::path::Path;
+use std::time::Instant;
+
+use super::interaction::Interaction;
+use crate::deck::spec::{self, ContactDefinition, Periodicity};
+use crate::diag::{Diagnostic, SourceMap};
+use crate::mesh::Mesh;
+use crate::periodic::MapError;
+use crate::search::pairing::{
+    Integration, SearchError, SearchResult, SearchSchedule, Searcher, Sphere, SurfaceGeometry,
+};
+use crate::search::periodic::{
+    Closure, PeriodicError, PeriodicPairing, PeriodicTransform, check_closure, check_one_to_one,
+    landing, periodic_map,
+};
+use crate::search::scene::{Pairing, SceneSearch, surface_geometries};
+use crate::search::{Overclosure, SearchSettings};
+use crate::surface::{SurfaceKind, SurfaceSet};
+
+/// Search every interaction and periodic pair of `def`.
+#[allow(clippy::too_many_arguments)]
+pub fn search_definition(
+    mesh: &Mesh,
+    def: &ContactDefinition,
+    surfaces: &SurfaceSet,
+    interactions: &[Interaction],
+    deck_dir: &Path,
+    sources: &SourceMap,
+    integration: Integration,
+) -> SceneSearch {
+    let mut out = SceneSearch::default();
+    let subdomain = subdomain(def);
+    let t = Instant::now();
+    let geometry = surface_geometries(mesh, surfaces, &mut out.diagnostics);
+    out.timing.build_s += t.elapsed().as_secs_f64();
+
+    for i in interactions {
+        let (Some(a), Some(b)) = (&geometry[i.side_a], &geometry[i.side_b]) else {
+            continue;
+        };
+        if b.faces.is_empty() {
+            continue;
+        }
+        let t = Instant::now();
+        let searcher = Searcher::new(b, &i.settings);
+        out.timing.build_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let mut result = searcher.search(a, b, &i.settings, integration, subdomain);
+        result.treat_overclosure(i.overclosure);
+        out.timing.search_s += t.elapsed().as_secs_f64();
+        out.pairings.push(Pairing {
+            side_a: i.side_a_name.clone(),
+            side_b: i.side_b_name.clone(),
+            side_a_surface: i.side_a,
+            side_b_surface: i.side_b,
+            periodic: false,
+            side_a_geometry: a.clone(),
+            side_b_geometry: b.clone(),
+            result,
+            worst_image_distance: None,
+        });
+    }
+
+    for p in &def.periodicity {
+        if let Some(found) = search_periodicity(
+            mesh,
+            def,
+            p,
+            surfaces,
+            &geometry,
+            deck_dir,
+            sources,
+            integration,
+            &mut out,
+        ) {
+            out.pairings.push(found.pairing);
+        }
+    }
+    out
+}
+
+/// `Restrict Contact To Subdomain` of a definition: the sphere outside which nothing is
+/// searched.
+pub fn subdomain(def: &ContactDefinition) -> Option<Sphere> {
+    def.restrict_contact_to_subdomain.as_ref().map(|s| Sphere {
+        center: s.point,
+        radius: s.radius,
+    })
+}
+
+/// Search settings of periodic pairs: the definition's search options.
+pub fn base_settings(def: &ContactDefinition, dim: usize) -> SearchSettings {
+    let mut s = SearchSettings::defaults(dim);
+    if let Some(o) = &def.search_options {
+        s.normal_tolerance = o.normal_tolerance.or(s.normal_tolerance);
+        s.tangential_tolerance = o.tangential_tolerance.unwrap_or(s.tangential_tolerance);
+        s.buffer_factor = o.buffer_factor.unwrap_or(s.buffer_factor);
+        s.field_factor = o.field_factor.unwrap_or(s.field_factor);
+        s.normal_check_angle = o.normal_check_angle.unwrap_or(s.normal_check_angle);
+    }
+    s
+}
+
+fn face_surface(surfaces: &SurfaceSet, name: &str) -> Option<usize> {
+    let name = name.to_ascii_lowercase();
+    surfaces
+        .surfaces
+        .iter()
+        .position(|s| s.name == name && s.kind == SurfaceKind::Faces)
+}
+
+/// The search schedule of a contact definition: `Update Search Every n Steps`, else the
+/// search options' `Search Update Frequency` (ELFEN's name for the same), else 1.
+pub fn search_schedule(def: &ContactDefinition) -> SearchSchedule {
+    SearchSchedule::new(
+        def.update_search_every_n_steps.or(def
+            .search_options
+            .as_ref()
+            .and_then(|o| o.search_update_frequency)),
+    )
+}
+
+impl From<&spec::PeriodicTransform> for PeriodicTransform {
+    fn from(t: &spec::PeriodicTransform) -> Self {
+        match t {
+            spec::PeriodicTransform::Rectangular { offset } => PeriodicTransform::Rectangular {
+                offset: offset.clone(),
+            },
+            spec::PeriodicTransform::Cylindrical {
+                axis,
+                center,
+                angle,
+            } => PeriodicTransform::Cylindrical {
+                axis: axis.clone(),
+                center: center.clone(),
+                angle: *angle,
+            },
+            spec::PeriodicTransform::AlignSurface {
+                destination,
+                invert_normals,
+            } => PeriodicTransform::AlignSurface {
+                destination: destination.clone(),
+                invert_normals: *invert_normals,
+            },
+            spec::PeriodicTransform::Mapped {
+                x_map,
+                y_map,
+                z_map,
+            } => PeriodicTransform::Mapped {
+                x_map: x_map.clone(),
+                y_map: y_map.clone(),
+                z_map: z_map.clone(),
+            },
+        }
+    }
+}
+
+impl From<spec::Overclosure> for Overclosure {
+    fn from(o: spec::Overclosure) -> Self {
+        match o {
+            spec::Overclosure::AdjustNodes => Overclosure::AdjustNodes,
+            spec::Overclosure::StoreOffsets => Overclosure::StoreOffsets,
+        }
+    }
+}
+
+/// Search one `Periodicity For S = …` of `def`: the image of `S` paired with its
+/// destination (given by `Align_Surface`, else the face surface other than `S` on which
+/// most image points land), and the map. `geometry` is [`surface_geometries`] of
+/// `surfaces`. Diagnostics (E0320–E0326, W0320) and timing go to `out`; `None` when the
+/// condition cannot be searched.
+#[allow(clippy::too_many_arguments)]
+pub fn search_periodicity(
+    mesh: &Mesh,
+    def: &ContactDefinition,
+    p: &Periodicity,
+    surfaces: &SurfaceSet,
+    geometry: &[Option<SurfaceGeometry>],
+    deck_dir: &Path,
+    sources: &SourceMap,
+    integration: Integration,
+    out: &mut SceneSearch,
+) -> Option<PeriodicPairing> {
+    let settings = base_settings(def, mesh.dim);
+    let subdomain = subdomain(def);
+    let at = sources.narrow(&p.at, &p.surface);
+    let Some(s) = face_surface(surfaces, &p.surface) else {
+        out.diagnostics.push(
+            Diagnostic::error(
+                "E0320",
+                format!("periodicity for `{}`: no contact surface of faces has that name", p.surface),
+            )
+            .at(Some(at))
+            .help("define the surface with `Contact Surface` (or a side set) before using it in a periodicity"),
+        );
+        return None;
+    };
+    let source = geometry[s].as_ref()?;
+    let transform = PeriodicTransform::from(&p.transform);
+    let model_size = mesh.model_size();
+    let mut destination = None;
+    if let PeriodicTransform::AlignSurface {
+        destination: dest, ..
+    } = &transform
+    {
+        let Some(d) = face_surface(surfaces, dest) else {
+            out.diagnostics.push(
+                Diagnostic::error(
+                    "E0320",
+                    format!(
+                        "periodicity for `{}`: unknown destination surface `{dest}`",
+                        p.surface
+                    ),
+                )
+                .at(Some(sources.narrow(&p.at, dest)))
+                .help("`Destination =` names a contact surface of faces"),
+            );
+            return None;
+        };
+        geometry[d].as_ref()?;
+        destination = Some(d);
+    }
+    match check_closure(&transform, source, model_size) {
+        Ok(Closure::AngleDoesNotDivide) => {
+            if let PeriodicTransform::Cylindrical { angle, .. } = &transform {
+                out.diagnostics.push(
+                    Diagnostic::warning(
+                        "W0320",
+                        format!(
+                            "periodicity for `{}`: the angle {angle}° does not divide 360°",
+                            p.surface
+                        ),
+                    )
+                    .at(Some(p.at.clone()))
+                    .help("a sector of a full ring has an angle of 360/N degrees"),
+                );
+            }
+        }
+        Ok(_) => {}
+        Err(e) => out.diagnostics.push(
+            Diagnostic::error("E0325", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(p.at.clone()))
+                .help("give the angle to full precision (e.g. 360/7 as 51.428571428571431)"),
+        ),
+    }
+    let chunk = if p.at.is_unknown() {
+        format!("periodicity for {}", p.surface)
+    } else {
+        format!("{}:{}", p.at.file, p.at.line)
+    };
+    let destination_geometry = destination.and_then(|d| geometry[d].as_ref());
+    let mut map = match periodic_map(
+        &transform,
+        source,
+        destination_geometry,
+        deck_dir,
+        &chunk,
+        model_size,
+    ) {
+        Ok(m) => m,
+        // A zero axis is rejected by the deck checks.
+        Err(PeriodicError::ZeroAxis) => return None,
+        Err(e @ PeriodicError::NoMeanNormal) => {
+            out.diagnostics.push(
+                Diagnostic::error("E0322", format!("periodicity for `{}`: {e}", p.surface))
+                    .at(Some(at))
+                    .help("`Align_Surface` needs two roughly planar surfaces"),
+            );
+            return None;
+        }
+        Err(e) => {
+            let help = match &e {
+                PeriodicError::Map(MapError::OutsideDeck(_)) => {
+                    "put the Lua file in the deck's directory or below it"
+                }
+                _ => "fix the Lua map; each map is an expression in x, y, z or `file.lua:function`",
+            };
+            out.diagnostics.push(
+                Diagnostic::error("E0321", format!("periodicity for `{}`: {e}", p.surface))
+                    .at(Some(at))
+                    .help(help),
+            );
+            return None;
+        }
+    };
+    let image_name = format!("{}_image", p.surface);
+    let t = Instant::now();
+    let image = match source.mapped(map.as_mut(), &image_name) {
+        Ok(g) => g,
+        Err(SearchError::Map { source: e, .. }) => {
+            out.diagnostics.push(
+                Diagnostic::error("E0321", format!("periodicity for `{}`: {e}", p.surface))
+                    .at(Some(at))
+                    .help("the map failed while mapping the surface's nodes"),
+            );
+            return None;
+        }
+        Err(e) => {
+            out.diagnostics
+                .push(Diagnostic::error("E0312", e.to_string()).at(Some(at)));
+            return None;
+        }
+    };
+    out.timing.build_s += t.elapsed().as_secs_f64();
+    if let Some(fold) = check_one_to_one(source, &image, |n| mesh.node_number(n)) {
+        let e = PeriodicError::Folds(Box::new(fold));
+        out.diagnostics.push(
+            Diagnostic::error("E0326", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(at))
+                .help("a periodic map carries each node to its own place on the partner surface (a rigid motion or close to one); check the map: a constant (`x_map = 0`) or a folding formula (`x_map = math.abs(x)`) sends several nodes to one point"),
+        );
+        return None;
+    }
+
+    // The destination: given, or the face surface that takes most image points.
+    let candidates: Vec<usize> = match destination {
+        Some(d) => vec![d],
+        None => (0..surfaces.surfaces.len())
+            .filter(|&d| d != s && geometry[d].as_ref().is_some_and(|g| !g.faces.is_empty()))
+            .collect(),
+    };
+    let mut best: Option<(usize, SearchResult)> = None;
+    for d in candidates {
+        let Some(dg) = &geometry[d] else { continue };
+        let t = Instant::now();
+        let searcher = Searcher::new(dg, &settings);
+        out.timing.build_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let r = searcher.search(&image, dg, &settings, integration, subdomain);
+        out.timing.search_s += t.elapsed().as_secs_f64();
+        if best
+            .as_ref()
+            .is_none_or(|(_, b)| r.stats.matched > b.stats.matched)
+        {
+            best = Some((d, r));
+        }
+    }
+    let Some((d, result)) = best.filter(|(_, r)| r.stats.matched > 0) else {
+        out.diagnostics.push(
+            Diagnostic::error(
+                "E0323",
+                format!("periodicity for `{}`: its image lands on no contact surface", p.surface),
+            )
+            .at(Some(at))
+            .help("check the transform (offset, axis, centre, angle or map): the image of the surface must lie on another contact surface"),
+        );
+        return None;
+    };
+    let dg = geometry[d].as_ref().expect("destination geometry exists");
+    let landed = landing(&image, dg);
+    if let Err(e) = landed.check(&surfaces.surfaces[d].name) {
+        out.diagnostics.push(
+            Diagnostic::error("E0324", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(at))
+                .help("the transform must carry the surface exactly onto its partner; check the offset, angle or map"),
+        );
+    }
+    Some(PeriodicPairing {
+        pairing: Pairing {
+            side_a: p.surface.to_ascii_lowercase(),
+            side_b: surfaces.surfaces[d].name.clone(),
+            side_a_surface: s,
+            side_b_surface: d,
+            periodic: true,
+            side_a_geometry: image,
+            side_b_geometry: dg.clone(),
+            result,
+            worst_image_distance: Some(landed.worst),
+        },
+        map,
+    })
+}

@@ -1,0 +1,351 @@
+//! The faces of a surface as coordinates ([`FaceGeom`], [`SurfaceGeometry`]): built
+//! from a contact surface or a side set, lofted, mapped to a periodic image, with node
+//! surfaces' tributary areas and normals; and the reference-face helpers (shape values,
+//! area Jacobian, Gauss rules) the search integrates with.
+
+use crate::fem::quadrature::gauss_legendre;
+use crate::mesh::{Mesh, NodeId, Side};
+use crate::periodic::PeriodicMap;
+use crate::script::ScriptError;
+use crate::search::bvh::Aabb;
+use crate::search::mortar::rule_triangle;
+use crate::search::project::{map_quad4, map_tri3, vector_area_quad4};
+use crate::surface::{ContactSurface, SurfaceKind};
+use crate::vec3::{V3, add, cross, norm, scale, sub};
+
+/// One face as coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaceGeom {
+    /// The mesh side it came from.
+    pub side: Side,
+    /// Node count: 3 or 4 (2-D edges are not searched yet).
+    pub len: u8,
+    pub nodes: [NodeId; 4],
+    pub x: [V3; 4],
+}
+
+impl FaceGeom {
+    pub fn coords(&self) -> &[V3] {
+        &self.x[..self.len as usize]
+    }
+
+    /// Vector area (normal × area).
+    pub fn vector_area(&self) -> V3 {
+        match self.len {
+            3 => {
+                let c = cross(sub(self.x[1], self.x[0]), sub(self.x[2], self.x[0]));
+                scale(c, 0.5)
+            }
+            _ => {
+                let q = [self.x[0], self.x[1], self.x[2], self.x[3]];
+                vector_area_quad4(&q)
+            }
+        }
+    }
+
+    pub fn area(&self) -> f64 {
+        norm(self.vector_area())
+    }
+
+    pub fn normal(&self) -> V3 {
+        let v = self.vector_area();
+        let n = norm(v);
+        if n > 0.0 { scale(v, 1.0 / n) } else { [0.0; 3] }
+    }
+
+    pub fn centroid(&self) -> V3 {
+        let k = self.len as usize;
+        let mut c = [0.0; 3];
+        for p in self.coords() {
+            c = add(c, *p);
+        }
+        scale(c, 1.0 / k as f64)
+    }
+
+    pub(super) fn aabb(&self) -> Aabb {
+        Aabb::from_points(self.coords())
+    }
+
+    pub(super) fn map(&self, xi: [f64; 2]) -> V3 {
+        match self.len {
+            3 => map_tri3(&[self.x[0], self.x[1], self.x[2]], xi),
+            _ => map_quad4(&[self.x[0], self.x[1], self.x[2], self.x[3]], xi),
+        }
+    }
+}
+
+/// The faces (or nodes) of one surface, as coordinates.
+#[derive(Clone, Debug, Default)]
+pub struct SurfaceGeometry {
+    pub name: String,
+    pub faces: Vec<FaceGeom>,
+    /// For node surfaces: the nodes and their coordinates.
+    pub nodes: Vec<(NodeId, V3)>,
+    /// For node surfaces, per node (parallel to `nodes`): its tributary area
+    /// `A_i = Σ_f ∫_f N_i dA` and unit normal `n_i ∝ Σ_f ∫_f N_i n dA` over the tributary
+    /// faces around it (zero area and normal for a node on none). See
+    /// [`SurfaceGeometry::tributary_of_nodes`].
+    pub node_area: Vec<f64>,
+    pub node_normal: Vec<V3>,
+    /// For node surfaces: the faces the areas and normals come from (not searched).
+    pub tributary: Vec<FaceGeom>,
+}
+
+/// Why a surface cannot be searched.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SearchError {
+    #[error("surface `{0}` is made of edges (a 2-D mesh): 2-D contact search is not supported yet")]
+    TwoDimensional(String),
+    #[error("periodic map of surface `{surface}`: {source}")]
+    Map {
+        surface: String,
+        source: ScriptError,
+    },
+}
+
+impl SurfaceGeometry {
+    /// The geometry of a built surface on coordinates `coords` (the mesh's, or moved
+    /// ones); shell faces are lofted along their normal by their `loft`.
+    pub fn from_surface(
+        mesh: &Mesh,
+        surface: &ContactSurface,
+        coords: &[V3],
+    ) -> Result<Self, SearchError> {
+        let mut out = SurfaceGeometry {
+            name: surface.name.clone(),
+            ..Default::default()
+        };
+        if surface.kind == SurfaceKind::Nodes {
+            out.nodes = surface
+                .nodes
+                .iter()
+                .map(|&n| (n, coords[n.index()]))
+                .collect();
+            for &side in &surface.tributary {
+                let g = face_geom(mesh, side, coords);
+                // Edges (2-D meshes) are not searched; as tributaries they give nothing.
+                if g.len >= 3 {
+                    out.tributary.push(g);
+                }
+            }
+            out.tributary_of_nodes();
+            return Ok(out);
+        }
+        out.faces.reserve(surface.faces.len());
+        for f in &surface.faces {
+            let mut g = face_geom(mesh, f.side, coords);
+            if g.len == 2 {
+                return Err(SearchError::TwoDimensional(surface.name.clone()));
+            }
+            if f.loft != 0.0 {
+                let n = g.normal();
+                for p in &mut g.x[..g.len as usize] {
+                    *p = add(*p, scale(n, f.loft));
+                }
+            }
+            out.faces.push(g);
+        }
+        Ok(out)
+    }
+
+    /// Each node's tributary area and normal from the tributary faces (module docs of
+    /// `enforce::interface`, node-to-face form): `A_i = Σ_f ∫_f N_i dA`, the row sum of the
+    /// face mass matrix, so `Σ_i A_i` is the faces' area and a constant flux q gives
+    /// `Σ_i A_i q = q A` exactly; `n_i = Σ_f ∫_f N_i n dA`, normalised. Tri3 faces are
+    /// flat (`∫ N_i = A/3`); Quad4 faces use the 2×2 Gauss rule of the bilinear map, exact
+    /// for `N_i |J|` on flat faces (N_i bilinear, |J| bilinear) and for `N_i J` on warped
+    /// ones (both of degree ≤ 2 in each coordinate).
+    pub fn tributary_of_nodes(&mut self) {
+        let index: std::collections::HashMap<NodeId, usize> = self
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(k, &(n, _))| (n, k))
+            .collect();
+        let mut area = vec![0.0; self.nodes.len()];
+        let mut vector = vec![[0.0; 3]; self.nodes.len()];
+        for f in &self.tributary {
+            let len = f.len as usize;
+            // A triangle's N_i is linear and its Jacobian constant: the centroid rule is
+            // exact.
+            let rule: Vec<([f64; 2], f64)> = if len == 3 {
+                vec![([1.0 / 3.0, 1.0 / 3.0], 0.5)]
+            } else {
+                let (g, w) = gauss_legendre(2);
+                [(0, 0), (1, 0), (1, 1), (0, 1)]
+                    .map(|(i, j)| ([g[i], g[j]], w[i] * w[j]))
+                    .to_vec()
+            };
+            for &(xi, w) in &rule {
+                let j = face_normal_jacobian(f, xi);
+                let shapes = face_shapes(len, xi);
+                for (node, shape) in f.nodes.iter().zip(shapes).take(len) {
+                    let Some(&i) = index.get(node) else {
+                        continue;
+                    };
+                    let wn = w * shape;
+                    area[i] += wn * norm(j);
+                    vector[i] = add(vector[i], scale(j, wn));
+                }
+            }
+        }
+        self.node_normal = vector
+            .iter()
+            .map(|&v| {
+                let l = norm(v);
+                if l > 0.0 { scale(v, 1.0 / l) } else { [0.0; 3] }
+            })
+            .collect();
+        self.node_area = area;
+    }
+
+    /// The geometry of side set `set` of the mesh taken whole as a surface, on the
+    /// mesh's coordinates (for hosts and tests that name their interface faces directly).
+    pub fn from_side_set(mesh: &Mesh, set: usize) -> Result<Self, SearchError> {
+        let ss = &mesh.side_sets[set];
+        let surface = ContactSurface {
+            name: ss.sierra_name(),
+            kind: SurfaceKind::Faces,
+            faces: ss
+                .sides
+                .iter()
+                .map(|&side| crate::surface::SurfaceFace {
+                    side,
+                    loft: 0.0,
+                    origin: 0,
+                })
+                .collect(),
+            tributary: Vec::new(),
+            nodes: Vec::new(),
+            origins: Vec::new(),
+            parent: None,
+        };
+        Self::from_surface(mesh, &surface, &mesh.coords)
+    }
+
+    /// The image of this surface under a periodic map, named `name`.
+    pub fn mapped(&self, map: &mut dyn PeriodicMap, name: &str) -> Result<Self, SearchError> {
+        let fail = |source| SearchError::Map {
+            surface: self.name.clone(),
+            source,
+        };
+        let mut out = self.clone();
+        out.name = name.to_string();
+        for f in &mut out.faces {
+            for p in &mut f.x[..f.len as usize] {
+                *p = map.map_point(*p).map_err(fail)?;
+            }
+        }
+        for (_, p) in &mut out.nodes {
+            *p = map.map_point(*p).map_err(fail)?;
+        }
+        for f in &mut out.tributary {
+            for p in &mut f.x[..f.len as usize] {
+                *p = map.map_point(*p).map_err(fail)?;
+            }
+        }
+        if !out.nodes.is_empty() {
+            out.tributary_of_nodes();
+        }
+        Ok(out)
+    }
+
+    /// The area of the faces, or for a node surface the sum of its nodes' tributary areas.
+    pub fn area(&self) -> f64 {
+        self.faces.iter().map(FaceGeom::area).sum::<f64>() + self.node_area.iter().sum::<f64>()
+    }
+
+    /// Mean face size (√area), the length scale of the search tolerances.
+    pub fn mean_face_size(&self) -> f64 {
+        if self.faces.is_empty() {
+            return 0.0;
+        }
+        self.faces.iter().map(|f| f.area().sqrt()).sum::<f64>() / self.faces.len() as f64
+    }
+}
+
+/// One face of the mesh as coordinates (unlofted).
+pub(super) fn face_geom(mesh: &Mesh, side: Side, coords: &[V3]) -> FaceGeom {
+    let mut g = FaceGeom {
+        side,
+        len: 0,
+        nodes: [NodeId(0); 4],
+        x: [[0.0; 3]; 4],
+    };
+    for (k, n) in mesh.side_nodes(side).enumerate().take(4) {
+        g.nodes[k] = n;
+        g.x[k] = coords[n.index()];
+        g.len += 1;
+    }
+    g
+}
+
+/// Shape functions of a Tri3 (`len` 3) or Quad4 face at `xi`, Exodus node order (the
+/// fourth value is 0 for a triangle).
+pub(crate) fn face_shapes(len: usize, xi: [f64; 2]) -> [f64; 4] {
+    let (s, t) = (xi[0], xi[1]);
+    if len == 3 {
+        [1.0 - s - t, s, t, 0.0]
+    } else {
+        [
+            0.25 * (1.0 - s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 - t),
+            0.25 * (1.0 + s) * (1.0 + t),
+            0.25 * (1.0 - s) * (1.0 + t),
+        ]
+    }
+}
+
+/// ∂x/∂ξ × ∂x/∂η at ξ: the face's area Jacobian times its unit normal.
+pub(super) fn face_normal_jacobian(face: &FaceGeom, xi: [f64; 2]) -> V3 {
+    let x = &face.x;
+    match face.len {
+        3 => cross(sub(x[1], x[0]), sub(x[2], x[0])),
+        _ => {
+            let (s, t) = (xi[0], xi[1]);
+            let d_xi: V3 = std::array::from_fn(|d| {
+                0.25 * (-(1.0 - t) * x[0][d] + (1.0 - t) * x[1][d] + (1.0 + t) * x[2][d]
+                    - (1.0 + t) * x[3][d])
+            });
+            let d_eta: V3 = std::array::from_fn(|d| {
+                0.25 * (-(1.0 - s) * x[0][d] - (1.0 + s) * x[1][d]
+                    + (1.0 + s) * x[2][d]
+                    + (1.0 - s) * x[3][d])
+            });
+            cross(d_xi, d_eta)
+        }
+    }
+}
+
+/// Gauss rule on a face's reference element: (ξ, weight on the reference element).
+pub(super) fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
+    match face.len {
+        3 => {
+            // Weights relative to the area, which is 1/2 on the reference triangle.
+            rule_triangle(order.max(1))
+                .points
+                .iter()
+                .map(|&(xi, w)| (xi, w * 0.5))
+                .collect()
+        }
+        _ => {
+            let (xs, ws) = gauss_legendre(order.clamp(1, 3));
+            let mut out = Vec::with_capacity(xs.len() * xs.len());
+            for (j, &eta) in xs.iter().enumerate() {
+                for (i, &xi) in xs.iter().enumerate() {
+                    out.push(([xi, eta], ws[i] * ws[j]));
+                }
+            }
+            out
+        }
+    }
+}
+
+/// |∂x/∂ξ × ∂x/∂η| at ξ: the area Jacobian of the face's map.
+pub(super) fn face_jacobian(face: &FaceGeom, xi: [f64; 2]) -> f64 {
+    match face.len {
+        3 => 2.0 * face.area(),
+        _ => norm(face_normal_jacobian(face, xi)),
+    }
+}

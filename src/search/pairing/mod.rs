@@ -1,0 +1,415 @@
+//! The contact search of one interaction: side-A points paired with side-B faces.
+//!
+//! Entry points: [`SurfaceGeometry`] (the faces of a surface as coordinates: lofted,
+//! or mapped to a periodic image), [`Searcher`] (a BVH over the side-B faces, refitted
+//! when only coordinates move) and [`Searcher::search`], which returns a
+//! [`SearchResult`]: one [`ContactPoint`] per side-A integration point (or mortar
+//! segment point) with its side-B face, parametric coordinates, gap and normals, and
+//! the statistics an analyst needs to trust it.
+//!
+//! A node surface (contact node set, `Contact Type = node`) gives one point per node,
+//! weighted by its tributary area and carrying its normal
+//! ([`SurfaceGeometry::tributary_of_nodes`]), whatever the integration mode.
+//!
+//! Two integration modes ([`Integration`]): `Quadrature` places Gauss points on each
+//! side-A face and projects each onto side B (fast; not exact on non-matching meshes);
+//! `Segments` clips every side-A face against the side-B faces projected onto it and
+//! places points on the overlap polygons (exact for polynomials of the rule's degree).
+//!
+//! Acceptance of a side-B face for a point, in this order:
+//! 1. the point projects inside the face (within its tangential tolerance);
+//! 2. normals: the side-B normal makes at most `normal_check_angle` with the opposite of
+//!    the side-A normal, and (unless culling is disabled) at least
+//!    `opposed_normal_threshold_angle` with the side-A normal;
+//! 3. distance: |gap| ≤ the normal tolerance, or, without one, ≤ field factor × the
+//!    target face's size (√area).
+//!
+//! Among accepted faces one that has the point inside beats one accepted by the
+//! tangential tolerance only; then the smallest |gap| wins, ties going to the lowest
+//! face index, so
+//! a point on a shared edge or vertex is paired exactly once, the same way every run.
+//! Gaps are positive when open (side A lies on the side side B's normal points to).
+//! Results do not depend on the number of threads: side-A faces are processed in fixed
+//! chunks whose results are concatenated in order.
+//!
+//! The parts: `geometry` (faces as coordinates, the reference-face helpers) and `points`
+//! (the acceptance tests and best face of each point of a chunk); this file holds the
+//! result types, the [`Searcher`] and its schedule.
+
+mod geometry;
+mod points;
+
+pub(crate) use geometry::face_shapes;
+pub use geometry::{FaceGeom, SearchError, SurfaceGeometry};
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::bvh::{Aabb, Bvh};
+use super::settings::{Overclosure, SearchSettings};
+use crate::vec3::{V3, dot, scale, sub};
+
+use points::Ctx;
+
+/// The highest integration order accepted from input. A segment rule of order p on a
+/// triangle has ((p + 2)/2)² points built in O(p³) work, so an order in the thousands
+/// would run for hours per segment; 20 integrates polynomials far beyond any contact
+/// law's.
+pub const MAX_ORDER: usize = 20;
+
+/// How side-A points are placed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integration {
+    /// Gauss points of each side-A face (order 1: centroid; 2: 3-point triangle and
+    /// 2×2 quad; 3+: 6-point triangle and 3×3 quad), each projected onto side B.
+    Quadrature { order: usize },
+    /// Points of the overlap polygons of side-A faces with side-B faces, exact for
+    /// polynomials of degree `order`.
+    Segments { order: usize },
+}
+
+/// Outcome of one side-A point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PointStatus {
+    Matched,
+    /// No side-B face within the search box had the point inside it.
+    Unmatched,
+    /// A face had the point inside, but too far along the normal.
+    RejectedDistance,
+    /// A face had the point inside, but its normal was not opposed enough.
+    RejectedAngle,
+    /// The point lies outside the `Restrict Contact To Subdomain` sphere.
+    RejectedSubdomain,
+}
+
+/// One side-A point and its pairing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactPoint {
+    /// Index of the side-A face in its [`SurfaceGeometry`] (`u32::MAX` for a node point).
+    pub a_face: u32,
+    /// Index of the side-A node for node surfaces, else `u32::MAX`.
+    pub a_node: u32,
+    pub xi_a: [f64; 2],
+    /// The point on side A.
+    pub x: V3,
+    /// Integration weight (area); a node point's tributary area.
+    pub weight: f64,
+    pub status: PointStatus,
+    /// Index of the side-B face (`u32::MAX` when unmatched).
+    pub b_face: u32,
+    pub xi_b: [f64; 2],
+    /// Signed gap, positive when open.
+    pub gap: f64,
+    /// Initial gap recorded by `Initial Overclosure = Store Offsets` (the enforcement
+    /// sees `gap − offset`); 0 otherwise.
+    pub offset: f64,
+    pub normal_a: V3,
+    pub normal_b: V3,
+}
+
+/// Counts and measures of one interaction's search.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SearchStats {
+    pub points: usize,
+    pub matched: usize,
+    pub unmatched: usize,
+    pub rejected_distance: usize,
+    pub rejected_angle: usize,
+    pub rejected_subdomain: usize,
+    /// Area of side A covered by side B (clipped overlap polygons of matched pairs; for
+    /// a node surface, the tributary areas of its matched nodes).
+    pub overlap_area: f64,
+    pub side_a_area: f64,
+    /// Over matched points; `None` when nothing matched.
+    pub gap_min: Option<f64>,
+    pub gap_max: Option<f64>,
+}
+
+/// The pairing of one interaction.
+#[derive(Clone, Debug, Default)]
+pub struct SearchResult {
+    pub points: Vec<ContactPoint>,
+    pub stats: SearchStats,
+    /// Per side-A face: the fraction (0…1) of its integration weight that is matched
+    /// (`Visualize Contact`).
+    pub contact_fraction: Vec<f64>,
+}
+
+/// A sphere outside which points take no part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    pub center: V3,
+    pub radius: f64,
+}
+
+/// The side-B half of a search: a BVH over the faces, kept between searches.
+pub struct Searcher {
+    bvh: Bvh,
+    /// Box inflation: the search buffer (mean face size × buffer factor, or more).
+    margin: f64,
+    /// The farthest a point may be from a face's own box and still pair with it (the
+    /// largest distance acceptance plus the tangential tolerance): candidates beyond it
+    /// are skipped before the (much dearer) projection.
+    reach: f64,
+}
+
+/// One chunk's points and, per face, (matched weight, total weight, overlap area).
+type ChunkOut = (Vec<ContactPoint>, Vec<(f64, f64, f64)>);
+
+/// Side-A faces per parallel chunk: large enough to amortise scheduling, fixed so
+/// results never depend on the thread count.
+const CHUNK: usize = 512;
+
+impl Searcher {
+    /// Build the tree over `b`'s faces for `settings`.
+    pub fn new(b: &SurfaceGeometry, settings: &SearchSettings) -> Searcher {
+        let margin = margin_for(b, settings);
+        let boxes: Vec<Aabb> = b.faces.iter().map(|f| f.aabb().inflate(margin)).collect();
+        let largest = max_face_size(b);
+        let reach = settings
+            .normal_tolerance
+            .unwrap_or(0.0)
+            .max(settings.field_factor * largest)
+            + settings.tangential_tolerance * largest;
+        Searcher {
+            bvh: Bvh::build(&boxes),
+            margin,
+            reach: reach.min(margin),
+        }
+    }
+
+    /// The side-B faces moved (same faces, new coordinates): refit the tree.
+    pub fn refit(&mut self, b: &SurfaceGeometry) {
+        let boxes: Vec<Aabb> = b
+            .faces
+            .iter()
+            .map(|f| f.aabb().inflate(self.margin))
+            .collect();
+        self.bvh.refit(&boxes);
+    }
+
+    /// Pair `a`'s points with `b`'s faces.
+    pub fn search(
+        &self,
+        a: &SurfaceGeometry,
+        b: &SurfaceGeometry,
+        settings: &SearchSettings,
+        integration: Integration,
+        subdomain: Option<Sphere>,
+    ) -> SearchResult {
+        self.run(a, b, settings, integration, subdomain, true)
+    }
+
+    /// [`Self::search`] without the overlap-area diagnostic (`stats.overlap_area` stays
+    /// 0 in quadrature mode): the pairing alone, for callers that redo it every step.
+    pub fn search_points(
+        &self,
+        a: &SurfaceGeometry,
+        b: &SurfaceGeometry,
+        settings: &SearchSettings,
+        integration: Integration,
+        subdomain: Option<Sphere>,
+    ) -> SearchResult {
+        self.run(a, b, settings, integration, subdomain, false)
+    }
+
+    fn run(
+        &self,
+        a: &SurfaceGeometry,
+        b: &SurfaceGeometry,
+        settings: &SearchSettings,
+        integration: Integration,
+        subdomain: Option<Sphere>,
+        overlap: bool,
+    ) -> SearchResult {
+        let ctx = Ctx {
+            bvh: &self.bvh,
+            margin: self.margin,
+            reach2: self.reach * self.reach,
+            b,
+            settings,
+            subdomain,
+            cos_check: settings.normal_check_angle.to_radians().cos(),
+            cos_opposed: settings
+                .cull_opposed_normals
+                .then(|| settings.opposed_normal_threshold_angle.to_radians().cos()),
+        };
+        let mut result = SearchResult::default();
+        // Faces, in fixed chunks, in parallel; each chunk gives its points and, per face,
+        // the matched weight, total weight and overlap area.
+        let chunks: Vec<ChunkOut> = (0..a.faces.len())
+            .step_by(CHUNK)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .map(|start| {
+                let end = (start + CHUNK).min(a.faces.len());
+                let mut points = Vec::new();
+                let mut per_face = Vec::with_capacity(end - start);
+                let mut scratch = Vec::new();
+                for fa in start..end {
+                    let before = points.len();
+                    match integration {
+                        Integration::Quadrature { order } => {
+                            ctx.quadrature_points(a, fa, order, &mut points)
+                        }
+                        Integration::Segments { order } => {
+                            ctx.segment_points(a, fa, order, &mut points, &mut scratch)
+                        }
+                    }
+                    let (mut hit, mut total) = (0.0, 0.0);
+                    for p in &points[before..] {
+                        total += p.weight;
+                        if p.status == PointStatus::Matched {
+                            hit += p.weight;
+                        }
+                    }
+                    let area = if overlap || matches!(integration, Integration::Segments { .. }) {
+                        ctx.overlap_of(a, fa, &points[before..], integration)
+                    } else {
+                        0.0
+                    };
+                    per_face.push((hit, total, area));
+                }
+                (points, per_face)
+            })
+            .collect();
+        for (points, per_face) in chunks {
+            result.points.extend(points);
+            for (hit, total, overlap) in per_face {
+                result
+                    .contact_fraction
+                    .push(if total > 0.0 { hit / total } else { 0.0 });
+                result.stats.overlap_area += overlap;
+            }
+        }
+        for k in 0..a.nodes.len() {
+            let p = ctx.pair_node(a, k);
+            if overlap && p.status == PointStatus::Matched {
+                // A node surface's covered area: its matched nodes' tributary areas.
+                result.stats.overlap_area += p.weight;
+            }
+            result.points.push(p);
+        }
+        result.stats.side_a_area = a.area();
+        tally(&mut result);
+        result
+    }
+}
+
+/// The search margin: the larger of the distance acceptance and the buffer (mean face
+/// size × buffer factor), so the box query never misses an acceptable face.
+fn margin_for(b: &SurfaceGeometry, s: &SearchSettings) -> f64 {
+    let size = b.mean_face_size();
+    let distance = s
+        .normal_tolerance
+        .unwrap_or(0.0)
+        .max(s.field_factor * max_face_size(b));
+    (size * s.buffer_factor).max(distance)
+}
+
+fn max_face_size(b: &SurfaceGeometry) -> f64 {
+    b.faces.iter().map(|f| f.area().sqrt()).fold(0.0, f64::max)
+}
+
+/// `Update Search Every n Steps`: a full search on the first step and every n-th step
+/// after it; on the steps between, the pairing is kept and only the geometry is
+/// refreshed ([`SearchResult::update_geometry`], [`Searcher::refit`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SearchSchedule {
+    every: u32,
+}
+
+impl SearchSchedule {
+    /// `None` (no such line) searches every step.
+    pub fn new(every: Option<u32>) -> Self {
+        SearchSchedule {
+            every: every.unwrap_or(1).max(1),
+        }
+    }
+
+    /// Whether step `step` (0-based) does a full search.
+    pub fn full_search(&self, step: u64) -> bool {
+        step.is_multiple_of(u64::from(self.every))
+    }
+}
+
+impl SearchResult {
+    /// Keep the pairing, refresh the geometry: every matched point is placed again at
+    /// its parametric coordinates on its side-A face and side-B face of the moved
+    /// surfaces, and its gap and normals are measured anew (quadrature points: along
+    /// side B's normal; node points likewise). Statistics follow.
+    pub fn update_geometry(&mut self, a: &SurfaceGeometry, b: &SurfaceGeometry) {
+        for p in &mut self.points {
+            if p.a_face != u32::MAX {
+                let fa = &a.faces[p.a_face as usize];
+                p.x = fa.map(p.xi_a);
+                p.normal_a = fa.normal();
+            } else if let Some((_, x)) = a.nodes.get(p.a_node as usize) {
+                let k = p.a_node as usize;
+                p.x = *x;
+                p.weight = a.node_area.get(k).copied().unwrap_or(0.0);
+                p.normal_a = a.node_normal.get(k).copied().unwrap_or([0.0; 3]);
+            }
+            if p.status != PointStatus::Matched {
+                continue;
+            }
+            let fb = &b.faces[p.b_face as usize];
+            let on_b = fb.map(p.xi_b);
+            p.normal_b = fb.normal();
+            p.gap = dot(sub(p.x, on_b), p.normal_b);
+        }
+        let (overlap, area) = (self.stats.overlap_area, self.stats.side_a_area);
+        self.stats = SearchStats {
+            overlap_area: overlap,
+            side_a_area: area,
+            ..SearchStats::default()
+        };
+        tally(self);
+    }
+
+    /// Apply the initial-overclosure treatment to matched points with a negative gap:
+    /// `AdjustNodes` moves the side-A point onto side B along side B's normal (gap 0);
+    /// `StoreOffsets` keeps the geometry and records the gap as the point's offset.
+    /// Statistics are recomputed.
+    pub fn treat_overclosure(&mut self, treatment: Overclosure) {
+        for p in &mut self.points {
+            if p.status != PointStatus::Matched || p.gap >= 0.0 {
+                continue;
+            }
+            match treatment {
+                Overclosure::AdjustNodes => {
+                    p.x = sub(p.x, scale(p.normal_b, p.gap));
+                    p.gap = 0.0;
+                }
+                Overclosure::StoreOffsets => p.offset = p.gap,
+            }
+        }
+        let (overlap, area) = (self.stats.overlap_area, self.stats.side_a_area);
+        self.stats = SearchStats {
+            overlap_area: overlap,
+            side_a_area: area,
+            ..SearchStats::default()
+        };
+        tally(self);
+    }
+}
+
+fn tally(r: &mut SearchResult) {
+    let s = &mut r.stats;
+    s.points = r.points.len();
+    for p in &r.points {
+        match p.status {
+            PointStatus::Matched => {
+                s.matched += 1;
+                s.gap_min = Some(s.gap_min.map_or(p.gap, |g| g.min(p.gap)));
+                s.gap_max = Some(s.gap_max.map_or(p.gap, |g| g.max(p.gap)));
+            }
+            PointStatus::Unmatched => s.unmatched += 1,
+            PointStatus::RejectedDistance => s.rejected_distance += 1,
+            PointStatus::RejectedAngle => s.rejected_angle += 1,
+            PointStatus::RejectedSubdomain => s.rejected_subdomain += 1,
+        }
+    }
+}
