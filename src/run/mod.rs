@@ -38,16 +38,20 @@
 //! nonlinear). The time `t` is 0 in a steady solve.
 
 mod fields;
+mod nodal_field;
+mod physics;
 mod posed;
 mod problem;
 mod steps;
 
+use nodal_field::read_nodal_field;
+use physics::{Materials, Physics, SharedSandbox, evaluate};
 pub use problem::{
     BcKind, BcSpec, ContactSpec, InitialSpec, MAX_MAGNITUDE, MAX_TEMPERATURE, MaterialSpec,
     MeshSpec, NodalFieldSpec, OutputSpec, Problem, RestartSpec, SolveSpec, SourceSpec, ToggleSpec,
     Value,
 };
-use problem::{ProblemFile, ProblemText, time_spec};
+use problem::{ProblemFile, ProblemText};
 
 use crate::enforce::interface::{InterfaceError, InterfacePoints, PointFlux};
 use crate::enforce::mortar::MortarTie;
@@ -62,17 +66,15 @@ use crate::diag::{Diagnostic, Diagnostics, SourceMap, did_you_mean};
 use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::{DEFAULT_BETA, HFn, HInput, HValue, InterfaceForm};
 use crate::enforce::model::ModelChoice;
-use crate::heat::law::Law;
 use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use crate::heat::transient::{
-    self, BlockLaws, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
+    self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
 };
-use crate::heat::{FaceBc, HeatError, Material, TEMPERATURE};
+use crate::heat::{HeatError, TEMPERATURE};
 use std::collections::HashSet;
 
 use crate::mesh::{self, Mesh, NodeId, Side};
 use crate::scene::{ContactScene, SceneOptions};
-use crate::script::{Limits, Sandbox};
 use crate::search::pairing::{Integration, PointStatus};
 use crate::search::scene::Pairing;
 
@@ -294,62 +296,24 @@ enum Outcome {
 /// The run, up to `stop`: the checks and set-up, then (unless stopped) the solve and output.
 fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, RunError> {
     let start = Instant::now();
-    let ProblemFile {
-        problem,
-        text: at,
-        dir,
-        transient,
-    } = ProblemFile::read(path)?;
+    let file = ProblemFile::read(path)?;
+    let (problem, at, dir, transient) = (&file.problem, &file.text, &file.dir, file.transient);
     let clock = Instant::now();
     options.phase("reading the mesh");
     let mesh = mesh::read(&dir.join(&problem.mesh.file))
         .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
     let mesh_s = clock.elapsed().as_secs_f64();
     let mut diags = Diagnostics::default();
-    let sandbox: SharedSandbox = Default::default();
-    let probe = match problem.initial.as_ref().map(|i| &i.temperature) {
-        Some(Value::Number(t)) => *t,
-        _ => 300.0,
-    };
-    let materials = materials(&problem, &mesh, probe, &mut diags);
-    check_bcs(&problem, &mut diags);
-    let dirichlet = dirichlet_nodes(&problem, &mesh, &mut diags);
-    let mut face_sites = face_sites(&problem, &mesh, &mut diags);
-    let timing_spec = time_spec(&problem, transient, &mut diags);
-    let block_source = block_sources(&problem, &mesh, &at, probe, timing_spec.start, &mut diags);
-    check_nodal_fields(&problem, &at, &mut diags);
-    // One law of x and t everywhere: a plain source function (both solvers); else per
-    // block (the general solver). A source failing at a point is reported after the solve.
-    let uniform = block_source.windows(2).all(|w| w[0] == w[1])
-        && !block_source.first().is_some_and(Law::uses_temperature);
-    let source_failed = std::sync::Mutex::new(None::<String>);
-    let source = block_source
-        .first()
-        .filter(|q| uniform && **q != Law::Constant(0.0))
-        .map(|q| source_of_x(q, timing_spec.start, &source_failed));
+    let mut physics = Physics::new(&file, &mesh, &mut diags);
     if diags.has_errors() {
         return Err(RunError::Input(diags, at.sources()));
     }
-    // Boundary data at the start: every expression is tried once here, so a bad one
-    // is an input error, not a failure in the middle of a run.
-    let start_time = timing_spec.start;
-    if let Err(e) = loads_at(
-        &problem,
-        &mesh,
-        &dirichlet,
-        &face_sites,
-        &sandbox,
-        start_time,
-    ) {
-        return Err(input_error(
-            "E0707",
-            e,
-            "a number, a table [[t, v], …] or a Lua expression of x, y, z, t",
-        ));
-    }
-    let mut field_names: Vec<String> = materials.fields.clone();
-    field_names.sort();
-    field_names.dedup();
+    physics.try_start()?;
+    let start_time = physics.time.start;
+    let field_names = physics.field_names.clone();
+    let materials = &physics.materials;
+    let dirichlet = &physics.dirichlet;
+    let sandbox = &physics.sandbox;
     let field_refs: Vec<&str> = field_names.iter().map(String::as_str).collect();
 
     // Contact: surfaces, interactions, search, enforcement per interaction.
@@ -479,9 +443,11 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             }
         }
     }
-    let before = face_sites.len();
-    face_sites.retain(|f| f.keep || !in_contact.contains(&f.side));
-    let masked = before - face_sites.len();
+    let before = physics.face_sites.len();
+    physics
+        .face_sites
+        .retain(|f| f.keep || !in_contact.contains(&f.side));
+    let masked = before - physics.face_sites.len();
     if masked > 0 {
         diags.push(
             Diagnostic::warning(
@@ -495,7 +461,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     // A steady problem needs every part of the mesh held at some temperature level.
     if !transient {
         let mut anchored: Vec<NodeId> = dirichlet.iter().map(|&(n, _)| n).collect();
-        for f in &face_sites {
+        for f in &physics.face_sites {
             let bc = &problem.bc[f.bc];
             let exchange = matches!(bc.kind, BcKind::Convection | BcKind::Radiation);
             if exchange && bc.value != Value::Number(0.0) {
@@ -546,12 +512,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         return Err(RunError::Input(diags, loaded.sources));
     }
     // The initial state is checked here (transient runs start from it).
-    let initial_state = match (&problem.initial, transient) {
-        (Some(_), _) | (None, true) => Some(initial_values(
-            &problem, &mesh, &dirichlet, &sandbox, start_time,
-        )?),
-        (None, false) => None,
-    };
+    let initial_state = physics.initial_state()?;
     if stop == Stop::BeforeSolve {
         return Ok(Outcome::Checked(Checked {
             diagnostics: diags,
@@ -559,15 +520,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         }));
     }
     // Nitsche weights need one k per block: the law at the probe temperature.
-    let conductivity: Vec<f64> = materials
-        .laws
-        .iter()
-        .map(|l| {
-            l.conductivity
-                .eval(probe, [0.0; 3], start_time)
-                .map_or(1.0, |v| v.0)
-        })
-        .collect();
+    let conductivity: Vec<f64> = physics.conductivity();
     // The time every conductance model sees (set by the solver through the loads).
     let clock = std::cell::Cell::new(start_time);
     let cutback = std::cell::Cell::new(false);
@@ -865,9 +818,6 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             .write_step(step, time, &fields)
             .map_err(|e| format!("cannot write the results of step {step}: {e}"))
     };
-    let source_fn = source
-        .as_ref()
-        .map(|s| s as &(dyn Fn([f64; 3]) -> f64 + Sync));
     let out_dir = match &problem.output.dir {
         Some(d) => {
             let out_dir = dir.join(d);
@@ -882,7 +832,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     };
 
     let linear_steady = !transient
-        && uniform
+        && physics.uniform
         && materials.constant().is_some()
         && field_names.len() == 1
         && toggles.iter().all(Option::is_none)
@@ -907,6 +857,9 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         iterations_per_solve: Vec::new(),
     };
     let solution = if linear_steady {
+        let source_failed = std::sync::Mutex::new(None::<String>);
+        let source = physics.source_of_x(&source_failed);
+        let source_fn = source.as_deref();
         let materials = materials.constant().expect("checked constant");
         // The temperature unknowns (multipliers aside) decide the automatic choice.
         let solid: Vec<usize> = (0..mesh.blocks.len())
@@ -920,15 +873,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             Some("direct") => false,
             _ => unknowns >= threshold,
         };
-        let loads = loads_at(
-            &problem,
-            &mesh,
-            &dirichlet,
-            &face_sites,
-            &sandbox,
-            start_time,
-        )
-        .map_err(RunError::Solve)?;
+        let loads = physics.loads_at(start_time).map_err(RunError::Solve)?;
         let steady = SteadyProblem {
             mesh: &mesh,
             materials: &materials,
@@ -960,7 +905,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     } else {
         let loads = |t: f64| -> Result<Loads, HeatError> {
             clock.set(t);
-            loads_at(&problem, &mesh, &dirichlet, &face_sites, &sandbox, t).map_err(HeatError::Step)
+            physics.loads_at(t).map_err(HeatError::Step)
         };
         let active = |k: usize, t: f64| -> bool {
             toggles[term_choice[k]]
@@ -982,7 +927,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                 .collect(),
             laws: &materials.laws,
             source: None,
-            block_source: Some(&block_source),
+            block_source: Some(&physics.block_source),
             loads: &loads,
             contact: contact_terms(),
             ties: tie_terms(),
@@ -1007,7 +952,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             Some(_) => Vec::new(),
             None => match initial_state {
                 Some(v) => v,
-                None => initial_values(&problem, &mesh, &dirichlet, &sandbox, start_time)?,
+                None => physics.initial_values()?,
             },
         };
         let at_node = |n: NodeId| initial[n.index()];
@@ -1015,16 +960,16 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             Some(state) => Start::Restart(state),
             None => Start::Fresh {
                 time: start_time,
-                dt: timing_spec.dt,
+                dt: physics.time.dt,
                 initial: &at_node,
             },
         };
         let mode = if transient {
             TimeMode::Transient {
-                scheme: timing_spec.scheme,
-                end: timing_spec.end,
-                adaptive: timing_spec.adaptive,
-                dt_min: timing_spec.dt_min,
+                scheme: physics.time.scheme,
+                end: physics.time.end,
+                adaptive: physics.time.adaptive,
+                dt_min: physics.time.dt_min,
             }
         } else {
             TimeMode::Steady { time: start_time }
@@ -1343,709 +1288,6 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     })))
 }
 
-fn block_index(mesh: &Mesh, name: &str, diags: &mut Diagnostics, what: &str) -> Option<usize> {
-    let found = mesh.find_block(name);
-    if found.is_none() {
-        let names: Vec<String> = mesh.blocks.iter().map(|b| b.sierra_name()).collect();
-        let help = did_you_mean(name, names.iter().map(String::as_str)).map_or_else(
-            || format!("the blocks are: {}", names.join(", ")),
-            |s| format!("did you mean `{s}`?"),
-        );
-        diags
-            .push(Diagnostic::error("E0703", format!("{what}: unknown block `{name}`")).help(help));
-    }
-    found
-}
-
-/// The materials of the blocks: per block its laws and its field name.
-struct Materials {
-    laws: Vec<BlockLaws>,
-    fields: Vec<String>,
-}
-
-impl Materials {
-    /// Constant k and ρc per block, for the linear steady solver.
-    fn constant(&self) -> Option<Vec<Material>> {
-        self.laws
-            .iter()
-            .map(|l| match (&l.conductivity, &l.capacity) {
-                (Law::Constant(k), Law::Constant(c)) => Some(Material {
-                    conductivity: *k,
-                    rho_c: *c,
-                }),
-                _ => None,
-            })
-            .collect()
-    }
-}
-
-/// A material value as a law of T: numbers, Lua expressions of T (x, y, z, t), tables
-/// in T; checked positive at `probe` (a Lua law only where it can be evaluated).
-fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law> {
-    let law = match v {
-        Value::Number(k) => Law::Constant(*k),
-        Value::Expr(e) => match e.trim().parse::<f64>() {
-            Ok(k) => Law::Constant(k),
-            Err(_) => Law::Lua {
-                expr: e.clone(),
-                chunk: what.to_string(),
-            },
-        },
-        Value::Table { table } => match Law::table(table.clone()) {
-            Ok(l) => l,
-            Err(m) => {
-                diags.push(
-                    Diagnostic::error("E0704", format!("{what}: {m}"))
-                        .help("a table is [[T, value], …] with T increasing"),
-                );
-                return None;
-            }
-        },
-    };
-    let bad = |v: f64| !(v > 0.0 && v <= MAX_MAGNITUDE);
-    let problem = match &law {
-        Law::Constant(k) if bad(*k) => {
-            Some(format!("must be positive and at most 1e100, found {k}"))
-        }
-        Law::Table(p) => p.iter().find(|q| bad(q.1)).map(|q| {
-            format!(
-                "must be positive and at most 1e100, found {} at T = {}",
-                q.1, q.0
-            )
-        }),
-        Law::Lua { .. } => match law.eval(probe, [0.0; 3], 0.0) {
-            Err(e) => Some(e),
-            Ok((k, _)) if bad(k) => Some(format!(
-                "must be positive and at most 1e100, found {k} at T = {probe}"
-            )),
-            Ok(_) => None,
-        },
-        _ => None,
-    };
-    if let Some(m) = problem {
-        diags.push(
-            Diagnostic::error("E0704", format!("{what} {m}"))
-                .help("k in W/m/K, ρ in kg/m³, c_p in J/kg/K: positive numbers up to 1e100, tables or Lua expressions of T"),
-        );
-        return None;
-    }
-    Some(law)
-}
-
-fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> Materials {
-    let mut out: Vec<Option<(BlockLaws, String)>> = vec![None; mesh.blocks.len()];
-    for (i, m) in p.material.iter().enumerate() {
-        let what = format!("[[material]] #{} conductivity", i + 1);
-        let Some(k) = law(&m.conductivity, &what, probe, diags) else {
-            continue;
-        };
-        let capacity = match (&m.density, &m.specific_heat, m.rho_c) {
-            (_, _, Some(_)) if m.density.is_some() || m.specific_heat.is_some() => {
-                diags.push(
-                    Diagnostic::error(
-                        "E0704",
-                        format!(
-                            "[[material]] #{}: rho_c and density/specific_heat both given",
-                            i + 1
-                        ),
-                    )
-                    .help("give either rho_c, or density and specific_heat"),
-                );
-                continue;
-            }
-            (_, _, Some(rc)) => law(
-                &Value::Number(rc),
-                &format!("[[material]] #{} rho_c", i + 1),
-                probe,
-                diags,
-            ),
-            (Some(rho), Some(cp), None) => {
-                let cp = law(
-                    cp,
-                    &format!("[[material]] #{} specific_heat", i + 1),
-                    probe,
-                    diags,
-                );
-                let rho_ok = *rho > 0.0 && *rho <= MAX_MAGNITUDE;
-                if !rho_ok {
-                    diags.push(
-                        Diagnostic::error(
-                            "E0704",
-                            format!(
-                                "[[material]] #{} density must be positive and at most 1e100, found {rho}",
-                                i + 1
-                            ),
-                        )
-                        .help("ρ in kg/m³"),
-                    );
-                }
-                cp.filter(|_| rho_ok).map(|cp| scale_law(cp, *rho))
-            }
-            (None, None, None) => Some(Law::Constant(1.0)),
-            _ => {
-                diags.push(
-                    Diagnostic::error(
-                        "E0704",
-                        format!(
-                            "[[material]] #{}: density and specific_heat go together",
-                            i + 1
-                        ),
-                    )
-                    .help("give both (or rho_c)"),
-                );
-                continue;
-            }
-        };
-        let Some(capacity) = capacity else { continue };
-        let field = m
-            .field
-            .clone()
-            .unwrap_or_else(|| TEMPERATURE.to_string())
-            .to_ascii_lowercase();
-        for b in &m.blocks {
-            if let Some(i) = block_index(mesh, b, diags, "[[material]]") {
-                out[i] = Some((
-                    BlockLaws {
-                        conductivity: k.clone(),
-                        capacity: capacity.clone(),
-                    },
-                    field.clone(),
-                ));
-            }
-        }
-    }
-    let mut laws = Vec::with_capacity(out.len());
-    let mut fields = Vec::with_capacity(out.len());
-    for (i, m) in out.into_iter().enumerate() {
-        match m {
-            Some((l, f)) => {
-                laws.push(l);
-                fields.push(f);
-            }
-            None => {
-                if mesh.blocks[i].topology.is_solid() {
-                    diags.push(
-                        Diagnostic::error(
-                            "E0705",
-                            format!("block {} has no material", mesh.blocks[i].sierra_name()),
-                        )
-                        .help("add it to the `blocks` of a [[material]]"),
-                    );
-                }
-                laws.push(BlockLaws {
-                    conductivity: Law::Constant(1.0),
-                    capacity: Law::Constant(1.0),
-                });
-                fields.push(TEMPERATURE.to_string());
-            }
-        }
-    }
-    Materials { laws, fields }
-}
-
-/// ρ·c_p(T) from c_p(T).
-fn scale_law(cp: Law, rho: f64) -> Law {
-    match cp {
-        Law::Constant(c) => Law::Constant(rho * c),
-        Law::Table(p) => Law::Table(p.into_iter().map(|(t, v)| (t, rho * v)).collect()),
-        Law::Lua { expr, chunk } => Law::Lua {
-            expr: format!("{rho:e} * ({expr})"),
-            chunk,
-        },
-        Law::TimeTable(p) => Law::TimeTable(p.into_iter().map(|(t, v)| (t, rho * v)).collect()),
-    }
-}
-
-/// The sandbox of the run's boundary and initial expressions.
-type SharedSandbox = std::cell::RefCell<Option<Sandbox>>;
-
-/// Evaluate a value at a point and time: numbers directly, tables in t, expressions in
-/// a sandbox shared by the run (built on first use, each expression compiled once).
-fn evaluate(
-    v: &Value,
-    x: [f64; 3],
-    t: f64,
-    sandbox: &SharedSandbox,
-    chunk: &str,
-) -> Result<f64, String> {
-    match v {
-        Value::Number(n) => Ok(*n),
-        Value::Table { table } => {
-            let law = Law::table(table.clone())?;
-            law.eval(t, x, t).map(|(v, _)| v)
-        }
-        Value::Expr(e) => {
-            let mut slot = sandbox.borrow_mut();
-            if slot.is_none() {
-                *slot = Some(Sandbox::new(Limits::default()).map_err(|e| e.to_string())?);
-            }
-            let s = slot.as_mut().expect("just built");
-            let f = match s.cached(e) {
-                Some(f) => f,
-                None => {
-                    let f = s
-                        .expression(chunk, e, &["x", "y", "z", "t"])
-                        .map_err(|e| e.to_string())?;
-                    s.cache(e, f.clone());
-                    f
-                }
-            };
-            s.call(&f, &[x[0], x[1], x[2], t])
-                .map_err(|e| e.to_string())
-        }
-    }
-}
-
-/// `v`, the value of `[[bc]]` #k at `x` and time `t`, if its kind accepts it.
-fn in_range(kind: BcKind, v: f64, k: usize, x: [f64; 3], t: f64) -> Result<(), String> {
-    kind.accepts(v).map_err(|range| {
-        format!(
-            "[[bc]] #{} value is {v:e} at ({}, {}, {}), t = {t}: {range}",
-            k + 1,
-            x[0],
-            x[1],
-            x[2]
-        )
-    })
-}
-
-/// The fields of each `[[bc]]` that go with its kind: `ambient` for convection and
-/// radiation only (never taken as 0 K), an emissivity in (0, 1].
-fn check_bcs(p: &Problem, diags: &mut Diagnostics) {
-    for (k, bc) in p.bc.iter().enumerate() {
-        let exchange = matches!(bc.kind, BcKind::Convection | BcKind::Radiation);
-        if exchange && bc.ambient.is_none() {
-            diags.push(
-                Diagnostic::error(
-                    "E0706",
-                    format!(
-                        "[[bc]] #{}: {} needs `ambient` (T∞, K)",
-                        k + 1,
-                        bc.kind.name()
-                    ),
-                )
-                .help("add ambient = 293.15 (say): it is not taken as 0 K"),
-            );
-        }
-        if let Some(a) = bc.ambient
-            && BcKind::Temperature.accepts(a).is_err()
-        {
-            diags.push(
-                Diagnostic::error(
-                    "E0706",
-                    format!("[[bc]] #{}: ambient {a:e} is out of range", k + 1),
-                )
-                .help("a temperature is finite and within ±1e12 K"),
-            );
-        }
-        if !exchange && bc.ambient.is_some() {
-            diags.push(
-                Diagnostic::error(
-                    "E0706",
-                    format!(
-                        "[[bc]] #{}: `ambient` belongs to convection and radiation, not {}",
-                        k + 1,
-                        bc.kind.name()
-                    ),
-                )
-                .help("remove `ambient`, or make the condition a convection or radiation"),
-            );
-        }
-        if bc.kind == BcKind::Radiation
-            && let Value::Number(e) = bc.value
-            && !(e > 0.0 && e <= 1.0)
-        {
-            diags.push(
-                Diagnostic::error(
-                    "E0706",
-                    format!("[[bc]] #{}: emissivity {e} is not in (0, 1]", k + 1),
-                )
-                .help("for radiation, `value` is the emissivity ε"),
-            );
-        }
-    }
-}
-
-/// The nodes of each temperature condition, with the condition.
-fn dirichlet_nodes(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<(NodeId, usize)> {
-    let mut out = Vec::new();
-    for (k, bc) in
-        p.bc.iter()
-            .enumerate()
-            .filter(|(_, b)| b.kind == BcKind::Temperature)
-    {
-        let mut nodes = Vec::new();
-        for s in &bc.surfaces {
-            if let Some(i) = mesh.find_side_set(s) {
-                for &side in &mesh.side_sets[i].sides {
-                    nodes.extend(mesh.side_nodes(side));
-                }
-            } else if let Some(i) = mesh.find_node_set(s) {
-                nodes.extend_from_slice(&mesh.node_sets[i].nodes);
-            } else {
-                diags.push(
-                    Diagnostic::error(
-                        "E0706",
-                        format!("[[bc]]: unknown side set or node set `{s}`"),
-                    )
-                    .help("bc surfaces name side sets (surface_<id> or their names) or node sets"),
-                );
-            }
-        }
-        nodes.sort_unstable();
-        nodes.dedup();
-        out.extend(nodes.into_iter().map(|n| (n, k)));
-    }
-    // A node in two conditions keeps the later one.
-    out.sort_by_key(|&(n, k)| (n, std::cmp::Reverse(k)));
-    out.dedup_by_key(|&mut (n, _)| n);
-    out
-}
-
-/// One face condition before evaluation: its side, condition index, face centroid and
-/// whether it opts out of masking on faces in contact.
-#[derive(Clone, Copy, Debug)]
-struct FaceSite {
-    side: Side,
-    bc: usize,
-    centroid: [f64; 3],
-    keep: bool,
-}
-
-fn face_sites(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<FaceSite> {
-    let mut out = Vec::new();
-    for (k, bc) in
-        p.bc.iter()
-            .enumerate()
-            .filter(|(_, b)| b.kind != BcKind::Temperature)
-    {
-        for s in &bc.surfaces {
-            let Some(i) = mesh.find_side_set(s) else {
-                diags.push(
-                    Diagnostic::error("E0706", format!("[[bc]]: unknown side set `{s}`"))
-                        .help("flux, convection and radiation conditions act on side sets"),
-                );
-                continue;
-            };
-            for &side in &mesh.side_sets[i].sides {
-                let nodes: Vec<_> = mesh.side_nodes(side).collect();
-                let mut c = [0.0; 3];
-                for n in &nodes {
-                    for (cd, xd) in c.iter_mut().zip(mesh.coords[n.index()]) {
-                        *cd += xd / nodes.len() as f64;
-                    }
-                }
-                out.push(FaceSite {
-                    side,
-                    bc: k,
-                    centroid: c,
-                    keep: bc.no_coverage_flux,
-                });
-            }
-        }
-    }
-    out
-}
-
-/// The boundary data at time t.
-fn loads_at(
-    p: &Problem,
-    mesh: &Mesh,
-    dirichlet: &[(NodeId, usize)],
-    faces: &[FaceSite],
-    sandbox: &SharedSandbox,
-    t: f64,
-) -> Result<Loads, String> {
-    let mut out = Loads::default();
-    for &(n, k) in dirichlet {
-        let v = evaluate(
-            &p.bc[k].value,
-            mesh.coords[n.index()],
-            t,
-            sandbox,
-            "[[bc]] value",
-        )
-        .map_err(|e| format!("[[bc]] #{} value: {e}", k + 1))?;
-        in_range(BcKind::Temperature, v, k, mesh.coords[n.index()], t)?;
-        out.dirichlet.push((n, v));
-    }
-    for f in faces {
-        let bc = &p.bc[f.bc];
-        let v = evaluate(&bc.value, f.centroid, t, sandbox, "[[bc]] value")
-            .map_err(|e| format!("[[bc]] #{} value: {e}", f.bc + 1))?;
-        in_range(bc.kind, v, f.bc, f.centroid, t)?;
-        let t_inf = bc.ambient.unwrap_or(0.0);
-        out.faces.push(match bc.kind {
-            BcKind::Flux => FaceBc::Flux { side: f.side, q: v },
-            BcKind::Radiation => FaceBc::Radiation {
-                side: f.side,
-                emissivity: v,
-                t_inf,
-            },
-            _ => FaceBc::Convection {
-                side: f.side,
-                h: v,
-                t_inf,
-            },
-        });
-    }
-    Ok(out)
-}
-
-/// The volumetric source per block, Q(T, x, t) in W/m³ (0 where none is given): a
-/// number, a Lua expression of x, y, z, t and T, or a table in t. Each block may be
-/// named once over all `[[source]]`s. A value is tried once, at the first node of its
-/// first block, at temperature `probe` and time `time`: a bad expression is an input
-/// error at its line, not a failure in the middle of a run.
-fn block_sources(
-    p: &Problem,
-    mesh: &Mesh,
-    at: &ProblemText,
-    probe: f64,
-    time: f64,
-    diags: &mut Diagnostics,
-) -> Vec<Law> {
-    let mut out = vec![Law::Constant(0.0); mesh.blocks.len()];
-    let mut given = vec![false; mesh.blocks.len()];
-    for (k, s) in p.source.iter().enumerate() {
-        let loc = at.loc("source", k, "value");
-        let law = match &s.value {
-            Value::Number(q) => Ok(Law::Constant(*q)),
-            Value::Expr(e) => Ok(e.trim().parse().map_or_else(
-                |_| Law::Lua {
-                    expr: e.clone(),
-                    chunk: format!("[[source]] #{} value", k + 1),
-                },
-                Law::Constant,
-            )),
-            Value::Table { table } => Law::table(table.clone()).map(|l| match l {
-                Law::Table(points) => Law::TimeTable(points),
-                other => other,
-            }),
-        };
-        let mut blocks = Vec::new();
-        for b in &s.blocks {
-            if let Some(i) = block_index(mesh, b, diags, "[[source]]") {
-                if given[i] {
-                    diags.push(
-                        Diagnostic::error(
-                            "E0714",
-                            format!("[[source]]: block `{b}` is given a source twice"),
-                        )
-                        .help("name each block in one [[source]] only"),
-                    );
-                }
-                given[i] = true;
-                blocks.push(i);
-            }
-        }
-        let x = blocks
-            .first()
-            .filter(|&&b| !mesh.blocks[b].is_empty())
-            .map_or([0.0; 3], |&b| {
-                mesh.coords[mesh.elem_nodes(mesh.blocks[b].first_elem)[0].index()]
-            });
-        let tried = law.and_then(|l| match l.eval(probe, x, time) {
-            Ok((q, dq)) if q.abs() <= MAX_MAGNITUDE && dq.is_finite() => Ok(l),
-            Ok((q, _)) => Err(format!(
-                "Q = {q} at ({}, {}, {}), T = {probe}, t = {time}",
-                x[0], x[1], x[2]
-            )),
-            // The first line: a Lua stack trace says nothing about a one-line expression.
-            Err(e) => Err(e.lines().next().unwrap_or_default().to_string()),
-        });
-        match tried {
-            Ok(law) => blocks.iter().for_each(|&i| out[i] = law.clone()),
-            Err(m) => diags.push(
-                Diagnostic::error("E0714", format!("[[source]] #{}: {m}", k + 1))
-                    .at(loc)
-                    .help("Q (W/m³, finite and within ±1e100) is a number, a Lua expression of x, y, z, t and T (the local temperature), or { table = [[t, Q], …] } with t increasing"),
-            ),
-        }
-    }
-    out
-}
-
-/// A source law that does not depend on T as a function of x at `time`, for the linear
-/// steady solver; the first failure (a Lua error, a non-finite value) is kept in
-/// `failed` and the point contributes nothing.
-fn source_of_x<'a>(
-    law: &'a Law,
-    time: f64,
-    failed: &'a std::sync::Mutex<Option<String>>,
-) -> impl Fn([f64; 3]) -> f64 + Sync + 'a {
-    move |x| match law.eval(0.0, x, time) {
-        Ok((v, _)) if v.is_finite() => v,
-        r => {
-            let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
-            let what = match r {
-                Err(e) => e.lines().next().unwrap_or_default().to_string(),
-                Ok((v, _)) => format!("Q = {v}"),
-            };
-            let [x0, x1, x2] = x;
-            slot.get_or_insert_with(|| format!("{what} at ({x0:.6}, {x1:.6}, {x2:.6})"));
-            0.0
-        }
-    }
-}
-
-/// Each `[[nodal_field]]` has a `value` or a `file`, and the file's `variable`, `time`
-/// and `step` only with a file.
-fn check_nodal_fields(p: &Problem, at: &ProblemText, diags: &mut Diagnostics) {
-    for (k, f) in p.nodal_field.iter().enumerate() {
-        let by_file = f.variable.is_some() || f.time.is_some() || f.step.is_some();
-        let wrong = match (&f.value, &f.file) {
-            (Some(_), Some(_)) => Some("has both `value` and `file`"),
-            (None, None) => Some("needs a `value` or a `file`"),
-            (Some(_), None) if by_file => Some("has `variable`, `time` or `step` without `file`"),
-            _ if f.time.is_some() && f.step.is_some() => Some("has both `time` and `step`"),
-            _ => None,
-        };
-        if let Some(m) = wrong {
-            diags.push(
-                Diagnostic::error("E0712", format!("[[nodal_field]] {}: {m}", f.name))
-                    .at(at.loc("nodal_field", k, ""))
-                    .help("value = a number or a Lua expression; or file = \"f.exo\", variable = \"v\" and time = t or step = n (default the last step)"),
-            );
-        }
-    }
-}
-
-/// A `[[nodal_field]]` read from a nodal variable of an Exodus II file, one value per
-/// mesh node, at `step` (1 = the first stored), at `time` (a stored time, or linearly
-/// interpolated between the two around it), or at the last step. The file's nodes are matched to the mesh's by their node numbers and must sit
-/// where the mesh's do (to 1e-6 of the mesh's size, so coordinates stored in single
-/// precision pass and another mesh with as many nodes does not). Errors: message, help.
-fn read_nodal_field(
-    f: &NodalFieldSpec,
-    file: &Path,
-    mesh: &Mesh,
-) -> Result<Vec<f64>, (String, String)> {
-    use crate::mesh::{MeshError, exodus};
-    let split = |e: MeshError| match e {
-        MeshError::Format {
-            path,
-            message,
-            help,
-        } => (format!("{}: {message}", path.display()), help),
-        MeshError::Open { path, source } => (
-            format!("cannot open {}: {source}", path.display()),
-            "the file is relative to the problem file".into(),
-        ),
-        other => (other.to_string(), "check the file".into()),
-    };
-    let name = f.variable.as_deref().unwrap_or(&f.name);
-    let shown = file.display();
-    let times = exodus::read_times(file).map_err(split)?;
-    let n = times.len();
-    // The stored steps to read and the weight of the second: a stored time or step is
-    // read as it is; a time between two stored times is interpolated linearly.
-    let (first, second, w) = match (f.step, f.time) {
-        _ if n == 0 => {
-            return Err((
-                format!("{shown} holds no time steps, so no values of `{name}`"),
-                "write the field as a nodal variable with at least one step".into(),
-            ));
-        }
-        (Some(s), _) if s == 0 || s > n => {
-            return Err((
-                format!(
-                    "{shown}: step {s} asked for, but the file holds {n} step(s), numbered from 1"
-                ),
-                format!("give step = 1 … {n}, or leave it out for the last"),
-            ));
-        }
-        (Some(s), _) => (s - 1, s - 1, 0.0),
-        (None, Some(t)) => {
-            let scale = times.iter().fold(t.abs(), |m, v| m.max(v.abs()));
-            let nearest = (0..n)
-                .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
-                .expect("n > 0");
-            let increasing = times.windows(2).all(|w| w[1] > w[0]);
-            if (times[nearest] - t).abs() <= 1e-9 * scale {
-                (nearest, nearest, 0.0)
-            } else if increasing && times[0] < t && t < times[n - 1] {
-                let i = times.partition_point(|&v| v <= t) - 1;
-                (i, i + 1, (t - times[i]) / (times[i + 1] - times[i]))
-            } else {
-                return Err((
-                    format!(
-                        "{shown}: time {t} for `{name}` is outside the stored times (or they do not increase): {n} step(s) from t = {} to {}; the nearest is t = {} (step {})",
-                        times[0],
-                        times[n - 1],
-                        times[nearest],
-                        nearest + 1
-                    ),
-                    "give a time within the stored ones (between two, the field is interpolated linearly), or the step as step = n".into(),
-                ));
-            }
-        }
-        (None, None) => (n - 1, n - 1, 0.0),
-    };
-    let mut values = exodus::read_nodal_variable(file, name, first).map_err(split)?;
-    if second != first {
-        let next = exodus::read_nodal_variable(file, name, second).map_err(split)?;
-        values
-            .iter_mut()
-            .zip(&next)
-            .for_each(|(v, u)| *v = (1.0 - w) * *v + w * u);
-    }
-    let source = exodus::read(file).map_err(split)?;
-    let help = "write the field on the run's mesh: the same nodes, paired by the node number map";
-    if source.num_nodes() != mesh.num_nodes() {
-        return Err((
-            format!(
-                "{shown}: `{name}` has values at {} nodes, but the mesh has {} nodes",
-                source.num_nodes(),
-                mesh.num_nodes()
-            ),
-            help.into(),
-        ));
-    }
-    let by_number: std::collections::HashMap<i64, usize> = (source.node_numbers.iter())
-        .enumerate()
-        .map(|(j, &number)| (number, j))
-        .collect();
-    let (lo, hi) = mesh.coords.iter().fold(
-        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-        |(lo, hi), x| {
-            (
-                std::array::from_fn(|d| lo[d].min(x[d])),
-                std::array::from_fn(|d| hi[d].max(x[d])),
-            )
-        },
-    );
-    let size = (0..3).map(|d| (hi[d] - lo[d]).powi(2)).sum::<f64>().sqrt();
-    let mut out = Vec::with_capacity(mesh.num_nodes());
-    for (x, &number) in mesh.coords.iter().zip(&mesh.node_numbers) {
-        let Some(&j) = by_number.get(&number) else {
-            return Err((
-                format!("{shown}: node {number} of the mesh is not in the file's node number map"),
-                help.into(),
-            ));
-        };
-        let y = source.coords[j];
-        let d = (0..3).map(|k| (x[k] - y[k]).powi(2)).sum::<f64>().sqrt();
-        if d > 1e-6 * size {
-            return Err((
-                format!(
-                    "{shown}: node {number} is at ({}, {}, {}) there but at ({}, {}, {}) in the mesh",
-                    y[0], y[1], y[2], x[0], x[1], x[2]
-                ),
-                help.into(),
-            ));
-        }
-        if !values[j].is_finite() {
-            return Err((
-                format!("{shown}: `{name}` is {} at node {number}", values[j]),
-                "the field must be finite at every node".into(),
-            ));
-        }
-        out.push(values[j]);
-    }
-    Ok(out)
-}
-
 /// An interaction's model, penalty scale and conductance model.
 type Choice = (ModelChoice, f64, Option<Box<dyn ConductanceModel>>);
 
@@ -2211,62 +1453,6 @@ fn point_pressures(
             }
         })
         .collect()
-}
-
-/// Initial nodal temperatures: `[initial] temperature`, else (a steady nonlinear
-/// solve's first guess) the mean of the Dirichlet values, else 0.
-fn initial_values(
-    p: &Problem,
-    mesh: &Mesh,
-    dirichlet: &[(NodeId, usize)],
-    sandbox: &SharedSandbox,
-    time: f64,
-) -> Result<Vec<f64>, RunError> {
-    match &p.initial {
-        Some(init) => mesh
-            .coords
-            .iter()
-            .map(|x| {
-                let v = evaluate(
-                    &init.temperature,
-                    *x,
-                    time,
-                    sandbox,
-                    "[initial] temperature",
-                )?;
-                BcKind::Temperature
-                    .accepts(v)
-                    .map_err(|range| format!("{v:e} at ({}, {}, {}): {range}", x[0], x[1], x[2]))?;
-                Ok(v)
-            })
-            .collect::<Result<Vec<f64>, String>>()
-            .map_err(|e| {
-                input_error(
-                    "E0707",
-                    format!("[initial] temperature: {e}"),
-                    "a number or a Lua expression of x, y, z",
-                )
-            }),
-        None => {
-            let mut sum = 0.0;
-            for &(n, k) in dirichlet {
-                sum += evaluate(
-                    &p.bc[k].value,
-                    mesh.coords[n.index()],
-                    time,
-                    sandbox,
-                    "[[bc]] value",
-                )
-                .unwrap_or(0.0);
-            }
-            let mean = if dirichlet.is_empty() {
-                0.0
-            } else {
-                sum / dirichlet.len() as f64
-            };
-            Ok(vec![mean; mesh.num_nodes()])
-        }
-    }
 }
 
 /// The mortar ties of the run, built as the solvers build them: in interaction order,
