@@ -37,6 +37,7 @@
 //! source that names `T` sees the interpolated temperature (and makes the problem
 //! nonlinear). The time `t` is 0 in a steady solve.
 
+mod contact;
 mod fields;
 mod nodal_field;
 mod physics;
@@ -44,14 +45,14 @@ mod posed;
 mod problem;
 mod steps;
 
-use nodal_field::read_nodal_field;
-use physics::{Materials, Physics, SharedSandbox, evaluate};
+use contact::{Choice, Couplings, RunContact};
+use physics::Physics;
+use problem::ProblemFile;
 pub use problem::{
     BcKind, BcSpec, ContactSpec, InitialSpec, MAX_MAGNITUDE, MAX_TEMPERATURE, MaterialSpec,
     MeshSpec, NodalFieldSpec, OutputSpec, Problem, RestartSpec, SolveSpec, SourceSpec, ToggleSpec,
     Value,
 };
-use problem::{ProblemFile, ProblemText};
 
 use crate::enforce::interface::{InterfaceError, InterfacePoints, PointFlux};
 use crate::enforce::mortar::MortarTie;
@@ -61,24 +62,20 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::assembly::DofMap;
-use crate::deck::{self, LoadedDeck};
-use crate::diag::{Diagnostic, Diagnostics, SourceMap, did_you_mean};
-use crate::enforce::conductance::{ConductanceModel, PointState};
+use crate::diag::{Diagnostic, Diagnostics, SourceMap};
+use crate::enforce::conductance::PointState;
 use crate::enforce::interface::{DEFAULT_BETA, HFn, HInput, HValue, InterfaceForm};
-use crate::enforce::model::ModelChoice;
 use crate::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use crate::heat::transient::{
     self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
 };
 use crate::heat::{HeatError, TEMPERATURE};
-use std::collections::HashSet;
 
-use crate::mesh::{self, Mesh, NodeId, Side};
-use crate::scene::{ContactScene, SceneOptions};
-use crate::search::pairing::{Integration, PointStatus};
+use crate::mesh::{self, Mesh, NodeId};
+use crate::search::pairing::PointStatus;
 use crate::search::scene::Pairing;
 
-use fields::{ContactView, Derived};
+use fields::Derived;
 
 /// The file a run that did not converge leaves in its output folder, holding the
 /// residual history and the likely cause.
@@ -313,212 +310,32 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let field_names = physics.field_names.clone();
     let materials = &physics.materials;
     let dirichlet = &physics.dirichlet;
-    let sandbox = &physics.sandbox;
-    let field_refs: Vec<&str> = field_names.iter().map(String::as_str).collect();
 
-    // Contact: surfaces, interactions, search, enforcement per interaction.
-    let mut timing = Timing::default();
-    let mut loaded = LoadedDeck::default();
-    let mut pairings: Vec<Pairing> = Vec::new();
-    let mut choices = Vec::new();
-    // Per pairing: what its contact output holds (`Visualize Contact`, `Output Rule`).
-    let mut views: Vec<ContactView> = Vec::new();
-    if let Some(c) = &problem.contact {
-        let deck_path = dir.join(&c.file);
-        loaded = deck::load(&deck_path);
-        if loaded.diagnostics.has_errors() {
-            return Err(RunError::Input(loaded.diagnostics, loaded.sources));
-        }
-        let integration = match c.integration.as_deref() {
-            None | Some("segments") => Integration::Segments {
-                order: c.order.unwrap_or(5),
-            },
-            Some("quadrature") => Integration::Quadrature {
-                order: c.order.unwrap_or(2),
-            },
-            Some(other) => {
-                return Err(input_error(
-                    "E0702",
-                    format!("unknown integration `{other}`"),
-                    "use \"segments\" or \"quadrature\"",
-                ));
-            }
-        };
-        if let Some(order) = c.order
-            && !(1..=crate::search::pairing::MAX_ORDER).contains(&order)
-        {
-            return Err(input_error(
-                "E0716",
-                format!(
-                    "[contact] order = {order}: the integration order must be 1 to {}",
-                    crate::search::pairing::MAX_ORDER
-                ),
-                "orders 2 (quadrature) and 5 (segments) are the defaults; higher ones only cost time",
-            ));
-        }
-        let deck_dir = deck_path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        for def in &loaded.deck.contact_definitions {
-            if ContactView::of(def).silenced {
-                diags.push(
-                    Diagnostic::warning(
-                        "W0702",
-                        "`Visualize Contact` is on, but `Output Rule = none`: this definition writes no contact fields",
-                    )
-                    .at(Some(def.at.clone()))
-                    .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
-                );
-            }
-            let every = def.update_search_every_n_steps.or(def
-                .search_options
-                .as_ref()
-                .and_then(|o| o.search_update_frequency));
-            if let Some(n) = every {
-                diags.push(
-                    Diagnostic::warning(
-                        "W0703",
-                        format!("`Update Search Every {n} Steps` (or `Search Update Frequency`) has no effect in this run: the mesh does not move, so the first search holds for every step"),
-                    )
-                    .at(Some(def.at.clone()))
-                    .help("remove the line, or keep it for a run coupled to a code that moves the mesh"),
-                );
-            }
-        }
-        let phase = |what: &str| options.phase(what);
-        let scene = ContactScene::build(
-            &mesh,
-            &loaded,
-            &deck_dir,
-            &SceneOptions {
-                integration,
-                fields: Some(&field_refs),
-                phase: Some(&phase),
-                search_only: false,
-            },
-            &mut diags,
-        );
-        timing.surfaces_s += scene.timing.surfaces_s;
-        timing.search_s += scene.timing.search_s;
-        for e in scene.entries {
-            views.push(ContactView::of(
-                &loaded.deck.contact_definitions[e.definition],
-            ));
-            choices.push((e.choice, e.penalty_scale, e.model));
-            pairings.push(e.pairing);
-        }
-    }
-    loaded.sources.add(&at.file, &at.text);
-    if diags.has_errors() {
-        return Err(RunError::Input(diags, loaded.sources));
-    }
-
-    // Aria masks ordinary flux and convection conditions on faces in contact: a side-A
-    // face with matched points (for a node surface, a tributary face with a matched
-    // node), or a side-B face some point paired with. A condition with
-    // `no_coverage_flux = true` stays.
-    let mut in_contact: HashSet<Side> = HashSet::new();
-    for p in &pairings {
-        if p.periodic {
-            continue;
-        }
-        let mut matched_nodes = HashSet::new();
-        for q in p
-            .result
-            .points
-            .iter()
-            .filter(|q| q.status == PointStatus::Matched)
-        {
-            if q.a_face != u32::MAX {
-                in_contact.insert(p.side_a_geometry.faces[q.a_face as usize].side);
-            } else if let Some(&(node, _)) = p.side_a_geometry.nodes.get(q.a_node as usize) {
-                matched_nodes.insert(node);
-            }
-            in_contact.insert(p.side_b_geometry.faces[q.b_face as usize].side);
-        }
-        for f in &p.side_a_geometry.tributary {
-            if f.nodes[..f.len as usize]
-                .iter()
-                .any(|n| matched_nodes.contains(n))
-            {
-                in_contact.insert(f.side);
-            }
-        }
-    }
-    let before = physics.face_sites.len();
-    physics
-        .face_sites
-        .retain(|f| f.keep || !in_contact.contains(&f.side));
-    let masked = before - physics.face_sites.len();
-    if masked > 0 {
-        diags.push(
-            Diagnostic::warning(
-                "W0701",
-                format!("{masked} face condition(s) on faces in contact are masked (Aria's rule)"),
-            )
-            .help("set `no_coverage_flux = true` in the [[bc]] to keep a condition on faces in contact"),
-        );
-    }
-
-    // A steady problem needs every part of the mesh held at some temperature level.
+    let contact = RunContact::build(&file, &mesh, &physics.field_names, options, &mut diags)?;
+    contact.mask_face_conditions(&mut physics.face_sites, &mut diags);
     if !transient {
-        let mut anchored: Vec<NodeId> = dirichlet.iter().map(|&(n, _)| n).collect();
-        for f in &physics.face_sites {
-            let bc = &problem.bc[f.bc];
-            let exchange = matches!(bc.kind, BcKind::Convection | BcKind::Radiation);
-            if exchange && bc.value != Value::Number(0.0) {
-                anchored.extend(mesh.side_nodes(f.side));
-            }
-        }
-        let floating = posed::floating_parts(&mesh, anchored, &pairings);
-        if let Some(first) = floating.first() {
-            let more = match floating.len() {
-                1 => String::new(),
-                n => format!(" (and {} more parts)", n - 1),
-            };
-            diags.push(
-                Diagnostic::error(
-                    "E0715",
-                    format!(
-                        "the steady problem has no unique answer: {} nodes in block(s) {}{more} meet no temperature, convection or radiation condition, through the mesh or a contact interface, so their temperature is fixed only up to a constant (and with fluxes or sources that do not balance, no steady state exists)",
-                        first.nodes,
-                        first.blocks.join(", ")
-                    ),
-                )
-                .help("add a [[bc]] of kind temperature, convection or radiation that reaches those blocks, join them to the rest by a contact interaction, or solve kind = \"transient\""),
-            );
-        }
+        posed::check_steady(&physics, &contact.pairings, &mut diags);
     }
-
-    // Per interaction: its toggle, its fields, its contact pressure per point.
-    let toggles = resolve_toggles(&problem, &choices, &mut diags);
-    let term_fields = interaction_fields(
-        &mesh,
-        &materials,
-        &field_names,
-        &pairings,
-        &choices,
-        &mut diags,
-    );
-    let pressures = point_pressures(
-        &problem,
-        &mesh,
-        &pairings,
-        &choices,
-        &sandbox,
-        start_time,
-        (&dir, &at),
-        &mut diags,
-    );
+    let couplings = Couplings::resolve(&file, &physics, &contact, &mut diags);
     if diags.has_errors() {
-        return Err(RunError::Input(diags, loaded.sources));
+        return Err(RunError::Input(diags, contact.loaded.sources));
     }
     // The initial state is checked here (transient runs start from it).
     let initial_state = physics.initial_state()?;
     if stop == Stop::BeforeSolve {
         return Ok(Outcome::Checked(Checked {
             diagnostics: diags,
-            sources: loaded.sources,
+            sources: contact.loaded.sources,
         }));
     }
+    let mut timing = Timing {
+        surfaces_s: contact.surfaces_s,
+        search_s: contact.search_s,
+        ..Timing::default()
+    };
+    let (pairings, choices, views) = (&contact.pairings, &contact.choices, &contact.views);
+    let (toggles, term_fields, pressures) =
+        (&couplings.toggles, &couplings.fields, &couplings.pressures);
     // Nitsche weights need one k per block: the law at the probe temperature.
     let conductivity: Vec<f64> = physics.conductivity();
     // The time every conductance model sees (set by the solver through the loads).
@@ -532,8 +349,8 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let h_fns: Vec<Box<HFn<'_>>> = choices
         .iter()
         .zip(&quarantined)
-        .zip(&pairings)
-        .zip(&pressures)
+        .zip(pairings)
+        .zip(pressures)
         .map(|((((choice, _, model), log), pairing), at_points)| {
             let pressure = choice.pressure;
             let quarantine = choice.quarantine;
@@ -587,7 +404,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let contact_terms = || -> Vec<ContactTerm<'_>> {
         pairings
             .iter()
-            .zip(&choices)
+            .zip(choices)
             .zip(&h_fns)
             .filter(|((_, (c, _, _)), _)| !c.mortar)
             .map(|((p, (c, scale, model)), h)| ContactTerm {
@@ -609,7 +426,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let tie_terms = || -> Vec<TieTerm<'_>> {
         pairings
             .iter()
-            .zip(&choices)
+            .zip(choices)
             .filter(|(_, (c, _, _))| c.mortar)
             .map(|(p, (c, _, _))| TieTerm {
                 side_a: &p.side_a_geometry,
@@ -649,8 +466,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let derive = |u: &[f64], dofs: &DofMap, time: f64, faces: bool| -> Result<Derived, String> {
         clock.set(time);
         let mut out = Derived::default();
-        for (k, ((p, (c, scale, model)), h)) in
-            pairings.iter().zip(&choices).zip(&h_fns).enumerate()
+        for (k, ((p, (c, scale, model)), h)) in pairings.iter().zip(choices).zip(&h_fns).enumerate()
         {
             let split = !mechanism_names[k].is_empty();
             if c.mortar && faces && views[k].faces {
@@ -659,11 +475,11 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                     rebuild_ties(
                         &mesh,
                         dofs,
-                        &pairings,
-                        &choices,
-                        &term_fields,
+                        pairings,
+                        choices,
+                        term_fields,
                         &field_names,
-                        &dirichlet,
+                        dirichlet,
                         &conductivity,
                     )
                 });
@@ -675,9 +491,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
                         p.side_a, p.side_b
                     ));
                 };
-                let on = toggles[k]
-                    .as_ref()
-                    .is_none_or(|on| on.iter().any(|&(a, b)| a <= time && time <= b));
+                let on = couplings.on(k, time);
                 let q = tie
                     .point_flux(&u[range.clone()], p.result.points.len())
                     .into_iter()
@@ -737,9 +551,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             // the next step's.
             cutback.set(false);
             let mut q = q?;
-            let on = toggles[k]
-                .as_ref()
-                .is_none_or(|on| on.iter().any(|&(a, b)| a <= time && time <= b));
+            let on = couplings.on(k, time);
             if !on {
                 q.iter_mut().flatten().for_each(|f| f.q = 0.0);
             }
@@ -907,11 +719,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             clock.set(t);
             physics.loads_at(t).map_err(HeatError::Step)
         };
-        let active = |k: usize, t: f64| -> bool {
-            toggles[term_choice[k]]
-                .as_ref()
-                .is_none_or(|on| on.iter().any(|&(a, b)| a <= t && t <= b))
-        };
+        let active = |k: usize, t: f64| -> bool { couplings.on(term_choice[k], t) };
         let tp = TransientProblem {
             mesh: &mesh,
             fields: field_names
@@ -1042,7 +850,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         }
         steps::final_solution(outcome, &history, &field_names, tp.contact.len())
     };
-    for ((p, (c, _, _)), log) in pairings.iter().zip(&choices).zip(&quarantined) {
+    for ((p, (c, _, _)), log) in pairings.iter().zip(choices).zip(&quarantined) {
         let log = log.borrow();
         if let Some((x, first)) = log.first() {
             diags.push(
@@ -1239,7 +1047,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     }
     let interactions = pairings
         .iter()
-        .zip(&choices)
+        .zip(choices)
         .zip(&heats)
         .map(|((p, (c, _, _)), &(a, b))| InteractionHeat {
             side_a: p.side_a.clone(),
@@ -1284,175 +1092,8 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         solution,
         history,
         warnings: diags,
-        sources: loaded.sources,
+        sources: contact.loaded.sources,
     })))
-}
-
-/// An interaction's model, penalty scale and conductance model.
-type Choice = (ModelChoice, f64, Option<Box<dyn ConductanceModel>>);
-
-/// Each interaction's toggle intervals (`Use Toggle Block` → `[[toggle]]`).
-fn resolve_toggles(
-    p: &Problem,
-    choices: &[Choice],
-    diags: &mut Diagnostics,
-) -> Vec<Option<Vec<(f64, f64)>>> {
-    choices
-        .iter()
-        .map(|(c, _, _)| {
-            let name = c.toggle.as_ref()?;
-            match p.toggle.iter().find(|t| t.name.eq_ignore_ascii_case(name)) {
-                Some(t) => Some(t.on.clone()),
-                None => {
-                    let names = p.toggle.iter().map(|t| t.name.as_str());
-                    let help = did_you_mean(name, names).map_or_else(
-                        || format!("add [[toggle]] name = \"{name}\", on = [[t0, t1]] to the problem file"),
-                        |s| format!("did you mean `{s}`?"),
-                    );
-                    diags.push(
-                        Diagnostic::error("E0711", format!("`Use Toggle Block = {name}`: no [[toggle]] of that name"))
-                            .help(help),
-                    );
-                    None
-                }
-            }
-        })
-        .collect()
-}
-
-/// Each interaction's (side-A field, side-B field), as indices into `field_names`,
-/// checked against `Side B Variable`.
-fn interaction_fields(
-    mesh: &Mesh,
-    materials: &Materials,
-    field_names: &[String],
-    pairings: &[Pairing],
-    choices: &[Choice],
-    diags: &mut Diagnostics,
-) -> Vec<(usize, usize)> {
-    let index = |f: &str| field_names.iter().position(|g| g == f).unwrap_or(0);
-    pairings
-        .iter()
-        .zip(choices)
-        .map(|(p, (c, _, _))| {
-            let side_field = |g: &crate::search::pairing::SurfaceGeometry| {
-                g.faces
-                    .first()
-                    .map(|f| materials.fields[mesh.block_of(f.side.elem)].clone())
-            };
-            let fa = side_field(&p.side_a_geometry).unwrap_or_else(|| TEMPERATURE.into());
-            let fb = side_field(&p.side_b_geometry).unwrap_or_else(|| TEMPERATURE.into());
-            match &c.variables {
-                Some((a, b)) if (a, b) != (&fa, &fb) => diags.push(
-                    Diagnostic::error(
-                        "E0428",
-                        format!(
-                            "interaction {} / {}: `Side B Variable {b} To {a}`, but side A carries `{fa}` and side B `{fb}`",
-                            p.side_a, p.side_b
-                        ),
-                    )
-                    .help(format!("write `Side B Variable {fb} To {fa}` (the fields come from [[material]] field)")),
-                ),
-                None if fa != fb => diags.push(
-                    Diagnostic::error(
-                        "E0428",
-                        format!(
-                            "interaction {} / {} joins two fields, `{fa}` on side A and `{fb}` on side B",
-                            p.side_a, p.side_b
-                        ),
-                    )
-                    .help(format!("say how they map: `Side B Variable {fb} To {fa}` in the enforcement")),
-                ),
-                _ => {}
-            }
-            (index(&fa), index(&fb))
-        })
-        .collect()
-}
-
-/// Per interaction with `Contact Pressure Variable`: the pressure at each of its
-/// points, interpolated on side A from the named `[[nodal_field]]` (evaluated at the
-/// nodes at `time`).
-#[allow(clippy::too_many_arguments)]
-fn point_pressures(
-    p: &Problem,
-    mesh: &Mesh,
-    pairings: &[Pairing],
-    choices: &[Choice],
-    sandbox: &SharedSandbox,
-    time: f64,
-    (dir, at): (&Path, &ProblemText),
-    diags: &mut Diagnostics,
-) -> Vec<Option<Vec<f64>>> {
-    pairings
-        .iter()
-        .zip(choices)
-        .map(|(pairing, (c, _, _))| {
-            let name = c.pressure_variable.as_ref()?;
-            let Some(field) = p.nodal_field.iter().find(|f| f.name.eq_ignore_ascii_case(name)) else {
-                let help = did_you_mean(name, p.nodal_field.iter().map(|f| f.name.as_str()))
-                    .map_or_else(
-                        || format!("add [[nodal_field]] name = \"{name}\", value = … to the problem file"),
-                        |s| format!("did you mean `{s}`?"),
-                    );
-                diags.push(
-                    Diagnostic::error(
-                        "E0712",
-                        format!("`Contact Pressure Variable = {name}`: no [[nodal_field]] of that name"),
-                    )
-                    .help(help),
-                );
-                return None;
-            };
-            // From a file: every node read at once; else evaluated at the nodes used.
-            let read = field.file.as_ref().map(|f| read_nodal_field(field, &dir.join(f), mesh));
-            let from_file = match read {
-                Some(Err((m, help))) => {
-                    let k = p.nodal_field.iter().position(|f| std::ptr::eq(f, field));
-                    let loc = k.and_then(|k| at.loc("nodal_field", k, "file"));
-                    diags.push(Diagnostic::error("E0712", format!("[[nodal_field]] {name}: {m}")).at(loc).help(help));
-                    return None;
-                }
-                Some(Ok(v)) => Some(v),
-                None => None,
-            };
-            let value = field.value.clone().unwrap_or(Value::Number(0.0));
-            let mut nodal = std::collections::HashMap::new();
-            let mut at = |n: NodeId| -> Result<f64, String> {
-                if let Some(v) = from_file.as_ref().map(|v| v[n.index()]).or(nodal.get(&n).copied()) {
-                    return Ok(v);
-                }
-                let v = evaluate(&value, mesh.coords[n.index()], time, sandbox, "[[nodal_field]] value")?;
-                nodal.insert(n, v);
-                Ok(v)
-            };
-            let mut out = Vec::with_capacity(pairing.result.points.len());
-            for q in &pairing.result.points {
-                if q.a_face == u32::MAX {
-                    let node = pairing.side_a_geometry.nodes.get(q.a_node as usize).map(|n| n.0);
-                    out.push(node.map_or(Ok(0.0), &mut at));
-                    continue;
-                }
-                let f = &pairing.side_a_geometry.faces[q.a_face as usize];
-                let n = crate::enforce::interface::face_shape_values(f.len as usize, q.xi_a);
-                let mut v = Ok(0.0);
-                for (node, nk) in f.nodes.iter().zip(n).take(f.len as usize) {
-                    v = v.and_then(|acc| at(*node).map(|x| acc + nk * x));
-                }
-                out.push(v);
-            }
-            match out.into_iter().collect::<Result<Vec<f64>, String>>() {
-                Ok(v) => Some(v),
-                Err(e) => {
-                    diags.push(
-                        Diagnostic::error("E0712", format!("[[nodal_field]] {name}: {e}"))
-                            .help("a number or a Lua expression of x, y, z, t"),
-                    );
-                    None
-                }
-            }
-        })
-        .collect()
 }
 
 /// The mortar ties of the run, built as the solvers build them: in interaction order,
