@@ -262,6 +262,11 @@ impl Couplings {
         }
     }
 
+    /// Whether some interaction is switched on and off.
+    pub(super) fn any_toggle(&self) -> bool {
+        self.toggles.iter().any(Option::is_some)
+    }
+
     /// Whether interaction `k` is on at time `t`.
     pub(super) fn on(&self, k: usize, t: f64) -> bool {
         self.toggles[k]

@@ -78,7 +78,7 @@ pub(super) struct Floating {
 
 /// The parts of `mesh`, joined through the matched points of `pairings`, that hold none
 /// of the `anchored` nodes.
-pub(super) fn floating_parts(
+fn floating_parts(
     mesh: &Mesh,
     anchored: impl IntoIterator<Item = NodeId>,
     pairings: &[Pairing],

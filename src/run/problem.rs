@@ -3,13 +3,15 @@
 //! `[solve]` ([`time_spec`]) and where a value sits in the text, for diagnostics.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::{RunError, input_error};
+use super::{RunError, RunOptions, input_error};
 use crate::deck;
 use crate::diag::{Diagnostic, Diagnostics, SourceMap};
 use crate::heat::transient::{self, Scheme};
+use crate::mesh::{self, Mesh};
 
 /// A number, a Lua expression, or a piecewise-linear table `{ table = [[s, v], …] }`
 /// (in time t for boundary values, in temperature T for material laws).
@@ -376,6 +378,15 @@ impl ProblemFile {
             dir,
             transient,
         })
+    }
+
+    /// The problem's mesh (`[mesh] file`), and the seconds reading it took.
+    pub(super) fn read_mesh(&self, options: &RunOptions) -> Result<(Mesh, f64), RunError> {
+        let clock = Instant::now();
+        options.phase("reading the mesh");
+        let mesh = mesh::read(&self.dir.join(&self.problem.mesh.file))
+            .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
+        Ok((mesh, clock.elapsed().as_secs_f64()))
     }
 }
 
