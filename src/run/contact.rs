@@ -18,8 +18,8 @@ use crate::search::scene::Pairing;
 
 use super::fields::ContactView;
 use super::nodal_field::read_nodal_field;
-use super::physics::{FaceSite, Materials, Physics, SharedSandbox, evaluate};
-use super::problem::{ContactSpec, Problem, ProblemFile, ProblemText, Value};
+use super::physics::{FaceSite, Materials, Physics, evaluate};
+use super::problem::{ContactSpec, Problem, ProblemFile, Value};
 use super::{RunError, RunOptions, input_error};
 
 /// An interaction's model, penalty scale and conductance model.
@@ -205,12 +205,12 @@ impl RunContact {
         let masked = before - face_sites.len();
         if masked > 0 {
             diags.push(
-            Diagnostic::warning(
-                "W0701",
-                format!("{masked} face condition(s) on faces in contact are masked (Aria's rule)"),
-            )
-            .help("set `no_coverage_flux = true` in the [[bc]] to keep a condition on faces in contact"),
-        );
+                Diagnostic::warning(
+                    "W0701",
+                    format!("{masked} face condition(s) on faces in contact are masked (Aria's rule)"),
+                )
+                .help("set `no_coverage_flux = true` in the [[bc]] to keep a condition on faces in contact"),
+            );
         }
     }
 }
@@ -245,16 +245,7 @@ impl Couplings {
             &contact.choices,
             diags,
         );
-        let pressures = point_pressures(
-            &file.problem,
-            physics.mesh,
-            &contact.pairings,
-            &contact.choices,
-            &physics.sandbox,
-            physics.time.start,
-            (&file.dir, &file.text),
-            diags,
-        );
+        let pressures = point_pressures(file, physics, contact, diags);
         Couplings {
             toggles,
             fields,
@@ -356,18 +347,16 @@ fn interaction_fields(
 
 /// Per interaction with `Contact Pressure Variable`: the pressure at each of its
 /// points, interpolated on side A from the named `[[nodal_field]]` (evaluated at the
-/// nodes at `time`).
-#[allow(clippy::too_many_arguments)]
+/// nodes at the start time).
 fn point_pressures(
-    p: &Problem,
-    mesh: &Mesh,
-    pairings: &[Pairing],
-    choices: &[Choice],
-    sandbox: &SharedSandbox,
-    time: f64,
-    (dir, at): (&Path, &ProblemText),
+    file: &ProblemFile,
+    physics: &Physics<'_>,
+    contact: &RunContact,
     diags: &mut Diagnostics,
 ) -> Vec<Option<Vec<f64>>> {
+    let (p, dir, at) = (&file.problem, &file.dir, &file.text);
+    let (mesh, sandbox, time) = (physics.mesh, &physics.sandbox, physics.time.start);
+    let (pairings, choices) = (&contact.pairings, &contact.choices);
     pairings
         .iter()
         .zip(choices)

@@ -38,7 +38,7 @@
 //! nonlinear). The time `t` is 0 in a steady solve.
 //!
 //! A run is a short sequence of named steps, each a value handed to the next
-//! ([`run_until`] reads as that sequence):
+//! (`run_until` reads as that sequence):
 //!
 //! 1. **problem** — the file read and checked (`problem`), its mesh read;
 //! 2. **physics** — materials, conditions, sources, time controls on the mesh (`physics`);

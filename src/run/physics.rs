@@ -1,7 +1,8 @@
 //! The physics of a run, from the problem file on the mesh: per block its material laws
 //! and field, the boundary conditions (Dirichlet nodes, face sites and their values at a
-//! time), the volumetric sources and the initial temperature. [`Physics::new`] checks them
-//! all into the diagnostics; the values are evaluated at a time by [`Physics::loads_at`].
+//! time), the volumetric sources, the initial temperature and the time controls of
+//! `[solve]`. [`Physics::new`] checks them all into the diagnostics; the values are
+//! evaluated at a time by [`Physics::loads_at`].
 //!
 //! Values are numbers, tables in t (T for material laws) or Lua expressions evaluated in one
 //! sandbox shared by the run: flux and convection values at each face's centroid,
