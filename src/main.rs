@@ -319,33 +319,28 @@ fn search(
         Integration::Quadrature { order }
     };
     let mut diags = loaded.diagnostics.clone();
+    let searched = ContactScene::search(
+        &mesh,
+        &loaded,
+        deck_dir,
+        &SceneOptions {
+            integration,
+            fields: None,
+            phase: None,
+            search_only: true,
+        },
+        &mut diags,
+    );
     let mut summaries = Vec::new();
     let mut timing = seam::search::scene::Timing::default();
     let mut details = Vec::new();
     let mut rule = OutputRule::Summary;
-    for def in &loaded.deck.contact_definitions {
-        let set = surface::build(&mesh, def, &loaded.sources);
-        diags.extend(set.diagnostics.clone());
-        let (interactions, d) =
-            seam::scene::interaction::resolve(def, &set, mesh.dim, &loaded.sources);
-        diags.extend(d);
-        if diags.has_errors() {
-            continue;
-        }
-        let scene = seam::scene::search::search_definition(
-            &mesh,
-            def,
-            &set,
-            &interactions,
-            deck_dir,
-            &loaded.sources,
-            integration,
-        );
-        diags.extend(scene.diagnostics);
-        timing.build_s += scene.timing.build_s;
-        timing.search_s += scene.timing.search_s;
+    for s in &searched {
+        let def = &loaded.deck.contact_definitions[s.definition];
+        timing.build_s += s.timing.build_s;
+        timing.search_s += s.timing.search_s;
         rule = def.output_rule.unwrap_or(OutputRule::Summary);
-        for p in &scene.pairings {
+        for p in &s.pairings {
             summaries.push(p.summary(def.visualize_contact));
             if matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose) {
                 details.push(point_details(p, rule == OutputRule::MoreVerbose));

@@ -6,9 +6,46 @@
 //! balance exactly, no steady state exists. Checked before the solve, so the answer is an
 //! input error naming the blocks, not a singular matrix or a temperature of 1e16.
 
+use crate::diag::{Diagnostic, Diagnostics};
 use crate::mesh::{Mesh, NodeId};
 use crate::search::pairing::PointStatus;
 use crate::search::scene::Pairing;
+
+use super::physics::Physics;
+use super::problem::{BcKind, Value};
+
+/// A steady problem needs every part of the mesh held at some temperature level: error
+/// E0715 naming the blocks of the first part that floats (with the contact `pairings`
+/// joining parts).
+pub(super) fn check_steady(physics: &Physics<'_>, pairings: &[Pairing], diags: &mut Diagnostics) {
+    let mesh = physics.mesh;
+    let mut anchored: Vec<NodeId> = physics.dirichlet.iter().map(|&(n, _)| n).collect();
+    for f in &physics.face_sites {
+        let bc = &physics.problem.bc[f.bc];
+        let exchange = matches!(bc.kind, BcKind::Convection | BcKind::Radiation);
+        if exchange && bc.value != Value::Number(0.0) {
+            anchored.extend(mesh.side_nodes(f.side));
+        }
+    }
+    let floating = floating_parts(mesh, anchored, pairings);
+    if let Some(first) = floating.first() {
+        let more = match floating.len() {
+            1 => String::new(),
+            n => format!(" (and {} more parts)", n - 1),
+        };
+        diags.push(
+            Diagnostic::error(
+                "E0715",
+                format!(
+                    "the steady problem has no unique answer: {} nodes in block(s) {}{more} meet no temperature, convection or radiation condition, through the mesh or a contact interface, so their temperature is fixed only up to a constant (and with fluxes or sources that do not balance, no steady state exists)",
+                    first.nodes,
+                    first.blocks.join(", ")
+                ),
+            )
+            .help("add a [[bc]] of kind temperature, convection or radiation that reaches those blocks, join them to the rest by a contact interaction, or solve kind = \"transient\""),
+        );
+    }
+}
 
 /// Union–find over the nodes, path-halving, union by index.
 struct Parts(Vec<u32>);
@@ -41,7 +78,7 @@ pub(super) struct Floating {
 
 /// The parts of `mesh`, joined through the matched points of `pairings`, that hold none
 /// of the `anchored` nodes.
-pub(super) fn floating_parts(
+fn floating_parts(
     mesh: &Mesh,
     anchored: impl IntoIterator<Item = NodeId>,
     pairings: &[Pairing],

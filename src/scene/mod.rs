@@ -39,10 +39,11 @@ use crate::enforce::interface::Form;
 use crate::enforce::model::{ConductanceLaw, ModelChoice};
 use crate::mesh::Mesh;
 use crate::search::pairing::{Integration, SearchStats};
-use crate::search::scene::Pairing;
+use crate::search::scene::{Pairing, SceneSearch, Timing as SearchTiming};
 use crate::surface;
 
 use enforcement::{resolve_for, seen_temperature};
+use interaction::Interaction;
 use search::search_definition;
 
 /// The equation every supported enforcement applies to.
@@ -100,37 +101,13 @@ impl ContactScene {
         options: &SceneOptions<'_>,
         diags: &mut Diagnostics,
     ) -> ContactScene {
-        let phase = |what: &str| {
-            if let Some(f) = options.phase {
-                f(what);
-            }
-        };
         let mut scene = ContactScene::default();
         for (d, def) in loaded.deck.contact_definitions.iter().enumerate() {
-            phase("building the contact surfaces");
-            let t = Instant::now();
-            let set = surface::build(mesh, def, &loaded.sources);
-            scene.timing.surfaces_s += t.elapsed().as_secs_f64();
-            scene.surfaces += set.surfaces.len();
-            diags.extend(set.diagnostics.clone());
-            let (list, found) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
-            diags.extend(found);
-            if diags.has_errors() {
+            let Some((list, searched)) =
+                scene.search_one(mesh, loaded, def, deck_dir, options, diags)
+            else {
                 continue;
-            }
-            phase("contact search");
-            let t = Instant::now();
-            let searched = search_definition(
-                mesh,
-                def,
-                &set,
-                &list,
-                deck_dir,
-                &loaded.sources,
-                options.integration,
-            );
-            scene.timing.search_s += t.elapsed().as_secs_f64();
-            diags.extend(searched.diagnostics);
+            };
             if options.search_only && def.enforcements.is_empty() {
                 diags.push(
                     Diagnostic::warning(
@@ -216,6 +193,87 @@ impl ContactScene {
         }
         scene
     }
+
+    /// The surfaces, interactions and search of every contact definition of `loaded` on
+    /// `mesh` — the first stage of [`ContactScene::build`] — without resolving any
+    /// enforcement: every pairing is kept, with its definition (what `seam search`
+    /// reports). As in `build`, no definition is searched once `diags` holds an error.
+    pub fn search(
+        mesh: &Mesh,
+        loaded: &LoadedDeck,
+        deck_dir: &Path,
+        options: &SceneOptions<'_>,
+        diags: &mut Diagnostics,
+    ) -> Vec<SearchedDefinition> {
+        let mut scene = ContactScene::default();
+        let mut out = Vec::new();
+        for (d, def) in loaded.deck.contact_definitions.iter().enumerate() {
+            if let Some((_, searched)) =
+                scene.search_one(mesh, loaded, def, deck_dir, options, diags)
+            {
+                out.push(SearchedDefinition {
+                    definition: d,
+                    pairings: searched.pairings,
+                    timing: searched.timing,
+                });
+            }
+        }
+        out
+    }
+
+    /// One definition's surfaces and interactions, then (unless `diags` holds an error
+    /// by then) its search, with their diagnostics moved to `diags` and their times and
+    /// surfaces counted in `self`.
+    fn search_one(
+        &mut self,
+        mesh: &Mesh,
+        loaded: &LoadedDeck,
+        def: &ContactDefinition,
+        deck_dir: &Path,
+        options: &SceneOptions<'_>,
+        diags: &mut Diagnostics,
+    ) -> Option<(Vec<Interaction>, SceneSearch)> {
+        let phase = |what: &str| {
+            if let Some(f) = options.phase {
+                f(what);
+            }
+        };
+        phase("building the contact surfaces");
+        let t = Instant::now();
+        let set = surface::build(mesh, def, &loaded.sources);
+        self.timing.surfaces_s += t.elapsed().as_secs_f64();
+        self.surfaces += set.surfaces.len();
+        diags.extend(set.diagnostics.clone());
+        let (list, found) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
+        diags.extend(found);
+        if diags.has_errors() {
+            return None;
+        }
+        phase("contact search");
+        let t = Instant::now();
+        let mut searched = search_definition(
+            mesh,
+            def,
+            &set,
+            &list,
+            deck_dir,
+            &loaded.sources,
+            options.integration,
+        );
+        self.timing.search_s += t.elapsed().as_secs_f64();
+        diags.extend(std::mem::take(&mut searched.diagnostics));
+        Some((list, searched))
+    }
+}
+
+/// One contact definition's pairings as its search made them, before any enforcement
+/// is resolved ([`ContactScene::search`]).
+pub struct SearchedDefinition {
+    /// Index of the contact definition in the deck.
+    pub definition: usize,
+    pub pairings: Vec<Pairing>,
+    /// The search's own times (bounding-volume hierarchies built, queries).
+    pub timing: SearchTiming,
 }
 
 /// Why a search paired nothing, from its counts.

@@ -1,0 +1,376 @@
+//! The solve of a run: one linear steady solve ([`solve_steady`]) when the problem allows
+//! it (one field, constant materials, a source of x, no toggles, no radiation), else the
+//! time loop of the general solver ([`transient::solve`]), of which a nonlinear steady
+//! solve is the one step. Each accepted step is recorded, written when due and
+//! checkpointed; the linear solver that ran is summarised with the reason for it.
+
+use crate::assembly::DofMap;
+use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
+use crate::heat::transient::{
+    self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
+};
+use crate::heat::{HeatError, TEMPERATURE};
+use crate::mesh::NodeId;
+
+use super::output::Output;
+use super::physics::Physics;
+use super::problem::{BcKind, ProblemFile};
+use super::steps;
+use super::summary::LinearSolverSummary;
+use super::terms::ContactTerms;
+use super::{RunError, RunOptions};
+
+/// What the solve gives.
+pub(super) struct Solved {
+    /// The final state (the last step of a stepped run).
+    pub solution: SteadySolution,
+    /// Every accepted step (empty for a linear steady solve).
+    pub history: Vec<StepReport>,
+    /// Per accepted step, the heat of each mechanism in the solver's term order.
+    pub mechanisms: Vec<Vec<Vec<f64>>>,
+    pub linear_solver: LinearSolverSummary,
+    /// Solved by the linear steady solver: one solve, no steps.
+    pub linear_steady: bool,
+}
+
+/// The solve of a run, over its physics and contact terms.
+pub(super) struct TimeLoop<'a> {
+    file: &'a ProblemFile,
+    physics: &'a Physics<'a>,
+    terms: &'a ContactTerms<'a>,
+    options: &'a RunOptions,
+    /// The `linear_solver` asked for (`None` or `auto` for the automatic choice).
+    requested: Option<&'a str>,
+    /// The size from which `auto` picks AMG-CG.
+    threshold: usize,
+}
+
+impl<'a> TimeLoop<'a> {
+    pub(super) fn new(
+        file: &'a ProblemFile,
+        physics: &'a Physics<'a>,
+        terms: &'a ContactTerms<'a>,
+        options: &'a RunOptions,
+    ) -> Self {
+        let solve = &file.problem.solve;
+        TimeLoop {
+            file,
+            physics,
+            terms,
+            options,
+            requested: solve.linear_solver.as_deref(),
+            threshold: solve
+                .auto_threshold
+                .unwrap_or(crate::heat::steady::AUTO_AMG_THRESHOLD),
+        }
+    }
+
+    /// Solve from `initial` (the checked initial state, if any), writing the steps to
+    /// `output` as they are accepted.
+    pub(super) fn run(
+        &self,
+        initial: Option<Vec<f64>>,
+        output: &mut Output<'a>,
+    ) -> Result<Solved, RunError> {
+        if self.is_linear_steady() {
+            self.linear_steady()
+        } else {
+            self.steps(initial, output)
+        }
+    }
+
+    /// Whether one linear steady solve answers the problem: steady, one field, constant
+    /// materials, a source of x alone, no toggles, no radiation.
+    fn is_linear_steady(&self) -> bool {
+        let physics = self.physics;
+        !self.file.transient
+            && physics.uniform
+            && physics.materials.constant().is_some()
+            && physics.field_names.len() == 1
+            && !self.terms.couplings.any_toggle()
+            && (self.file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
+    }
+
+    /// One linear steady solve, by a factorisation or AMG-CG as `linear_solver` and the
+    /// size say.
+    fn linear_steady(&self) -> Result<Solved, RunError> {
+        let (physics, mesh, problem) = (self.physics, self.physics.mesh, &self.file.problem);
+        let (requested, threshold) = (self.requested, self.threshold);
+        let source_failed = std::sync::Mutex::new(None::<String>);
+        let source = physics.source_of_x(&source_failed);
+        let source_fn = source.as_deref();
+        let materials = physics.materials.constant().expect("checked constant");
+        // The temperature unknowns (multipliers aside) decide the automatic choice.
+        let solid: Vec<usize> = (0..mesh.blocks.len())
+            .filter(|&b| mesh.blocks[b].topology.is_solid())
+            .collect();
+        let unknowns = DofMap::new(mesh, &[(TEMPERATURE, &solid)])
+            .map_err(|e| RunError::Solve(e.to_string()))?
+            .len();
+        let iterative = match requested {
+            Some("amg") => true,
+            Some("direct") => false,
+            _ => unknowns >= threshold,
+        };
+        let loads = physics
+            .loads_at(physics.time.start)
+            .map_err(RunError::Solve)?;
+        let steady = SteadyProblem {
+            mesh,
+            materials: &materials,
+            source: source_fn,
+            dirichlet: &loads.dirichlet,
+            face_bcs: &loads.faces,
+            contact: self.terms.contact_terms(),
+            ties: self.terms.tie_terms(),
+            iterative,
+            tolerance: problem.solve.tolerance,
+            max_iterations: problem.solve.max_iterations,
+        };
+        self.options.phase(&format!(
+            "assembling and solving ({} nodes)",
+            mesh.num_nodes()
+        ));
+        let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+        let linear_solver = linear_solver_summary(
+            requested,
+            threshold,
+            unknowns,
+            !steady.ties.is_empty(),
+            &solved.linear,
+        );
+        if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
+            return Err(RunError::Solve(format!("[[source]]: {e}")));
+        }
+        Ok(Solved {
+            solution: solved,
+            history: Vec::new(),
+            mechanisms: Vec::new(),
+            linear_solver,
+            linear_steady: true,
+        })
+    }
+
+    /// The general solver's steps: a transient run, or a nonlinear steady solve as one
+    /// step; from a checkpoint when the run restarts.
+    fn steps(
+        &self,
+        initial: Option<Vec<f64>>,
+        output: &mut Output<'a>,
+    ) -> Result<Solved, RunError> {
+        let (physics, mesh, terms) = (self.physics, self.physics.mesh, self.terms);
+        let (problem, requested) = (&self.file.problem, self.requested);
+        let time = &physics.time;
+        let loads = |t: f64| -> Result<Loads, HeatError> {
+            terms.set_time(t);
+            physics.loads_at(t).map_err(HeatError::Step)
+        };
+        let active = |k: usize, t: f64| -> bool { terms.term_on(k, t) };
+        let tp = TransientProblem {
+            mesh,
+            fields: physics
+                .field_names
+                .iter()
+                .map(|f| FieldSpec {
+                    name: f.clone(),
+                    blocks: (0..mesh.blocks.len())
+                        .filter(|&b| {
+                            mesh.blocks[b].topology.is_solid() && physics.materials.fields[b] == *f
+                        })
+                        .collect(),
+                })
+                .collect(),
+            laws: &physics.materials.laws,
+            source: None,
+            block_source: Some(&physics.block_source),
+            loads: &loads,
+            contact: terms.contact_terms(),
+            ties: terms.tie_terms(),
+            term_fields: terms.term_fields(),
+            active: Some(&active),
+            cutback: Some(terms.cutback()),
+            tolerance: problem.solve.tolerance,
+            max_iterations: problem.solve.max_iterations,
+            reproducible: problem.solve.reproducible.unwrap_or(true),
+            amg_threshold: match requested {
+                Some("direct") => None,
+                Some("amg") => Some(0),
+                _ => Some(self.threshold),
+            },
+        };
+        let restart = match (&problem.restart, self.options.restart.as_ref()) {
+            (_, Some(file)) => Some(steps::read_checkpoint(file)?),
+            (Some(r), None) => Some(steps::read_checkpoint(&self.file.dir.join(&r.file))?),
+            (None, None) => None,
+        };
+        let initial = match restart {
+            Some(_) => Vec::new(),
+            None => match initial {
+                Some(v) => v,
+                None => physics.initial_values()?,
+            },
+        };
+        let at_node = |n: NodeId| initial[n.index()];
+        let start = match restart {
+            Some(state) => Start::Restart(state),
+            None => Start::Fresh {
+                time: time.start,
+                dt: time.dt,
+                initial: &at_node,
+            },
+        };
+        let mode = if self.file.transient {
+            TimeMode::Transient {
+                scheme: time.scheme,
+                end: time.end,
+                adaptive: time.adaptive,
+                dt_min: time.dt_min,
+            }
+        } else {
+            TimeMode::Steady { time: time.start }
+        };
+        let mut recorder = Recorder {
+            output,
+            terms,
+            progress: self.options.progress.as_deref(),
+            history: Vec::new(),
+            mechanisms: Vec::new(),
+        };
+        self.options.phase(&format!(
+            "assembling and factorising the first step ({} nodes)",
+            mesh.num_nodes()
+        ));
+        let mut on_step = |r: &StepReport, st: &State, dofs: &DofMap| recorder.record(r, st, dofs);
+        let outcome = transient::solve(&tp, mode, start, &mut on_step)
+            .map_err(|e| RunError::Solve(e.to_string()))?;
+        let Recorder {
+            output,
+            history,
+            mechanisms,
+            ..
+        } = recorder;
+        output.finish_steps(&outcome, &history)?;
+        let linear_solver = self.stepped_solver_summary(&history, outcome.dofs.len());
+        let solution =
+            steps::final_solution(outcome, &history, &physics.field_names, tp.contact.len());
+        Ok(Solved {
+            solution,
+            history,
+            mechanisms,
+            linear_solver,
+            linear_steady: false,
+        })
+    }
+
+    /// The linear solver of a stepped run with `n` unknowns: AMG-CG when its steps were
+    /// solved by CG (with the iterations per accepted step), else factorisations.
+    fn stepped_solver_summary(&self, history: &[StepReport], n: usize) -> LinearSolverSummary {
+        let auto = matches!(self.requested, None | Some("auto"));
+        let threshold = self.threshold;
+        // CG iterations per accepted step, when the steps were solved by AMG-CG.
+        let per_step: Vec<usize> = history.iter().map(|r| r.cg_iterations).collect();
+        if per_step.iter().any(|&k| k > 0) {
+            LinearSolverSummary {
+                name: "AMG-CG".into(),
+                reason: if auto {
+                    format!(
+                        "auto: {n:.1e} unknowns, symmetric positive definite steps → AMG-CG (hierarchy kept while the matrix is unchanged)"
+                    )
+                } else {
+                    "requested by linear_solver".into()
+                },
+                iterations: per_step.iter().sum(),
+                iterations_per_solve: per_step,
+            }
+        } else {
+            LinearSolverSummary {
+                name: "direct".into(),
+                reason: if auto {
+                    format!(
+                        "auto: step systems below {threshold} unknowns or not symmetric positive definite are factored (Cholesky, LDLᵀ or LU by their kind)"
+                    )
+                } else {
+                    "requested by linear_solver".into()
+                },
+                iterations: 0,
+                iterations_per_solve: Vec::new(),
+            }
+        }
+    }
+}
+
+/// What happens at each accepted step: progress shown, the state derived (its point
+/// fluxes when its fields are written, its mechanism heats always), written when due,
+/// checkpointed, and kept in the history.
+struct Recorder<'o, 'a> {
+    output: &'o mut Output<'a>,
+    terms: &'a ContactTerms<'a>,
+    progress: Option<&'a dyn Fn(&StepReport)>,
+    history: Vec<StepReport>,
+    mechanisms: Vec<Vec<Vec<f64>>>,
+}
+
+impl Recorder<'_, '_> {
+    fn record(&mut self, r: &StepReport, st: &State, dofs: &DofMap) -> Result<(), HeatError> {
+        if let Some(progress) = self.progress {
+            progress(r);
+        }
+        let due = self.output.due(r.step);
+        let derived = self
+            .terms
+            .derive(&st.u, dofs, st.time, due)
+            .map_err(HeatError::Step)?;
+        self.mechanisms.push(self.terms.term_mechanisms(&derived));
+        if due {
+            self.output
+                .write_state(&st.u, dofs, st.step, st.time, Some(derived), &r.heat)
+                .map_err(HeatError::Step)?;
+        }
+        self.output
+            .checkpoint(st)
+            .map_err(|e| HeatError::Step(e.to_string()))?;
+        self.history.push(r.clone());
+        Ok(())
+    }
+}
+
+/// The summary of a linear steady solve's solver: `requested` is the `linear_solver`
+/// field (`None` or `auto` for the automatic choice), `n` the unknowns.
+fn linear_solver_summary(
+    requested: Option<&str>,
+    threshold: usize,
+    n: usize,
+    ties: bool,
+    linear: &crate::heat::steady::LinearSolves,
+) -> LinearSolverSummary {
+    use crate::heat::steady::LinearMethod;
+    let auto = matches!(requested, None | Some("auto"));
+    let why = match linear.method {
+        Some(LinearMethod::AmgCg) => {
+            format!("{n:.1e} unknowns, symmetric positive definite → AMG-CG")
+        }
+        Some(LinearMethod::SaddleLdlt) => "multipliers make the system indefinite → LDLᵀ".into(),
+        Some(LinearMethod::Lu) => {
+            "a temperature-dependent conductance makes the Jacobian unsymmetric → LU".into()
+        }
+        Some(LinearMethod::Cholesky) if ties => {
+            "dual mortar ties condensed to a symmetric positive definite system → Cholesky".into()
+        }
+        Some(LinearMethod::Cholesky) => format!("{n} unknowns (< {threshold}) → Cholesky"),
+        None => "no linear solve was needed".into(),
+    };
+    let asked_amg = requested == Some("amg");
+    let reason = if auto {
+        format!("auto: {why}")
+    } else if asked_amg && linear.method.is_some_and(|m| m != LinearMethod::AmgCg) {
+        format!("linear_solver = \"amg\" requested, but {why}")
+    } else {
+        "requested by linear_solver".into()
+    };
+    LinearSolverSummary {
+        name: linear.method.map_or("none", LinearMethod::name).into(),
+        reason,
+        iterations: linear.cg_iterations.iter().sum(),
+        iterations_per_solve: linear.cg_iterations.clone(),
+    }
+}
