@@ -53,7 +53,6 @@
 use std::sync::{Arc, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
-use crate::enforce::conductance::PluginConductance;
 use crate::enforce::interface::{DEFAULT_BETA, Form, InterfaceError, InterfacePoints};
 use crate::mesh::{Mesh, NodeId, ValidationError};
 use crate::periodic::PeriodicMap;
@@ -383,13 +382,14 @@ pub struct Condensed {
 /// The conductance of a flux-type interaction.
 enum Law {
     Constant(f64),
-    /// A model from the deck (`Gap Conductance Coefficient = …`) and the contact
-    /// pressure it sees.
-    Model(Box<dyn ConductanceModel>, f64),
-    /// A plugin (`Enforcement for Energy = Plugin …`) and the contact pressure it sees:
-    /// its faults and cutback requests become [`EmbedError::Plugin`] and
-    /// [`EmbedError::Cutback`].
-    Plugin(Box<PluginConductance>, f64),
+    /// A model from the deck (`Gap Conductance Coefficient = …`, or a plugin: its faults
+    /// and cutback requests become [`EmbedError::Plugin`] and [`EmbedError::Cutback`])
+    /// and the contact pressure it sees.
+    Model {
+        model: Box<dyn ConductanceModel>,
+        pressure: f64,
+        plugin: bool,
+    },
     /// A model the host gave in code (a Rust model or closure, a C callback).
     Host(Arc<dyn ConductanceModel>),
 }

@@ -64,8 +64,9 @@ impl Embedding {
                         ..HValue::default()
                     });
                 }
-                Law::Model(m, pressure) => (m.as_ref(), *pressure),
-                Law::Plugin(m, pressure) => (m.as_ref(), *pressure),
+                Law::Model {
+                    model, pressure, ..
+                } => (model.as_ref(), *pressure),
                 Law::Host(m) => (m.as_ref(), 0.0),
             };
             let state = PointState {
@@ -84,7 +85,7 @@ impl Embedding {
                 }),
                 Err(e) => {
                     let message = e.to_string();
-                    if matches!(law, Law::Plugin(..)) {
+                    if matches!(law, Law::Model { plugin: true, .. }) {
                         fault.set(Some(e));
                     }
                     Err(message)

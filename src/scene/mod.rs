@@ -44,7 +44,6 @@ use crate::surface;
 
 use enforcement::{resolve_for, seen_temperature};
 use interaction::Interaction;
-use search::search_definition;
 
 /// The equation every supported enforcement applies to.
 const ENERGY: &str = "energy";
@@ -59,6 +58,21 @@ pub struct Enforced {
     pub model: Option<Box<dyn ConductanceModel>>,
     /// Index of the contact definition in the deck.
     pub definition: usize,
+    /// What searching this pair again takes (a host that moves nodes):
+    /// [`ContactScene::build_for_host`] keeps it, [`ContactScene::build`] does not.
+    pub again: Option<SearchAgain>,
+}
+
+/// A pairing's surfaces and search options, to search it again after the nodes move.
+pub struct SearchAgain {
+    pub side_a: surface::ContactSurface,
+    pub side_b: surface::ContactSurface,
+    pub settings: crate::search::SearchSettings,
+    /// `None` for a periodic pair, which keeps its gaps as found.
+    pub overclosure: Option<crate::search::Overclosure>,
+    pub subdomain: Option<crate::search::pairing::Sphere>,
+    /// A periodic pair's map: side A is the image of `side_a` under it.
+    pub map: Option<Box<dyn crate::periodic::PeriodicMap>>,
 }
 
 /// How to build a scene.
@@ -87,6 +101,9 @@ pub struct ContactScene {
     pub entries: Vec<Enforced>,
     /// Number of contact surfaces built, over every definition.
     pub surfaces: usize,
+    /// Plugin enforcements whose library could not be loaded (their E0500 is in the
+    /// diagnostics): side A, side B, why.
+    pub plugins_refused: Vec<(String, String, String)>,
     pub timing: SceneTiming,
 }
 
@@ -101,13 +118,41 @@ impl ContactScene {
         options: &SceneOptions<'_>,
         diags: &mut Diagnostics,
     ) -> ContactScene {
+        Self::build_with(mesh, loaded, deck_dir, options, diags, false)
+    }
+
+    /// As [`Self::build`], each entry keeping what searching it again takes
+    /// ([`Enforced::again`]): the scene of a host that moves its nodes.
+    pub fn build_for_host(
+        mesh: &Mesh,
+        loaded: &LoadedDeck,
+        deck_dir: &Path,
+        options: &SceneOptions<'_>,
+        diags: &mut Diagnostics,
+    ) -> ContactScene {
+        Self::build_with(mesh, loaded, deck_dir, options, diags, true)
+    }
+
+    fn build_with(
+        mesh: &Mesh,
+        loaded: &LoadedDeck,
+        deck_dir: &Path,
+        options: &SceneOptions<'_>,
+        diags: &mut Diagnostics,
+        keep: bool,
+    ) -> ContactScene {
         let mut scene = ContactScene::default();
         for (d, def) in loaded.deck.contact_definitions.iter().enumerate() {
-            let Some((list, searched)) =
+            let Some((list, searched, set, found_maps)) =
                 scene.search_one(mesh, loaded, def, deck_dir, options, diags)
             else {
                 continue;
             };
+            let mut maps: Vec<Option<Box<dyn crate::periodic::PeriodicMap>>> =
+                searched.pairings.iter().map(|_| None).collect();
+            for (k, map) in found_maps {
+                maps[k] = Some(map);
+            }
             if options.search_only && def.enforcements.is_empty() {
                 diags.push(
                     Diagnostic::warning(
@@ -119,7 +164,7 @@ impl ContactScene {
                 );
                 continue;
             }
-            for pairing in searched.pairings {
+            for (pairing, map) in searched.pairings.into_iter().zip(maps) {
                 let interaction = list
                     .iter()
                     .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
@@ -180,14 +225,36 @@ impl ContactScene {
                 let Ok(model) =
                     conductance_model(enf, &choice, deck_dir, &loaded.sources, pair, diags)
                 else {
+                    if let Some(d) = diags.0.last().filter(|d| d.code == "E0500") {
+                        scene.plugins_refused.push((
+                            pairing.side_a.clone(),
+                            pairing.side_b.clone(),
+                            d.message.clone(),
+                        ));
+                    }
                     continue;
                 };
+                let again = keep.then(|| SearchAgain {
+                    side_a: set.surfaces[pairing.side_a_surface].clone(),
+                    side_b: set.surfaces[pairing.side_b_surface].clone(),
+                    settings: match (interaction, pairing.periodic) {
+                        (Some(i), false) => i.settings.clone(),
+                        _ => search::base_settings(def, mesh.dim),
+                    },
+                    overclosure: match (interaction, pairing.periodic) {
+                        (Some(i), false) => Some(i.overclosure),
+                        _ => None,
+                    },
+                    subdomain: search::subdomain(def),
+                    map,
+                });
                 scene.entries.push(Enforced {
                     pairing,
                     choice,
                     penalty_scale: interaction.map_or(1.0, |i| i.penalty_scale),
                     model,
                     definition: d,
+                    again,
                 });
             }
         }
@@ -208,7 +275,7 @@ impl ContactScene {
         let mut scene = ContactScene::default();
         let mut out = Vec::new();
         for (d, def) in loaded.deck.contact_definitions.iter().enumerate() {
-            if let Some((_, searched)) =
+            if let Some((_, searched, _, _)) =
                 scene.search_one(mesh, loaded, def, deck_dir, options, diags)
             {
                 out.push(SearchedDefinition {
@@ -232,7 +299,12 @@ impl ContactScene {
         deck_dir: &Path,
         options: &SceneOptions<'_>,
         diags: &mut Diagnostics,
-    ) -> Option<(Vec<Interaction>, SceneSearch)> {
+    ) -> Option<(
+        Vec<Interaction>,
+        SceneSearch,
+        surface::SurfaceSet,
+        search::PairingMaps,
+    )> {
         let phase = |what: &str| {
             if let Some(f) = options.phase {
                 f(what);
@@ -251,7 +323,8 @@ impl ContactScene {
         }
         phase("contact search");
         let t = Instant::now();
-        let mut searched = search_definition(
+        let mut maps = Vec::new();
+        let mut searched = search::search_definition_with_maps(
             mesh,
             def,
             &set,
@@ -259,10 +332,11 @@ impl ContactScene {
             deck_dir,
             &loaded.sources,
             options.integration,
+            &mut maps,
         );
         self.timing.search_s += t.elapsed().as_secs_f64();
         diags.extend(std::mem::take(&mut searched.diagnostics));
-        Some((list, searched))
+        Some((list, searched, set, maps))
     }
 }
 

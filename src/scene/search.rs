@@ -50,6 +50,35 @@ pub fn search_definition(
     sources: &SourceMap,
     integration: Integration,
 ) -> SceneSearch {
+    let mut maps = Vec::new();
+    search_definition_with_maps(
+        mesh,
+        def,
+        surfaces,
+        interactions,
+        deck_dir,
+        sources,
+        integration,
+        &mut maps,
+    )
+}
+
+/// The map of a periodic pairing, by the pairing's index in [`SceneSearch::pairings`].
+pub type PairingMaps = Vec<(usize, Box<dyn crate::periodic::PeriodicMap>)>;
+
+/// As [`search_definition`], keeping each periodic pairing's map in `maps` (for hosts
+/// that move nodes and map side A again).
+#[allow(clippy::too_many_arguments)]
+pub fn search_definition_with_maps(
+    mesh: &Mesh,
+    def: &ContactDefinition,
+    surfaces: &SurfaceSet,
+    interactions: &[Interaction],
+    deck_dir: &Path,
+    sources: &SourceMap,
+    integration: Integration,
+    maps: &mut PairingMaps,
+) -> SceneSearch {
     let mut out = SceneSearch::default();
     let subdomain = subdomain(def);
     let t = Instant::now();
@@ -95,6 +124,7 @@ pub fn search_definition(
             integration,
             &mut out,
         ) {
+            maps.push((out.pairings.len(), found.map));
             out.pairings.push(found.pairing);
         }
     }

@@ -450,3 +450,61 @@ fn embed_header_side_table_is_seams() {
         }
     }
 }
+
+/// The embedding reads a deck through the same scene as `seam run`: a `Side B
+/// Variable` naming a field the host does not have is the same error (E0428) through
+/// both doors, where the embedding once accepted it; and a deck line an embedding
+/// cannot honour (`Use Toggle Block`, times of `seam run`'s problem file) is refused.
+#[test]
+fn embed_reads_a_deck_as_seam_run_does() {
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
+    let wrong_field = deck.replace(
+        "enforcement for energy = gap_conductance",
+        "enforcement for energy = tied\n    side b variable temprature to temperature",
+    );
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    let err = seam
+        .add_deck("wrong.i", &wrong_field)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("E0428") && err.contains("did you mean `temperature`"),
+        "{err}"
+    );
+    let dir = std::env::temp_dir().join(format!("seam-embed-api-field-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let problem = std::fs::read_to_string(scene().join("problem.toml"))
+        .unwrap()
+        .replace(
+            "file = \"two_blocks.exo\"",
+            &format!(
+                "file = {:?}",
+                scene().join("two_blocks.exo").display().to_string()
+            ),
+        );
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    std::fs::write(dir.join("contact_run.i"), &wrong_field).unwrap();
+    match seam::run::check(&dir.join("problem.toml")) {
+        Err(seam::run::RunError::Input(d, _)) => {
+            assert!(d.0.iter().any(|x| x.code == "E0428"), "{d:?}")
+        }
+        Ok(c) => assert!(c.diagnostics.0.iter().any(|x| x.code == "E0428")),
+        Err(e) => panic!("{e:?}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let toggled = deck.replace(
+        "gap conductance coefficient = constant h = 500",
+        "gap conductance coefficient = constant h = 500\n    use toggle block on_off",
+    );
+    let err = seam
+        .add_deck("toggled.i", &toggled)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("E0430") && err.contains("Use Toggle Block"),
+        "{err}"
+    );
+    assert!(seam.is_empty(), "nothing added on an error");
+}
