@@ -468,5 +468,6 @@ pub use crate::enforce::conductance::{
 };
 pub use builder::EmbeddingBuilder;
 pub use csr::{CsrMatrix, Evaluation};
+pub(crate) use fields::face_values;
 pub use fields::{Coverage, FaceValues, HostFace, PointValues, Unpaired, UnpairedReason};
 pub use ties::TieConstraints;

@@ -1,5 +1,5 @@
 use super::{Condensed, EmbedError, Embedding, Enforcement, Heat, Multipliers, argument};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashSet};
 
 use crate::enforce::mortar::mortar_tie;
 use crate::mesh::NodeId;
@@ -55,28 +55,24 @@ impl TieConstraints {
         count: usize,
     ) -> Result<Vec<Option<f64>>, EmbedError> {
         self.check_lambda(lambda)?;
-        let mut out = vec![None; count];
-        for &(p, k, psi) in &self.point_psi {
-            if let Some(q) = out.get_mut(p as usize) {
-                *q.get_or_insert(0.0) += psi * lambda[k as usize];
-            }
-        }
-        Ok(out)
+        Ok(crate::enforce::mortar::multiplier_field(
+            &self.point_psi,
+            lambda,
+            count,
+        ))
     }
 
     /// Heat leaving each side for multipliers `lambda` (the flux from A to B), one per
     /// multiplier: `Σ_{i ∈ side} (Cᵀλ)_i`.
     pub fn heat(&self, lambda: &[f64]) -> Result<Heat, EmbedError> {
         self.check_lambda(lambda)?;
-        let mut ct: HashMap<usize, f64> = HashMap::new();
-        for &(k, j, c) in &self.entries {
-            *ct.entry(j).or_default() += c * lambda[k];
-        }
-        let sum = |set: &[usize]| set.iter().filter_map(|d| ct.get(d)).sum::<f64>();
-        Ok(Heat {
-            side_a: sum(&self.side_a_dofs),
-            side_b: sum(&self.side_b_dofs),
-        })
+        let (side_a, side_b) = crate::enforce::mortar::tie_heat(
+            self.entries.iter().copied(),
+            lambda,
+            &self.side_a_dofs,
+            &self.side_b_dofs,
+        );
+        Ok(Heat { side_a, side_b })
     }
 
     /// Dual multipliers of a host that condensed the tie: `λ_k = −r_k / D_k`, with `r`

@@ -58,19 +58,62 @@ pub struct MortarTie {
     pub point_psi: Vec<(u32, u32, f64)>,
 }
 
+/// Heat leaving side A and side B through a tie for multipliers `lambda` (one per
+/// multiplier, the flux from A to B): `Σ_{d ∈ side} (Cᵀλ)_d`, with `entries` the
+/// `(multiplier, dof, C)` entries of C in any dof numbering. The one place the tie heat
+/// is computed: the solvers, the embedding and its C face all call it.
+pub fn tie_heat<D: Copy + Ord>(
+    entries: impl IntoIterator<Item = (usize, D, f64)>,
+    lambda: &[f64],
+    side_a: &[D],
+    side_b: &[D],
+) -> (f64, f64) {
+    let mut ct = std::collections::BTreeMap::<D, f64>::new();
+    for (k, d, c) in entries {
+        *ct.entry(d).or_default() += c * lambda[k];
+    }
+    let sum = |set: &[D]| {
+        set.iter()
+            .map(|d| ct.get(d).copied().unwrap_or(0.0))
+            .sum::<f64>()
+    };
+    (sum(side_a), sum(side_b))
+}
+
+/// The multiplier field `λ_h = Σ_k ψ_k λ_k` at `count` points from the basis values
+/// `(point, multiplier, ψ)` (`None` at points without a multiplier).
+pub fn multiplier_field(
+    point_psi: &[(u32, u32, f64)],
+    lambda: &[f64],
+    count: usize,
+) -> Vec<Option<f64>> {
+    let mut out = vec![None; count];
+    for &(p, k, psi) in point_psi {
+        if let Some(q) = out.get_mut(p as usize) {
+            *q.get_or_insert(0.0) += psi * lambda[k as usize];
+        }
+    }
+    out
+}
+
 impl MortarTie {
+    /// Heat leaving side A and side B for multipliers `lambda` ([`tie_heat`]).
+    pub fn heat(&self, lambda: &[f64]) -> (f64, f64) {
+        tie_heat(
+            self.entries.iter().map(|&(k, d, c)| (k as usize, d, c)),
+            lambda,
+            &self.side_a_dofs,
+            &self.side_b_dofs,
+        )
+    }
+
     /// The multiplier field `λ_h = Σ_k ψ_k λ_k` at each of the pairing's `count` points
     /// (`None` where the tie has no multiplier: unmatched points, crosspoint nodes). It is
     /// the heat flux from side A to side B: the heat leaving side A is
     /// `Σ_{d∈A} (Cᵀλ)_d = Σ_points w λ_h`, since side A's shape functions sum to one (at a
     /// node point ψ = 1 and side A's entry is w).
     pub fn point_flux(&self, lambda: &[f64], count: usize) -> Vec<Option<f64>> {
-        let mut out = vec![None; count];
-        for &(p, k, psi) in &self.point_psi {
-            let q = out[p as usize].get_or_insert(0.0);
-            *q += psi * lambda[k as usize];
-        }
-        out
+        multiplier_field(&self.point_psi, lambda, count)
     }
 }
 

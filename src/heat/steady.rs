@@ -384,19 +384,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let tie_heat = ties
         .iter()
         .enumerate()
-        .map(|(t, tie)| {
-            // Σ over each side's dofs of Cᵀλ.
-            let mut ct = std::collections::HashMap::<u32, f64>::new();
-            for &(k, d, c) in &tie.entries {
-                *ct.entry(d).or_default() += c * u[lambda_first[t] + k as usize];
-            }
-            let sum = |set: &[u32]| {
-                set.iter()
-                    .map(|d| ct.get(d).copied().unwrap_or(0.0))
-                    .sum::<f64>()
-            };
-            (sum(&tie.side_a_dofs), sum(&tie.side_b_dofs))
-        })
+        .map(|(t, tie)| tie.heat(&u[lambda_first[t]..lambda_first[t] + tie.nodes.len()]))
         .collect();
     let crosspoints = ties.iter().map(|t| t.crosspoints.clone()).collect();
     let temperature = dofs.nodal_values(field, &u);
@@ -592,18 +580,7 @@ fn solve_dual(
     let tie_heat = ties
         .iter()
         .zip(&lambdas)
-        .map(|(tie, lambda)| {
-            let mut ct = std::collections::HashMap::<u32, f64>::new();
-            for &(kk, d, c) in &tie.entries {
-                *ct.entry(d).or_default() += c * lambda[kk as usize];
-            }
-            let sum = |set: &[u32]| {
-                set.iter()
-                    .map(|d| ct.get(d).copied().unwrap_or(0.0))
-                    .sum::<f64>()
-            };
-            (sum(&tie.side_a_dofs), sum(&tie.side_b_dofs))
-        })
+        .map(|(tie, lambda)| tie.heat(lambda))
         .collect();
     let heat = points
         .iter()

@@ -19,7 +19,6 @@ use crate::fem::shape::reference_nodes;
 use crate::fem::{MAX_NODES, eval_point};
 use crate::heat::transient::BlockLaws;
 use crate::mesh::{Mesh, NodeId};
-use crate::search::pairing::{PointStatus, SurfaceGeometry};
 use crate::search::scene::Pairing;
 
 /// −k∇T at the centroid of every element, x, y, z interleaved, in dense element order
@@ -120,14 +119,6 @@ pub(super) struct ContactFields {
     pub faces: Vec<ContactFace>,
 }
 
-/// Per matched point and face: the sums a face's fields are made of.
-#[derive(Clone, Copy, Default)]
-struct Sums {
-    weight: f64,
-    gap: f64,
-    flux: f64,
-}
-
 /// The faces of one interaction (`interaction`, 1-based) with their fields: side A's
 /// always, side B's with `side_b`. `fluxes` holds each point's flux (from
 /// [`crate::enforce::interface::point_flux`]), or is `None` for an interaction without
@@ -139,53 +130,28 @@ pub(super) fn contact_faces(
     side_b: bool,
     out: &mut ContactFields,
 ) {
-    let a = &pairing.side_a_geometry;
-    let b = &pairing.side_b_geometry;
-    let mut on_a = vec![Sums::default(); a.faces.len()];
-    let mut on_b = vec![Sums::default(); b.faces.len()];
-    for (k, p) in pairing.result.points.iter().enumerate() {
-        if p.status != PointStatus::Matched || p.a_face == u32::MAX {
-            continue;
-        }
-        let q = match fluxes {
-            Some(f) => f.get(k).copied().flatten().map_or(0.0, |f| f.q),
-            None => f64::NAN,
-        };
-        for s in [&mut on_a[p.a_face as usize], &mut on_b[p.b_face as usize]] {
-            s.weight += p.weight;
-            s.gap += p.weight * p.gap;
-            s.flux += p.weight * q;
-        }
-    }
-    let mut push = |geometry: &SurfaceGeometry, sums: &[Sums], side: u8| {
-        for (f, s) in geometry.faces.iter().zip(sums) {
-            let face_area = f.area();
-            let matched = s.weight > 0.0;
-            out.faces.push(ContactFace {
-                nodes: f.nodes,
-                len: f.len,
-                interaction,
-                side,
-                gap: if matched { s.gap / s.weight } else { 0.0 },
-                // Σw of a fully covered flat face is its area up to round-off; clamp.
-                fraction: if face_area > 0.0 {
-                    (s.weight / face_area).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                },
-                area: s.weight,
-                face_area,
-                flux: match (fluxes, matched) {
-                    (None, _) => f64::NAN,
-                    (Some(_), true) => s.flux / s.weight,
-                    (Some(_), false) => 0.0,
-                },
-            });
-        }
-    };
-    push(a, &on_a, 0);
-    if side_b {
-        push(b, &on_b, 1);
+    // The aggregation of the embedding API's face fields (one implementation).
+    let (a, b) = (&pairing.side_a_geometry, &pairing.side_b_geometry);
+    let values = crate::embed::face_values(
+        a,
+        b,
+        &pairing.result.points,
+        |k| fluxes.and_then(|f| f.get(k).copied().flatten()).map(|f| f.q),
+        side_b,
+    );
+    let geometry = a.faces.iter().chain(if side_b { &b.faces[..] } else { &[] });
+    for (f, v) in geometry.zip(values) {
+        out.faces.push(ContactFace {
+            nodes: f.nodes,
+            len: f.len,
+            interaction,
+            side: v.side,
+            gap: v.gap,
+            fraction: v.fraction,
+            area: v.paired_area,
+            face_area: v.area,
+            flux: if fluxes.is_some() { v.flux } else { f64::NAN },
+        });
     }
 }
 

@@ -248,16 +248,7 @@ impl Context<'_, '_> {
             .collect();
         for (ti, tie) in self.setup.ties.iter().enumerate() {
             let l0 = self.setup.lambda_first[ti];
-            let mut ct = std::collections::BTreeMap::<u32, f64>::new();
-            for &(k, d, c) in &tie.entries {
-                *ct.entry(d).or_default() += c * u[l0 + k as usize];
-            }
-            let sum = |set: &[u32]| {
-                set.iter()
-                    .map(|d| ct.get(d).copied().unwrap_or(0.0))
-                    .sum::<f64>()
-            };
-            out.push((sum(&tie.side_a_dofs), sum(&tie.side_b_dofs)));
+            out.push(tie.heat(&u[l0..l0 + tie.nodes.len()]));
         }
         out
     }
