@@ -1,14 +1,22 @@
 //! seam: interface enforcement for implicit finite-element multiphysics codes.
 //!
-//! The data flow, one module per arrow: [`deck`] (Sierra syntax or TOML → typed spec),
-//! [`mesh`] (Exodus II, Gmsh, generators), [`surface`] (contact surfaces by the Sierra
-//! rules), [`plugin`] (user enforcement models loaded as shared libraries). Diagnostics shared by all of them live in [`diag`].
+//! The modules, bottom to top (docs/architecture.md has the map, the data flow and
+//! where to add a model, a mesh format or an equation); each uses only those below it:
 //!
-//! Layers depend only downward: [`fem`] (reference elements, the one Gauss rule) at the
-//! bottom; [`search`], [`enforce`] and [`plugin`] over typed settings of their own, never
-//! a deck; [`scene`] above them, which lowers the typed deck spec to those settings
-//! ([`surface`] still reads its surface definitions from the spec itself); the hosts
-//! ([`embed`], [`run`], the binary) on top.
+//! - [`fem`]: reference elements, shape functions, the one Gauss–Legendre rule;
+//! - foundations: [`mesh`] (Exodus II, Gmsh, generators, validation), [`deck`] (Sierra
+//!   syntax or TOML → typed spec), [`script`] (sandboxed Lua), [`periodic`] (maps),
+//!   [`solve`] (sparse direct and AMG-CG), [`assembly`] (dofs and sparse patterns),
+//!   [`output`] (Exodus, VTU, plots), [`diag`] (diagnostics);
+//! - [`surface`]: contact surfaces by the Sierra rules;
+//! - [`search`]: contact search over typed settings (BVH, projection, mortar segments);
+//! - [`enforce`]: interface forms and conductance models at contact points;
+//! - [`plugin`]: user models loaded as C-ABI shared libraries;
+//! - [`scene`]: the one consumer of the deck spec — a contact definition resolved on a
+//!   mesh into surfaces, interactions, searches and enforcements;
+//! - hosts: [`embed`] (the public host API) and [`capi`] (its C face), [`heat`] (seam's
+//!   conduction solvers) and [`run`] (`seam run`); the binary's CLI on top;
+//! - [`error`]: [`Error`], wrapping every module's own error.
 
 pub mod assembly;
 pub mod capi;

@@ -420,6 +420,24 @@ pub unsafe extern "C" fn seam_jacobian_csr(
     })
 }
 
+/// One dense vector of the last `seam_evaluate_csr`, through the out pointers.
+unsafe fn dense_out(
+    embedding: *const SeamEmbedding,
+    pick: fn(&crate::embed::Evaluation) -> &Vec<f64>,
+    out_n: *mut usize,
+    out_values: *mut *const f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let v = pick(csr(e)?);
+        unsafe {
+            out(out_n, v.len(), "out_n")?;
+            out(out_values, v.as_ptr(), "out_values")
+        }
+    })
+}
+
 /// The residual of the last `seam_evaluate_csr`, dense by host dof (`n` entries).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_residual_dense(
@@ -427,15 +445,7 @@ pub unsafe extern "C" fn seam_residual_dense(
     out_n: *mut usize,
     out_values: *mut *const f64,
 ) -> c_int {
-    guard(|| {
-        // SAFETY: a non-null handle came from this library (module Safety).
-        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let r = &csr(e)?.residual;
-        unsafe {
-            out(out_n, r.len(), "out_n")?;
-            out(out_values, r.as_ptr(), "out_values")
-        }
-    })
+    unsafe { dense_out(embedding, |e| &e.residual, out_n, out_values) }
 }
 
 /// The load (right-hand side of linear models) of the last `seam_evaluate_csr`, dense.
@@ -445,15 +455,7 @@ pub unsafe extern "C" fn seam_load_dense(
     out_n: *mut usize,
     out_values: *mut *const f64,
 ) -> c_int {
-    guard(|| {
-        // SAFETY: a non-null handle came from this library (module Safety).
-        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let r = &csr(e)?.load;
-        unsafe {
-            out(out_n, r.len(), "out_n")?;
-            out(out_values, r.as_ptr(), "out_values")
-        }
-    })
+    unsafe { dense_out(embedding, |e| &e.load, out_n, out_values) }
 }
 
 /// A point's state as a C conductance callback sees it.

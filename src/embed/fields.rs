@@ -226,19 +226,28 @@ impl Embedding {
     /// (by host dof), in the interaction's point order. A mortar tie is refused: its
     /// fields come from its multipliers ([`Self::tie_point_fields`]).
     pub fn point_fields(&self, i: usize, u: &[f64]) -> Result<Vec<PointValues>, EmbedError> {
-        let p = self.pair_at(i)?;
-        let local = self.local_field(u)?;
+        let (p, fluxes) = self.point_fluxes(i, u)?;
         let points = &Self::searched(p)?.points;
-        let fluxes = self
-            .with_form(p, |cache, form| {
-                cache.point_flux(form, &local, points.len())
-            })?
-            .ok_or_else(|| tie_refused(p))?;
         Ok(points
             .iter()
             .zip(&fluxes)
             .map(|(q, f)| point_values(p, q, *f, None))
             .collect())
+    }
+
+    /// Flux interaction `i` and the flux at each of its points at the host's field `u`.
+    fn point_fluxes(
+        &self,
+        i: usize,
+        u: &[f64],
+    ) -> Result<(&super::Pair, Vec<Option<PointFlux>>), EmbedError> {
+        let p = self.pair_at(i)?;
+        let local = self.local_field(u)?;
+        let count = Self::searched(p)?.points.len();
+        let fluxes = self
+            .with_form(p, |cache, form| cache.point_flux(form, &local, count))?
+            .ok_or_else(|| tie_refused(p))?;
+        Ok((p, fluxes))
     }
 
     /// Per face of flux interaction `i` at the host's field `u`: side A's faces, then
@@ -249,14 +258,8 @@ impl Embedding {
         u: &[f64],
         side_b: bool,
     ) -> Result<Vec<FaceValues>, EmbedError> {
-        let p = self.pair_at(i)?;
-        let local = self.local_field(u)?;
+        let (p, fluxes) = self.point_fluxes(i, u)?;
         let points = &Self::searched(p)?.points;
-        let fluxes = self
-            .with_form(p, |cache, form| {
-                cache.point_flux(form, &local, points.len())
-            })?
-            .ok_or_else(|| tie_refused(p))?;
         Ok(face_values(
             &p.a,
             &p.b,

@@ -136,10 +136,17 @@ pub(super) fn contact_faces(
         a,
         b,
         &pairing.result.points,
-        |k| fluxes.and_then(|f| f.get(k).copied().flatten()).map(|f| f.q),
+        |k| {
+            fluxes
+                .and_then(|f| f.get(k).copied().flatten())
+                .map(|f| f.q)
+        },
         side_b,
     );
-    let geometry = a.faces.iter().chain(if side_b { &b.faces[..] } else { &[] });
+    let geometry = a
+        .faces
+        .iter()
+        .chain(if side_b { &b.faces[..] } else { &[] });
     for (f, v) in geometry.zip(values) {
         out.faces.push(ContactFace {
             nodes: f.nodes,
