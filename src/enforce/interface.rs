@@ -327,7 +327,7 @@ fn element_length(mesh: &Mesh, elem: ElemId, side: Side) -> f64 {
 
 /// Above this many times the penalty scale α, a resistance (`P = h`) gives way to the
 /// Robin–Nitsche coefficients. The resistance form's matrix grows with h, so its heat
-/// `h [u]` loses about `log10(h/α) + 2` digits to round-off in [u] (a 1e20 conductance
+/// `h [u]` loses about `log10(h/α) + 2` digits to round-off in `[u]` (a 1e20 conductance
 /// reports nothing meaningful); the Robin–Nitsche form is a consistent discretisation of
 /// the same condition `q = h [u]` whose coefficients stay bounded by α for every h up to
 /// ∞. Where h is 100 α the interface is practically tied: both forms are exact for fields
