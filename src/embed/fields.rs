@@ -164,11 +164,11 @@ pub(crate) fn face_values(
     let mut on_a = vec![Sums::default(); a.faces.len()];
     let mut on_b = vec![Sums::default(); b.faces.len()];
     for (k, p) in points.iter().enumerate() {
-        if p.status != PointStatus::Matched || p.a_face == u32::MAX {
+        let Some((fa, fb)) = p.matched_faces() else {
             continue;
-        }
+        };
         let q = flux(k).unwrap_or(0.0);
-        for s in [&mut on_a[p.a_face as usize], &mut on_b[p.b_face as usize]] {
+        for s in [&mut on_a[fa], &mut on_b[fb]] {
             s.weight += p.weight;
             s.gap += p.weight * p.gap;
             s.flux += p.weight * q;
@@ -330,12 +330,8 @@ fn point_values(
         x: q.x,
         weight: q.weight,
         paired,
-        side_a: host_face(&p.a, q.a_face),
-        side_b: if paired {
-            host_face(&p.b, q.b_face)
-        } else {
-            None
-        },
+        side_a: q.a_face.and_then(|k| host_face(&p.a, k)),
+        side_b: q.matched_b_face().and_then(|k| host_face(&p.b, k as u32)),
         gap: if paired { q.gap } else { 0.0 },
         flux: flux.map_or(0.0, |f| f.q),
         temp_a: flux.map_or(f64::NAN, |f| f.temp_a),

@@ -54,7 +54,7 @@ use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId};
 use crate::fem::shape::reference_nodes;
 use crate::fem::{MAX_NODES, eval_point};
 use crate::mesh::{ElemId, Mesh, Side, Topology};
-use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
+use crate::search::pairing::{ContactPoint, SurfaceGeometry};
 use crate::vec3::{cross, dot, norm, sub};
 
 /// Default Nitsche penalty factor β in `α = β k_eff / h_e`: well above the inverse-
@@ -560,13 +560,13 @@ impl InterfacePoints {
         // (0, element A, element B) apart from node points (1, node, element B).
         let mut evaluated = Vec::new();
         for (index, p) in points.iter().enumerate() {
-            if p.status != PointStatus::Matched {
+            let Some(face_b) = p.matched_b_face() else {
                 continue;
-            }
-            let fb = &b.faces[p.b_face as usize];
+            };
+            let fb = &b.faces[face_b];
             let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, form.conductivity)?;
-            let (key, l, elem, side) = if p.a_face == u32::MAX {
-                let Some(&(node, _)) = a.nodes.get(p.a_node as usize) else {
+            let (key, l, elem, side) = if let Some((a_node, _)) = p.matched_node() {
+                let Some(&(node, _)) = a.nodes.get(a_node) else {
                     continue;
                 };
                 if p.weight == 0.0 {
@@ -576,7 +576,10 @@ impl InterfacePoints {
                 let l = local_node(dof, &eb, form.beta);
                 ((1u8, node.0, eb.elem.0), l, mesh.node_number(node), 0)
             } else {
-                let fa = &a.faces[p.a_face as usize];
+                let Some((face_a, _)) = p.matched_faces() else {
+                    continue;
+                };
+                let fa = &a.faces[face_a];
                 let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, form.conductivity)?;
                 let l = local(&ea, &eb, form.form, form.beta);
                 let key = (0u8, ea.elem.0, eb.elem.0);

@@ -35,7 +35,7 @@ use std::collections::{BTreeMap, HashSet};
 
 use crate::assembly::DofMap;
 use crate::mesh::{Mesh, NodeId};
-use crate::search::pairing::{ContactPoint, PointStatus, SurfaceGeometry};
+use crate::search::pairing::{ContactPoint, SurfaceGeometry};
 
 use super::interface::{FieldPair, InterfaceError, face_shape_values, node_dof, side_eval};
 
@@ -173,15 +173,15 @@ pub fn mortar_tie(
         Multipliers::Standard => vec![None; a.faces.len()],
         Multipliers::Dual => {
             let mut m = vec![[[0.0f64; 4]; 4]; a.faces.len()];
-            for p in points
-                .iter()
-                .filter(|p| p.status == PointStatus::Matched && p.a_face != u32::MAX)
-            {
-                let f = &a.faces[p.a_face as usize];
+            for p in points {
+                let Some((fa, _)) = p.matched_faces() else {
+                    continue;
+                };
+                let f = &a.faces[fa];
                 let n = face_shape_values(f.len as usize, p.xi_a);
                 for k in 0..f.len as usize {
                     for l in 0..f.len as usize {
-                        m[p.a_face as usize][k][l] += p.weight * n[k] * n[l];
+                        m[fa][k][l] += p.weight * n[k] * n[l];
                     }
                 }
             }
@@ -197,13 +197,12 @@ pub fn mortar_tie(
     let mut side_a = Vec::new();
     let mut side_b = Vec::new();
     let mut point_psi = Vec::new();
-    for (at, p) in points
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| p.status == PointStatus::Matched && p.a_face != u32::MAX)
-    {
-        let fa = &a.faces[p.a_face as usize];
-        let fb = &b.faces[p.b_face as usize];
+    for (at, p) in points.iter().enumerate() {
+        let Some((face_a, face_b)) = p.matched_faces() else {
+            continue;
+        };
+        let fa = &a.faces[face_a];
+        let fb = &b.faces[face_b];
         let ea = side_eval(mesh, dofs, fields.a, fa.side, p.xi_a, conductivity)?;
         let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, conductivity)?;
         let nodes_a = mesh.elem_nodes(ea.elem);
@@ -219,7 +218,7 @@ pub fn mortar_tie(
         };
         let face = &fa.nodes[..fa.len as usize];
         // The multiplier basis at this point, per face node: N, or the dual ψ.
-        let basis: Vec<f64> = match &dual[p.a_face as usize] {
+        let basis: Vec<f64> = match &dual[face_a] {
             None => face.iter().map(|&n| shape_of(n)).collect(),
             Some(c) => {
                 let nf = face_shape_values(face.len(), p.xi_a);
@@ -306,11 +305,14 @@ fn node_tie(
     let mut node_points: Vec<(usize, &ContactPoint)> = points
         .iter()
         .enumerate()
-        .filter(|(_, p)| p.status == PointStatus::Matched && p.a_face == u32::MAX && p.weight > 0.0)
+        .filter(|(_, p)| p.matched_node().is_some() && p.weight > 0.0)
         .collect();
     node_points.sort_by_key(|(_, p)| p.a_node);
     for (at, p) in node_points {
-        let Some(&(node, _)) = a.nodes.get(p.a_node as usize) else {
+        let Some((a_node, face_b)) = p.matched_node() else {
+            continue;
+        };
+        let Some(&(node, _)) = a.nodes.get(a_node) else {
             continue;
         };
         if constrained.contains(&node) {
@@ -321,7 +323,7 @@ fn node_tie(
             continue; // one multiplier per node
         }
         let own = node_dof(mesh, dofs, fields.a, node, &a.name)?;
-        let fb = &b.faces[p.b_face as usize];
+        let fb = &b.faces[face_b];
         let eb = side_eval(mesh, dofs, fields.b, fb.side, p.xi_b, conductivity)?;
         let k = tie.nodes.len() as u32;
         tie.nodes.push(node);

@@ -13,7 +13,7 @@ use crate::enforce::model::ModelChoice;
 use crate::heat::TEMPERATURE;
 use crate::mesh::{Mesh, NodeId, Side};
 use crate::scene::{ContactScene, SceneOptions};
-use crate::search::pairing::{Integration, PointStatus};
+use crate::search::pairing::Integration;
 use crate::search::scene::Pairing;
 
 use super::fields::ContactView;
@@ -178,18 +178,19 @@ impl RunContact {
                 continue;
             }
             let mut matched_nodes = HashSet::new();
-            for q in p
-                .result
-                .points
-                .iter()
-                .filter(|q| q.status == PointStatus::Matched)
-            {
-                if q.a_face != u32::MAX {
-                    in_contact.insert(p.side_a_geometry.faces[q.a_face as usize].side);
-                } else if let Some(&(node, _)) = p.side_a_geometry.nodes.get(q.a_node as usize) {
+            for q in &p.result.points {
+                let Some(face_b) = q.matched_b_face() else {
+                    continue;
+                };
+                if let Some(fa) = q.a_face {
+                    in_contact.insert(p.side_a_geometry.faces[fa as usize].side);
+                } else if let Some(&(node, _)) = q
+                    .a_node
+                    .and_then(|k| p.side_a_geometry.nodes.get(k as usize))
+                {
                     matched_nodes.insert(node);
                 }
-                in_contact.insert(p.side_b_geometry.faces[q.b_face as usize].side);
+                in_contact.insert(p.side_b_geometry.faces[face_b].side);
             }
             for f in &p.side_a_geometry.tributary {
                 if f.nodes[..f.len as usize]
@@ -401,12 +402,15 @@ fn point_pressures(
             };
             let mut out = Vec::with_capacity(pairing.result.points.len());
             for q in &pairing.result.points {
-                if q.a_face == u32::MAX {
-                    let node = pairing.side_a_geometry.nodes.get(q.a_node as usize).map(|n| n.0);
+                let Some(fa) = q.a_face else {
+                    let node = q
+                        .a_node
+                        .and_then(|k| pairing.side_a_geometry.nodes.get(k as usize))
+                        .map(|n| n.0);
                     out.push(node.map_or(Ok(0.0), &mut at));
                     continue;
-                }
-                let f = &pairing.side_a_geometry.faces[q.a_face as usize];
+                };
+                let f = &pairing.side_a_geometry.faces[fa as usize];
                 let n = crate::enforce::interface::face_shape_values(f.len as usize, q.xi_a);
                 let mut v = Ok(0.0);
                 for (node, nk) in f.nodes.iter().zip(n).take(f.len as usize) {

@@ -8,7 +8,6 @@
 
 use crate::diag::{Diagnostic, Diagnostics};
 use crate::mesh::{Mesh, NodeId};
-use crate::search::pairing::PointStatus;
 use crate::search::scene::Pairing;
 
 use super::physics::Physics;
@@ -93,19 +92,18 @@ fn floating_parts(
     for p in pairings {
         let (a, b) = (&p.side_a_geometry, &p.side_b_geometry);
         for q in p.result.points.iter() {
-            if q.status != PointStatus::Matched {
+            let Some(face_b) = q.matched_b_face() else {
                 continue;
-            }
-            let on_a = match a.faces.get(q.a_face as usize) {
-                Some(f) => f.nodes[0],
-                None => match a.nodes.get(q.a_node as usize) {
+            };
+            let on_a = match (q.a_face, q.a_node) {
+                (Some(f), _) => a.faces[f as usize].nodes[0],
+                (None, Some(k)) => match a.nodes.get(k as usize) {
                     Some(n) => n.0,
                     None => continue,
                 },
+                (None, None) => continue,
             };
-            if let Some(f) = b.faces.get(q.b_face as usize) {
-                parts.join(on_a, f.nodes[0]);
-            }
+            parts.join(on_a, b.faces[face_b].nodes[0]);
         }
     }
     let mut fixed = vec![false; mesh.num_nodes()];

@@ -125,7 +125,7 @@ fn points_on_edges_and_vertices_pair_exactly_once() {
         // point in [i/6, (i+1)/6] × [j/6, (j+1)/6].
         let lo = |v: f64| (((v * 6.0) - 1e-9).floor().max(0.0)) as u32;
         let expect = 6 * lo(y) + lo(x);
-        assert_eq!(q.b_face, expect, "point ({x}, {y})");
+        assert_eq!(q.b_face, Some(expect), "point ({x}, {y})");
         assert!(q.gap.abs() < 1e-15);
     }
 }
@@ -216,7 +216,7 @@ fn concentric_cylinders_overlap_and_gap_statistics() {
         // gap along side B's normal, cos(π/36) − x·e_j; segments along side A's normal
         // n_A, which divides that by n_A·e_j. And the point's angle lies in the facet's.
         for q in &s.pairings[0].result.points {
-            let j = (q.b_face as usize % nb) as f64;
+            let j = (q.b_face.expect("matched") as usize % nb) as f64;
             let mid = ((j + 0.5) * 360.0 / nb as f64).to_radians();
             let e = [mid.cos(), mid.sin(), 0.0];
             let along_b =

@@ -87,18 +87,18 @@ pub enum PointStatus {
 /// One side-A point and its pairing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactPoint {
-    /// Index of the side-A face in its [`SurfaceGeometry`] (`u32::MAX` for a node point).
-    pub a_face: u32,
-    /// Index of the side-A node for node surfaces, else `u32::MAX`.
-    pub a_node: u32,
+    /// Index of the side-A face in its [`SurfaceGeometry`] (`None` for a node point).
+    pub a_face: Option<u32>,
+    /// Index of the side-A node for node surfaces (`None` for a face point).
+    pub a_node: Option<u32>,
     pub xi_a: [f64; 2],
     /// The point on side A.
     pub x: V3,
     /// Integration weight (area); a node point's tributary area.
     pub weight: f64,
     pub status: PointStatus,
-    /// Index of the side-B face (`u32::MAX` when unmatched).
-    pub b_face: u32,
+    /// Index of the side-B face (`None` when unmatched).
+    pub b_face: Option<u32>,
     pub xi_b: [f64; 2],
     /// Signed gap, positive when open.
     pub gap: f64,
@@ -107,6 +107,26 @@ pub struct ContactPoint {
     pub offset: f64,
     pub normal_a: V3,
     pub normal_b: V3,
+}
+
+impl ContactPoint {
+    /// The side-B face of a matched point.
+    pub fn matched_b_face(&self) -> Option<usize> {
+        match (self.status, self.b_face) {
+            (PointStatus::Matched, Some(j)) => Some(j as usize),
+            _ => None,
+        }
+    }
+
+    /// (side-A face, side-B face) of a matched face point.
+    pub fn matched_faces(&self) -> Option<(usize, usize)> {
+        Some((self.a_face? as usize, self.matched_b_face()?))
+    }
+
+    /// (side-A node, side-B face) of a matched node point.
+    pub fn matched_node(&self) -> Option<(usize, usize)> {
+        Some((self.a_node? as usize, self.matched_b_face()?))
+    }
 }
 
 /// Counts and measures of one interaction's search.
@@ -342,20 +362,21 @@ impl SearchResult {
     /// side B's normal; node points likewise). Statistics follow.
     pub fn update_geometry(&mut self, a: &SurfaceGeometry, b: &SurfaceGeometry) {
         for p in &mut self.points {
-            if p.a_face != u32::MAX {
-                let fa = &a.faces[p.a_face as usize];
+            if let Some(f) = p.a_face {
+                let fa = &a.faces[f as usize];
                 p.x = fa.map(p.xi_a);
                 p.normal_a = fa.normal();
-            } else if let Some((_, x)) = a.nodes.get(p.a_node as usize) {
-                let k = p.a_node as usize;
+            } else if let Some(k) = p.a_node.map(|k| k as usize)
+                && let Some((_, x)) = a.nodes.get(k)
+            {
                 p.x = *x;
                 p.weight = a.node_area.get(k).copied().unwrap_or(0.0);
                 p.normal_a = a.node_normal.get(k).copied().unwrap_or([0.0; 3]);
             }
-            if p.status != PointStatus::Matched {
+            let (PointStatus::Matched, Some(j)) = (p.status, p.b_face) else {
                 continue;
-            }
-            let fb = &b.faces[p.b_face as usize];
+            };
+            let fb = &b.faces[j as usize];
             let on_b = fb.map(p.xi_b);
             p.normal_b = fb.normal();
             p.gap = dot(sub(p.x, on_b), p.normal_b);

@@ -138,8 +138,8 @@ impl Ctx<'_> {
 
     pub(super) fn point(
         &self,
-        a_face: u32,
-        a_node: u32,
+        a_face: Option<u32>,
+        a_node: Option<u32>,
         xi_a: [f64; 2],
         x: V3,
         w: f64,
@@ -152,7 +152,7 @@ impl Ctx<'_> {
             x,
             weight: w,
             status: PointStatus::Unmatched,
-            b_face: u32::MAX,
+            b_face: None,
             xi_b: [0.0; 2],
             gap: 0.0,
             offset: 0.0,
@@ -167,7 +167,7 @@ impl Ctx<'_> {
         match best.found {
             Some(((_, _, j), xi_b, gap, n_b)) => {
                 p.status = PointStatus::Matched;
-                p.b_face = j;
+                p.b_face = Some(j);
                 p.xi_b = xi_b;
                 p.gap = gap;
                 p.normal_b = n_b;
@@ -183,7 +183,7 @@ impl Ctx<'_> {
         let x = a.nodes[k].1;
         let w = a.node_area.get(k).copied().unwrap_or(0.0);
         let n = a.node_normal.get(k).copied().unwrap_or([0.0; 3]);
-        self.point(u32::MAX, k as u32, [0.0; 2], x, w, n)
+        self.point(None, Some(k as u32), [0.0; 2], x, w, n)
     }
 
     pub(super) fn quadrature_points(
@@ -198,7 +198,7 @@ impl Ctx<'_> {
         for (xi, w) in face_rule(face, order) {
             let x = face.map(xi);
             let jac = face_jacobian(face, xi);
-            out.push(self.point(fa as u32, u32::MAX, xi, x, w * jac, n_a));
+            out.push(self.point(Some(fa as u32), None, xi, x, w * jac, n_a));
         }
     }
 
@@ -237,13 +237,13 @@ impl Ctx<'_> {
                     PointStatus::Matched
                 };
                 out.push(ContactPoint {
-                    a_face: fa as u32,
-                    a_node: u32::MAX,
+                    a_face: Some(fa as u32),
+                    a_node: None,
                     xi_a: m.xi_a,
                     x: m.x_a,
                     weight: m.weight,
                     status,
-                    b_face: j as u32,
+                    b_face: Some(j as u32),
                     xi_b: m.xi_b,
                     gap: m.gap,
                     offset: 0.0,
