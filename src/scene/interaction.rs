@@ -61,28 +61,7 @@ pub fn resolve(
     sources: &SourceMap,
 ) -> (Vec<Interaction>, Diagnostics) {
     let mut diags = Diagnostics::default();
-    let mut base = SearchSettings::defaults(dim);
-    if let Some(opts) = &def.search_options {
-        if let Some(v) = opts.normal_tolerance {
-            base.normal_tolerance = Some(v);
-        }
-        if let Some(v) = opts.tangential_tolerance {
-            base.tangential_tolerance = v;
-        }
-        if let Some(v) = opts.buffer_factor {
-            base.buffer_factor = v;
-        }
-        if let Some(v) = opts.field_factor {
-            base.field_factor = v;
-        }
-        if let Some(v) = opts.normal_check_angle {
-            base.normal_check_angle = v;
-        }
-    }
-    if let Some(a) = def.opposed_normal_threshold_angle {
-        base.opposed_normal_threshold_angle = a;
-    }
-    base.cull_opposed_normals = !def.disable_opposed_normal_interaction_culling;
+    let base = super::search::base_settings(def, dim);
 
     let self_default = def
         .search_options

@@ -140,7 +140,9 @@ pub fn subdomain(def: &ContactDefinition) -> Option<Sphere> {
     })
 }
 
-/// Search settings of periodic pairs: the definition's search options.
+/// The search settings a definition gives every pair it searches — its interactions
+/// (before their own overrides) and its periodic pairs: the search options, `Opposed
+/// Normal Threshold Angle` and `Disable Opposed Normal Interaction Culling`.
 pub fn base_settings(def: &ContactDefinition, dim: usize) -> SearchSettings {
     let mut s = SearchSettings::defaults(dim);
     if let Some(o) = &def.search_options {
@@ -150,6 +152,10 @@ pub fn base_settings(def: &ContactDefinition, dim: usize) -> SearchSettings {
         s.field_factor = o.field_factor.unwrap_or(s.field_factor);
         s.normal_check_angle = o.normal_check_angle.unwrap_or(s.normal_check_angle);
     }
+    if let Some(a) = def.opposed_normal_threshold_angle {
+        s.opposed_normal_threshold_angle = a;
+    }
+    s.cull_opposed_normals = !def.disable_opposed_normal_interaction_culling;
     s
 }
 
@@ -421,4 +427,25 @@ pub fn search_periodicity(
         },
         map,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Periodic pairs see the definition's opposed-normal settings, as its interactions
+    /// do (they once took only the search options).
+    #[test]
+    fn periodic_pairs_take_the_definitions_opposed_normal_settings() {
+        let def = ContactDefinition {
+            opposed_normal_threshold_angle: Some(30.0),
+            disable_opposed_normal_interaction_culling: true,
+            ..ContactDefinition::default()
+        };
+        let s = base_settings(&def, 3);
+        assert_eq!(s.opposed_normal_threshold_angle, 30.0);
+        assert!(!s.cull_opposed_normals);
+        let plain = base_settings(&ContactDefinition::default(), 3);
+        assert_eq!(plain, SearchSettings::defaults(3));
+    }
 }
