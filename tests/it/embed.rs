@@ -874,6 +874,20 @@ fn embed_header_declares_the_exported_functions() {
 /// contact deck are read in place (absolute paths) and nothing is written; the deck's
 /// folder may be another copy of the scene (a plugin library built next to it).
 fn run_scene(scene: &Path, deck_dir: &Path, problem: &str) -> seam::run::RunResult {
+    run_scene_with(scene, deck_dir, problem, None)
+}
+
+/// As [`run_scene`], writing the output into `out`.
+fn run_scene_into(scene: &Path, deck_dir: &Path, problem: &str, out: &Path) {
+    run_scene_with(scene, deck_dir, problem, Some(out));
+}
+
+fn run_scene_with(
+    scene: &Path,
+    deck_dir: &Path,
+    problem: &str,
+    out: Option<&Path>,
+) -> seam::run::RunResult {
     let text = std::fs::read_to_string(scene.join(problem)).unwrap();
     let mut table: toml::Table = toml::from_str(&text).unwrap();
     for (key, folder) in [("mesh", scene), ("contact", deck_dir)] {
@@ -886,6 +900,11 @@ fn run_scene(scene: &Path, deck_dir: &Path, problem: &str) -> seam::run::RunResu
         }
     }
     table.remove("output");
+    if let Some(out) = out {
+        let mut section = toml::Table::new();
+        section.insert("dir".into(), out.display().to_string().into());
+        table.insert("output".into(), section.into());
+    }
     let dir = scratch(&format!("run-{problem}"));
     let name = deck_dir.file_name().unwrap().to_string_lossy().into_owned();
     let path = dir.join(format!("{name}-{problem}"));
@@ -914,7 +933,7 @@ fn turbine_host(
     mesh: &seam::mesh::Mesh,
     dof: &[usize],
     tie: &seam::embed::TieConstraints,
-) -> (Vec<f64>, seam::embed::Heat) {
+) -> (Vec<f64>, seam::embed::Heat, Vec<f64>) {
     use seam::heat::kernel::{face_convection, face_flux};
     let n = mesh.num_nodes();
     let m = tie.multiplier_dofs.len();
@@ -961,7 +980,7 @@ fn turbine_host(
     f[n..].copy_from_slice(&tie.rhs);
     let x = example::solve_dense(a, f, size).unwrap();
     let heat = tie.heat(&x[n..]).unwrap();
-    ((0..n).map(|i| x[dof[i]]).collect(), heat)
+    ((0..n).map(|i| x[dof[i]]).collect(), heat, x[n..].to_vec())
 }
 
 fn relative_spread(a: &[f64], b: &[f64]) -> f64 {
@@ -1013,7 +1032,7 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
     assert_eq!(ties.len(), 1);
     // One multiplier per node of cut_start: 7 radii × 3 heights.
     assert_eq!(ties[0].multiplier_dofs.len(), 21);
-    let (temperature, heat) = turbine_host(&mesh, &dof, &ties[0]);
+    let (temperature, heat, lambda) = turbine_host(&mesh, &dof, &ties[0]);
     let t_err = relative_spread(&temperature, &reference.solution.temperature);
     let q_err = relative(heat.side_a, cut.heat_side_a);
     println!(
@@ -1025,6 +1044,43 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
     assert!(t_err <= 1e-10, "{t_err:.3e}");
     // Heat crosses the cut (the load is not symmetric within the sector).
     assert!(heat.side_a.abs() > 1.0, "{}", heat.side_a);
+    // The multiplier field on the periodic image, point by point, against `seam run`'s
+    // contact_points.vtu of the same deck.
+    let deck_dir = scratch("turbine-points-deck");
+    let deck = std::fs::read_to_string(turbine().join("contact.i")).unwrap();
+    std::fs::write(
+        deck_dir.join("contact.i"),
+        deck.replacen(
+            "  periodicity for",
+            "  visualize contact\n  output rule = more verbose\n  periodicity for",
+            1,
+        ),
+    )
+    .unwrap();
+    let out = scratch("turbine-points");
+    run_scene_into(&turbine(), &deck_dir, "problem.toml", &out);
+    let xml = std::fs::read_to_string(out.join("contact_points.vtu")).unwrap();
+    let file = crate::run_fields::vtu_array(&xml, "interface_flux");
+    let points = by_deck.tie_point_fields(&ties[0], &lambda).unwrap();
+    assert_eq!(points.len(), file.len());
+    let scale = file
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut worst = 0.0f64;
+    for (p, f) in points.iter().zip(&file) {
+        assert_eq!(p.multiplier.is_some(), f.is_finite(), "{p:?} {f}");
+        if let Some(m) = p.multiplier {
+            worst = worst.max((m - f).abs() / scale);
+        }
+    }
+    println!(
+        "turbine sector: λ_h at {} points, largest difference {worst:.2e}",
+        points.len()
+    );
+    assert!(worst <= 1e-9, "{worst:.3e}");
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&deck_dir);
 
     // The same periodicity built in code, on the side sets themselves.
     let mut by_code = builder();
@@ -1047,7 +1103,7 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
     by_code.search().unwrap();
     let code_ties = by_code.constraints().unwrap();
     assert_eq!(code_ties[0].entries, ties[0].entries);
-    let (_, code_heat) = turbine_host(&mesh, &dof, &code_ties[0]);
+    let (_, code_heat, _) = turbine_host(&mesh, &dof, &code_ties[0]);
     assert_eq!(code_heat, heat);
 
     // Moving every node by a rigid turn about the axis keeps the sector periodic: the
@@ -1139,6 +1195,45 @@ fn embed_plugin_conductance_matches_seam_run() {
     assert!(relative(heat.side_b, i.heat_side_b) <= 1e-10);
     // The base (350 K) heats the cover: heat leaves side A.
     assert!(heat.side_a > 0.0);
+    // Point by point, the plugin's flux against `seam run`'s contact_points.vtu.
+    let deck = std::fs::read_to_string(deck_dir.join("contact.i")).unwrap();
+    std::fs::write(
+        deck_dir.join("contact.i"),
+        deck.replacen(
+            "  begin interaction",
+            "  visualize contact\n  output rule = more verbose\n  begin interaction",
+            1,
+        ),
+    )
+    .unwrap();
+    let out = scratch("plugin-points");
+    run_scene_into(&scene, &deck_dir, "problem.toml", &out);
+    let xml = std::fs::read_to_string(out.join("contact_points.vtu")).unwrap();
+    let file = crate::run_fields::vtu_array(&xml, "interface_flux");
+    let points = seam.point_fields(0, &u).unwrap();
+    assert_eq!(points.len(), file.len());
+    let scale = file
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, |m, v| m.max(v.abs()));
+    let worst = points
+        .iter()
+        .zip(&file)
+        .map(|(p, f)| {
+            assert_eq!(p.paired, f.is_finite());
+            if p.paired {
+                (p.flux - f).abs() / scale
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max);
+    println!(
+        "plugin conductance: {} points, largest flux difference {worst:.2e}",
+        points.len()
+    );
+    assert!(worst <= 1e-9, "{worst:.3e}");
+    let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&deck_dir);
 }
 
