@@ -7,8 +7,7 @@ use std::ffi::c_void;
 use std::sync::Arc;
 
 use crate::embed::{
-    Conductance, ConductanceError, ConductanceModel, Coverage, FaceValues, PointState, PointValues,
-    UnpairedReason,
+    Conductance, Coverage, FaceValues, FnConductance, PointState, PointValues, UnpairedReason,
 };
 
 /// Arrays the field and coverage queries return (valid until the next such query).
@@ -19,8 +18,9 @@ pub(super) struct Buffers {
     unpaired_index: Vec<usize>,
     unpaired_xyz: Vec<f64>,
     unpaired_reason: Vec<c_int>,
-    /// Heat of the last `seam_evaluate_csr`.
-    pub(super) csr_heat: Option<Vec<Option<(f64, f64)>>>,
+    /// The last evaluation was `seam_evaluate_csr` (its results are the embedding's
+    /// `evaluation()`).
+    pub(super) csr_current: bool,
 }
 
 /// What a search paired (`seam_coverage`).
@@ -112,6 +112,18 @@ impl From<&FaceValues> for SeamFaceValues {
             gap: f.gap,
             flux: f.flux,
         }
+    }
+}
+
+/// An array the handle keeps, through the out pointers (count and start).
+unsafe fn array_out<T>(
+    values: &[T],
+    out_n: *mut usize,
+    out_values: *mut *const T,
+) -> Result<(), Failure> {
+    unsafe {
+        out(out_n, values.len(), "out_n")?;
+        out(out_values, values.as_ptr(), "out_values")
     }
 }
 
@@ -215,10 +227,7 @@ pub unsafe extern "C" fn seam_point_fields(
         let u = unsafe { slice(u, n, "u") }?;
         let values = e.inner.point_fields(index, u)?;
         e.buffers.points = values.iter().map(SeamPointValues::from).collect();
-        unsafe {
-            out(out_n, e.buffers.points.len(), "out_n")?;
-            out(out_values, e.buffers.points.as_ptr(), "out_values")
-        }
+        unsafe { array_out(&e.buffers.points, out_n, out_values) }
     })
 }
 
@@ -239,10 +248,7 @@ pub unsafe extern "C" fn seam_face_fields(
         let u = unsafe { slice(u, n, "u") }?;
         let values = e.inner.face_fields(index, u, side_b != 0)?;
         e.buffers.faces = values.iter().map(SeamFaceValues::from).collect();
-        unsafe {
-            out(out_n, e.buffers.faces.len(), "out_n")?;
-            out(out_values, e.buffers.faces.as_ptr(), "out_values")
-        }
+        unsafe { array_out(&e.buffers.faces, out_n, out_values) }
     })
 }
 
@@ -264,10 +270,7 @@ pub unsafe extern "C" fn seam_tie_point_fields(
         let t = ties::tie(e, tie)?.0.clone();
         let values = e.inner.tie_point_fields(&t, lambda)?;
         e.buffers.points = values.iter().map(SeamPointValues::from).collect();
-        unsafe {
-            out(out_n, e.buffers.points.len(), "out_n")?;
-            out(out_values, e.buffers.points.as_ptr(), "out_values")
-        }
+        unsafe { array_out(&e.buffers.points, out_n, out_values) }
     })
 }
 
@@ -353,15 +356,10 @@ pub unsafe extern "C" fn seam_evaluate_csr(
         let u = unsafe { slice(u, n, "u") }?;
         e.evaluated = None;
         e.cutback = None;
-        e.buffers.csr_heat = None;
+        e.buffers.csr_current = false;
         match e.inner.evaluate(u) {
-            Ok(ev) => {
-                let heat = ev
-                    .heat
-                    .iter()
-                    .map(|h| h.map(|h| (h.side_a, h.side_b)))
-                    .collect();
-                e.buffers.csr_heat = Some(heat);
+            Ok(_) => {
+                e.buffers.csr_current = true;
                 Ok(())
             }
             Err(err) => {
@@ -374,11 +372,10 @@ pub unsafe extern "C" fn seam_evaluate_csr(
     })
 }
 
-fn csr(e: &SeamEmbedding) -> Result<&crate::embed::Evaluation, Failure> {
-    e.buffers
-        .csr_heat
-        .as_ref()
-        .and(e.inner.evaluation())
+pub(super) fn csr(e: &SeamEmbedding) -> Result<&crate::embed::Evaluation, Failure> {
+    e.inner
+        .evaluation()
+        .filter(|_| e.buffers.csr_current)
         .ok_or_else(|| {
             Failure(
                 SeamStatus::Order,
@@ -430,11 +427,7 @@ unsafe fn dense_out(
     guard(|| {
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let v = pick(csr(e)?);
-        unsafe {
-            out(out_n, v.len(), "out_n")?;
-            out(out_values, v.as_ptr(), "out_values")
-        }
+        unsafe { array_out(pick(csr(e)?), out_n, out_values) }
     })
 }
 
@@ -476,8 +469,9 @@ pub type SeamConductanceFn = Option<
     unsafe extern "C" fn(*const SeamPointState, *mut c_void, *mut f64, *mut f64, *mut f64) -> c_int,
 >;
 
-/// A conductance the host computes in C.
-struct Callback {
+/// `callback(state, user_data, …)` as a conductance: a non-zero status is a failure at
+/// the point, and what it returns is checked like every model's.
+fn callback_conductance(
     f: unsafe extern "C" fn(
         *const SeamPointState,
         *mut c_void,
@@ -486,15 +480,8 @@ struct Callback {
         *mut f64,
     ) -> c_int,
     user_data: *mut c_void,
-    depends_on_temperature: bool,
-}
-
-impl ConductanceModel for Callback {
-    fn name(&self) -> String {
-        "host conductance callback".into()
-    }
-
-    fn evaluate(&self, state: &PointState) -> Result<Conductance, ConductanceError> {
+) -> impl Fn(&PointState) -> Result<Conductance, String> {
+    move |state: &PointState| {
         let s = SeamPointState {
             gap: state.gap,
             pressure: state.pressure,
@@ -506,28 +493,16 @@ impl ConductanceModel for Callback {
         let (mut h, mut da, mut db) = (f64::NAN, 0.0, 0.0);
         // SAFETY: the host promised (seam.h) a callback and user data valid while the
         // embedding lives; the out pointers are to these locals.
-        let status = unsafe { (self.f)(&s, self.user_data, &mut h, &mut da, &mut db) };
+        let status = unsafe { f(&s, user_data, &mut h, &mut da, &mut db) };
         if status != 0 {
-            return Err(ConductanceError::Evaluation {
-                model: self.name(),
-                state: *state,
-                message: format!("the callback returned {status}"),
-            });
+            return Err(format!("the callback returned {status}"));
         }
-        crate::enforce::conductance::check(
-            self,
-            state,
-            Conductance {
-                h,
-                dh_dtemp_a: da,
-                dh_dtemp_b: db,
-                ..Conductance::default()
-            },
-        )
-    }
-
-    fn depends_on_temperature(&self) -> bool {
-        self.depends_on_temperature
+        Ok(Conductance {
+            h,
+            dh_dtemp_a: da,
+            dh_dtemp_b: db,
+            ..Conductance::default()
+        })
     }
 }
 
@@ -559,11 +534,11 @@ pub unsafe extern "C" fn seam_add_interaction_with_conductance(
         let model = interactions::model_of(model, 0.0)?;
         // An embedding is used by one thread at a time (seam.h), like its models.
         #[allow(clippy::arc_with_non_send_sync)]
-        let c = Arc::new(Callback {
-            f,
-            user_data,
-            depends_on_temperature: depends_on_temperature != 0,
-        });
+        let c = Arc::new(FnConductance::new(
+            "host conductance callback",
+            depends_on_temperature != 0,
+            callback_conductance(f, user_data),
+        ));
         interactions::add(
             e,
             Interaction::new(a, b, model).conductance(c).offset(offset),

@@ -235,7 +235,7 @@ impl SeamEmbedding {
     fn forget_results(&mut self) {
         self.evaluated = None;
         self.rows = None;
-        self.buffers.csr_heat = None;
+        self.buffers.csr_current = false;
     }
 }
 

@@ -13,7 +13,7 @@ pub unsafe extern "C" fn seam_evaluate(
         let u = unsafe { slice(u, n, "u") }?;
         e.evaluated = None;
         e.cutback = None;
-        e.buffers.csr_heat = None;
+        e.buffers.csr_current = false;
         match e.inner.contributions(u) {
             Ok(c) => e.evaluated = Some(Evaluated::from(c)),
             Err(err) => {
@@ -145,10 +145,14 @@ pub unsafe extern "C" fn seam_heat(
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
         // The heat of the last evaluation, triplets or CSR.
-        let heat = match (&e.evaluated, &e.buffers.csr_heat) {
-            (Some(ev), _) => &ev.heat,
-            (None, Some(heat)) => heat,
-            (None, None) => &evaluated(e)?.heat,
+        let heat: Vec<Option<(f64, f64)>> = match &e.evaluated {
+            Some(ev) => ev.heat.clone(),
+            None if e.buffers.csr_current => fields::csr(e)?
+                .heat
+                .iter()
+                .map(|h| h.map(|h| (h.side_a, h.side_b)))
+                .collect(),
+            None => evaluated(e)?.heat.clone(),
         };
         let (a, b) = match heat.get(index) {
             Some(Some(h)) => *h,

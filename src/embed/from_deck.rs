@@ -64,26 +64,36 @@ impl Embedding {
                 message: message.clone(),
             });
         }
-        // What a host cannot be given: fields of `seam run`'s problem file.
-        for e in &scene.entries {
-            let def = &loaded.deck.contact_definitions[e.definition];
+        // What an embedding cannot honour: lines about `seam run`'s problem file, and a
+        // quarantine the host would not see (a failing point is an error here).
+        for enf in loaded
+            .deck
+            .contact_definitions
+            .iter()
+            .flat_map(|d| &d.enforcements)
+        {
             let unsupported = [
                 (
-                    e.choice.pressure_variable.is_some(),
+                    enf.contact_pressure_variable.is_some(),
                     "`Contact Pressure Variable` names a nodal field of `seam run`'s problem file",
                     "give `Contact Pressure = p`, or pass h from the host's own model (Interaction::conductance)",
                 ),
                 (
-                    e.choice.toggle.is_some(),
+                    enf.use_toggle_block.is_some(),
                     "`Use Toggle Block` switches an enforcement by `seam run`'s [[toggle]] times",
                     "leave the line out and add or drop the interaction's terms in the host",
+                ),
+                (
+                    enf.quarantine_faulty_points,
+                    "`Quarantine Faulty Points` keeps a run going past failing points",
+                    "leave the line out: a point where the model fails is an error that names it, for the host to handle",
                 ),
             ];
             for (used, what, help) in unsupported {
                 if used {
                     diags.push(
                         Diagnostic::error("E0430", format!("{what}; an embedding has none"))
-                            .at(Some(def.at.clone()))
+                            .at(Some(enf.at.clone()))
                             .help(help),
                     );
                 }
