@@ -1008,6 +1008,9 @@ fn relative_spread(a: &[f64], b: &[f64]) -> f64 {
 /// mapped wrong moves the answers by percents.
 #[test]
 fn embed_turbine_sector_periodic_tie_matches_seam_run() {
+    let _turn = crate::TURBINE_RUNS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let reference = run_scene(&turbine(), &turbine(), "problem.toml");
     let cut = &reference.summary.interactions[0];
     let mesh = seam::mesh::read(&turbine().join("sector.exo")).unwrap();
@@ -1428,6 +1431,9 @@ fn embed_plugin_faults_and_cutbacks_are_reported() {
 /// so round-off differs; a wrong map, face or dof would move the heat by percents.
 #[test]
 fn embed_c_sector_host_matches_seam_run() {
+    let _turn = crate::TURBINE_RUNS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let stdout = run_c_host("sector.c");
     assert!(
         stdout.contains("expected error 4: periodic interaction cut_start / cut_end: its image does not land on `cut_end`"),

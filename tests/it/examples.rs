@@ -258,6 +258,9 @@ fn spread(t: &[f64]) -> f64 {
 /// (the cut carries over 1 % of the rim's heat).
 #[test]
 fn turbine_sector_equals_the_full_ring() {
+    let _turn = crate::TURBINE_RUNS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let dir = copy_scene("turbine_sector");
     let sector = run(&dir.join("problem.toml"));
     let ring = run(&dir.join("ring_problem.toml"));

@@ -28,3 +28,11 @@ mod search_kernels;
 mod sources;
 mod surfaces;
 mod transient;
+
+/// Held by the tests that run the turbine sector in this process. Two of them running at
+/// once give wrong answers (sector against ring, embedding against `seam run`) in about
+/// four runs of six of `cargo test --test it turbine` — already so before issue 12's
+/// change (measured at 7e6556a). The cause, some state two concurrent runs of this scene
+/// share, is not found yet; until it is, they take turns so the suite checks the
+/// numbers and not the race.
+pub(crate) static TURBINE_RUNS: std::sync::Mutex<()> = std::sync::Mutex::new(());
