@@ -81,7 +81,7 @@ extern "C" {
 #define SEAM_ERR_ENFORCEMENT 6   /* an enforcement failed at a contact point */
 #define SEAM_ERR_INTERNAL 7      /* a bug in seam (a caught panic) */
 #define SEAM_ERR_PLUGIN 8        /* a plugin could not be loaded, or failed at a contact point */
-#define SEAM_CUTBACK 9           /* a plugin asks for a smaller step (seam_cutback_factor) */
+#define SEAM_CUTBACK 9           /* a conductance model or plugin asks for a smaller step (seam_cutback_factor) */
 #define SEAM_ERR_NOTHING_PAIRED 10 /* a flux interaction's search paired no point (seam_allow_unpaired) */
 
 /* Element topologies (3-D solids). */
@@ -238,6 +238,27 @@ int seam_unpaired_points(seam_embedding *embedding, size_t index, size_t *out_n,
  * pairs nothing (wrong surfaces or sides, surfaces apart). allow != 0 lets interaction
  * `index` (every one with SIZE_MAX) stand with zero terms; 0 refuses it again. */
 int seam_allow_unpaired(seam_embedding *embedding, size_t index, int allow);
+
+/* --- switching, point pressures, quarantine ----------------------------------------- */
+/* Switch interaction `index` on (on != 0) or off (Use Toggle Block): while off a flux
+ * interaction adds nothing and reports 0 W, and the CSR pattern is kept. A tie's rows
+ * stay in seam_constraints: the host drops them while it is off. */
+int seam_set_active(seam_embedding *embedding, size_t index, int on);
+/* The contact pressure (Pa, >= 0) a conductance model sees at each of the n contact
+ * points of interaction `index`, in point order (seam_point_fields); pressures NULL and
+ * n = 0 go back to the enforcement's Contact Pressure. seam copies the array; a search
+ * drops the values. */
+int seam_set_point_pressures(seam_embedding *embedding, size_t index, const double *pressures,
+                             size_t n);
+/* Quarantine (on != 0) the points where interaction `index`'s conductance fails: they
+ * contribute nothing and are listed by seam_quarantined (Quarantine Faulty Points). A
+ * model's cutback request is still SEAM_CUTBACK. */
+int seam_set_quarantine(seam_embedding *embedding, size_t index, int on);
+/* The points of interaction `index` quarantined so far: xyz (3 per point) and the
+ * reasons, one line per point ('\n'-separated, NUL-terminated). Both valid until the
+ * next seam_quarantined on this handle. */
+int seam_quarantined(seam_embedding *embedding, size_t index, size_t *out_n,
+                     const double **out_xyz, const char **out_reasons);
 /* Values at every side-A point of flux interaction `index` at the host's field u (n
  * entries, by host dof), in point order. Array valid until the next point-field call. */
 int seam_point_fields(seam_embedding *embedding, size_t index, const double *u, size_t n,

@@ -198,6 +198,22 @@ static void check_callbacks(const seam_builder *b, const double *u, size_t n, do
     printf("callback heat: %.17g W (constant model %.17g W)\n", a, q_a);
     int status = seam_heat_at(e, 1, u, n, &a, &side_b);
     printf("expected callback failure %d: %s\n", status, seam_last_error());
+    /* Quarantined, the failing points carry nothing and are listed. */
+    size_t nq, past = 0;
+    const double *xyz;
+    const char *reasons;
+    CHECK(seam_set_quarantine(e, 1, 1));
+    CHECK(seam_heat_at(e, 1, u, n, &a, &side_b));
+    CHECK(seam_quarantined(e, 1, &nq, &xyz, &reasons));
+    for (size_t i = 0; i < nq; i++) past += xyz[3 * i] > 0.5;
+    printf("quarantine: heat %.17g W, %zu points, past x = 0.5: %zu, first reason: %.40s\n", a,
+           nq, past, nq > 0 ? reasons : "");
+    /* Switched off: 0 W; point pressures of the wrong count are refused. */
+    CHECK(seam_set_active(e, 0, 0));
+    CHECK(seam_heat_at(e, 0, u, n, &a, &side_b));
+    double p[2] = {1e5, 1e5};
+    status = seam_set_point_pressures(e, 0, p, 2);
+    printf("switched off: %.17g W; expected pressure error %d\n", a, status);
     seam_embedding_free(e);
 }
 

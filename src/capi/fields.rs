@@ -18,6 +18,8 @@ pub(super) struct Buffers {
     unpaired_index: Vec<usize>,
     unpaired_xyz: Vec<f64>,
     unpaired_reason: Vec<c_int>,
+    pub(super) quarantined_xyz: Vec<f64>,
+    pub(super) quarantined_reasons: std::ffi::CString,
     /// The last evaluation was `seam_evaluate_csr` (its results are the embedding's
     /// `evaluation()`).
     pub(super) csr_current: bool,
@@ -127,7 +129,9 @@ unsafe fn array_out<T>(
     }
 }
 
-unsafe fn handle_ref<'a>(ptr: *mut SeamEmbedding) -> Result<&'a mut SeamEmbedding, Failure> {
+pub(super) unsafe fn handle_ref<'a>(
+    ptr: *mut SeamEmbedding,
+) -> Result<&'a mut SeamEmbedding, Failure> {
     unsafe { handle(ptr, "embedding") }
 }
 

@@ -284,6 +284,7 @@ pub extern "C" fn seam_last_error() -> *const c_char {
 mod builder;
 mod fields;
 mod interactions;
+mod state;
 mod terms;
 mod ties;
 

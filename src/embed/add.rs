@@ -3,7 +3,6 @@ use super::{
     Periodic, argument,
 };
 use std::path::Path;
-use std::sync::OnceLock;
 
 use crate::diag::did_you_mean;
 use crate::enforce::interface::Form;
@@ -66,21 +65,17 @@ impl Embedding {
         enforcement: Enforcement,
     ) -> Result<Pair, EmbedError> {
         let (a, b) = (self.geometry(&side_a)?, self.geometry(&side_b)?);
-        Ok(Pair {
+        Ok(Pair::new(
             side_a,
             side_b,
-            a,
-            b,
+            (a, b),
             settings,
-            overclosure: Some(overclosure),
+            Some(overclosure),
             subdomain,
-            image: None,
+            None,
             enforcement,
-            searcher: None,
-            result: None,
-            points: OnceLock::new(),
-            allow_unpaired: false,
-        })
+            self.field.into(),
+        ))
     }
 
     /// A periodic pair built in code: side A's image under `periodic`, checked to land
@@ -141,21 +136,17 @@ impl Embedding {
                 "the map must carry side A exactly onto side B; check the offset, axis, centre, angle or map",
             )
         })?;
-        Ok(Pair {
+        Ok(Pair::new(
             side_a,
             side_b,
-            a,
-            b,
+            (a, b),
             settings,
-            overclosure: None,
-            subdomain: None,
-            image: Some(Image { map, name }),
+            None,
+            None,
+            Some(Image { map, name }),
             enforcement,
-            searcher: None,
-            result: None,
-            points: OnceLock::new(),
-            allow_unpaired: false,
-        })
+            self.field.into(),
+        ))
     }
 
     /// Add an interaction built in code; returns its index.
@@ -229,6 +220,7 @@ impl Embedding {
             Some(periodic) => self.periodic_pair(a, b, settings, periodic, enforcement)?,
         };
         pair.allow_unpaired = i.allow_unpaired;
+        pair.quarantine = i.quarantine;
         self.pairs.push(pair);
         Ok(self.pairs.len() - 1)
     }

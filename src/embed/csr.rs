@@ -80,26 +80,42 @@ impl Embedding {
     /// [`Self::search`] or [`Self::move_nodes`] and only its values change afterwards.
     pub fn evaluate(&mut self, u: &[f64]) -> Result<&Evaluation, EmbedError> {
         let local = self.local_field(u)?;
-        let systems = self
-            .pairs
-            .iter()
-            .map(|p| self.system(p, &local))
-            .collect::<Result<Vec<_>, _>>()?;
         let n = u.len();
         let host = |d: u32| self.host_dof[d as usize];
+        let reuse = self
+            .evaluation
+            .as_ref()
+            .is_some_and(|e| e.current && e.jacobian.n == n && e.slots.len() == self.pairs.len());
+        // An interaction switched off is evaluated only to build a pattern, so the
+        // pattern does not change when it is switched on again.
+        let mut systems = Vec::with_capacity(self.pairs.len());
+        for p in &self.pairs {
+            systems.push(if p.active || !reuse {
+                self.system(p, &local)?
+            } else {
+                None
+            });
+        }
         // The pattern holds while the blocks have the entry counts it was built from.
-        let fits = self.evaluation.as_ref().is_some_and(|e| {
-            e.current
-                && e.jacobian.n == n
-                && e.slots.len() == systems.len()
-                && e.slots.iter().zip(&systems).all(|(slots, s)| {
-                    let entries = s
-                        .as_ref()
-                        .map_or(0, |s| s.blocks.iter().map(|(d, _)| d.len() * d.len()).sum());
-                    slots.len() == entries
-                })
-        });
+        let fits = reuse
+            && self.evaluation.as_ref().is_some_and(|e| {
+                e.slots
+                    .iter()
+                    .zip(&systems)
+                    .zip(&self.pairs)
+                    .all(|((slots, s), p)| {
+                        let entries = s
+                            .as_ref()
+                            .map_or(0, |s| s.blocks.iter().map(|(d, _)| d.len() * d.len()).sum());
+                        !p.active || slots.len() == entries
+                    })
+            });
         if !fits {
+            for (s, p) in systems.iter_mut().zip(&self.pairs) {
+                if s.is_none() && !p.active {
+                    *s = self.system(p, &local)?;
+                }
+            }
             let previous = self.evaluation.as_ref().map_or(0, |e| e.pattern);
             let mut entries: Vec<(usize, usize)> = Vec::new();
             for s in systems.iter().flatten() {
@@ -159,7 +175,11 @@ impl Embedding {
         e.residual.fill(0.0);
         e.load.fill(0.0);
         e.heat.clear();
-        for (s, slots) in systems.iter().zip(&e.slots) {
+        for ((s, slots), p) in systems.iter().zip(&e.slots).zip(&self.pairs) {
+            if !p.active {
+                e.heat.push(p.is_flux().then(Heat::default));
+                continue;
+            }
             let Some(s) = s else {
                 e.heat.push(None);
                 continue;

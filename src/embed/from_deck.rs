@@ -5,13 +5,13 @@
 
 use super::{EmbedError, Embedding, Enforcement, Image, Law, Multipliers, Pair, argument};
 use std::path::Path;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use crate::deck::{self, LoadedDeck};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap};
-use crate::enforce::interface::DEFAULT_BETA;
+use crate::enforce::interface::{DEFAULT_BETA, FieldPair};
 use crate::enforce::model::ConductanceLaw;
-use crate::scene::{ContactScene, SceneOptions};
+use crate::scene::{ContactScene, Enforced, SceneOptions};
 
 /// The one field of an embedding: what `Side B Variable` may name.
 const FIELDS: [&str; 1] = ["temperature"];
@@ -64,8 +64,8 @@ impl Embedding {
                 message: message.clone(),
             });
         }
-        // What an embedding cannot honour: lines about `seam run`'s problem file, and a
-        // quarantine the host would not see (a failing point is an error here).
+        // What an embedding cannot honour: lines about `seam run`'s problem file (whose
+        // host gives them through `set_point_pressures` and `set_active`).
         for enf in loaded
             .deck
             .contact_definitions
@@ -83,11 +83,6 @@ impl Embedding {
                     "`Use Toggle Block` switches an enforcement by `seam run`'s [[toggle]] times",
                     "leave the line out and add or drop the interaction's terms in the host",
                 ),
-                (
-                    enf.quarantine_faulty_points,
-                    "`Quarantine Faulty Points` keeps a run going past failing points",
-                    "leave the line out: a point where the model fails is an error that names it, for the host to handle",
-                ),
             ];
             for (used, what, help) in unsupported {
                 if used {
@@ -102,56 +97,12 @@ impl Embedding {
         if diags.has_errors() {
             return Err(fail(&diags));
         }
-        let mut added = Vec::with_capacity(scene.entries.len());
-        for e in scene.entries {
-            let again = e.again.expect("kept by build_for_host");
-            let p = e.pairing;
-            let c = &e.choice;
-            let enforcement = if c.mortar {
-                Enforcement::Tie {
-                    multipliers: if c.dual {
-                        Multipliers::Dual
-                    } else {
-                        Multipliers::Standard
-                    },
-                    offset: c.offset,
-                }
-            } else {
-                let law = match (&c.conductance, e.model) {
-                    (Some(ConductanceLaw::Constant(h)), _) => Law::Constant(*h),
-                    (Some(law), Some(model)) => Law::Model {
-                        model,
-                        pressure: c.pressure,
-                        plugin: *law == ConductanceLaw::Plugin,
-                    },
-                    _ => Law::Constant(0.0),
-                };
-                Enforcement::Flux {
-                    form: c.form,
-                    law,
-                    offset: c.offset,
-                    beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * e.penalty_scale,
-                }
-            };
-            added.push(Pair {
-                side_a: again.side_a,
-                side_b: again.side_b,
-                a: p.side_a_geometry,
-                b: p.side_b_geometry,
-                settings: again.settings,
-                overclosure: again.overclosure,
-                subdomain: again.subdomain,
-                image: again.map.map(|map| Image {
-                    map,
-                    name: format!("{}_image", p.side_a),
-                }),
-                enforcement,
-                searcher: None,
-                result: Some(p.result),
-                points: OnceLock::new(),
-                allow_unpaired: false,
-            });
-        }
+        let field = self.field.into();
+        let added: Vec<Pair> = scene
+            .entries
+            .into_iter()
+            .map(|e| scene_pair(e, field))
+            .collect();
         if added.is_empty() {
             return Err(argument(
                 "the deck defines no interaction".into(),
@@ -165,4 +116,55 @@ impl Embedding {
         }
         Ok((first..self.pairs.len()).collect())
     }
+}
+
+/// The pair of one resolved scene entry (kept for searching again), over `fields`.
+pub(super) fn scene_pair(e: Enforced, fields: FieldPair) -> Pair {
+    let again = e.again.expect("kept by build_for_host");
+    let p = e.pairing;
+    let c = &e.choice;
+    let enforcement = if c.mortar {
+        Enforcement::Tie {
+            multipliers: if c.dual {
+                Multipliers::Dual
+            } else {
+                Multipliers::Standard
+            },
+            offset: c.offset,
+        }
+    } else {
+        let law = match (&c.conductance, e.model) {
+            (Some(ConductanceLaw::Constant(h)), _) => Law::Constant(*h),
+            (Some(law), Some(model)) => Law::Model {
+                model: Arc::from(model),
+                pressure: c.pressure,
+                plugin: *law == ConductanceLaw::Plugin,
+            },
+            _ => Law::Constant(0.0),
+        };
+        Enforcement::Flux {
+            form: c.form,
+            law,
+            offset: c.offset,
+            beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * e.penalty_scale,
+        }
+    };
+    let image = again.map.map(|map| Image {
+        map,
+        name: format!("{}_image", p.side_a),
+    });
+    let mut pair = Pair::new(
+        again.side_a,
+        again.side_b,
+        (p.side_a_geometry, p.side_b_geometry),
+        again.settings,
+        again.overclosure,
+        again.subdomain,
+        image,
+        enforcement,
+        fields,
+    );
+    pair.result = Some(p.result);
+    pair.quarantine = c.quarantine;
+    pair
 }

@@ -50,10 +50,10 @@
 //! - Nothing here panics on host input: every check returns an [`EmbedError`] that says
 //!   what is wrong, where, and how to fix it.
 
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
-use crate::enforce::interface::{DEFAULT_BETA, Form, InterfaceError, InterfacePoints};
+use crate::enforce::interface::{DEFAULT_BETA, FieldPair, Form, InterfaceError, InterfacePoints};
 use crate::mesh::{Mesh, NodeId, ValidationError};
 use crate::periodic::PeriodicMap;
 use crate::search::SearchSettings;
@@ -229,6 +229,7 @@ pub struct Interaction {
     periodic: Option<Periodic>,
     conductance: Option<Arc<dyn ConductanceModel>>,
     allow_unpaired: bool,
+    quarantine: bool,
 }
 
 impl std::fmt::Debug for Interaction {
@@ -242,6 +243,7 @@ impl std::fmt::Debug for Interaction {
             .field("periodic", &self.periodic)
             .field("conductance", &self.conductance.as_ref().map(|m| m.name()))
             .field("allow_unpaired", &self.allow_unpaired)
+            .field("quarantine", &self.quarantine)
             .finish()
     }
 }
@@ -259,6 +261,7 @@ impl Interaction {
             periodic: None,
             conductance: None,
             allow_unpaired: false,
+            quarantine: false,
         }
     }
 
@@ -294,6 +297,14 @@ impl Interaction {
     /// that are apart otherwise look like an interface that carries no heat.
     pub fn allow_unpaired(mut self) -> Self {
         self.allow_unpaired = true;
+        self
+    }
+
+    /// A point where the conductance model fails contributes nothing and is kept for
+    /// [`Embedding::quarantined`], instead of failing the evaluation (`Quarantine Faulty
+    /// Points`). A model's request for a smaller step is still [`EmbedError::Cutback`].
+    pub fn quarantine(mut self) -> Self {
+        self.quarantine = true;
         self
     }
 
@@ -386,7 +397,7 @@ enum Law {
     /// and cutback requests become [`EmbedError::Plugin`] and [`EmbedError::Cutback`])
     /// and the contact pressure it sees.
     Model {
-        model: Box<dyn ConductanceModel>,
+        model: Arc<dyn ConductanceModel>,
         pressure: f64,
         plugin: bool,
     },
@@ -434,6 +445,71 @@ struct Pair {
     points: OnceLock<InterfacePoints>,
     /// A flux interaction whose search pairs nothing is an error unless this is set.
     allow_unpaired: bool,
+    /// The host's fields on side A and on side B (one field unless the embedding was
+    /// made over several, as `seam run`'s).
+    fields: FieldPair,
+    /// The contact pressure at each point of `result`, from the host; `None`: the
+    /// enforcement's (cleared by a search, whose points are new).
+    pressures: Option<Vec<f64>>,
+    /// Quarantine: a point where the model fails contributes nothing and is kept in
+    /// `quarantined` (each place once).
+    quarantine: bool,
+    quarantined: Mutex<Vec<Quarantined>>,
+    /// Switched off by the host ([`Embedding::set_active`]): no terms, no heat.
+    active: bool,
+}
+
+impl Pair {
+    /// A flux-type interaction (not a mortar tie).
+    fn is_flux(&self) -> bool {
+        matches!(self.enforcement, Enforcement::Flux { .. })
+    }
+
+    /// A pair of searched (or yet unsearched) geometry with the defaults of the
+    /// host-set state: one field, no point pressures, no quarantine, switched on.
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        side_a: ContactSurface,
+        side_b: ContactSurface,
+        (a, b): (SurfaceGeometry, SurfaceGeometry),
+        settings: SearchSettings,
+        overclosure: Option<Overclosure>,
+        subdomain: Option<Sphere>,
+        image: Option<Image>,
+        enforcement: Enforcement,
+        fields: FieldPair,
+    ) -> Pair {
+        Pair {
+            side_a,
+            side_b,
+            a,
+            b,
+            settings,
+            overclosure,
+            subdomain,
+            image,
+            enforcement,
+            searcher: None,
+            result: None,
+            points: OnceLock::new(),
+            allow_unpaired: false,
+            fields,
+            pressures: None,
+            quarantine: false,
+            quarantined: Mutex::new(Vec::new()),
+            active: true,
+        }
+    }
+}
+
+/// A contact point where an interaction's conductance model failed and which was
+/// quarantined ([`Interaction::quarantine`]): it carries no heat.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Quarantined {
+    /// The point (side A).
+    pub x: [f64; 3],
+    /// Why the model failed there.
+    pub message: String,
 }
 
 /// seam inside a host: the host's mesh and numbering, its interactions and their search.
@@ -460,6 +536,7 @@ mod csr;
 mod fields;
 mod from_deck;
 mod search;
+mod state;
 mod terms;
 mod ties;
 

@@ -61,6 +61,7 @@ impl Embedding {
             }
             p.searcher = Some(searcher);
             p.result = Some(result);
+            p.pressures = None;
             p.points = OnceLock::new();
         }
         if let Some(e) = &mut self.evaluation {

@@ -4,7 +4,9 @@
 //! turns the interaction's law into the h the interface form sees and a model's fault
 //! into the matching [`EmbedError`].
 
-use super::{Contributions, EmbedError, Embedding, Enforcement, Heat, Law, Pair, argument};
+use super::{
+    Contributions, EmbedError, Embedding, Enforcement, Heat, Law, Pair, Quarantined, argument,
+};
 use std::cell::Cell;
 
 use crate::enforce::conductance::{ConductanceError, ConductanceModel, PointState};
@@ -53,7 +55,7 @@ impl Embedding {
         else {
             return Ok(None);
         };
-        // A plugin's fault, kept to tell a plugin failure or cutback request from the
+        // A model's fault, kept to tell a plugin failure or a cutback request from the
         // other failures once the interface terms stop at it.
         let fault: Cell<Option<ConductanceError>> = Cell::new(None);
         let h = |x: &HInput| -> Result<HValue, String> {
@@ -71,7 +73,7 @@ impl Embedding {
             };
             let state = PointState {
                 gap: x.gap,
-                pressure,
+                pressure: p.pressures.as_ref().map_or(pressure, |v| v[x.point]),
                 temp_a: x.temp_a,
                 temp_b: x.temp_b,
                 x: x.x,
@@ -83,11 +85,21 @@ impl Embedding {
                     dh_dtemp_a: c.dh_dtemp_a,
                     dh_dtemp_b: c.dh_dtemp_b,
                 }),
+                // Quarantined: the point contributes nothing; each Newton step meets it
+                // again, so it is kept once.
+                Err(e) if p.quarantine && !e.is_cutback() => {
+                    let mut kept = p.quarantined.lock().unwrap_or_else(|e| e.into_inner());
+                    if !kept.iter().any(|q| q.x == x.x) {
+                        kept.push(Quarantined {
+                            x: x.x,
+                            message: e.to_string(),
+                        });
+                    }
+                    Ok(HValue::default())
+                }
                 Err(e) => {
                     let message = e.to_string();
-                    if matches!(law, Law::Model { plugin: true, .. }) {
-                        fault.set(Some(e));
-                    }
+                    fault.set(Some(e));
                     Err(message)
                 }
             }
@@ -110,7 +122,7 @@ impl Embedding {
                 let made = InterfacePoints::new(
                     &self.mesh,
                     &self.dofs,
-                    self.field,
+                    p.fields,
                     &p.a,
                     &p.b,
                     &result.points,
@@ -122,6 +134,7 @@ impl Embedding {
         };
         f(points, &form).map(Some).map_err(|source| {
             let (side_a, side_b) = (p.side_a.name.clone(), p.side_b.name.clone());
+            let plugin = matches!(law, Law::Model { plugin: true, .. });
             match fault.take() {
                 Some(ConductanceError::Cutback { factor, .. }) => EmbedError::Cutback {
                     side_a,
@@ -129,12 +142,12 @@ impl Embedding {
                     factor,
                     message: source.to_string(),
                 },
-                Some(_) => EmbedError::Plugin {
+                Some(_) if plugin => EmbedError::Plugin {
                     side_a,
                     side_b,
                     message: source.to_string(),
                 },
-                None => named(source),
+                _ => named(source),
             }
         })
     }
@@ -148,6 +161,18 @@ impl Embedding {
         self.with_form(p, |points, form| points.evaluate(form, local))
     }
 
+    /// The heat of flux interaction `p` at seam's field `local`: 0 while it is switched
+    /// off, `None` for a tie.
+    fn pair_heat(&self, p: &Pair, local: &[f64]) -> Result<Option<Heat>, EmbedError> {
+        if !p.active {
+            return Ok(p.is_flux().then(Heat::default));
+        }
+        Ok(self.system(p, local)?.map(|s| {
+            let (side_a, side_b) = s.heat();
+            Heat { side_a, side_b }
+        }))
+    }
+
     /// The interface terms of every flux-type interaction at the host's field `u` (by
     /// host dof): residual, Jacobian (exact, including dh/dT) and heat, as triplets. A
     /// host that assembles at every Newton step into a matrix of fixed pattern is better
@@ -157,6 +182,10 @@ impl Embedding {
         let mut out = Contributions::default();
         let host = |d: u32| self.host_dof[d as usize];
         for p in &self.pairs {
+            if !p.active {
+                out.heat.push(p.is_flux().then(Heat::default));
+                continue;
+            }
             let Some(s) = self.system(p, &local)? else {
                 out.heat.push(None);
                 continue;
@@ -199,10 +228,7 @@ impl Embedding {
             )
         })?;
         let local = self.local_field(u)?;
-        Ok(self.system(p, &local)?.map(|s| {
-            let (side_a, side_b) = s.heat();
-            Heat { side_a, side_b }
-        }))
+        self.pair_heat(p, &local)
     }
 
     /// Heat (W) leaving each side of every interaction at the host's field `u` (by host
@@ -212,12 +238,7 @@ impl Embedding {
         let local = self.local_field(u)?;
         self.pairs
             .iter()
-            .map(|p| {
-                Ok(self.system(p, &local)?.map(|s| {
-                    let (side_a, side_b) = s.heat();
-                    Heat { side_a, side_b }
-                }))
-            })
+            .map(|p| self.pair_heat(p, &local))
             .collect()
     }
 }

@@ -15,6 +15,9 @@ pub struct TieConstraints {
     pub entries: Vec<(usize, usize, f64)>,
     /// `g_k = ΔT ∫ψ_k`.
     pub rhs: Vec<f64>,
+    /// Side-A nodes left without a multiplier because they were fixed or belong to an
+    /// earlier tie (crosspoints), as host node indices.
+    pub crosspoints: Vec<usize>,
     /// Dual multipliers only: each multiplier's side-A dof in condensed form (a host
     /// without multipliers substitutes these rows; the system stays SPD).
     pub condensed: Vec<Condensed>,
@@ -104,6 +107,13 @@ impl Embedding {
     /// The constraint rows of every mortar tie, in interaction order. Fixed nodes and
     /// nodes of an earlier tie get no multiplier (crosspoints).
     pub fn constraints(&self) -> Result<Vec<TieConstraints>, EmbedError> {
+        self.tie_rows(true)
+    }
+
+    /// The constraint rows of every mortar tie; dual ties in condensed form too when
+    /// `condensed_too` (a host that solves for the multipliers does not need it, and a
+    /// partly covered side A cannot be condensed).
+    pub(crate) fn tie_rows(&self, condensed_too: bool) -> Result<Vec<TieConstraints>, EmbedError> {
         let mut constrained: HashSet<NodeId> = self.fixed.iter().copied().collect();
         let mut out = Vec::new();
         for (index, p) in self.pairs.iter().enumerate() {
@@ -118,7 +128,7 @@ impl Embedding {
             let tie = mortar_tie(
                 &self.mesh,
                 &self.dofs,
-                self.field,
+                p.fields,
                 &p.a,
                 &p.b,
                 &result.points,
@@ -135,7 +145,7 @@ impl Embedding {
             let own: Vec<u32> = tie
                 .nodes
                 .iter()
-                .map(|&n| self.dofs.dof(self.field, n).map_or(u32::MAX, |d| d.0))
+                .map(|&n| self.dofs.dof(p.fields.a, n).map_or(u32::MAX, |d| d.0))
                 .collect();
             let mut rows: Vec<BTreeMap<u32, f64>> = vec![BTreeMap::new(); tie.nodes.len()];
             for &(k, d, c) in &tie.entries {
@@ -155,13 +165,14 @@ impl Embedding {
                     .map(|&(k, d, c)| (k as usize, host(d), c))
                     .collect(),
                 rhs: tie.psi_integral.iter().map(|psi| offset * psi).collect(),
+                crosspoints: tie.crosspoints.iter().map(|n| n.index()).collect(),
                 condensed: Vec::new(),
                 diagonal,
                 side_a_dofs: tie.side_a_dofs.iter().map(|&d| host(d)).collect(),
                 side_b_dofs: tie.side_b_dofs.iter().map(|&d| host(d)).collect(),
                 point_psi: tie.point_psi.clone(),
             };
-            if *multipliers == Multipliers::Dual {
+            if condensed_too && *multipliers == Multipliers::Dual {
                 t.condensed = condense(&t, &rows, &own, &host, &p.side_a.name)?;
             }
             out.push(t);

@@ -261,6 +261,15 @@ fn c_host_fields(stdout: &str, heat: f64) {
             && stdout.contains("the callback returned 7"),
         "{stdout}"
     );
+    // Quarantine, switching off and point pressures through C.
+    let q = printed(stdout, "quarantine: ");
+    assert!(q[0] != 0.0 && q[1] > 0.0 && q[1] == q[2], "{stdout}");
+    assert!(
+        stdout.contains("first reason: conductance model"),
+        "{stdout}"
+    );
+    let off = printed(stdout, "switched off: ");
+    assert!(off[0] == 0.0 && off[1] == 4.0, "{stdout}");
     assert!(
         stdout.contains(
             "expected nothing paired 10: interaction base_top / lid_bottom paired nothing"

@@ -508,3 +508,218 @@ fn embed_reads_a_deck_as_seam_run_does() {
     );
     assert!(seam.is_empty(), "nothing added on an error");
 }
+
+/// h = 800 where x ≤ 0.5, and a model that fails past x = 0.5 (`fail`) or gives 0 there.
+fn half_model(
+    fail: bool,
+) -> Arc<FnConductance<impl Fn(&PointState) -> Result<Conductance, String>>> {
+    Arc::new(FnConductance::new("half", true, move |s: &PointState| {
+        if s.x[0] > 0.5 {
+            return if fail {
+                Err("no data past x = 0.5".into())
+            } else {
+                Ok(Conductance::default())
+            };
+        }
+        Ok(Conductance {
+            h: 800.0,
+            ..Conductance::default()
+        })
+    }))
+}
+
+/// A quarantined point contributes exactly what h = 0 would, is listed once with its
+/// place and reason however often it is evaluated, and without quarantine the same
+/// model is an error.
+#[test]
+fn embed_quarantine_skips_failing_points_and_lists_them() {
+    let interaction = |fail| {
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(half_model(fail))
+    };
+    let (quarantined, n) = two_blocks(interaction(true).quarantine());
+    let (zero_there, _) = two_blocks(interaction(false));
+    let u = field(n, 0.0);
+    let (q, z) = (
+        quarantined.contributions(&u).unwrap(),
+        zero_there.contributions(&u).unwrap(),
+    );
+    let (hq, hz) = (q.heat[0].unwrap(), z.heat[0].unwrap());
+    assert!(hz.side_a.abs() > 1.0, "the interface carries heat: {hz:?}");
+    assert!(
+        (hq.side_a - hz.side_a).abs() <= 1e-12 * hz.side_a.abs(),
+        "{hq:?} vs {hz:?}"
+    );
+    assert_eq!(q.jacobian, z.jacobian);
+    let listed = quarantined.quarantined(0);
+    assert!(!listed.is_empty());
+    assert!(
+        listed
+            .iter()
+            .all(|p| p.x[0] > 0.5 && p.message.contains("no data past"))
+    );
+    // Evaluated again: each place kept once.
+    quarantined.contributions(&u).unwrap();
+    assert_eq!(quarantined.quarantined(0).len(), listed.len());
+    // The points failing are the points of the model's region: every one is listed.
+    let past: usize = zero_there
+        .point_fields(0, &u)
+        .unwrap()
+        .iter()
+        .filter(|p| p.x[0] > 0.5 && p.paired)
+        .count();
+    assert_eq!(listed.len(), past);
+    let (strict, _) = two_blocks(interaction(true));
+    assert!(strict.contributions(&u).is_err());
+    assert!(strict.quarantined(0).is_empty());
+}
+
+/// `Quarantine Faulty Points` in a deck is honoured by an embedding (it was refused
+/// before the embedding could report the points).
+#[test]
+fn embed_deck_quarantine_is_honoured() {
+    let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
+    let line = "gap conductance coefficient = constant h = 500\n";
+    assert!(deck.contains(line));
+    let with = deck.replace(line, &format!("{line}    Quarantine Faulty Points\n"));
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let dof = example::host_dofs(&mesh);
+    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+    seam.add_deck("contact_run.i", &with).unwrap();
+    seam.search().unwrap();
+    let u = field(mesh.num_nodes(), 0.0);
+    assert!(seam.contributions(&u).is_ok());
+    assert!(
+        seam.quarantined(0).is_empty(),
+        "a sound model quarantines nothing"
+    );
+}
+
+/// Switched off, a flux interaction adds nothing and reports 0 W; the CSR pattern
+/// survives off and on, and the values come back.
+#[test]
+fn embed_set_active_switches_terms_and_keeps_the_pattern() {
+    let (mut seam, n) = two_blocks(Interaction::new(
+        "base_top",
+        "lid_bottom",
+        Model::GapConductance { h: 500.0 },
+    ));
+    let u = field(n, 0.0);
+    let (pattern, values) = {
+        let e = seam.evaluate(&u).unwrap();
+        assert!(e.heat[0].unwrap().side_a.abs() > 1.0);
+        (e.pattern, e.jacobian.values.clone())
+    };
+    seam.set_active(0, false).unwrap();
+    assert!(!seam.is_active(0));
+    {
+        let e = seam.evaluate(&u).unwrap();
+        assert_eq!(e.pattern, pattern);
+        assert!(e.jacobian.values.iter().all(|&v| v == 0.0));
+        assert!(e.residual.iter().all(|&v| v == 0.0));
+        assert_eq!(e.heat[0], Some(seam::embed::Heat::default()));
+    }
+    let c = seam.contributions(&u).unwrap();
+    assert!(c.jacobian.is_empty() && c.residual.is_empty());
+    assert_eq!(
+        seam.heat(&u).unwrap()[0],
+        Some(seam::embed::Heat::default())
+    );
+    seam.set_active(0, true).unwrap();
+    let e = seam.evaluate(&u).unwrap();
+    assert_eq!(e.pattern, pattern);
+    assert_eq!(e.jacobian.values, values);
+    // Off before the first evaluation: the pattern is still the whole interface's.
+    let (mut late, _) = two_blocks(Interaction::new(
+        "base_top",
+        "lid_bottom",
+        Model::GapConductance { h: 500.0 },
+    ));
+    late.set_active(0, false).unwrap();
+    let nnz = late.evaluate(&u).unwrap().jacobian.columns.len();
+    assert_eq!(nnz, values.len());
+    assert!(late.set_active(3, true).is_err());
+}
+
+/// Point pressures reach the model: h = 1e-3 p with p set per point equals the constant
+/// model at the same h, and a pressure list of the wrong length or sign is refused.
+#[test]
+fn embed_point_pressures_reach_the_model() {
+    let by_pressure = Arc::new(FnConductance::new("h(p)", false, |s: &PointState| {
+        Ok(Conductance {
+            h: 1e-3 * s.pressure,
+            ..Conductance::default()
+        })
+    }));
+    let (mut seam, n) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(by_pressure),
+    );
+    let (constant, _) = two_blocks(Interaction::new(
+        "base_top",
+        "lid_bottom",
+        Model::GapConductance { h: 700.0 },
+    ));
+    let u = field(n, 0.0);
+    let zero = |seam: &Embedding| seam.heat(&u).unwrap()[0].unwrap().side_a.abs() <= 1e-9;
+    assert!(zero(&seam), "no pressure: h = 0");
+    let points = seam.coverage(0).unwrap().points;
+    seam.set_point_pressures(0, Some(vec![7e5; points]))
+        .unwrap();
+    let (a, b) = (
+        seam.heat(&u).unwrap()[0].unwrap(),
+        constant.heat(&u).unwrap()[0].unwrap(),
+    );
+    assert!(
+        (a.side_a - b.side_a).abs() <= 1e-12 * b.side_a.abs(),
+        "{a:?} {b:?}"
+    );
+    assert!(
+        seam.set_point_pressures(0, Some(vec![1.0; points + 1]))
+            .is_err()
+    );
+    let mut negative = vec![7e5; points];
+    negative[points / 2] = -1.0;
+    assert!(seam.set_point_pressures(0, Some(negative)).is_err());
+    // A search pairs new points and drops the pressures.
+    seam.search().unwrap();
+    assert!(zero(&seam));
+}
+
+/// A model's request for a smaller step is `Cutback` whatever the model (not only a
+/// plugin's), with the factor it asked for.
+#[test]
+fn embed_cutback_from_any_model() {
+    struct Shrink;
+    impl seam::embed::ConductanceModel for Shrink {
+        fn name(&self) -> String {
+            "shrink".into()
+        }
+        fn evaluate(&self, s: &PointState) -> Result<Conductance, seam::embed::ConductanceError> {
+            Err(seam::embed::ConductanceError::Cutback {
+                model: "shrink".into(),
+                state: *s,
+                factor: 0.25,
+                message: "too fast".into(),
+            })
+        }
+        fn depends_on_temperature(&self) -> bool {
+            true
+        }
+    }
+    let (seam, n) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(Arc::new(Shrink))
+            .quarantine(),
+    );
+    let err = seam.contributions(&field(n, 0.0)).unwrap_err();
+    assert!(
+        matches!(err, EmbedError::Cutback { factor, .. } if factor == 0.25),
+        "{err}"
+    );
+    assert!(
+        seam.quarantined(0).is_empty(),
+        "a cutback is no faulty point"
+    );
+    assert!(!seam.is_linear());
+}

@@ -1,0 +1,103 @@
+//! What a host sets on its interactions between evaluations — which are switched on,
+//! the contact pressure at their points, quarantine — and what they kept: the
+//! quarantined points.
+
+use super::{EmbedError, Embedding, Pair, Quarantined, argument};
+
+impl Embedding {
+    fn pair_mut(&mut self, i: usize) -> Result<&mut Pair, EmbedError> {
+        let count = self.pairs.len();
+        self.pairs.get_mut(i).ok_or_else(|| {
+            argument(
+                format!("no interaction {i}, there are {count}"),
+                "interaction indices are 0-based, in the order they were added",
+            )
+        })
+    }
+
+    /// Switch interaction `i` on or off (`Use Toggle Block`): while off, a flux
+    /// interaction adds no terms and reports 0 W; the CSR pattern of
+    /// [`Self::evaluate`] keeps its entries, so it does not change when it comes back.
+    /// A mortar tie's rows stay in [`Self::constraints`]: the host drops them (and keeps
+    /// its multipliers at 0) while the tie is off.
+    pub fn set_active(&mut self, i: usize, on: bool) -> Result<(), EmbedError> {
+        self.pair_mut(i)?.active = on;
+        Ok(())
+    }
+
+    /// Whether interaction `i` is switched on (true unless [`Self::set_active`] said
+    /// otherwise).
+    pub fn is_active(&self, i: usize) -> bool {
+        self.pairs.get(i).is_some_and(|p| p.active)
+    }
+
+    /// The contact pressure (Pa) a conductance model sees at each contact point of
+    /// interaction `i`, in the order of its search's points (`Contact Pressure
+    /// Variable`); `None` goes back to the enforcement's `Contact Pressure`. A search
+    /// pairs new points and drops these.
+    pub fn set_point_pressures(
+        &mut self,
+        i: usize,
+        pressures: Option<Vec<f64>>,
+    ) -> Result<(), EmbedError> {
+        let p = self.pair_mut(i)?;
+        if let Some(v) = &pressures {
+            let points = Self::searched(p)?.points.len();
+            if v.len() != points {
+                return Err(argument(
+                    format!(
+                        "{} pressures for interaction {} / {}, which has {points} contact points",
+                        v.len(),
+                        p.side_a.name,
+                        p.side_b.name
+                    ),
+                    "give one pressure per contact point, in the order of point_fields",
+                ));
+            }
+            if let Some(k) = v.iter().position(|x| !x.is_finite() || *x < 0.0) {
+                return Err(argument(
+                    format!("pressure {} at point {k} is not a number ≥ 0", v[k]),
+                    "give contact pressures in Pa",
+                ));
+            }
+        }
+        p.pressures = pressures;
+        Ok(())
+    }
+
+    /// Quarantine the failing points of interaction `i` (see
+    /// [`super::Interaction::quarantine`]), or stop doing so; the points kept so far stay
+    /// listed.
+    pub fn set_quarantine(&mut self, i: usize, on: bool) -> Result<(), EmbedError> {
+        self.pair_mut(i)?.quarantine = on;
+        Ok(())
+    }
+
+    /// Whether every interaction's terms are linear in the field (constant h, or a
+    /// model that does not depend on temperature): the Jacobian is then constant and
+    /// symmetric, and one linear solve answers a steady problem.
+    pub fn is_linear(&self) -> bool {
+        self.pairs.iter().all(|p| match &p.enforcement {
+            super::Enforcement::Flux {
+                law: super::Law::Model { model, .. },
+                ..
+            } => !model.depends_on_temperature(),
+            super::Enforcement::Flux {
+                law: super::Law::Host(model),
+                ..
+            } => !model.depends_on_temperature(),
+            _ => true,
+        })
+    }
+
+    /// The points of interaction `i` quarantined so far ([`super::Interaction::quarantine`]),
+    /// in the order they failed.
+    pub fn quarantined(&self, i: usize) -> Vec<Quarantined> {
+        self.pairs.get(i).map_or_else(Vec::new, |p| {
+            p.quarantined
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .clone()
+        })
+    }
+}
