@@ -206,7 +206,7 @@ pub unsafe extern "C" fn seam_set_time(embedding: *mut SeamEmbedding, time: f64)
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
         e.inner.set_time(time)?;
-        e.evaluated = None;
+        e.values_changed();
         Ok(())
     })
 }

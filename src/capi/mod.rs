@@ -230,6 +230,13 @@ pub struct SeamEmbedding {
 }
 
 impl SeamEmbedding {
+    /// What the terms depend on changed (time, switches, pressures): the last
+    /// evaluation's values no longer hold; its pattern does.
+    fn values_changed(&mut self) {
+        self.evaluated = None;
+        self.buffers.csr_current = false;
+    }
+
     /// The interactions or the geometry changed: the last evaluation and tie rows no
     /// longer hold.
     fn forget_results(&mut self) {

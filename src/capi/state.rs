@@ -17,8 +17,7 @@ pub unsafe extern "C" fn seam_set_active(
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
         e.inner.set_active(index, on != 0)?;
-        e.evaluated = None;
-        e.buffers.csr_current = false;
+        e.values_changed();
         Ok(())
     })
 }
@@ -41,8 +40,7 @@ pub unsafe extern "C" fn seam_set_point_pressures(
             Some(unsafe { slice(pressures, n, "pressures") }?.to_vec())
         };
         e.inner.set_point_pressures(index, given)?;
-        e.evaluated = None;
-        e.buffers.csr_current = false;
+        e.values_changed();
         Ok(())
     })
 }
