@@ -15,7 +15,8 @@
 //! - [`scene`]: the one consumer of the deck spec — a contact definition resolved on a
 //!   mesh into surfaces, interactions, searches and enforcements;
 //! - hosts: [`embed`] (the public host API) and [`capi`] (its C face), [`heat`] (seam's
-//!   conduction solvers) and [`run`] (`seam run`); the binary's CLI on top;
+//!   conduction solvers, which take interfaces through [`heat::interfaces::Interfaces`])
+//!   and [`run`] (`seam run`, itself a host of [`embed`]); the binary's CLI on top;
 //! - [`error`]: [`Error`], wrapping every module's own error.
 
 pub mod assembly;

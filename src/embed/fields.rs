@@ -235,6 +235,16 @@ impl Embedding {
             .collect())
     }
 
+    /// The flux at each point of flux interaction `i` at the host's field `u` (`None`
+    /// where it paired nothing), with the temperatures the model saw.
+    pub(crate) fn point_flux(
+        &self,
+        i: usize,
+        u: &[f64],
+    ) -> Result<Vec<Option<PointFlux>>, EmbedError> {
+        Ok(self.point_fluxes(i, u)?.1)
+    }
+
     /// Flux interaction `i` and the flux at each of its points at the host's field `u`.
     fn point_fluxes(
         &self,

@@ -9,9 +9,14 @@ use std::sync::Arc;
 
 use crate::deck::{self, LoadedDeck};
 use crate::diag::{Diagnostic, Diagnostics, SourceMap};
+use crate::enforce::conductance::ConductanceModel;
 use crate::enforce::interface::{DEFAULT_BETA, FieldPair};
 use crate::enforce::model::ConductanceLaw;
-use crate::scene::{ContactScene, Enforced, SceneOptions};
+use crate::enforce::model::ModelChoice;
+use crate::scene::{ContactScene, Enforced, SceneOptions, SearchAgain};
+use crate::search::SearchSettings;
+use crate::search::scene::Pairing;
+use crate::surface::{ContactSurface, SurfaceKind};
 
 /// The one field of an embedding: what `Side B Variable` may name.
 const FIELDS: [&str; 1] = ["temperature"];
@@ -121,8 +126,28 @@ impl Embedding {
 /// The pair of one resolved scene entry (kept for searching again), over `fields`.
 pub(super) fn scene_pair(e: Enforced, fields: FieldPair) -> Pair {
     let again = e.again.expect("kept by build_for_host");
-    let p = e.pairing;
-    let c = &e.choice;
+    let model = e.model.map(Arc::from);
+    resolved_pair(
+        e.pairing,
+        &e.choice,
+        e.penalty_scale,
+        model,
+        Some(again),
+        fields,
+    )
+}
+
+/// The pair of a pairing and its resolved enforcement over `fields`, searched already;
+/// without `again` (`seam run`, whose mesh does not move) it keeps only its surfaces'
+/// names and is not searched again.
+pub(super) fn resolved_pair(
+    p: Pairing,
+    c: &ModelChoice,
+    penalty_scale: f64,
+    model: Option<Arc<dyn ConductanceModel>>,
+    again: Option<SearchAgain>,
+    fields: FieldPair,
+) -> Pair {
     let enforcement = if c.mortar {
         Enforcement::Tie {
             multipliers: if c.dual {
@@ -133,10 +158,10 @@ pub(super) fn scene_pair(e: Enforced, fields: FieldPair) -> Pair {
             offset: c.offset,
         }
     } else {
-        let law = match (&c.conductance, e.model) {
+        let law = match (&c.conductance, model) {
             (Some(ConductanceLaw::Constant(h)), _) => Law::Constant(*h),
             (Some(law), Some(model)) => Law::Model {
-                model: Arc::from(model),
+                model,
                 pressure: c.pressure,
                 plugin: *law == ConductanceLaw::Plugin,
             },
@@ -146,20 +171,46 @@ pub(super) fn scene_pair(e: Enforced, fields: FieldPair) -> Pair {
             form: c.form,
             law,
             offset: c.offset,
-            beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * e.penalty_scale,
+            beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * penalty_scale,
         }
     };
-    let image = again.map.map(|map| Image {
-        map,
-        name: format!("{}_image", p.side_a),
-    });
+    let named = |name: &str| ContactSurface {
+        name: name.to_string(),
+        kind: SurfaceKind::Faces,
+        faces: Vec::new(),
+        tributary: Vec::new(),
+        nodes: Vec::new(),
+        origins: Vec::new(),
+        parent: None,
+    };
+    let (side_a, side_b, settings, overclosure, subdomain, image) = match again {
+        Some(again) => (
+            again.side_a,
+            again.side_b,
+            again.settings,
+            again.overclosure,
+            again.subdomain,
+            again.map.map(|map| Image {
+                map,
+                name: format!("{}_image", p.side_a),
+            }),
+        ),
+        None => (
+            named(&p.side_a),
+            named(&p.side_b),
+            SearchSettings::defaults(3),
+            None,
+            None,
+            None,
+        ),
+    };
     let mut pair = Pair::new(
-        again.side_a,
-        again.side_b,
+        side_a,
+        side_b,
         (p.side_a_geometry, p.side_b_geometry),
-        again.settings,
-        again.overclosure,
-        again.subdomain,
+        settings,
+        overclosure,
+        subdomain,
         image,
         enforcement,
         fields,

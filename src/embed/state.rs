@@ -3,6 +3,15 @@
 //! quarantined points.
 
 use super::{EmbedError, Embedding, Pair, Quarantined, argument};
+use std::sync::Arc;
+
+use crate::assembly::{DofMap, FieldId};
+use crate::enforce::conductance::ConductanceModel;
+use crate::enforce::interface::FieldPair;
+use crate::enforce::model::ModelChoice;
+use crate::mesh::{Mesh, NodeId};
+use crate::search::pairing::Integration;
+use crate::search::scene::Pairing;
 
 impl Embedding {
     fn pair_mut(&mut self, i: usize) -> Result<&mut Pair, EmbedError> {
@@ -99,5 +108,56 @@ impl Embedding {
                 .unwrap_or_else(|e| e.into_inner())
                 .clone()
         })
+    }
+
+    /// `seam run`'s embedding: over its mesh and its own dof numbering (one or several
+    /// fields; the host's dofs are seam's), with `fixed` nodes (its Dirichlet data) and
+    /// the block `conductivity` weighing the Nitsche forms. Its interactions come from
+    /// the run's scene ([`Self::add_resolved`]); their terms then come through the
+    /// public calls, as an external host's do.
+    pub(crate) fn over_dofs(
+        mesh: Mesh,
+        dofs: DofMap,
+        conductivity: Vec<f64>,
+        fixed: Vec<NodeId>,
+        integration: Integration,
+    ) -> Embedding {
+        Embedding {
+            host_dof: (0..dofs.len()).collect(),
+            field: FieldId(0),
+            mesh,
+            dofs,
+            conductivity,
+            fixed,
+            integration,
+            pairs: Vec::new(),
+            time: 0.0,
+            evaluation: None,
+        }
+    }
+
+    /// Add a pairing of `seam run`'s scene with its resolved enforcement over
+    /// `fields`; it is searched already (and not searched again: the run's mesh does
+    /// not move). Returns its index.
+    pub(crate) fn add_resolved(
+        &mut self,
+        pairing: Pairing,
+        choice: &ModelChoice,
+        penalty_scale: f64,
+        model: Option<Arc<dyn ConductanceModel>>,
+        fields: FieldPair,
+    ) -> usize {
+        self.pairs.push(super::from_deck::resolved_pair(
+            pairing,
+            choice,
+            penalty_scale,
+            model,
+            None,
+            fields,
+        ));
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
+        }
+        self.pairs.len() - 1
     }
 }

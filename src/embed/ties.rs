@@ -18,13 +18,15 @@ pub struct TieConstraints {
     /// Side-A nodes left without a multiplier because they were fixed or belong to an
     /// earlier tie (crosspoints), as host node indices.
     pub crosspoints: Vec<usize>,
+    /// Standard or dual multipliers.
+    pub multipliers: Multipliers,
     /// Dual multipliers only: each multiplier's side-A dof in condensed form (a host
     /// without multipliers substitutes these rows; the system stays SPD).
     pub condensed: Vec<Condensed>,
     /// `C_kk` of each multiplier's own dof (dual: the diagonal `D`).
     diagonal: Vec<f64>,
-    side_a_dofs: Vec<usize>,
-    side_b_dofs: Vec<usize>,
+    pub(crate) side_a_dofs: Vec<usize>,
+    pub(crate) side_b_dofs: Vec<usize>,
     /// `(point, multiplier, ψ)`: the multiplier basis at the pairing's points.
     point_psi: Vec<(u32, u32, f64)>,
 }
@@ -52,7 +54,7 @@ impl TieConstraints {
 
     /// The multiplier field `λ_h = Σ ψ_k λ_k` at each of the pairing's `count` points
     /// (`None` where the tie has no multiplier): the heat flux from side A to side B.
-    pub(super) fn multiplier_field(
+    pub(crate) fn multiplier_field(
         &self,
         lambda: &[f64],
         count: usize,
@@ -166,6 +168,7 @@ impl Embedding {
                     .collect(),
                 rhs: tie.psi_integral.iter().map(|psi| offset * psi).collect(),
                 crosspoints: tie.crosspoints.iter().map(|n| n.index()).collect(),
+                multipliers: *multipliers,
                 condensed: Vec::new(),
                 diagonal,
                 side_a_dofs: tie.side_a_dofs.iter().map(|&d| host(d)).collect(),

@@ -856,36 +856,15 @@ impl InterfacePoints {
 
 impl InterfaceSystem {
     /// Add the blocks of a system evaluated from the [`InterfacePoints`] that made
-    /// `scatter`.
-    pub fn add_scattered(&self, asm: &mut Assembler<'_>, scatter: &Scatter) {
+    /// `scatter`, its couplings numbered from `first` in the assembler.
+    pub fn add_scattered(&self, asm: &mut Assembler<'_>, scatter: &Scatter, first: usize) {
         let values = self.blocks.iter().flat_map(|(_, m)| m);
         debug_assert_eq!(values.clone().count(), scatter.slots.len());
         for (&slot, &v) in scatter.slots.iter().zip(values) {
             match slot {
                 Slot::Diagonal(i) => asm.add_diagonal(i, v),
-                Slot::Upper(k) => asm.add_coupling(k, v, 0.0),
-                Slot::Lower(k) => asm.add_coupling(k, 0.0, v),
-            }
-        }
-    }
-
-    /// Move a linear form's residual from u to u + du (exact when h does not depend
-    /// on u: the blocks are then the form's matrix).
-    pub fn advance(&mut self, du: &[f64]) {
-        let mut change: Vec<(u32, f64)> = Vec::new();
-        for (dofs, m) in &self.blocks {
-            let n = dofs.len();
-            for a in 0..n {
-                let v: f64 = (0..n).map(|c| m[a * n + c] * du[dofs[c] as usize]).sum();
-                change.push((dofs[a], v));
-            }
-        }
-        change.sort_by_key(|c| c.0);
-        let mut k = 0;
-        for (d, r) in self.residual.iter_mut() {
-            while k < change.len() && change[k].0 == *d {
-                *r += change[k].1;
-                k += 1;
+                Slot::Upper(k) => asm.add_coupling(first + k, v, 0.0),
+                Slot::Lower(k) => asm.add_coupling(first + k, 0.0, v),
             }
         }
     }

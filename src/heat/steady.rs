@@ -12,39 +12,17 @@
 use std::time::Instant;
 
 use crate::assembly::{Assembler, DofMap, Pattern};
-use crate::enforce::interface::{InterfaceForm, InterfacePoints, InterfaceSystem};
-use crate::enforce::mortar::{MortarTie, Multipliers, mortar_tie};
 use crate::mesh::{Mesh, NodeId};
-use crate::search::pairing::{ContactPoint, SurfaceGeometry};
 use crate::solve::{
     AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
 };
 use std::collections::HashSet;
 
+pub use super::interfaces::{ContactTerm, TieTerm};
+use super::interfaces::{InterfaceFailure, Interfaces, Terms, TieRows};
 use super::{
     FaceBc, HeatError, Material, SourceFn, TEMPERATURE, assemble_conduction, dirichlet_dofs,
 };
-
-/// One enforced interface: a pairing and its form.
-pub struct ContactTerm<'a> {
-    pub side_a: &'a SurfaceGeometry,
-    pub side_b: &'a SurfaceGeometry,
-    pub points: &'a [ContactPoint],
-    pub form: InterfaceForm<'a>,
-    /// The conductance does not depend on the field (the system stays linear and
-    /// symmetric).
-    pub linear: bool,
-}
-
-/// One Lagrange-multiplier mortar tie (`Tied` with `Side B Variable`).
-pub struct TieTerm<'a> {
-    pub side_a: &'a SurfaceGeometry,
-    pub side_b: &'a SurfaceGeometry,
-    pub points: &'a [ContactPoint],
-    /// Prescribed jump `a − b` (`Offset Temperature`).
-    pub offset: f64,
-    pub multipliers: Multipliers,
-}
 
 /// Relative residual at which AMG-preconditioned CG stops, ‖b − Ax‖ ≤ 1e-11 ‖b‖: three
 /// orders below the default Newton tolerance (1e-10), so one CG solve finishes a linear
@@ -115,6 +93,10 @@ pub struct SteadyProblem<'a> {
     pub contact: Vec<ContactTerm<'a>>,
     /// Mortar ties with multipliers (solved as a saddle-point system).
     pub ties: Vec<TieTerm<'a>>,
+    /// The interfaces from elsewhere (`seam run`'s come through `seam::embed`), over
+    /// this solve's dof numbering: the temperature over every solid block, then the
+    /// multipliers. Instead of `contact` and `ties`, which must then be empty.
+    pub interfaces: Option<&'a dyn Interfaces>,
     /// Solve the linear systems by CG with the algebraic-multigrid preconditioner
     /// instead of a factorisation (symmetric problems without multipliers; for sizes a
     /// factorisation does not fit).
@@ -167,39 +149,36 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         .ok_or(HeatError::NoTemperatureField)?;
     let n_primal = dofs.len();
     let bcs = dirichlet_dofs(mesh, &dofs, field, p.dirichlet)?;
-    // Mortar ties: multipliers on side-A nodes not constrained already.
     let conductivity: Vec<f64> = p.materials.iter().map(|m| m.conductivity).collect();
-    let mut constrained: HashSet<NodeId> = p.dirichlet.iter().map(|&(node, _)| node).collect();
-    let mut ties = Vec::with_capacity(p.ties.len());
-    for t in &p.ties {
-        let tie = mortar_tie(
-            mesh,
-            &dofs,
-            field,
-            t.side_a,
-            t.side_b,
-            t.points,
-            &conductivity,
-            &mut constrained,
-            t.multipliers,
-        )
-        .map_err(|e| HeatError::Contact(e.to_string()))?;
-        ties.push(tie);
-    }
-    let dual = p.ties.iter().any(|t| t.multipliers == Multipliers::Dual);
-    if dual {
-        if p.ties.iter().any(|t| t.multipliers != Multipliers::Dual)
-            || p.contact.iter().any(|c| !c.linear)
-        {
+    let fixed: HashSet<NodeId> = p.dirichlet.iter().map(|&(node, _)| node).collect();
+    let own;
+    let iface: &dyn Interfaces = match p.interfaces {
+        Some(_) if !p.contact.is_empty() || !p.ties.is_empty() => {
+            return Err(HeatError::Contact(
+                "give the interfaces either as terms or from elsewhere, not both".into(),
+            ));
+        }
+        Some(i) => i,
+        None => {
+            let terms = (p.contact.as_slice(), p.ties.as_slice());
+            own = Terms::new(mesh, &dofs, field.into(), terms, fixed, &conductivity)
+                .map_err(HeatError::Contact)?;
+            &own
+        }
+    };
+    // Mortar ties: multipliers on side-A nodes not constrained already.
+    let ties = iface.ties().map_err(HeatError::Contact)?;
+    if ties.iter().any(|t| t.dual) {
+        if ties.iter().any(|t| !t.dual) || !iface.is_linear() {
             return Err(HeatError::Contact(
                 "dual mortar ties are condensed in a linear solve: do not mix them with standard ties or temperature-dependent conductances".into(),
             ));
         }
-        return solve_dual(p, dofs, field, bcs, ties);
+        return solve_dual(p, iface, dofs, field, bcs, ties);
     }
     let mut lambda_first = Vec::with_capacity(ties.len());
     for tie in &ties {
-        lambda_first.push(dofs.add_extra(tie.nodes.len()).start);
+        lambda_first.push(dofs.add_extra(tie.own.len()).start);
     }
     let n = dofs.len();
     let mut u = vec![0.0; n];
@@ -207,31 +186,21 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         u[d] = g;
     }
     let mut timing = SolveTiming::default();
+    let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
 
     // The pattern: elements plus every interface coupling (fixed by the pairing).
     let t = Instant::now();
     let mut pattern = Pattern::new(mesh, &dofs);
-    // The interface geometry at the points, once; Newton iterations only apply h.
-    let points = interface_points(p, &dofs, field)?;
-    let mut scatters = Vec::with_capacity(p.contact.len());
-    let mut terms: Vec<InterfaceSystem> = Vec::with_capacity(p.contact.len());
-    for (c, points) in p.contact.iter().zip(&points) {
-        let cp = points.couplings();
-        let first = pattern.add_couplings(&cp)?.start;
-        scatters.push(points.scatter(&cp, first));
-        terms.push(
-            points
-                .evaluate(&c.form, &u)
-                .map_err(|e| HeatError::Contact(e.to_string()))?,
-        );
-    }
+    let first = pattern
+        .add_couplings(&iface.couplings(&u, 0.0).map_err(failed)?)?
+        .start;
     // Tie couplings (primal dof, multiplier dof), one per entry of C.
     let mut tie_coupling_first = Vec::with_capacity(ties.len());
     for (t, tie) in ties.iter().enumerate() {
         let pairs: Vec<(usize, usize)> = tie
             .entries
             .iter()
-            .map(|&(k, d, _)| (d as usize, lambda_first[t] + k as usize))
+            .map(|&(k, d, _)| (d, lambda_first[t] + k))
             .collect();
         tie_coupling_first.push(pattern.add_couplings(&pairs)?.start);
     }
@@ -244,7 +213,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let f_vol = asm.rhs();
     timing.assembly_s += t.elapsed().as_secs_f64();
 
-    let symmetric = p.contact.iter().all(|c| c.linear);
+    let symmetric = iface.is_linear();
     let mut chol = Cholesky::new(Ordering::Metis);
     let mut amg = AmgCg::new(AmgOptions {
         tolerance: AMG_TOLERANCE,
@@ -258,36 +227,29 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let mut iterations = 0;
     let mut target = None;
     let mut last_step = f64::INFINITY;
+    let mut heat = Vec::new();
     for it in 0..=p.max_iterations {
         let t = Instant::now();
-        if it > 0 {
-            for (k, c) in p.contact.iter().enumerate() {
-                terms[k] = points[k]
-                    .evaluate(&c.form, &u)
-                    .map_err(|e| HeatError::Contact(e.to_string()))?;
-            }
-        }
-        // R = K u − F + Σ R_Γ.
+        // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
         let mut r = vec![0.0; n];
         spmv(&k_vol, &u, &mut r);
         for (ri, fi) in r.iter_mut().zip(&f_vol) {
             *ri -= fi;
         }
-        for s in &terms {
-            for &(d, v) in &s.residual {
-                r[d as usize] += v;
-            }
-        }
+        asm.reset_couplings();
+        heat = iface
+            .assemble(&u, 0.0, &mut r, &mut asm, first)
+            .map_err(failed)?;
         // Ties: Cᵀλ on the primal rows, C u − ΔT ∫ψ on the multiplier rows.
         for (t, tie) in ties.iter().enumerate() {
             let l0 = lambda_first[t];
             for &(k, d, c) in &tie.entries {
-                let l = l0 + k as usize;
-                r[d as usize] += c * u[l];
-                r[l] += c * u[d as usize];
+                let l = l0 + k;
+                r[d] += c * u[l];
+                r[l] += c * u[d];
             }
-            for (k, w) in tie.psi_integral.iter().enumerate() {
-                r[l0 + k] -= p.ties[t].offset * w;
+            for (k, g) in tie.rhs.iter().enumerate() {
+                r[l0 + k] -= g;
             }
         }
         for &(d, _) in &bcs {
@@ -328,10 +290,6 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         }
         iterations += 1;
         let t = Instant::now();
-        asm.reset_couplings();
-        for (s, scatter) in terms.iter().zip(&scatters) {
-            s.add_scattered(&mut asm, scatter);
-        }
         for (t, tie) in ties.iter().enumerate() {
             for (e, &(_, _, c)) in tie.entries.iter().enumerate() {
                 asm.add_coupling(tie_coupling_first[t] + e, c, c);
@@ -380,11 +338,11 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             *ui += d;
         }
     }
-    let heat = terms.iter().map(InterfaceSystem::heat).collect();
+    // `heat` is of the final state: the loop ends right after assembling at it.
     let tie_heat = ties
         .iter()
         .enumerate()
-        .map(|(t, tie)| tie.heat(&u[lambda_first[t]..lambda_first[t] + tie.nodes.len()]))
+        .map(|(t, tie)| tie.heat(&u[lambda_first[t]..lambda_first[t] + tie.own.len()]))
         .collect();
     let crosspoints = ties.iter().map(|t| t.crosspoints.clone()).collect();
     let temperature = dofs.nodal_values(field, &u);
@@ -409,60 +367,51 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
 /// Cholesky; the multipliers are recovered from the condensed rows.
 fn solve_dual(
     p: &SteadyProblem<'_>,
+    iface: &dyn Interfaces,
     dofs: DofMap,
     field: crate::assembly::FieldId,
     bcs: Vec<(usize, f64)>,
-    ties: Vec<MortarTie>,
+    ties: Vec<TieRows>,
 ) -> Result<SteadySolution, HeatError> {
     use faer::sparse::{SparseColMat, Triplet};
     let mesh = p.mesh;
     let n = dofs.len();
     let mut timing = SolveTiming::default();
     let t = Instant::now();
-    // K and F with the flux-type contact terms (linear: evaluated at u = 0).
+    let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
+    // K and F with the flux-type contact terms (linear: evaluated at u = 0, where the
+    // residual is −F_Γ).
     let zero = vec![0.0; n];
     let mut pattern = Pattern::new(mesh, &dofs);
-    let points = interface_points(p, &dofs, field)?;
-    let mut terms = Vec::new();
-    let mut scatters = Vec::new();
-    for (c, points) in p.contact.iter().zip(&points) {
-        let cp = points.couplings();
-        let first = pattern.add_couplings(&cp)?.start;
-        scatters.push(points.scatter(&cp, first));
-        terms.push(
-            points
-                .evaluate(&c.form, &zero)
-                .map_err(|e| HeatError::Contact(e.to_string()))?,
-        );
-    }
+    let first = pattern
+        .add_couplings(&iface.couplings(&zero, 0.0).map_err(failed)?)?
+        .start;
     pattern.build()?;
     let mut asm = Assembler::new(&pattern);
     assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
-    for (s, scatter) in terms.iter().zip(&scatters) {
-        s.add_scattered(&mut asm, scatter);
-    }
+    let mut r_contact = vec![0.0; n];
+    iface
+        .assemble(&zero, 0.0, &mut r_contact, &mut asm, first)
+        .map_err(failed)?;
     let k = asm.matrix()?;
     let mut f = asm.rhs();
-    for s in &terms {
-        for &(d, v) in &s.rhs {
-            f[d as usize] += v;
-        }
+    for (fi, ri) in f.iter_mut().zip(&r_contact) {
+        *fi -= ri;
     }
     drop(asm);
     // The condensation map: condensed dof → (constant, [(dof, coefficient)]).
     type Condensed = Option<(f64, Vec<(usize, f64)>)>;
     let mut map: Vec<Condensed> = vec![None; n];
     let mut diag = vec![0.0; n];
-    for (t, tie) in ties.iter().enumerate() {
-        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); tie.nodes.len()];
+    for tie in &ties {
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); tie.own.len()];
         for &(kk, d, c) in &tie.entries {
-            rows[kk as usize].push((d as usize, c));
+            rows[kk].push((d, c));
         }
-        for (kk, node) in tie.nodes.iter().enumerate() {
-            let own = dofs
-                .dof(field, *node)
-                .ok_or(HeatError::NoTemperatureField)?
-                .index();
+        for (kk, &own) in tie.own.iter().enumerate() {
+            if own == usize::MAX {
+                return Err(HeatError::NoTemperatureField);
+            }
             let d = rows[kk]
                 .iter()
                 .filter(|(j, _)| *j == own)
@@ -477,7 +426,7 @@ fn solve_dual(
                 .filter(|(j, _)| *j != own)
                 .map(|&(j, c)| (j, -c / d))
                 .collect();
-            map[own] = Some((p.ties[t].offset * tie.psi_integral[kk] / d, others));
+            map[own] = Some((tie.rhs[kk] / d, others));
         }
     }
     // Side-A rows of a dual basis reference no other condensed dof (biorthogonality);
@@ -564,10 +513,9 @@ fn solve_dual(
     let lambdas: Vec<Vec<f64>> = ties
         .iter()
         .map(|tie| {
-            tie.nodes
+            tie.own
                 .iter()
-                .map(|node| {
-                    let d = dofs.dof(field, *node).map_or(0, |d| d.index());
+                .map(|&d| {
                     if diag[d] == 0.0 {
                         0.0
                     } else {
@@ -582,16 +530,7 @@ fn solve_dual(
         .zip(&lambdas)
         .map(|(tie, lambda)| tie.heat(lambda))
         .collect();
-    let heat = points
-        .iter()
-        .zip(&p.contact)
-        .map(|(points, c)| {
-            let s = points
-                .evaluate(&c.form, &u)
-                .map_err(|e| HeatError::Contact(e.to_string()))?;
-            Ok(s.heat())
-        })
-        .collect::<Result<Vec<_>, HeatError>>()?;
+    let heat = iface.heat(&u, 0.0).map_err(failed)?;
     let temperature = dofs.nodal_values(field, &u);
     // The multipliers after the primal dofs, as the saddle-point path stores them.
     let mut dofs = dofs;
@@ -615,19 +554,4 @@ fn solve_dual(
             cg_iterations: Vec::new(),
         },
     })
-}
-
-/// The geometry at every contact term's points (see [`InterfacePoints`]).
-fn interface_points(
-    p: &SteadyProblem<'_>,
-    dofs: &DofMap,
-    field: crate::assembly::FieldId,
-) -> Result<Vec<InterfacePoints>, HeatError> {
-    p.contact
-        .iter()
-        .map(|c| {
-            InterfacePoints::new(p.mesh, dofs, field, c.side_a, c.side_b, c.points, &c.form)
-                .map_err(|e| HeatError::Contact(e.to_string()))
-        })
-        .collect()
 }

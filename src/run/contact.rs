@@ -5,6 +5,7 @@
 
 use std::collections::HashSet;
 use std::path::Path;
+use std::sync::Arc;
 
 use crate::deck::{self, LoadedDeck};
 use crate::diag::{Diagnostic, Diagnostics, did_you_mean};
@@ -23,7 +24,7 @@ use super::problem::{ContactSpec, Problem, ProblemFile, Value};
 use super::{RunError, RunOptions, input_error};
 
 /// An interaction's model, penalty scale and conductance model.
-pub(super) type Choice = (ModelChoice, f64, Option<Box<dyn ConductanceModel>>);
+pub(super) type Choice = (ModelChoice, f64, Option<Arc<dyn ConductanceModel>>);
 
 /// The contact of a run: the deck, and per interaction (in the scene's order) its
 /// pairing, its enforcement and what its contact output holds.
@@ -156,7 +157,8 @@ impl RunContact {
             out.views.push(ContactView::of(
                 &loaded.deck.contact_definitions[e.definition],
             ));
-            out.choices.push((e.choice, e.penalty_scale, e.model));
+            out.choices
+                .push((e.choice, e.penalty_scale, e.model.map(Arc::from)));
             out.pairings.push(e.pairing);
         }
         out.loaded = loaded;

@@ -88,7 +88,7 @@ use output::Output;
 use physics::Physics;
 use problem::ProblemFile;
 use solve::TimeLoop;
-use terms::{ContactTerms, ModelState};
+use terms::ContactTerms;
 
 /// What went wrong: bad input (diagnostics) or a solve that failed.
 #[derive(Debug)]
@@ -213,8 +213,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         }));
     }
     // Time loop: the contact terms over the scene, solved, each accepted step written.
-    let models = ModelState::new(physics.time.start, contact.pairings.len());
-    let terms = ContactTerms::new(&physics, &contact, &couplings, &models);
+    let terms = ContactTerms::new(&physics, &contact, &couplings);
     let mut output = Output::open(&file, &physics, &terms)?;
     let solved = TimeLoop::new(&file, &physics, &terms, options).run(initial, &mut output)?;
     terms.report_quarantined(&mut diags);

@@ -104,9 +104,10 @@ impl<'a> TimeLoop<'a> {
         let solid: Vec<usize> = (0..mesh.blocks.len())
             .filter(|&b| mesh.blocks[b].topology.is_solid())
             .collect();
-        let unknowns = DofMap::new(mesh, &[(TEMPERATURE, &solid)])
-            .map_err(|e| RunError::Solve(e.to_string()))?
-            .len();
+        let dofs = DofMap::new(mesh, &[(TEMPERATURE, &solid)])
+            .map_err(|e| RunError::Solve(e.to_string()))?;
+        let unknowns = dofs.len();
+        let interfaces = self.terms.prepare(&dofs).map_err(RunError::Solve)?;
         let iterative = match requested {
             Some("amg") => true,
             Some("direct") => false,
@@ -121,8 +122,9 @@ impl<'a> TimeLoop<'a> {
             source: source_fn,
             dirichlet: &loads.dirichlet,
             face_bcs: &loads.faces,
-            contact: self.terms.contact_terms(),
-            ties: self.terms.tie_terms(),
+            contact: Vec::new(),
+            ties: Vec::new(),
+            interfaces: Some(interfaces),
             iterative,
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
@@ -136,7 +138,7 @@ impl<'a> TimeLoop<'a> {
             requested,
             threshold,
             unknowns,
-            !steady.ties.is_empty(),
+            !solved.tie_heat.is_empty(),
             &solved.linear,
         );
         if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
@@ -161,34 +163,35 @@ impl<'a> TimeLoop<'a> {
         let (physics, mesh, terms) = (self.physics, self.physics.mesh, self.terms);
         let (problem, requested) = (&self.file.problem, self.requested);
         let time = &physics.time;
-        let loads = |t: f64| -> Result<Loads, HeatError> {
-            terms.set_time(t);
-            physics.loads_at(t).map_err(HeatError::Step)
-        };
-        let active = |k: usize, t: f64| -> bool { terms.term_on(k, t) };
+        let loads =
+            |t: f64| -> Result<Loads, HeatError> { physics.loads_at(t).map_err(HeatError::Step) };
+        let fields: Vec<FieldSpec> = physics
+            .field_names
+            .iter()
+            .map(|f| FieldSpec {
+                name: f.clone(),
+                blocks: (0..mesh.blocks.len())
+                    .filter(|&b| {
+                        mesh.blocks[b].topology.is_solid() && physics.materials.fields[b] == *f
+                    })
+                    .collect(),
+            })
+            .collect();
+        // The solver's dofs, as it numbers them: the fields in order.
+        let list: Vec<(&str, &[usize])> = fields
+            .iter()
+            .map(|f| (f.name.as_str(), f.blocks.as_slice()))
+            .collect();
+        let dofs = DofMap::new(mesh, &list).map_err(|e| RunError::Solve(e.to_string()))?;
+        let interfaces = terms.prepare(&dofs).map_err(RunError::Solve)?;
         let tp = TransientProblem {
             mesh,
-            fields: physics
-                .field_names
-                .iter()
-                .map(|f| FieldSpec {
-                    name: f.clone(),
-                    blocks: (0..mesh.blocks.len())
-                        .filter(|&b| {
-                            mesh.blocks[b].topology.is_solid() && physics.materials.fields[b] == *f
-                        })
-                        .collect(),
-                })
-                .collect(),
+            fields,
             laws: &physics.materials.laws,
             source: None,
             block_source: Some(&physics.block_source),
             loads: &loads,
-            contact: terms.contact_terms(),
-            ties: terms.tie_terms(),
-            term_fields: terms.term_fields(),
-            active: Some(&active),
-            cutback: Some(terms.cutback()),
+            interfaces: Some(interfaces),
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
             reproducible: problem.solve.reproducible.unwrap_or(true),
@@ -251,8 +254,12 @@ impl<'a> TimeLoop<'a> {
         } = recorder;
         output.finish_steps(&outcome, &history)?;
         let linear_solver = self.stepped_solver_summary(&history, outcome.dofs.len());
-        let solution =
-            steps::final_solution(outcome, &history, &physics.field_names, tp.contact.len());
+        let solution = steps::final_solution(
+            outcome,
+            &history,
+            &physics.field_names,
+            interfaces.flux_count(),
+        );
         Ok(Solved {
             solution,
             history,

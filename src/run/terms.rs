@@ -1,95 +1,76 @@
-//! The contact terms of a run's solve, over its scene: per interaction the conductance as
-//! the interface forms see it (the model at the point's gap, temperatures and pressure,
-//! with quarantine and cutbacks), the terms and ties the solvers assemble, and what a
-//! solved state derives from them — the flux at each contact point, the heat of each
-//! mechanism of a summed conductance, the contact faces of the output.
+//! The contact terms of a run's solve, over its scene: the run is a host of seam's own
+//! embedding API. Its interactions go into an [`Embedding`] over the run's mesh and
+//! dofs (with the point pressures of the problem file, switched by its toggles, with
+//! quarantine and cutbacks as their enforcements say), and the solvers take the terms
+//! from it through [`Interfaces`] — the Jacobian as the embedding's CSR, refreshed in
+//! place, scattered into the solver's coupling slots; the ties as its constraint rows.
+//! What a solved state derives from them — the flux at each contact point, the heat of
+//! each mechanism of a summed conductance, the contact faces of the output — comes
+//! from the same embedding.
 //!
 //! The solvers order the terms contact terms first, then multiplier ties
 //! ([`ContactTerms::term_choice`] maps that order to the interactions').
 
-use std::cell::{Cell, OnceCell, RefCell};
+use std::cell::{OnceCell, RefCell};
 
-use crate::assembly::DofMap;
+use crate::assembly::{Assembler, DofMap};
 use crate::diag::{Diagnostic, Diagnostics};
-use crate::enforce::conductance::PointState;
-use crate::enforce::interface::{
-    DEFAULT_BETA, HFn, HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints, PointFlux,
-};
-use crate::enforce::mortar::MortarTie;
-use crate::heat::steady::{ContactTerm, TieTerm};
-use crate::mesh::{Mesh, NodeId};
-use crate::search::scene::Pairing;
+use crate::embed::{EmbedError, Embedding, TieConstraints};
+use crate::enforce::interface::{FieldPair, PointFlux};
+use crate::heat::interfaces::{InterfaceFailure, Interfaces, TieRows};
+use crate::mesh::NodeId;
+use crate::search::pairing::Integration;
 
-use super::contact::{Choice, Couplings, RunContact};
+use super::contact::{Couplings, RunContact};
 use super::fields::{self, Derived};
 use super::physics::Physics;
 
-/// Per interaction, the points a conductance model failed at, with the reason.
-type Quarantined = RefCell<Vec<([f64; 3], String)>>;
-
-/// What the conductance models of a run share while it runs: the time they see (set by
-/// the solver through the loads), a smaller step one asked for, and per interaction the
-/// points quarantined.
-pub(super) struct ModelState {
-    clock: Cell<f64>,
-    cutback: Cell<bool>,
-    quarantined: Vec<Quarantined>,
+/// Where an entry of the embedding's CSR Jacobian goes among the solver's couplings
+/// (numbered from the interfaces' first).
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    Diagonal(usize),
+    /// `(i, j)` of coupling k.
+    Upper(usize),
+    /// `(j, i)` of coupling k.
+    Lower(usize),
 }
 
-impl ModelState {
-    /// At time `start`, for `interactions` interactions.
-    pub(super) fn new(start: f64, interactions: usize) -> Self {
-        ModelState {
-            clock: Cell::new(start),
-            cutback: Cell::new(false),
-            quarantined: (0..interactions).map(|_| Default::default()).collect(),
-        }
-    }
+/// The run's contact as an embedding over the solve's dofs.
+struct Embedded {
+    embedding: RefCell<Embedding>,
+    /// The CSR pattern the slots were made for, and the slot of each entry.
+    slots: RefCell<(u64, Vec<Slot>)>,
+    /// The ties' rows, made once.
+    ties: OnceCell<Result<Vec<TieConstraints>, String>>,
 }
 
 /// The contact of a run as its solvers see it, and what its states derive from it.
 pub(super) struct ContactTerms<'a> {
-    mesh: &'a Mesh,
     physics: &'a Physics<'a>,
     pub contact: &'a RunContact,
     pub couplings: &'a Couplings,
-    models: &'a ModelState,
     /// One conductivity per block, for the Nitsche weights: the law at the probe
     /// temperature.
     conductivity: Vec<f64>,
-    /// Per interaction, its conductance model seen by the interface forms: the point's
-    /// gap and temperatures and the enforcement's contact pressure in, h and dh/dT out.
-    h_fns: Vec<Box<HFn<'a>>>,
     /// The solver's term order (contact terms, then ties) → interaction index.
     pub term_choice: Vec<usize>,
+    /// How many of them are flux-type terms.
+    flux_count: usize,
     /// Per interaction: the names of its conductance's mechanisms (empty unless a sum).
     pub mechanism_names: Vec<Vec<String>>,
-    /// The mortar ties as the solver built them, for their multipliers' fluxes (made at
-    /// the first state that asks).
-    tie_geometry: OnceCell<Result<Vec<MortarTie>, String>>,
-    /// Per interaction, the geometry at its points, for the point fluxes.
-    point_geometry: Vec<OnceCell<Result<InterfacePoints, String>>>,
+    /// Made when the solve starts, over its dofs ([`Self::prepare`]).
+    embedded: OnceCell<Embedded>,
 }
 
 impl<'a> ContactTerms<'a> {
-    /// The terms of `contact` with the `couplings` of the problem file, their
-    /// conductances sharing `models`.
+    /// The terms of `contact` with the `couplings` of the problem file.
     pub(super) fn new(
         physics: &'a Physics<'a>,
         contact: &'a RunContact,
         couplings: &'a Couplings,
-        models: &'a ModelState,
     ) -> Self {
         let choices = &contact.choices;
-        let h_fns = choices
-            .iter()
-            .zip(&models.quarantined)
-            .zip(&contact.pairings)
-            .zip(&couplings.pressures)
-            .map(|(((choice, log), pairing), at_points)| {
-                conductance(choice, log, pairing, at_points, models)
-            })
-            .collect();
         let term_choice: Vec<usize> = (0..choices.len())
             .filter(|&k| !choices[k].0.mortar)
             .chain((0..choices.len()).filter(|&k| choices[k].0.mortar))
@@ -102,92 +83,108 @@ impl<'a> ContactTerms<'a> {
             })
             .collect();
         ContactTerms {
-            mesh: physics.mesh,
             physics,
             contact,
             couplings,
-            models,
             conductivity: physics.conductivity(),
-            h_fns,
+            flux_count: choices.iter().filter(|c| !c.0.mortar).count(),
             term_choice,
             mechanism_names,
-            tie_geometry: Default::default(),
-            point_geometry: contact
-                .pairings
-                .iter()
-                .map(|_| Default::default())
-                .collect(),
+            embedded: OnceCell::new(),
         }
     }
 
-    /// The flux-type terms (every interaction but the multiplier ties).
-    pub(super) fn contact_terms(&self) -> Vec<ContactTerm<'_>> {
-        let conductivity = &self.conductivity;
-        self.contact
-            .pairings
+    /// Hand the run's interactions to an embedding over the solve's `dofs` (the fields,
+    /// before any multiplier), with the Dirichlet nodes at the start fixed; once.
+    pub(super) fn prepare(&self, dofs: &DofMap) -> Result<&dyn Interfaces, String> {
+        if self.embedded.get().is_none() {
+            let made = self.embed(dofs)?;
+            let _ = self.embedded.set(made);
+        }
+        Ok(self)
+    }
+
+    fn embed(&self, dofs: &DofMap) -> Result<Embedded, String> {
+        let physics = self.physics;
+        let fixed: Vec<NodeId> = physics
+            .loads_at(physics.time.start)?
+            .dirichlet
             .iter()
-            .zip(&self.contact.choices)
-            .zip(&self.h_fns)
-            .filter(|((_, (c, _, _)), _)| !c.mortar)
-            .map(|((p, (c, scale, model)), h)| ContactTerm {
-                side_a: &p.side_a_geometry,
-                side_b: &p.side_b_geometry,
-                points: &p.result.points,
-                form: InterfaceForm {
-                    form: c.form,
-                    h: h.as_ref(),
-                    offset: c.offset,
-                    beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
-                    conductivity,
-                },
-                // A conductance independent of T keeps the system linear and symmetric.
-                linear: model.as_ref().is_none_or(|m| !m.depends_on_temperature()),
+            .map(|&(n, _)| n)
+            .collect();
+        let mut embedding = Embedding::over_dofs(
+            physics.mesh.clone(),
+            dofs.clone(),
+            self.conductivity.clone(),
+            fixed,
+            Integration::Segments { order: 5 },
+        );
+        let field = |i: usize| {
+            let name = &physics.field_names[i];
+            dofs.field(name)
+                .ok_or_else(|| format!("no dofs of field `{name}`"))
+        };
+        let (pairings, choices) = (&self.contact.pairings, &self.contact.choices);
+        for (k, (p, (c, scale, model))) in pairings.iter().zip(choices).enumerate() {
+            let (fa, fb) = self.couplings.fields[k];
+            let fields = FieldPair {
+                a: field(fa)?,
+                b: field(fb)?,
+            };
+            embedding.add_resolved(p.clone(), c, *scale, model.clone(), fields);
+            if let Some(v) = &self.couplings.pressures[k] {
+                embedding
+                    .set_point_pressures(k, Some(v.clone()))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        Ok(Embedded {
+            embedding: RefCell::new(embedding),
+            slots: RefCell::new((0, Vec::new())),
+            ties: OnceCell::new(),
+        })
+    }
+
+    fn embedded(&self) -> Result<&Embedded, InterfaceFailure> {
+        self.embedded.get().ok_or_else(|| {
+            InterfaceFailure::Failed(
+                "the contact terms were asked for before the solve's dofs".into(),
+            )
+        })
+    }
+
+    /// The embedding at time `t`, each interaction switched as its toggle says.
+    fn at_time(&self, e: &Embedded, t: f64) -> Result<(), InterfaceFailure> {
+        let mut embedding = e.embedding.borrow_mut();
+        embedding.set_time(t).map_err(failure)?;
+        for k in 0..self.contact.choices.len() {
+            embedding
+                .set_active(k, self.couplings.on(k, t))
+                .map_err(failure)?;
+        }
+        Ok(())
+    }
+
+    /// The flux terms' heat (in the solver's order) from the embedding's per-interaction
+    /// heat.
+    fn flux_heat(&self, heat: &[Option<crate::embed::Heat>]) -> Vec<(f64, f64)> {
+        self.term_choice[..self.flux_count]
+            .iter()
+            .map(|&k| heat[k].map_or((0.0, 0.0), |h| (h.side_a, h.side_b)))
+            .collect()
+    }
+
+    /// The ties' rows as the embedding makes them (once).
+    fn ties_of(e: &Embedded) -> Result<&[TieConstraints], String> {
+        e.ties
+            .get_or_init(|| {
+                e.embedding
+                    .borrow()
+                    .tie_rows(false)
+                    .map_err(|e| e.to_string())
             })
-            .collect()
-    }
-
-    /// The multiplier (mortar) ties.
-    pub(super) fn tie_terms(&self) -> Vec<TieTerm<'_>> {
-        self.contact
-            .pairings
-            .iter()
-            .zip(&self.contact.choices)
-            .filter(|(_, (c, _, _))| c.mortar)
-            .map(|(p, (c, _, _))| TieTerm {
-                side_a: &p.side_a_geometry,
-                side_b: &p.side_b_geometry,
-                points: &p.result.points,
-                offset: c.offset,
-                multipliers: if c.dual {
-                    crate::enforce::mortar::Multipliers::Dual
-                } else {
-                    crate::enforce::mortar::Multipliers::Standard
-                },
-            })
-            .collect()
-    }
-
-    /// The time the conductance models see.
-    pub(super) fn set_time(&self, t: f64) {
-        self.models.clock.set(t);
-    }
-
-    /// Set by a conductance model that asks for a smaller step.
-    pub(super) fn cutback(&self) -> &Cell<bool> {
-        &self.models.cutback
-    }
-
-    /// Whether solver term `k` (contact terms, then ties) is on at time `t`.
-    pub(super) fn term_on(&self, k: usize, t: f64) -> bool {
-        self.couplings.on(self.term_choice[k], t)
-    }
-
-    /// Per solver term, its (side-A field, side-B field).
-    pub(super) fn term_fields(&self) -> Vec<(usize, usize)> {
-        self.term_choice
-            .iter()
-            .map(|&k| self.couplings.fields[k])
-            .collect()
+            .as_deref()
+            .map_err(Clone::clone)
     }
 
     /// What a state gives beyond its temperature: per interaction the flux at its points
@@ -205,19 +202,19 @@ impl<'a> ContactTerms<'a> {
             &self.contact.choices,
             &self.contact.views,
         );
-        let (field_names, conductivity) = (&self.physics.field_names, &self.conductivity);
-        let mechanism_names = &self.mechanism_names;
         let pressures = &self.couplings.pressures;
-        self.set_time(time);
         let mut out = Derived::default();
-        for (k, ((p, (c, scale, model)), h)) in
-            pairings.iter().zip(choices).zip(&self.h_fns).enumerate()
-        {
-            let split = !mechanism_names[k].is_empty();
+        let e = self.embedded().map_err(|e| e.to_string())?;
+        self.at_time(e, time).map_err(|e| e.to_string())?;
+        let named = |p: &crate::search::scene::Pairing, e: EmbedError| {
+            format!("interaction {} / {}: {e}", p.side_a, p.side_b)
+        };
+        for (k, (p, (c, _, model))) in pairings.iter().zip(choices).enumerate() {
+            let split = !self.mechanism_names[k].is_empty();
+            let on = self.couplings.on(k, time);
             if c.mortar && faces && views[k].faces {
                 // A multiplier tie: the flux is its multiplier field λ_h at the points.
-                let ties = self.tie_geometry.get_or_init(|| self.rebuild_ties(dofs));
-                let ties = ties.as_ref().map_err(Clone::clone)?;
+                let ties = Self::ties_of(e)?;
                 let t = choices[..k].iter().filter(|(c, _, _)| c.mortar).count();
                 let (Some(tie), Some(range)) = (ties.get(t), dofs.extra_ranges().get(t)) else {
                     return Err(format!(
@@ -225,9 +222,9 @@ impl<'a> ContactTerms<'a> {
                         p.side_a, p.side_b
                     ));
                 };
-                let on = self.couplings.on(k, time);
                 let q = tie
-                    .point_flux(&u[range.clone()], p.result.points.len())
+                    .multiplier_field(&u[range.clone()], p.result.points.len())
+                    .map_err(|e| named(p, e))?
                     .into_iter()
                     .map(|q| {
                         q.map(|q| PointFlux {
@@ -246,46 +243,9 @@ impl<'a> ContactTerms<'a> {
                 out.mechanisms.push(Vec::new());
                 continue;
             }
-            let field = |i: usize| {
-                dofs.field(&field_names[i])
-                    .ok_or_else(|| format!("no dofs of field `{}`", field_names[i]))
-            };
-            let (fa, fb) = self.couplings.fields[k];
-            let pair = crate::enforce::interface::FieldPair {
-                a: field(fa)?,
-                b: field(fb)?,
-            };
-            let form = InterfaceForm {
-                form: c.form,
-                h: h.as_ref(),
-                offset: c.offset,
-                beta: c.penalty_factor.unwrap_or(DEFAULT_BETA) * scale,
-                conductivity,
-            };
-            let named = |e: InterfaceError| format!("interaction {} / {}: {e}", p.side_a, p.side_b);
-            // The points' geometry is made at the first state that asks and kept: the
-            // pairing and the dofs do not change over a run.
-            let points = self.point_geometry[k].get_or_init(|| {
-                InterfacePoints::new(
-                    self.mesh,
-                    dofs,
-                    pair,
-                    &p.side_a_geometry,
-                    &p.side_b_geometry,
-                    &p.result.points,
-                    &form,
-                )
-                .map_err(named)
-            });
-            let points = points.as_ref().map_err(Clone::clone)?;
-            let q = points
-                .point_flux(&form, u, p.result.points.len())
-                .map_err(named);
-            // The output evaluates the models once more; a cutback asked for here is not
-            // the next step's.
-            self.models.cutback.set(false);
-            let mut q = q?;
-            let on = self.couplings.on(k, time);
+            // The points keep their places while the interaction is off; their flux is 0.
+            let q = e.embedding.borrow().point_flux(k, u);
+            let mut q = q.map_err(|e| named(p, e))?;
             if !on {
                 q.iter_mut().flatten().for_each(|f| f.q = 0.0);
             }
@@ -368,21 +328,21 @@ impl<'a> ContactTerms<'a> {
 
     /// A warning per interaction whose model failed at some points (quarantined).
     pub(super) fn report_quarantined(&self, diags: &mut Diagnostics) {
+        let Some(e) = self.embedded.get() else {
+            return;
+        };
+        let embedding = e.embedding.borrow();
         let contact = self.contact;
-        for ((p, (c, _, _)), log) in contact
-            .pairings
-            .iter()
-            .zip(&contact.choices)
-            .zip(&self.models.quarantined)
-        {
-            let log = log.borrow();
-            if let Some((x, first)) = log.first() {
+        for (k, (p, (c, _, _))) in contact.pairings.iter().zip(&contact.choices).enumerate() {
+            let kept = embedding.quarantined(k);
+            if let Some(first) = kept.first() {
+                let x = first.x;
                 diags.push(
                     Diagnostic::warning(
                         "W0501",
                         format!(
-                            "interaction {} / {} ({}): {} point(s) quarantined; the first at ({:.6}, {:.6}, {:.6}): {first}",
-                            p.side_a, p.side_b, c.name, log.len(), x[0], x[1], x[2]
+                            "interaction {} / {} ({}): {} point(s) quarantined; the first at ({:.6}, {:.6}, {:.6}): {}",
+                            p.side_a, p.side_b, c.name, kept.len(), x[0], x[1], x[2], first.message
                         ),
                     )
                     .help("the conductance model failed there; those points carry no heat"),
@@ -390,114 +350,120 @@ impl<'a> ContactTerms<'a> {
             }
         }
     }
+}
 
-    /// The mortar ties of the run, built as the solvers build them: in interaction order,
-    /// with the Dirichlet nodes and the earlier ties' nodes left without multipliers, so
-    /// multiplier `k` of tie `t` is entry `k` of the state's `t`-th extra range.
-    fn rebuild_ties(&self, dofs: &DofMap) -> Result<Vec<MortarTie>, String> {
-        let field_names = &self.physics.field_names;
-        let mut constrained: std::collections::HashSet<NodeId> =
-            self.physics.dirichlet.iter().map(|&(n, _)| n).collect();
-        let field = |i: usize| {
-            dofs.field(&field_names[i])
-                .ok_or_else(|| format!("no dofs of field `{}`", field_names[i]))
-        };
-        let mut out = Vec::new();
-        for (k, (p, (c, _, _))) in self
-            .contact
-            .pairings
-            .iter()
-            .zip(&self.contact.choices)
-            .enumerate()
-        {
-            if !c.mortar {
-                continue;
-            }
-            let (fa, fb) = self.couplings.fields[k];
-            let pair = crate::enforce::interface::FieldPair {
-                a: field(fa)?,
-                b: field(fb)?,
-            };
-            let multipliers = if c.dual {
-                crate::enforce::mortar::Multipliers::Dual
-            } else {
-                crate::enforce::mortar::Multipliers::Standard
-            };
-            let tie = crate::enforce::mortar::mortar_tie(
-                self.mesh,
-                dofs,
-                pair,
-                &p.side_a_geometry,
-                &p.side_b_geometry,
-                &p.result.points,
-                &self.conductivity,
-                &mut constrained,
-                multipliers,
-            )
-            .map_err(|e| format!("interaction {} / {}: {e}", p.side_a, p.side_b))?;
-            out.push(tie);
-        }
-        Ok(out)
+/// A failure of the embedding as the solvers take it: a cutback request retries the
+/// step; a model that failed at a point names it, and how to go past such points.
+fn failure(e: EmbedError) -> InterfaceFailure {
+    match e {
+        EmbedError::Cutback { .. } => InterfaceFailure::Cutback(e.to_string()),
+        EmbedError::Enforcement { .. } | EmbedError::Plugin { .. } => InterfaceFailure::Failed(
+            format!("{e} (add `Quarantine Faulty Points` to the enforcement to skip such points)"),
+        ),
+        e => InterfaceFailure::Failed(e.to_string()),
     }
 }
 
-/// One interaction's conductance as the interface forms call it: its model at the
-/// point's state, with the contact pressure of the point (`at_points`) or of the
-/// enforcement. A failing point is quarantined (kept in `log`, contributing nothing) when
-/// the enforcement says so, asks for a smaller step when the model says so, and is an
-/// error otherwise.
-fn conductance<'a>(
-    (choice, _, model): &'a Choice,
-    log: &'a Quarantined,
-    pairing: &Pairing,
-    at_points: &'a Option<Vec<f64>>,
-    models: &'a ModelState,
-) -> Box<HFn<'a>> {
-    let pressure = choice.pressure;
-    let quarantine = choice.quarantine;
-    let label = format!(
-        "interaction {} / {} ({})",
-        pairing.side_a, pairing.side_b, choice.name
-    );
-    let (clock, cutback) = (&models.clock, &models.cutback);
-    let f = move |p: &HInput| -> Result<HValue, String> {
-        let Some(m) = model else {
-            return Ok(HValue::default());
-        };
-        let state = PointState {
-            gap: p.gap,
-            pressure: at_points.as_ref().map_or(pressure, |v| v[p.point]),
-            temp_a: p.temp_a,
-            temp_b: p.temp_b,
-            x: p.x,
-            time: clock.get(),
-        };
-        let c = match m.evaluate(&state) {
-            Ok(c) => c,
-            Err(e) if e.is_cutback() => {
-                cutback.set(true);
-                return Err(format!("{label}: {e}"));
-            }
-            // Quarantine: the point contributes nothing; it is reported after the
-            // run. Each Newton step evaluates it again, so keep it once.
-            Err(e) if quarantine => {
-                let mut log = log.borrow_mut();
-                if !log.iter().any(|(x, _)| *x == p.x) {
-                    log.push((p.x, e.to_string()));
+impl Interfaces for ContactTerms<'_> {
+    fn flux_count(&self) -> usize {
+        self.flux_count
+    }
+
+    fn is_linear(&self) -> bool {
+        // A conductance independent of T keeps the system linear and symmetric.
+        self.contact
+            .choices
+            .iter()
+            .all(|(c, _, m)| c.mortar || m.as_ref().is_none_or(|m| !m.depends_on_temperature()))
+    }
+
+    fn ties(&self) -> Result<Vec<TieRows>, String> {
+        let e = self.embedded().map_err(|e| e.to_string())?;
+        Ok(Self::ties_of(e)?
+            .iter()
+            .map(|t| TieRows {
+                own: t.multiplier_dofs.clone(),
+                entries: t.entries.clone(),
+                rhs: t.rhs.clone(),
+                crosspoints: t.crosspoints.iter().map(|&n| NodeId(n as u32)).collect(),
+                side_a_dofs: t.side_a_dofs.clone(),
+                side_b_dofs: t.side_b_dofs.clone(),
+                dual: t.multipliers == crate::embed::Multipliers::Dual,
+            })
+            .collect())
+    }
+
+    fn tie_on(&self, k: usize, t: f64) -> bool {
+        self.couplings.on(self.term_choice[self.flux_count + k], t)
+    }
+
+    fn couplings(&self, u: &[f64], t: f64) -> Result<Vec<(usize, usize)>, InterfaceFailure> {
+        let e = self.embedded()?;
+        self.at_time(e, t)?;
+        let mut embedding = e.embedding.borrow_mut();
+        let ev = embedding.evaluate(u).map_err(failure)?;
+        let (pattern, j) = (ev.pattern, &ev.jacobian);
+        let mut slots: Vec<Option<Slot>> = vec![None; j.columns.len()];
+        let mut pairs = Vec::new();
+        for i in 0..j.n {
+            for k in j.row_offsets[i]..j.row_offsets[i + 1] {
+                let col = j.columns[k];
+                if col == i {
+                    slots[k] = Some(Slot::Diagonal(i));
+                    continue;
                 }
-                return Ok(HValue::default());
+                if slots[k].is_some() {
+                    continue; // the transpose of an entry already paired
+                }
+                let c = pairs.len();
+                pairs.push((i, col));
+                slots[k] = Some(Slot::Upper(c));
+                let (a, b) = (j.row_offsets[col], j.row_offsets[col + 1]);
+                if let Ok(at) = j.columns[a..b].binary_search(&i) {
+                    slots[a + at] = Some(Slot::Lower(c));
+                }
             }
-            Err(e) => {
-                return Err(format!(
-                    "{label}: {e} (add `Quarantine Faulty Points` to the enforcement to skip such points)"
-                ));
+        }
+        *e.slots.borrow_mut() = (pattern, slots.into_iter().flatten().collect());
+        drop(embedding);
+        Ok(pairs)
+    }
+
+    fn assemble(
+        &self,
+        u: &[f64],
+        t: f64,
+        r: &mut [f64],
+        asm: &mut Assembler<'_>,
+        first: usize,
+    ) -> Result<Vec<(f64, f64)>, InterfaceFailure> {
+        let e = self.embedded()?;
+        self.at_time(e, t)?;
+        let mut embedding = e.embedding.borrow_mut();
+        let ev = embedding.evaluate(u).map_err(failure)?;
+        let slots = e.slots.borrow();
+        if ev.pattern != slots.0 || ev.jacobian.values.len() != slots.1.len() {
+            return Err(InterfaceFailure::Failed(
+                "the interface pattern changed during the solve".into(),
+            ));
+        }
+        for (&slot, &v) in slots.1.iter().zip(&ev.jacobian.values) {
+            match slot {
+                Slot::Diagonal(i) => asm.add_diagonal(i, v),
+                Slot::Upper(c) => asm.add_coupling(first + c, v, 0.0),
+                Slot::Lower(c) => asm.add_coupling(first + c, 0.0, v),
             }
-        };
-        Ok(HValue {
-            h: c.h,
-            dh_dtemp_a: c.dh_dtemp_a,
-            dh_dtemp_b: c.dh_dtemp_b,
-        })
-    };
-    Box::new(f)
+        }
+        for (ri, v) in r.iter_mut().zip(&ev.residual) {
+            *ri += v;
+        }
+        Ok(self.flux_heat(&ev.heat))
+    }
+
+    fn heat(&self, u: &[f64], t: f64) -> Result<Vec<(f64, f64)>, InterfaceFailure> {
+        let e = self.embedded()?;
+        self.at_time(e, t)?;
+        let heat = e.embedding.borrow().heat(u).map_err(failure)?;
+        Ok(self.flux_heat(&heat))
+    }
 }

@@ -6,8 +6,8 @@ use std::cell::Cell;
 use rayon::prelude::*;
 
 use crate::assembly::Assembler;
-use crate::enforce::interface::InterfaceSystem;
 use crate::fem::MAX_NODES;
+use crate::heat::interfaces::InterfaceFailure;
 use crate::heat::kernel;
 use crate::heat::law::Law;
 use crate::heat::{FirstError, HeatError, bad_jacobian, elem_coords};
@@ -15,8 +15,11 @@ use crate::heat::{FirstError, HeatError, bad_jacobian, elem_coords};
 use super::newton::{Context, History};
 use super::{Failure, Loads};
 
+/// Heat leaving side A and side B of one interface, W.
+pub(super) type Heat = (f64, f64);
+
 impl Context<'_, '_> {
-    /// Residual and Jacobian (left in `asm`) at `u`, and the interface systems.
+    /// Residual and Jacobian (left in `asm`) at `u`, and the heat of each flux term.
     pub(super) fn assemble(
         &self,
         asm: &mut Assembler<'_>,
@@ -25,7 +28,7 @@ impl Context<'_, '_> {
         loads: &Loads,
         history: Option<&History<'_>>,
         linear: bool,
-    ) -> Result<(Vec<f64>, Vec<Option<InterfaceSystem>>), Failure> {
+    ) -> Result<(Vec<f64>, Vec<Heat>), Failure> {
         let p = self.p;
         let setup = self.setup;
         let mesh = p.mesh;
@@ -192,63 +195,47 @@ impl Context<'_, '_> {
             }
         }
         // Interfaces.
-        let mut systems = Vec::with_capacity(p.contact.len());
-        for (k, c) in p.contact.iter().enumerate() {
-            if !p.is_active(k, t) {
-                systems.push(None);
-                continue;
-            }
-            let s = self.points[k].evaluate(&c.form, u);
-            let s = match s {
-                Ok(s) => s,
-                Err(e) => {
-                    if p.cutback.is_some_and(|c| c.replace(false)) {
-                        return Err(Failure::Retry(format!(
-                            "a conductance model asked for a smaller step ({e})"
-                        )));
-                    }
-                    return Err(Failure::Fatal(HeatError::Contact(e.to_string())));
-                }
-            };
-            for &(d, v) in &s.residual {
-                r[d as usize] += v;
-            }
-            s.add_scattered(asm, &self.scatters[k]);
-            systems.push(Some(s));
-        }
+        let heat = match p.interfaces {
+            Some(i) => i
+                .assemble(u, t, &mut r, asm, self.first)
+                .map_err(|e| match e {
+                    InterfaceFailure::Cutback(m) => Failure::Retry(format!(
+                        "a conductance model asked for a smaller step ({m})"
+                    )),
+                    InterfaceFailure::Failed(m) => Failure::Fatal(HeatError::Contact(m)),
+                })?,
+            None => Vec::new(),
+        };
         // Ties: Cᵀλ and C u − ΔT ∫ψ; a tie switched off keeps λ = 0.
         for (ti, tie) in setup.ties.iter().enumerate() {
             let l0 = setup.lambda_first[ti];
-            if !p.is_active(p.contact.len() + ti, t) {
-                for k in 0..tie.nodes.len() {
+            if !p.tie_on(ti, t) {
+                for k in 0..tie.own.len() {
                     r[l0 + k] = u[l0 + k];
                     asm.add_diagonal(l0 + k, 1.0);
                 }
                 continue;
             }
             for (e, &(k, d, c)) in tie.entries.iter().enumerate() {
-                let l = l0 + k as usize;
-                r[d as usize] += c * u[l];
-                r[l] += c * u[d as usize];
+                let l = l0 + k;
+                r[d] += c * u[l];
+                r[l] += c * u[d];
                 asm.add_coupling(self.tie_first[ti] + e, c, c);
             }
-            for (k, w) in tie.psi_integral.iter().enumerate() {
-                r[l0 + k] -= p.ties[ti].offset * w;
+            for (k, g) in tie.rhs.iter().enumerate() {
+                r[l0 + k] -= g;
             }
         }
-        Ok((r, systems))
+        Ok((r, heat))
     }
 
-    /// Heat through each interface at `u`: contact terms from their residuals, ties
-    /// from Cᵀλ.
-    pub(super) fn heat(&self, systems: &[Option<InterfaceSystem>], u: &[f64]) -> Vec<(f64, f64)> {
-        let mut out: Vec<(f64, f64)> = systems
-            .iter()
-            .map(|s| s.as_ref().map_or((0.0, 0.0), InterfaceSystem::heat))
-            .collect();
+    /// Heat through each interface at `u`: the flux terms' `flux` (from the last
+    /// assembly at `u`), then the ties' from Cᵀλ.
+    pub(super) fn heat(&self, flux: Vec<Heat>, u: &[f64]) -> Vec<Heat> {
+        let mut out = flux;
         for (ti, tie) in self.setup.ties.iter().enumerate() {
             let l0 = self.setup.lambda_first[ti];
-            out.push(tie.heat(&u[l0..l0 + tie.nodes.len()]));
+            out.push(tie.heat(&u[l0..l0 + tie.own.len()]));
         }
         out
     }

@@ -26,8 +26,10 @@
 //! A linear step (constant laws, conductances independent of T, linear faces and
 //! sources) costs one assembly: the element matrices are kept while the faces'
 //! derivatives do not change, the residual after the solve is `R + J du`, and a fixed
-//! step reuses its factorisation. The interface geometry at the contact points is
-//! evaluated once per run ([`InterfacePoints`]).
+//! step reuses its factorisation. The interfaces come through
+//! [`Interfaces`](crate::heat::interfaces::Interfaces): `seam run` gives its contact
+//! through the public embedding API, whose pattern is fixed after the search and whose
+//! values are refreshed in place.
 //!
 //! Results are reproducible bit for bit: element loops write fixed slots, interface
 //! sums run in a fixed order, and the factorisations run sequentially when
@@ -42,15 +44,14 @@ mod assemble;
 mod newton;
 mod setup;
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
 
 use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
-use crate::enforce::interface::{FieldPair, InterfacePoints};
 use crate::mesh::{Mesh, NodeId};
 
 use super::TEMPERATURE;
+use super::interfaces::Interfaces;
 use super::law::Law;
-use super::steady::{ContactTerm, TieTerm};
 use super::{FaceBc, HeatError, SourceFn};
 
 use newton::{Context, History, Solvers};
@@ -111,16 +112,10 @@ pub struct TransientProblem<'a> {
     pub block_source: Option<&'a [Law]>,
     /// Boundary data at time t.
     pub loads: &'a dyn Fn(f64) -> Result<Loads, HeatError>,
-    pub contact: Vec<ContactTerm<'a>>,
-    pub ties: Vec<TieTerm<'a>>,
-    /// Per contact term, then per tie: indices into `fields` of side A's and side B's
-    /// field (both 0 when empty).
-    pub term_fields: Vec<(usize, usize)>,
-    /// Whether term `k` (contact terms, then ties) is switched on at time t
-    /// (`Use Toggle Block`); always on when `None`.
-    pub active: Option<&'a dyn Fn(usize, f64) -> bool>,
-    /// Set by a conductance model that asks for a smaller step; the step is retried.
-    pub cutback: Option<&'a Cell<bool>>,
+    /// The interfaces, over this problem's dofs (the fields in order, then one
+    /// multiplier range per tie): flux terms switched on and off, and their models'
+    /// requests for a smaller step, are theirs to give.
+    pub interfaces: Option<&'a dyn Interfaces>,
     /// Newton stops when the update is below `tolerance × max|u|`.
     pub tolerance: f64,
     pub max_iterations: usize,
@@ -233,16 +228,8 @@ impl TransientProblem<'_> {
         }
     }
 
-    fn term_pair(&self, k: usize, fields: &[FieldId]) -> FieldPair {
-        let (a, b) = self.term_fields.get(k).copied().unwrap_or((0, 0));
-        FieldPair {
-            a: fields[a],
-            b: fields[b],
-        }
-    }
-
-    fn is_active(&self, k: usize, t: f64) -> bool {
-        self.active.is_none_or(|f| f(k, t))
+    fn tie_on(&self, k: usize, t: f64) -> bool {
+        self.interfaces.is_none_or(|i| i.tie_on(k, t))
     }
 }
 
@@ -314,30 +301,19 @@ pub fn solve(
     let mesh = p.mesh;
     // The pattern: elements, interface couplings (from a first evaluation), ties.
     let mut pattern = Pattern::new(mesh, &setup.dofs);
-    let mut points = Vec::with_capacity(p.contact.len());
-    let mut scatters = Vec::with_capacity(p.contact.len());
-    for (k, c) in p.contact.iter().enumerate() {
-        let cache = InterfacePoints::new(
-            mesh,
-            &setup.dofs,
-            p.term_pair(k, &setup.fields),
-            c.side_a,
-            c.side_b,
-            c.points,
-            &c.form,
-        )
-        .map_err(|e| HeatError::Contact(e.to_string()))?;
-        let cp = cache.couplings();
-        let first = pattern.add_couplings(&cp)?.start;
-        scatters.push(cache.scatter(&cp, first));
-        points.push(cache);
-    }
+    let couplings = match p.interfaces {
+        Some(i) => i
+            .couplings(&state.u, state.time)
+            .map_err(|e| HeatError::Contact(e.to_string()))?,
+        None => Vec::new(),
+    };
+    let first = pattern.add_couplings(&couplings)?.start;
     let mut tie_first = Vec::with_capacity(setup.ties.len());
     for (t, tie) in setup.ties.iter().enumerate() {
         let pairs: Vec<(usize, usize)> = tie
             .entries
             .iter()
-            .map(|&(k, d, _)| (d as usize, setup.lambda_first[t] + k as usize))
+            .map(|&(k, d, _)| (d, setup.lambda_first[t] + k))
             .collect();
         tie_first.push(pattern.add_couplings(&pairs)?.start);
     }
@@ -347,8 +323,7 @@ pub fn solve(
     let ctx = Context {
         p,
         setup: &setup,
-        points: &points,
-        scatters: &scatters,
+        first,
         element_matrices: RefCell::new(None),
         tie_first: &tie_first,
         unconverged: RefCell::new(None),

@@ -4,7 +4,6 @@
 use std::cell::RefCell;
 
 use crate::assembly::Assembler;
-use crate::enforce::interface::{InterfacePoints, Scatter};
 use crate::heat::{FaceBc, HeatError};
 use crate::solve::{
     AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
@@ -63,9 +62,8 @@ impl Solvers {
 pub(super) struct Context<'c, 'a> {
     pub(super) p: &'c TransientProblem<'a>,
     pub(super) setup: &'c Setup,
-    /// Per contact term: its points' geometry and where its blocks go.
-    pub(super) points: &'c [InterfacePoints],
-    pub(super) scatters: &'c [Scatter],
+    /// Where the interfaces' couplings start in the assembler.
+    pub(super) first: usize,
     /// The face-derivative signature under which the element matrix slots were last
     /// computed for a linear problem (None: not kept).
     pub(super) element_matrices: RefCell<Option<Vec<(u32, u8, f64)>>>,
@@ -142,10 +140,12 @@ impl Context<'_, '_> {
         let mut carried = None;
         for it in 0..=p.max_iterations {
             let clock = std::time::Instant::now();
-            let (mut r, mut terms) = match carried.take() {
-                Some(x) => x,
+            // The flux terms' heat at u: known from an assembly at u, not after a
+            // linear step moved u without one.
+            let (mut r, flux) = match carried.take() {
+                Some(r) => (r, None),
                 None => match self.assemble(asm, u, t, &loads, history.as_ref(), linear) {
-                    Ok(x) => x,
+                    Ok((r, flux)) => (r, Some(flux)),
                     Err(Failure::Retry(msg)) => return Ok(Err(msg)),
                     Err(Failure::Fatal(e)) => return Err(e),
                 },
@@ -161,14 +161,20 @@ impl Context<'_, '_> {
             }
             let done = it > 0 && (linear || last_update <= p.tolerance);
             if done || it == p.max_iterations {
+                let flux = match flux {
+                    Some(flux) => flux,
+                    None => match p.interfaces.map_or(Ok(Vec::new()), |i| i.heat(u, t)) {
+                        Ok(flux) => flux,
+                        Err(e) => return Err(HeatError::Contact(e.to_string())),
+                    },
+                };
+                report.heat = self.heat(flux, u);
                 if !done {
                     let message = unconverged(p.max_iterations, t, &report.residual_history);
-                    report.heat = self.heat(&terms, u);
                     report.diagnosis = Some(message.clone());
                     *self.unconverged.borrow_mut() = Some(report);
                     return Ok(Err(message));
                 }
-                report.heat = self.heat(&terms, u);
                 return Ok(Ok(report));
             }
             let clock = std::time::Instant::now();
@@ -251,10 +257,7 @@ impl Context<'_, '_> {
                 let mut jdu = vec![0.0; r.len()];
                 spmv(&jac, &rhs, &mut jdu);
                 r.iter_mut().zip(&jdu).for_each(|(r, j)| *r += j);
-                for s in terms.iter_mut().flatten() {
-                    s.advance(&rhs);
-                }
-                carried = Some((r, terms));
+                carried = Some(r);
                 report.assembly_s += clock.elapsed().as_secs_f64();
             }
             let u_max = u[..setup.n_primal]
@@ -277,7 +280,7 @@ impl Context<'_, '_> {
                 .faces
                 .iter()
                 .all(|f| !matches!(f, FaceBc::Radiation { .. }))
-            && self.p.contact.iter().all(|c| c.linear)
+            && self.p.interfaces.is_none_or(|i| i.is_linear())
             && (self.p.block_source).is_none_or(|s| s.iter().all(|q| !q.uses_temperature()))
     }
 }

@@ -2,11 +2,9 @@
 //! multiplier rows, the Dirichlet dofs, the lumped capacity weights and the element
 //! bases.
 
-use std::collections::HashSet;
-
 use crate::assembly::{DofMap, FieldId};
-use crate::enforce::mortar::{MortarTie, mortar_tie};
 use crate::fem::{Basis, MAX_NODES};
+use crate::heat::interfaces::TieRows;
 use crate::heat::kernel;
 use crate::heat::{HeatError, bad_jacobian, block_rules, elem_coords};
 use crate::mesh::{Mesh, NodeId};
@@ -20,7 +18,7 @@ pub(super) struct Setup {
     pub(super) fields: Vec<FieldId>,
     pub(super) n_primal: usize,
     pub(super) n: usize,
-    pub(super) ties: Vec<MortarTie>,
+    pub(super) ties: Vec<TieRows>,
     pub(super) lambda_first: Vec<usize>,
     pub(super) dirichlet_dofs: Vec<usize>,
     pub(super) lumped: Vec<LumpedWeight>,
@@ -48,34 +46,13 @@ impl Setup {
             .into_iter()
             .map(|(d, _)| d)
             .collect();
-        let conductivity: Vec<f64> = p
-            .laws
-            .iter()
-            .map(|l| l.conductivity.eval(300.0, [0.0; 3], time).map(|(k, _)| k))
-            .collect::<Result<_, _>>()
-            .map_err(HeatError::Step)?;
-        let mut constrained: HashSet<NodeId> = loads.dirichlet.iter().map(|d| d.0).collect();
-        let mut ties = Vec::with_capacity(p.ties.len());
-        for (t, tie) in p.ties.iter().enumerate() {
-            let pair = p.term_pair(p.contact.len() + t, &fields);
-            ties.push(
-                mortar_tie(
-                    mesh,
-                    &dofs,
-                    pair,
-                    tie.side_a,
-                    tie.side_b,
-                    tie.points,
-                    &conductivity,
-                    &mut constrained,
-                    tie.multipliers,
-                )
-                .map_err(|e| HeatError::Contact(e.to_string()))?,
-            );
-        }
+        let ties = match p.interfaces {
+            Some(i) => i.ties().map_err(HeatError::Contact)?,
+            None => Vec::new(),
+        };
         let lambda_first = ties
             .iter()
-            .map(|t| dofs.add_extra(t.nodes.len()).start)
+            .map(|t| dofs.add_extra(t.own.len()).start)
             .collect();
         let lumped = lumped_weights(mesh, &dofs)?;
         let mut blocks: Vec<usize> = Vec::new();
