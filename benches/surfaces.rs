@@ -10,7 +10,7 @@ use std::time::Instant;
 use seam::deck::spec::{ContactDefinition, SurfaceDef};
 use seam::diag::{Loc, SourceMap};
 use seam::mesh::generate::{self, BoxSpec};
-use seam::surface;
+use seam::scene::surfaces;
 
 fn peak_rss_mb() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
@@ -49,7 +49,7 @@ fn main() {
     let mut faces = 0;
     for _ in 0..5 {
         let t = Instant::now();
-        let set = surface::build(&mesh, &def, &sources);
+        let set = surfaces::build(&mesh, &def, &sources);
         times.push(t.elapsed().as_secs_f64());
         faces = set.surfaces.iter().map(|s| s.faces.len()).sum::<usize>();
         std::hint::black_box(&set);

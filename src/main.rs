@@ -12,10 +12,10 @@ use serde::Serialize;
 use seam::deck::{self, LoadedDeck};
 use seam::diag::{Diagnostic, Diagnostics, SourceMap};
 use seam::run::RunError;
-use seam::scene::{ContactScene, SceneOptions};
+use seam::scene::{self, ContactScene, SceneOptions};
 
 use seam::mesh::{self, ElemId, Mesh};
-use seam::surface::{self, SurfaceKind};
+use seam::surface::SurfaceKind;
 
 const EXIT_BAD_INPUT: u8 = 2;
 const EXIT_PLUGIN_FAULT: u8 = 3;
@@ -215,7 +215,7 @@ fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) 
     let mut diags = loaded.diagnostics.clone();
     let mut rows = Vec::new();
     for def in &loaded.deck.contact_definitions {
-        let set = surface::build_with_dead(&mesh, def, &loaded.sources, &dead);
+        let set = scene::surfaces::build_with_dead(&mesh, def, &loaded.sources, &dead);
         diags.extend(set.diagnostics);
         for s in set.surfaces {
             rows.push(SurfaceRow {

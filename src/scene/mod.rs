@@ -27,6 +27,7 @@ pub mod enforcement;
 pub mod interaction;
 pub mod plugin;
 pub mod search;
+pub mod surfaces;
 
 use std::path::Path;
 use std::time::Instant;
@@ -312,7 +313,7 @@ impl ContactScene {
         };
         phase("building the contact surfaces");
         let t = Instant::now();
-        let set = surface::build(mesh, def, &loaded.sources);
+        let set = surfaces::build(mesh, def, &loaded.sources);
         self.timing.surfaces_s += t.elapsed().as_secs_f64();
         self.surfaces += set.surfaces.len();
         diags.extend(set.diagnostics.clone());

@@ -88,6 +88,8 @@ fn layers_point_only_down() {
         (
             "surface",
             &[
+                "crate::deck",
+                "crate::scene",
                 "crate::search",
                 "crate::enforce",
                 "crate::embed",

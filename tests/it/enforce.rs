@@ -866,7 +866,7 @@ fn crosspoints_of_a_tie_with_dirichlet_and_periodic_faces() {
     assert!(!diags.has_errors(), "{diags:?}");
     let def = &d.contact_definitions[0];
     let sources = seam::diag::SourceMap::default();
-    let set = seam::surface::build(&mesh, def, &sources);
+    let set = seam::scene::surfaces::build(&mesh, def, &sources);
     let (list, _) = seam::scene::interaction::resolve(def, &set, 3, &sources);
     let scene = seam::scene::search::search_definition(
         &mesh,

@@ -7,8 +7,8 @@ use seam::deck::parse_sierra;
 use seam::diag::SourceMap;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::scene::interaction::{self, Interaction};
+use seam::scene::surfaces;
 use seam::search::Overclosure;
-use seam::surface;
 
 /// Three boxes meshed apart, blocks 1..3, and a node set on block 1's nodes.
 fn resolve(deck: &str) -> (Vec<(String, String)>, Vec<Interaction>, Vec<&'static str>) {
@@ -28,7 +28,7 @@ fn resolve(deck: &str) -> (Vec<(String, String)>, Vec<Interaction>, Vec<&'static
     let (d, diags) = parse_sierra(&Arc::from("deck.i"), deck);
     assert!(!diags.has_errors(), "{diags:?}");
     let def = &d.contact_definitions[0];
-    let set = surface::build(&mesh, def, &SourceMap::default());
+    let set = surfaces::build(&mesh, def, &SourceMap::default());
     let (list, diags) = interaction::resolve(def, &set, 3, &SourceMap::default());
     let pairs = list
         .iter()

@@ -11,9 +11,10 @@ use seam::heat::Material;
 use seam::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, TieTerm, solve_steady};
 use seam::mesh::generate::{self, BoxSpec, SolidKind};
 use seam::mesh::{Mesh, NodeId, NodeSet};
+use seam::scene::surfaces;
 use seam::search::SearchSettings;
 use seam::search::pairing::{ContactPoint, Integration, PointStatus, Searcher, SurfaceGeometry};
-use seam::surface::{self, SurfaceKind, SurfaceSet};
+use seam::surface::{SurfaceKind, SurfaceSet};
 
 /// Block 1 on [0,1]²×[0,1] (n1 cells a side), block 2 on [0,1]²×[1,2] (n2), meshed
 /// apart. Side sets: 1 top of block 1, 2 bottom of block 2, 3 bottom of block 1 (z = 0),
@@ -82,7 +83,7 @@ fn surfaces(mesh: &Mesh, side_a: SideA) -> SurfaceSet {
         surfaces: vec![a, b],
         ..ContactDefinition::default()
     };
-    let set = surface::build(mesh, &def, &SourceMap::default());
+    let set = surfaces::build(mesh, &def, &SourceMap::default());
     assert!(!set.diagnostics.has_errors(), "{:?}", set.diagnostics);
     set
 }
@@ -473,7 +474,7 @@ fn isolated_nodes_are_reported_and_carry_nothing() {
         }],
         ..ContactDefinition::default()
     };
-    let set = surface::build(&mesh, &def, &SourceMap::default());
+    let set = surfaces::build(&mesh, &def, &SourceMap::default());
     let w: Vec<_> = set
         .diagnostics
         .0

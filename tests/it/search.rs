@@ -10,9 +10,9 @@ use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{Mesh, NodeSet};
 use seam::scene::interaction;
 use seam::scene::search::search_definition;
+use seam::scene::surfaces;
 use seam::search::pairing::{Integration, PointStatus, Searcher, SurfaceGeometry};
 use seam::search::scene::SceneSearch;
-use seam::surface;
 
 fn run(mesh: &Mesh, deck: &str, integration: Integration) -> SceneSearch {
     run_in(mesh, deck, integration, Path::new("."))
@@ -22,7 +22,7 @@ fn run_in(mesh: &Mesh, deck: &str, integration: Integration, dir: &Path) -> Scen
     let (d, diags) = parse_sierra(&Arc::from("deck.i"), deck);
     assert!(!diags.has_errors(), "{diags:?}");
     let def = &d.contact_definitions[0];
-    let set = surface::build(mesh, def, &SourceMap::default());
+    let set = surfaces::build(mesh, def, &SourceMap::default());
     assert!(!set.diagnostics.has_errors(), "{:?}", set.diagnostics);
     let (list, diags) = interaction::resolve(def, &set, mesh.dim, &SourceMap::default());
     assert!(!diags.has_errors(), "{diags:?}");
@@ -340,7 +340,7 @@ fn maps_that_miss_or_do_not_close_are_errors() {
 #[test]
 fn refit_after_a_move_equals_a_rebuild() {
     let mesh = two_boxes(5, 4);
-    let set = surface::build(
+    let set = surfaces::build(
         &mesh,
         &parse_sierra(&Arc::from("d"), PAIR).0.contact_definitions[0],
         &SourceMap::default(),
@@ -516,7 +516,7 @@ fn pairing_is_reused_between_search_updates() {
         .0
         .contact_definitions
         .remove(0);
-    let set = surface::build(&mesh, &def, &SourceMap::default());
+    let set = surfaces::build(&mesh, &def, &SourceMap::default());
     let settings = seam::search::SearchSettings::defaults(3);
     let geo = |coords: &[[f64; 3]], name: &str| {
         SurfaceGeometry::from_surface(&mesh, set.get(name).unwrap(), coords).unwrap()

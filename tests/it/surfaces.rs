@@ -11,7 +11,8 @@ use seam::deck::spec::{
 use seam::diag::{Loc, SourceMap};
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{ElemId, Mesh, NodeId, NodeSet, Side, SideSet, Topology};
-use seam::surface::{self, SurfaceKind, SurfaceSet};
+use seam::scene::surfaces;
+use seam::surface::{SurfaceKind, SurfaceSet};
 
 fn contains(name: &str, items: &[&str]) -> SurfaceDef {
     SurfaceDef::Contains {
@@ -43,7 +44,7 @@ fn def(surfaces: Vec<SurfaceDef>) -> ContactDefinition {
 }
 
 fn build(mesh: &Mesh, surfaces: Vec<SurfaceDef>) -> SurfaceSet {
-    surface::build(mesh, &def(surfaces), &SourceMap::default())
+    surfaces::build(mesh, &def(surfaces), &SourceMap::default())
 }
 
 fn faces(set: &SurfaceSet, name: &str) -> usize {
@@ -460,7 +461,7 @@ fn restrict_to_subdomain_keeps_faces_inside_the_sphere() {
         radius: 0.3,
         point: [0.0; 3],
     });
-    let set = surface::build(&mesh, &d, &SourceMap::default());
+    let set = surfaces::build(&mesh, &d, &SourceMap::default());
     assert_eq!(faces(&set, "s"), 3);
 }
 
@@ -473,11 +474,11 @@ fn element_death_exposes_faces_of_skins_and_shrinks_side_sets() {
         contains("bottom", &["surface_5"]),
         contains("skin", &["block_1"]),
     ]);
-    let alive = surface::build(&mesh, &d, &SourceMap::default());
+    let alive = surfaces::build(&mesh, &d, &SourceMap::default());
     assert_eq!(faces(&alive, "skin"), 14 - 3);
     // Kill the middle element: the two end cubes have 6 faces each, 2 of them in the side set.
     let dead: HashSet<ElemId> = [ElemId(1)].into();
-    let set = surface::build_with_dead(&mesh, &d, &SourceMap::default(), &dead);
+    let set = surfaces::build_with_dead(&mesh, &d, &SourceMap::default(), &dead);
     assert_eq!(faces(&set, "bottom"), 2);
     assert_eq!(faces(&set, "skin"), 12 - 2);
 }

@@ -14,11 +14,12 @@
 
 use std::collections::{HashMap, VecDeque};
 
-use super::geometry::dot;
-use super::{Builder, ContactSurface, SurfaceFace, face_normal};
+use super::Builder;
 use crate::deck::spec::SurfaceBlock;
 use crate::diag::{Diagnostic, Loc};
 use crate::mesh::NodeId;
+use crate::surface::geometry::dot;
+use crate::surface::{ContactSurface, SurfaceFace, face_normal};
 
 /// Threshold on n̂·v̂ for `Subset … With Normal` (Sierra/SM).
 const SUBSET_NORMAL_DOT: f64 = 0.45;
