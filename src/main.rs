@@ -12,7 +12,7 @@ use serde::Serialize;
 use seam::deck::{self, LoadedDeck};
 use seam::diag::{Diagnostic, Diagnostics, SourceMap};
 use seam::run::RunError;
-use seam::scene::{self, ContactScene, SceneOptions};
+use seam::scene::{ContactScene, SceneOptions};
 
 use seam::mesh::{self, ElemId, Mesh};
 use seam::surface::SurfaceKind;
@@ -214,8 +214,7 @@ fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) 
     };
     let mut diags = loaded.diagnostics.clone();
     let mut rows = Vec::new();
-    for def in &loaded.deck.contact_definitions {
-        let set = scene::surfaces::build_with_dead(&mesh, def, &loaded.sources, &dead);
+    for (definition, set) in ContactScene::surfaces(&mesh, &loaded, &dead) {
         diags.extend(set.diagnostics);
         for s in set.surfaces {
             rows.push(SurfaceRow {
@@ -223,7 +222,7 @@ fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) 
                 faces: s.faces.len(),
                 nodes: s.nodes.len(),
                 kind: s.kind,
-                definition: def.name.clone(),
+                definition: definition.clone(),
                 parent: s.parent,
                 origins: s
                     .origins
@@ -305,7 +304,7 @@ fn search(
     segments: bool,
     order: usize,
 ) -> ExitCode {
-    use seam::deck::spec::OutputRule;
+    use seam::scene::OutputRule;
     use seam::search::pairing::Integration;
     let (loaded, mesh) = match load(deck_path, Some(mesh_path)) {
         Ok(x) => x,
@@ -336,12 +335,11 @@ fn search(
     let mut details = Vec::new();
     let mut rule = OutputRule::Summary;
     for s in &searched {
-        let def = &loaded.deck.contact_definitions[s.definition];
         timing.build_s += s.timing.build_s;
         timing.search_s += s.timing.search_s;
-        rule = def.output_rule.unwrap_or(OutputRule::Summary);
+        rule = s.view.rule;
         for p in &s.pairings {
-            summaries.push(p.summary(def.visualize_contact));
+            summaries.push(p.summary(s.view.visualize));
             if matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose) {
                 details.push(point_details(p, rule == OutputRule::MoreVerbose));
             }

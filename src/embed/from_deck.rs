@@ -13,7 +13,7 @@ use crate::enforce::conductance::ConductanceModel;
 use crate::enforce::interface::{DEFAULT_BETA, FieldPair};
 use crate::enforce::model::ConductanceLaw;
 use crate::enforce::model::ModelChoice;
-use crate::scene::{ContactScene, Enforced, SceneOptions, SearchAgain};
+use crate::scene::{ContactScene, Enforced, ProblemFileLine, SceneOptions, SearchAgain};
 use crate::search::SearchSettings;
 use crate::search::scene::Pairing;
 use crate::surface::{ContactSurface, SurfaceKind};
@@ -71,33 +71,22 @@ impl Embedding {
         }
         // What an embedding cannot honour: lines about `seam run`'s problem file (whose
         // host gives them through `set_point_pressures` and `set_active`).
-        for enf in loaded
-            .deck
-            .contact_definitions
-            .iter()
-            .flat_map(|d| &d.enforcements)
-        {
-            let unsupported = [
-                (
-                    enf.contact_pressure_variable.is_some(),
+        for (at, line) in crate::scene::problem_file_lines(&loaded) {
+            let (what, help) = match line {
+                ProblemFileLine::ContactPressureVariable => (
                     "`Contact Pressure Variable` names a nodal field of `seam run`'s problem file",
                     "give `Contact Pressure = p`, or pass h from the host's own model (Interaction::conductance)",
                 ),
-                (
-                    enf.use_toggle_block.is_some(),
+                ProblemFileLine::UseToggleBlock => (
                     "`Use Toggle Block` switches an enforcement by `seam run`'s [[toggle]] times",
                     "leave the line out and add or drop the interaction's terms in the host",
                 ),
-            ];
-            for (used, what, help) in unsupported {
-                if used {
-                    diags.push(
-                        Diagnostic::error("E0430", format!("{what}; an embedding has none"))
-                            .at(Some(enf.at.clone()))
-                            .help(help),
-                    );
-                }
-            }
+            };
+            diags.push(
+                Diagnostic::error("E0430", format!("{what}; an embedding has none"))
+                    .at(Some(at))
+                    .help(help),
+            );
         }
         if diags.has_errors() {
             return Err(fail(&diags));

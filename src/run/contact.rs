@@ -17,11 +17,11 @@ use crate::scene::{ContactScene, SceneOptions};
 use crate::search::pairing::Integration;
 use crate::search::scene::Pairing;
 
-use super::fields::ContactView;
 use super::nodal_field::read_nodal_field;
 use super::physics::{FaceSite, Materials, Physics, evaluate};
 use super::problem::{ContactSpec, Problem, ProblemFile, Value};
 use super::{RunError, RunOptions, input_error};
+use crate::scene::ContactView;
 
 /// An interaction's model, penalty scale and conductance model.
 pub(super) type Choice = (ModelChoice, f64, Option<Arc<dyn ConductanceModel>>);
@@ -108,34 +108,11 @@ impl RunContact {
             ));
         }
         let deck_dir = deck_path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        for def in &loaded.deck.contact_definitions {
-            if ContactView::of(def).silenced {
-                diags.push(
-                    Diagnostic::warning(
-                        "W0702",
-                        "`Visualize Contact` is on, but `Output Rule = none`: this definition writes no contact fields",
-                    )
-                    .at(Some(def.at.clone()))
-                    .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
-                );
-            }
-            let every = def.update_search_every_n_steps.or(def
-                .search_options
-                .as_ref()
-                .and_then(|o| o.search_update_frequency));
-            if let Some(n) = every {
-                diags.push(
-                    Diagnostic::warning(
-                        "W0703",
-                        format!("`Update Search Every {n} Steps` (or `Search Update Frequency`) has no effect in this run: the mesh does not move, so the first search holds for every step"),
-                    )
-                    .at(Some(def.at.clone()))
-                    .help("remove the line, or keep it for a run coupled to a code that moves the mesh"),
-                );
-            }
-        }
+        let diags_before = diags.0.len();
         let field_refs: Vec<&str> = field_names.iter().map(String::as_str).collect();
         let phase = |what: &str| options.phase(what);
+        // The scene's own diagnostics follow the run's notes on its definitions.
+        let mut found = std::mem::take(diags);
         let scene = ContactScene::build(
             mesh,
             &loaded,
@@ -146,17 +123,40 @@ impl RunContact {
                 phase: Some(&phase),
                 search_only: false,
             },
-            diags,
+            &mut found,
         );
+        let (before, after) = found.0.split_at(diags_before);
+        diags.0.extend_from_slice(before);
+        for def in &scene.definitions {
+            if def.view.silenced {
+                diags.push(
+                    Diagnostic::warning(
+                        "W0702",
+                        "`Visualize Contact` is on, but `Output Rule = none`: this definition writes no contact fields",
+                    )
+                    .at(Some(def.at.clone()))
+                    .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
+                );
+            }
+            if let Some(n) = def.search_every {
+                diags.push(
+                    Diagnostic::warning(
+                        "W0703",
+                        format!("`Update Search Every {n} Steps` (or `Search Update Frequency`) has no effect in this run: the mesh does not move, so the first search holds for every step"),
+                    )
+                    .at(Some(def.at.clone()))
+                    .help("remove the line, or keep it for a run coupled to a code that moves the mesh"),
+                );
+            }
+        }
+        diags.0.extend_from_slice(after);
         let mut out = RunContact {
             surfaces_s: scene.timing.surfaces_s,
             search_s: scene.timing.search_s,
             ..RunContact::default()
         };
         for e in scene.entries {
-            out.views.push(ContactView::of(
-                &loaded.deck.contact_definitions[e.definition],
-            ));
+            out.views.push(e.view);
             out.choices
                 .push((e.choice, e.penalty_scale, e.model.map(Arc::from)));
             out.pairings.push(e.pairing);

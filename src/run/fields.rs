@@ -3,7 +3,7 @@
 //! enforced interactions, and the heat of each mechanism of a summed conductance.
 //!
 //! Entry points: [`element_heat_flux`], [`contact_faces`] (and [`ContactFields::nodal`]
-//! for the side-A nodes) as [`ContactView`] asks, [`mechanism_heat`] with
+//! for the side-A nodes) as [`crate::scene::ContactView`] asks, [`mechanism_heat`] with
 //! [`mechanism_names`]; [`Derived`] holds what the run derives from one state.
 //!
 //! Conventions: the interface flux is the heat flux from side A to side B (W/m²), the
@@ -12,7 +12,6 @@
 //! sum of the weights of its matched points (segments integration: the clipped overlap
 //! area, exact for flat faces).
 
-use crate::deck::spec::{ContactDefinition, OutputRule};
 use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::PointFlux;
 use crate::fem::shape::reference_nodes;
@@ -260,37 +259,6 @@ pub(super) fn mechanism_heat(
         }
     }
     out
-}
-
-/// What one interaction writes as contact output, from its definition's `Visualize
-/// Contact` and `Output Rule`:
-///
-/// | `Output Rule` | with `Visualize Contact` |
-/// |---|---|
-/// | `none` | nothing (warning `W0702`) |
-/// | `summary` (default) | side-A faces in `contact.vtu`, nodal fields in `results.exo` |
-/// | `verbose` | and the side-B faces with their own values |
-/// | `more verbose` | and every side-A point in `contact_points.vtu` |
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub(super) struct ContactView {
-    pub faces: bool,
-    pub side_b: bool,
-    pub points: bool,
-    /// `Visualize Contact` on and `Output Rule = none`.
-    pub silenced: bool,
-}
-
-impl ContactView {
-    pub(super) fn of(def: &ContactDefinition) -> Self {
-        let rule = def.output_rule.unwrap_or(OutputRule::Summary);
-        let on = def.visualize_contact && rule != OutputRule::None;
-        ContactView {
-            faces: on,
-            side_b: on && matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose),
-            points: on && rule == OutputRule::MoreVerbose,
-            silenced: def.visualize_contact && rule == OutputRule::None,
-        }
-    }
 }
 
 /// The points of one interaction for `contact_points.vtu`: its 1-based index, its

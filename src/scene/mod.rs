@@ -59,6 +59,8 @@ pub struct Enforced {
     pub model: Option<Box<dyn ConductanceModel>>,
     /// Index of the contact definition in the deck.
     pub definition: usize,
+    /// What the definition's contact output holds.
+    pub view: ContactView,
     /// What searching this pair again takes (a host that moves nodes):
     /// [`ContactScene::build_for_host`] keeps it, [`ContactScene::build`] does not.
     pub again: Option<SearchAgain>,
@@ -96,10 +98,95 @@ pub struct SceneTiming {
     pub search_s: f64,
 }
 
+pub use crate::deck::spec::OutputRule;
+
+/// What a definition's contact output holds, from `Visualize Contact` and `Output Rule`:
+///
+/// | rule | with `Visualize Contact` |
+/// |---|---|
+/// | `none` | nothing (and a warning: the two lines disagree) |
+/// | `summary` (default) | the side-A faces: gap, contact fraction, flux |
+/// | `verbose` | and the side-B faces with their own values |
+/// | `more verbose` | and every side-A point |
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContactView {
+    /// `Visualize Contact`.
+    pub visualize: bool,
+    /// `Output Rule`, `summary` when not given.
+    pub rule: OutputRule,
+    pub faces: bool,
+    pub side_b: bool,
+    pub points: bool,
+    /// `Visualize Contact` on and `Output Rule = none`.
+    pub silenced: bool,
+}
+
+impl ContactView {
+    fn of(def: &ContactDefinition) -> Self {
+        let rule = def.output_rule.unwrap_or(OutputRule::Summary);
+        let on = def.visualize_contact && rule != OutputRule::None;
+        ContactView {
+            visualize: def.visualize_contact,
+            rule,
+            faces: on,
+            side_b: on && matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose),
+            points: on && rule == OutputRule::MoreVerbose,
+            silenced: def.visualize_contact && rule == OutputRule::None,
+        }
+    }
+}
+
+impl Default for ContactView {
+    fn default() -> Self {
+        ContactView::of(&ContactDefinition::default())
+    }
+}
+
+/// What a host needs of a contact definition beyond its pairings.
+#[derive(Clone, Debug)]
+pub struct DefinitionNotes {
+    /// Where the definition is (its `begin Contact Definition` line).
+    pub at: crate::diag::Loc,
+    pub view: ContactView,
+    /// `Update Search Every n Steps` (or `Search Update Frequency`) when given.
+    pub search_every: Option<u32>,
+}
+
+/// An enforcement line that refers to `seam run`'s problem file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProblemFileLine {
+    /// `Contact Pressure Variable = name`: a `[[nodal_field]]`.
+    ContactPressureVariable,
+    /// `Use Toggle Block t`: a `[[toggle]]`.
+    UseToggleBlock,
+}
+
+/// Every enforcement line of `loaded` that refers to `seam run`'s problem file, at its
+/// enforcement block (a host without one refuses them).
+pub fn problem_file_lines(loaded: &LoadedDeck) -> Vec<(crate::diag::Loc, ProblemFileLine)> {
+    let mut out = Vec::new();
+    for enf in loaded
+        .deck
+        .contact_definitions
+        .iter()
+        .flat_map(|d| &d.enforcements)
+    {
+        if enf.contact_pressure_variable.is_some() {
+            out.push((enf.at.clone(), ProblemFileLine::ContactPressureVariable));
+        }
+        if enf.use_toggle_block.is_some() {
+            out.push((enf.at.clone(), ProblemFileLine::UseToggleBlock));
+        }
+    }
+    out
+}
+
 /// Every pairing of a deck on a mesh, with its enforcement.
 #[derive(Default)]
 pub struct ContactScene {
     pub entries: Vec<Enforced>,
+    /// Per contact definition of the deck, in deck order.
+    pub definitions: Vec<DefinitionNotes>,
     /// Number of contact surfaces built, over every definition.
     pub surfaces: usize,
     /// Plugin enforcements whose library could not be loaded (their E0500 is in the
@@ -142,7 +229,23 @@ impl ContactScene {
         diags: &mut Diagnostics,
         keep: bool,
     ) -> ContactScene {
-        let mut scene = ContactScene::default();
+        let definitions = loaded
+            .deck
+            .contact_definitions
+            .iter()
+            .map(|def| DefinitionNotes {
+                at: def.at.clone(),
+                view: ContactView::of(def),
+                search_every: def.update_search_every_n_steps.or(def
+                    .search_options
+                    .as_ref()
+                    .and_then(|o| o.search_update_frequency)),
+            })
+            .collect();
+        let mut scene = ContactScene {
+            definitions,
+            ..ContactScene::default()
+        };
         for (d, def) in loaded.deck.contact_definitions.iter().enumerate() {
             let Some((list, searched, set, found_maps)) =
                 scene.search_one(mesh, loaded, def, deck_dir, options, diags)
@@ -255,11 +358,31 @@ impl ContactScene {
                     penalty_scale: interaction.map_or(1.0, |i| i.penalty_scale),
                     model,
                     definition: d,
+                    view: ContactView::of(def),
                     again,
                 });
             }
         }
         scene
+    }
+
+    /// The contact surfaces of every definition of `loaded` — the scene's first stage
+    /// alone — as if the `dead` elements (dense ids) never existed: per definition its
+    /// name and its surfaces with their diagnostics.
+    pub fn surfaces(
+        mesh: &Mesh,
+        loaded: &LoadedDeck,
+        dead: &std::collections::HashSet<crate::mesh::ElemId>,
+    ) -> Vec<(Option<String>, surface::SurfaceSet)> {
+        loaded
+            .deck
+            .contact_definitions
+            .iter()
+            .map(|def| {
+                let set = surfaces::build_with_dead(mesh, def, &loaded.sources, dead);
+                (def.name.clone(), set)
+            })
+            .collect()
     }
 
     /// The surfaces, interactions and search of every contact definition of `loaded` on
@@ -281,6 +404,7 @@ impl ContactScene {
             {
                 out.push(SearchedDefinition {
                     definition: d,
+                    view: ContactView::of(def),
                     pairings: searched.pairings,
                     timing: searched.timing,
                 });
@@ -346,6 +470,8 @@ impl ContactScene {
 pub struct SearchedDefinition {
     /// Index of the contact definition in the deck.
     pub definition: usize,
+    /// What the definition's contact output holds.
+    pub view: ContactView,
     pub pairings: Vec<Pairing>,
     /// The search's own times (bounding-volume hierarchies built, queries).
     pub timing: SearchTiming,

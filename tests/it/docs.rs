@@ -119,6 +119,32 @@ fn layers_point_only_down() {
     );
 }
 
+/// The scene is the one reader of the typed deck spec: nothing else in `src/` names
+/// `deck::spec` or walks a deck's enforcement blocks.
+#[test]
+fn only_the_scene_reads_the_deck_spec() {
+    let mut found = Vec::new();
+    for (path, text) in sources("") {
+        let inside = ["deck", "scene"]
+            .iter()
+            .any(|d| path.starts_with(Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(d)));
+        if inside {
+            continue;
+        }
+        for (n, line) in text.lines().enumerate() {
+            let code = line.split("//").next().unwrap_or("");
+            if code.contains("deck::spec") || code.contains(".enforcements") {
+                found.push(format!("{}:{}: {}", path.display(), n + 1, line.trim()));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "deck spec read outside the scene:\n{}",
+        found.join("\n")
+    );
+}
+
 /// No source file over 1000 lines, and `lib.rs` declares every top-level module.
 #[test]
 fn source_files_stay_small_and_lib_lists_every_module() {
