@@ -133,7 +133,10 @@ fn conduction(c: usize, reps: usize) {
     let big = vals.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let row_sum = ones.iter().fold(0.0f64, |m, v| m.max(v.abs())) / big;
     let us = |t: f64| t * 1e6 / ne as f64;
-    println!("Hex8 conduction, {c}³ = {ne} elements, {} unknowns", dofs.len());
+    println!(
+        "Hex8 conduction, {c}³ = {ne} elements, {} unknowns",
+        dofs.len()
+    );
     println!("| phase | median s | µs per element |");
     println!("|---|---:|---:|");
     for (phase, t) in [

@@ -1,9 +1,16 @@
 //! Shape functions mapped to physical space: the isoparametric map of one element at a
 //! reference point, untabulated ([`eval_point`]) or tabulated at the points of a rule
-//! ([`Basis`]).
+//! ([`Basis`]); for a `Hex8` with its standard 2×2×2 rule, all eight points at once
+//! ([`Basis::map_hex8`], the fast path of the element kernels).
 //!
 //! Formulas: `J_ij = Σ_a x_a,i ∂N_a/∂ξ_j`, `∇_x N = J⁻ᵀ ∇_ξ N`, `jxw = det J · w`; a
 //! non-positive det J is a [`BadJacobian`]. 2-D elements (`Quad4`, `Tri3`) use x and y.
+//!
+//! The `Hex8` map does the arithmetic of the general one operation for operation, in
+//! the same order, only laid out across the eight points (J, det J, J⁻¹, positions) and
+//! across the eight nodes (gradients) so that fixed-length loops vectorise; its values
+//! are therefore the general map's to the last bit, and kernels built on it need no
+//! tolerance of their own.
 
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
@@ -44,6 +51,35 @@ pub struct Basis {
     pub rule: QuadratureRule,
     n: Vec<[f64; MAX_NODES]>,
     dn: Vec<[[f64; 3]; MAX_NODES]>,
+    /// The same tables laid out for [`Basis::map_hex8`]; `None` unless the basis is a
+    /// `Hex8` on an eight-point rule.
+    hex8: Option<Box<Hex8Tables>>,
+}
+
+/// Reference values of a `Hex8` at the eight points of its rule, in the layouts the
+/// vectorised map reads: by node then point (sums over nodes, across points) and by
+/// point then node (gradients, across nodes).
+#[derive(Clone, Debug)]
+struct Hex8Tables {
+    /// `n_by_node[a][q] = N_a(ξ_q)`.
+    n_by_node: [[f64; 8]; 8],
+    /// `dn_by_node[a][8k + q] = ∂N_a/∂ξ_k (ξ_q)`.
+    dn_by_node: [[f64; 24]; 8],
+    /// `dn_by_point[q][k][a] = ∂N_a/∂ξ_k (ξ_q)`.
+    dn_by_point: [[[f64; 8]; 3]; 8],
+    weights: [f64; 8],
+}
+
+/// A `Hex8` mapped at the eight points of its rule ([`Basis::map_hex8`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Hex8Points {
+    /// `grad[q][i][a] = ∂N_a/∂x_i` at point q (component-major, so that the loops over
+    /// the nodes a are contiguous).
+    pub grad: [[[f64; 8]; 3]; 8],
+    /// Physical position of each point.
+    pub x: [[f64; 3]; 8],
+    /// det J · w at each point.
+    pub jxw: [f64; 8],
 }
 
 impl Basis {
@@ -58,12 +94,117 @@ impl Basis {
             n.push(v);
             dn.push(g);
         }
+        let hex8 = (topology == Topology::Hex8 && rule.len() == 8).then(|| {
+            let mut t = Hex8Tables {
+                n_by_node: [[0.0; 8]; 8],
+                dn_by_node: [[0.0; 24]; 8],
+                dn_by_point: [[[0.0; 8]; 3]; 8],
+                weights: [0.0; 8],
+            };
+            for q in 0..8 {
+                t.weights[q] = rule.weights[q];
+                for a in 0..8 {
+                    t.n_by_node[a][q] = n[q][a];
+                    for k in 0..3 {
+                        t.dn_by_node[a][8 * k + q] = dn[q][a][k];
+                        t.dn_by_point[q][k][a] = dn[q][a][k];
+                    }
+                }
+            }
+            Box::new(t)
+        });
         Basis {
             topology,
             rule,
             n,
             dn,
+            hex8,
         }
+    }
+
+    /// The same basis without its `Hex8` tables: kernels then take the general path
+    /// (for tests that hold the fast path against it).
+    pub fn without_fast_path(mut self) -> Self {
+        self.hex8 = None;
+        self
+    }
+
+    /// Whether [`Basis::map_hex8`] applies (a `Hex8` on an eight-point rule).
+    pub fn has_hex8_path(&self) -> bool {
+        self.hex8.is_some()
+    }
+
+    /// Shape-function values at point `q`.
+    pub fn values(&self, q: usize) -> &[f64; MAX_NODES] {
+        &self.n[q]
+    }
+
+    /// All eight points of a `Hex8` mapped at once: gradients, positions and det J · w,
+    /// equal to the last bit to [`Basis::eval`] at each point (module docs). `None`
+    /// when the basis has no `Hex8` tables; a [`BadJacobian`] names the first point (in
+    /// rule order) with det J ≤ 0 or NaN, as [`Basis::eval`] would.
+    #[inline(always)]
+    pub fn map_hex8(&self, coords: &[[f64; 3]; 8]) -> Option<Result<Hex8Points, BadJacobian>> {
+        let t = self.hex8.as_deref()?;
+        // J_ik and x_i at every point, summed over the nodes in node order
+        // (`j[i][8k + q]`, `x[i][q]`).
+        let mut j = [[0.0; 24]; 3];
+        let mut x = [[0.0; 8]; 3];
+        for a in 0..8 {
+            let (c, n, dn) = (coords[a], &t.n_by_node[a], &t.dn_by_node[a]);
+            for i in 0..3 {
+                for q in 0..8 {
+                    x[i][q] += n[q] * c[i];
+                }
+                for kq in 0..24 {
+                    j[i][kq] += c[i] * dn[kq];
+                }
+            }
+        }
+        // det J and J⁻¹ by cofactors, as `map_point`.
+        let mut det = [0.0; 8];
+        let mut inv = [[[0.0; 8]; 3]; 3];
+        for q in 0..8 {
+            let m = |i: usize, k: usize| j[i][8 * k + q];
+            let c00 = m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1);
+            let c01 = m(1, 2) * m(2, 0) - m(1, 0) * m(2, 2);
+            let c02 = m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0);
+            let d = m(0, 0) * c00 + m(0, 1) * c01 + m(0, 2) * c02;
+            let r = 1.0 / d;
+            det[q] = d;
+            inv[0][0][q] = c00 * r;
+            inv[1][0][q] = c01 * r;
+            inv[2][0][q] = c02 * r;
+            inv[0][1][q] = (m(0, 2) * m(2, 1) - m(0, 1) * m(2, 2)) * r;
+            inv[1][1][q] = (m(0, 0) * m(2, 2) - m(0, 2) * m(2, 0)) * r;
+            inv[2][1][q] = (m(0, 1) * m(2, 0) - m(0, 0) * m(2, 1)) * r;
+            inv[0][2][q] = (m(0, 1) * m(1, 2) - m(0, 2) * m(1, 1)) * r;
+            inv[1][2][q] = (m(0, 2) * m(1, 0) - m(0, 0) * m(1, 2)) * r;
+            inv[2][2][q] = (m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0)) * r;
+        }
+        if let Some(q) = (0..8).find(|&q| det[q].is_nan() || det[q] <= 0.0) {
+            return Some(Err(BadJacobian {
+                det: det[q],
+                point: self.rule.points[q],
+            }));
+        }
+        let mut out = Hex8Points {
+            grad: [[[0.0; 8]; 3]; 8],
+            x: [[0.0; 3]; 8],
+            jxw: [0.0; 8],
+        };
+        for q in 0..8 {
+            let d = &t.dn_by_point[q];
+            for i in 0..3 {
+                let (r0, r1, r2) = (inv[0][i][q], inv[1][i][q], inv[2][i][q]);
+                for a in 0..8 {
+                    out.grad[q][i][a] = r0 * d[0][a] + r1 * d[1][a] + r2 * d[2][a];
+                }
+                out.x[q][i] = x[i][q];
+            }
+            out.jxw[q] = det[q] * t.weights[q];
+        }
+        Some(Ok(out))
     }
 
     /// The element's standard rule ([`QuadratureRule::standard`]); `None` for shells
