@@ -474,6 +474,32 @@ impl Pattern {
     }
 }
 
+/// A value slot outside the element slots, fixed before its values are known: one
+/// direction of a coupling, or a diagonal entry ([`Assembler::add_at_all`]). Worked out
+/// once per pattern, it saves a caller that adds many values the choice between
+/// [`Assembler::add_coupling`] and [`Assembler::add_diagonal`] for each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExtraSlot(u32);
+
+impl ExtraSlot {
+    /// The high bit marks a diagonal slot; the rest is the coupling slot or the dof.
+    const DIAGONAL: u32 = 1 << 31;
+
+    /// Entry `(i, j)` of coupling `k` or, `transposed`, its `(j, i)`. Panics beyond
+    /// 2³⁰ couplings (a pattern that size does not fit the 32-bit slot positions).
+    pub fn coupling(k: usize, transposed: bool) -> Self {
+        let slot = 2 * k + usize::from(transposed);
+        assert!(slot < Self::DIAGONAL as usize, "coupling {k} beyond 2^30");
+        ExtraSlot(slot as u32)
+    }
+
+    /// The diagonal entry of `dof`. Panics for dofs beyond 2³¹.
+    pub fn diagonal(dof: usize) -> Self {
+        assert!(dof < Self::DIAGONAL as usize, "dof {dof} beyond 2^31");
+        ExtraSlot(Self::DIAGONAL | dof as u32)
+    }
+}
+
 /// Collects element matrices and vectors, couplings and diagonal terms into the slot
 /// arrays of a [`Pattern`], then makes the sparse matrix by values only.
 pub struct Assembler<'p> {
@@ -565,6 +591,25 @@ impl<'p> Assembler<'p> {
         self.values[base + dof] += v;
     }
 
+    /// Add `values[k]` at `slots[k]` for every k, in order: each as
+    /// [`Self::add_coupling`] with one of its two values, or [`Self::add_diagonal`];
+    /// coupling slots count from coupling `first` (where a caller's list of couplings
+    /// was registered).
+    #[inline]
+    pub fn add_at_all(&mut self, slots: &[ExtraSlot], values: &[f64], first: usize) {
+        assert_eq!(slots.len(), values.len(), "one value per slot");
+        let couplings = self.pattern.elem_values + 2 * first;
+        let diagonal = self.pattern.elem_values + 2 * self.pattern.couplings.len();
+        for (&slot, &v) in slots.iter().zip(values) {
+            let base = if slot.0 & ExtraSlot::DIAGONAL != 0 {
+                diagonal
+            } else {
+                couplings
+            };
+            self.values[base + (slot.0 & !ExtraSlot::DIAGONAL) as usize] += v;
+        }
+    }
+
     /// Add `v` to the right-hand side at `dof`.
     pub fn add_rhs(&mut self, dof: usize, v: f64) {
         self.vector[self.vec_elem_len + dof] += v;
@@ -593,16 +638,55 @@ impl<'p> Assembler<'p> {
     /// The assembled matrix (values only: the pattern's symbolic structure is cloned
     /// and the slots are added into their positions in slot order).
     pub fn matrix(&self) -> Result<SparseColMat<usize, f64>, AssemblyError> {
-        let (sym, positions) = self
-            .pattern
+        let sym = self.built()?.0;
+        let mut vals = vec![0.0; sym.row_idx().len()];
+        self.sum_slots(&mut vals)?;
+        Ok(SparseColMat::new(sym.clone(), vals))
+    }
+
+    /// The assembled values written into `matrix`, which holds this pattern's structure
+    /// (made by [`Self::matrix`] from the same pattern): the values refreshed in place,
+    /// with no allocation and no copy of the structure; the same bits as
+    /// [`Self::matrix`]. A matrix of another size or entry count is an error.
+    pub fn refresh_matrix(
+        &self,
+        matrix: &mut SparseColMat<usize, f64>,
+    ) -> Result<(), AssemblyError> {
+        let sym = self.built()?.0;
+        let (have, vals) = matrix.parts_mut();
+        if have.nrows() != sym.nrows()
+            || have.ncols() != sym.ncols()
+            || have.col_ptr() != sym.col_ptr()
+        {
+            return Err(AssemblyError::Faer(format!(
+                "the matrix to refresh ({}×{}, {} entries) is not this pattern's ({}×{}, {} entries)",
+                have.nrows(),
+                have.ncols(),
+                vals.len(),
+                sym.nrows(),
+                sym.ncols(),
+                sym.row_idx().len()
+            )));
+        }
+        vals.fill(0.0);
+        self.sum_slots(vals)
+    }
+
+    fn built(&self) -> Result<(&SymbolicSparseColMat<usize>, &[u32]), AssemblyError> {
+        self.pattern
             .built
             .as_ref()
-            .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))?;
-        let mut vals = vec![0.0; sym.row_idx().len()];
+            .map(|(sym, positions)| (sym, positions.as_slice()))
+            .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))
+    }
+
+    /// Adds every slot into its position of the CSC value array `vals`, slot after slot.
+    fn sum_slots(&self, vals: &mut [f64]) -> Result<(), AssemblyError> {
+        let positions = self.built()?.1;
         for (&p, &v) in positions.iter().zip(&self.values) {
             vals[p as usize] += v;
         }
-        Ok(SparseColMat::new(sym.clone(), vals))
+        Ok(())
     }
 
     /// The assembled right-hand side: the direct loads, then the element vectors added
@@ -620,5 +704,54 @@ impl<'p> Assembler<'p> {
             }
         }
         f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate::{BoxSpec, single_box};
+
+    /// Element slots filled with values that depend on the element, the entry and a
+    /// round number, so two rounds differ everywhere.
+    fn assemble(asm: &mut Assembler<'_>, mesh: &Mesh, round: f64) {
+        asm.elements(mesh, None, |e, ke, fe| {
+            for (k, v) in ke.iter_mut().enumerate() {
+                *v = round + e.0 as f64 * 0.1 + k as f64 * 1e-3;
+            }
+            fe.fill(round);
+        });
+    }
+
+    /// A refresh in place gives the bits a new matrix gives, keeps the structure, and
+    /// refuses a matrix of another pattern.
+    #[test]
+    fn refreshed_matrix_equals_a_new_one() {
+        let mesh = single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [2, 2, 1], 1));
+        let dofs = DofMap::new(&mesh, &[("t", &[0])]).unwrap();
+        let mut pattern = Pattern::new(&mesh, &dofs);
+        pattern.add_couplings(&[(0, 17)]).unwrap();
+        pattern.build().unwrap();
+        let mut asm = Assembler::new(&pattern);
+        assemble(&mut asm, &mesh, 1.0);
+        asm.add_coupling(0, 2.5, -1.5);
+        let mut kept = asm.matrix().unwrap();
+        assemble(&mut asm, &mesh, 7.0);
+        asm.reset_couplings();
+        asm.add_coupling(0, 0.25, 3.0);
+        asm.add_diagonal(4, 9.0);
+        asm.refresh_matrix(&mut kept).unwrap();
+        let fresh = asm.matrix().unwrap();
+        let bits = |m: &SparseColMat<usize, f64>| -> Vec<u64> {
+            m.val().iter().map(|v| v.to_bits()).collect()
+        };
+        assert_eq!(bits(&kept), bits(&fresh));
+        assert_eq!(kept.symbolic().row_idx(), fresh.symbolic().row_idx());
+        let other = single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [3, 1, 1], 1));
+        let other_dofs = DofMap::new(&other, &[("t", &[0])]).unwrap();
+        let mut other_pattern = Pattern::new(&other, &other_dofs);
+        other_pattern.build().unwrap();
+        let mut wrong = Assembler::new(&other_pattern).matrix().unwrap();
+        assert!(asm.refresh_matrix(&mut wrong).is_err());
     }
 }
