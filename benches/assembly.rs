@@ -254,7 +254,11 @@ fn interface(n: usize, reps: usize) {
     let mut direct = None;
     let t_into = timed(reps, || {
         asm.reset_couplings();
-        direct = Some(points.evaluate_into(&form, &u, &mut asm, &scatter, first).unwrap());
+        direct = Some(
+            points
+                .evaluate_into(&form, &u, &mut asm, &scatter, first)
+                .unwrap(),
+        );
     });
     let direct = direct.unwrap();
     let t_terms = timed(reps.min(3), || {

@@ -47,15 +47,24 @@
 //! leaving side A, `∫ P([u] − ΔT) − θ{k∂u}`; with `v = 1` on side B, minus the same. So
 //! the heat through each side is read off the assembled interface residual, and their
 //! sum is zero to round-off for every model here.
+//!
+//! Layout: [`InterfacePoints`] holds the geometry of one pairing (made once per search)
+//! and evaluates the form at a field, into dense blocks ([`InterfacePoints::evaluate`])
+//! or straight into an assembler ([`InterfacePoints::evaluate_into`]); `side` evaluates
+//! one side of the interface at a point ([`side_eval`]).
 
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas' subscripts
 
 use crate::assembly::{Assembler, AssemblyError, DofMap, ExtraSlot, FieldId};
-use crate::fem::shape::reference_nodes;
-use crate::fem::{MAX_NODES, eval_point};
-use crate::mesh::{ElemId, Mesh, NodeId, Side, Topology};
+use crate::fem::MAX_NODES;
+use crate::mesh::{Mesh, Topology};
 use crate::search::pairing::{ContactPoint, SurfaceGeometry};
-use crate::vec3::{cross, dot, norm, sub};
+use crate::vec3::dot;
+
+mod side;
+
+use side::FaceElement;
+pub use side::{SideEval, side_eval};
 
 /// Default Nitsche penalty factor β in `α = β k_eff / h_e`: well above the inverse-
 /// estimate constant of trilinear and linear elements with `h_e` = volume / face area
@@ -131,21 +140,6 @@ pub struct InterfaceForm<'a> {
     pub conductivity: &'a [f64],
 }
 
-/// Everything one contact point needs from one side: the element, its dofs, shape
-/// values and physical gradients at the point, the outward normal, k and h_e.
-#[derive(Clone, Copy, Debug)]
-pub struct SideEval {
-    pub elem: ElemId,
-    pub len: usize,
-    pub dofs: [u32; MAX_NODES],
-    pub n: [f64; MAX_NODES],
-    pub grad: [[f64; 3]; MAX_NODES],
-    pub normal: [f64; 3],
-    pub k: f64,
-    /// Element volume / face area: the length of the Nitsche penalty.
-    pub h_e: f64,
-}
-
 /// Why an interface could not be set up.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -202,194 +196,6 @@ pub(crate) fn node_dof(
             surface: surface.to_string(),
             field: dofs.field_name(field).to_string(),
         })
-}
-
-/// Evaluate one side at a point of face `side`, face coordinates `xi`.
-pub fn side_eval(
-    mesh: &Mesh,
-    dofs: &DofMap,
-    field: FieldId,
-    side: Side,
-    xi: [f64; 2],
-    conductivity: &[f64],
-) -> Result<SideEval, InterfaceError> {
-    FaceElement::new(mesh, dofs, field, side, conductivity).eval(mesh, dofs, xi)
-}
-
-/// What every point of one face needs from the element behind it: the part of a
-/// [`SideEval`] that does not depend on where on the face the point is, so an
-/// interface evaluates it once per face. Its failures wait for [`FaceElement::eval`],
-/// which reports them in the order [`side_eval`] always has (no shape functions, bad
-/// element at the point, missing dof).
-#[derive(Clone, Copy, Debug)]
-struct FaceElement {
-    side: Side,
-    topology: Topology,
-    /// Reference coordinates of the face's nodes in the element (`None`: no shape
-    /// functions), and the face's node count.
-    face_nodes: Option<([[f64; 3]; 4], usize)>,
-    len: usize,
-    dofs: [u32; MAX_NODES],
-    /// The first node without a dof of the field, if any.
-    missing: Option<NodeId>,
-    field: FieldId,
-    normal: [f64; 3],
-    k: f64,
-    h_e: f64,
-}
-
-impl FaceElement {
-    fn new(mesh: &Mesh, dofs: &DofMap, field: FieldId, side: Side, conductivity: &[f64]) -> Self {
-        let elem = side.elem;
-        let topology = mesh.topology(elem);
-        let nodes = mesh.elem_nodes(elem);
-        let mut out = FaceElement {
-            side,
-            topology,
-            face_nodes: face_reference_nodes(topology, side.side),
-            len: nodes.len(),
-            dofs: [0; MAX_NODES],
-            missing: None,
-            field,
-            normal: outward_normal(mesh, side),
-            k: conductivity[mesh.block_of(elem)],
-            h_e: element_length(mesh, elem, side),
-        };
-        for (k, &node) in nodes.iter().enumerate() {
-            match dofs.dof(field, node) {
-                Some(d) => out.dofs[k] = d.0,
-                None => {
-                    out.missing = Some(node);
-                    break;
-                }
-            }
-        }
-        out
-    }
-
-    /// The side at face coordinates `xi`: shape values and physical gradients there.
-    fn eval(&self, mesh: &Mesh, dofs: &DofMap, xi: [f64; 2]) -> Result<SideEval, InterfaceError> {
-        let (elem, topology) = (self.side.elem, self.topology);
-        let number = mesh.elem_number(elem);
-        let (nodes, len) = self
-            .face_nodes
-            .ok_or(InterfaceError::NoShapes { number, topology })?;
-        // The face's own shape functions interpolate its nodes' reference coordinates.
-        let w = face_shape_values(len, xi);
-        let mut xi3 = [0.0; 3];
-        for k in 0..len {
-            for d in 0..3 {
-                xi3[d] += w[k] * nodes[k][d];
-            }
-        }
-        let coords = elem_coords(mesh, elem);
-        let pv = eval_point(topology, &coords[..self.len], xi3, 1.0)
-            .map_err(|b| InterfaceError::BadElement { number, det: b.det })?;
-        if let Some(node) = self.missing {
-            return Err(InterfaceError::NoDof {
-                number: mesh.node_number(node),
-                elem: number,
-                field: dofs.field_name(self.field).to_string(),
-            });
-        }
-        Ok(SideEval {
-            elem,
-            len: self.len,
-            dofs: self.dofs,
-            n: pv.n,
-            grad: pv.grad,
-            normal: self.normal,
-            k: self.k,
-            h_e: self.h_e,
-        })
-    }
-}
-
-/// Reference coordinates, in an element of `topology`, of the nodes of its local side
-/// `side` (1-based), and their count; `None` without shape functions or for a side
-/// that is not a triangle or quadrilateral.
-fn face_reference_nodes(topology: Topology, side: u8) -> Option<([[f64; 3]; 4], usize)> {
-    let nodes = reference_nodes(topology)?;
-    let local = topology.sides().get((side as usize).checked_sub(1)?)?;
-    if !matches!(local.len(), 3 | 4) {
-        return None;
-    }
-    let mut out = [[0.0; 3]; 4];
-    for (k, &l) in local.iter().enumerate() {
-        out[k] = nodes[l as usize];
-    }
-    Some((out, local.len()))
-}
-
-/// The coordinates of an element's nodes (the first `node_count` entries).
-fn elem_coords(mesh: &Mesh, elem: ElemId) -> [[f64; 3]; MAX_NODES] {
-    let mut coords = [[0.0; 3]; MAX_NODES];
-    for (k, n) in mesh.elem_nodes(elem).iter().enumerate() {
-        coords[k] = mesh.coords[n.index()];
-    }
-    coords
-}
-
-/// Twice the vector area of a (planar or nearly planar) side: the cross product of two
-/// edges of a triangle, of the diagonals of a quadrilateral; zero for other node counts.
-fn side_vector(mesh: &Mesh, side: Side) -> [f64; 3] {
-    let mut p = [[0.0; 3]; 4];
-    let mut len = 0;
-    for n in mesh.side_nodes(side) {
-        if len < 4 {
-            p[len] = mesh.coords[n.index()];
-        }
-        len += 1;
-    }
-    match len {
-        3 => cross(sub(p[1], p[0]), sub(p[2], p[0])),
-        4 => cross(sub(p[2], p[0]), sub(p[3], p[1])),
-        _ => [0.0; 3],
-    }
-}
-
-/// Outward unit normal of a (planar or nearly planar) side: its vector area.
-fn outward_normal(mesh: &Mesh, side: Side) -> [f64; 3] {
-    let v = side_vector(mesh, side);
-    let l = norm(v);
-    if l > 0.0 { v.map(|c| c / l) } else { v }
-}
-
-/// Volume of the element over the area of the side: the element's thickness normal to
-/// the interface. The volume is det J at the reference centroid times the reference
-/// volume — exact for affine elements and a fair length scale for others, which is all
-/// a penalty length needs (one shape-function evaluation, no quadrature).
-fn element_length(mesh: &Mesh, elem: ElemId, side: Side) -> f64 {
-    let topology = mesh.topology(elem);
-    let Some(reference) = reference_nodes(topology) else {
-        return 0.0;
-    };
-    let coords = elem_coords(mesh, elem);
-    let mut center = [0.0; 3];
-    for r in reference {
-        for d in 0..3 {
-            center[d] += r[d] / reference.len() as f64;
-        }
-    }
-    let reference_volume = match topology {
-        Topology::Hex8 => 8.0,
-        Topology::Tet4 => 1.0 / 6.0,
-        Topology::Wedge6 => 1.0,
-        Topology::Pyramid5 => 4.0 / 3.0,
-        Topology::Quad4 => 4.0,
-        Topology::Tri3 => 0.5,
-        _ => 0.0,
-    };
-    let volume = eval_point(
-        topology,
-        &coords[..reference.len()],
-        center,
-        reference_volume,
-    )
-    .map_or(0.0, |pv| pv.jxw.abs());
-    // Both triangle and quadrilateral areas are half the side vector's length.
-    let area = 0.5 * norm(side_vector(mesh, side));
-    if area > 0.0 { volume / area } else { 0.0 }
 }
 
 /// Above this many times the penalty scale α, a resistance (`P = h`) gives way to the
@@ -1107,170 +913,4 @@ pub fn point_flux(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::assembly::Pattern;
-    use crate::mesh::generate::{self, BoxSpec};
-    use crate::search::SearchSettings;
-    use crate::search::pairing::{Integration, Searcher};
-
-    /// A 4 × 4-face slab under a 3 × 3-face one (non-matching, slightly tilted so the
-    /// normals and gradients are not axis-aligned), with a temperature-dependent h.
-    fn scene() -> (Mesh, DofMap, InterfacePoints, Vec<f64>) {
-        let mut mesh = generate::boxes(
-            &[
-                BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.5], [4, 4, 2], 1)
-                    .with_side_sets([0, 0, 0, 0, 0, 1]),
-                BoxSpec::hex([0.0, 0.0, 0.5], [1.0, 1.0, 1.0], [3, 3, 2], 2)
-                    .with_side_sets([0, 0, 0, 0, 2, 0]),
-            ],
-            false,
-        );
-        for p in &mut mesh.coords {
-            p[2] += 0.1 * p[0] - 0.05 * p[1];
-        }
-        let a = SurfaceGeometry::from_side_set(&mesh, 0).unwrap();
-        let b = SurfaceGeometry::from_side_set(&mesh, 1).unwrap();
-        let settings = SearchSettings::defaults(3);
-        let r = Searcher::new(&b, &settings).search_points(
-            &a,
-            &b,
-            &settings,
-            Integration::Quadrature { order: 2 },
-            None,
-        );
-        let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();
-        let field = dofs.field("temperature").unwrap();
-        let points =
-            InterfacePoints::new(&mesh, &dofs, field, &a, &b, &r.points, &form(&H)).unwrap();
-        let u = (0..dofs.len()).map(|d| 300.0 + (d % 7) as f64).collect();
-        (mesh, dofs, points, u)
-    }
-
-    static H: fn(&HInput) -> Result<HValue, String> = |p| {
-        Ok(HValue {
-            h: 50.0 + 0.1 * p.temp_a + 0.2 * p.temp_b,
-            dh_dtemp_a: 0.1,
-            dh_dtemp_b: 0.2,
-        })
-    };
-
-    fn form<'a>(h: &'a HFn<'a>) -> InterfaceForm<'a> {
-        InterfaceForm {
-            form: Form::GapConductance,
-            h,
-            offset: 0.5,
-            beta: DEFAULT_BETA,
-            conductivity: &[16.0, 200.0],
-        }
-    }
-
-    /// The blocks of `evaluate` against the form written entry by entry,
-    /// `w [P J_i J_j − θ (F_i J_j + J_i F_j) − S F_i F_j + (∂r_i/∂h) ∂h/∂u_j]`: equal to
-    /// round-off (1e-14 of the block's largest entry; the evaluation regroups the terms).
-    #[test]
-    fn evaluated_blocks_are_the_form() {
-        let (_, _, points, u) = scene();
-        let f = form(&H);
-        let system = points.evaluate(&f, &u).unwrap();
-        assert!(points.groups() > 9);
-        for (g, (dofs, m)) in system.blocks.iter().enumerate() {
-            let nl = dofs.len();
-            let mut want = vec![0.0; nl * nl];
-            for p in &points.points[points.group_points[g]..points.group_points[g + 1]] {
-                let e = points.at_point(p, dofs, &f, &u).unwrap();
-                let ([cp, ct, cs], [dp, dt, ds]) = coefficients(f.form, e.hv.h, p.alpha);
-                for i in 0..nl {
-                    let (ji, fi) = (e.jump[i], e.flux[i]);
-                    let dr = dp * ji * e.jump_u
-                        - dt * (fi * e.jump_u + ji * e.flux_u)
-                        - ds * fi * e.flux_u;
-                    for j in 0..nl {
-                        let (jj, fj) = (e.jump[j], e.flux[j]);
-                        let dh = if j < p.na as usize {
-                            e.hv.dh_dtemp_a * jj
-                        } else {
-                            -e.hv.dh_dtemp_b * jj
-                        };
-                        let lin = cp * ji * jj - ct * (fi * jj + ji * fj) - cs * fi * fj;
-                        want[i * nl + j] += p.weight * (lin + dr * dh);
-                    }
-                }
-            }
-            let big = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for (k, (v, w)) in m.iter().zip(&want).enumerate() {
-                assert!(
-                    (v - w).abs() <= 1e-14 * big,
-                    "group {g} entry {k}: {v} vs {w}"
-                );
-            }
-        }
-    }
-
-    /// The couplings are every pair of dofs met in a group, sorted and without repeats;
-    /// adding through the scatter slots gives the matrix that adding each entry with
-    /// `add_coupling`/`add_diagonal` gives, and `evaluate_into` gives the same bits and
-    /// the same residual.
-    #[test]
-    fn couplings_and_scatter_place_every_entry() {
-        let (mesh, dofs, points, u) = scene();
-        let mut want = Vec::new();
-        for g in 0..points.groups() {
-            let d = points.group(g);
-            for a in 0..d.len() {
-                for b in a + 1..d.len() {
-                    if d[a] != d[b] {
-                        want.push((d[a].min(d[b]) as usize, d[a].max(d[b]) as usize));
-                    }
-                }
-            }
-        }
-        want.sort_unstable();
-        want.dedup();
-        let couplings = points.couplings();
-        assert_eq!(couplings, want);
-        let mut pattern = Pattern::new(&mesh, &dofs);
-        pattern.add_couplings(&[(0, 1), (1, 2)]).unwrap();
-        let first = pattern.add_couplings(&couplings).unwrap().start;
-        pattern.build().unwrap();
-        let system = points.evaluate(&form(&H), &u).unwrap();
-        // Slots counted from this list's start, placed at `first` when added.
-        let scatter = points.scatter(&couplings, 0);
-        let mut fast = Assembler::new(&pattern);
-        system.add_scattered(&mut fast, &scatter, first);
-        let mut slow = Assembler::new(&pattern);
-        for (d, m) in &system.blocks {
-            let nl = d.len();
-            for a in 0..nl {
-                for b in 0..nl {
-                    let (i, j, v) = (d[a] as usize, d[b] as usize, m[a * nl + b]);
-                    if i == j {
-                        slow.add_diagonal(i, v);
-                    } else {
-                        let k = first + couplings.binary_search(&(i.min(j), i.max(j))).unwrap();
-                        let (vij, vji) = if i < j { (v, 0.0) } else { (0.0, v) };
-                        slow.add_coupling(k, vij, vji);
-                    }
-                }
-            }
-        }
-        let mut into = Assembler::new(&pattern);
-        let direct = points
-            .evaluate_into(&form(&H), &u, &mut into, &scatter, first)
-            .unwrap();
-        assert!(direct.blocks.is_empty());
-        assert_eq!(direct.residual, system.residual);
-        assert_eq!(direct.rhs, system.rhs);
-        let (fast, slow, into) = (
-            fast.matrix().unwrap(),
-            slow.matrix().unwrap(),
-            into.matrix().unwrap(),
-        );
-        assert!(fast.val().iter().any(|v| *v != 0.0));
-        assert_eq!(fast.val(), slow.val());
-        let bits = |m: &faer::sparse::SparseColMat<usize, f64>| -> Vec<u64> {
-            m.val().iter().map(|v| v.to_bits()).collect()
-        };
-        assert_eq!(bits(&into), bits(&fast));
-    }
-}
+mod tests;
