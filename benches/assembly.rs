@@ -7,7 +7,7 @@
 //!   `-- large` for c = 100, 1 000 000): the conductivity kernel alone (element
 //!   coordinates gathered, `Ke` computed into a stack array, element after element),
 //!   the nonlinear kernel of the transient solver (`R` and `J` at a temperature, k
-//!   constant), `assemble_conduction` into a kept pattern (kernels writing their slots),
+//!   constant, so dk/dT = 0 as for a linear law), `assemble_conduction` into a kept pattern (kernels writing their slots),
 //!   and the slot sum into the CSC values, into a new matrix (`Assembler::matrix`) or
 //!   the kept one (`Assembler::refresh_matrix`);
 //! - interface terms of a gap conductance (constant h) on a non-matching planar

@@ -22,6 +22,8 @@
 //! same operations in the same order, as on the general path (point after point; `k
 //! ∇N_a·∇N_b` as `k (∂₁N_a ∂₁N_b + ∂₂N_a ∂₂N_b + ∂₃N_a ∂₃N_b)`), so both paths give the
 //! same bits and the matrices stay exactly symmetric (each product commutes exactly).
+//! The one exception: the nonlinear kernel leaves out its dk/dT term where dk/dT = 0
+//! (a linear law), which adds ±0 and so changes no value (at most the sign of a zero).
 
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
@@ -367,8 +369,16 @@ pub fn conduction_residual_jacobian(
                 let ga_gt = gx[a] * gt[0] + gy[a] * gt[1] + gz[a] * gt[2];
                 re[a] += kq * ga_gt * jxw;
                 let gg = gradient_products(&m.grad[q], a);
-                for b in 0..8 {
-                    je[a * 8 + b] += (kq * gg[b] + dk * n[b] * ga_gt) * jxw;
+                let row = &mut je[a * 8..a * 8 + 8];
+                if dk == 0.0 {
+                    // The dk/dT term is ±0 here: leaving it out changes no value.
+                    for b in 0..8 {
+                        row[b] += (kq * gg[b]) * jxw;
+                    }
+                } else {
+                    for b in 0..8 {
+                        row[b] += (kq * gg[b] + dk * n[b] * ga_gt) * jxw;
+                    }
                 }
             }
         }
@@ -449,6 +459,9 @@ mod tests {
                 let (mut re, mut rs, mut fe) = ([0.0; 8], [0.0; 8], [0.0; 8]);
                 conductivity(basis, &x, k, &mut ke).unwrap();
                 conduction_residual_jacobian(basis, &x, &t, kt, &mut re, &mut je).unwrap();
+                // A law without dk/dT (the fast path's shortcut), into the same arrays.
+                let linear = |_: f64, p: [f64; 3]| (k(p), 0.0);
+                conduction_residual_jacobian(basis, &x, &t, linear, &mut re, &mut je).unwrap();
                 source(basis, &x, |p| 1.0 + p[1], &mut fe).unwrap();
                 source_residual_jacobian(basis, &x, &t, q, &mut rs, &mut js).unwrap();
                 capacity_lumped(basis, &x, 3.0, &mut me).unwrap();

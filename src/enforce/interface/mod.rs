@@ -444,8 +444,8 @@ impl InterfacePoints {
         // Every point's group key, its cached part and its local vectors, in pairing
         // order; the key keeps face points (0, element A, element B) apart from node
         // points (1, node, element B).
-        let mut keys: Vec<((u8, u32, u32), u32)> = Vec::new();
-        let mut evaluated: Vec<(CachedPoint, Local)> = Vec::new();
+        let mut keys: Vec<((u8, u32, u32), u32)> = Vec::with_capacity(points.len());
+        let mut evaluated: Vec<(CachedPoint, Local)> = Vec::with_capacity(points.len());
         for (index, p) in points.iter().enumerate() {
             let Some(k_b) = p.matched_b_face() else {
                 continue;
@@ -502,7 +502,7 @@ impl InterfacePoints {
         let mut sides = vec![0u8; dofs.len()];
         let mut last_key = None;
         for (key, at) in keys {
-            let (mut point, l) = evaluated[at as usize];
+            let (point, l) = &evaluated[at as usize];
             if last_key != Some(key) {
                 if last_key.is_some() {
                     out.group_dofs.push(out.dofs.len());
@@ -511,13 +511,13 @@ impl InterfacePoints {
                 out.dofs.extend_from_slice(l.dofs());
                 last_key = Some(key);
             }
-            point.at = out.values.len() as u32;
+            let at = out.values.len() as u32;
             out.values.extend_from_slice(&l.jump[..l.len]);
             out.values.extend_from_slice(&l.flux[..l.len]);
             for (k, &d) in l.dofs().iter().enumerate() {
                 sides[d as usize] |= if k < l.na { 1 } else { 2 };
             }
-            out.points.push(point);
+            out.points.push(CachedPoint { at, ..*point });
         }
         if last_key.is_some() {
             out.group_dofs.push(out.dofs.len());
