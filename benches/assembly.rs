@@ -210,9 +210,8 @@ fn interface(n: usize, reps: usize) {
         on_b[n.index()] = true;
     }
     let mut u = vec![0.0; dofs.len()];
-    for i in 0..mesh.num_nodes() {
-        let p = mesh.coords[i];
-        let jump = if on_b[i] { 1.0 } else { 0.0 };
+    for (i, (p, &b)) in mesh.coords.iter().zip(&on_b).enumerate() {
+        let jump = if b { 1.0 } else { 0.0 };
         let d = dofs.dof(field, NodeId(i as u32)).unwrap();
         u[d.index()] = 300.0 + 10.0 * p[0] - 5.0 * p[1] + 100.0 * p[2] + jump;
     }
