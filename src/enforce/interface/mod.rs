@@ -619,30 +619,43 @@ impl InterfacePoints {
                 .map(|w| (w[1] - w[0]).pow(2))
                 .sum(),
         );
+        let mut order = [0usize; 2 * MAX_NODES];
         for g in 0..self.groups() {
             let dofs = self.group(g);
             let nl = dofs.len();
             let block = slots.len();
             slots.resize(block + nl * nl, ExtraSlot::diagonal(0));
-            // Entry (a, b) and its transpose (b, a) share one coupling.
-            for a in 0..nl {
-                slots[block + a * nl + a] = ExtraSlot::diagonal(dofs[a] as usize);
-                for b in a + 1..nl {
-                    let (i, j) = (dofs[a] as usize, dofs[b] as usize);
-                    if i == j {
-                        slots[block + a * nl + b] = ExtraSlot::diagonal(i);
-                        slots[block + b * nl + a] = ExtraSlot::diagonal(i);
+            // The group's entries by ascending dof: the partners of each dof are then
+            // met in the order of its run of couplings, which one pass walks through
+            // (no search). Entry (a, b) and its transpose (b, a) share one coupling.
+            let order = &mut order[..nl];
+            for (k, o) in order.iter_mut().enumerate() {
+                *o = k;
+            }
+            order.sort_unstable_by_key(|&k| dofs[k]);
+            for (p, &a) in order.iter().enumerate() {
+                let lo = dofs[a] as usize;
+                slots[block + a * nl + a] = ExtraSlot::diagonal(lo);
+                let run = match row.get(lo..lo + 2) {
+                    Some(&[start, end]) => &couplings[start..end],
+                    _ => &[],
+                };
+                let mut r = 0;
+                for &b in &order[p + 1..] {
+                    let hi = dofs[b] as usize;
+                    if hi == lo {
+                        slots[block + a * nl + b] = ExtraSlot::diagonal(lo);
+                        slots[block + b * nl + a] = ExtraSlot::diagonal(lo);
                         continue;
                     }
-                    let (lo, hi) = (i.min(j), i.max(j));
-                    let run = &couplings[row[lo]..row[lo + 1]];
-                    let k = first
-                        + row[lo]
-                        + run
-                            .binary_search_by_key(&hi, |c| c.1)
-                            .expect("coupling registered from the same groups");
-                    slots[block + a * nl + b] = ExtraSlot::coupling(k, i > j);
-                    slots[block + b * nl + a] = ExtraSlot::coupling(k, j > i);
+                    while run[r].1 < hi {
+                        r += 1;
+                    }
+                    assert_eq!(run[r].1, hi, "coupling registered from the same groups");
+                    let k = first + row[lo] + r;
+                    // (a, b) is (lo, hi), the coupling as registered; (b, a) its transpose.
+                    slots[block + a * nl + b] = ExtraSlot::coupling(k, false);
+                    slots[block + b * nl + a] = ExtraSlot::coupling(k, true);
                 }
             }
         }
