@@ -81,112 +81,59 @@ impl Embedding {
     pub fn evaluate(&mut self, u: &[f64]) -> Result<&Evaluation, EmbedError> {
         let local = self.local_field(u)?;
         let n = u.len();
-        let host = |d: u32| self.host_dof[d as usize];
         let reuse = self
             .evaluation
             .as_ref()
             .is_some_and(|e| e.current && e.jacobian.n == n && e.slots.len() == self.pairs.len());
-        // An interaction switched off is evaluated only to build a pattern, so the
-        // pattern does not change when it is switched on again.
-        let mut systems = Vec::with_capacity(self.pairs.len());
-        for p in &self.pairs {
-            systems.push(if p.active || !reuse {
-                self.system(p, &local)?
-            } else {
-                None
-            });
+        if !reuse {
+            self.build_pattern(&local, n)?;
         }
-        // The pattern holds while the blocks have the entry counts it was built from.
-        let fits = reuse
-            && self.evaluation.as_ref().is_some_and(|e| {
-                e.slots
-                    .iter()
-                    .zip(&systems)
-                    .zip(&self.pairs)
-                    .all(|((slots, s), p)| {
-                        let entries = s
-                            .as_ref()
-                            .map_or(0, |s| s.blocks.iter().map(|(d, _)| d.len() * d.len()).sum());
-                        !p.active || slots.len() == entries
-                    })
-            });
-        if !fits {
-            for (s, p) in systems.iter_mut().zip(&self.pairs) {
-                if s.is_none() && !p.active {
-                    *s = self.system(p, &local)?;
-                }
-            }
-            let previous = self.evaluation.as_ref().map_or(0, |e| e.pattern);
-            let mut entries: Vec<(usize, usize)> = Vec::new();
-            for s in systems.iter().flatten() {
-                for (dofs, _) in &s.blocks {
-                    for &i in dofs {
-                        entries.extend(dofs.iter().map(|&j| (host(i), host(j))));
-                    }
-                }
-            }
-            entries.sort_unstable();
-            entries.dedup();
-            let mut row_offsets = vec![0; n + 1];
-            for &(i, _) in &entries {
-                row_offsets[i + 1] += 1;
-            }
-            for i in 0..n {
-                row_offsets[i + 1] += row_offsets[i];
-            }
-            let columns: Vec<usize> = entries.iter().map(|e| e.1).collect();
-            let slot = |i: usize, j: usize| {
-                let (a, b) = (row_offsets[i], row_offsets[i + 1]);
-                a + columns[a..b]
-                    .binary_search(&j)
-                    .expect("the pattern holds every block entry")
-            };
-            let slots = systems
-                .iter()
-                .map(|s| {
-                    let mut out = Vec::new();
-                    for (dofs, _) in s.iter().flat_map(|s| &s.blocks) {
-                        for &i in dofs {
-                            out.extend(dofs.iter().map(|&j| slot(host(i), host(j))));
-                        }
-                    }
-                    out
-                })
-                .collect();
-            let nnz = columns.len();
-            self.evaluation = Some(Evaluation {
-                jacobian: CsrMatrix {
-                    n,
-                    row_offsets,
-                    columns,
-                    values: vec![0.0; nnz],
-                },
-                residual: vec![0.0; n],
-                load: vec![0.0; n],
-                heat: Vec::new(),
-                pattern: previous + 1,
-                slots,
-                current: true,
-            });
-        }
+        // Each block is added into the CSR values as it is made (no block is kept).
+        let mut e = self.evaluation.take().expect("made above");
+        let refreshed = self.refresh(&mut e, &local);
+        self.evaluation = Some(e);
+        refreshed?;
+        Ok(self.evaluation.as_ref().expect("just put back"))
+    }
+
+    /// The values of `e` at seam's field `local`, in place.
+    fn refresh(&self, e: &mut Evaluation, local: &[f64]) -> Result<(), EmbedError> {
         let host_dof = &self.host_dof;
-        let e = self.evaluation.as_mut().expect("made above");
         e.jacobian.values.fill(0.0);
         e.residual.fill(0.0);
         e.load.fill(0.0);
         e.heat.clear();
-        for ((s, slots), p) in systems.iter().zip(&e.slots).zip(&self.pairs) {
+        for (p, slots) in self.pairs.iter().zip(&e.slots) {
             if !p.active {
                 e.heat.push(p.is_flux().then(Heat::default));
                 continue;
             }
-            let Some(s) = s else {
+            let values = &mut e.jacobian.values;
+            let mut k = 0;
+            let system = self.with_form(p, |points, form| {
+                points.for_each_block(form, local, |_, m| {
+                    for &v in m {
+                        if let Some(&at) = slots.get(k) {
+                            values[at] += v;
+                        }
+                        k += 1;
+                    }
+                })
+            })?;
+            let Some(s) = system else {
                 e.heat.push(None);
                 continue;
             };
-            let values = s.blocks.iter().flat_map(|(_, m)| m);
-            for (&k, &v) in slots.iter().zip(values) {
-                e.jacobian.values[k] += v;
+            if k != slots.len() {
+                return Err(EmbedError::Order {
+                    what: format!(
+                        "interaction {} / {}: {k} Jacobian entries against a pattern of {}",
+                        p.side_a.name,
+                        p.side_b.name,
+                        slots.len()
+                    ),
+                    help: "search again after changing the interactions".into(),
+                });
             }
             for &(d, v) in &s.residual {
                 e.residual[host_dof[d as usize]] += v;
@@ -197,7 +144,73 @@ impl Embedding {
             let (side_a, side_b) = s.heat();
             e.heat.push(Some(Heat { side_a, side_b }));
         }
-        Ok(e)
+        Ok(())
+    }
+
+    /// A new CSR pattern for `n` host dofs: every entry any interaction's blocks can
+    /// fill (switched-off ones too, so switching does not change it), and each block
+    /// entry's place in it.
+    fn build_pattern(&mut self, local: &[f64], n: usize) -> Result<(), EmbedError> {
+        let host = |d: u32| self.host_dof[d as usize];
+        let mut blocks: Vec<Vec<Vec<u32>>> = Vec::with_capacity(self.pairs.len());
+        for p in &self.pairs {
+            let mut dofs_of = Vec::new();
+            self.with_form(p, |points, form| {
+                points.for_each_block(form, local, |dofs, _| dofs_of.push(dofs.to_vec()))
+            })?;
+            blocks.push(dofs_of);
+        }
+        let previous = self.evaluation.as_ref().map_or(0, |e| e.pattern);
+        let mut entries: Vec<(usize, usize)> = Vec::new();
+        for dofs in blocks.iter().flatten() {
+            for &i in dofs {
+                entries.extend(dofs.iter().map(|&j| (host(i), host(j))));
+            }
+        }
+        entries.sort_unstable();
+        entries.dedup();
+        let mut row_offsets = vec![0; n + 1];
+        for &(i, _) in &entries {
+            row_offsets[i + 1] += 1;
+        }
+        for i in 0..n {
+            row_offsets[i + 1] += row_offsets[i];
+        }
+        let columns: Vec<usize> = entries.iter().map(|e| e.1).collect();
+        let slot = |i: usize, j: usize| {
+            let (a, b) = (row_offsets[i], row_offsets[i + 1]);
+            a + columns[a..b]
+                .binary_search(&j)
+                .expect("the pattern holds every block entry")
+        };
+        let slots = blocks
+            .iter()
+            .map(|pair| {
+                let mut out = Vec::new();
+                for dofs in pair {
+                    for &i in dofs {
+                        out.extend(dofs.iter().map(|&j| slot(host(i), host(j))));
+                    }
+                }
+                out
+            })
+            .collect();
+        let nnz = columns.len();
+        self.evaluation = Some(Evaluation {
+            jacobian: CsrMatrix {
+                n,
+                row_offsets,
+                columns,
+                values: vec![0.0; nnz],
+            },
+            residual: vec![0.0; n],
+            load: vec![0.0; n],
+            heat: Vec::new(),
+            pattern: previous + 1,
+            slots,
+            current: true,
+        });
+        Ok(())
     }
 
     /// The last [`Self::evaluate`], until the next search or move.

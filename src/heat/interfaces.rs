@@ -218,12 +218,11 @@ impl Interfaces for Terms<'_> {
         let mut heat = Vec::with_capacity(self.contact.len());
         for ((c, points), scatter) in self.contact.iter().zip(&self.points).zip(scatters.iter()) {
             let s = points
-                .evaluate(&c.form, u)
+                .evaluate_into(&c.form, u, asm, scatter, first)
                 .map_err(|e| InterfaceFailure::Failed(e.to_string()))?;
             for &(d, v) in &s.residual {
                 r[d as usize] += v;
             }
-            s.add_scattered(asm, scatter, first);
             heat.push(s.heat());
         }
         Ok(heat)

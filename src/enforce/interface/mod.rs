@@ -782,7 +782,9 @@ impl InterfacePoints {
 
     /// The form at `u`, block by block: `block(dofs, matrix)` for each group in order,
     /// the matrix row-major over the group's dofs; returns the system without blocks.
-    fn for_each_block(
+    /// A caller with a matrix of its own (the embedding's CSR) adds each block where
+    /// it goes without keeping it.
+    pub fn for_each_block(
         &self,
         form: &InterfaceForm<'_>,
         u: &[f64],

@@ -8,6 +8,7 @@ use crate::heat::{FaceBc, HeatError};
 use crate::solve::{
     AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
 };
+use faer::sparse::SparseColMat;
 
 use super::setup::{Setup, node_dofs};
 use super::{Failure, Loads, StepReport, TransientProblem};
@@ -30,6 +31,9 @@ pub(super) struct Solvers {
     /// problem stepping with a fixed step reuses the factorisation (bit for bit the
     /// same as factoring again).
     pub(super) factored: Option<(Vec<f64>, Which)>,
+    /// The step matrix of the last assembly: later ones refresh its values in place
+    /// (the pattern does not change over a run).
+    pub(super) matrix: Option<SparseColMat<usize, f64>>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,6 +59,7 @@ impl Solvers {
                 ..AmgOptions::default()
             }),
             factored: None,
+            matrix: None,
         }
     }
 }
@@ -178,7 +183,13 @@ impl Context<'_, '_> {
                 return Ok(Ok(report));
             }
             let clock = std::time::Instant::now();
-            let mut jac = asm.matrix()?;
+            let mut jac = match solvers.matrix.take() {
+                Some(mut kept) => {
+                    asm.refresh_matrix(&mut kept)?;
+                    kept
+                }
+                None => asm.matrix()?,
+            };
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
             apply_dirichlet(&mut jac, &mut rhs, &zero)?;
             report.assembly_s += clock.elapsed().as_secs_f64();
@@ -260,6 +271,7 @@ impl Context<'_, '_> {
                 carried = Some(r);
                 report.assembly_s += clock.elapsed().as_secs_f64();
             }
+            solvers.matrix = Some(jac);
             let u_max = u[..setup.n_primal]
                 .iter()
                 .fold(0.0f64, |m, v| m.max(v.abs()))
