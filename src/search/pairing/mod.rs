@@ -268,6 +268,7 @@ impl Searcher {
                 let mut points = Vec::new();
                 let mut per_face = Vec::with_capacity(end - start);
                 let mut scratch = Vec::new();
+                let mut candidates = Vec::new();
                 for fa in start..end {
                     let before = points.len();
                     match integration {
@@ -286,7 +287,7 @@ impl Searcher {
                         }
                     }
                     let area = if overlap || matches!(integration, Integration::Segments { .. }) {
-                        ctx.overlap_of(a, fa, &points[before..], integration)
+                        ctx.overlap_of(a, fa, &points[before..], integration, &mut candidates)
                     } else {
                         0.0
                     };

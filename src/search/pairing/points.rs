@@ -3,7 +3,7 @@
 //! quadrature points, mortar segment points and node points.
 
 use crate::search::bvh::{Aabb, Bvh};
-use crate::search::mortar::{overlap_area_face_face, rule_triangle, segments_face_face_into};
+use crate::search::mortar::{FaceOverlap, rule_triangle, segments_face_face_into};
 use crate::search::project::{project_point_quad4, project_point_tri3};
 use crate::search::settings::SearchSettings;
 use crate::vec3::{V3, dot, norm, scale, sub};
@@ -264,6 +264,7 @@ impl Ctx<'_> {
         fa: usize,
         points: &[ContactPoint],
         integration: Integration,
+        candidates: &mut Vec<usize>,
     ) -> f64 {
         if let Integration::Segments { .. } = integration {
             return points
@@ -276,18 +277,20 @@ impl Ctx<'_> {
         if self.outside(face.centroid()) {
             return 0.0;
         }
+        let Some(mut clip) = FaceOverlap::new(face.coords()) else {
+            return 0.0;
+        };
         let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
-        let mut candidates = Vec::new();
-        self.face_candidates(face, &mut candidates);
-        for j in candidates {
+        self.face_candidates(face, candidates);
+        for &j in candidates.iter() {
             let fb = &self.b.faces[j];
             if !self.normals_ok(n_a, fb.normal())
                 || dot(sub(fb.centroid(), c_a), n_a).abs() > self.distance_limit(fb)
             {
                 continue;
             }
-            area += overlap_area_face_face(face.coords(), fb.coords());
+            area += clip.area_with(fb.coords());
         }
         area
     }
