@@ -28,7 +28,7 @@
 use faer::sparse::SparseColMat;
 use rayon::prelude::*;
 
-use super::{LinearSolver, SolveError, SolveReport, check_rhs, norm};
+use super::{LinearSolver, SolveError, SolveReport, check_rhs, dot, norm};
 
 /// A compressed sparse row matrix, the AMG's own storage (row access for smoothing).
 #[derive(Clone, Debug, Default)]
@@ -468,10 +468,6 @@ impl LinearSolver for AmgCg {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.par_iter().zip(b).map(|(a, b)| a * b).sum()
-}
-
 fn smooth(lev: &mut Level, smoother: Smoother, forward: bool) {
     match smoother {
         Smoother::SymmetricGaussSeidel => {
@@ -718,6 +714,38 @@ mod tests {
         let aa = a.matmul(&a);
         // (A²)_{ii} = 1 + 4 + 1 = 6 inside, 5 at the ends; exact integers.
         assert_eq!(aa.diagonal(), vec![5.0, 6.0, 6.0, 6.0, 6.0, 6.0, 5.0]);
+    }
+
+    /// The same system solved on one thread and on three gives the same bits: every
+    /// reduction sums fixed chunks in order.
+    #[test]
+    fn amg_cg_gives_the_same_bits_on_any_number_of_threads() {
+        let n = 50_000;
+        let a = laplace_1d(n);
+        let b: Vec<f64> = (0..n)
+            .map(|i| ((i * 7919) % 1000) as f64 / 1000.0)
+            .collect();
+        let solve = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut s = AmgCg::new(AmgOptions::default());
+                s.setup(a.clone()).unwrap();
+                let mut x = vec![0.0; n];
+                let rep = s.pcg(&b, &mut x).unwrap();
+                (x, rep.iterations)
+            })
+        };
+        let (one, k1) = solve(1);
+        let (three, k3) = solve(3);
+        assert_eq!(k1, k3);
+        assert!(
+            one.iter()
+                .zip(&three)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        );
     }
 
     #[test]

@@ -147,8 +147,23 @@ pub fn relative_residual(a: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> 
     if den > 0.0 { num / den } else { num }
 }
 
+/// Entries per partial sum of the parallel reductions. Fixed, so a sum is made of the
+/// same partial sums in the same order on any number of threads: results do not depend
+/// on the thread count.
+const REDUCE_CHUNK: usize = 4096;
+
+/// `a · b`, in fixed chunks summed in order (the same bits on any number of threads).
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let parts: Vec<f64> = a
+        .par_chunks(REDUCE_CHUNK)
+        .zip(b.par_chunks(REDUCE_CHUNK))
+        .map(|(a, b)| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>())
+        .collect();
+    parts.iter().sum()
+}
+
 pub(crate) fn norm(x: &[f64]) -> f64 {
-    x.par_iter().map(|v| v * v).sum::<f64>().sqrt()
+    dot(x, x).sqrt()
 }
 
 /// Apply Dirichlet conditions `(dof, value)` by symmetric elimination, in place:
