@@ -101,6 +101,9 @@ pub struct SteadyProblem<'a> {
     /// instead of a factorisation (symmetric problems without multipliers; for sizes a
     /// factorisation does not fit).
     pub iterative: bool,
+    /// Factor on one thread: the same bits on any number of threads (the iterative
+    /// path is so anyway).
+    pub reproducible: bool,
     /// Relative tolerance on the residual norm.
     pub tolerance: f64,
     pub max_iterations: usize,
@@ -215,11 +218,13 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
 
     let symmetric = iface.is_linear();
     let mut chol = Cholesky::new(Ordering::Metis);
+    chol.sequential = p.reproducible;
     let mut amg = AmgCg::new(AmgOptions {
         tolerance: AMG_TOLERANCE,
         ..AmgOptions::default()
     });
     let mut saddle = SaddleLdlt::with_primal(n_primal, n, Ordering::Metis);
+    saddle.sequential = p.reproducible;
     let mut lu = Lu::new();
     let mut linear = LinearSolves::default();
     let mut history = Vec::new();
@@ -496,6 +501,7 @@ fn solve_dual(
     timing.assembly_s += t.elapsed().as_secs_f64();
     let t = Instant::now();
     let mut chol = Cholesky::new(Ordering::Metis);
+    chol.sequential = p.reproducible;
     chol.factor(&reduced)?;
     timing.factor_s += t.elapsed().as_secs_f64();
     let t = Instant::now();

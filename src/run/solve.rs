@@ -126,6 +126,7 @@ impl<'a> TimeLoop<'a> {
             ties: Vec::new(),
             interfaces: Some(interfaces),
             iterative,
+            reproducible: problem.solve.reproducible.unwrap_or(true),
             tolerance: problem.solve.tolerance,
             max_iterations: problem.solve.max_iterations,
         };
