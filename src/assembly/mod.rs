@@ -20,6 +20,11 @@
 //!   element connectivity, couplings and diagonal, together with each slot's
 //!   position in the CSC value array; each assembly only writes slot values and adds
 //!   them into a fresh value array, slot after slot.
+//! - A pattern built for direct assembly ([`Pattern::build_direct`], [`Assembler::direct`])
+//!   keeps no element slots: element matrices are added into the CSC value array as
+//!   they are made (in element order, so the sums have the bits of the slot path) and
+//!   are not kept — for a matrix whose element part is assembled once. Couplings and
+//!   diagonal entries keep their slots.
 //! - Determinism and symmetry: element kernels run in parallel (rayon) but write only
 //!   their own slot, and slots are summed in slot order, so the matrix is
 //!   bit-identical whatever the number of threads, and entries `(i, j)` and `(j, i)`
@@ -34,6 +39,8 @@ use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 
 use crate::mesh::{ElemId, Mesh, NodeId};
+
+mod direct;
 
 /// A named field of a [`DofMap`], by position.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -255,8 +262,17 @@ pub struct Pattern {
     /// Global dofs of each element slot row, concatenated block after block.
     elem_dofs: Vec<u32>,
     couplings: Vec<(u32, u32)>,
-    /// The CSC structure and, for every slot, its position in the value array.
-    built: Option<(SymbolicSparseColMat<usize>, Vec<u32>)>,
+    /// The CSC structure and the slot positions.
+    built: Option<Built>,
+}
+
+/// A built pattern: the CSC structure and, for every slot, its position in the value
+/// array — element slots first unless built for direct assembly.
+#[derive(Clone, Debug)]
+struct Built {
+    sym: SymbolicSparseColMat<usize>,
+    positions: Vec<u32>,
+    element_slots: bool,
 }
 
 impl Pattern {
@@ -333,7 +349,21 @@ impl Pattern {
     /// `j`; columns are built in parallel from a dof → element map (no global sort of
     /// all slots), then each slot finds its position by binary search in its column.
     pub fn build(&mut self) -> Result<(), AssemblyError> {
-        if self.built.is_some() {
+        self.build_with(true)
+    }
+
+    /// As [`Self::build`] without the element slots' positions (4 bytes per element
+    /// matrix entry), for [`Assembler::direct`] only.
+    pub fn build_direct(&mut self) -> Result<(), AssemblyError> {
+        self.build_with(false)
+    }
+
+    fn build_with(&mut self, element_slots: bool) -> Result<(), AssemblyError> {
+        if self
+            .built
+            .as_ref()
+            .is_some_and(|b| b.element_slots || !element_slots)
+        {
             return Ok(());
         }
         let n = self.n;
@@ -410,9 +440,10 @@ impl Pattern {
                 (lens, rows)
             })
             .collect();
+        drop((d2e, d2e_ptr, partners, c_ptr, elems));
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0usize);
-        let mut row_idx = Vec::new();
+        let mut row_idx = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
         for (lens, rows) in chunks {
             for l in lens {
                 col_ptr.push(col_ptr.last().unwrap() + l);
@@ -429,11 +460,12 @@ impl Pattern {
             let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
             (col_ptr[col] + rows.partition_point(|&r| r < row)) as u32
         };
-        let mut positions = vec![0u32; self.value_count()];
-        let (elem_part, rest) = positions.split_at_mut(self.elem_values);
+        let elem_len = if element_slots { self.elem_values } else { 0 };
+        let mut positions = vec![0u32; self.value_count() - self.elem_values + elem_len];
+        let (elem_part, rest) = positions.split_at_mut(elem_len);
         let mut elem_part = elem_part;
         let mut dof_off = 0;
-        for &(_, ne, count) in &self.block_slots {
+        for &(_, ne, count) in self.block_slots.iter().filter(|_| element_slots) {
             let (block_part, tail) = elem_part.split_at_mut(count * ne * ne);
             elem_part = tail;
             let dofs = &self.elem_dofs[dof_off..dof_off + count * ne];
@@ -459,13 +491,17 @@ impl Pattern {
             *p = pos(i, i);
         }
         let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        self.built = Some((sym, positions));
+        self.built = Some(Built {
+            sym,
+            positions,
+            element_slots,
+        });
         Ok(())
     }
 
     /// The symbolic CSC structure (after [`Pattern::build`]).
     pub fn symbolic(&self) -> Option<&SymbolicSparseColMat<usize>> {
-        self.built.as_ref().map(|b| &b.0)
+        self.built.as_ref().map(|b| &b.sym)
     }
 
     /// Stored entries of the matrix (after [`Pattern::build`]).
@@ -504,7 +540,10 @@ impl ExtraSlot {
 /// arrays of a [`Pattern`], then makes the sparse matrix by values only.
 pub struct Assembler<'p> {
     pattern: &'p Pattern,
+    /// The slot values: element slots (unless direct), then couplings and diagonal.
     values: Vec<f64>,
+    /// Direct assembly: the element matrices summed into the CSC value array.
+    direct: Option<direct::Summed>,
     /// Element vector slots (`ne` per element), then one per dof for direct loads.
     vector: Vec<f64>,
     vec_elem_len: usize,
@@ -516,8 +555,18 @@ impl<'p> Assembler<'p> {
         Assembler {
             pattern,
             values: vec![0.0; pattern.value_count()],
+            direct: None,
             vector: vec![0.0; vec_elem_len + pattern.n],
             vec_elem_len,
+        }
+    }
+
+    /// First slot of the couplings in `values`.
+    fn extra_base(&self) -> usize {
+        if self.direct.is_some() {
+            0
+        } else {
+            self.pattern.elem_values
         }
     }
 
@@ -544,6 +593,10 @@ impl<'p> Assembler<'p> {
     ) where
         F: Fn(ElemId, &mut [f64], &mut [f64]) + Sync,
     {
+        if self.direct.is_some() {
+            assert!(!keep_matrix, "a direct assembler keeps no element matrices");
+            return self.elements_direct(mesh, blocks, kernel);
+        }
         let pattern = self.pattern;
         let mut vec_off = 0;
         for (b, block) in mesh.blocks.iter().enumerate() {
@@ -574,20 +627,20 @@ impl<'p> Assembler<'p> {
     /// Zero the coupling and diagonal slots (keeping the element slots), so interface
     /// terms can be assembled again without re-running the element kernels.
     pub fn reset_couplings(&mut self) {
-        let start = self.pattern.elem_values;
+        let start = self.extra_base();
         self.values[start..].fill(0.0);
     }
 
     /// Add values to coupling `k`: `v_ij` at `(i, j)` and `v_ji` at `(j, i)`.
     pub fn add_coupling(&mut self, k: usize, v_ij: f64, v_ji: f64) {
-        let base = self.pattern.elem_values + 2 * k;
+        let base = self.extra_base() + 2 * k;
         self.values[base] += v_ij;
         self.values[base + 1] += v_ji;
     }
 
     /// Add `v` to the diagonal entry of `dof`.
     pub fn add_diagonal(&mut self, dof: usize, v: f64) {
-        let base = self.pattern.elem_values + 2 * self.pattern.couplings.len();
+        let base = self.extra_base() + 2 * self.pattern.couplings.len();
         self.values[base + dof] += v;
     }
 
@@ -598,8 +651,8 @@ impl<'p> Assembler<'p> {
     #[inline]
     pub fn add_at_all(&mut self, slots: &[ExtraSlot], values: &[f64], first: usize) {
         assert_eq!(slots.len(), values.len(), "one value per slot");
-        let couplings = self.pattern.elem_values + 2 * first;
-        let diagonal = self.pattern.elem_values + 2 * self.pattern.couplings.len();
+        let couplings = self.extra_base() + 2 * first;
+        let diagonal = self.extra_base() + 2 * self.pattern.couplings.len();
         for (&slot, &v) in slots.iter().zip(values) {
             let base = if slot.0 & ExtraSlot::DIAGONAL != 0 {
                 diagonal
@@ -617,6 +670,9 @@ impl<'p> Assembler<'p> {
 
     /// Check every element slot for non-finite values and name the first bad one.
     pub fn check_finite(&self, mesh: &Mesh) -> Result<(), AssemblyError> {
+        if let Some(d) = &self.direct {
+            return d.check_finite(mesh);
+        }
         for (b, block) in mesh.blocks.iter().enumerate() {
             let (off, ne, count) = self.pattern.block_slots[b];
             let vals = &self.values[off..off + count * ne * ne];
@@ -639,9 +695,22 @@ impl<'p> Assembler<'p> {
     /// and the slots are added into their positions in slot order).
     pub fn matrix(&self) -> Result<SparseColMat<usize, f64>, AssemblyError> {
         let sym = self.built()?.0;
-        let mut vals = vec![0.0; sym.row_idx().len()];
-        self.sum_slots(&mut vals)?;
+        let mut vals = Vec::new();
+        self.values_into(&mut vals)?;
         Ok(SparseColMat::new(sym.clone(), vals))
+    }
+
+    /// The assembled values in the CSC order of [`Pattern::symbolic`] (the bits of
+    /// [`Self::matrix`]) written into `vals`, resized to the entry count: a matrix
+    /// without a copy of the structure.
+    pub fn values_into(&self, vals: &mut Vec<f64>) -> Result<(), AssemblyError> {
+        let nnz = self.built()?.0.row_idx().len();
+        vals.clear();
+        match &self.direct {
+            Some(d) => vals.extend_from_slice(&d.values),
+            None => vals.resize(nnz, 0.0),
+        }
+        self.sum_slots(vals)
     }
 
     /// The assembled values written into `matrix`, which holds this pattern's structure
@@ -668,19 +737,34 @@ impl<'p> Assembler<'p> {
                 sym.row_idx().len()
             )));
         }
-        vals.fill(0.0);
+        match &self.direct {
+            Some(d) => vals.copy_from_slice(&d.values),
+            None => vals.fill(0.0),
+        }
         self.sum_slots(vals)
     }
 
     fn built(&self) -> Result<(&SymbolicSparseColMat<usize>, &[u32]), AssemblyError> {
-        self.pattern
-            .built
-            .as_ref()
-            .map(|(sym, positions)| (sym, positions.as_slice()))
-            .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))
+        match &self.pattern.built {
+            // A direct assembler skips the element slots of a pattern that has them.
+            Some(b) if self.direct.is_some() => {
+                let skip = if b.element_slots {
+                    self.pattern.elem_values
+                } else {
+                    0
+                };
+                Ok((&b.sym, &b.positions[skip..]))
+            }
+            Some(b) if b.element_slots => Ok((&b.sym, &b.positions)),
+            Some(_) => Err(AssemblyError::Faer(
+                "the pattern was built for direct assembly (Pattern::build_direct)".into(),
+            )),
+            None => Err(AssemblyError::Faer("Pattern::build was not called".into())),
+        }
     }
 
-    /// Adds every slot into its position of the CSC value array `vals`, slot after slot.
+    /// Adds every slot into its position of the CSC value array `vals`, slot after slot
+    /// (after the element sums of a direct assembler).
     fn sum_slots(&self, vals: &mut [f64]) -> Result<(), AssemblyError> {
         let positions = self.built()?.1;
         for (&p, &v) in positions.iter().zip(&self.values) {

@@ -14,8 +14,10 @@ use std::time::Instant;
 use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{
-    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
+    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet,
+    apply_dirichlet_mut, spmv, spmv_ref,
 };
+use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
 use std::collections::HashSet;
 
 pub use super::interfaces::{ContactTerm, TieTerm};
@@ -207,12 +209,15 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             .collect();
         tie_coupling_first.push(pattern.add_couplings(&pairs)?.start);
     }
-    pattern.build()?;
-    // The conduction part is linear: assemble it once, keep K and F, and keep the
-    // assembler's element slots for every Newton step (only interface slots change).
-    let mut asm = Assembler::new(&pattern);
+    // The conduction part is linear: assemble it once, straight into the matrix values
+    // (no element matrix is kept), and keep K and F for every Newton step (only the
+    // interface slots change). K's values are the assembler's element sums, over the
+    // pattern's structure: no copy of either.
+    pattern.build_direct()?;
+    let structure = pattern.symbolic().expect("built");
+    let sym = structure.as_ref();
+    let mut asm = Assembler::direct(&pattern)?;
     assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
-    let k_vol = asm.matrix()?;
     let f_vol = asm.rhs();
     timing.assembly_s += t.elapsed().as_secs_f64();
 
@@ -237,7 +242,8 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         let t = Instant::now();
         // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
         let mut r = vec![0.0; n];
-        spmv(&k_vol, &u, &mut r);
+        let k_vol = asm.element_values().expect("a direct assembler");
+        spmv_ref(SparseColMatRef::new(sym, k_vol), &u, &mut r);
         for (ri, fi) in r.iter_mut().zip(&f_vol) {
             *ri -= fi;
         }
@@ -300,14 +306,18 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
                 asm.add_coupling(tie_coupling_first[t] + e, c, c);
             }
         }
-        let mut jac = asm.matrix()?;
+        // The Jacobian's values over the pattern's structure, copied into a matrix only
+        // for a factorisation (AMG-CG keeps its own copy in row storage).
+        let mut jac_values = Vec::new();
+        asm.values_into(&mut jac_values)?;
         let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
         let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
-        apply_dirichlet(&mut jac, &mut rhs, &zero)?;
+        apply_dirichlet_mut(SparseColMatMut::new(sym, &mut jac_values), &mut rhs, &zero)?;
         timing.assembly_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
         if p.iterative && symmetric && ties.is_empty() {
-            amg.factor(&jac)?;
+            amg.factor_ref(SparseColMatRef::new(sym, &jac_values))?;
+            drop(jac_values);
             timing.factor_s += t.elapsed().as_secs_f64();
             let t = Instant::now();
             let report = amg.solve(&mut rhs)?;
@@ -320,6 +330,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             }
             continue;
         }
+        let jac = SparseColMat::new(structure.clone(), jac_values);
         let saddle_ok = !ties.is_empty() && symmetric && saddle.factor(&jac).is_ok();
         let use_chol = !saddle_ok && ties.is_empty() && symmetric && chol.factor(&jac).is_ok();
         if !saddle_ok && !use_chol {
@@ -378,7 +389,7 @@ fn solve_dual(
     bcs: Vec<(usize, f64)>,
     ties: Vec<TieRows>,
 ) -> Result<SteadySolution, HeatError> {
-    use faer::sparse::{SparseColMat, Triplet};
+    use faer::sparse::Triplet;
     let mesh = p.mesh;
     let n = dofs.len();
     let mut timing = SolveTiming::default();

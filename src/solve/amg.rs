@@ -25,7 +25,7 @@
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SparseColMatRef};
 use rayon::prelude::*;
 
 use super::{LinearSolver, SolveError, SolveReport, check_rhs, dot, norm};
@@ -42,7 +42,7 @@ pub struct Csr {
 
 impl Csr {
     /// Row storage of a faer CSC matrix (a transpose of index arrays).
-    pub fn from_csc(a: &SparseColMat<usize, f64>) -> Csr {
+    pub fn from_csc(a: SparseColMatRef<'_, usize, f64>) -> Csr {
         let s = a.symbolic();
         let (m, n) = (a.nrows(), a.ncols());
         let mut ptr = vec![0usize; m + 1];
@@ -276,6 +276,14 @@ impl AmgCg {
         }
     }
 
+    /// [`LinearSolver::factor`] of a borrowed matrix (e.g. a pattern's structure with
+    /// values kept apart, which the caller may free once this returns: the hierarchy
+    /// holds its own copy).
+    pub fn factor_ref(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), SolveError> {
+        super::check_finite_ref(a)?;
+        self.setup(Csr::from_csc(a))
+    }
+
     /// Build the hierarchy for a matrix in row storage.
     pub fn setup(&mut self, a: Csr) -> Result<(), SolveError> {
         self.levels.clear();
@@ -453,8 +461,7 @@ impl AmgCg {
 
 impl LinearSolver for AmgCg {
     fn factor(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), SolveError> {
-        super::check_finite(a)?;
-        self.setup(Csr::from_csc(a))
+        self.factor_ref(a.as_ref())
     }
 
     fn solve(&mut self, b: &mut [f64]) -> Result<SolveReport, SolveError> {

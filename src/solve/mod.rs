@@ -29,7 +29,7 @@ mod direct;
 pub use amg::{AmgCg, AmgOptions, Smoother};
 pub use direct::{Cholesky, Lu, Ordering, SaddleLdlt, metis_ordering};
 
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
 use rayon::prelude::*;
 
 /// Errors of factorisation and solution.
@@ -92,6 +92,11 @@ pub trait LinearSolver {
 
 /// Reject a matrix with a non-finite stored entry, naming it.
 pub fn check_finite(a: &SparseColMat<usize, f64>) -> Result<(), SolveError> {
+    check_finite_ref(a.as_ref())
+}
+
+/// [`check_finite`] of a borrowed matrix.
+pub fn check_finite_ref(a: SparseColMatRef<'_, usize, f64>) -> Result<(), SolveError> {
     let s = a.symbolic();
     let (ri, v) = (s.row_idx(), a.val());
     for col in 0..a.ncols() {
@@ -123,6 +128,11 @@ fn check_rhs(n: usize, b: &[f64]) -> Result<(), SolveError> {
 
 /// `y = A x` for a CSC matrix with both triangles stored (general: no symmetry used).
 pub fn spmv(a: &SparseColMat<usize, f64>, x: &[f64], y: &mut [f64]) {
+    spmv_ref(a.as_ref(), x, y)
+}
+
+/// [`spmv`] of a borrowed matrix (e.g. a pattern's structure with values kept apart).
+pub fn spmv_ref(a: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64]) {
     let s = a.symbolic();
     let (ri, v) = (s.row_idx(), a.val());
     y.fill(0.0);
@@ -173,6 +183,17 @@ pub(crate) fn norm(x: &[f64]) -> f64 {
 /// twice takes its last value.
 pub fn apply_dirichlet(
     a: &mut SparseColMat<usize, f64>,
+    b: &mut [f64],
+    bcs: &[(usize, f64)],
+) -> Result<(), SolveError> {
+    let (sym, vals) = a.parts_mut();
+    apply_dirichlet_mut(SparseColMatMut::new(sym, vals), b, bcs)
+}
+
+/// [`apply_dirichlet`] on a borrowed matrix (e.g. a pattern's structure with values
+/// kept apart).
+pub fn apply_dirichlet_mut(
+    a: SparseColMatMut<'_, usize, f64>,
     b: &mut [f64],
     bcs: &[(usize, f64)],
 ) -> Result<(), SolveError> {

@@ -1,0 +1,214 @@
+//! Direct assembly ([`Assembler::direct`]): element matrices added into the CSC value
+//! array as they are made, instead of kept in slots. Elements are computed in parallel
+//! in fixed batches and added serially in element order, entries of an element
+//! row-major — the order the slot path sums them in — so the values have the same bits
+//! whatever the number of threads, and the same as [`Assembler::new`] would give.
+
+use rayon::prelude::*;
+
+use super::{Assembler, AssemblyError, NONE, Pattern};
+use crate::mesh::{ElemId, Mesh};
+
+/// Elements made at once (in parallel) before they are added: large enough for the
+/// threads to share, small enough that the batch's matrices stay in cache-sized memory
+/// (4096 Hex8 matrices are 2 MB).
+const BATCH: usize = 4096;
+
+/// The element part of a direct assembler's matrix.
+pub(super) struct Summed {
+    /// The element matrices summed, in the CSC order of the pattern's structure.
+    pub(super) values: Vec<f64>,
+    /// The first non-finite element entry met: element, local row and column, value.
+    bad: Option<(ElemId, usize, usize, f64)>,
+}
+
+impl Summed {
+    pub(super) fn check_finite(&self, mesh: &Mesh) -> Result<(), AssemblyError> {
+        match self.bad {
+            None => Ok(()),
+            Some((e, row, col, value)) => Err(AssemblyError::NonFiniteElement {
+                elem: e.0,
+                number: mesh.elem_number(e),
+                row,
+                col,
+                value,
+            }),
+        }
+    }
+}
+
+impl<'p> Assembler<'p> {
+    /// An assembler that adds each element matrix into the matrix values as it is made
+    /// and keeps none: for a pattern (built by [`Pattern::build_direct`] or
+    /// [`Pattern::build`]) whose element part is assembled once — [`Self::elements`]
+    /// adds, so run each block once. Couplings, the diagonal and the right-hand side
+    /// work as with [`Assembler::new`], and [`Self::matrix`] gives the same bits.
+    pub fn direct(pattern: &'p Pattern) -> Result<Self, AssemblyError> {
+        let nnz = pattern
+            .symbolic()
+            .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))?
+            .row_idx()
+            .len();
+        let vec_elem_len = pattern.block_slots.iter().map(|s| s.1 * s.2).sum();
+        Ok(Assembler {
+            pattern,
+            values: vec![0.0; pattern.value_count() - pattern.elem_values],
+            direct: Some(Summed {
+                values: vec![0.0; nnz],
+                bad: None,
+            }),
+            vector: vec![0.0; vec_elem_len + pattern.n],
+            vec_elem_len,
+        })
+    }
+
+    /// The element matrices summed so far, in the CSC order of the pattern's structure
+    /// (`None` for a slot assembler): the matrix without its coupling and diagonal
+    /// slots, without a copy.
+    pub fn element_values(&self) -> Option<&[f64]> {
+        self.direct.as_ref().map(|d| d.values.as_slice())
+    }
+
+    /// [`Self::elements`] of a direct assembler.
+    pub(super) fn elements_direct<F>(&mut self, mesh: &Mesh, blocks: Option<&[usize]>, kernel: F)
+    where
+        F: Fn(ElemId, &mut [f64], &mut [f64]) + Sync,
+    {
+        let pattern = self.pattern;
+        let sym = pattern
+            .symbolic()
+            .expect("a direct assembler's pattern is built");
+        let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+        let summed = self.direct.as_mut().expect("a direct assembler");
+        let (mut vec_off, mut buf, mut at) = (0, Vec::new(), Vec::new());
+        for (b, block) in mesh.blocks.iter().enumerate() {
+            let (_, ne, count) = pattern.block_slots[b];
+            let run = blocks.is_none_or(|l| l.contains(&b));
+            if run && count > 0 {
+                let first = block.first_elem.0;
+                let vec = &mut self.vector[vec_off..vec_off + count * ne];
+                let dofs = &pattern.elem_dofs[vec_off..vec_off + count * ne];
+                buf.resize(BATCH * ne * ne, 0.0);
+                at.resize(ne * ne, usize::MAX);
+                for start in (0..count).step_by(BATCH) {
+                    let m = BATCH.min(count - start);
+                    buf[..m * ne * ne]
+                        .par_chunks_mut(ne * ne)
+                        .zip(vec[start * ne..(start + m) * ne].par_chunks_mut(ne))
+                        .enumerate()
+                        .with_min_len(256)
+                        .for_each(|(k, (ke, fe))| {
+                            ke.fill(0.0);
+                            fe.fill(0.0);
+                            kernel(ElemId(first + (start + k) as u32), ke, fe);
+                        });
+                    for (k, ke) in buf[..m * ne * ne].chunks_exact(ne * ne).enumerate() {
+                        let e = start + k;
+                        if summed.bad.is_none()
+                            && let Some(p) = ke.iter().position(|v| !v.is_finite())
+                        {
+                            summed.bad = Some((ElemId(first + e as u32), p / ne, p % ne, ke[p]));
+                        }
+                        positions(col_ptr, row_idx, &dofs[e * ne..(e + 1) * ne], &mut at);
+                        for (&p, &v) in at.iter().zip(ke) {
+                            if p != usize::MAX {
+                                summed.values[p] += v;
+                            }
+                        }
+                    }
+                }
+            }
+            vec_off += count * ne;
+        }
+    }
+}
+
+/// The CSC position of every entry `(d[a], d[b])` of an element, row-major into `at`
+/// (`usize::MAX` where a dof is missing), by binary search in column `d[b]`.
+fn positions(col_ptr: &[usize], row_idx: &[usize], d: &[u32], at: &mut [usize]) {
+    let ne = d.len();
+    for (b, &c) in d.iter().enumerate() {
+        if c == NONE {
+            (0..ne).for_each(|a| at[a * ne + b] = usize::MAX);
+            continue;
+        }
+        let (lo, hi) = (col_ptr[c as usize], col_ptr[c as usize + 1]);
+        let rows = &row_idx[lo..hi];
+        for (a, &r) in d.iter().enumerate() {
+            at[a * ne + b] = if r == NONE {
+                usize::MAX
+            } else {
+                lo + rows.partition_point(|&x| x < r as usize)
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::DofMap;
+    use super::*;
+    use crate::mesh::generate::{BoxSpec, single_box};
+    use faer::sparse::SparseColMat;
+
+    fn bits(m: &SparseColMat<usize, f64>) -> Vec<u64> {
+        m.val().iter().map(|v| v.to_bits()).collect()
+    }
+
+    /// Element matrices with values that differ per element and entry (not symmetric,
+    /// so a transposed position would show), plus couplings and diagonal terms: the
+    /// direct assembler gives the slot assembler's matrix and right-hand side bit for
+    /// bit, on a pattern built either way, and names the first non-finite entry.
+    #[test]
+    fn direct_assembly_equals_slot_assembly() {
+        let mesh = single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [3, 2, 2], 1));
+        let dofs = DofMap::new(&mesh, &[("t", &[0])]).unwrap();
+        let kernel = |e: ElemId, ke: &mut [f64], fe: &mut [f64]| {
+            for (k, v) in ke.iter_mut().enumerate() {
+                *v = 0.1 + (e.0 as f64 * 0.37 + k as f64 * 1.3e-3).sin();
+            }
+            fe.iter_mut()
+                .enumerate()
+                .for_each(|(k, f)| *f = e.0 as f64 + k as f64);
+        };
+        let extras = |asm: &mut Assembler<'_>| {
+            asm.add_coupling(0, 2.5, -1.5);
+            asm.add_coupling(1, 0.125, 7.0);
+            asm.add_diagonal(5, 9.0);
+            asm.add_rhs(3, 4.0);
+        };
+        let mut slots = Pattern::new(&mesh, &dofs);
+        slots.add_couplings(&[(0, 35), (7, 20)]).unwrap();
+        let mut direct = slots.clone();
+        slots.build().unwrap();
+        direct.build_direct().unwrap();
+        let mut reference = Assembler::new(&slots);
+        reference.elements(&mesh, None, kernel);
+        extras(&mut reference);
+        let want = reference.matrix().unwrap();
+        for pattern in [&direct, &slots] {
+            let mut asm = Assembler::direct(pattern).unwrap();
+            asm.elements(&mesh, None, kernel);
+            extras(&mut asm);
+            let got = asm.matrix().unwrap();
+            assert_eq!(got.symbolic().row_idx(), want.symbolic().row_idx());
+            assert_eq!(bits(&got), bits(&want));
+            assert_eq!(asm.rhs(), reference.rhs());
+            asm.check_finite(&mesh).unwrap();
+        }
+        // A slot assembler cannot use a pattern built for direct assembly.
+        assert!(Assembler::new(&direct).matrix().is_err());
+        let mut bad = Assembler::direct(&direct).unwrap();
+        bad.elements(&mesh, None, |e, ke, _| {
+            if e.0 >= 4 {
+                ke[9] = f64::NAN;
+            }
+        });
+        match bad.check_finite(&mesh) {
+            Err(AssemblyError::NonFiniteElement { elem, row, col, .. }) => {
+                assert_eq!((elem, row, col), (4, 1, 1));
+            }
+            other => panic!("expected the first non-finite entry, got {other:?}"),
+        }
+    }
+}
