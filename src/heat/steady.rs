@@ -316,8 +316,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing.assembly_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
         if p.iterative && symmetric && ties.is_empty() {
-            amg.factor_ref(SparseColMatRef::new(sym, &jac_values))?;
-            drop(jac_values);
+            amg.factor_values(sym, jac_values)?;
             timing.factor_s += t.elapsed().as_secs_f64();
             let t = Instant::now();
             let report = amg.solve(&mut rhs)?;

@@ -25,7 +25,7 @@
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
-use faer::sparse::{SparseColMat, SparseColMatRef};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
 use super::{LinearSolver, SolveError, SolveReport, check_rhs, dot, norm};
@@ -36,7 +36,9 @@ pub struct Csr {
     pub nrows: usize,
     pub ncols: usize,
     pub ptr: Vec<usize>,
-    pub idx: Vec<usize>,
+    /// Column indices, 32 bits (a dof is 32 bits): a third less memory traffic per
+    /// stored entry than `usize` in every product and smoothing sweep.
+    pub idx: Vec<u32>,
     pub val: Vec<f64>,
 }
 
@@ -61,7 +63,7 @@ impl Csr {
         for j in 0..n {
             for p in s.col_range(j) {
                 let i = s.row_idx()[p];
-                idx[next[i]] = j;
+                idx[next[i]] = j as u32;
                 val[next[i]] = a.val()[p];
                 next[i] += 1;
             }
@@ -75,6 +77,60 @@ impl Csr {
         }
     }
 
+    /// Row storage of a CSC matrix given as its structure and values, taking the
+    /// values. A structurally symmetric matrix (each stored `(i, j)` has its `(j, i)`,
+    /// as assembled patterns do) has its columns' structure as rows: its values are
+    /// transposed in place, pair by pair, and nothing else is copied but the indices.
+    /// Any other matrix goes through [`Self::from_csc`]. The same result either way.
+    pub fn from_csc_values(sym: SymbolicSparseColMatRef<'_, usize>, mut val: Vec<f64>) -> Csr {
+        assert_eq!(sym.row_idx().len(), val.len(), "one value per stored entry");
+        let n = sym.ncols();
+        let (ptr, ri) = (sym.col_ptr(), sym.row_idx());
+        // Each stored (i, j) below the diagonal meets its (j, i) in column i: the rows
+        // asked of column i come in increasing j, so one cursor per column suffices.
+        let walk = |val: Option<&mut [f64]>| -> bool {
+            let mut cursor: Vec<usize> = ptr[..n].to_vec();
+            let (mut lower, mut upper) = (0usize, 0usize);
+            let mut val = val;
+            for j in 0..n {
+                for p in ptr[j]..ptr[j + 1] {
+                    let i = ri[p];
+                    if i < j {
+                        upper += 1;
+                        continue;
+                    }
+                    if i == j {
+                        continue;
+                    }
+                    lower += 1;
+                    let end = ptr[i + 1];
+                    while cursor[i] < end && ri[cursor[i]] < j {
+                        cursor[i] += 1;
+                    }
+                    if cursor[i] == end || ri[cursor[i]] != j {
+                        return false;
+                    }
+                    if let Some(v) = val.as_deref_mut() {
+                        v.swap(p, cursor[i]);
+                    }
+                }
+            }
+            lower == upper
+        };
+        let square = sym.nrows() == n && sym.col_nnz().is_none();
+        if !(square && walk(None)) {
+            return Csr::from_csc(SparseColMatRef::new(sym, &val));
+        }
+        walk(Some(&mut val));
+        Csr {
+            nrows: n,
+            ncols: n,
+            ptr: ptr.to_vec(),
+            idx: ri.iter().map(|&i| i as u32).collect(),
+            val,
+        }
+    }
+
     pub fn nnz(&self) -> usize {
         self.idx.len()
     }
@@ -82,7 +138,7 @@ impl Csr {
     pub fn transpose(&self) -> Csr {
         let mut ptr = vec![0usize; self.ncols + 1];
         for &j in &self.idx {
-            ptr[j + 1] += 1;
+            ptr[j as usize + 1] += 1;
         }
         for j in 0..self.ncols {
             ptr[j + 1] += ptr[j];
@@ -92,8 +148,8 @@ impl Csr {
         let mut next = ptr.clone();
         for i in 0..self.nrows {
             for p in self.ptr[i]..self.ptr[i + 1] {
-                let j = self.idx[p];
-                idx[next[j]] = i;
+                let j = self.idx[p] as usize;
+                idx[next[j]] = i as u32;
                 val[next[j]] = self.val[p];
                 next[j] += 1;
             }
@@ -115,7 +171,7 @@ impl Csr {
             .for_each(|(i, yi)| {
                 let mut s = 0.0;
                 for p in self.ptr[i]..self.ptr[i + 1] {
-                    s += self.val[p] * x[self.idx[p]];
+                    s += self.val[p] * x[self.idx[p] as usize];
                 }
                 *yi = s;
             });
@@ -125,7 +181,7 @@ impl Csr {
     /// concatenated in order (deterministic).
     pub fn matmul(&self, b: &Csr) -> Csr {
         const CHUNK: usize = 2048;
-        let chunks: Vec<(Vec<usize>, Vec<usize>, Vec<f64>)> = (0..self.nrows.div_ceil(CHUNK))
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..self.nrows.div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
                 let rows = c * CHUNK..((c + 1) * CHUNK).min(self.nrows);
@@ -135,19 +191,19 @@ impl Csr {
                 for i in rows {
                     let start = idx.len();
                     for p in self.ptr[i]..self.ptr[i + 1] {
-                        let (k, aik) = (self.idx[p], self.val[p]);
+                        let (k, aik) = (self.idx[p] as usize, self.val[p]);
                         for q in b.ptr[k]..b.ptr[k + 1] {
-                            let j = b.idx[q];
+                            let j = b.idx[q] as usize;
                             if marker[j] != i {
                                 marker[j] = i;
                                 acc[j] = 0.0;
-                                idx.push(j);
+                                idx.push(j as u32);
                             }
                             acc[j] += aik * b.val[q];
                         }
                     }
                     idx[start..].sort_unstable();
-                    val.extend(idx[start..].iter().map(|&j| acc[j]));
+                    val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
                     lens.push(idx.len() - start);
                 }
                 (lens, idx, val)
@@ -175,7 +231,7 @@ impl Csr {
         (0..self.nrows)
             .map(|i| {
                 (self.ptr[i]..self.ptr[i + 1])
-                    .find(|&p| self.idx[p] == i)
+                    .find(|&p| self.idx[p] as usize == i)
                     .map_or(0.0, |p| self.val[p])
             })
             .collect()
@@ -282,6 +338,17 @@ impl AmgCg {
     pub fn factor_ref(&mut self, a: SparseColMatRef<'_, usize, f64>) -> Result<(), SolveError> {
         super::check_finite_ref(a)?;
         self.setup(Csr::from_csc(a))
+    }
+
+    /// [`Self::factor_ref`] of a matrix given as its structure and values, taking the
+    /// values into the finest level (no copy for a structurally symmetric matrix).
+    pub fn factor_values(
+        &mut self,
+        sym: SymbolicSparseColMatRef<'_, usize>,
+        values: Vec<f64>,
+    ) -> Result<(), SolveError> {
+        super::check_finite_ref(SparseColMatRef::new(sym, &values))?;
+        self.setup(Csr::from_csc_values(sym, values))
     }
 
     /// Build the hierarchy for a matrix in row storage.
@@ -499,7 +566,7 @@ fn gauss_seidel(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64], forward: bo
     let mut row = |i: usize| {
         let mut s = b[i];
         for p in a.ptr[i]..a.ptr[i + 1] {
-            s -= a.val[p] * x[a.idx[p]];
+            s -= a.val[p] * x[a.idx[p] as usize];
         }
         x[i] += s * inv_diag[i];
     };
@@ -542,7 +609,7 @@ fn aggregate(a: &Csr, theta: f64) -> (Vec<usize>, usize) {
     let strong = |i: usize| {
         let di = diag[i].abs();
         (a.ptr[i]..a.ptr[i + 1]).filter_map(move |p| {
-            let j = a.idx[p];
+            let j = a.idx[p] as usize;
             (j != i && a.val[p] != 0.0 && a.val[p].abs() >= theta * (di * diag[j].abs()).sqrt())
                 .then_some(j)
         })
@@ -596,45 +663,48 @@ fn aggregate(a: &Csr, theta: f64) -> (Vec<usize>, usize) {
     (agg, count)
 }
 
-/// `P = (I − ω D⁻¹ A) P̂`, `P̂_{i,agg(i)} = 1`.
+/// `P = (I − ω D⁻¹ A) P̂`, `P̂_{i,agg(i)} = 1`, row by row without a copy of A: row i
+/// of `S P̂` (`S = ω D⁻¹ A`) sums `a_ij (ω d_i⁻¹)` over the neighbours j of each
+/// aggregate, in the order and with the rounding of the product `S · P̂`; then
+/// `P = P̂ − S P̂` (P̂'s entry of row i is among those columns: A stores its diagonal).
 fn smoothed_prolongator(a: &Csr, inv_diag: &[f64], agg: &[usize], nagg: usize, omega: f64) -> Csr {
     let n = a.nrows;
-    let mut tent = Csr {
+    let mut p = Csr {
         nrows: n,
         ncols: nagg,
         ptr: Vec::with_capacity(n + 1),
         idx: Vec::new(),
         val: Vec::new(),
     };
-    tent.ptr.push(0);
-    for &g in agg {
-        if g != usize::MAX {
-            tent.idx.push(g);
-            tent.val.push(1.0);
-        }
-        tent.ptr.push(tent.idx.len());
-    }
-    // D⁻¹A with the jacobi weight folded in: S = ω D⁻¹ A.
-    let mut s = a.clone();
+    p.ptr.push(0);
+    let mut marker = vec![usize::MAX; nagg];
+    let mut acc = vec![0.0; nagg];
     for i in 0..n {
-        for p in s.ptr[i]..s.ptr[i + 1] {
-            s.val[p] *= omega * inv_diag[i];
+        let start = p.idx.len();
+        let scale = omega * inv_diag[i];
+        for q in a.ptr[i]..a.ptr[i + 1] {
+            let g = agg[a.idx[q] as usize];
+            if g == usize::MAX {
+                continue;
+            }
+            if marker[g] != i {
+                marker[g] = i;
+                acc[g] = 0.0;
+                p.idx.push(g as u32);
+            }
+            acc[g] += a.val[q] * scale;
         }
-    }
-    let mut sp = s.matmul(&tent);
-    // P = P̂ − S P̂: P̂'s entry of row i (if any) is among S P̂'s row i columns, because
-    // S has a (nonzero-pattern) diagonal.
-    for i in 0..n {
-        sp.val[sp.ptr[i]..sp.ptr[i + 1]]
-            .iter_mut()
-            .for_each(|v| *v = -*v);
+        p.idx[start..].sort_unstable();
+        p.val
+            .extend(p.idx[start..].iter().map(|&g| -acc[g as usize]));
         if agg[i] != usize::MAX
-            && let Some(p) = (sp.ptr[i]..sp.ptr[i + 1]).find(|&p| sp.idx[p] == agg[i])
+            && let Some(k) = (start..p.idx.len()).find(|&k| p.idx[k] as usize == agg[i])
         {
-            sp.val[p] += 1.0;
+            p.val[k] += 1.0;
         }
+        p.ptr.push(p.idx.len());
     }
-    sp
+    p
 }
 
 /// Dense Cholesky of a small SPD matrix, row-major lower factor.
@@ -643,7 +713,7 @@ fn dense_cholesky(a: &Csr) -> Result<Vec<f64>, SolveError> {
     let mut l = vec![0.0; n * n];
     for i in 0..n {
         for p in a.ptr[i]..a.ptr[i + 1] {
-            l[i * n + a.idx[p]] = a.val[p];
+            l[i * n + a.idx[p] as usize] = a.val[p];
         }
     }
     for j in 0..n {
@@ -698,13 +768,13 @@ mod tests {
         };
         for i in 0..n {
             if i > 0 {
-                c.idx.push(i - 1);
+                c.idx.push((i - 1) as u32);
                 c.val.push(-1.0);
             }
-            c.idx.push(i);
+            c.idx.push(i as u32);
             c.val.push(2.0);
             if i + 1 < n {
-                c.idx.push(i + 1);
+                c.idx.push((i + 1) as u32);
                 c.val.push(-1.0);
             }
             c.ptr.push(c.idx.len());
@@ -753,6 +823,46 @@ mod tests {
                 .zip(&three)
                 .all(|(a, b)| a.to_bits() == b.to_bits())
         );
+    }
+
+    /// Row storage from taken values: the in-place transposition of a structurally
+    /// symmetric matrix and the copy of any other give `from_csc`'s arrays.
+    #[test]
+    fn row_storage_from_values_matches_from_csc() {
+        use faer::sparse::Triplet;
+        let entries = [
+            (0, 0, 4.0),
+            (1, 0, -1.5),
+            (0, 1, -1.25),
+            (2, 1, 0.5),
+            (1, 2, 0.75),
+        ];
+        let mut unsym: Vec<_> = entries
+            .iter()
+            .map(|&(i, j, v)| Triplet::new(i, j, v))
+            .collect();
+        for (k, t) in [
+            SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &unsym).unwrap(),
+            {
+                unsym.push(Triplet::new(2, 0, 9.0));
+                SparseColMat::try_new_from_triplets(3, 3, &unsym).unwrap()
+            },
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let want = Csr::from_csc(t.as_ref());
+            let got = Csr::from_csc_values(t.symbolic(), t.val().to_vec());
+            assert_eq!(
+                (got.ptr, got.idx, got.val),
+                (want.ptr, want.idx, want.val),
+                "case {k}"
+            );
+        }
+        let lap = super::super::laplacian_7pt(4);
+        let want = Csr::from_csc(lap.as_ref());
+        let got = Csr::from_csc_values(lap.symbolic(), lap.val().to_vec());
+        assert_eq!((got.ptr, got.idx, got.val), (want.ptr, want.idx, want.val));
     }
 
     #[test]
