@@ -180,11 +180,19 @@ impl Csr {
     /// `self · b` by Gustavson's row-by-row product; rows in parallel chunks,
     /// concatenated in order (deterministic).
     pub fn matmul(&self, b: &Csr) -> Csr {
+        self.matmul_rows(None, b)
+    }
+
+    /// Rows `rows` (all when `None`) of `self · b`, each made as [`Self::matmul`]
+    /// makes it.
+    fn matmul_rows(&self, rows: Option<&[u32]>, b: &Csr) -> Csr {
         const CHUNK: usize = 2048;
-        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..self.nrows.div_ceil(CHUNK))
+        let m = rows.map_or(self.nrows, <[u32]>::len);
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..m.div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {
-                let rows = c * CHUNK..((c + 1) * CHUNK).min(self.nrows);
+                let rows = (c * CHUNK..((c + 1) * CHUNK).min(m))
+                    .map(|k| rows.map_or(k, |r| r[k] as usize));
                 let mut marker = vec![usize::MAX; b.ncols];
                 let mut acc = vec![0.0; b.ncols];
                 let (mut lens, mut idx, mut val) = (Vec::new(), Vec::new(), Vec::new());
@@ -210,9 +218,9 @@ impl Csr {
             })
             .collect();
         let mut out = Csr {
-            nrows: self.nrows,
+            nrows: m,
             ncols: b.ncols,
-            ptr: Vec::with_capacity(self.nrows + 1),
+            ptr: Vec::with_capacity(m + 1),
             ..Csr::default()
         };
         out.ptr.push(0);
@@ -374,7 +382,7 @@ impl AmgCg {
                 if nagg > 0 && (nagg as f64) < 0.8 * n as f64 {
                     let p = smoothed_prolongator(&a, &inv_diag, &agg, nagg, omega);
                     let r = p.transpose();
-                    let ac = r.matmul(&a.matmul(&p));
+                    let ac = galerkin(&r, &a, &p);
                     coarse = Some((p, r, ac));
                 }
             }
@@ -707,6 +715,53 @@ fn smoothed_prolongator(a: &Csr, inv_diag: &[f64], agg: &[usize], nagg: usize, o
     p
 }
 
+/// The Galerkin product `R (A P)`, a block of coarse rows at a time: each block makes
+/// only the rows of `A P` its rows of `R` reach, so the whole of `A P` (about as large
+/// as A) is never held. Each row of `A P` and of the product is made as
+/// [`Csr::matmul`] makes it, and the block's rows of `R` keep their order, so the bits
+/// are those of `R.matmul(&A.matmul(&P))`.
+fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
+    const BLOCK: usize = 2048;
+    let mut out = Csr {
+        nrows: r.nrows,
+        ncols: p.ncols,
+        ptr: vec![0],
+        ..Csr::default()
+    };
+    // Fine row → its row in the block's `A P`.
+    let mut local = vec![u32::MAX; a.nrows];
+    for start in (0..r.nrows).step_by(BLOCK) {
+        let end = (start + BLOCK).min(r.nrows);
+        let span = r.ptr[start]..r.ptr[end];
+        let mut fine = r.idx[span.clone()].to_vec();
+        fine.sort_unstable();
+        fine.dedup();
+        for (k, &i) in fine.iter().enumerate() {
+            local[i as usize] = k as u32;
+        }
+        let ap = a.matmul_rows(Some(&fine), p);
+        let block = Csr {
+            nrows: end - start,
+            ncols: fine.len(),
+            ptr: r.ptr[start..=end]
+                .iter()
+                .map(|&q| q - r.ptr[start])
+                .collect(),
+            idx: r.idx[span.clone()]
+                .iter()
+                .map(|&i| local[i as usize])
+                .collect(),
+            val: r.val[span].to_vec(),
+        };
+        let c = block.matmul(&ap);
+        let base = out.idx.len();
+        out.ptr.extend(c.ptr[1..].iter().map(|&q| base + q));
+        out.idx.extend(c.idx);
+        out.val.extend(c.val);
+    }
+    out
+}
+
 /// Dense Cholesky of a small SPD matrix, row-major lower factor.
 fn dense_cholesky(a: &Csr) -> Result<Vec<f64>, SolveError> {
     let n = a.nrows;
@@ -789,6 +844,26 @@ mod tests {
         assert_eq!(t.ptr, a.ptr);
         assert_eq!(t.idx, a.idx);
         let aa = a.matmul(&a);
+        // The blocked Galerkin product is the plain one, bit for bit (blocks of
+        // coarse rows reach overlapping fine rows, out of order, here).
+        let n = 5000;
+        let big = laplace_1d(n);
+        let agg: Vec<usize> = (0..n)
+            .map(|i| {
+                if i % 7 == 3 {
+                    usize::MAX
+                } else {
+                    (i * 31) % 2900
+                }
+            })
+            .collect();
+        let p = smoothed_prolongator(&big, &vec![0.5; n], &agg, 2900, 0.6);
+        let r = p.transpose();
+        let want = r.matmul(&big.matmul(&p));
+        let got = galerkin(&r, &big, &p);
+        assert_eq!((&got.ptr, &got.idx), (&want.ptr, &want.idx));
+        let bits = |c: &Csr| c.val.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&want));
         // (A²)_{ii} = 1 + 4 + 1 = 6 inside, 5 at the ends; exact integers.
         assert_eq!(aa.diagonal(), vec![5.0, 6.0, 6.0, 6.0, 6.0, 6.0, 5.0]);
     }
