@@ -69,6 +69,23 @@ impl<'p> Assembler<'p> {
         self.direct.as_ref().map(|d| d.values.as_slice())
     }
 
+    /// The assembled values (those of [`Self::values_into`]) made in the element sums'
+    /// own array, which the assembler gives up: a matrix needed once, without a copy.
+    /// The assembler makes no matrix afterwards.
+    pub fn take_values(&mut self) -> Result<Vec<f64>, AssemblyError> {
+        let Some(d) = self.direct.as_mut() else {
+            return Err(AssemblyError::Faer(
+                "a slot assembler keeps its values".into(),
+            ));
+        };
+        let mut vals = std::mem::take(&mut d.values);
+        if vals.is_empty() {
+            return Err(AssemblyError::Faer("the element values were taken".into()));
+        }
+        self.sum_slots(&mut vals)?;
+        Ok(vals)
+    }
+
     /// [`Self::elements`] of a direct assembler.
     pub(super) fn elements_direct<F>(&mut self, mesh: &Mesh, blocks: Option<&[usize]>, kernel: F)
     where
@@ -195,6 +212,13 @@ mod tests {
             assert_eq!(bits(&got), bits(&want));
             assert_eq!(asm.rhs(), reference.rhs());
             asm.check_finite(&mesh).unwrap();
+            // Taken values are the matrix's; the assembler makes none afterwards.
+            let taken = asm.take_values().unwrap();
+            assert_eq!(
+                taken.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                bits(&want)
+            );
+            assert!(asm.matrix().is_err() && asm.take_values().is_err());
         }
         // A slot assembler cannot use a pattern built for direct assembly.
         assert!(Assembler::new(&direct).matrix().is_err());

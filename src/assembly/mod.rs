@@ -707,6 +707,9 @@ impl<'p> Assembler<'p> {
         let nnz = self.built()?.0.row_idx().len();
         vals.clear();
         match &self.direct {
+            Some(d) if d.values.len() != nnz => {
+                return Err(AssemblyError::Faer("the element values were taken".into()));
+            }
             Some(d) => vals.extend_from_slice(&d.values),
             None => vals.resize(nnz, 0.0),
         }
@@ -738,6 +741,9 @@ impl<'p> Assembler<'p> {
             )));
         }
         match &self.direct {
+            Some(d) if d.values.len() != vals.len() => {
+                return Err(AssemblyError::Faer("the element values were taken".into()));
+            }
             Some(d) => vals.copy_from_slice(&d.values),
             None => vals.fill(0.0),
         }

@@ -246,19 +246,33 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let mut target = None;
     let mut last_step = f64::INFINITY;
     let mut heat = Vec::new();
+    // AMG-CG of a linear problem: the Jacobian K + J_Γ is the same at every step, so
+    // its hierarchy is set up once, taking K's values (no copy: K is not kept), and the
+    // residual after a step is R + J Δu — the hierarchy's matrix is J with the
+    // Dirichlet rows and columns eliminated, and Δu is 0 on those rows.
+    let linear_amg = p.iterative && symmetric && ties.is_empty();
+    let mut after_step: Option<Vec<f64>> = None;
     for it in 0..=p.max_iterations {
         let t = Instant::now();
-        // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
-        let mut r = vec![0.0; n];
-        let k_vol = asm.element_values().expect("a direct assembler");
-        spmv_ref(SparseColMatRef::new(sym, k_vol), &u, &mut r);
-        for (ri, fi) in r.iter_mut().zip(&f_vol) {
-            *ri -= fi;
+        let mut r;
+        if let Some(next) = after_step.take() {
+            r = next;
+            heat = iface.heat(&u, 0.0).map_err(failed)?;
+        } else {
+            // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
+            r = vec![0.0; n];
+            let k_vol = asm
+                .element_values()
+                .expect("K is kept until AMG-CG takes it");
+            spmv_ref(SparseColMatRef::new(sym, k_vol), &u, &mut r);
+            for (ri, fi) in r.iter_mut().zip(&f_vol) {
+                *ri -= fi;
+            }
+            asm.reset_couplings();
+            heat = iface
+                .assemble(&u, 0.0, &mut r, &mut asm, first)
+                .map_err(failed)?;
         }
-        asm.reset_couplings();
-        heat = iface
-            .assemble(&u, 0.0, &mut r, &mut asm, first)
-            .map_err(failed)?;
         // Ties: Cᵀλ on the primal rows, C u − ΔT ∫ψ on the multiplier rows.
         for (t, tie) in ties.iter().enumerate() {
             let l0 = lambda_first[t];
@@ -308,6 +322,31 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             break;
         }
         iterations += 1;
+        if linear_amg {
+            let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
+            let t = Instant::now();
+            if amg.hierarchy().rows.is_empty() {
+                let mut jac_values = asm.take_values()?;
+                let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
+                apply_dirichlet_mut(SparseColMatMut::new(sym, &mut jac_values), &mut rhs, &zero)?;
+                amg.factor_values(sym, jac_values)?;
+            }
+            timing.factor_s += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let report = amg.solve(&mut rhs)?;
+            linear.method = Some(LinearMethod::AmgCg);
+            linear.cg_iterations.push(report.iterations);
+            last_step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (ui, d) in u.iter_mut().zip(&rhs) {
+                *ui += d;
+            }
+            let mut jdu = vec![0.0; n];
+            amg.apply(&rhs, &mut jdu);
+            r.iter_mut().zip(&jdu).for_each(|(ri, v)| *ri += v);
+            after_step = Some(r);
+            timing.solve_s += t.elapsed().as_secs_f64();
+            continue;
+        }
         let t = Instant::now();
         for (t, tie) in ties.iter().enumerate() {
             for (e, &(_, _, c)) in tie.entries.iter().enumerate() {
@@ -323,20 +362,6 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         apply_dirichlet_mut(SparseColMatMut::new(sym, &mut jac_values), &mut rhs, &zero)?;
         timing.assembly_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        if p.iterative && symmetric && ties.is_empty() {
-            amg.factor_values(sym, jac_values)?;
-            timing.factor_s += t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let report = amg.solve(&mut rhs)?;
-            linear.method = Some(LinearMethod::AmgCg);
-            linear.cg_iterations.push(report.iterations);
-            timing.solve_s += t.elapsed().as_secs_f64();
-            last_step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for (ui, d) in u.iter_mut().zip(&rhs) {
-                *ui += d;
-            }
-            continue;
-        }
         let jac = SparseColMat::new(structure.clone(), jac_values);
         let saddle_ok = !ties.is_empty() && symmetric && saddle.factor(&jac).is_ok();
         let use_chol = !saddle_ok && ties.is_empty() && symmetric && chol.factor(&jac).is_ok();

@@ -421,6 +421,13 @@ impl AmgCg {
         Ok(())
     }
 
+    /// `y = A x` with the matrix of the last set-up.
+    pub fn apply(&self, x: &[f64], y: &mut [f64]) {
+        if let Some(level) = self.levels.first() {
+            level.a.spmv(x, y);
+        }
+    }
+
     /// Apply one V-cycle to `r` (zero initial guess), giving `z ≈ A⁻¹ r`.
     fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
         self.levels[0].b.copy_from_slice(r);

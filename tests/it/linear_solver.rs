@@ -4,8 +4,9 @@
 //! system indefinite; `direct` and `amg` still override. The threshold is lowered with
 //! the `[solve] auto_threshold` field so that a small scene crosses it.
 //!
-//! AMG-CG stops at ‖b − Ax‖ ≤ 1e-11 ‖b‖ (`seam::heat::steady::AMG_TOLERANCE`); on the
-//! electronics scene (1 043 unknowns, several AMG levels, about 30 CG iterations; a
+//! A steady AMG-CG solve stops at ‖b − Ax‖ ≤ 1e-13 ‖b‖
+//! (`seam::heat::steady::STEADY_AMG_TOLERANCE`), time steps at 1e-11
+//! (`seam::heat::steady::AMG_TOLERANCE`); on the electronics scene (1 043 unknowns, several AMG levels, about 30 CG iterations; a
 //! silicon die under an aluminium sink through a pressure-dependent contact conductance,
 //! convection outside) that leaves the temperature and the interface heat
 //! within 1e-8 relative of the Cholesky answer: they agree to about 1e-13, so the bound
