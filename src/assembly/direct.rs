@@ -42,14 +42,16 @@ impl<'p> Assembler<'p> {
     /// and keeps none: for a pattern (built by [`Pattern::build_direct`] or
     /// [`Pattern::build`]) whose element part is assembled once — [`Self::elements`]
     /// adds, so run each block once. Couplings, the diagonal and the right-hand side
-    /// work as with [`Assembler::new`], and [`Self::matrix`] gives the same bits.
+    /// work as with [`Assembler::new`], and [`Self::matrix`] gives the same bits; so
+    /// does [`Self::rhs`] when direct loads ([`Self::add_rhs`]) come before the
+    /// elements (element vectors are added into the right-hand side as they are made),
+    /// the same to round-off otherwise.
     pub fn direct(pattern: &'p Pattern) -> Result<Self, AssemblyError> {
         let nnz = pattern
             .symbolic()
             .ok_or_else(|| AssemblyError::Faer("Pattern::build was not called".into()))?
             .row_idx()
             .len();
-        let vec_elem_len = pattern.block_slots.iter().map(|s| s.1 * s.2).sum();
         Ok(Assembler {
             pattern,
             values: vec![0.0; pattern.value_count() - pattern.elem_values],
@@ -57,8 +59,9 @@ impl<'p> Assembler<'p> {
                 values: vec![0.0; nnz],
                 bad: None,
             }),
-            vector: vec![0.0; vec_elem_len + pattern.n],
-            vec_elem_len,
+            // No element vector slots: element vectors are added into the loads.
+            vector: vec![0.0; pattern.n],
+            vec_elem_len: 0,
         })
     }
 
@@ -97,21 +100,22 @@ impl<'p> Assembler<'p> {
             .expect("a direct assembler's pattern is built");
         let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
         let summed = self.direct.as_mut().expect("a direct assembler");
-        let (mut vec_off, mut buf, mut at) = (0, Vec::new(), Vec::new());
+        let (mut vec_off, mut buf, mut fbuf, mut at) = (0, Vec::new(), Vec::new(), Vec::new());
         for (b, block) in mesh.blocks.iter().enumerate() {
             let (_, ne, count) = pattern.block_slots[b];
             let run = blocks.is_none_or(|l| l.contains(&b));
             if run && count > 0 {
                 let first = block.first_elem.0;
-                let vec = &mut self.vector[vec_off..vec_off + count * ne];
+                let rhs = &mut self.vector;
                 let dofs = &pattern.elem_dofs[vec_off..vec_off + count * ne];
                 buf.resize(BATCH * ne * ne, 0.0);
+                fbuf.resize(BATCH * ne, 0.0);
                 at.resize(ne * ne, usize::MAX);
                 for start in (0..count).step_by(BATCH) {
                     let m = BATCH.min(count - start);
                     buf[..m * ne * ne]
                         .par_chunks_mut(ne * ne)
-                        .zip(vec[start * ne..(start + m) * ne].par_chunks_mut(ne))
+                        .zip(fbuf[..m * ne].par_chunks_mut(ne))
                         .enumerate()
                         .with_min_len(256)
                         .for_each(|(k, (ke, fe))| {
@@ -130,6 +134,12 @@ impl<'p> Assembler<'p> {
                         for (&p, &v) in at.iter().zip(ke) {
                             if p != usize::MAX {
                                 summed.values[p] += v;
+                            }
+                        }
+                        let fe = &fbuf[k * ne..(k + 1) * ne];
+                        for (&d, &v) in dofs[e * ne..(e + 1) * ne].iter().zip(fe) {
+                            if d != NONE {
+                                rhs[d as usize] += v;
                             }
                         }
                     }
@@ -192,7 +202,6 @@ mod tests {
             asm.add_coupling(0, 2.5, -1.5);
             asm.add_coupling(1, 0.125, 7.0);
             asm.add_diagonal(5, 9.0);
-            asm.add_rhs(3, 4.0);
         };
         let mut slots = Pattern::new(&mesh, &dofs);
         slots.add_couplings(&[(0, 35), (7, 20)]).unwrap();
@@ -200,17 +209,20 @@ mod tests {
         slots.build().unwrap();
         direct.build_direct().unwrap();
         let mut reference = Assembler::new(&slots);
+        reference.add_rhs(3, 4.0);
         reference.elements(&mesh, None, kernel);
         extras(&mut reference);
         let want = reference.matrix().unwrap();
         for pattern in [&direct, &slots] {
             let mut asm = Assembler::direct(pattern).unwrap();
+            asm.add_rhs(3, 4.0);
             asm.elements(&mesh, None, kernel);
             extras(&mut asm);
             let got = asm.matrix().unwrap();
             assert_eq!(got.symbolic().row_idx(), want.symbolic().row_idx());
             assert_eq!(bits(&got), bits(&want));
-            assert_eq!(asm.rhs(), reference.rhs());
+            let bits_of = |v: Vec<f64>| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits_of(asm.rhs()), bits_of(reference.rhs()));
             asm.check_finite(&mesh).unwrap();
             // Taken values are the matrix's; the assembler makes none afterwards.
             let taken = asm.take_values().unwrap();
