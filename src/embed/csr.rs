@@ -86,7 +86,7 @@ impl Embedding {
             .as_ref()
             .is_some_and(|e| e.current && e.jacobian.n == n && e.slots.len() == self.pairs.len());
         if !reuse {
-            self.build_pattern(&local, n)?;
+            self.build_pattern(n)?;
         }
         // Each block is added into the CSR values as it is made (no block is kept).
         let mut e = self.evaluation.take().expect("made above");
@@ -150,15 +150,17 @@ impl Embedding {
     /// A new CSR pattern for `n` host dofs: every entry any interaction's blocks can
     /// fill (switched-off ones too, so switching does not change it), and each block
     /// entry's place in it.
-    fn build_pattern(&mut self, local: &[f64], n: usize) -> Result<(), EmbedError> {
+    fn build_pattern(&mut self, n: usize) -> Result<(), EmbedError> {
         let host = |d: u32| self.host_dof[d as usize];
+        // The blocks' dofs come from the points' groups: no conductance is evaluated.
         let mut blocks: Vec<Vec<Vec<u32>>> = Vec::with_capacity(self.pairs.len());
         for p in &self.pairs {
-            let mut dofs_of = Vec::new();
-            self.with_form(p, |points, form| {
-                points.for_each_block(form, local, |dofs, _| dofs_of.push(dofs.to_vec()))
+            let groups = self.with_form(p, |points, _| {
+                Ok((0..points.groups())
+                    .map(|g| points.group(g).to_vec())
+                    .collect())
             })?;
-            blocks.push(dofs_of);
+            blocks.push(groups.unwrap_or_default());
         }
         let previous = self.evaluation.as_ref().map_or(0, |e| e.pattern);
         let mut entries: Vec<(usize, usize)> = Vec::new();

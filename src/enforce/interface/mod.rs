@@ -556,8 +556,9 @@ impl InterfacePoints {
         self.points.is_empty()
     }
 
-    /// The dofs of group `g` (side A's element, then side B's).
-    fn group(&self, g: usize) -> &[u32] {
+    /// The dofs of group `g` (side A's element, then side B's): the rows and columns
+    /// of the `g`-th block [`Self::for_each_block`] gives, without evaluating anything.
+    pub fn group(&self, g: usize) -> &[u32] {
         &self.dofs[self.group_dofs[g]..self.group_dofs[g + 1]]
     }
 
