@@ -43,6 +43,8 @@ struct Embedded {
     slots: RefCell<(u64, Vec<Slot>)>,
     /// The ties' rows, made once.
     ties: OnceCell<Result<Vec<TieConstraints>, String>>,
+    /// The number of dofs (fields, no multipliers) it was made over.
+    dofs: usize,
 }
 
 /// The contact of a run as its solvers see it, and what its states derive from it.
@@ -97,9 +99,19 @@ impl<'a> ContactTerms<'a> {
     /// Hand the run's interactions to an embedding over the solve's `dofs` (the fields,
     /// before any multiplier), with the Dirichlet nodes at the start fixed; once.
     pub(super) fn prepare(&self, dofs: &DofMap) -> Result<&dyn Interfaces, String> {
-        if self.embedded.get().is_none() {
-            let made = self.embed(dofs)?;
-            let _ = self.embedded.set(made);
+        match self.embedded.get() {
+            None => {
+                let made = self.embed(dofs)?;
+                let _ = self.embedded.set(made);
+            }
+            Some(e) if e.dofs != dofs.len() => {
+                return Err(format!(
+                    "the contact terms were made for {} dofs, the solve has {}",
+                    e.dofs,
+                    dofs.len()
+                ));
+            }
+            Some(_) => {}
         }
         Ok(self)
     }
@@ -142,6 +154,7 @@ impl<'a> ContactTerms<'a> {
             embedding: RefCell::new(embedding),
             slots: RefCell::new((0, Vec::new())),
             ties: OnceCell::new(),
+            dofs: dofs.len(),
         })
     }
 
@@ -424,7 +437,12 @@ impl Interfaces for ContactTerms<'_> {
                 }
             }
         }
-        *e.slots.borrow_mut() = (pattern, slots.into_iter().flatten().collect());
+        // Every entry got a slot: (i, i) its diagonal, (i, j) a coupling or its transpose.
+        let slots: Option<Vec<Slot>> = slots.into_iter().collect();
+        let slots = slots.ok_or_else(|| {
+            InterfaceFailure::Failed("an interface Jacobian entry without a place".into())
+        })?;
+        *e.slots.borrow_mut() = (pattern, slots);
         drop(embedding);
         Ok(pairs)
     }
