@@ -575,24 +575,31 @@ fn embed_quarantine_skips_failing_points_and_lists_them() {
 }
 
 /// `Quarantine Faulty Points` in a deck is honoured by an embedding (it was refused
-/// before the embedding could report the points).
+/// before the embedding could report the points): a Lua coefficient that is NaN past
+/// x = 0.5 stops the evaluation without the line and is quarantined there with it.
 #[test]
 fn embed_deck_quarantine_is_honoured() {
     let deck = std::fs::read_to_string(scene().join("contact_run.i")).unwrap();
     let line = "gap conductance coefficient = constant h = 500\n";
     assert!(deck.contains(line));
-    let with = deck.replace(line, &format!("{line}    Quarantine Faulty Points\n"));
+    let failing = "gap conductance coefficient = lua \"x > 0.5 and 0/0 or 500\"\n";
     let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
     let dof = example::host_dofs(&mesh);
-    let mut seam = example::embedding(&mesh, &dof).build().unwrap();
-    seam.add_deck("contact_run.i", &with).unwrap();
-    seam.search().unwrap();
     let u = field(mesh.num_nodes(), 0.0);
-    assert!(seam.contributions(&u).is_ok());
-    assert!(
-        seam.quarantined(0).is_empty(),
-        "a sound model quarantines nothing"
-    );
+    let embedding = |text: &str| {
+        let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+        seam.add_deck("contact_run.i", text).unwrap();
+        seam.search().unwrap();
+        seam
+    };
+    let strict = embedding(&deck.replace(line, failing));
+    assert!(strict.contributions(&u).is_err());
+    let quarantined =
+        embedding(&deck.replace(line, &format!("{failing}    Quarantine Faulty Points\n")));
+    assert!(quarantined.contributions(&u).is_ok());
+    let kept = quarantined.quarantined(0);
+    assert!(!kept.is_empty());
+    assert!(kept.iter().all(|q| q.x[0] > 0.5), "{kept:?}");
 }
 
 /// Switched off, a flux interaction adds nothing and reports 0 W; the CSR pattern
