@@ -201,6 +201,7 @@ impl<'a> TimeLoop<'a> {
                 Some("amg") => Some(0),
                 _ => Some(self.threshold),
             },
+            electric: None,
         };
         let restart = match (&problem.restart, self.options.restart.as_ref()) {
             (_, Some(file)) => Some(steps::read_checkpoint(file)?),

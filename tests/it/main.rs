@@ -6,6 +6,7 @@ mod cases;
 mod cli;
 mod conductance;
 mod docs;
+mod electric;
 mod embed;
 mod embed_api;
 mod enforce;

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 
 use crate::assembly::Assembler;
 use crate::fem::MAX_NODES;
+use crate::heat::electric;
 use crate::heat::interfaces::InterfaceFailure;
 use crate::heat::kernel;
 use crate::heat::law::Law;
@@ -41,8 +42,27 @@ impl Context<'_, '_> {
             .map(|(k, f)| (f.side().elem.0, k))
             .collect();
         faces.sort_unstable();
+        let mut currents: Vec<(u32, usize)> = loads
+            .currents
+            .iter()
+            .enumerate()
+            .map(|(k, (side, _))| (side.elem.0, k))
+            .collect();
+        currents.sort_unstable();
         let errors = FirstError::new();
         let (laws, source, block_source) = (p.laws, p.source, p.block_source);
+        let sigmas = p.electric.as_ref().map(|el| el.conductivity);
+        let cx = ElementCx {
+            mesh,
+            laws,
+            block_source,
+            setup,
+            u,
+            t,
+            loads,
+            faces: &faces,
+            currents: &currents,
+        };
         // A linear problem's element matrices (conduction, and the faces' dg/dT) stay
         // the same while the face conditions' derivatives do: then they are kept in
         // their slots and only the vectors are computed. Either way a linear element's
@@ -57,6 +77,12 @@ impl Context<'_, '_> {
         let keep = signature.is_some() && *self.element_matrices.borrow() == signature;
         asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
             let b = mesh.block_of(e);
+            if let Some(sigma) = sigmas.and_then(|s| s[b].as_ref()) {
+                if let Err(err) = cx.electric_element(e, sigma, re, je) {
+                    errors.record(e, err);
+                }
+                return;
+            }
             let topo = mesh.blocks[b].topology;
             let rule = rules[b].as_ref().expect("rule of a field block");
             let mut x = [[0.0; 3]; MAX_NODES];
@@ -206,6 +232,22 @@ impl Context<'_, '_> {
                 })?,
             None => Vec::new(),
         };
+        // Electrical contacts: the voltage interface and its Joule heat.
+        if let Some(el) = &p.electric {
+            let mut power = Vec::with_capacity(setup.electric.len());
+            for ((c, (_, h)), &first) in setup
+                .electric
+                .iter()
+                .zip(&el.contacts)
+                .zip(self.electric_first)
+            {
+                let pw = c
+                    .assemble(u, *h, &mut r, asm, first)
+                    .map_err(|m| Failure::Fatal(HeatError::Contact(m)))?;
+                power.push(pw);
+            }
+            *self.power.borrow_mut() = power;
+        }
         // Ties: Cᵀλ and C u − ΔT ∫ψ; a tie switched off keeps λ = 0.
         for (ti, tie) in setup.ties.iter().enumerate() {
             let l0 = setup.lambda_first[ti];
@@ -238,5 +280,144 @@ impl Context<'_, '_> {
             out.push(tie.heat(&u[l0..l0 + tie.own.len()]));
         }
         out
+    }
+}
+
+/// What an element of a block with a voltage needs (shared by the element threads).
+struct ElementCx<'c> {
+    mesh: &'c crate::mesh::Mesh,
+    laws: &'c [super::BlockLaws],
+    block_source: Option<&'c [Law]>,
+    setup: &'c super::setup::Setup,
+    u: &'c [f64],
+    t: f64,
+    loads: &'c Loads,
+    /// `(element, index)` of the face conditions and of the currents, sorted.
+    faces: &'c [(u32, usize)],
+    currents: &'c [(u32, usize)],
+}
+
+impl ElementCx<'_> {
+    /// One element of a block with a voltage: the coupled conduction, Joule heat and
+    /// charge kernel, its face conditions on the temperature (flux, convection,
+    /// radiation) and on the voltage (currents), and its block's heat source.
+    fn electric_element(
+        &self,
+        e: crate::mesh::ElemId,
+        sigma: &Law,
+        re: &mut [f64],
+        je: &mut [f64],
+    ) -> Result<(), HeatError> {
+        let (setup, mesh, u, t, loads) = (self.setup, self.mesh, self.u, self.t, self.loads);
+        let (faces, currents) = (self.faces, self.currents);
+        let b = mesh.block_of(e);
+        let topo = mesh.blocks[b].topology;
+        let rule = setup.rules[b].as_ref().expect("rule of a field block");
+        let mut x = [[0.0; 3]; MAX_NODES];
+        let nn = elem_coords(mesh, e, &mut x);
+        let mut elem_dofs = Vec::with_capacity(2 * nn);
+        setup.dofs.elem_dofs(mesh, e, &mut elem_dofs);
+        let mut te = [0.0; MAX_NODES];
+        let mut ve = [0.0; MAX_NODES];
+        for k in 0..nn {
+            te[k] = u[elem_dofs[k] as usize];
+            ve[k] = u[elem_dofs[nn + k] as usize];
+        }
+        let block = mesh.blocks[b].id;
+        let failed = Cell::new(None);
+        let k = checked(&self.laws[b].conductivity, "conductivity", t, &failed);
+        let s = checked(sigma, "electrical conductivity", t, &failed);
+        electric::joule_residual_jacobian(rule, &x[..nn], &te[..nn], &ve[..nn], (k, s), re, je)
+            .map_err(|bad| bad_jacobian(mesh, e, bad))?;
+        if let Some(message) = failed.take() {
+            return Err(HeatError::Material { block, message });
+        }
+        // The temperature and voltage blocks of the element matrix, nn × nn each.
+        let w = 2 * nn;
+        let mut add = |off: usize, rs: &[f64], js: &[f64]| {
+            for a in 0..nn {
+                re[off + a] += rs[a];
+                for c in 0..nn {
+                    je[(off + a) * w + off + c] += js[a * nn + c];
+                }
+            }
+        };
+        let mut rs = [0.0; MAX_NODES];
+        let mut js = [0.0; MAX_NODES * MAX_NODES];
+        let start = faces.partition_point(|f| f.0 < e.0);
+        for &(_, k) in faces[start..].iter().take_while(|f| f.0 == e.0) {
+            let bc = loads.faces[k];
+            let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
+            rs.fill(0.0);
+            js.fill(0.0);
+            kernel::face_load(
+                topo,
+                &x[..nn],
+                bc.side().side,
+                &te[..nn],
+                |temp, _| bc.outflow(temp),
+                rs,
+                js,
+            );
+            add(0, rs, js);
+        }
+        let start = currents.partition_point(|f| f.0 < e.0);
+        for &(_, k) in currents[start..].iter().take_while(|f| f.0 == e.0) {
+            let (side, j) = loads.currents[k];
+            let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
+            rs.fill(0.0);
+            js.fill(0.0);
+            kernel::face_load(
+                topo,
+                &x[..nn],
+                side.side,
+                &ve[..nn],
+                |_, _| (-j, 0.0),
+                rs,
+                js,
+            );
+            add(nn, rs, js);
+        }
+        if let Some(qb) = self.block_source {
+            let q_failed = Cell::new(None);
+            let q = |temp: f64, xq: [f64; 3]| match qb[b].eval(temp, xq, t) {
+                Ok(v) => v,
+                Err(m) => {
+                    q_failed.set(Some(m));
+                    (0.0, 0.0)
+                }
+            };
+            let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
+            rs.fill(0.0);
+            js.fill(0.0);
+            kernel::source_residual_jacobian(rule, &x[..nn], &te[..nn], q, rs, js)
+                .map_err(|bad| bad_jacobian(mesh, e, bad))?;
+            if let Some(message) = q_failed.take() {
+                return Err(HeatError::Source { block, message });
+            }
+            add(0, rs, js);
+        }
+        Ok(())
+    }
+}
+
+/// A material law as a kernel calls it: a failure or a non-finite value is kept in
+/// `failed` (the element reports it) and gives 0.
+fn checked<'l>(
+    law: &'l Law,
+    what: &'static str,
+    t: f64,
+    failed: &'l Cell<Option<String>>,
+) -> impl Fn(f64, [f64; 3]) -> (f64, f64) + 'l {
+    move |temp, xq| match law.eval(temp, xq, t) {
+        Ok(v) if v.0.is_finite() && v.1.is_finite() => v,
+        Ok(v) => {
+            failed.set(Some(format!("{what} = {} at T = {temp}", v.0)));
+            (0.0, 0.0)
+        }
+        Err(m) => {
+            failed.set(Some(format!("{what}: {m}")));
+            (0.0, 0.0)
+        }
     }
 }

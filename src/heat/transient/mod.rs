@@ -50,9 +50,11 @@ use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
 use crate::mesh::{Mesh, NodeId};
 
 use super::TEMPERATURE;
+use super::electric::{ContactPower, ElectricContact};
 use super::interfaces::Interfaces;
 use super::law::Law;
 use super::{FaceBc, HeatError, SourceFn};
+use crate::enforce::interface::HFn;
 
 use newton::{Context, History, Solvers};
 use setup::Setup;
@@ -90,6 +92,20 @@ pub struct BlockLaws {
 pub struct Loads {
     pub dirichlet: Vec<(NodeId, f64)>,
     pub faces: Vec<FaceBc>,
+    /// Nodal voltages (V), with [`TransientProblem::electric`].
+    pub voltage: Vec<(NodeId, f64)>,
+    /// Current densities into the body (A/m²) on element sides, with
+    /// [`TransientProblem::electric`].
+    pub currents: Vec<(crate::mesh::Side, f64)>,
+}
+
+/// The electrical part of a thermal–electrical problem ([`crate::heat::electric`]).
+pub struct Electric<'a> {
+    /// σ(T) per mesh block (S/m); `None`: the block carries no voltage.
+    pub conductivity: &'a [Option<Law>],
+    /// The electrical contacts, each with its contact conductance h_e (S/m²) as a law of
+    /// the gap and the two sides' temperatures.
+    pub contacts: Vec<(ElectricContact, &'a HFn<'a>)>,
 }
 
 /// A field and the blocks it lives on (each block carries one field).
@@ -126,6 +142,9 @@ pub struct TransientProblem<'a> {
     /// definite (no multipliers) and has at least this many unknowns, keeping the
     /// hierarchy while the matrix is unchanged; `None`: always factor.
     pub amg_threshold: Option<usize>,
+    /// The voltage field, its Joule heat and electrical contacts: the problem becomes a
+    /// coupled thermal–electrical one, solved monolithically.
+    pub electric: Option<Electric<'a>>,
 }
 
 /// Step-size control.
@@ -184,6 +203,8 @@ pub struct StepReport {
     pub solve_s: f64,
     /// CG iterations of the step's AMG-CG solves (0 when it factored).
     pub cg_iterations: usize,
+    /// Per electrical contact: the current through it and its Joule heat.
+    pub electric: Vec<ContactPower>,
     /// `None` when Newton converged; for a steady solve that did not, what happened
     /// (the residual history and the likely cause): the state is the last iterate.
     pub diagnosis: Option<String>,
@@ -282,6 +303,7 @@ pub fn solve(
                     }
                 }
             }
+            // The voltage starts at 0 (a linear equation: Newton's first step solves it).
             State {
                 step: 0,
                 time,
@@ -317,6 +339,10 @@ pub fn solve(
             .collect();
         tie_first.push(pattern.add_couplings(&pairs)?.start);
     }
+    let mut electric_first = Vec::with_capacity(setup.electric.len());
+    for c in &setup.electric {
+        electric_first.push(pattern.add_couplings(&c.couplings())?.start);
+    }
     pattern.build()?;
     let mut solver = Solvers::new(&setup, p.reproducible);
     let mut asm = Assembler::new(&pattern);
@@ -326,6 +352,8 @@ pub fn solve(
         first,
         element_matrices: RefCell::new(None),
         tie_first: &tie_first,
+        electric_first: &electric_first,
+        power: RefCell::new(Vec::new()),
         unconverged: RefCell::new(None),
     };
 

@@ -10,7 +10,7 @@ use crate::solve::{
 };
 use faer::sparse::SparseColMat;
 
-use super::setup::{Setup, node_dofs};
+use super::setup::Setup;
 use super::{Failure, Loads, StepReport, TransientProblem};
 
 /// The time history a step needs.
@@ -73,6 +73,10 @@ pub(super) struct Context<'c, 'a> {
     /// computed for a linear problem (None: not kept).
     pub(super) element_matrices: RefCell<Option<Vec<(u32, u8, f64)>>>,
     pub(super) tie_first: &'c [usize],
+    /// Where each electrical contact's couplings start in the assembler.
+    pub(super) electric_first: &'c [usize],
+    /// The electrical contacts' current and Joule heat at the last assembly.
+    pub(super) power: RefCell<Vec<crate::heat::electric::ContactPower>>,
     /// The report of the last Newton attempt that ran out of iterations (its
     /// `diagnosis` set), for a steady solve to hand on with its last iterate.
     pub(super) unconverged: RefCell<Option<StepReport>>,
@@ -111,7 +115,7 @@ impl Context<'_, '_> {
         let p = self.p;
         let setup = self.setup;
         let loads = (p.loads)(t)?;
-        let bcs = node_dofs(p.mesh, &setup.dofs, &setup.fields, &loads.dirichlet)?;
+        let bcs = setup.dirichlet(p.mesh, &loads)?;
         if bcs.len() != setup.dirichlet_dofs.len() {
             return Err(HeatError::Step(format!(
                 "the Dirichlet nodes changed at t = {t}: {} now against {} at the start",
@@ -136,6 +140,7 @@ impl Context<'_, '_> {
             factor_s: 0.0,
             solve_s: 0.0,
             cg_iterations: 0,
+            electric: Vec::new(),
             diagnosis: None,
         };
         let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
@@ -174,6 +179,7 @@ impl Context<'_, '_> {
                     },
                 };
                 report.heat = self.heat(flux, u);
+                report.electric = self.power.borrow().clone();
                 if !done {
                     let message = unconverged(p.max_iterations, t, &report.residual_history);
                     report.diagnosis = Some(message.clone());
@@ -294,5 +300,6 @@ impl Context<'_, '_> {
                 .all(|f| !matches!(f, FaceBc::Radiation { .. }))
             && self.p.interfaces.is_none_or(|i| i.is_linear())
             && (self.p.block_source).is_none_or(|s| s.iter().all(|q| !q.uses_temperature()))
+            && self.p.electric.is_none()
     }
 }

@@ -9,7 +9,8 @@ use crate::heat::kernel;
 use crate::heat::{HeatError, bad_jacobian, block_rules, elem_coords};
 use crate::mesh::{Mesh, NodeId};
 
-use super::TransientProblem;
+use super::{Loads, TransientProblem};
+use crate::heat::electric::{ElectricContact, VOLTAGE};
 
 /// What does not change over a run: dofs, ties, the pattern's couplings, the lumped
 /// capacity weights.
@@ -25,27 +26,54 @@ pub(super) struct Setup {
     /// The blocks carrying a field, and the element basis of each.
     pub(super) blocks: Vec<usize>,
     pub(super) rules: Vec<Option<Basis>>,
+    /// The voltage field of a thermal–electrical problem.
+    pub(super) voltage: Option<FieldId>,
+    /// Its electrical contacts, bound to the dofs.
+    pub(super) electric: Vec<ElectricContact>,
 }
 
 impl Setup {
     pub(super) fn new(p: &TransientProblem<'_>, time: f64) -> Result<Setup, HeatError> {
         let mesh = p.mesh;
         let specs = p.fields_or_default();
-        let list: Vec<(&str, &[usize])> = specs
+        let mut list: Vec<(&str, &[usize])> = specs
             .iter()
             .map(|f| (f.name.as_str(), f.blocks.as_slice()))
             .collect();
+        // The voltage is numbered after the thermal fields, so an element's dofs are its
+        // temperatures then its voltages.
+        let voltage_blocks: Vec<usize> = p.electric.as_ref().map_or_else(Vec::new, |e| {
+            (0..mesh.blocks.len())
+                .filter(|&b| e.conductivity.get(b).is_some_and(Option::is_some))
+                .collect()
+        });
+        if p.electric.is_some() {
+            list.push((VOLTAGE, voltage_blocks.as_slice()));
+        }
         let mut dofs = DofMap::new(mesh, &list)?;
+        let voltage = p.electric.as_ref().and_then(|_| dofs.field(VOLTAGE));
         let fields: Vec<FieldId> = specs
             .iter()
             .map(|f| dofs.field(&f.name).expect("field just made"))
             .collect();
         let n_primal = dofs.len();
         let loads = (p.loads)(time)?;
-        let dirichlet_dofs = node_dofs(mesh, &dofs, &fields, &loads.dirichlet)?
+        let mut dirichlet_dofs: Vec<usize> = node_dofs(mesh, &dofs, &fields, &loads.dirichlet)?
             .into_iter()
             .map(|(d, _)| d)
             .collect();
+        if let Some(v) = voltage {
+            dirichlet_dofs.extend(voltage_dofs(mesh, &dofs, v, &loads.voltage)?.map(|(d, _)| d));
+        }
+        let mut electric = Vec::new();
+        if let (Some(e), Some(v)) = (&p.electric, voltage) {
+            let t = fields[0];
+            for (c, _) in &e.contacts {
+                let mut c = c.clone();
+                c.bind(mesh, &dofs, t, v).map_err(HeatError::Contact)?;
+                electric.push(c);
+            }
+        }
         let ties = match p.interfaces {
             Some(i) => i.ties().map_err(HeatError::Contact)?,
             None => Vec::new(),
@@ -77,8 +105,42 @@ impl Setup {
             lumped,
             blocks,
             rules,
+            voltage,
+            electric,
         })
     }
+
+    /// The Dirichlet dofs and values of `loads`: the temperatures on whichever thermal
+    /// field the node carries, then the voltages.
+    pub(super) fn dirichlet(
+        &self,
+        mesh: &Mesh,
+        loads: &Loads,
+    ) -> Result<Vec<(usize, f64)>, HeatError> {
+        let mut out = node_dofs(mesh, &self.dofs, &self.fields, &loads.dirichlet)?;
+        if let Some(v) = self.voltage {
+            out.extend(voltage_dofs(mesh, &self.dofs, v, &loads.voltage)?);
+        }
+        Ok(out)
+    }
+}
+
+/// `(dof, value)` of nodal voltages; a node without a voltage is an error that names it.
+fn voltage_dofs<'d>(
+    mesh: &'d Mesh,
+    dofs: &'d DofMap,
+    v: FieldId,
+    data: &'d [(NodeId, f64)],
+) -> Result<impl Iterator<Item = (usize, f64)> + 'd, HeatError> {
+    if let Some(&(n, _)) = data.iter().find(|(n, _)| dofs.dof(v, *n).is_none()) {
+        return Err(HeatError::Step(format!(
+            "node {} has a voltage condition but no voltage: its blocks have no electrical_conductivity",
+            mesh.node_number(n)
+        )));
+    }
+    Ok(data
+        .iter()
+        .map(move |&(n, val)| (dofs.dof(v, n).expect("checked above").index(), val)))
 }
 
 /// `(dof, value)` of nodal data on whichever field the node carries.
