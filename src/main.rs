@@ -562,6 +562,12 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                         i.side_a, i.side_b, i.model, i.heat_side_a, i.heat_side_b, i.imbalance
                     );
                 }
+                for e in &s.electrical_contacts {
+                    println!(
+                        "  {} / {} (voltage): current A → B {:.6e} A, contact Joule heat {:.6e} W",
+                        e.side_a, e.side_b, e.current, e.joule_heat
+                    );
+                }
                 if let Some(t) = &s.transient {
                     println!(
                         "  {} time step(s) to t = {} ({} rejected and retried)",

@@ -534,7 +534,7 @@ const MODEL_KEYS: &[(&str, &[&str], &str)] = &[
 ];
 
 /// The material properties seam supports, as a help line lists them.
-const SUPPORTED_PROPERTIES: &str = "seam supports `gap conductance coefficient`, `contact surface pressure` (or `contact pressure`), `offset temperature` and `contact gap temperature`";
+const SUPPORTED_PROPERTIES: &str = "seam supports `gap conductance coefficient`, `contact surface pressure` (or `contact pressure`), `offset temperature`, `offset voltage` and `contact gap temperature`";
 
 fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut Diagnostics) {
     let who = match &e.name {
@@ -577,6 +577,30 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
             "the offset is a temperature difference added across the interface (K)",
         );
     }
+    if let Some(v) = e.offset_voltage {
+        range(
+            out,
+            v.is_finite(),
+            &who,
+            "offset voltage",
+            v,
+            "finite",
+            locs.or(&format!("{d}.enforcement.{k}.offset_voltage"), &e.at),
+            "the offset is a voltage difference added across the interface (V)",
+        );
+    }
+    if let Some(f) = e.joule_fraction_side_a {
+        range(
+            out,
+            (0.0..=1.0).contains(&f),
+            &who,
+            "joule heat fraction side a",
+            f,
+            "in [0, 1]",
+            locs.or(&format!("{d}.enforcement.{k}.joule_fraction_side_a"), &e.at),
+            "the share of the contact's Joule heat that goes to side A; the rest goes to side B",
+        );
+    }
     let mut first: HashMap<&str, usize> = HashMap::new();
     for (m, model) in e.models.iter().enumerate() {
         let eq = model.equation.as_str();
@@ -608,7 +632,7 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
                     )
                     .at(at.clone())
                     .help(format!(
-                        "{hint}Aria's equations are {}; seam solves `energy`",
+                        "{hint}Aria's equations are {}; seam solves `energy` and `voltage`",
                         registry::EQUATIONS
                             .iter()
                             .map(|(n, _)| format!("`{n}`"))

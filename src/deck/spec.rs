@@ -324,6 +324,13 @@ pub struct Enforcement {
     pub dash_penalty_factor: Option<f64>,
     #[serde(default)]
     pub offset_temperature: Option<f64>,
+    /// `Offset Voltage = v`: the voltage jump of an `Enforcement for Voltage`.
+    #[serde(default)]
+    pub offset_voltage: Option<f64>,
+    /// `Joule Heat Fraction Side A = f`: the share of an electrical contact's Joule heat
+    /// given to side A (0.5 when absent).
+    #[serde(default)]
+    pub joule_fraction_side_a: Option<f64>,
     /// `Contact Pressure = p` (Pa), for pressure-dependent conductance models.
     #[serde(default)]
     pub contact_pressure: Option<f64>,

@@ -223,6 +223,8 @@ fn full_expected() -> Deck {
             }),
             dash_penalty_factor: Some(10.0),
             offset_temperature: Some(273.15),
+            offset_voltage: None,
+            joule_fraction_side_a: None,
             contact_pressure: None,
             quarantine_faulty_points: false,
             use_toggle_block: Some("tog".into()),

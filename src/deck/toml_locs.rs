@@ -124,6 +124,8 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
                 "use_toggle_block",
                 "dash_penalty_factor",
                 "offset_temperature",
+                "offset_voltage",
+                "joule_fraction_side_a",
                 "contact_pressure",
             ] {
                 put(format!("{d}.enforcement.{k}.{key}"), sub(n, key));

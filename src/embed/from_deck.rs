@@ -88,6 +88,21 @@ impl Embedding {
                     .help(help),
             );
         }
+        // An electrical contact couples a voltage with the temperature; an embedding
+        // joins one field per interaction.
+        for e in &scene.electrical {
+            diags.push(
+                Diagnostic::error(
+                    "E0430",
+                    format!(
+                        "`Enforcement for Voltage` on {} / {}: an embedding joins one field and has no voltage",
+                        e.side_a, e.side_b
+                    ),
+                )
+                .at(Some(e.at.clone()))
+                .help("leave the voltage block out of the deck an embedding reads; `seam run` solves the thermal–electrical problem"),
+            );
+        }
         if diags.has_errors() {
             return Err(fail(&diags));
         }

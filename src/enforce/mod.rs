@@ -5,6 +5,7 @@
 //! conductance, tied Nitsche and interior penalty — assembled at contact points).
 
 pub mod conductance;
+pub mod electric;
 pub mod interface;
 pub mod model;
 pub mod mortar;

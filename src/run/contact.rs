@@ -36,6 +36,8 @@ pub(super) struct RunContact {
     pub choices: Vec<Choice>,
     /// What each contact output holds (`Visualize Contact`, `Output Rule`).
     pub views: Vec<ContactView>,
+    /// The electrical contacts (`Enforcement for Voltage`).
+    pub electrical: Vec<crate::scene::electric::ElectricalEnforced>,
     /// Wall-clock seconds building the contact surfaces and searching.
     pub surfaces_s: f64,
     pub search_s: f64,
@@ -155,6 +157,7 @@ impl RunContact {
             search_s: scene.timing.search_s,
             ..RunContact::default()
         };
+        out.electrical = scene.electrical;
         for e in scene.entries {
             out.views.push(e.view);
             out.choices

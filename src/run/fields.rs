@@ -16,6 +16,7 @@ use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::PointFlux;
 use crate::fem::shape::reference_nodes;
 use crate::fem::{MAX_NODES, eval_point};
+use crate::heat::law::Law;
 use crate::heat::transient::BlockLaws;
 use crate::mesh::{Mesh, NodeId};
 use crate::search::scene::Pairing;
@@ -32,9 +33,51 @@ pub(super) fn element_heat_flux(
     temperature: &[f64],
     time: f64,
 ) -> Result<Vec<f64>, String> {
+    let law = |b: usize| Some(&laws[b].conductivity);
+    element_flux(
+        mesh,
+        law,
+        temperature,
+        temperature,
+        time,
+        ("heat flux", "conductivity"),
+    )
+}
+
+/// −σ∇V at the centroid of every element (A/m²), as [`element_heat_flux`] with the
+/// block's electrical conductivity at the centroid temperature; NaN in blocks without a
+/// voltage.
+pub(super) fn element_current_density(
+    mesh: &Mesh,
+    sigma: &[Option<Law>],
+    temperature: &[f64],
+    voltage: &[f64],
+    time: f64,
+) -> Result<Vec<f64>, String> {
+    let law = |b: usize| sigma[b].as_ref();
+    element_flux(
+        mesh,
+        law,
+        temperature,
+        voltage,
+        time,
+        ("current density", "electrical conductivity"),
+    )
+}
+
+/// −c∇p at the centroid of every element for a potential `p` and a coefficient law
+/// `coefficient(block)` of the centroid temperature (NaN where either is missing).
+fn element_flux<'l>(
+    mesh: &Mesh,
+    coefficient: impl Fn(usize) -> Option<&'l Law>,
+    temperature: &[f64],
+    potential: &[f64],
+    time: f64,
+    (what, law_name): (&str, &str),
+) -> Result<Vec<f64>, String> {
     let mut out = Vec::with_capacity(3 * mesh.num_elems());
     for (b, block) in mesh.blocks.iter().enumerate() {
-        let Some(reference) = reference_nodes(block.topology) else {
+        let (Some(reference), Some(law)) = (reference_nodes(block.topology), coefficient(b)) else {
             out.extend(std::iter::repeat_n(f64::NAN, 3 * block.len()));
             continue;
         };
@@ -48,41 +91,40 @@ pub(super) fn element_heat_flux(
             let nodes = block.elem_nodes(k);
             let mut coords = [[0.0; 3]; MAX_NODES];
             let mut t = [0.0; MAX_NODES];
+            let mut p = [0.0; MAX_NODES];
             for (a, n) in nodes.iter().enumerate() {
                 coords[a] = mesh.coords[n.index()];
                 t[a] = temperature.get(n.index()).copied().unwrap_or(f64::NAN);
+                p[a] = potential.get(n.index()).copied().unwrap_or(f64::NAN);
             }
-            if t[..nodes.len()].iter().any(|v| !v.is_finite()) {
+            let nn = nodes.len();
+            if t[..nn].iter().chain(&p[..nn]).any(|v| !v.is_finite()) {
                 out.extend([f64::NAN; 3]);
                 continue;
             }
             let elem = block.first_elem.0 as usize + k;
-            let pv =
-                eval_point(block.topology, &coords[..nodes.len()], center, 1.0).map_err(|e| {
-                    format!(
-                        "heat flux: element {} is inverted at its centroid (det J = {:.3e})",
-                        mesh.elem_numbers
-                            .get(elem)
-                            .copied()
-                            .unwrap_or(elem as i64 + 1),
-                        e.det
-                    )
-                })?;
-            let mut tc = 0.0;
-            let mut grad = [0.0; 3];
-            for ((n, g), t) in pv.n.iter().zip(&pv.grad).zip(&t).take(nodes.len()) {
-                tc += n * t;
-                for (gd, dn) in grad.iter_mut().zip(g) {
-                    *gd += dn * t;
-                }
-            }
-            let (k_c, _) = laws[b].conductivity.eval(tc, pv.x, time).map_err(|e| {
+            let pv = eval_point(block.topology, &coords[..nn], center, 1.0).map_err(|e| {
                 format!(
-                    "heat flux: conductivity of block {}: {e}",
-                    block.sierra_name()
+                    "{what}: element {} is inverted at its centroid (det J = {:.3e})",
+                    mesh.elem_numbers
+                        .get(elem)
+                        .copied()
+                        .unwrap_or(elem as i64 + 1),
+                    e.det
                 )
             })?;
-            out.extend(grad.map(|g| -k_c * g + 0.0));
+            let mut tc = 0.0;
+            let mut grad = [0.0; 3];
+            for (((n, g), t), p) in pv.n.iter().zip(&pv.grad).zip(&t).zip(&p).take(nn) {
+                tc += n * t;
+                for (gd, dn) in grad.iter_mut().zip(g) {
+                    *gd += dn * p;
+                }
+            }
+            let (c, _) = law
+                .eval(tc, pv.x, time)
+                .map_err(|e| format!("{what}: {law_name} of block {}: {e}", block.sierra_name()))?;
+            out.extend(grad.map(|g| -c * g + 0.0));
         }
     }
     Ok(out)

@@ -198,6 +198,21 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     // Scene: the contact, the face conditions it masks, what the file joins to it.
     let contact = RunContact::build(&file, &mesh, &physics.field_names, options, &mut diags)?;
     contact.mask_face_conditions(&mut physics.face_sites, &mut diags);
+    if let Some(e) = contact.electrical.first()
+        && !physics.materials.electric()
+    {
+        diags.push(
+            Diagnostic::error(
+                "E0431",
+                format!(
+                    "electrical contact {} / {}: no block of the problem carries a voltage",
+                    e.side_a, e.side_b
+                ),
+            )
+            .at(Some(e.at.clone()))
+            .help("give the blocks on both sides an electrical_conductivity (S/m) in their [[material]]"),
+        );
+    }
     if !file.transient {
         posed::check_steady(&physics, &contact.pairings, &mut diags);
     }

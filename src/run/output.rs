@@ -8,6 +8,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::assembly::DofMap;
+use crate::heat::electric::VOLTAGE;
 use crate::heat::transient::{self, StepReport};
 use crate::search::pairing::PointStatus;
 
@@ -21,6 +22,9 @@ use super::terms::ContactTerms;
 
 /// The file a run that did not converge leaves in its output folder, holding the
 /// residual history and the likely cause.
+/// A state's nodal voltage and current density per element (x, y, z interleaved).
+type ElectricFields = (Vec<f64>, Vec<f64>);
+
 pub const NOT_CONVERGED: &str = "NOT_CONVERGED";
 
 /// The results of a run being written.
@@ -94,16 +98,37 @@ impl<'a> Output<'a> {
         let q =
             fields::element_heat_flux(self.physics.mesh, &self.physics.materials.laws, &t, time)?;
         let contact = self.terms.contact_of(&derived);
+        let electric = self.electric_fields(u, dofs, &t, time)?;
         let fields = steps::StepFields {
             temperature: &t,
             heat_flux: &q,
             contact: contact.as_ref(),
             heat_names: &self.heat_names,
             heat,
+            electric: electric.as_ref().map(|(v, j)| (v.as_slice(), j.as_slice())),
         };
         self.writer
             .write_step(step, time, &fields)
             .map_err(|e| format!("cannot write the results of step {step}: {e}"))
+    }
+
+    /// A thermal–electrical state's nodal voltage and current density per element
+    /// (`None` for a run without a voltage).
+    fn electric_fields(
+        &self,
+        u: &[f64],
+        dofs: &DofMap,
+        temperature: &[f64],
+        time: f64,
+    ) -> Result<Option<ElectricFields>, String> {
+        let Some(v) = dofs.field(VOLTAGE) else {
+            return Ok(None);
+        };
+        let voltage = dofs.nodal_values(v, u);
+        let sigma = &self.physics.materials.sigma;
+        let j =
+            fields::element_current_density(self.physics.mesh, sigma, temperature, &voltage, time)?;
+        Ok(Some((voltage, j)))
     }
 
     /// After an accepted step: its checkpoint, when one is due.
@@ -181,12 +206,21 @@ impl<'a> Output<'a> {
             .chain(&solution.tie_heat)
             .copied()
             .collect();
+        let electric = self
+            .electric_fields(
+                &solution.u,
+                &solution.dofs,
+                &solution.temperature,
+                final_time,
+            )
+            .map_err(RunError::Solve)?;
         let state = steps::StepFields {
             temperature: &solution.temperature,
             heat_flux: &heat_flux,
             contact: contact.as_ref(),
             heat_names: &self.heat_names,
             heat: &steady_heat,
+            electric: electric.as_ref().map(|(v, j)| (v.as_slice(), j.as_slice())),
         };
         let file = dir.join("temperature.vtu");
         let per_field: Vec<(String, Vec<f64>)> = if field_names.len() > 1 {
@@ -245,6 +279,12 @@ impl<'a> Output<'a> {
         let names = terms.term_mechanism_names();
         if !history.is_empty() {
             steps::write_steps(dir, history)?;
+            let contacts: Vec<(&str, &str)> = (terms.contact.electrical.iter())
+                .map(|e| (e.side_a.as_str(), e.side_b.as_str()))
+                .collect();
+            if !contacts.is_empty() {
+                steps::write_electrical_contacts(dir, history, &contacts)?;
+            }
             let rows: Vec<steps::HeatRow<'_>> = history
                 .iter()
                 .zip(&solved.mechanisms)

@@ -31,6 +31,8 @@ pub(super) struct Physics<'a> {
     pub field_names: Vec<String>,
     /// The nodes of the temperature conditions, with the condition.
     pub dirichlet: Vec<(NodeId, usize)>,
+    /// The nodes of the voltage conditions, with the condition.
+    pub voltage: Vec<(NodeId, usize)>,
     /// The face conditions (flux, convection, radiation), before evaluation.
     pub face_sites: Vec<FaceSite>,
     pub time: TimeSpec,
@@ -56,7 +58,9 @@ impl<'a> Physics<'a> {
         };
         let materials = materials(problem, mesh, probe, diags);
         check_bcs(problem, diags);
-        let dirichlet = dirichlet_nodes(problem, mesh, diags);
+        let dirichlet = nodal_condition_nodes(problem, mesh, BcKind::Temperature, diags);
+        let voltage = nodal_condition_nodes(problem, mesh, BcKind::Voltage, diags);
+        check_electric(problem, &materials, &voltage, diags);
         let face_sites = face_sites(problem, mesh, diags);
         let time = time_spec(problem, file.transient, diags);
         let block_source = block_sources(problem, mesh, &file.text, probe, time.start, diags);
@@ -73,6 +77,7 @@ impl<'a> Physics<'a> {
             materials,
             field_names,
             dirichlet,
+            voltage,
             face_sites,
             time,
             block_source,
@@ -100,7 +105,7 @@ impl<'a> Physics<'a> {
         loads_at(
             self.problem,
             self.mesh,
-            &self.dirichlet,
+            (&self.dirichlet, &self.voltage),
             &self.face_sites,
             &self.sandbox,
             t,
@@ -173,6 +178,15 @@ fn block_index(mesh: &Mesh, name: &str, diags: &mut Diagnostics, what: &str) -> 
 pub(super) struct Materials {
     pub laws: Vec<BlockLaws>,
     pub fields: Vec<String>,
+    /// Per block its electrical conductivity σ(T), if it carries a voltage.
+    pub sigma: Vec<Option<Law>>,
+}
+
+impl Materials {
+    /// Whether some block carries a voltage: a thermal–electrical problem.
+    pub(super) fn electric(&self) -> bool {
+        self.sigma.iter().any(Option::is_some)
+    }
 }
 
 impl Materials {
@@ -246,10 +260,21 @@ fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law
 
 fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> Materials {
     let mut out: Vec<Option<(BlockLaws, String)>> = vec![None; mesh.blocks.len()];
+    let mut sigma: Vec<Option<Law>> = vec![None; mesh.blocks.len()];
     for (i, m) in p.material.iter().enumerate() {
         let what = format!("[[material]] #{} conductivity", i + 1);
         let Some(k) = law(&m.conductivity, &what, probe, diags) else {
             continue;
+        };
+        let s = match &m.electrical_conductivity {
+            Some(v) => {
+                let what = format!("[[material]] #{} electrical_conductivity", i + 1);
+                match law(v, &what, probe, diags) {
+                    Some(s) => Some(s),
+                    None => continue,
+                }
+            }
+            None => None,
         };
         let capacity = match (&m.density, &m.specific_heat, m.rho_c) {
             (_, _, Some(_)) if m.density.is_some() || m.specific_heat.is_some() => {
@@ -316,6 +341,7 @@ fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> M
             .to_ascii_lowercase();
         for b in &m.blocks {
             if let Some(i) = block_index(mesh, b, diags, "[[material]]") {
+                sigma[i] = s.clone();
                 out[i] = Some((
                     BlockLaws {
                         conductivity: k.clone(),
@@ -352,7 +378,50 @@ fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> M
             }
         }
     }
-    Materials { laws, fields }
+    Materials {
+        laws,
+        fields,
+        sigma,
+    }
+}
+
+/// A voltage needs blocks with an electrical conductivity, and those blocks a voltage
+/// condition somewhere (else the potential floats).
+fn check_electric(
+    p: &Problem,
+    materials: &Materials,
+    voltage: &[(NodeId, usize)],
+    diags: &mut Diagnostics,
+) {
+    let electric_bcs: Vec<usize> = (p.bc.iter().enumerate())
+        .filter(|(_, b)| matches!(b.kind, BcKind::Voltage | BcKind::Current))
+        .map(|(k, _)| k)
+        .collect();
+    if !materials.electric() {
+        if let Some(&k) = electric_bcs.first() {
+            diags.push(
+                Diagnostic::error(
+                    "E0706",
+                    format!(
+                        "[[bc]] #{}: a {} condition, but no block carries a voltage",
+                        k + 1,
+                        p.bc[k].kind.name()
+                    ),
+                )
+                .help("give the conducting blocks' [[material]] an electrical_conductivity (S/m)"),
+            );
+        }
+        return;
+    }
+    if voltage.is_empty() {
+        diags.push(
+            Diagnostic::error(
+                "E0706",
+                "blocks carry a voltage, but no [[bc]] of kind \"voltage\" fixes it anywhere: the potential would float",
+            )
+            .help("add a [[bc]] with kind = \"voltage\" (say value = 0 on the grounded face)"),
+        );
+    }
 }
 
 /// ρ·c_p(T) from c_p(T).
@@ -478,14 +547,16 @@ fn check_bcs(p: &Problem, diags: &mut Diagnostics) {
     }
 }
 
-/// The nodes of each temperature condition, with the condition.
-fn dirichlet_nodes(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<(NodeId, usize)> {
+/// The nodes of each nodal condition of `kind` (temperature or voltage), with the
+/// condition.
+fn nodal_condition_nodes(
+    p: &Problem,
+    mesh: &Mesh,
+    kind: BcKind,
+    diags: &mut Diagnostics,
+) -> Vec<(NodeId, usize)> {
     let mut out = Vec::new();
-    for (k, bc) in
-        p.bc.iter()
-            .enumerate()
-            .filter(|(_, b)| b.kind == BcKind::Temperature)
-    {
+    for (k, bc) in p.bc.iter().enumerate().filter(|(_, b)| b.kind == kind) {
         let mut nodes = Vec::new();
         for s in &bc.surfaces {
             if let Some(i) = mesh.find_side_set(s) {
@@ -529,13 +600,14 @@ fn face_sites(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<FaceSite
     for (k, bc) in
         p.bc.iter()
             .enumerate()
-            .filter(|(_, b)| b.kind != BcKind::Temperature)
+            .filter(|(_, b)| !matches!(b.kind, BcKind::Temperature | BcKind::Voltage))
     {
         for s in &bc.surfaces {
             let Some(i) = mesh.find_side_set(s) else {
                 diags.push(
-                    Diagnostic::error("E0706", format!("[[bc]]: unknown side set `{s}`"))
-                        .help("flux, convection and radiation conditions act on side sets"),
+                    Diagnostic::error("E0706", format!("[[bc]]: unknown side set `{s}`")).help(
+                        "flux, convection, radiation and current conditions act on side sets",
+                    ),
                 );
                 continue;
             };
@@ -559,27 +631,35 @@ fn face_sites(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<FaceSite
     out
 }
 
+/// A node of a nodal condition, with the condition's index.
+type NodalSite = (NodeId, usize);
+
 /// The boundary data at time t.
 fn loads_at(
     p: &Problem,
     mesh: &Mesh,
-    dirichlet: &[(NodeId, usize)],
+    (dirichlet, voltage): (&[NodalSite], &[NodalSite]),
     faces: &[FaceSite],
     sandbox: &SharedSandbox,
     t: f64,
 ) -> Result<Loads, String> {
     let mut out = Loads::default();
-    for &(n, k) in dirichlet {
-        let v = evaluate(
-            &p.bc[k].value,
-            mesh.coords[n.index()],
-            t,
-            sandbox,
-            "[[bc]] value",
-        )
-        .map_err(|e| format!("[[bc]] #{} value: {e}", k + 1))?;
-        in_range(BcKind::Temperature, v, k, mesh.coords[n.index()], t)?;
-        out.dirichlet.push((n, v));
+    for (nodes, kind) in [(dirichlet, BcKind::Temperature), (voltage, BcKind::Voltage)] {
+        for &(n, k) in nodes {
+            let v = evaluate(
+                &p.bc[k].value,
+                mesh.coords[n.index()],
+                t,
+                sandbox,
+                "[[bc]] value",
+            )
+            .map_err(|e| format!("[[bc]] #{} value: {e}", k + 1))?;
+            in_range(kind, v, k, mesh.coords[n.index()], t)?;
+            match kind {
+                BcKind::Voltage => out.voltage.push((n, v)),
+                _ => out.dirichlet.push((n, v)),
+            }
+        }
     }
     for f in faces {
         let bc = &p.bc[f.bc];
@@ -587,6 +667,10 @@ fn loads_at(
             .map_err(|e| format!("[[bc]] #{} value: {e}", f.bc + 1))?;
         in_range(bc.kind, v, f.bc, f.centroid, t)?;
         let t_inf = bc.ambient.unwrap_or(0.0);
+        if bc.kind == BcKind::Current {
+            out.currents.push((f.side, v));
+            continue;
+        }
         out.faces.push(match bc.kind {
             BcKind::Flux => FaceBc::Flux { side: f.side, q: v },
             BcKind::Radiation => FaceBc::Radiation {

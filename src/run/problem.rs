@@ -124,6 +124,10 @@ pub struct MaterialSpec {
     /// fields are joined by `Side B Variable b To a`.
     #[serde(default)]
     pub field: Option<String>,
+    /// σ (S/m): a number, a Lua expression of T (and x, y, z, t), or a table in T. Gives
+    /// the blocks a `voltage` field, with its Joule heat σ|∇V|² in the temperature.
+    #[serde(default)]
+    pub electrical_conductivity: Option<Value>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -134,6 +138,11 @@ pub enum BcKind {
     Convection,
     /// εσ(T⁴ − T∞⁴): `value` is the emissivity ε, `ambient` T∞.
     Radiation,
+    /// A nodal voltage (V), on blocks with an `electrical_conductivity`.
+    Voltage,
+    /// A current density into the body (A/m²) on faces of blocks with an
+    /// `electrical_conductivity`.
+    Current,
 }
 
 /// Largest temperature (K) a problem file may give: far beyond any physical one, and
@@ -161,6 +170,14 @@ impl BcKind {
                 "a heat-transfer coefficient is in [0, 1e100] W/m²K",
             ),
             BcKind::Radiation => (v > 0.0 && v <= 1.0, "an emissivity is in (0, 1]"),
+            BcKind::Voltage => (
+                v.abs() <= MAX_MAGNITUDE,
+                "a voltage is finite and within ±1e100 V",
+            ),
+            BcKind::Current => (
+                v.abs() <= MAX_MAGNITUDE,
+                "a current density is finite and within ±1e100 A/m²",
+            ),
         };
         if ok { Ok(()) } else { Err(range) }
     }
@@ -172,6 +189,8 @@ impl BcKind {
             BcKind::Flux => "flux",
             BcKind::Convection => "convection",
             BcKind::Radiation => "radiation",
+            BcKind::Voltage => "voltage",
+            BcKind::Current => "current",
         }
     }
 }

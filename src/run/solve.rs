@@ -5,6 +5,9 @@
 //! checkpointed; the linear solver that ran is summarised with the reason for it.
 
 use crate::assembly::DofMap;
+use crate::enforce::conductance::{ConductanceModel, PointState};
+use crate::enforce::interface::{HInput, HValue};
+use crate::heat::electric::VOLTAGE;
 use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
 use crate::heat::transient::{
     self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
@@ -87,6 +90,7 @@ impl<'a> TimeLoop<'a> {
             && physics.uniform
             && physics.materials.constant().is_some()
             && physics.field_names.len() == 1
+            && !physics.materials.electric()
             && !self.terms.couplings.any_toggle()
             && (self.file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
     }
@@ -178,13 +182,26 @@ impl<'a> TimeLoop<'a> {
                     .collect(),
             })
             .collect();
-        // The solver's dofs, as it numbers them: the fields in order.
-        let list: Vec<(&str, &[usize])> = fields
+        // The solver's dofs, as it numbers them: the fields in order, then the voltage.
+        let mut list: Vec<(&str, &[usize])> = fields
             .iter()
             .map(|f| (f.name.as_str(), f.blocks.as_slice()))
             .collect();
+        let sigma = &physics.materials.sigma;
+        let voltage_blocks: Vec<usize> = (0..mesh.blocks.len())
+            .filter(|&b| sigma[b].is_some())
+            .collect();
+        if physics.materials.electric() {
+            list.push((VOLTAGE, &voltage_blocks));
+        }
         let dofs = DofMap::new(mesh, &list).map_err(|e| RunError::Solve(e.to_string()))?;
         let interfaces = terms.prepare(&dofs).map_err(RunError::Solve)?;
+        let contact_conductances: Vec<_> = terms
+            .contact
+            .electrical
+            .iter()
+            .map(|e| electric_conductance(e.model.as_ref(), e.pressure))
+            .collect();
         let tp = TransientProblem {
             mesh,
             fields,
@@ -201,7 +218,16 @@ impl<'a> TimeLoop<'a> {
                 Some("amg") => Some(0),
                 _ => Some(self.threshold),
             },
-            electric: None,
+            electric: physics.materials.electric().then(|| transient::Electric {
+                conductivity: sigma,
+                contacts: terms
+                    .contact
+                    .electrical
+                    .iter()
+                    .zip(&contact_conductances)
+                    .map(|(e, h)| (e.contact.clone(), h as &transient::ContactConductance<'_>))
+                    .collect(),
+            }),
         };
         let restart = match (&problem.restart, self.options.restart.as_ref()) {
             (_, Some(file)) => Some(steps::read_checkpoint(file)?),
@@ -381,5 +407,30 @@ fn linear_solver_summary(
         reason,
         iterations: linear.cg_iterations.iter().sum(),
         iterations_per_solve: linear.cg_iterations.clone(),
+    }
+}
+
+/// An electrical contact's conductance model as the solver calls it: h_e at a point's
+/// gap and temperatures, the contact pressure and the time.
+fn electric_conductance(
+    model: &dyn ConductanceModel,
+    pressure: f64,
+) -> impl Fn(&HInput, f64) -> Result<HValue, String> + '_ {
+    move |i, time| {
+        let c = model
+            .evaluate(&PointState {
+                gap: i.gap,
+                pressure,
+                temp_a: i.temp_a,
+                temp_b: i.temp_b,
+                x: i.x,
+                time,
+            })
+            .map_err(|e| format!("electrical contact conductance `{}`: {e}", model.name()))?;
+        Ok(HValue {
+            h: c.h,
+            dh_dtemp_a: c.dh_dtemp_a,
+            dh_dtemp_b: c.dh_dtemp_b,
+        })
     }
 }

@@ -48,6 +48,9 @@ pub(super) struct StepFields<'a> {
     /// Per term (contact terms, then ties): the heat leaving side A and side B; empty
     /// when the state has none (its globals are then written as NaN).
     pub heat: &'a [(f64, f64)],
+    /// A thermal–electrical run's nodal voltage and −σ∇V per element (x, y, z
+    /// interleaved; NaN where there is none).
+    pub electric: Option<(&'a [f64], &'a [f64])>,
 }
 
 /// The names of the global variables of `results.exo`: per term (side A, side B
@@ -86,6 +89,12 @@ pub(super) struct StepWriter<'m> {
 
 /// The element variables of `results.exo`.
 const HEAT_FLUX: [&str; 3] = ["heat_flux_x", "heat_flux_y", "heat_flux_z"];
+/// The element variables of the current density in `results.exo`.
+const CURRENT_DENSITY: [&str; 3] = [
+    "current_density_x",
+    "current_density_y",
+    "current_density_z",
+];
 /// The nodal contact variables of `results.exo` (with contact output).
 const CONTACT_NODAL: [&str; 3] = ["contact_gap", "contact_fraction", "interface_flux"];
 
@@ -165,12 +174,17 @@ impl<'m> StepWriter<'m> {
             if fields.contact.is_some() {
                 nodal.extend(CONTACT_NODAL);
             }
+            let mut element = HEAT_FLUX.to_vec();
+            if fields.electric.is_some() {
+                nodal.push("voltage");
+                element.extend(CURRENT_DENSITY);
+            }
             let global: Vec<&str> = fields.heat_names.iter().map(String::as_str).collect();
             self.exodus = Some(ExodusWriter::create_with_globals(
                 &dir.join("results.exo"),
                 self.mesh,
                 &nodal,
-                &HEAT_FLUX,
+                &element,
                 &global,
             )?);
         }
@@ -182,17 +196,16 @@ impl<'m> StepWriter<'m> {
         if let Some(c) = fields.contact {
             nodal.extend(c.nodal(self.mesh));
         }
-        let element: Vec<Vec<f64>> = (0..3)
-            .map(|d| {
-                fields
-                    .heat_flux
-                    .iter()
-                    .skip(d)
-                    .step_by(3)
-                    .map(|&v| finite(v))
-                    .collect()
-            })
-            .collect();
+        let components = |v: &[f64]| -> Vec<Vec<f64>> {
+            (0..3)
+                .map(|d| v.iter().skip(d).step_by(3).map(|&v| finite(v)).collect())
+                .collect()
+        };
+        let mut element = components(fields.heat_flux);
+        if let Some((v, j)) = fields.electric {
+            nodal.push(v.iter().map(|&v| finite(v)).collect());
+            element.extend(components(j));
+        }
         let nodal: Vec<&[f64]> = nodal.iter().map(Vec::as_slice).collect();
         let element: Vec<&[f64]> = element.iter().map(Vec::as_slice).collect();
         let global: Vec<f64> = if fields.heat.len() * 2 == fields.heat_names.len() {
@@ -241,13 +254,12 @@ pub(super) fn write_temperature_vtu(
 ) -> std::io::Result<()> {
     let mut point = vec![Array::scalar("temperature", fields.temperature)];
     point.extend(extra.iter().map(|&(n, v)| Array::scalar(n, v)));
-    write_vtu_arrays(
-        path,
-        mesh,
-        &point,
-        &[Array::vector("heat_flux", fields.heat_flux)],
-        VtuEncoding::Ascii,
-    )
+    let mut cell = vec![Array::vector("heat_flux", fields.heat_flux)];
+    if let Some((v, j)) = fields.electric {
+        point.push(Array::scalar("voltage", v));
+        cell.push(Array::vector("current_density", j));
+    }
+    write_vtu_arrays(path, mesh, &point, &cell, VtuEncoding::Ascii)
 }
 
 /// `contact.vtu`: the contact faces as polygon cells over their own points (the mesh
@@ -453,6 +465,25 @@ pub(super) fn write_steps(dir: &Path, history: &[StepReport]) -> std::io::Result
         ));
     }
     std::fs::write(dir.join("steps.csv"), s)
+}
+
+/// `electrical_contacts.csv`: per step and electrical contact (side A, side B surface
+/// names), the current from side A to side B (A) and the contact's Joule heat (W).
+pub(super) fn write_electrical_contacts(
+    dir: &Path,
+    history: &[StepReport],
+    contacts: &[(&str, &str)],
+) -> std::io::Result<()> {
+    let mut s = String::from("step,time,side_a,side_b,current,joule_heat\n");
+    for r in history {
+        for ((a, b), p) in contacts.iter().zip(&r.electric) {
+            s.push_str(&format!(
+                "{},{:e},{a},{b},{:e},{:e}\n",
+                r.step, r.time, p.current, p.joule
+            ));
+        }
+    }
+    std::fs::write(dir.join("electrical_contacts.csv"), s)
 }
 
 /// One step's interface heat: per term (contact terms, then ties) the heat leaving

@@ -27,6 +27,17 @@ pub struct InteractionHeat {
     pub imbalance: f64,
 }
 
+/// One electrical contact's line in the summary (`Enforcement for Voltage`).
+#[derive(Clone, Debug, Serialize)]
+pub struct ElectricalContact {
+    pub side_a: String,
+    pub side_b: String,
+    /// The current from side A to side B through the contact (A).
+    pub current: f64,
+    /// The Joule heat released at the contact, h_e (V_A − V_B − ΔV)² over its area (W).
+    pub joule_heat: f64,
+}
+
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct Timing {
     /// Reading the mesh.
@@ -60,6 +71,10 @@ pub struct Summary {
     pub diagnosis: Option<String>,
     /// Which linear solver ran and why.
     pub linear_solver: LinearSolverSummary,
+    /// Thermal–electrical runs: each electrical contact's current and Joule heat at the
+    /// end.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub electrical_contacts: Vec<ElectricalContact>,
 }
 
 /// The linear solver of a run, the reason it was chosen, and its CG iterations.
@@ -167,6 +182,7 @@ impl Summary {
             peak_memory_mib: peak_memory_mib(),
             diagnosis: history.last().and_then(|r| r.diagnosis.clone()),
             linear_solver: solved.linear_solver.clone(),
+            electrical_contacts: electrical_contacts(terms, history.last()),
         }
     }
 }
@@ -196,4 +212,24 @@ pub(super) fn report_crosspoints(mesh: &Mesh, solution: &SteadySolution, diags: 
             );
         }
     }
+}
+
+/// The electrical contacts of `terms` with their current and Joule heat in `last`.
+pub(super) fn electrical_contacts(
+    terms: &ContactTerms<'_>,
+    last: Option<&crate::heat::transient::StepReport>,
+) -> Vec<ElectricalContact> {
+    let power = last.map_or(&[][..], |r| r.electric.as_slice());
+    terms
+        .contact
+        .electrical
+        .iter()
+        .zip(power)
+        .map(|(e, p)| ElectricalContact {
+            side_a: e.side_a.clone(),
+            side_b: e.side_b.clone(),
+            current: p.current,
+            joule_heat: p.joule,
+        })
+        .collect()
 }

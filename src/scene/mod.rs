@@ -23,6 +23,7 @@
 //! [`PluginSpec`](crate::plugin::PluginSpec)).
 
 pub mod conductance;
+pub mod electric;
 pub mod enforcement;
 pub mod interaction;
 pub mod plugin;
@@ -185,6 +186,8 @@ pub fn problem_file_lines(loaded: &LoadedDeck) -> Vec<(crate::diag::Loc, Problem
 #[derive(Default)]
 pub struct ContactScene {
     pub entries: Vec<Enforced>,
+    /// The electrical contacts of the definitions' `Enforcement for Voltage` blocks.
+    pub electrical: Vec<electric::ElectricalEnforced>,
     /// Per contact definition of the deck, in deck order.
     pub definitions: Vec<DefinitionNotes>,
     /// Number of contact surfaces built, over every definition.
@@ -268,7 +271,25 @@ impl ContactScene {
                 );
                 continue;
             }
+            let voltage = electric::voltage_block(def).unwrap_or_else(|e| {
+                diags.push(e);
+                None
+            });
+            let energy = def
+                .enforcements
+                .iter()
+                .any(|e| e.models.iter().any(|m| m.equation == ENERGY));
             for (pairing, map) in searched.pairings.into_iter().zip(maps) {
+                if let Some(v) = voltage
+                    && let Some(e) =
+                        electric::electrical(v, d, &pairing, deck_dir, &loaded.sources, diags)
+                {
+                    scene.electrical.push(e);
+                }
+                // A definition with a Voltage block and no Energy one joins no temperatures.
+                if voltage.is_some() && !energy {
+                    continue;
+                }
                 let interaction = list
                     .iter()
                     .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
@@ -665,7 +686,23 @@ pub fn check_enforcements(
         {
             diags.push(double_claim(first, second, None));
         }
+        match electric::voltage_block(def) {
+            Ok(Some(enf)) => {
+                let name = enf.name.as_deref().unwrap_or("(check)");
+                let _ =
+                    electric::voltage_model(enf, deck_dir, &loaded.sources, (name, name), diags);
+            }
+            Ok(None) => {}
+            Err(e) => diags.push(e),
+        }
         for enf in &def.enforcements {
+            if enf
+                .models
+                .iter()
+                .any(|m| m.equation == electric::VOLTAGE_EQUATION)
+            {
+                continue;
+            }
             match resolve_for(enf, fields) {
                 Ok(choice) => {
                     let name = enf.name.as_deref().unwrap_or("(check)");

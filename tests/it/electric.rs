@@ -183,6 +183,7 @@ fn run(
     sigma: [Law; 2],
     h_e: &(dyn Fn(&HInput) -> Result<HValue, String> + Sync),
 ) -> (StepReport, DofMap, Vec<f64>) {
+    let h_e = |i: &HInput, _t: f64| h_e(i);
     let p = pair(mesh);
     let laws: Vec<BlockLaws> = bars
         .k
@@ -262,7 +263,7 @@ fn run(
         amg_threshold: None,
         electric: Some(Electric {
             conductivity: &sigma,
-            contacts: vec![(contact, h_e)],
+            contacts: vec![(contact, &h_e)],
         }),
     };
     let initial = |_| bars.t_inf;
@@ -514,4 +515,60 @@ fn newton_converges_quadratically_with_sigma_of_t_and_a_temperature_dependent_co
     );
     let last = *orders.last().unwrap();
     assert!(last > 1.8, "Newton's order {last:.2} (residuals {r:?})");
+}
+
+/// The busbar scene with `edit` applied to its problem file and `deck_edit` to its deck:
+/// the codes of `seam check`'s errors.
+fn check_codes(edit: impl Fn(&str) -> String, deck_edit: impl Fn(&str) -> String) -> Vec<String> {
+    let dir = crate::examples::copy_scene_as("busbar_joint", "electric-check");
+    let problem = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
+    std::fs::write(dir.join("problem.toml"), edit(&problem)).unwrap();
+    let deck = std::fs::read_to_string(dir.join("contact.i")).unwrap();
+    std::fs::write(dir.join("contact.i"), deck_edit(&deck)).unwrap();
+    let codes = match seam::run::check(&dir.join("problem.toml")) {
+        Err(seam::run::RunError::Input(d, _)) => d.errors().map(|d| d.code.to_string()).collect(),
+        Ok(_) => Vec::new(),
+        Err(e) => panic!("{e:?}"),
+    };
+    std::fs::remove_dir_all(&dir).ok();
+    codes
+}
+
+#[test]
+fn electrical_input_that_cannot_be_solved_is_refused_with_its_reason() {
+    let same = |s: &str| s.to_string();
+    assert!(
+        check_codes(same, same).is_empty(),
+        "the scene itself checks"
+    );
+    // A voltage contact in a problem where nothing carries a voltage (and no voltage
+    // conditions either).
+    let no_sigma = |s: &str| {
+        s.replace("electrical_conductivity = 5.8e7\n", "")
+            .replace("kind = \"current\"", "kind = \"flux\"")
+            .replace(
+                "[[bc]]\nkind = \"voltage\"\nsurfaces = [\"b_end\"]\nvalue = 0.0\n",
+                "",
+            )
+    };
+    assert_eq!(check_codes(no_sigma, same), ["E0431"]);
+    // A voltage that floats: no voltage condition.
+    let floating = |s: &str| s.replace("kind = \"voltage\"", "kind = \"current\"");
+    assert_eq!(check_codes(floating, same), ["E0706"]);
+    // One block claiming Energy and Voltage: its coefficient cannot be both.
+    let mixed = |d: &str| {
+        d.replace(
+            "    enforcement for energy = gap_conductance\n",
+            "    enforcement for energy = gap_conductance\n    enforcement for voltage = gap_conductance\n",
+        )
+    };
+    assert!(check_codes(same, mixed).contains(&"E0431".to_string()));
+    // A tied voltage is not offered.
+    let tied = |d: &str| {
+        d.replace(
+            "enforcement for voltage = gap_conductance",
+            "enforcement for voltage = tied_voltage",
+        )
+    };
+    assert_eq!(check_codes(same, tied), ["E0431"]);
 }

@@ -507,6 +507,22 @@ fn embed_reads_a_deck_as_seam_run_does() {
         "{err}"
     );
     assert!(seam.is_empty(), "nothing added on an error");
+    // A voltage block: `seam run` solves it with the temperature; an embedding joins one
+    // field, so it refuses the block rather than leave it out.
+    let electrical = deck.replace(
+        "  begin interaction",
+        "  begin enforcement electrical\n    enforcement for voltage = gap_conductance\n    gap conductance coefficient = constant h = 1e8\n  end\n  begin interaction",
+    );
+    assert_ne!(electrical, deck);
+    let err = seam
+        .add_deck("electrical.i", &electrical)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("E0430") && err.contains("Enforcement for Voltage"),
+        "{err}"
+    );
+    assert!(seam.is_empty(), "nothing added on an error");
 }
 
 /// h = 800 where x ≤ 0.5, and a model that fails past x = 0.5 (`fail`) or gives 0 there.

@@ -630,3 +630,43 @@ fn electronics_warms_up_toward_its_steady_state() {
         assert!(dir.join("out").join(f).exists(), "{f} missing");
     }
 }
+
+/// Busbar joint: the current entering bar A's end all crosses the bolted contact into
+/// bar B (charge conservation across non-matching faces), and the electrical power put
+/// in, ∫ j V dA over the end where the current enters (B's end is grounded, V = 0),
+/// leaves as heat by convection — the bulk and contact Joule heat included. Discrete
+/// balances, to the balance tolerance.
+#[test]
+fn busbar_joint_power_leaves_as_heat() {
+    let dir = copy_scene("busbar_joint");
+    let r = run(&dir.join("problem.toml"));
+    let problem = problem_table(&dir.join("problem.toml"));
+    let j0 = number(&bc(&problem, "a_end")["value"]);
+    let current = j0 * area(&r.mesh, "a_end");
+    let dofs = &r.solution.dofs;
+    let voltage = dofs.nodal_values(dofs.field("voltage").unwrap(), &r.solution.u);
+    let power = j0 * face_integral(&r.mesh, &voltage, "a_end", |_, v| v);
+    let mut out = 0.0;
+    let bcs = problem["bc"].as_array().unwrap().iter();
+    for b in bcs
+        .map(|b| b.as_table().unwrap())
+        .filter(|b| b["kind"].as_str() == Some("convection"))
+    {
+        let (h, t_inf) = (number(&b["value"]), number(&b["ambient"]));
+        for s in b["surfaces"].as_array().unwrap() {
+            let s = s.as_str().unwrap();
+            out += face_integral(&r.mesh, &r.solution.temperature, s, |_, t| h * (t - t_inf));
+        }
+    }
+    let c = &r.summary.electrical_contacts[0];
+    eprintln!(
+        "busbar: {current:.9} A in, {:.9} A across the joint; {power:.9} W in, {out:.9} W out (relative {:e}); contact Joule heat {:.6} W",
+        c.current,
+        (out - power).abs() / power,
+        c.joule_heat
+    );
+    assert!((c.current - current).abs() <= BALANCE * current);
+    assert!((out - power).abs() <= BALANCE * power);
+    assert!(c.joule_heat > 0.0 && c.joule_heat < power);
+    std::fs::remove_dir_all(&dir).ok();
+}

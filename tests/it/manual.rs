@@ -430,7 +430,6 @@ fn equations_of_arias_list_other_than_energy_are_refused() {
         "Porous_Enthalpy",
         "Porous_Species",
         "Species",
-        "Voltage",
     ] {
         let lower = eq.to_lowercase();
         let text = in_enforcement(&format!("Enforcement For {eq} = Tied"));
@@ -449,7 +448,7 @@ fn equations_of_arias_list_other_than_energy_are_refused() {
             d.0[0]
                 .help
                 .as_deref()
-                .is_some_and(|h| h.starts_with("seam solves Energy only")),
+                .is_some_and(|h| h.starts_with("seam solves Energy and Voltage only")),
             "{eq}"
         );
         // The spec still carries the line.
@@ -610,7 +609,7 @@ fn material_models_that_seam_refuses() {
         (
             "Contact Gap Voltage = Constant Value = 1",
             "contact gap voltage",
-            "the voltage equation",
+            "a conductance that depends on the voltage",
         ),
         (
             "Offset Darcy Potential = Constant Value = 1",
@@ -641,11 +640,6 @@ fn material_models_that_seam_refuses() {
             "Offset Velocity = Constant Value = 1",
             "offset velocity",
             "fluid flow",
-        ),
-        (
-            "Offset Voltage = Constant Value = 1",
-            "offset voltage",
-            "the voltage equation",
         ),
         (
             r#"User Expression = "h * 2""#,
@@ -1152,10 +1146,10 @@ equation = "energy"
 model = "gap_conductance"
 args = [{ key = "h", value = "5" }]
 [[contact_definition.enforcement.model]]
-equation = "voltage"
+equation = "species"
 model = "tied"
 [[contact_definition.enforcement.property]]
-property = "offset_voltage"
+property = "offset_species"
 model = "constant"
 [[contact_definition.enforcement.property]]
 property = "gap_conductence_coefficient"
@@ -1188,4 +1182,24 @@ transform = { kind = "mapped", z_map = "z + 1" }
             .as_deref()
             .is_some_and(|h| h.starts_with("did you mean `gap_conductance_coefficient`?"))
     );
+}
+
+/// `Enforcement For Voltage` and `Offset Voltage` are read: the equation seam solves
+/// beside Energy, and the jump of its contact.
+#[test]
+fn voltage_enforcements_are_read() {
+    let text = in_enforcement(
+        "Enforcement For Voltage = Gap_Conductance\n    Offset Voltage = Constant Value = 0.25\n    Joule Heat Fraction Side A = 0.3",
+    );
+    let (deck, d) = parse(&text);
+    assert!(diags(&d).is_empty(), "{:?}", diags(&d));
+    let e = &deck.contact_definitions[0].enforcements[0];
+    assert_eq!(e.models[0].equation, "voltage");
+    assert_eq!(e.offset_voltage, Some(0.25));
+    assert_eq!(e.joule_fraction_side_a, Some(0.3));
+    let (_, d) = parse(&in_enforcement(
+        "Enforcement For Voltage = Gap_Conductance\n    Joule Heat Fraction Side A = 1.5",
+    ));
+    assert_eq!(diags(&d).len(), 1, "{:?}", diags(&d));
+    assert_eq!(diags(&d)[0].0, "E0227");
 }

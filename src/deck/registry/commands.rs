@@ -209,12 +209,12 @@ pub static COMMANDS: &[CommandSpec] = &[
     refused!(
         "contact gap voltage",
         "contact_gap_voltage",
-        "the voltage equation, which seam does not solve (seam solves energy only)"
+        "a conductance that depends on the voltage, which seam's conductance models do not (an electrical contact conductance sees the two sides' temperatures, as `contact gap temperature` says)"
     ),
     refused!(
         "offset darcy potential",
         "offset_darcy_potential",
-        "porous flow (Darcy potential), which seam does not solve (seam solves energy only)"
+        "porous flow (Darcy potential), which seam does not solve (seam solves energy and voltage only)"
     ),
     refused!(
         "offset mesh displacements",
@@ -224,7 +224,7 @@ pub static COMMANDS: &[CommandSpec] = &[
     refused!(
         "offset pressure",
         "offset_pressure",
-        "fluid flow (pressure), which seam does not solve (seam solves energy only)"
+        "fluid flow (pressure), which seam does not solve (seam solves energy and voltage only)"
     ),
     refused!(
         "offset solid displacements",
@@ -234,17 +234,26 @@ pub static COMMANDS: &[CommandSpec] = &[
     refused!(
         "offset species",
         "offset_species",
-        "species transport, which seam does not solve (seam solves energy only)"
+        "species transport, which seam does not solve (seam solves energy and voltage only)"
     ),
     refused!(
         "offset velocity",
         "offset_velocity",
-        "fluid flow (velocity), which seam does not solve (seam solves energy only)"
+        "fluid flow (velocity), which seam does not solve (seam solves energy and voltage only)"
     ),
-    refused!(
+    cmd!(
         "offset voltage",
         "offset_voltage",
-        "the voltage equation, which seam does not solve (seam solves energy only)"
+        [ENF],
+        "= [constant [value =]] <v>",
+        "Voltage offset across the interface of an `Enforcement for Voltage` (material model `Offset Voltage = Constant Value = <v>`): the current is h_e (V_A - V_B - v). Range: finite (else E0227)."
+    ),
+    cmd!(
+        "joule heat fraction side a",
+        "joule_fraction_side_a",
+        [ENF],
+        "= <f>",
+        "seam: the share of an electrical contact's Joule heat h_e (V_A - V_B)^2 given to side A's temperature (the rest to side B). Default 0.5. Range: [0, 1] (else E0227)."
     ),
     refused!(
         "user expression",

@@ -234,11 +234,12 @@ pub static EQUATIONS: &[(&str, Status)] = &[
     ("porous_enthalpy", Status::Refused(NOT_ENERGY)),
     ("porous_species", Status::Refused(NOT_ENERGY)),
     ("species", Status::Refused(NOT_ENERGY)),
-    ("voltage", Status::Refused(NOT_ENERGY)),
+    ("voltage", Status::Implemented),
 ];
 
-const NOT_ENERGY: &str = "seam solves Energy only";
-const CVFEM: &str = "seam solves Energy only, with finite elements (no control-volume form)";
+const NOT_ENERGY: &str = "seam solves Energy and Voltage only";
+const CVFEM: &str =
+    "seam solves Energy and Voltage only, with finite elements (no control-volume form)";
 
 /// The status of equation `name` (lower case), `None` if it is not in Aria's list.
 pub fn equation(name: &str) -> Option<Status> {
@@ -435,7 +436,8 @@ mod tests {
             Some(("contact_pressure", 3))
         );
         assert!(elfen_refused("corner_REGION_size").is_some());
-        assert_eq!(equation("voltage"), Some(Status::Refused(NOT_ENERGY)));
+        assert_eq!(equation("species"), Some(Status::Refused(NOT_ENERGY)));
+        assert_eq!(equation("voltage"), Some(Status::Implemented));
         assert_eq!(equation("energy"), Some(Status::Implemented));
         assert_eq!(equation("enrgy"), None);
     }

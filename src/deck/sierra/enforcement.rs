@@ -134,6 +134,23 @@ impl Lower {
                             .set(format!("{d}.enforcement.{k}.dash_penalty_factor"), v_at);
                     }
                 }
+                "offset_voltage" => {
+                    self.once(&mut seen, &c);
+                    if let Some((v, v_at)) = self.constant_value(&mut c, "a voltage difference") {
+                        e.offset_voltage = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.offset_voltage"), v_at);
+                    }
+                }
+                "joule_fraction_side_a" => {
+                    self.once(&mut seen, &c);
+                    c.skip_sep();
+                    if let Some((v, v_at)) = self.number(&mut c, "a fraction in [0, 1]") {
+                        e.joule_fraction_side_a = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.joule_fraction_side_a"), v_at);
+                    }
+                }
                 "offset_temperature" => {
                     self.once(&mut seen, &c);
                     if let Some((v, v_at)) = self.constant_value(&mut c, "a temperature difference")

@@ -241,8 +241,9 @@ impl Context<'_, '_> {
                 .zip(&el.contacts)
                 .zip(self.electric_first)
             {
+                let at_t = |i: &crate::enforce::interface::HInput| h(i, t);
                 let pw = c
-                    .assemble(u, *h, &mut r, asm, first)
+                    .assemble(u, &at_t, &mut r, asm, first)
                     .map_err(|m| Failure::Fatal(HeatError::Contact(m)))?;
                 power.push(pw);
             }

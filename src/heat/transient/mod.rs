@@ -54,7 +54,7 @@ use super::electric::{ContactPower, ElectricContact};
 use super::interfaces::Interfaces;
 use super::law::Law;
 use super::{FaceBc, HeatError, SourceFn};
-use crate::enforce::interface::HFn;
+use crate::enforce::interface::{HInput, HValue};
 
 use newton::{Context, History, Solvers};
 use setup::Setup;
@@ -104,9 +104,13 @@ pub struct Electric<'a> {
     /// σ(T) per mesh block (S/m); `None`: the block carries no voltage.
     pub conductivity: &'a [Option<Law>],
     /// The electrical contacts, each with its contact conductance h_e (S/m²) as a law of
-    /// the gap and the two sides' temperatures.
-    pub contacts: Vec<(ElectricContact, &'a HFn<'a>)>,
+    /// the point's gap and two temperatures and of the time.
+    pub contacts: Vec<(ElectricContact, &'a ContactConductance<'a>)>,
 }
+
+/// An electrical contact conductance at a point and time: h_e and its temperature
+/// derivatives, or why it failed.
+pub type ContactConductance<'a> = dyn Fn(&HInput, f64) -> Result<HValue, String> + 'a;
 
 /// A field and the blocks it lives on (each block carries one field).
 #[derive(Clone, Debug)]

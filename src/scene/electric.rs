@@ -1,0 +1,163 @@
+//! `Enforcement for Voltage`: a definition's electrical contact on each of its pairings.
+//!
+//! The voltage block of a definition (one at most) applies to every pair of the
+//! definition, beside the Energy block. Its model is a contact conductance
+//! (`Gap_Conductance` or `Conductance`) whose `Gap Conductance Coefficient` lines give
+//! the electrical contact conductance h_e (S/m²) — every coefficient model, plugins
+//! included, as for Energy: the temperatures they see are the thermal ones at the point.
+//! `Offset Voltage` is the jump ΔV in `j = h_e (V_A − V_B − ΔV)`, `Joule Heat Fraction
+//! Side A` the share of the contact's Joule heat given to side A (0.5 by default).
+
+use std::path::Path;
+
+use crate::deck::spec::{ContactDefinition, Enforcement};
+use crate::diag::{Diagnostic, Diagnostics, SourceMap};
+use crate::enforce::conductance::ConductanceModel;
+use crate::enforce::electric::ElectricContact;
+use crate::search::scene::Pairing;
+
+use super::enforcement::resolve_for;
+
+/// The equation of an electrical contact.
+pub const VOLTAGE_EQUATION: &str = "voltage";
+
+/// A pairing's electrical contact.
+pub struct ElectricalEnforced {
+    pub side_a: String,
+    pub side_b: String,
+    pub contact: ElectricContact,
+    /// The electrical contact conductance h_e (S/m²) as a law of the point's state.
+    pub model: Box<dyn ConductanceModel>,
+    /// The contact pressure its pressure-dependent models see (Pa).
+    pub pressure: f64,
+    /// Index of the contact definition in the deck.
+    pub definition: usize,
+    /// The voltage block, for messages.
+    pub at: crate::diag::Loc,
+}
+
+/// The voltage block of `def`, if it has one; two, or one that claims another equation
+/// too, are an error.
+pub(super) fn voltage_block(def: &ContactDefinition) -> Result<Option<&Enforcement>, Diagnostic> {
+    let claims: Vec<&Enforcement> = def
+        .enforcements
+        .iter()
+        .filter(|e| e.models.iter().any(|m| m.equation == VOLTAGE_EQUATION))
+        .collect();
+    match claims.as_slice() {
+        [] => Ok(None),
+        [one] if one.models.iter().any(|m| m.equation != VOLTAGE_EQUATION) => Err(
+            Diagnostic::error(
+                "E0431",
+                "this enforcement block claims Voltage and another equation: its `Gap Conductance Coefficient` would be both the thermal (W/m²K) and the electrical (S/m²) contact conductance",
+            )
+            .at(Some(one.at.clone()))
+            .help("put `Enforcement for Voltage = …` and its coefficient in a `begin Enforcement` block of its own"),
+        ),
+        [one] => Ok(Some(one)),
+        [_, second, ..] => Err(Diagnostic::error(
+            "E0431",
+            "two enforcement blocks of this definition claim Voltage",
+        )
+        .at(Some(second.at.clone()))
+        .help("give the definition one `Enforcement for Voltage` block")),
+    }
+}
+
+/// The electrical contact of `pairing` under the voltage block `enf` of definition `d`,
+/// or `None` with the reasons in `diags`.
+pub(super) fn electrical(
+    enf: &Enforcement,
+    d: usize,
+    pairing: &Pairing,
+    deck_dir: &Path,
+    sources: &SourceMap,
+    diags: &mut Diagnostics,
+) -> Option<ElectricalEnforced> {
+    let pair = (pairing.side_a.as_str(), pairing.side_b.as_str());
+    let (conductance, pressure) = voltage_model(enf, deck_dir, sources, pair, diags)?;
+    let fraction = enf.joule_fraction_side_a.unwrap_or(0.5);
+    let contact = match ElectricContact::new(
+        &pairing.side_a_geometry,
+        &pairing.side_b_geometry,
+        &pairing.result.points,
+        enf.offset_voltage.unwrap_or(0.0),
+        fraction,
+    ) {
+        Ok(c) => c,
+        Err(m) => {
+            diags.push(
+                Diagnostic::error(
+                    "E0431",
+                    format!(
+                        "electrical contact {} / {}: {m}",
+                        pairing.side_a, pairing.side_b
+                    ),
+                )
+                .at(Some(enf.at.clone()))
+                .help("side A of an electrical contact is a face surface"),
+            );
+            return None;
+        }
+    };
+    Some(ElectricalEnforced {
+        side_a: pairing.side_a.clone(),
+        side_b: pairing.side_b.clone(),
+        contact,
+        model: conductance,
+        pressure,
+        definition: d,
+        at: enf.at.clone(),
+    })
+}
+
+/// The electrical contact conductance of the voltage block `enf` and its contact
+/// pressure, lowered as an Energy block's conductance is (the same models and checks);
+/// `None` with the reasons in `diags`.
+pub(super) fn voltage_model(
+    enf: &Enforcement,
+    deck_dir: &Path,
+    sources: &SourceMap,
+    pair: (&str, &str),
+    diags: &mut Diagnostics,
+) -> Option<(Box<dyn ConductanceModel>, f64)> {
+    let line = enf.models.iter().find(|m| m.equation == VOLTAGE_EQUATION)?;
+    let model = line.model.to_ascii_lowercase();
+    if !matches!(model.as_str(), "gap_conductance" | "conductance") {
+        diags.push(
+            Diagnostic::error(
+                "E0431",
+                format!("`Enforcement for Voltage = {model}`: seam joins voltages across a contact by a contact conductance only"),
+            )
+            .at(Some(line.at.clone()))
+            .help("write `Enforcement for Voltage = Gap_Conductance` with a `Gap Conductance Coefficient` (S/m²); a tied voltage is not supported yet"),
+        );
+        return None;
+    }
+    let mut as_energy = enf.clone();
+    as_energy.models = vec![crate::deck::spec::EnforcementModel {
+        equation: "energy".into(),
+        ..line.clone()
+    }];
+    let choice = match resolve_for(&as_energy, None) {
+        Ok(c) => c,
+        Err(ds) => {
+            ds.into_iter().for_each(|x| diags.push(x));
+            return None;
+        }
+    };
+    let Some(model) =
+        super::conductance_model(&as_energy, &choice, deck_dir, sources, pair, diags).ok()?
+    else {
+        diags.push(
+            Diagnostic::error(
+                "E0431",
+                "this `Enforcement for Voltage` block has no `Gap Conductance Coefficient`",
+            )
+            .at(Some(enf.at.clone()))
+            .help("give the electrical contact conductance, e.g. `Gap Conductance Coefficient = Constant H = 1e8` (S/m²)"),
+        );
+        return None;
+    };
+    Some((model, choice.pressure))
+}
