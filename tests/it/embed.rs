@@ -882,7 +882,7 @@ fn embed_header_declares_the_exported_functions() {
 /// `seam run` on `examples/<scene>/<problem>` as it stands, except that the mesh and the
 /// contact deck are read in place (absolute paths) and nothing is written; the deck's
 /// folder may be another copy of the scene (a plugin library built next to it).
-fn run_scene(scene: &Path, deck_dir: &Path, problem: &str) -> seam::run::RunResult {
+pub(crate) fn run_scene(scene: &Path, deck_dir: &Path, problem: &str) -> seam::run::RunResult {
     run_scene_with(scene, deck_dir, problem, None)
 }
 

@@ -12,6 +12,7 @@ mod embed_api;
 mod enforce;
 mod examples;
 mod fem;
+mod fortran_plugin;
 mod fuzz_regressions;
 mod hard_cases;
 mod hard_input;

@@ -143,7 +143,7 @@ fn rust_plugins() -> &'static RustPlugins {
     })
 }
 
-fn data(real: &[f64], integer: &[i64]) -> PluginData {
+pub(crate) fn data(real: &[f64], integer: &[i64]) -> PluginData {
     PluginData {
         model: None,
         integer_data: integer.to_vec(),
@@ -163,7 +163,7 @@ fn ctx() -> StepContext<'static> {
     }
 }
 
-fn point(gap: f64, pressure: f64, temp_a: f64, temp_b: f64) -> ContactPoint {
+pub(crate) fn point(gap: f64, pressure: f64, temp_a: f64, temp_b: f64) -> ContactPoint {
     ContactPoint {
         gap,
         pressure,
@@ -176,7 +176,10 @@ fn point(gap: f64, pressure: f64, temp_a: f64, temp_b: f64) -> ContactPoint {
     }
 }
 
-fn eval(plugin: &Plugin, points: &[ContactPoint]) -> Result<Vec<PointResult>, PluginFault> {
+pub(crate) fn eval(
+    plugin: &Plugin,
+    points: &[ContactPoint],
+) -> Result<Vec<PointResult>, PluginFault> {
     let mut r = vec![PointResult::default(); points.len()];
     plugin.evaluate(&ctx(), points, &mut r, None)?;
     Ok(r)
@@ -486,9 +489,9 @@ fn calls_to_a_plugin_that_is_not_thread_safe_are_serialised() {
 // --- the examples ----------------------------------------------------------------------
 
 /// Table used in the c_table tests: (pressure, conductance) pairs.
-const TABLE: [(f64, f64); 4] = [(0.0, 1e3), (1e6, 5e3), (4e6, 6.5e3), (1e7, 6.5e3)];
+pub(crate) const TABLE: [(f64, f64); 4] = [(0.0, 1e3), (1e6, 5e3), (4e6, 6.5e3), (1e7, 6.5e3)];
 
-fn table_real() -> Vec<f64> {
+pub(crate) fn table_real() -> Vec<f64> {
     TABLE.iter().flat_map(|&(p, h)| [p, h]).collect()
 }
 
