@@ -25,12 +25,10 @@ pub struct Builder {
 
 impl Builder {
     fn update(&mut self, f: impl FnOnce(EmbeddingBuilder) -> EmbeddingBuilder) -> PyResult<()> {
-        let b = self.inner.take().ok_or_else(|| {
-            argument(
-                "this builder has already built its embedding",
-                "make a new seam.Builder for another embedding",
-            )
-        })?;
+        let b = self
+            .inner
+            .take()
+            .ok_or_else(|| argument("the builder is empty", "make a new seam.Builder"))?;
         self.inner = Some(f(b));
         Ok(())
     }

@@ -55,7 +55,7 @@ pub fn model(
     function: Py<PyAny>,
     depends_on_temperature: bool,
     raised: Raised,
-) -> PyResult<Arc<dyn ConductanceModel>> {
+) -> Arc<dyn ConductanceModel> {
     let name = Python::attach(|py| {
         function
             .bind(py)
@@ -86,11 +86,7 @@ pub fn model(
             })
         })
     };
-    Ok(Arc::new(FnConductance::new(
-        &label,
-        depends_on_temperature,
-        call,
-    )))
+    Arc::new(FnConductance::new(&label, depends_on_temperature, call))
 }
 
 /// A function's answer: `h` or `(h, dh_dtemp_a, dh_dtemp_b)`.

@@ -332,7 +332,7 @@ impl Embedding {
         let mut slot = None;
         if let Some(f) = conductance {
             let raised = Raised::default();
-            i = i.conductance(callback::model(f, depends_on_temperature, raised.clone())?);
+            i = i.conductance(callback::model(f, depends_on_temperature, raised.clone()));
             slot = Some(raised);
         }
         let index = self.inner.add_interaction(i).py_err()?;

@@ -4,8 +4,11 @@ heat through the cut is the exact flux times the cut's area (1 m²)."""
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg  # noqa: F401  (sp.linalg)
 
-from skfem_two_boxes import TwoBoxes, exact, solve_linear
+import seam
+from skfem_two_boxes import SKFEM_OF_EXODUS, TwoBoxes, exact, solve_linear
 
 # Round-off of a 189-node solve: the nodal values are O(1), the matrices' condition
 # number O(1e2); 1e-11 leaves three decades above what is measured (3e-15).
@@ -62,8 +65,6 @@ def test_standard_mortar_tie_through_the_constraint_rows(host):
     assert m == len(tie.multiplier_dofs) > 0
     u_exact, q = exact(host)
     # [K Cᵀ; C 0] [u; λ] = [0; g], u fixed on the outer boundary.
-    import scipy.sparse as sp
-
     saddle = sp.bmat([[host.K, c.T], [c, None]], format="csr")
     n = host.n
     free = np.setdiff1d(np.arange(n + m), host.boundary)
@@ -88,8 +89,6 @@ def test_dual_mortar_tie_condensed(host):
     (tie,) = e.constraints()
     dofs, constants, t = tie.condensed(host.n)
     assert len(dofs) > 0
-    import scipy.sparse as sp
-
     # u = P ũ + g: P is the identity on the kept dofs and T on the condensed ones.
     n = host.n
     kept = np.setdiff1d(np.arange(n), dofs)
@@ -159,3 +158,38 @@ def test_coverage_and_fields_of_a_fully_paired_cut(host):
     assert np.all(np.isclose(faces.fraction, 1.0))
     assert np.abs(faces.flux + 6.0).max() < 1e-9
     assert set(np.asarray(faces.surface)) == {0, 1}
+
+
+def test_periodic_tie_with_a_jump_across_a_box(host):
+    """Box A's faces x = 1 and x = 0 tied through the map x ↦ x − 1 with the jump
+    u(1, y, z) − u(0, y, z) = 0.7 K: the field 2y + 3z + 0.7x is exact, and 0.7 k_a W/m²
+    flows in through x = 1 over its 0.5 m²."""
+    mesh, k_mat = host.parts[0]
+
+    def faces(x0):
+        f = mesh.facets_satisfying(lambda x: np.isclose(x[0], x0), boundaries_only=True)
+        return mesh.facets[:, f].T
+
+    e = (
+        seam.Builder(mesh.p.T)
+        .block("a", "hex8", mesh.t[SKFEM_OF_EXODUS].T, host.k_a)
+        .face_set("east", faces(1.0))
+        .face_set("west", faces(0.0))
+        .dofs(np.arange(mesh.nvertices))
+        .build()
+    )
+    jump = 0.7
+    e.add_interaction("east", "west", "tied_nitsche", offset=jump, periodic=seam.Rectangular((-1.0, 0.0, 0.0)))
+    e.search()
+    terms = e.evaluate(np.zeros(mesh.nvertices))
+    x, y, z = mesh.p
+    u_exact = 2 * y + 3 * z + jump * x
+    fixed = np.flatnonzero(np.isclose(y, 0) | np.isclose(y, 1) | np.isclose(z, 0) | np.isclose(z, 0.5))
+    free = np.setdiff1d(np.arange(mesh.nvertices), fixed)
+    a = (k_mat + terms.jacobian).tocsr()
+    u = u_exact.copy()
+    u[free] = sp.linalg.spsolve(
+        a[free][:, free].tocsc(), terms.load[free] - a[free][:, fixed] @ u_exact[fixed]
+    )
+    assert np.abs(u - u_exact).max() < ROUND_OFF
+    assert e.heat(u)[0].side_a == pytest.approx(-jump * host.k_a * 0.5, abs=1e-10)
