@@ -350,6 +350,20 @@ int main(int argc, char **argv) {
     for (int i = 0; i < n; i++) fprintf(dump, "temperature %d %.17g\n", i + 1, temp[i]);
     free(temp);
   }
+  /* A thermal-electrical run's voltage, last step. */
+  int volt = var_index(vnames[0], nvar[0], "voltage");
+  if (volt) {
+    double *v = xcalloc((size_t)n, sizeof(double));
+    CALL(ex_get_var(re, steps, EX_NODAL, volt, 1, n, v));
+    for (int i = 0; i < n; i++) {
+      if (!isfinite(v[i])) {
+        FAIL("voltage is not finite at node %d", i + 1);
+        break;
+      }
+      fprintf(dump, "voltage %d %.17g\n", i + 1, v[i]);
+    }
+    free(v);
+  }
   if (nvar[2] > 0) {
     double *g = xcalloc((size_t)nvar[2], sizeof(double));
     for (int s = 1; s <= steps; s++) {

@@ -286,7 +286,30 @@ def check_vtk(path, meshio, np, expect_heat_flux):
     return t
 
 
-def read_dump(path):
+def check_voltage(voltage, last_vtu, np):
+    """A thermal-electrical run: the voltage libexodus read from results.exo equals the
+    point data `voltage` VTK reads from the last `.vtu`, which also has the 3-component
+    cell data `current_density`."""
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+
+    r = vtkXMLUnstructuredGridReader()
+    r.SetFileName(str(last_vtu))
+    r.Update()
+    grid = r.GetOutput()
+    v = grid.GetPointData().GetArray("voltage")
+    j = grid.GetCellData().GetArray("current_density")
+    if v is None or j is None or j.GetNumberOfComponents() != 3:
+        raise CheckError(f"{last_vtu}: VTK finds no point data `voltage` or 3-component cell data `current_density`")
+    v = vtk_to_numpy(v)
+    if len(v) != len(voltage):
+        raise CheckError(f"{last_vtu}: {len(v)} voltages, results.exo has {len(voltage)}")
+    for k in range(len(v)):
+        if np.isfinite(v[k]) and abs(voltage[k + 1] - v[k]) > 1e-12 * max(1.0, abs(v[k])):
+            raise CheckError(f"node {k + 1}: voltage {voltage[k + 1]!r} in results.exo (libexodus), {float(v[k])!r} in {last_vtu.name} (VTK)")
+
+
+def read_dump(path, voltage=None):
     times, temperature, glob = {}, {}, {}
     for line in Path(path).read_text().splitlines():
         f = line.split(" ")
@@ -294,6 +317,9 @@ def read_dump(path):
             times[int(f[1])] = float(f[2])
         elif f[0] == "temperature":
             temperature[int(f[1])] = float(f[2])
+        elif f[0] == "voltage":
+            if voltage is not None:
+                voltage[int(f[1])] = float(f[2])
         elif f[0] == "global":
             glob[(int(f[1]), " ".join(f[2:-1]))] = float(f[-1])
         else:
@@ -316,10 +342,13 @@ def interface_heat_rows(path):
 
 def check_dump(dump, out, last_vtu, np):
     """Compare what libexodus read from results.exo with VTK and interface_heat.csv."""
-    times, temperature, glob = read_dump(dump)
+    voltage = {}
+    times, temperature, glob = read_dump(dump, voltage)
     if not times:
         raise CheckError(f"{dump}: no steps")
     compared = 0
+    if voltage and last_vtu is not None:
+        check_voltage(voltage, last_vtu, np)
     if last_vtu is not None:
         _, t, _ = vtk_read(last_vtu, np)
         if len(t) != len(temperature):
