@@ -304,7 +304,21 @@ impl<'a> TimeLoop<'a> {
         let threshold = self.threshold;
         // CG iterations per accepted step, when the steps were solved by AMG-CG.
         let per_step: Vec<usize> = history.iter().map(|r| r.cg_iterations).collect();
-        if per_step.iter().any(|&k| k > 0) {
+        if per_step.iter().any(|&k| k > 0) && self.physics.materials.electric() {
+            LinearSolverSummary {
+                name: "GMRES".into(),
+                reason: if auto {
+                    format!(
+                        "auto: {n:.1e} unknowns, unsymmetric coupled thermal–electrical Newton steps → GMRES preconditioned by AMG on the temperature and voltage blocks"
+                    )
+                } else {
+                    "requested by linear_solver (unsymmetric coupled steps → GMRES with block AMG)"
+                        .into()
+                },
+                iterations: per_step.iter().sum(),
+                iterations_per_solve: per_step,
+            }
+        } else if per_step.iter().any(|&k| k > 0) {
             LinearSolverSummary {
                 name: "AMG-CG".into(),
                 reason: if auto {

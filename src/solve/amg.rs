@@ -131,6 +131,30 @@ impl Csr {
         }
     }
 
+    /// The block of rows `rows` and columns `cols`, renumbered from 0.
+    pub fn block(&self, rows: std::ops::Range<usize>, cols: std::ops::Range<usize>) -> Csr {
+        let mut out = Csr {
+            nrows: rows.len(),
+            ncols: cols.len(),
+            ptr: Vec::with_capacity(rows.len() + 1),
+            idx: Vec::new(),
+            val: Vec::new(),
+        };
+        out.ptr.push(0);
+        let (lo, hi) = (cols.start as u32, cols.end as u32);
+        for i in rows {
+            for p in self.ptr[i]..self.ptr[i + 1] {
+                let j = self.idx[p];
+                if (lo..hi).contains(&j) {
+                    out.idx.push(j - lo);
+                    out.val.push(self.val[p]);
+                }
+            }
+            out.ptr.push(out.idx.len());
+        }
+        out
+    }
+
     pub fn nnz(&self) -> usize {
         self.idx.len()
     }
@@ -426,6 +450,12 @@ impl AmgCg {
         if let Some(level) = self.levels.first() {
             level.a.spmv(x, y);
         }
+    }
+
+    /// One V-cycle of the hierarchy set up last: `z ≈ A⁻¹ r` from a zero guess (a
+    /// preconditioner for other Krylov methods).
+    pub fn apply_vcycle(&mut self, r: &[f64], z: &mut [f64]) {
+        self.precondition(r, z);
     }
 
     /// Apply one V-cycle to `r` (zero initial guess), giving `z ≈ A⁻¹ r`.

@@ -25,9 +25,11 @@
 
 pub mod amg;
 mod direct;
+mod gmres;
 
 pub use amg::{AmgCg, AmgOptions, Smoother};
 pub use direct::{Cholesky, Lu, Ordering, SaddleLdlt, metis_ordering};
+pub use gmres::BlockGmres;
 
 use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
 use rayon::prelude::*;
@@ -113,7 +115,7 @@ pub fn check_finite_ref(a: SparseColMatRef<'_, usize, f64>) -> Result<(), SolveE
     Ok(())
 }
 
-fn check_rhs(n: usize, b: &[f64]) -> Result<(), SolveError> {
+pub(crate) fn check_rhs(n: usize, b: &[f64]) -> Result<(), SolveError> {
     if b.len() != n {
         return Err(SolveError::Dimension {
             matrix: n,

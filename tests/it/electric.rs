@@ -572,3 +572,42 @@ fn electrical_input_that_cannot_be_solved_is_refused_with_its_reason() {
     };
     assert_eq!(check_codes(same, tied), ["E0431"]);
 }
+
+/// Above the size threshold a coupled run solves its Newton steps by GMRES with the
+/// temperature and voltage blocks' AMG, and gets the factorisation's answer.
+#[test]
+fn large_coupled_runs_take_block_amg_gmres_and_match_the_factorisation() {
+    let dir = crate::examples::copy_scene_as("busbar_joint", "electric-gmres");
+    let problem = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
+    let solve = |extra: &str, name: &str| {
+        let text = problem.replace("tolerance = 1e-12", &format!("tolerance = 1e-12\n{extra}"));
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(
+            &path,
+            text.replace("dir = \"out\"", &format!("dir = \"{name}\"")),
+        )
+        .unwrap();
+        let r = seam::run::run(&path).unwrap_or_else(|e| panic!("{e:?}"));
+        let dofs = &r.solution.dofs;
+        let v = dofs.nodal_values(dofs.field(VOLTAGE).unwrap(), &r.solution.u);
+        (
+            r.summary.linear_solver.name.clone(),
+            r.solution.temperature.clone(),
+            v,
+        )
+    };
+    let (direct, t0, v0) = solve("linear_solver = \"direct\"", "direct");
+    let (krylov, t1, v1) = solve("auto_threshold = 1000", "gmres");
+    assert_eq!(direct, "direct");
+    assert_eq!(krylov, "GMRES");
+    let diff = |a: &[f64], b: &[f64]| {
+        let scale = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / scale
+    };
+    assert!(diff(&t1, &t0) < 1e-10, "temperature {:e}", diff(&t1, &t0));
+    assert!(diff(&v1, &v0) < 1e-9, "voltage {:e}", diff(&v1, &v0));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -6,7 +6,8 @@ use std::cell::RefCell;
 use crate::assembly::Assembler;
 use crate::heat::{FaceBc, HeatError};
 use crate::solve::{
-    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet, spmv,
+    AmgCg, AmgOptions, BlockGmres, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, SolveError,
+    apply_dirichlet, spmv,
 };
 use faer::sparse::SparseColMat;
 
@@ -27,6 +28,9 @@ pub(super) struct Solvers {
     pub(super) saddle: SaddleLdlt,
     pub(super) lu: Lu,
     pub(super) amg: AmgCg,
+    /// GMRES preconditioned block by block (temperatures, voltages) for a coupled
+    /// thermal–electrical Jacobian.
+    pub(super) gmres: Option<BlockGmres>,
     /// The values of the matrix factored last and which solver holds it: a linear
     /// problem stepping with a fixed step reuses the factorisation (bit for bit the
     /// same as factoring again).
@@ -42,6 +46,7 @@ pub(super) enum Which {
     Cholesky,
     Lu,
     Amg,
+    Gmres,
 }
 
 impl Solvers {
@@ -57,6 +62,12 @@ impl Solvers {
             amg: AmgCg::new(AmgOptions {
                 tolerance: crate::heat::steady::AMG_TOLERANCE,
                 ..AmgOptions::default()
+            }),
+            gmres: setup.voltage.map(|v| {
+                BlockGmres::new(
+                    setup.dofs.field_range(v).start,
+                    crate::heat::steady::AMG_TOLERANCE,
+                )
             }),
             factored: None,
             matrix: None,
@@ -201,8 +212,10 @@ impl Context<'_, '_> {
             report.assembly_s += clock.elapsed().as_secs_f64();
             let symmetric = linear;
             // AMG-CG for a symmetric positive definite step system from the threshold on.
-            let amg =
-                setup.ties.is_empty() && symmetric && p.amg_threshold.is_some_and(|k| setup.n >= k);
+            let large = setup.ties.is_empty() && p.amg_threshold.is_some_and(|k| setup.n >= k);
+            let amg = large && symmetric;
+            // A coupled thermal–electrical Jacobian (unsymmetric): block-AMG GMRES.
+            let gmres = large && solvers.gmres.is_some();
             let solved = (|| -> Result<(f64, f64, usize), HeatError> {
                 let t0 = std::time::Instant::now();
                 let same = solvers
@@ -218,6 +231,9 @@ impl Context<'_, '_> {
                         let w = if amg {
                             solvers.amg.factor(&jac)?;
                             Which::Amg
+                        } else if let (true, Some(g)) = (gmres, solvers.gmres.as_mut()) {
+                            g.factor(&jac)?;
+                            Which::Gmres
                         } else if tied && symmetric && solvers.saddle.factor(&jac).is_ok() {
                             Which::Saddle
                         } else if !tied && symmetric && solvers.chol.factor(&jac).is_ok() {
@@ -248,6 +264,10 @@ impl Context<'_, '_> {
                         0
                     }
                     Which::Amg => solvers.amg.solve(&mut rhs)?.iterations,
+                    Which::Gmres => {
+                        let g = solvers.gmres.as_mut().ok_or(SolveError::NotFactored)?;
+                        g.solve(&mut rhs)?.iterations
+                    }
                 };
                 Ok((factor_s, t1.elapsed().as_secs_f64(), cg))
             })();
