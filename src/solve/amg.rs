@@ -131,30 +131,6 @@ impl Csr {
         }
     }
 
-    /// The block of rows `rows` and columns `cols`, renumbered from 0.
-    pub fn block(&self, rows: std::ops::Range<usize>, cols: std::ops::Range<usize>) -> Csr {
-        let mut out = Csr {
-            nrows: rows.len(),
-            ncols: cols.len(),
-            ptr: Vec::with_capacity(rows.len() + 1),
-            idx: Vec::new(),
-            val: Vec::new(),
-        };
-        out.ptr.push(0);
-        let (lo, hi) = (cols.start as u32, cols.end as u32);
-        for i in rows {
-            for p in self.ptr[i]..self.ptr[i + 1] {
-                let j = self.idx[p];
-                if (lo..hi).contains(&j) {
-                    out.idx.push(j - lo);
-                    out.val.push(self.val[p]);
-                }
-            }
-            out.ptr.push(out.idx.len());
-        }
-        out
-    }
-
     pub fn nnz(&self) -> usize {
         self.idx.len()
     }

@@ -169,9 +169,9 @@ impl LinearSolver for BlockGmres {
         super::check_finite_ref(a.as_ref())?;
         self.a = Csr::from_csc(a.as_ref());
         let (n, s) = (self.a.nrows, self.split);
-        self.first.setup(self.a.block(0..s, 0..s))?;
-        self.second.setup(self.a.block(s..n, s..n))?;
-        self.a21 = self.a.block(s..n, 0..s);
+        self.first.setup(block(&self.a, 0..s, 0..s))?;
+        self.second.setup(block(&self.a, s..n, s..n))?;
+        self.a21 = block(&self.a, s..n, 0..s);
         Ok(())
     }
 
@@ -181,6 +181,30 @@ impl LinearSolver for BlockGmres {
         b.fill(0.0);
         self.gmres(&rhs, b)
     }
+}
+
+/// The block of `a`'s rows `rows` and columns `cols`, renumbered from 0.
+fn block(a: &Csr, rows: std::ops::Range<usize>, cols: std::ops::Range<usize>) -> Csr {
+    let mut out = Csr {
+        nrows: rows.len(),
+        ncols: cols.len(),
+        ptr: Vec::with_capacity(rows.len() + 1),
+        idx: Vec::new(),
+        val: Vec::new(),
+    };
+    out.ptr.push(0);
+    let (lo, hi) = (cols.start as u32, cols.end as u32);
+    for i in rows {
+        for p in a.ptr[i]..a.ptr[i + 1] {
+            let j = a.idx[p];
+            if (lo..hi).contains(&j) {
+                out.idx.push(j - lo);
+                out.val.push(a.val[p]);
+            }
+        }
+        out.ptr.push(out.idx.len());
+    }
+    out
 }
 
 #[cfg(test)]
