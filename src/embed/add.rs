@@ -9,7 +9,9 @@ use crate::enforce::interface::Form;
 use crate::mesh::Mesh;
 use crate::search::SearchSettings;
 use crate::search::pairing::{Sphere, SurfaceGeometry};
-use crate::search::periodic::{PeriodicError, check_closure, landing, periodic_map};
+use crate::search::periodic::{
+    PeriodicError, PeriodicTransform, check_closure, landing, periodic_map,
+};
 use crate::surface::{ContactSurface, SurfaceFace, SurfaceKind};
 
 impl Embedding {
@@ -94,6 +96,13 @@ impl Embedding {
         let (source, b) = (self.geometry(&side_a)?, self.geometry(&side_b)?);
         let transform = periodic.transform(&side_b.name);
         let model_size = self.mesh.model_size();
+        let axisymmetric = "in an axisymmetric model a periodicity repeats along the axis (y): a translation by (0, dy)";
+        if self.mesh.axisymmetric && matches!(transform, PeriodicTransform::Cylindrical { .. }) {
+            return Err(fail(
+                &PeriodicError::CylindricalInAxisymmetric,
+                axisymmetric,
+            ));
+        }
         check_closure(&transform, &source, model_size).map_err(|e| {
             fail(
                 &e,
@@ -122,6 +131,10 @@ impl Embedding {
         let a = source
             .mapped(map.as_mut(), &name)
             .map_err(|e| fail(&e, "the map failed while mapping side A's nodes"))?;
+        crate::search::periodic::check_axisymmetric(&transform, &source, &a, model_size, |n| {
+            self.mesh.node_number(n)
+        })
+        .map_err(|e| fail(&e, axisymmetric))?;
         if let Some(fold) =
             crate::search::periodic::check_one_to_one(&source, &a, |n| self.mesh.node_number(n))
         {

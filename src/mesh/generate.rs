@@ -1,9 +1,13 @@
 //! Mesh generators for tests, examples and benchmarks: structured boxes (Hex8 or Tet4),
 //! annular cylinder sectors, and stacks of boxes as several blocks — merged into one
-//! conforming mesh or kept apart (non-matching parts, as contact needs).
+//! conforming mesh or kept apart (non-matching parts, as contact needs); in 2-D the
+//! same with rectangles ([`rectangles`], Quad4 or Tri3) and annular sectors in the xy
+//! plane ([`ring`]).
 //!
 //! Side sets of a box are numbered by face: `xmin, xmax, ymin, ymax, zmin, zmax`
-//! (for a cylinder sector: `inner, outer, theta_start, theta_end, zmin, zmax`).
+//! (for a cylinder sector: `inner, outer, theta_start, theta_end, zmin, zmax`); of a
+//! rectangle by edge: `xmin, xmax, ymin, ymax` (of a 2-D ring sector: `inner, outer,
+//! theta_start, theta_end`).
 
 use std::collections::HashMap;
 
@@ -53,6 +57,92 @@ impl BoxSpec {
         self.side_sets = ids;
         self
     }
+}
+
+/// Element type of a generated 2-D mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlaneKind {
+    Quad4,
+    /// Two triangles per quadrilateral cell, split along the diagonal from its first
+    /// corner (conforming across cells).
+    Tri3,
+}
+
+/// One structured rectangle of a generated 2-D mesh (z = 0).
+#[derive(Clone, Debug)]
+pub struct RectSpec {
+    pub min: [f64; 2],
+    pub max: [f64; 2],
+    pub cells: [usize; 2],
+    pub kind: PlaneKind,
+    /// Block id; the block name is left empty so Sierra calls it `block_<id>`.
+    pub block_id: i64,
+    /// Side-set ids for the four edges (`xmin, xmax, ymin, ymax`); 0 = none.
+    pub side_sets: [i64; 4],
+}
+
+impl RectSpec {
+    pub fn quad(min: [f64; 2], max: [f64; 2], cells: [usize; 2], block_id: i64) -> Self {
+        RectSpec {
+            min,
+            max,
+            cells,
+            kind: PlaneKind::Quad4,
+            block_id,
+            side_sets: [0; 4],
+        }
+    }
+
+    pub fn tri(min: [f64; 2], max: [f64; 2], cells: [usize; 2], block_id: i64) -> Self {
+        RectSpec {
+            kind: PlaneKind::Tri3,
+            ..RectSpec::quad(min, max, cells, block_id)
+        }
+    }
+
+    pub fn with_side_sets(mut self, ids: [i64; 4]) -> Self {
+        self.side_sets = ids;
+        self
+    }
+}
+
+/// Several rectangles as a 2-D mesh, one block each (blocks with equal ids are merged
+/// into one block); with `merge`, nodes at the same position are shared.
+pub fn rectangles(specs: &[RectSpec], merge: bool) -> Mesh {
+    let mut b = Builder::new(2, merge);
+    for spec in specs {
+        let [nx, ny] = spec.cells;
+        let (lo, hi) = (spec.min, spec.max);
+        let place =
+            move |i: usize, j: usize| [lerp(lo[0], hi[0], i, nx), lerp(lo[1], hi[1], j, ny), 0.0];
+        b.add_plane(spec.cells, place, spec.kind, spec.block_id, spec.side_sets);
+    }
+    b.finish()
+}
+
+/// A 2-D annular sector in the xy plane: radii `r_in..r_out`, angles `0..angle_deg`
+/// about the origin, `cells = [radial, circumferential]`. A full ring (`angle_deg =
+/// 360`) closes up with shared nodes. Side sets `inner, outer, theta_start, theta_end`.
+pub fn ring(
+    r_in: f64,
+    r_out: f64,
+    angle_deg: f64,
+    cells: [usize; 2],
+    kind: PlaneKind,
+    block_id: i64,
+    side_sets: [i64; 4],
+) -> Mesh {
+    let mut b = Builder::new(2, true);
+    let full = (angle_deg - 360.0).abs() < 1e-9;
+    let [nr, nt] = cells;
+    let place = |i: usize, j: usize| -> [f64; 3] {
+        let r = r_in + (r_out - r_in) * i as f64 / nr as f64;
+        let j = if full && j == nt { 0 } else { j };
+        let t = (angle_deg * j as f64 / nt as f64).to_radians();
+        [r * t.cos(), r * t.sin(), 0.0]
+    };
+    b.add_plane(cells, place, kind, block_id, side_sets);
+    b.finish()
 }
 
 /// The unit cube `[0,1]³` as one Hex8 element in block 1.
@@ -253,6 +343,78 @@ impl Builder {
                     })
                     .collect();
                 // Positions are block-local; `finish` shifts them once blocks are numbered.
+                self.side_sets.push((side_sets[f], block, sides));
+            }
+        }
+    }
+
+    /// A structured 2-D grid of `cells` whose node `(i, j)` sits at `place(i, j)`;
+    /// Quad4 cells, or each split into two Tri3 along its diagonal 0–2.
+    fn add_plane(
+        &mut self,
+        cells: [usize; 2],
+        place: impl Fn(usize, usize) -> [f64; 3],
+        kind: PlaneKind,
+        block_id: i64,
+        side_sets: [i64; 4],
+    ) {
+        let [nx, ny] = cells;
+        let mut ids = Vec::with_capacity((nx + 1) * (ny + 1));
+        for j in 0..=ny {
+            for i in 0..=nx {
+                ids.push(self.node(place(i, j)));
+            }
+        }
+        let at = |i: usize, j: usize| ids[i + (nx + 1) * j];
+        let topology = match kind {
+            PlaneKind::Quad4 => Topology::Quad4,
+            PlaneKind::Tri3 => Topology::Tri3,
+        };
+        let block = match self.blocks.iter().position(|b| b.0 == block_id) {
+            Some(b) => b,
+            None => {
+                self.blocks.push((block_id, topology, Vec::new()));
+                self.blocks.len() - 1
+            }
+        };
+        let mut edge_sides: [Vec<(usize, u8)>; 4] = Default::default();
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+                let on = [i == 0, i == nx - 1, j == 0, j == ny - 1];
+                let conn = &mut self.blocks[block].2;
+                // (element, edge of the cell: xmin, xmax, ymin, ymax, Exodus side).
+                let mut sides: Vec<(usize, usize, u8)> = Vec::with_capacity(4);
+                match kind {
+                    PlaneKind::Quad4 => {
+                        let e = conn.len() / 4;
+                        conn.extend_from_slice(&c);
+                        // Exodus quad sides: 1 (0-1) −y, 2 (1-2) +x, 3 (2-3) +y, 4 (3-0) −x.
+                        sides.extend([(e, 0, 4), (e, 1, 2), (e, 2, 1), (e, 3, 3)]);
+                    }
+                    PlaneKind::Tri3 => {
+                        let e = conn.len() / 3;
+                        conn.extend_from_slice(&[c[0], c[1], c[2], c[0], c[2], c[3]]);
+                        // (0, 1, 2): side 1 −y, side 2 +x; (0, 2, 3): side 2 +y, side 3 −x.
+                        sides.extend([(e, 2, 1), (e, 1, 2), (e + 1, 3, 2), (e + 1, 0, 3)]);
+                    }
+                }
+                for (e, edge, side) in sides {
+                    if on[edge] {
+                        edge_sides[edge].push((e, side));
+                    }
+                }
+            }
+        }
+        for f in 0..4 {
+            if side_sets[f] != 0 {
+                let sides = edge_sides[f]
+                    .iter()
+                    .map(|&(e, side)| Side {
+                        elem: ElemId(e as u32),
+                        side,
+                    })
+                    .collect();
                 self.side_sets.push((side_sets[f], block, sides));
             }
         }

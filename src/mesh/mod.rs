@@ -155,6 +155,10 @@ pub struct Mesh {
     pub assemblies: Vec<Assembly>,
     /// The file this mesh came from, for messages.
     pub source: Option<PathBuf>,
+    /// A 2-D mesh read as axisymmetric: x is the radius r ≥ 0, y the axial coordinate,
+    /// and every volume and surface integral is per full revolution (× 2πr). Files do
+    /// not say so: `seam run` sets it from `[mesh] axisymmetric`, a host in code.
+    pub axisymmetric: bool,
 }
 
 /// Errors while reading a mesh file.

@@ -13,7 +13,9 @@
 //! their deck location: E0320 (unknown surface), E0321 (the map cannot be made or
 //! fails), E0322 (no mean normal), E0323 (the image lands nowhere), E0324 (the image
 //! misses its destination), E0325 (a rotation that does not close), E0326 (a map that is
-//! not one-to-one, before the search), W0320 (an angle that does not divide 360°).
+//! not one-to-one, before the search), E0327 (in an axisymmetric model: a cylindrical
+//! transform, or a map that changes a node's radius), W0320 (an angle that does not
+//! divide 360°).
 //!
 //! This is also where the deck's search options become the typed
 //! [`SearchSettings`] of periodic pairs ([`base_settings`]), its subdomain a
@@ -32,8 +34,8 @@ use crate::search::pairing::{
     Integration, SearchError, SearchResult, SearchSchedule, Searcher, Sphere, SurfaceGeometry,
 };
 use crate::search::periodic::{
-    Closure, PeriodicError, PeriodicPairing, PeriodicTransform, check_closure, check_one_to_one,
-    landing, periodic_map,
+    Closure, PeriodicError, PeriodicPairing, PeriodicTransform, check_axisymmetric, check_closure,
+    check_one_to_one, landing, periodic_map,
 };
 use crate::search::scene::{Pairing, SceneSearch, surface_geometries};
 use crate::search::{Overclosure, SearchSettings};
@@ -256,6 +258,16 @@ pub fn search_periodicity(
     let source = geometry[s].as_ref()?;
     let transform = PeriodicTransform::from(&p.transform);
     let model_size = mesh.model_size();
+    let axisymmetric_help = "in an axisymmetric model a periodicity repeats along the axis: `Rectangular Offset = 0 dy`";
+    if mesh.axisymmetric && matches!(transform, PeriodicTransform::Cylindrical { .. }) {
+        let e = PeriodicError::CylindricalInAxisymmetric;
+        out.diagnostics.push(
+            Diagnostic::error("E0327", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(p.at.clone()))
+                .help(axisymmetric_help),
+        );
+        return None;
+    }
     let mut destination = None;
     if let PeriodicTransform::AlignSurface {
         destination: dest, ..
@@ -360,6 +372,15 @@ pub fn search_periodicity(
         }
     };
     out.timing.build_s += t.elapsed().as_secs_f64();
+    let numbers = |n| mesh.node_number(n);
+    if let Err(e) = check_axisymmetric(&transform, source, &image, model_size, numbers) {
+        out.diagnostics.push(
+            Diagnostic::error("E0327", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(at))
+                .help(axisymmetric_help),
+        );
+        return None;
+    }
     if let Some(fold) = check_one_to_one(source, &image, |n| mesh.node_number(n)) {
         let e = PeriodicError::Folds(Box::new(fold));
         out.diagnostics.push(

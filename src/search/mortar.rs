@@ -4,7 +4,9 @@
 //! Entry points: [`clip_polygon_polygon`] (2-D convex clipping), [`segments_face_face`]
 //! and [`segments_face_face_into`] (quadrature points on the overlap of two faces, as
 //! [`MortarPoint`]s),
-//! [`overlap_area_face_face`] and [`rule_triangle`] (the triangle quadrature rules).
+//! [`overlap_area_face_face`] and [`rule_triangle`] (the triangle quadrature rules); for
+//! the edges of a 2-D mesh, [`segments_line_line_into`], [`overlap_length_line_line`]
+//! and [`rule_line`].
 //!
 //! Conventions:
 //! - The integration plane is the plane of face A: through its centroid (node average),
@@ -21,9 +23,14 @@
 //!   when B lies on the side A's normal points to: with outward normals, positive means
 //!   open, negative means penetration.
 //! - Parametric coordinates as in [`super::project`]: Tri3 `(ξ, η)` with node 0 at the
-//!   origin, Quad4 `(ξ, η) ∈ [-1, 1]²` in Exodus node order.
+//!   origin, Quad4 `(ξ, η) ∈ [-1, 1]²` in Exodus node order, Line2 `ξ ∈ [-1, 1]`.
+//! - In 2-D the same holds one dimension down: the integration line is the line of edge
+//!   A (through its midpoint, along `x₁ − x₀`, normal [`normal_line2`]); B's nodes are
+//!   projected onto it along `n_A`, the overlap is an interval of that line, and its
+//!   Gauss points are carried back to A and B along `n_A`. The weights of one pair sum
+//!   to the overlap's length.
 
-use super::project::{map_quad4, map_tri3};
+use super::project::{map_line2, map_quad4, map_tri3, normal_line2};
 use crate::fem::quadrature::gauss_legendre_01;
 use crate::vec3::{V3, axpy, cross, dot, norm, normalize, sub};
 
@@ -607,6 +614,79 @@ pub fn segments_face_face_into(
     out.len() - before
 }
 
+/// The Gauss–Legendre rule on `[0, 1]` exact for polynomials of degree `order` (at least
+/// 1): `order / 2 + 1` points, as `(points, weights)` with weights summing to 1.
+pub fn rule_line(order: usize) -> (Vec<f64>, Vec<f64>) {
+    gauss_legendre_01(order.max(1) / 2 + 1)
+}
+
+/// The overlap of edge `b` with edge `a` on `a`'s line: `(lo, hi)` in the arc length
+/// from `a`'s midpoint along `a`, B's ends `(s₀, s₁)` there, `a`'s line (midpoint, unit
+/// tangent, normal) and `a`'s length; `None` when either edge is not a finite 2-node
+/// edge, `a` is degenerate or the overlap has no length.
+#[allow(clippy::type_complexity)]
+fn line_overlap(a: &[V3], b: &[V3]) -> Option<((f64, f64), (f64, f64), [V3; 3], f64)> {
+    let valid = |f: &[V3]| f.len() == 2 && f.iter().flatten().all(|v| v.is_finite());
+    if !valid(a) || !valid(b) {
+        return None;
+    }
+    let normal = normal_line2(&[a[0], a[1]]);
+    let e = sub(a[1], a[0]);
+    let len = norm(e);
+    if normal == [0.0; 3] || len == 0.0 {
+        return None;
+    }
+    let t = [e[0] / len, e[1] / len, e[2] / len];
+    let mid = axpy(a[0], 0.5, e);
+    let along = |x: V3| dot(sub(x, mid), t);
+    let (s0, s1) = (along(b[0]), along(b[1]));
+    let lo = (-0.5 * len).max(s0.min(s1));
+    let hi = (0.5 * len).min(s0.max(s1));
+    (hi > lo && s0 != s1).then_some(((lo, hi), (s0, s1), [mid, t, normal], len))
+}
+
+/// Length (on the line of edge `a`) of the overlap of edge `b`, projected along `a`'s
+/// normal, with edge `a`; zero for degenerate or unsupported edges.
+pub fn overlap_length_line_line(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+    line_overlap(a, b).map_or(0.0, |((lo, hi), ..)| hi - lo)
+}
+
+/// Quadrature points on the overlap of side-A edge `a` and side-B edge `b` (the Line2
+/// faces of a 2-D mesh), with the rule `(points, weights)` on `[0, 1]` of
+/// [`rule_line`]: each Gauss point `s` of the overlap interval is `x_a` on A at
+/// `ξ_a = 2s/L_A`, and on B at the `ξ_b` where B's projection reaches `s` (linear in s:
+/// the projection along `n_A` is affine), so the points are exact for polynomials of the
+/// rule's degree in the arc length of A. Appends to `out`; returns the number appended
+/// (0 when the edges do not overlap or either is degenerate).
+pub fn segments_line_line_into(
+    a: &[[f64; 3]],
+    b: &[[f64; 3]],
+    rule: &(Vec<f64>, Vec<f64>),
+    out: &mut Vec<MortarPoint>,
+) -> usize {
+    let Some(((lo, hi), (s0, s1), [_, _, normal], len)) = line_overlap(a, b) else {
+        return 0;
+    };
+    let (ea, eb) = ([a[0], a[1]], [b[0], b[1]]);
+    for (&r, &w) in rule.0.iter().zip(&rule.1) {
+        let s = lo + r * (hi - lo);
+        let xi_a = [2.0 * s / len, 0.0];
+        let xi_b = [-1.0 + 2.0 * (s - s0) / (s1 - s0), 0.0];
+        let x_a = map_line2(&ea, xi_a);
+        let x_b = map_line2(&eb, xi_b);
+        out.push(MortarPoint {
+            weight: w * (hi - lo),
+            xi_a,
+            xi_b,
+            x_a,
+            x_b,
+            gap: dot(sub(x_b, x_a), normal),
+            normal,
+        });
+    }
+    rule.0.len()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -785,5 +865,65 @@ mod tests {
         assert!((overlap_area_face_face(&a, &b) - exact).abs() < 1e-14);
         let w: f64 = segments_face_face(&a, &b, 1).iter().map(|p| p.weight).sum();
         assert!((w - exact).abs() < 1e-14);
+    }
+
+    /// Edge A = (0,0) → (2,0) (normal −y), edge B = (3, −0.5) → (1, −0.5) below it,
+    /// facing up: they overlap on x ∈ [1, 2]; B lies on the side A's normal points to,
+    /// so the gap is +0.5 (open).
+    #[test]
+    fn edges_overlap_on_an_interval_with_exact_moments() {
+        let a = [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        let b = [[3.0, -0.5, 0.0], [1.0, -0.5, 0.0]];
+        assert!((overlap_length_line_line(&a, &b) - 1.0).abs() < 1e-15);
+        for order in [1, 2, 3, 5, 8] {
+            let mut pts = Vec::new();
+            let n = segments_line_line_into(&a, &b, &rule_line(order), &mut pts);
+            assert_eq!(n, pts.len());
+            // ∫_1^2 x^p dx = (2^{p+1} − 1)/(p + 1), exact up to the rule's degree.
+            for p in 0..=order as i32 {
+                let got: f64 = pts.iter().map(|m| m.weight * m.x_a[0].powi(p)).sum();
+                let want = (2f64.powi(p + 1) - 1.0) / (p + 1) as f64;
+                assert!((got - want).abs() < 1e-14 * want, "order {order}, x^{p}");
+            }
+            for m in &pts {
+                assert!((m.gap - 0.5).abs() < 1e-15 && m.normal == [0.0, -1.0, 0.0]);
+                assert!((m.x_b[0] - m.x_a[0]).abs() < 1e-15 && m.x_b[1] == -0.5);
+                assert!((m.xi_a[0] - (m.x_a[0] - 1.0)).abs() < 1e-15);
+                assert!((m.xi_b[0] - (2.0 - m.x_a[0])).abs() < 1e-15);
+            }
+        }
+        // Touching at a point, apart, degenerate, or not edges: nothing.
+        let touch = [[2.0, 1.0, 0.0], [5.0, 1.0, 0.0]];
+        assert_eq!(overlap_length_line_line(&a, &touch), 0.0);
+        let apart = [[4.0, 1.0, 0.0], [5.0, 1.0, 0.0]];
+        assert_eq!(overlap_length_line_line(&a, &apart), 0.0);
+        let point = [[1.0, 1.0, 0.0]; 2];
+        assert_eq!(overlap_length_line_line(&a, &point), 0.0);
+        assert_eq!(overlap_length_line_line(&point, &a), 0.0);
+        let tri = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let mut pts = Vec::new();
+        assert_eq!(
+            segments_line_line_into(&tri, &a, &rule_line(2), &mut pts),
+            0
+        );
+        // Perpendicular B: its projection is a point.
+        let across = [[1.0, -1.0, 0.0], [1.0, 1.0, 0.0]];
+        assert_eq!(overlap_length_line_line(&a, &across), 0.0);
+    }
+
+    /// A tilted B: the gap is linear along A and the points lie on B.
+    #[test]
+    fn tilted_edge_gives_a_linear_gap_and_points_on_it() {
+        let a = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
+        let b = [[1.5, -0.1, 0.0], [-0.5, -0.3, 0.0]];
+        let mut pts = Vec::new();
+        segments_line_line_into(&a, &b, &rule_line(3), &mut pts);
+        let w: f64 = pts.iter().map(|m| m.weight).sum();
+        assert!((w - 1.0).abs() < 1e-15);
+        for m in &pts {
+            // B's line: y = −0.1 − 0.1 (1.5 − x); the gap along −y is −y.
+            let y = -0.1 - 0.1 * (1.5 - m.x_a[0]);
+            assert!((m.gap + y).abs() < 1e-15 && (m.x_b[1] - y).abs() < 1e-15);
+        }
     }
 }

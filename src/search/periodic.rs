@@ -18,7 +18,12 @@
 //!   and pass every other check;
 //! - an N-fold cylindrical rotation (`360/θ` an integer N) must close up: the map applied
 //!   N times returns every node within 1e-12 × model size; an angle that does not divide
-//!   360° is reported as such ([`Closure::AngleDoesNotDivide`]).
+//!   360° is reported as such ([`Closure::AngleDoesNotDivide`]);
+//! - in an axisymmetric model ([`check_axisymmetric`]) a cylindrical transform is
+//!   refused (the model is already the full revolution about its axis), and any other
+//!   map must keep every node's radius: a node stands for a ring of circumference 2πr,
+//!   so a map that changes r would pair rings of different size and heat would not
+//!   balance across the pair.
 
 use std::path::Path;
 
@@ -86,6 +91,14 @@ pub enum PeriodicError {
         point(.0.image[0]), point(.0.image[1]), .0.image_distance(), .0.face_size
     )]
     Folds(Box<Fold>),
+    #[error(
+        "a cylindrical transform in an axisymmetric model: the model is already the full revolution about its axis (y), so there is no sector to repeat"
+    )]
+    CylindricalInAxisymmetric,
+    #[error(
+        "in an axisymmetric model the map must keep each node's radius (x): node {number} at r = {from} lands at r = {to}"
+    )]
+    ChangesRadius { number: i64, from: f64, to: f64 },
     #[error(
         "its image does not land on `{destination}`: the worst image node is {worst:.3e} away (accepted: {limit:.3e})"
     )]
@@ -314,6 +327,39 @@ pub fn check_closure(
     Ok(Closure::Closes { n })
 }
 
+/// The checks of a periodic map in an axisymmetric model (module docs): no cylindrical
+/// transform, and every node of `source` keeps its radius in `image` (to 1e-12 ×
+/// `model_size`, the round-off of a translation along y). Nothing to check when
+/// `source` is not axisymmetric. `numbers` gives the nodes' user-visible numbers.
+pub fn check_axisymmetric(
+    transform: &PeriodicTransform,
+    source: &SurfaceGeometry,
+    image: &SurfaceGeometry,
+    model_size: f64,
+    numbers: impl Fn(NodeId) -> i64,
+) -> Result<(), PeriodicError> {
+    if !source.axisymmetric {
+        return Ok(());
+    }
+    if matches!(transform, PeriodicTransform::Cylindrical { .. }) {
+        return Err(PeriodicError::CylindricalInAxisymmetric);
+    }
+    for (f, g) in source.faces.iter().zip(&image.faces) {
+        for k in 0..f.len as usize {
+            let (from, to) = (f.x[k][0], g.x[k][0]);
+            let kept = (from - to).abs() <= 1e-12 * model_size;
+            if !kept {
+                return Err(PeriodicError::ChangesRadius {
+                    number: numbers(f.nodes[k]),
+                    from,
+                    to,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// How far an image lies from its destination: the worst distance from an image node to
 /// the destination's faces, and the distance accepted.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -374,7 +420,6 @@ fn centroid_and_normal(g: &SurfaceGeometry) -> ([f64; 3], [f64; 3]) {
 /// Largest distance from a node of `image` to the nearest face of `dest`.
 fn worst_distance(image: &SurfaceGeometry, dest: &SurfaceGeometry) -> f64 {
     use super::bvh::{Aabb, Bvh};
-    use super::project::{project_point_quad4, project_point_tri3};
     let size = dest.mean_face_size();
     let boxes: Vec<Aabb> = dest
         .faces
@@ -387,12 +432,7 @@ fn worst_distance(image: &SurfaceGeometry, dest: &SurfaceGeometry) -> f64 {
         for &x in f.coords() {
             let mut nearest = f64::INFINITY;
             bvh.query(&Aabb::from_point(x), |j| {
-                let g = &dest.faces[j];
-                let pr = match g.len {
-                    3 => project_point_tri3(x, &[g.x[0], g.x[1], g.x[2]]),
-                    _ => project_point_quad4(x, &[g.x[0], g.x[1], g.x[2], g.x[3]]),
-                };
-                nearest = nearest.min(pr.distance);
+                nearest = nearest.min(dest.faces[j].project(x).distance);
             });
             worst = worst.max(nearest);
         }

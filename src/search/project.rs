@@ -1,10 +1,15 @@
 //! Closest-point projection of a point onto a face, and the shape functions of the faces.
 //!
-//! Entry points: [`project_point_tri3`], [`project_point_quad4`], giving a [`Projection`];
-//! the helpers [`shape_tri3`], [`map_tri3`], [`shape_quad4`], [`dshape_quad4`],
-//! [`map_quad4`], [`tangents_quad4`].
+//! Entry points: [`project_point_tri3`], [`project_point_quad4`] and, for the edges of a
+//! 2-D mesh, [`project_point_line2`], giving a [`Projection`]; the helpers
+//! [`shape_tri3`], [`map_tri3`], [`shape_quad4`], [`dshape_quad4`], [`map_quad4`],
+//! [`tangents_quad4`], [`map_line2`], [`normal_line2`].
 //!
 //! Conventions:
+//! - Line2 (an edge of a 2-D mesh, in the xy plane) parametric coordinate `ξ ∈ [-1, 1]`
+//!   (the second is 0): `x = ½ (1 − ξ) x₀ + ½ (1 + ξ) x₁`; its normal is the edge direction
+//!   turned clockwise by 90° in the xy plane, `(t_y, −t_x, 0)`, which points out of a
+//!   counter-clockwise element (the convention of the surfaces' own geometry).
 //! - Tri3 parametric coordinates `(ξ, η)`: `x = x₀ + ξ (x₁ − x₀) + η (x₂ − x₀)`, node 0 at
 //!   `(0, 0)`, node 1 at `(1, 0)`, node 2 at `(0, 1)`.
 //! - Quad4 parametric coordinates `(ξ, η) ∈ [-1, 1]²`, nodes in Exodus order at
@@ -35,6 +40,12 @@ pub const INSIDE_TOL: f64 = 1e-10;
 /// that ratio the normal computed from the nodes carries a relative error above
 /// ε / 1e-10 ≈ 2e-6 rad, so it is not a geometric normal any more.
 pub const DEGENERATE_AREA: f64 = 1e-10;
+
+/// An edge of a 2-D mesh is degenerate when its length is at most `DEGENERATE_LENGTH`
+/// times its nodes' distance from the origin: 1e-12 is ~4000 ε, so such an edge is the
+/// round-off of coordinates that were meant to coincide and its direction (its normal)
+/// is noise.
+pub const DEGENERATE_LENGTH: f64 = 1e-12;
 
 /// The closest point of a face to a given point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -130,6 +141,26 @@ pub fn vector_area_quad4(x: &[[f64; 3]; 4]) -> [f64; 3] {
     scale(cross(sub(x[2], x[0]), sub(x[3], x[1])), 0.5)
 }
 
+/// The point of a Line2 face at `xi` (only `xi[0]` is used): `½ (1 − ξ) x₀ + ½ (1 + ξ) x₁`.
+#[inline]
+pub fn map_line2(x: &[[f64; 3]; 2], xi: [f64; 2]) -> [f64; 3] {
+    let s = xi[0];
+    axpy(scale(x[0], 0.5 * (1.0 - s)), 0.5 * (1.0 + s), x[1])
+}
+
+/// The unit normal of a Line2 face in the xy plane: its direction turned clockwise by
+/// 90°, `(t_y, −t_x, 0)`; zero for an edge of zero length.
+#[inline]
+pub fn normal_line2(x: &[[f64; 3]; 2]) -> [f64; 3] {
+    let d = sub(x[1], x[0]);
+    let l = (d[0] * d[0] + d[1] * d[1]).sqrt();
+    if l > 0.0 && l.is_finite() {
+        [d[1] / l, -d[0] / l, 0.0]
+    } else {
+        [0.0; 3]
+    }
+}
+
 /// Whether a face with vector-area norm `area` and longest squared edge `l2` is
 /// degenerate ([`DEGENERATE_AREA`]); non-finite sizes count as degenerate.
 pub(crate) fn is_degenerate(area: f64, l2: f64) -> bool {
@@ -220,6 +251,37 @@ pub fn project_point_tri3(p: [f64; 3], x: &[[f64; 3]; 3]) -> Projection {
         _ => [0.0, 1.0 - t],
     };
     finish(p, xi, map_tri3(x, xi), normal, inside, false)
+}
+
+/// Closest point of the Line2 face `x` (an edge of a 2-D mesh) to `p`.
+///
+/// Exact: the foot of the perpendicular on the edge's line, `ξ = 2 (p − c)·e / |e|²` with
+/// `c` the midpoint and `e = x₁ − x₀`, clamped to `[-1, 1]`. `inside` when the unclamped
+/// ξ lies within [`INSIDE_TOL`] of the edge. An edge whose length is not above
+/// [`DEGENERATE_LENGTH`] times its nodes' distance from the origin (or not finite) is
+/// degenerate: the closest point is taken and the normal is zero.
+pub fn project_point_line2(p: [f64; 3], x: &[[f64; 3]; 2]) -> Projection {
+    let e = sub(x[1], x[0]);
+    let ee = dot(e, e);
+    let size2 = norm2(x[0]).max(norm2(x[1]));
+    let normal = normal_line2(x);
+    let degenerate = !(ee > DEGENERATE_LENGTH * DEGENERATE_LENGTH * size2 && ee.is_finite());
+    if degenerate || normal == [0.0; 3] {
+        let (t, _) = closest_on_segment(p, x[0], x[1]);
+        let xi = [2.0 * t - 1.0, 0.0];
+        return finish(p, xi, map_line2(x, xi), [0.0; 3], false, true);
+    }
+    let c = scale(add(x[0], x[1]), 0.5);
+    let xi = 2.0 * dot(sub(p, c), e) / ee;
+    let inside = xi.abs() <= 1.0 + INSIDE_TOL;
+    let clamped = [xi.clamp(-1.0, 1.0), 0.0];
+    if xi.abs() <= 1.0 {
+        // The foot of the perpendicular, `p − ((p − x₀)·n) n`, so a point on an
+        // axis-aligned edge comes back exactly (as for the triangles).
+        let q = axpy(p, -dot(sub(p, x[0]), normal), normal);
+        return finish(p, clamped, q, normal, true, false);
+    }
+    finish(p, clamped, map_line2(x, clamped), normal, inside, false)
 }
 
 /// Closest point on the edges of a degenerate face; `to_xi(edge, t)` gives the
@@ -768,5 +830,37 @@ mod tests {
         let pr = project_point_quad4([0.2, 0.2, 1.0], &collapsed);
         assert!(!pr.degenerate && pr.inside && close(pr.gap, 1.0, TOL));
         assert!(close(pr.point[0], 0.2, TOL) && close(pr.point[1], 0.2, TOL));
+    }
+
+    /// An edge of a 2-D mesh: interior, beyond either end, on the edge, and degenerate.
+    /// The edge (2, 1) → (0, 1) runs in −x, so its normal (t_y, −t_x) is +y.
+    #[test]
+    fn line2_interior_ends_and_degenerate() {
+        let e = [[2.0, 1.0, 0.0], [0.0, 1.0, 0.0]];
+        assert_eq!(normal_line2(&e), [0.0, 1.0, 0.0]);
+        let pr = project_point_line2([0.5, 1.25, 0.0], &e);
+        assert!(pr.inside && !pr.degenerate);
+        assert!(close(pr.xi[0], 0.5, TOL) && pr.xi[1] == 0.0);
+        assert_eq!(pr.point, [0.5, 1.0, 0.0]);
+        assert!(close(pr.gap, 0.25, TOL) && close(pr.distance, 0.25, TOL));
+        // Below the edge: a negative gap.
+        let pr = project_point_line2([1.5, 0.5, 0.0], &e);
+        assert!(pr.inside && close(pr.gap, -0.5, TOL) && close(pr.xi[0], -0.5, TOL));
+        // Beyond node 1 (ξ = 1.5): clamped onto the node, not inside.
+        let pr = project_point_line2([-0.5, 2.0, 0.0], &e);
+        assert!(!pr.inside && pr.xi[0] == 1.0 && pr.point == [0.0, 1.0, 0.0]);
+        assert!(close(pr.distance, 1.25f64.sqrt(), TOL) && close(pr.gap, 1.0, TOL));
+        // Just past node 0, within the tolerance: inside.
+        let pr = project_point_line2([2.0 + 1e-12, 1.0, 0.0], &e);
+        assert!(pr.inside && pr.xi[0] == -1.0);
+        // The point maps back to itself on the edge.
+        let q = map_line2(&e, [0.3, 0.0]);
+        assert!(close(q[0], 0.7, TOL) && q[1] == 1.0);
+        // A zero-length edge: degenerate, finite, the node itself.
+        let pr = project_point_line2([1.0, 2.0, 0.0], &[[1.0, 1.0, 0.0]; 2]);
+        assert!(pr.degenerate && !pr.inside && pr.normal == [0.0; 3]);
+        assert!(close(pr.distance, 1.0, TOL) && close(pr.gap, 1.0, TOL));
+        let nan = project_point_line2([0.0; 3], &[[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0]]);
+        assert!(nan.degenerate);
     }
 }

@@ -61,7 +61,7 @@ pub fn surface_geometries(
             Err(e) => {
                 diagnostics.push(
                     Diagnostic::error("E0312", e.to_string())
-                        .help("2-D meshes give surfaces of edges; search them in a later version"),
+                        .help("check the surface's faces in `seam surfaces`"),
                 );
                 geometry.push(None);
             }

@@ -30,6 +30,7 @@ mod search_kernels;
 mod sources;
 mod surfaces;
 mod transient;
+mod twod;
 
 /// Held by the tests that run the turbine sector in this process. Two of them running at
 /// once give wrong answers (sector against ring, embedding against `seam run`) in about

@@ -142,11 +142,11 @@ impl FaceElement {
 
 /// Reference coordinates, in an element of `topology`, of the nodes of its local side
 /// `side` (1-based), and their count; `None` without shape functions or for a side
-/// that is not a triangle or quadrilateral.
+/// that is not an edge (2-D), a triangle or a quadrilateral.
 fn face_reference_nodes(topology: Topology, side: u8) -> Option<([[f64; 3]; 4], usize)> {
     let nodes = reference_nodes(topology)?;
     let local = topology.sides().get((side as usize).checked_sub(1)?)?;
-    if !matches!(local.len(), 3 | 4) {
+    if !matches!(local.len(), 2..=4) {
         return None;
     }
     let mut out = [[0.0; 3]; 4];
@@ -166,7 +166,8 @@ fn elem_coords(mesh: &Mesh, elem: ElemId) -> [[f64; 3]; MAX_NODES] {
 }
 
 /// Twice the vector area of a (planar or nearly planar) side: the cross product of two
-/// edges of a triangle, of the diagonals of a quadrilateral; zero for other node counts.
+/// edges of a triangle, of the diagonals of a quadrilateral, twice an edge's length
+/// times its normal (2-D); zero for other node counts.
 fn side_vector(mesh: &Mesh, side: Side) -> [f64; 3] {
     let mut p = [[0.0; 3]; 4];
     let mut len = 0;
@@ -177,6 +178,10 @@ fn side_vector(mesh: &Mesh, side: Side) -> [f64; 3] {
         len += 1;
     }
     match len {
+        2 => {
+            let d = sub(p[1], p[0]);
+            [2.0 * d[1], -2.0 * d[0], 0.0]
+        }
         3 => cross(sub(p[1], p[0]), sub(p[2], p[0])),
         4 => cross(sub(p[2], p[0]), sub(p[3], p[1])),
         _ => [0.0; 3],
@@ -222,7 +227,8 @@ fn element_length(mesh: &Mesh, elem: ElemId, side: Side) -> f64 {
         reference_volume,
     )
     .map_or(0.0, |pv| pv.jxw.abs());
-    // Both triangle and quadrilateral areas are half the side vector's length.
+    // Triangle and quadrilateral areas, and edge lengths, are half the side vector's
+    // length (a 2-D element's area over its edge's length: the same thickness).
     let area = 0.5 * norm(side_vector(mesh, side));
     if area > 0.0 { volume / area } else { 0.0 }
 }

@@ -2,6 +2,12 @@
 //! from a contact surface or a side set, lofted, mapped to a periodic image, with node
 //! surfaces' tributary areas and normals; and the reference-face helpers (shape values,
 //! area Jacobian, Gauss rules) the search integrates with.
+//!
+//! Faces are Tri3 and Quad4 in 3-D, Line2 (the edges of Quad4 and Tri3 elements) in
+//! 2-D, where a face's "area" is its length. An axisymmetric surface
+//! ([`SurfaceGeometry::axisymmetric`], x the radius) measures its integrals per full
+//! revolution: every weight, tributary area and surface area carries `2πr`
+//! ([`revolution`]); the sizes that scale the search tolerances stay plain lengths.
 
 use crate::fem::quadrature::gauss_legendre;
 use crate::mesh::{Mesh, NodeId, Side};
@@ -9,7 +15,10 @@ use crate::periodic::PeriodicMap;
 use crate::script::ScriptError;
 use crate::search::bvh::Aabb;
 use crate::search::mortar::rule_triangle;
-use crate::search::project::{map_quad4, map_tri3, vector_area_quad4};
+use crate::search::project::{
+    Projection, map_line2, map_quad4, map_tri3, normal_line2, project_point_line2,
+    project_point_quad4, project_point_tri3, vector_area_quad4,
+};
 use crate::surface::{ContactSurface, SurfaceKind};
 use crate::vec3::{V3, add, cross, norm, scale, sub};
 
@@ -18,7 +27,7 @@ use crate::vec3::{V3, add, cross, norm, scale, sub};
 pub struct FaceGeom {
     /// The mesh side it came from.
     pub side: Side,
-    /// Node count: 3 or 4 (2-D edges are not searched yet).
+    /// Node count: 3 or 4, or 2 for an edge of a 2-D mesh.
     pub len: u8,
     pub nodes: [NodeId; 4],
     pub x: [V3; 4],
@@ -29,9 +38,13 @@ impl FaceGeom {
         &self.x[..self.len as usize]
     }
 
-    /// Vector area (normal × area).
+    /// Vector area (normal × area; for an edge, normal × length).
     pub fn vector_area(&self) -> V3 {
         match self.len {
+            2 => {
+                let e = [self.x[0], self.x[1]];
+                scale(normal_line2(&e), norm(sub(e[1], e[0])))
+            }
             3 => {
                 let c = cross(sub(self.x[1], self.x[0]), sub(self.x[2], self.x[0]));
                 scale(c, 0.5)
@@ -43,8 +56,24 @@ impl FaceGeom {
         }
     }
 
+    /// The face's area (an edge's length), on the plain geometry.
     pub fn area(&self) -> f64 {
         norm(self.vector_area())
+    }
+
+    /// The face's size, the length that scales the search tolerances: √area, or an
+    /// edge's length.
+    pub fn size(&self) -> f64 {
+        match self.len {
+            2 => self.area(),
+            _ => self.area().sqrt(),
+        }
+    }
+
+    /// The face's measure: its area, or per full revolution `∫ 2πr dA` when
+    /// `axisymmetric` (an edge's `2π r̄ L`, exact since r is linear along it).
+    pub fn measure(&self, axisymmetric: bool) -> f64 {
+        self.area() * revolution(axisymmetric, self.centroid())
     }
 
     pub fn normal(&self) -> V3 {
@@ -62,12 +91,24 @@ impl FaceGeom {
         scale(c, 1.0 / k as f64)
     }
 
+    /// The closest point of the face to `p` ([`project_point_line2`],
+    /// [`project_point_tri3`] or [`project_point_quad4`] by node count).
+    pub fn project(&self, p: V3) -> Projection {
+        let x = &self.x;
+        match self.len {
+            2 => project_point_line2(p, &[x[0], x[1]]),
+            3 => project_point_tri3(p, &[x[0], x[1], x[2]]),
+            _ => project_point_quad4(p, x),
+        }
+    }
+
     pub(super) fn aabb(&self) -> Aabb {
         Aabb::from_points(self.coords())
     }
 
     pub(super) fn map(&self, xi: [f64; 2]) -> V3 {
         match self.len {
+            2 => map_line2(&[self.x[0], self.x[1]], xi),
             3 => map_tri3(&[self.x[0], self.x[1], self.x[2]], xi),
             _ => map_quad4(&[self.x[0], self.x[1], self.x[2], self.x[3]], xi),
         }
@@ -89,12 +130,28 @@ pub struct SurfaceGeometry {
     pub node_normal: Vec<V3>,
     /// For node surfaces: the faces the areas and normals come from (not searched).
     pub tributary: Vec<FaceGeom>,
+    /// A 2-D axisymmetric model (x the radius r ≥ 0, y the axis): weights, tributary
+    /// areas and [`Self::area`] are per full revolution (× 2πr). Taken from the mesh.
+    pub axisymmetric: bool,
+}
+
+/// The factor of a point's weight: `2πr` (r = x) per full revolution when
+/// `axisymmetric`, else 1.
+#[inline]
+pub(crate) fn revolution(axisymmetric: bool, x: V3) -> f64 {
+    if axisymmetric {
+        std::f64::consts::TAU * x[0]
+    } else {
+        1.0
+    }
 }
 
 /// Why a surface cannot be searched.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SearchError {
+    /// Not returned any more (2-D surfaces are searched since 2-D search came); kept so
+    /// code that matches on it still builds.
     #[error("surface `{0}` is made of edges (a 2-D mesh): 2-D contact search is not supported yet")]
     TwoDimensional(String),
     #[error("periodic map of surface `{surface}`: {source}")]
@@ -114,6 +171,7 @@ impl SurfaceGeometry {
     ) -> Result<Self, SearchError> {
         let mut out = SurfaceGeometry {
             name: surface.name.clone(),
+            axisymmetric: mesh.axisymmetric,
             ..Default::default()
         };
         if surface.kind == SurfaceKind::Nodes {
@@ -123,11 +181,7 @@ impl SurfaceGeometry {
                 .map(|&n| (n, coords[n.index()]))
                 .collect();
             for &side in &surface.tributary {
-                let g = face_geom(mesh, side, coords);
-                // Edges (2-D meshes) are not searched; as tributaries they give nothing.
-                if g.len >= 3 {
-                    out.tributary.push(g);
-                }
+                out.tributary.push(face_geom(mesh, side, coords));
             }
             out.tributary_of_nodes();
             return Ok(out);
@@ -135,9 +189,6 @@ impl SurfaceGeometry {
         out.faces.reserve(surface.faces.len());
         for f in &surface.faces {
             let mut g = face_geom(mesh, f.side, coords);
-            if g.len == 2 {
-                return Err(SearchError::TwoDimensional(surface.name.clone()));
-            }
             if f.loft != 0.0 {
                 let n = g.normal();
                 for p in &mut g.x[..g.len as usize] {
@@ -155,7 +206,8 @@ impl SurfaceGeometry {
     /// `Σ_i A_i q = q A` exactly; `n_i = Σ_f ∫_f N_i n dA`, normalised. Tri3 faces are
     /// flat (`∫ N_i = A/3`); Quad4 faces use the 2×2 Gauss rule of the bilinear map, exact
     /// for `N_i |J|` on flat faces (N_i bilinear, |J| bilinear) and for `N_i J` on warped
-    /// ones (both of degree ≤ 2 in each coordinate).
+    /// ones (both of degree ≤ 2 in each coordinate); edges the 2-point Gauss rule, exact
+    /// for `N_i 2πr` (degree 2) when axisymmetric.
     pub fn tributary_of_nodes(&mut self) {
         let index: std::collections::HashMap<NodeId, usize> = self
             .nodes
@@ -169,7 +221,10 @@ impl SurfaceGeometry {
             let len = f.len as usize;
             // A triangle's N_i is linear and its Jacobian constant: the centroid rule is
             // exact.
-            let rule: Vec<([f64; 2], f64)> = if len == 3 {
+            let rule: Vec<([f64; 2], f64)> = if len == 2 {
+                let (g, w) = gauss_legendre(2);
+                vec![([g[0], 0.0], w[0]), ([g[1], 0.0], w[1])]
+            } else if len == 3 {
                 vec![([1.0 / 3.0, 1.0 / 3.0], 0.5)]
             } else {
                 let (g, w) = gauss_legendre(2);
@@ -179,6 +234,7 @@ impl SurfaceGeometry {
             };
             for &(xi, w) in &rule {
                 let j = face_normal_jacobian(f, xi);
+                let w = w * revolution(self.axisymmetric, f.map(xi));
                 let shapes = face_shapes(len, xi);
                 for (node, shape) in f.nodes.iter().zip(shapes).take(len) {
                     let Some(&i) = index.get(node) else {
@@ -251,17 +307,23 @@ impl SurfaceGeometry {
         Ok(out)
     }
 
-    /// The area of the faces, or for a node surface the sum of its nodes' tributary areas.
+    /// The area of the faces (per full revolution when axisymmetric), or for a node
+    /// surface the sum of its nodes' tributary areas.
     pub fn area(&self) -> f64 {
-        self.faces.iter().map(FaceGeom::area).sum::<f64>() + self.node_area.iter().sum::<f64>()
+        self.faces
+            .iter()
+            .map(|f| f.measure(self.axisymmetric))
+            .sum::<f64>()
+            + self.node_area.iter().sum::<f64>()
     }
 
-    /// Mean face size (√area), the length scale of the search tolerances.
+    /// Mean face size (√area, an edge's length), the length scale of the search
+    /// tolerances.
     pub fn mean_face_size(&self) -> f64 {
         if self.faces.is_empty() {
             return 0.0;
         }
-        self.faces.iter().map(|f| f.area().sqrt()).sum::<f64>() / self.faces.len() as f64
+        self.faces.iter().map(FaceGeom::size).sum::<f64>() / self.faces.len() as f64
     }
 }
 
@@ -281,11 +343,13 @@ pub(super) fn face_geom(mesh: &Mesh, side: Side, coords: &[V3]) -> FaceGeom {
     g
 }
 
-/// Shape functions of a Tri3 (`len` 3) or Quad4 face at `xi`, Exodus node order (the
-/// fourth value is 0 for a triangle).
+/// Shape functions of a Line2 (`len` 2), Tri3 (3) or Quad4 face at `xi`, Exodus node
+/// order (the values past `len` are 0).
 pub(crate) fn face_shapes(len: usize, xi: [f64; 2]) -> [f64; 4] {
     let (s, t) = (xi[0], xi[1]);
-    if len == 3 {
+    if len == 2 {
+        [0.5 * (1.0 - s), 0.5 * (1.0 + s), 0.0, 0.0]
+    } else if len == 3 {
         [1.0 - s - t, s, t, 0.0]
     } else {
         [
@@ -297,10 +361,12 @@ pub(crate) fn face_shapes(len: usize, xi: [f64; 2]) -> [f64; 4] {
     }
 }
 
-/// ∂x/∂ξ × ∂x/∂η at ξ: the face's area Jacobian times its unit normal.
+/// ∂x/∂ξ × ∂x/∂η at ξ: the face's area Jacobian times its unit normal (an edge's
+/// `|∂x/∂ξ| = L/2` times its normal).
 pub(super) fn face_normal_jacobian(face: &FaceGeom, xi: [f64; 2]) -> V3 {
     let x = &face.x;
     match face.len {
+        2 => scale(face.vector_area(), 0.5),
         3 => cross(sub(x[1], x[0]), sub(x[2], x[0])),
         _ => {
             let (s, t) = (xi[0], xi[1]);
@@ -318,9 +384,14 @@ pub(super) fn face_normal_jacobian(face: &FaceGeom, xi: [f64; 2]) -> V3 {
     }
 }
 
-/// Gauss rule on a face's reference element: (ξ, weight on the reference element).
+/// Gauss rule on a face's reference element: (ξ, weight on the reference element); an
+/// edge takes `order` Gauss points (1 to 3) on `[-1, 1]`, as each direction of a quad.
 pub(super) fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
     match face.len {
+        2 => {
+            let (xs, ws) = gauss_legendre(order.clamp(1, 3));
+            xs.iter().zip(ws).map(|(&x, w)| ([x, 0.0], w)).collect()
+        }
         3 => {
             // Weights relative to the area, which is 1/2 on the reference triangle.
             rule_triangle(order.max(1))
@@ -342,9 +413,10 @@ pub(super) fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
     }
 }
 
-/// |∂x/∂ξ × ∂x/∂η| at ξ: the area Jacobian of the face's map.
+/// |∂x/∂ξ × ∂x/∂η| at ξ: the area Jacobian of the face's map (an edge's L/2).
 pub(super) fn face_jacobian(face: &FaceGeom, xi: [f64; 2]) -> f64 {
     match face.len {
+        2 => 0.5 * face.area(),
         3 => 2.0 * face.area(),
         _ => norm(face_normal_jacobian(face, xi)),
     }

@@ -331,7 +331,7 @@ fn margin_for(b: &SurfaceGeometry, s: &SearchSettings) -> f64 {
 }
 
 fn max_face_size(b: &SurfaceGeometry) -> f64 {
-    b.faces.iter().map(|f| f.area().sqrt()).fold(0.0, f64::max)
+    b.faces.iter().map(FaceGeom::size).fold(0.0, f64::max)
 }
 
 /// `Update Search Every n Steps`: a full search on the first step and every n-th step

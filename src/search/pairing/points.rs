@@ -3,12 +3,14 @@
 //! quadrature points, mortar segment points and node points.
 
 use crate::search::bvh::{Aabb, Bvh};
-use crate::search::mortar::{FaceOverlap, rule_triangle, segments_face_face_into};
-use crate::search::project::{project_point_quad4, project_point_tri3};
+use crate::search::mortar::{
+    FaceOverlap, MortarPoint, overlap_length_line_line, rule_line, rule_triangle,
+    segments_face_face_into, segments_line_line_into,
+};
 use crate::search::settings::SearchSettings;
 use crate::vec3::{V3, dot, norm, scale, sub};
 
-use super::geometry::{FaceGeom, SurfaceGeometry, face_jacobian, face_rule};
+use super::geometry::{FaceGeom, SurfaceGeometry, face_jacobian, face_rule, revolution};
 use super::{ContactPoint, Integration, PointStatus, Sphere};
 
 pub(super) struct Ctx<'a> {
@@ -56,7 +58,7 @@ impl Ctx<'_> {
     pub(super) fn distance_limit(&self, face: &FaceGeom) -> f64 {
         self.settings
             .normal_tolerance
-            .unwrap_or(self.settings.field_factor * face.area().sqrt())
+            .unwrap_or(self.settings.field_factor * face.size())
     }
 
     /// Normals acceptable? `n_a` zero (node points) skips the test.
@@ -98,10 +100,7 @@ impl Ctx<'_> {
                 return;
             }
             let face = &self.b.faces[j];
-            let pr = match face.len {
-                3 => project_point_tri3(x, &[face.x[0], face.x[1], face.x[2]]),
-                _ => project_point_quad4(x, &[face.x[0], face.x[1], face.x[2], face.x[3]]),
-            };
+            let pr = face.project(x);
             if pr.degenerate || !(pr.inside || self.within_tangential(face, &pr.point, x)) {
                 return;
             }
@@ -126,7 +125,7 @@ impl Ctx<'_> {
     /// A point that did not project inside may still pair if it lies within the
     /// tangential tolerance (× face size) of the face, measured in the face's plane.
     pub(super) fn within_tangential(&self, face: &FaceGeom, closest: &V3, x: V3) -> bool {
-        let t = self.settings.tangential_tolerance * face.area().sqrt();
+        let t = self.settings.tangential_tolerance * face.size();
         if t <= 0.0 {
             return false;
         }
@@ -197,8 +196,8 @@ impl Ctx<'_> {
         let n_a = face.normal();
         for (xi, w) in face_rule(face, order) {
             let x = face.map(xi);
-            let jac = face_jacobian(face, xi);
-            out.push(self.point(Some(fa as u32), None, xi, x, w * jac, n_a));
+            let w = w * face_jacobian(face, xi) * revolution(a.axisymmetric, x);
+            out.push(self.point(Some(fa as u32), None, xi, x, w, n_a));
         }
     }
 
@@ -208,18 +207,29 @@ impl Ctx<'_> {
         fa: usize,
         order: usize,
         out: &mut Vec<ContactPoint>,
-        scratch: &mut Vec<crate::search::mortar::MortarPoint>,
+        scratch: &mut Vec<MortarPoint>,
     ) {
         let face = &a.faces[fa];
         let n_a = face.normal();
-        let rule = rule_triangle(order);
+        // Edges: a Gauss rule on the overlap interval, one degree higher when the weight
+        // carries 2πr, so that it stays exact for the same integrands.
+        let (line, triangle) = match face.len {
+            2 => (Some(rule_line(order + usize::from(a.axisymmetric))), None),
+            _ => (None, Some(rule_triangle(order))),
+        };
         let mut candidates = Vec::new();
         self.face_candidates(face, &mut candidates);
         let outside = self.outside(face.centroid());
         for j in candidates {
             let fb = &self.b.faces[j];
             scratch.clear();
-            segments_face_face_into(face.coords(), fb.coords(), &rule, scratch);
+            match (&line, &triangle) {
+                (Some(line), _) => {
+                    segments_line_line_into(face.coords(), fb.coords(), line, scratch)
+                }
+                (_, Some(tri)) => segments_face_face_into(face.coords(), fb.coords(), tri, scratch),
+                _ => 0,
+            };
             if scratch.is_empty() {
                 continue;
             }
@@ -241,7 +251,7 @@ impl Ctx<'_> {
                     a_node: None,
                     xi_a: m.xi_a,
                     x: m.x_a,
-                    weight: m.weight,
+                    weight: m.weight * revolution(a.axisymmetric, m.x_a),
                     status,
                     b_face: Some(j as u32),
                     xi_b: m.xi_b,
@@ -277,11 +287,17 @@ impl Ctx<'_> {
         if self.outside(face.centroid()) {
             return 0.0;
         }
-        let Some(mut clip) = FaceOverlap::new(face.coords()) else {
-            return 0.0;
+        let mut clip = match face.len {
+            2 => None,
+            _ => match FaceOverlap::new(face.coords()) {
+                Some(c) => Some(c),
+                None => return 0.0,
+            },
         };
         let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
+        let mut scratch = Vec::new();
+        let midpoint = rule_line(1);
         self.face_candidates(face, candidates);
         for &j in candidates.iter() {
             let fb = &self.b.faces[j];
@@ -290,7 +306,19 @@ impl Ctx<'_> {
             {
                 continue;
             }
-            area += clip.area_with(fb.coords());
+            area += match &mut clip {
+                Some(clip) => clip.area_with(fb.coords()),
+                None if !a.axisymmetric => overlap_length_line_line(face.coords(), fb.coords()),
+                // ∫ 2πr over the interval: its midpoint rule is exact (r is linear).
+                None => {
+                    scratch.clear();
+                    segments_line_line_into(face.coords(), fb.coords(), &midpoint, &mut scratch);
+                    scratch
+                        .iter()
+                        .map(|m| m.weight * revolution(true, m.x_a))
+                        .sum()
+                }
+            };
         }
         area
     }
