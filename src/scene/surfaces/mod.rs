@@ -187,7 +187,9 @@ impl<'a> Builder<'a> {
         let mut out = Vec::new();
         for &side in self.mesh_skin.as_deref().unwrap_or_default() {
             let mut key: Vec<NodeId> = self.mesh.side_nodes(side).collect();
-            if key.len() < 3 || !key.iter().all(|n| members.contains(n)) {
+            // Faces in 3-D (a shell's edges give no area), edges in 2-D.
+            let too_small = key.len() < 3 && self.mesh.dim == 3;
+            if too_small || !key.iter().all(|n| members.contains(n)) {
                 continue;
             }
             key.sort_unstable();

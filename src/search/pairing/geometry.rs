@@ -421,3 +421,57 @@ pub(super) fn face_jacobian(face: &FaceGeom, xi: [f64; 2]) -> f64 {
         _ => norm(face_normal_jacobian(face, xi)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn edge(nodes: [u32; 2], x: [V3; 2]) -> FaceGeom {
+        FaceGeom {
+            side: Side {
+                elem: crate::mesh::ElemId(0),
+                side: 1,
+            },
+            len: 2,
+            nodes: [NodeId(nodes[0]), NodeId(nodes[1]), NodeId(0), NodeId(0)],
+            x: [x[0], x[1], [0.0; 3], [0.0; 3]],
+        }
+    }
+
+    /// The tributary lengths of a 2-D node surface: the row sums of the edge mass
+    /// matrix, L/2 from each edge; per revolution `∫ N_i 2πr ds`, which for an edge from
+    /// r₀ to r₁ gives node 0 `2π L (2r₀ + r₁)/6`. Normals are the edges' (+y here).
+    #[test]
+    fn edge_tributaries_per_unit_depth_and_per_revolution() {
+        let xs = [[1.0, 2.0, 0.0], [0.5, 2.0, 0.0], [0.0, 2.0, 0.0]];
+        for axisymmetric in [false, true] {
+            let mut g = SurfaceGeometry {
+                nodes: (0..3).map(|k| (NodeId(k), xs[k as usize])).collect(),
+                tributary: vec![edge([0, 1], [xs[0], xs[1]]), edge([1, 2], [xs[1], xs[2]])],
+                axisymmetric,
+                ..Default::default()
+            };
+            g.tributary_of_nodes();
+            let want = if axisymmetric {
+                let tau = std::f64::consts::TAU;
+                let half = |r0: f64, r1: f64| tau * 0.5 * (2.0 * r0 + r1) / 6.0;
+                [
+                    half(1.0, 0.5),
+                    half(0.5, 1.0) + half(0.5, 0.0),
+                    half(0.0, 0.5),
+                ]
+            } else {
+                [0.25, 0.5, 0.25]
+            };
+            for (k, want) in want.iter().enumerate() {
+                assert!((g.node_area[k] - want).abs() < 1e-15, "{axisymmetric} {k}");
+                let n = g.node_normal[k];
+                assert!(n[0].abs() < 1e-15 && (n[1] - 1.0).abs() < 1e-15 && n[2] == 0.0);
+            }
+            // The same total as the faces' own measure (2π r̄ L = 2π · 0.5 · 1).
+            let total: f64 = g.node_area.iter().sum();
+            let faces: f64 = g.tributary.iter().map(|f| f.measure(axisymmetric)).sum();
+            assert!((total - faces).abs() < 1e-15);
+        }
+    }
+}
