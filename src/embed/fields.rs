@@ -177,7 +177,8 @@ pub(crate) fn face_values(
     let mut out = Vec::with_capacity(on_a.len() + if side_b { on_b.len() } else { 0 });
     let mut push = |geometry: &SurfaceGeometry, sums: &[Sums], side: u8| {
         for (f, s) in geometry.faces.iter().zip(sums) {
-            let area = f.area();
+            // Per revolution in an axisymmetric model, as the points' weights are.
+            let area = f.measure(geometry.axisymmetric);
             let paired = s.weight > 0.0;
             out.push(FaceValues {
                 face: HostFace {

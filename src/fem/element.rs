@@ -17,6 +17,7 @@
 
 use crate::mesh::Topology;
 
+use super::Measure;
 use super::quadrature::QuadratureRule;
 use super::shape::shape;
 
@@ -54,6 +55,8 @@ pub struct Basis {
     /// The same tables laid out for [`Basis::map_hex8`]; `None` unless the basis is a
     /// `Hex8` on an eight-point rule.
     hex8: Option<Box<Hex8Tables>>,
+    /// Per unit depth (plane) or per revolution: [`Basis::eval`]'s `jxw` carries 2πr.
+    measure: Measure,
 }
 
 /// Reference values of a `Hex8` at the eight points of its rule, in the layouts the
@@ -119,7 +122,30 @@ impl Basis {
             n,
             dn,
             hex8,
+            measure: Measure::Plane,
         }
+    }
+
+    /// The same basis measured by `measure`: axisymmetric, [`Basis::eval`]'s `jxw` is
+    /// `det J · w · 2πr` at the point, so every kernel built on it integrates per full
+    /// revolution. Only 2-D topologies are axisymmetric; a 3-D basis stays plane.
+    pub fn with_measure(mut self, measure: Measure) -> Self {
+        if self.topology.parametric_dim() == 2 {
+            self.measure = measure;
+        }
+        self
+    }
+
+    /// The basis of a block of a mesh whose integrals are measured by `measure`: the
+    /// standard rule, plane; axisymmetric, a rule one degree higher for `Tri3` (3
+    /// instead of 2) so the capacity's `N_a N_b r` stays exact — `Quad4`'s 2×2 rule is
+    /// exact to degree 3 in each direction already.
+    pub fn for_measure(topology: Topology, measure: Measure) -> Option<Self> {
+        let rule = match (topology, measure) {
+            (Topology::Tri3, Measure::Axisymmetric) => QuadratureRule::with_degree(topology, 3)?,
+            _ => QuadratureRule::standard(topology)?,
+        };
+        Some(Self::new(topology, rule).with_measure(measure))
     }
 
     /// The same basis without its `Hex8` tables: kernels then take the general path
@@ -223,15 +249,20 @@ impl Basis {
     }
 
     /// Values at quadrature point `q` of the element with nodes at `coords`.
+    /// Axisymmetric ([`Basis::with_measure`]), `jxw` carries 2πr at the point.
     pub fn eval(&self, q: usize, coords: &[[f64; 3]]) -> Result<PointValues, BadJacobian> {
-        map_point(
+        let mut pv = map_point(
             self.topology,
             coords,
             &self.n[q],
             &self.dn[q],
             self.rule.points[q],
             self.rule.weights[q],
-        )
+        )?;
+        if self.measure == Measure::Axisymmetric {
+            pv.jxw *= self.measure.factor(pv.x);
+        }
+        Ok(pv)
     }
 }
 

@@ -13,7 +13,11 @@
 //! - nonlinear conduction `R_a = ∫ k(T) ∇N_a·∇T dV` with the exact Jacobian
 //!   `∂R_a/∂T_b = ∫ [k ∇N_a·∇N_b + (dk/dT) N_b ∇N_a·∇T] dV`.
 //!
-//! 2-D elements (`Quad4`, `Tri3`) use x and y and integrate per unit depth.
+//! 2-D elements (`Quad4`, `Tri3`) use x and y and integrate per unit depth, or per full
+//! revolution when axisymmetric: the volume kernels through their basis
+//! ([`Basis::with_measure`]), the face kernels through their `_with` forms
+//! ([`face_flux_with`], [`face_convection_with`], [`face_load_with`]) — every weight
+//! times 2πr.
 //!
 //! Fast path: on a `Hex8` basis with its eight-point rule ([`Basis::has_hex8_path`]) the
 //! volume kernels map all points at once ([`Basis::map_hex8`]) and accumulate into the
@@ -30,7 +34,7 @@
 
 use crate::fem::quadrature::QuadratureRule;
 use crate::fem::shape::face_shape;
-use crate::fem::{BadJacobian, Basis, Hex8Points, MAX_NODES};
+use crate::fem::{BadJacobian, Basis, Hex8Points, MAX_NODES, Measure};
 use crate::mesh::{FaceShape, Topology};
 
 /// The `Hex8` fast path of `basis` for these coordinates, if it applies.
@@ -206,6 +210,7 @@ fn face_points<'a>(
     face: FaceShape,
     fcoords: &'a [[f64; 3]],
     rule: &'a QuadratureRule,
+    measure: Measure,
 ) -> impl Iterator<Item = FacePoint> + 'a {
     rule.points.iter().zip(&rule.weights).map(move |(p, w)| {
         let mut n = [0.0; 4];
@@ -232,7 +237,11 @@ fn face_points<'a>(
                 (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
             }
         };
-        FacePoint { n, x, jxw: da * w }
+        FacePoint {
+            n,
+            x,
+            jxw: da * w * measure.factor(x),
+        }
     })
 }
 
@@ -277,8 +286,20 @@ pub fn face_flux(
     q: impl Fn([f64; 3]) -> f64,
     fe: &mut [f64],
 ) {
+    face_flux_with(Measure::Plane, topology, coords, side, q, fe)
+}
+
+/// [`face_flux`] measured by `measure` (per revolution: `dA = 2πr ds`).
+pub fn face_flux_with(
+    measure: Measure,
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+    q: impl Fn([f64; 3]) -> f64,
+    fe: &mut [f64],
+) {
     let (face, local, fc) = side_geometry(topology, coords, side);
-    for fp in face_points(face, &fc, face_rule(face)) {
+    for fp in face_points(face, &fc, face_rule(face), measure) {
         let qw = q(fp.x) * fp.jxw;
         for (k, &l) in local.iter().enumerate() {
             fe[l as usize] += qw * fp.n[k];
@@ -296,9 +317,24 @@ pub fn face_convection(
     ke: &mut [f64],
     fe: &mut [f64],
 ) {
+    face_convection_with(Measure::Plane, topology, coords, side, h, t_inf, ke, fe)
+}
+
+/// [`face_convection`] measured by `measure` (per revolution: `dA = 2πr ds`).
+#[allow(clippy::too_many_arguments)]
+pub fn face_convection_with(
+    measure: Measure,
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+    h: f64,
+    t_inf: f64,
+    ke: &mut [f64],
+    fe: &mut [f64],
+) {
     let nn = topology.node_count();
     let (face, local, fc) = side_geometry(topology, coords, side);
-    for fp in face_points(face, &fc, face_rule(face)) {
+    for fp in face_points(face, &fc, face_rule(face), measure) {
         for (k, &a) in local.iter().enumerate() {
             fe[a as usize] += h * t_inf * fp.n[k] * fp.jxw;
             for (m, &b) in local.iter().enumerate() {
@@ -321,9 +357,24 @@ pub fn face_load(
     re: &mut [f64],
     je: &mut [f64],
 ) {
+    face_load_with(Measure::Plane, topology, coords, side, t, g, re, je)
+}
+
+/// [`face_load`] measured by `measure` (per revolution: `dA = 2πr ds`).
+#[allow(clippy::too_many_arguments)]
+pub fn face_load_with(
+    measure: Measure,
+    topology: Topology,
+    coords: &[[f64; 3]],
+    side: u8,
+    t: &[f64],
+    g: impl Fn(f64, [f64; 3]) -> (f64, f64),
+    re: &mut [f64],
+    je: &mut [f64],
+) {
     let nn = topology.node_count();
     let (face, local, fc) = side_geometry(topology, coords, side);
-    for fp in face_points(face, &fc, face_rule(face)) {
+    for fp in face_points(face, &fc, face_rule(face), measure) {
         let tq: f64 = local
             .iter()
             .enumerate()

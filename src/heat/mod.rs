@@ -33,7 +33,7 @@ use crate::assembly::{Assembler, AssemblyError, DofMap, FieldId, Pattern};
 use crate::mesh::{ElemId, Mesh, NodeId, Side};
 use crate::solve::{LinearSolver, Lu, SolveError, apply_dirichlet};
 
-use crate::fem::{BadJacobian, MAX_NODES};
+use crate::fem::{BadJacobian, MAX_NODES, Measure};
 
 pub use crate::fem::{Basis, QuadratureRule};
 
@@ -192,7 +192,8 @@ fn bad_jacobian(mesh: &Mesh, elem: ElemId, b: BadJacobian) -> HeatError {
     }
 }
 
-/// Standard bases of the temperature blocks, checking every block is a solid.
+/// Standard bases of the temperature blocks (per revolution in an axisymmetric mesh),
+/// checking every block is a solid.
 fn block_rules(
     mesh: &Mesh,
     dofs: &DofMap,
@@ -201,12 +202,13 @@ fn block_rules(
     let mut rules = vec![None; mesh.blocks.len()];
     for &b in dofs.field_blocks(field) {
         let block = &mesh.blocks[b];
-        rules[b] = Some(
-            Basis::standard(block.topology).ok_or(HeatError::UnsupportedTopology {
+        let measure = Measure::of(mesh.axisymmetric);
+        rules[b] = Some(Basis::for_measure(block.topology, measure).ok_or(
+            HeatError::UnsupportedTopology {
                 block: block.id,
                 topology: block.topology,
-            })?,
-        );
+            },
+        )?);
     }
     Ok(rules)
 }
@@ -260,6 +262,7 @@ pub fn assemble_conduction(
         });
     }
     let rules = block_rules(mesh, dofs, field)?;
+    let measure = Measure::of(mesh.axisymmetric);
     // Face conditions sorted by element so each element kernel finds its own.
     let mut faces: Vec<(u32, usize)> = Vec::with_capacity(flux_bcs.len());
     for (k, bc) in flux_bcs.iter().enumerate() {
@@ -299,9 +302,11 @@ pub fn assemble_conduction(
         let first = faces.partition_point(|f| f.0 < e.0);
         for &(_, k) in faces[first..].iter().take_while(|f| f.0 == e.0) {
             match flux_bcs[k] {
-                FaceBc::Flux { side, q } => kernel::face_flux(topo, x, side.side, |_| q, fe),
+                FaceBc::Flux { side, q } => {
+                    kernel::face_flux_with(measure, topo, x, side.side, |_| q, fe)
+                }
                 FaceBc::Convection { side, h, t_inf } => {
-                    kernel::face_convection(topo, x, side.side, h, t_inf, ke, fe)
+                    kernel::face_convection_with(measure, topo, x, side.side, h, t_inf, ke, fe)
                 }
                 FaceBc::Radiation { .. } => {
                     errors.record(e, HeatError::NonlinearFace);
@@ -364,7 +369,7 @@ pub fn error_norms(
                 topology: block.topology,
             },
         )?;
-        let basis = Basis::new(block.topology, rule);
+        let basis = Basis::new(block.topology, rule).with_measure(Measure::of(mesh.axisymmetric));
         let per: Vec<Result<(f64, f64), HeatError>> = (0..block.len())
             .into_par_iter()
             .with_min_len(256)

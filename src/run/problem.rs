@@ -103,6 +103,10 @@ pub struct NodalFieldSpec {
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
     pub file: PathBuf,
+    /// A 2-D mesh read as the section of a body of revolution: x is the radius r ≥ 0, y
+    /// the axial coordinate; integrals, heats and fluxes are per full revolution.
+    #[serde(default)]
+    pub axisymmetric: bool,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -399,13 +403,56 @@ impl ProblemFile {
         })
     }
 
-    /// The problem's mesh (`[mesh] file`), and the seconds reading it took.
+    /// The problem's mesh (`[mesh] file`), read as `[mesh] axisymmetric` says, and the
+    /// seconds reading it took.
     pub(super) fn read_mesh(&self, options: &RunOptions) -> Result<(Mesh, f64), RunError> {
         let clock = Instant::now();
         options.phase("reading the mesh");
-        let mesh = mesh::read(&self.dir.join(&self.problem.mesh.file))
+        let mut mesh = mesh::read(&self.dir.join(&self.problem.mesh.file))
             .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
+        if self.problem.mesh.axisymmetric {
+            self.check_axisymmetric(&mesh)?;
+            mesh.axisymmetric = true;
+        }
         Ok((mesh, clock.elapsed().as_secs_f64()))
+    }
+
+    /// `[mesh] axisymmetric = true` needs a 2-D mesh (E0717) with every node at x ≥ 0,
+    /// the radius (E0718; within 1e-12 of the model's size, the round-off of a node
+    /// meant to lie on the axis).
+    fn check_axisymmetric(&self, mesh: &Mesh) -> Result<(), RunError> {
+        let at = self.text.loc_in_table("mesh", "axisymmetric");
+        let fail = |code, message: String, help: &str| {
+            let mut d = Diagnostics::default();
+            d.push(Diagnostic::error(code, message).at(at.clone()).help(help));
+            RunError::Input(d, self.text.sources())
+        };
+        let file = self.problem.mesh.file.display();
+        if mesh.dim != 2 {
+            return Err(fail(
+                "E0717",
+                format!(
+                    "`axisymmetric = true` needs a 2-D mesh; {file} is {}-D",
+                    mesh.dim
+                ),
+                "an axisymmetric model is the (r, z) section of a body of revolution, meshed in 2-D with x the radius; a 3-D mesh is modelled as it is (drop the line)",
+            ));
+        }
+        let tolerance = 1e-12 * mesh.model_size();
+        let off_side = |x: &&[f64; 3]| x[0] < -tolerance || x[0].is_nan();
+        if let Some((n, x)) = mesh.coords.iter().enumerate().find(|(_, x)| off_side(x)) {
+            let count = mesh.coords.iter().filter(off_side).count();
+            return Err(fail(
+                "E0718",
+                format!(
+                    "`axisymmetric = true`: x is the radius, but node {} of {file} lies at x = {} ({count} node(s) at x < 0)",
+                    mesh.node_number(crate::mesh::NodeId(n as u32)),
+                    x[0]
+                ),
+                "mesh the section on the side x ≥ 0 of the axis x = 0 (the y axis is the axis of revolution)",
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -426,6 +473,19 @@ impl ProblemText {
         let root = DeTable::parse(&self.text).ok()?;
         let entry = find(root.get_ref(), array)?.get_ref().as_array()?.get(k)?;
         let node = entry.get_ref().as_table().and_then(|t| find(t, key));
+        let span = node.unwrap_or(entry).span();
+        Some(deck::byte_span_loc(&self.file, &self.text, span))
+    }
+
+    /// Where `key` of the table `table` sits (the table's header when it has no `key`).
+    pub(super) fn loc_in_table(&self, table: &str, key: &str) -> Option<crate::diag::Loc> {
+        use toml::de::DeTable;
+        let root = DeTable::parse(&self.text).ok()?;
+        let (_, entry) = root.get_ref().iter().find(|(n, _)| n.get_ref() == table)?;
+        let node = entry
+            .get_ref()
+            .as_table()
+            .and_then(|t| t.iter().find(|(n, _)| n.get_ref() == key).map(|(_, v)| v));
         let span = node.unwrap_or(entry).span();
         Some(deck::byte_span_loc(&self.file, &self.text, span))
     }

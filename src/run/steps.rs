@@ -87,9 +87,10 @@ pub(super) struct StepWriter<'m> {
     last_written: Option<usize>,
 }
 
-/// The element variables of `results.exo`.
+/// The element variables of `results.exo`: the heat flux's components, x and y only in
+/// a 2-D mesh (ParaView's Exodus reader joins them into the vector `heat_flux`).
 const HEAT_FLUX: [&str; 3] = ["heat_flux_x", "heat_flux_y", "heat_flux_z"];
-/// The element variables of the current density in `results.exo`.
+/// The element variables of the current density in `results.exo` (x and y in 2-D).
 const CURRENT_DENSITY: [&str; 3] = [
     "current_density_x",
     "current_density_y",
@@ -174,10 +175,12 @@ impl<'m> StepWriter<'m> {
             if fields.contact.is_some() {
                 nodal.extend(CONTACT_NODAL);
             }
-            let mut element = HEAT_FLUX.to_vec();
+            // One component per dimension: x and y only in a 2-D mesh.
+            let dims = self.mesh.dim.clamp(2, 3);
+            let mut element = HEAT_FLUX[..dims].to_vec();
             if fields.electric.is_some() {
                 nodal.push("voltage");
-                element.extend(CURRENT_DENSITY);
+                element.extend(&CURRENT_DENSITY[..dims]);
             }
             let global: Vec<&str> = fields.heat_names.iter().map(String::as_str).collect();
             self.exodus = Some(ExodusWriter::create_with_globals(
@@ -196,8 +199,9 @@ impl<'m> StepWriter<'m> {
         if let Some(c) = fields.contact {
             nodal.extend(c.nodal(self.mesh));
         }
+        let dims = self.mesh.dim.clamp(2, 3);
         let components = |v: &[f64]| -> Vec<Vec<f64>> {
-            (0..3)
+            (0..dims)
                 .map(|d| v.iter().skip(d).step_by(3).map(|&v| finite(v)).collect())
                 .collect()
         };

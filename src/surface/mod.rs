@@ -54,13 +54,15 @@ pub struct ContactSurface {
 }
 
 impl ContactSurface {
-    /// Total area (length in 2-D) of the faces, evaluated on the unlofted geometry; for a
-    /// node surface, of its tributary faces (the sum of its nodes' tributary areas when it
-    /// owns every node of those faces).
+    /// Total area (length in 2-D, per full revolution `2π r̄ L` when the mesh is
+    /// axisymmetric) of the faces, evaluated on the unlofted geometry; for a node surface,
+    /// of its tributary faces (the sum of its nodes' tributary areas when it owns every
+    /// node of those faces).
     pub fn area(&self, mesh: &Mesh) -> f64 {
+        let revolution = crate::fem::Measure::of(mesh.axisymmetric);
         let measure = |side: Side| {
             let nodes: Vec<NodeId> = mesh.side_nodes(side).collect();
-            measure_and_normal(mesh, &nodes).0
+            measure_and_normal(mesh, &nodes).0 * revolution.factor(geometry::centroid(mesh, &nodes))
         };
         self.faces.iter().map(|f| measure(f.side)).sum::<f64>()
             + self.tributary.iter().map(|&s| measure(s)).sum::<f64>()

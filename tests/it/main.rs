@@ -1,5 +1,6 @@
 //! The one integration-test binary; each module is one area.
 
+mod axisymmetric;
 mod bad_cli;
 mod bad_decks;
 mod cases;

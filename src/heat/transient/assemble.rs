@@ -148,7 +148,8 @@ impl Context<'_, '_> {
                 } else {
                     &mut *je
                 };
-                kernel::face_load(
+                kernel::face_load_with(
+                    crate::fem::Measure::of(mesh.axisymmetric),
                     topo,
                     &x[..nn],
                     bc.side().side,

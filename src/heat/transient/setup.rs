@@ -174,10 +174,12 @@ pub(super) fn lumped_weights(mesh: &Mesh, dofs: &DofMap) -> Result<Vec<LumpedWei
         if dofs.block_fields(b).is_empty() {
             continue;
         }
-        let basis = Basis::standard(block.topology).ok_or(HeatError::UnsupportedTopology {
-            block: block.id,
-            topology: block.topology,
-        })?;
+        let measure = crate::fem::Measure::of(mesh.axisymmetric);
+        let basis =
+            Basis::for_measure(block.topology, measure).ok_or(HeatError::UnsupportedTopology {
+                block: block.id,
+                topology: block.topology,
+            })?;
         let nn = block.topology.node_count();
         let mut me = vec![0.0; nn * nn];
         for k in 0..block.len() {

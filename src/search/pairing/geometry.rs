@@ -139,11 +139,7 @@ pub struct SurfaceGeometry {
 /// `axisymmetric`, else 1.
 #[inline]
 pub(crate) fn revolution(axisymmetric: bool, x: V3) -> f64 {
-    if axisymmetric {
-        std::f64::consts::TAU * x[0]
-    } else {
-        1.0
-    }
+    crate::fem::Measure::of(axisymmetric).factor(x)
 }
 
 /// Why a surface cannot be searched.
