@@ -46,6 +46,9 @@ enum Command {
         /// Dead elements, by element number: `3,7,10-20`.
         #[arg(long)]
         dead: Option<String>,
+        /// Read the (2-D) mesh as axisymmetric: x the radius, areas per full revolution.
+        #[arg(long)]
+        axisymmetric: bool,
     },
     /// Build surfaces, pair them by the deck's interactions and periodicity, and report
     /// the coverage of each pair.
@@ -62,6 +65,9 @@ enum Command {
         /// Quadrature order (Gauss points per face direction, or segment rule degree), 1 to 20.
         #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u16).range(1..=seam::search::pairing::MAX_ORDER as i64))]
         order: u16,
+        /// Read the (2-D) mesh as axisymmetric: x the radius, areas per full revolution.
+        #[arg(long)]
+        axisymmetric: bool,
     },
     /// Solve a heat-transfer problem with contact (a TOML problem file) and write the
     /// temperature as VTK XML. Exit 1 if Newton does not converge.
@@ -106,6 +112,9 @@ enum Command {
         /// A problem file (`seam run`'s) to check up to the solve, with its mesh and deck.
         #[arg(long)]
         problem: Option<PathBuf>,
+        /// Read the mesh given by --mesh as axisymmetric (a problem file says so itself).
+        #[arg(long)]
+        axisymmetric: bool,
     },
 }
 
@@ -117,14 +126,16 @@ fn main() -> ExitCode {
             mesh,
             json,
             dead,
-        } => surfaces(&deck, &mesh, json, dead.as_deref()),
+            axisymmetric,
+        } => surfaces(&deck, &mesh, json, dead.as_deref(), axisymmetric),
         Command::Search {
             deck,
             mesh,
             json,
             segments,
             order,
-        } => search(&deck, &mesh, json, segments, order as usize),
+            axisymmetric,
+        } => search(&deck, &mesh, json, segments, order as usize, axisymmetric),
         Command::Run {
             problem,
             json,
@@ -141,7 +152,8 @@ fn main() -> ExitCode {
             deck,
             mesh,
             problem,
-        } => check(&deck, mesh.as_deref(), problem.as_deref()),
+            axisymmetric,
+        } => check(&deck, mesh.as_deref(), problem.as_deref(), axisymmetric),
     }
 }
 
@@ -149,6 +161,7 @@ fn main() -> ExitCode {
 fn load(
     deck_path: &Path,
     mesh_path: Option<&Path>,
+    axisymmetric: bool,
 ) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
     let loaded = deck::load(deck_path);
     if loaded.diagnostics.has_errors() {
@@ -158,7 +171,19 @@ fn load(
     let mesh = match mesh_path {
         None => None,
         Some(p) => match mesh::read(p) {
-            Ok(m) => Some(m),
+            Ok(mut m) => {
+                if axisymmetric && let Err(e) = m.set_axisymmetric() {
+                    eprint!("{}", loaded.diagnostics.render(&loaded.sources));
+                    eprintln!(
+                        "error[{}]: --axisymmetric, {}: {e}\n  = help: {}",
+                        e.code(),
+                        p.display(),
+                        e.help()
+                    );
+                    return Err(ExitCode::from(EXIT_BAD_INPUT));
+                }
+                Some(m)
+            }
             Err(e) => {
                 eprint!("{}", loaded.diagnostics.render(&loaded.sources));
                 eprintln!("error[E0400]: {e}");
@@ -199,8 +224,14 @@ struct SurfacesReport {
     warnings: Vec<Warning>,
 }
 
-fn surfaces(deck_path: &Path, mesh_path: &Path, json: bool, dead: Option<&str>) -> ExitCode {
-    let (loaded, mesh) = match load(deck_path, Some(mesh_path)) {
+fn surfaces(
+    deck_path: &Path,
+    mesh_path: &Path,
+    json: bool,
+    dead: Option<&str>,
+    axisymmetric: bool,
+) -> ExitCode {
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric) {
         Ok(x) => x,
         Err(code) => return code,
     };
@@ -303,10 +334,11 @@ fn search(
     json: bool,
     segments: bool,
     order: usize,
+    axisymmetric: bool,
 ) -> ExitCode {
     use seam::scene::OutputRule;
     use seam::search::pairing::Integration;
-    let (loaded, mesh) = match load(deck_path, Some(mesh_path)) {
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric) {
         Ok(x) => x,
         Err(code) => return code,
     };
@@ -696,8 +728,13 @@ fn check_plugin(path: &Path, real: &[f64], integer: &[i64], isolate: bool) -> Ex
 /// compiled, plugins loaded and probed). With `--mesh`: the surfaces, interactions and
 /// search, and each pair's enforcement. With `--problem`: the whole problem file as
 /// `seam run` reads it, up to the solve.
-fn check(deck_path: &Path, mesh_path: Option<&Path>, problem: Option<&Path>) -> ExitCode {
-    let (loaded, mesh) = match load(deck_path, mesh_path) {
+fn check(
+    deck_path: &Path,
+    mesh_path: Option<&Path>,
+    problem: Option<&Path>,
+    axisymmetric: bool,
+) -> ExitCode {
+    let (loaded, mesh) = match load(deck_path, mesh_path, axisymmetric) {
         Ok(x) => x,
         Err(code) => return code,
     };

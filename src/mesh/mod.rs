@@ -199,6 +199,40 @@ impl MeshError {
     }
 }
 
+/// Why a mesh cannot be read as axisymmetric ([`Mesh::set_axisymmetric`]).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum AxisymmetricError {
+    #[error("an axisymmetric model needs a 2-D mesh; this one is {0}-D")]
+    NotTwoDimensional(usize),
+    #[error(
+        "x is the radius in an axisymmetric model, but node {number} lies at x = {x} ({count} node(s) at x < 0)"
+    )]
+    NegativeRadius { number: i64, x: f64, count: usize },
+}
+
+impl AxisymmetricError {
+    /// The diagnostic code: E0717 (not 2-D), E0718 (a node at x < 0).
+    pub fn code(&self) -> &'static str {
+        match self {
+            AxisymmetricError::NotTwoDimensional(_) => "E0717",
+            AxisymmetricError::NegativeRadius { .. } => "E0718",
+        }
+    }
+
+    /// How to fix it.
+    pub fn help(&self) -> &'static str {
+        match self {
+            AxisymmetricError::NotTwoDimensional(_) => {
+                "an axisymmetric model is the (r, z) section of a body of revolution, meshed in 2-D with x the radius; a 3-D mesh is modelled as it is (drop the setting)"
+            }
+            AxisymmetricError::NegativeRadius { .. } => {
+                "mesh the section on the side x ≥ 0 of the axis x = 0 (the y axis is the axis of revolution)"
+            }
+        }
+    }
+}
+
 /// Read a mesh by extension (`.e .exo .g .gen .ex2 .nc` → Exodus II, `.msh` → Gmsh 4.1)
 /// and validate it.
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
@@ -234,6 +268,26 @@ fn sierra_name(stored: &str, prefix: &str, id: i64) -> String {
 }
 
 impl Mesh {
+    /// Read this mesh as axisymmetric ([`Mesh::axisymmetric`]): it must be 2-D with every
+    /// node at x ≥ 0, the radius (within 1e-12 of the model's size, the round-off of a
+    /// node meant to lie on the axis).
+    pub fn set_axisymmetric(&mut self) -> Result<(), AxisymmetricError> {
+        if self.dim != 2 {
+            return Err(AxisymmetricError::NotTwoDimensional(self.dim));
+        }
+        let tolerance = 1e-12 * self.model_size();
+        let off_side = |x: &&[f64; 3]| x[0] < -tolerance || x[0].is_nan();
+        if let Some((n, x)) = self.coords.iter().enumerate().find(|(_, x)| off_side(x)) {
+            return Err(AxisymmetricError::NegativeRadius {
+                number: self.node_number(NodeId(n as u32)),
+                x: x[0],
+                count: self.coords.iter().filter(off_side).count(),
+            });
+        }
+        self.axisymmetric = true;
+        Ok(())
+    }
+
     pub fn num_nodes(&self) -> usize {
         self.coords.len()
     }

@@ -410,49 +410,19 @@ impl ProblemFile {
         options.phase("reading the mesh");
         let mut mesh = mesh::read(&self.dir.join(&self.problem.mesh.file))
             .map_err(|e| input_error("E0400", e.to_string(), "check [mesh] file"))?;
-        if self.problem.mesh.axisymmetric {
-            self.check_axisymmetric(&mesh)?;
-            mesh.axisymmetric = true;
+        if self.problem.mesh.axisymmetric
+            && let Err(e) = mesh.set_axisymmetric()
+        {
+            let at = self.text.loc_in_table("mesh", "axisymmetric");
+            let message = format!(
+                "`axisymmetric = true`, {}: {e}",
+                self.problem.mesh.file.display()
+            );
+            let mut d = Diagnostics::default();
+            d.push(Diagnostic::error(e.code(), message).at(at).help(e.help()));
+            return Err(RunError::Input(d, self.text.sources()));
         }
         Ok((mesh, clock.elapsed().as_secs_f64()))
-    }
-
-    /// `[mesh] axisymmetric = true` needs a 2-D mesh (E0717) with every node at x ≥ 0,
-    /// the radius (E0718; within 1e-12 of the model's size, the round-off of a node
-    /// meant to lie on the axis).
-    fn check_axisymmetric(&self, mesh: &Mesh) -> Result<(), RunError> {
-        let at = self.text.loc_in_table("mesh", "axisymmetric");
-        let fail = |code, message: String, help: &str| {
-            let mut d = Diagnostics::default();
-            d.push(Diagnostic::error(code, message).at(at.clone()).help(help));
-            RunError::Input(d, self.text.sources())
-        };
-        let file = self.problem.mesh.file.display();
-        if mesh.dim != 2 {
-            return Err(fail(
-                "E0717",
-                format!(
-                    "`axisymmetric = true` needs a 2-D mesh; {file} is {}-D",
-                    mesh.dim
-                ),
-                "an axisymmetric model is the (r, z) section of a body of revolution, meshed in 2-D with x the radius; a 3-D mesh is modelled as it is (drop the line)",
-            ));
-        }
-        let tolerance = 1e-12 * mesh.model_size();
-        let off_side = |x: &&[f64; 3]| x[0] < -tolerance || x[0].is_nan();
-        if let Some((n, x)) = mesh.coords.iter().enumerate().find(|(_, x)| off_side(x)) {
-            let count = mesh.coords.iter().filter(off_side).count();
-            return Err(fail(
-                "E0718",
-                format!(
-                    "`axisymmetric = true`: x is the radius, but node {} of {file} lies at x = {} ({count} node(s) at x < 0)",
-                    mesh.node_number(crate::mesh::NodeId(n as u32)),
-                    x[0]
-                ),
-                "mesh the section on the side x ≥ 0 of the axis x = 0 (the y axis is the axis of revolution)",
-            ));
-        }
-        Ok(())
     }
 }
 
