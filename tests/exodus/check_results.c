@@ -10,8 +10,8 @@
  *   TETRA4 as Cubit does), element count, nodes per element, connectivity; shell
  *   thickness attributes where the mesh has them;
  * - every side set (id, name, element and side lists) and node set (id, name, nodes);
- * - the variables: nodal `temperature`, element `heat_flux_x/_y/_z` (stored on every
- *   non-empty block, by the truth table), global variables in `heat_side_a:…` /
+ * - the variables: nodal `temperature`, element `heat_flux_x/_y/_z` (`_x/_y` in 2-D;
+ *   stored on every non-empty block, by the truth table), global variables in `heat_side_a:…` /
  *   `heat_side_b:…` pairs; at least one step, finite non-decreasing times; every value
  *   finite; a QA record from seam.
  * Then writes DUMP.txt for tests/python/check_results.py, which compares it with
@@ -294,7 +294,8 @@ int main(int argc, char **argv) {
   int t = var_index(vnames[0], nvar[0], "temperature");
   if (!t) FAIL("no nodal variable `temperature`");
   const char *flux[3] = {"heat_flux_x", "heat_flux_y", "heat_flux_z"};
-  for (int k = 0; k < 3; k++) {
+  /* One component per dimension: a 2-D run writes x and y only. */
+  for (int k = 0; k < dim[0] && k < 3; k++) {
     int v = var_index(vnames[1], nvar[1], flux[k]);
     if (!v) {
       FAIL("no element variable `%s`", flux[k]);

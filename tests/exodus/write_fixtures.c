@@ -4,11 +4,15 @@
  *   write_fixtures OUTDIR
  *
  * writes, for a 3-D mesh (every 3-D topology seam reads: HEX8, TETRA4, WEDGE6,
- * PYRAMID5, SHELL4 with a thickness attribute, TRISHELL3, BAR2 and an empty block) and
- * a 2-D mesh (QUAD4, TRI3), each in the three netCDF flavours,
+ * PYRAMID5, SHELL4 with a thickness attribute, TRISHELL3, BAR2 and an empty block), a
+ * 2-D mesh (QUAD4, TRI3) and a 2-D contact mesh (a QUAD4 part and a TRI3 part meshed
+ * apart, their edges at y = 1 not matching, with the edge side sets and a node set a
+ * 2-D contact deck names; x >= 0 with nodes on x = 0, so it reads axisymmetric too),
+ * each in the three netCDF flavours,
  *
  *   ref3d_classic.exo  ref3d_offset64.exo  ref3d_nc4.exo   (nc4: 64-bit integers stored)
  *   ref2d_classic.exo  ref2d_offset64.exo  ref2d_nc4.exo
+ *   contact2d_classic.exo  contact2d_offset64.exo  contact2d_nc4.exo
  *
  * with number maps, an extra named node map, block/set names, side sets and node sets
  * (with distribution factors on some, an empty one of each), QA and information
@@ -220,6 +224,49 @@ static void mesh2d(struct mesh *m) {
   *s = (struct side_set){8, "", 1, {4}, {2}, 0};
   struct node_set *n = &m->ns[m->nns++];
   *n = (struct node_set){9, "west", 2, {q[0], q[3]}, 1};
+}
+
+/* 2-D contact: block 1 `lower`, 3x2 QUAD4 on [0,1]x[0,1]; block 2 `upper`, 4x2 cells
+ * on [0,1]x[1,2] each split into two TRI3 along its diagonal 0-2, on nodes of its own.
+ * Side sets: 1 lower_bottom, 2 lower_top, 3 upper_bottom, 4 upper_top; node set 10
+ * lower_top_nodes (the lower part's nodes on y = 1). */
+static void contact2d(struct mesh *m) {
+  memset(m, 0, sizeof *m);
+  m->key = "contact2d";
+  m->title = "seam reference fixture, 2-D contact";
+  m->dim = 2;
+  int q[3][4], t[3][5];
+  for (int j = 0; j < 3; j++)
+    for (int i = 0; i < 4; i++) q[j][i] = add_node(m, i / 3.0, j / 2.0, 0);
+  for (int j = 0; j < 3; j++)
+    for (int i = 0; i < 5; i++) t[j][i] = add_node(m, i / 4.0, 1.0 + j / 2.0, 0);
+  struct block *b = add_block(m, 1, "lower", "QUAD4", 4);
+  for (int j = 0; j < 2; j++)
+    for (int i = 0; i < 3; i++) {
+      int e[4] = {q[j][i], q[j][i + 1], q[j + 1][i + 1], q[j + 1][i]};
+      add_elem(b, e);
+    }
+  b = add_block(m, 2, "upper", "TRI3", 3);
+  for (int j = 0; j < 2; j++)
+    for (int i = 0; i < 4; i++) {
+      int a[3] = {t[j][i], t[j][i + 1], t[j + 1][i + 1]};
+      int c[3] = {t[j][i], t[j + 1][i + 1], t[j + 1][i]};
+      add_elem(b, a);
+      add_elem(b, c);
+    }
+  /* Element positions: quads 1-6 (row by row), triangles 7-22 (cell by cell, the one
+   * under the diagonal first: its side 1 is the cell's bottom, the other's side 2 its
+   * top). */
+  struct side_set *s = &m->ss[m->nss++];
+  *s = (struct side_set){1, "lower_bottom", 3, {1, 2, 3}, {1, 1, 1}, 0};
+  s = &m->ss[m->nss++];
+  *s = (struct side_set){2, "lower_top", 3, {4, 5, 6}, {3, 3, 3}, 1};
+  s = &m->ss[m->nss++];
+  *s = (struct side_set){3, "upper_bottom", 4, {7, 9, 11, 13}, {1, 1, 1, 1}, 0};
+  s = &m->ss[m->nss++];
+  *s = (struct side_set){4, "upper_top", 4, {16, 18, 20, 22}, {2, 2, 2, 2}, 0};
+  struct node_set *n = &m->ns[m->nns++];
+  *n = (struct node_set){10, "lower_top_nodes", 4, {q[2][0], q[2][1], q[2][2], q[2][3]}, 0};
 }
 
 static void write_mesh(const struct mesh *m, const char *path, int mode) {
@@ -455,9 +502,11 @@ int main(int argc, char **argv) {
     fprintf(stderr, "usage: %s OUTDIR\n", argv[0]);
     return 2;
   }
-  static struct mesh meshes[2];
+  enum { MESHES = 3 };
+  static struct mesh meshes[MESHES];
   mesh3d(&meshes[0]);
   mesh2d(&meshes[1]);
+  contact2d(&meshes[2]);
   const struct {
     const char *tag;
     int mode;
@@ -467,7 +516,7 @@ int main(int argc, char **argv) {
       {"nc4", EX_NETCDF4 | EX_ALL_INT64_DB},
   };
   char path[4096];
-  for (int i = 0; i < 2; i++)
+  for (int i = 0; i < MESHES; i++)
     for (int k = 0; k < 3; k++) {
       snprintf(path, sizeof path, "%s/%s_%s.exo", argv[1], meshes[i].key, flavours[k].tag);
       write_mesh(&meshes[i], path, flavours[k].mode);
@@ -479,9 +528,9 @@ int main(int argc, char **argv) {
     return 1;
   }
   fprintf(f, "{\n");
-  for (int i = 0; i < 2; i++) {
+  for (int i = 0; i < MESHES; i++) {
     write_json(f, &meshes[i]);
-    fprintf(f, "%s\n", i ? "" : ",");
+    fprintf(f, "%s\n", i + 1 < MESHES ? "," : "");
   }
   fprintf(f, "}\n");
   return fclose(f) == 0 ? 0 : 1;

@@ -516,3 +516,125 @@ fn transient_axisymmetric_run_stores_what_the_source_makes() {
     assert!(core - ring > 10.0, "the field is not uniform");
     assert!((stored - made).abs() <= 1e-11 * made);
 }
+
+/// A sphere in a spherical shell, axisymmetric, on the gmsh meshes of
+/// tests/fixtures/make_2d_fixtures.py (the half-disc section, triangles in the core,
+/// recombined quads in the shell, meshed apart: a curved non-matching interface, nodes
+/// on the axis): a source q in the core, T_b on ρ = 2, a gap conductance h at ρ = 1.
+/// The heat crossing the gap is all the core makes, q V_h, with V_h the volume of the
+/// meshed core's revolution (Pappus: Σ 2π r̄ A over its straight-sided elements, summed
+/// here) — to round-off on every mesh; and the temperature converges in L2 (per
+/// revolution) to T = T_b + (Q/4πk₂)(1/ρ − ½) in the shell, the core's
+/// T_c + q (1 − ρ²)/(6k₁) above the jump Q/(4πh) (Q = 4πq/3), at rate 2 (each above
+/// 1.8: the meshes are unstructured, h halving at each level).
+#[test]
+fn sphere_in_a_shell_on_gmsh_meshes_converges_axisymmetric() {
+    let (k, h, q, t_b) = ([2.0, 5.0], 3.0, 600.0, 300.0);
+    let total = 4.0 * std::f64::consts::PI * q / 3.0;
+    let t_shell = move |rho: f64| t_b + total / (2.0 * TAU * k[1]) * (1.0 / rho - 0.5);
+    let t_core = t_shell(1.0) + total / (2.0 * TAU * h);
+    let exact = move |block: usize, x: [f64; 3]| -> (f64, [f64; 3]) {
+        let rho = x[0].hypot(x[1]);
+        let (t, dt) = if block == 0 {
+            (
+                t_core + q * (1.0 - rho * rho) / (6.0 * k[0]),
+                -q * rho / (3.0 * k[0]),
+            )
+        } else {
+            (t_shell(rho), -total / (2.0 * TAU * k[1] * rho * rho))
+        };
+        // dT/dρ along (x, y)/ρ.
+        let g = if rho > 0.0 { dt / rho } else { 0.0 };
+        (t, [g * x[0], g * x[1], 0.0])
+    };
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let dir = scratch("axi-spheres");
+    let expected: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixtures.join("expected_2d.json")).unwrap())
+            .unwrap();
+    let mut l2 = Vec::new();
+    for level in 1..=3 {
+        let path = fixtures.join(format!("spheres_axi_{level}.msh"));
+        std::fs::write(
+            dir.join("problem.toml"),
+            format!(
+                "[mesh]\nfile = {:?}\naxisymmetric = true\n\
+                 [[material]]\nblocks = [\"core\"]\nconductivity = {}\n\
+                 [[material]]\nblocks = [\"shell\"]\nconductivity = {}\n\
+                 [[source]]\nblocks = [\"core\"]\nvalue = {q}\n\
+                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"shell_outer\"]\nvalue = {t_b}\n\
+                 [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n",
+                path.to_str().unwrap(),
+                k[0],
+                k[1]
+            ),
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("contact.i"),
+            format!(
+                "begin contact definition\n contact surface core_face contains core_surface\n contact surface shell_face contains shell_inner\n\
+                 begin interaction\n  side a core_face\n  side b shell_face\n end\n\
+                 begin enforcement\n  enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = {h}\n end\nend\n"
+            ),
+        )
+        .unwrap();
+        let r = run(&dir.join("problem.toml"));
+        let m = &r.mesh;
+        let core = m.find_block("core").unwrap();
+        // The mesh is what gmsh made (the script's sidecar).
+        let made = &expected[format!("spheres_axi_{level}.msh").as_str()];
+        let shell = m.find_block("shell").unwrap();
+        assert_eq!(
+            m.blocks[core].len() as u64,
+            made["core_elements"].as_u64().unwrap()
+        );
+        assert_eq!(
+            m.blocks[shell].len() as u64,
+            made["shell_elements"].as_u64().unwrap()
+        );
+        let on_axis = m.coords.iter().filter(|x| x[0] == 0.0).count() as u64;
+        assert_eq!(on_axis, made["axis_nodes"].as_u64().unwrap());
+        let volume: f64 = (0..m.blocks[core].len())
+            .map(|e| {
+                let x: Vec<[f64; 3]> = m.blocks[core]
+                    .elem_nodes(e)
+                    .iter()
+                    .map(|n| m.coords[n.index()])
+                    .collect();
+                // Triangles and quads alike: fan from the first node (Pappus per piece).
+                (1..x.len() - 1)
+                    .map(|i| {
+                        let (a, b, c) = (x[0], x[i], x[i + 1]);
+                        let area =
+                            0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1]));
+                        TAU * (a[0] + b[0] + c[0]) / 3.0 * area
+                    })
+                    .sum::<f64>()
+            })
+            .sum();
+        let i = &r.summary.interactions[0];
+        let balance = (i.heat_side_a - q * volume).abs() / (q * volume);
+        let blocks: Vec<usize> = (0..m.blocks.len()).collect();
+        let mut sum = 0.0;
+        for &b in &blocks {
+            let block = usize::from(b != core);
+            let e = |x: [f64; 3]| exact(block, x).0;
+            let g = |x: [f64; 3]| exact(block, x).1;
+            let n = error_norms(m, &[b], &r.solution.temperature, &e, &g, 6).unwrap();
+            sum += n.l2 * n.l2;
+        }
+        let e = sum.sqrt();
+        eprintln!(
+            "spheres, level {level}: interface heat {:.10} W, q V_h {:.10} ({balance:.1e}; the sphere's {:.10}), L2 error {e:.4e}",
+            i.heat_side_a,
+            q * volume,
+            total
+        );
+        assert!(balance <= 1e-12, "{balance:e}");
+        l2.push(e);
+    }
+    let r = rates(&l2);
+    eprintln!("spheres: L2 rates {r:.2?}");
+    assert!(r.iter().all(|&r| r > 1.8), "{r:?}");
+}

@@ -379,7 +379,7 @@ fn check_against_reference(m: &Mesh, e: &Value, file: &str) {
 #[test]
 fn exodus_reference_library_files_read_in_every_flavour_2d_and_3d() {
     let r = reference();
-    for key in ["ref3d", "ref2d"] {
+    for key in ["ref3d", "ref2d", "contact2d"] {
         for flavour in FLAVOURS {
             let file = format!("{key}_{flavour}.exo");
             let path = reference_dir().join(&file);
@@ -415,7 +415,7 @@ fn exodus_reference_library_files_read_in_every_flavour_2d_and_3d() {
 #[test]
 fn exodus_reference_library_records_and_variables_read_in_every_flavour() {
     let r = reference();
-    for key in ["ref3d", "ref2d"] {
+    for key in ["ref3d", "ref2d", "contact2d"] {
         let e = &r[key];
         for flavour in FLAVOURS {
             let file = format!("{key}_{flavour}.exo");
@@ -529,7 +529,7 @@ fn exodus_writer_round_trips_the_reference_meshes() {
     let r = reference();
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("exodus-writer");
     std::fs::create_dir_all(&dir).unwrap();
-    for key in ["ref3d", "ref2d"] {
+    for key in ["ref3d", "ref2d", "contact2d"] {
         let input = reference_dir().join(format!("{key}_offset64.exo"));
         let m = mesh::read(&input).unwrap();
         let out = dir.join(format!("{key}_written.exo"));

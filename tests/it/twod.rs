@@ -624,3 +624,165 @@ fn cylindrical_periodicity_converges_in_plane_2d() {
         assert!(w[1][1] > 0.5 * w[0][1], "insulated edges converge?");
     }
 }
+
+/// The 2-D contact mesh written by the Exodus II C library (tests/exodus/write_fixtures.c,
+/// `contact2d`: QUAD4 below, TRI3 above, 3 against 4 edges at y = 1; the committed copy,
+/// or `SEAM_EXODUS_REFERENCE_DIR`'s fresh one), in each netCDF flavour, run plane and
+/// axisymmetric with the deck naming its side sets by their stored names: 300 K at y =
+/// 0, 400 K at y = 2, a gap conductance or a dual tie between the parts. The field is
+/// axial and linear either side, so the heat is the series value exactly — per unit
+/// depth over the unit width plane, per revolution over the disc r < 1 (× π)
+/// axisymmetric. With `SEAM_EXODUS_CHECKER` (CI: tests/exodus/check_results.c) the C
+/// library also reads the `results.exo` of each run and compares it with the mesh.
+#[test]
+fn exodus_writer_2d_runs_on_the_libexodus_contact_mesh() {
+    let reference = match std::env::var_os("SEAM_EXODUS_REFERENCE_DIR") {
+        Some(d) if !d.is_empty() => PathBuf::from(d),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/reference"),
+    };
+    let dir = scratch("libexodus-contact2d");
+    let k = [1.0, 5.0];
+    for flavour in ["classic", "offset64", "nc4"] {
+        // Absolute: the problem file's paths are relative to its own folder.
+        let mesh =
+            std::fs::canonicalize(reference.join(format!("contact2d_{flavour}.exo"))).unwrap();
+        for axisymmetric in [false, true] {
+            for (model, h) in [
+                (
+                    "enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = 10",
+                    10.0,
+                ),
+                (
+                    "enforcement for energy = tied multipliers = dual\n  side b variable temperature to temperature",
+                    f64::INFINITY,
+                ),
+            ] {
+                std::fs::write(
+                    dir.join("problem.toml"),
+                    format!(
+                        "[mesh]\nfile = {:?}\naxisymmetric = {axisymmetric}\n\
+                         [[material]]\nblocks = [\"lower\"]\nconductivity = {}\n\
+                         [[material]]\nblocks = [\"upper\"]\nconductivity = {}\n\
+                         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lower_bottom\"]\nvalue = 300\n\
+                         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"upper_top\"]\nvalue = 400\n\
+                         [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n\
+                         [output]\ndir = \"out\"\n",
+                        mesh.to_str().unwrap(),
+                        k[0],
+                        k[1]
+                    ),
+                )
+                .unwrap();
+                std::fs::write(
+                    dir.join("contact.i"),
+                    format!(
+                        "begin contact definition\n contact surface a contains lower_top\n contact surface b contains upper_bottom\n\
+                         visualize contact\n begin interaction\n  side a a\n  side b b\n end\n\
+                         begin enforcement\n  {model}\n end\nend\n"
+                    ),
+                )
+                .unwrap();
+                let r = run(&dir.join("problem.toml"));
+                let area = if axisymmetric {
+                    std::f64::consts::PI
+                } else {
+                    1.0
+                };
+                let q = series_flux(k, |_, _| h) * area;
+                let i = &r.summary.interactions[0];
+                let err = (i.heat_side_a + q).abs() / q;
+                eprintln!(
+                    "contact2d_{flavour}, axisymmetric {axisymmetric}, {}: heat {:.12} W, exact {q:.12}, relative {err:.1e}",
+                    model.lines().next().unwrap(),
+                    i.heat_side_a
+                );
+                assert!(err <= 1e-12, "{err:e}");
+                if let Some(checker) = std::env::var_os("SEAM_EXODUS_CHECKER") {
+                    let o = std::process::Command::new(checker)
+                        .arg(&mesh)
+                        .arg(dir.join("out/results.exo"))
+                        .arg(dir.join("out/results.dump"))
+                        .output()
+                        .unwrap();
+                    assert!(
+                        o.status.success(),
+                        "the Exodus II library disagrees:\n{}{}",
+                        String::from_utf8_lossy(&o.stdout),
+                        String::from_utf8_lossy(&o.stderr)
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The 2-D contact mesh made with the gmsh Python API (tests/fixtures/make_2d_fixtures.py:
+/// recombined quads below, unstructured triangles above, meshed apart): read as gmsh made
+/// it (element and edge counts from the script's sidecar, physical names as blocks and
+/// side sets, 2-D) and run with a gap conductance and a dual tie: the series heat to
+/// round-off, the triangles' edges at y = 1 not matching the quads'.
+#[test]
+fn gmsh_2d_contact_mesh_reads_and_runs() {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
+    let expected: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixtures.join("expected_2d.json")).unwrap())
+            .unwrap();
+    let e = &expected["contact2d.msh"];
+    let path = fixtures.join("contact2d.msh");
+    let m = seam::mesh::read(&path).unwrap();
+    assert_eq!(m.dim, 2);
+    let count = |name: &str| m.blocks[m.find_block(name).unwrap()].len() as u64;
+    assert_eq!(count("lower"), e["quads"].as_u64().unwrap());
+    assert_eq!(count("upper"), e["triangles"].as_u64().unwrap());
+    for (name, n) in e["edges"].as_object().unwrap() {
+        let set = m.side_sets.iter().find(|s| s.name == *name).unwrap();
+        assert_eq!(set.sides.len() as u64, n.as_u64().unwrap(), "{name}");
+    }
+    let dir = scratch("gmsh-contact2d");
+    let k = [1.0, 5.0];
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = {:?}\n\
+             [[material]]\nblocks = [\"lower\"]\nconductivity = {}\n\
+             [[material]]\nblocks = [\"upper\"]\nconductivity = {}\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"lower_bottom\"]\nvalue = 300\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"upper_top\"]\nvalue = 400\n\
+             [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n",
+            path.to_str().unwrap(),
+            k[0],
+            k[1]
+        ),
+    )
+    .unwrap();
+    for (model, h) in [
+        (
+            "enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = 10",
+            10.0,
+        ),
+        (
+            "enforcement for energy = tied multipliers = dual\n  side b variable temperature to temperature",
+            f64::INFINITY,
+        ),
+    ] {
+        std::fs::write(
+            dir.join("contact.i"),
+            format!(
+                "begin contact definition\n contact surface a contains lower_top\n contact surface b contains upper_bottom\n\
+                 begin interaction\n  side a a\n  side b b\n end\n\
+                 begin enforcement\n  {model}\n end\nend\n"
+            ),
+        )
+        .unwrap();
+        let r = run(&dir.join("problem.toml"));
+        let q = series_flux(k, |_, _| h);
+        let i = &r.summary.interactions[0];
+        let err = (i.heat_side_a + q).abs() / q;
+        eprintln!(
+            "gmsh contact2d, {}: heat {:.12} W/m, exact {q:.12}, relative {err:.1e}",
+            model.lines().next().unwrap(),
+            i.heat_side_a
+        );
+        assert!(err <= 1e-12, "{err:e}");
+    }
+}
