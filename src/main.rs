@@ -588,6 +588,9 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
                     ),
                 };
                 println!("  linear solver: {} ({}){cg}", ls.name, ls.reason);
+                if s.axisymmetric {
+                    println!("  axisymmetric: heats are per full revolution (W)");
+                }
                 for i in &s.interactions {
                     println!(
                         "  {} / {} ({}): heat out of A {:.6e}, out of B {:.6e}, imbalance {:.3e}",

@@ -236,7 +236,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let written = output.write_final(&solved)?;
     summary::report_crosspoints(&mesh, &solved.solution, &mut diags);
     let timing = Timing::of(mesh_s, &contact, &solved.solution.timing, start);
-    let summary = Summary::new(
+    let mut summary = Summary::new(
         &terms,
         &solved,
         timing,
@@ -244,6 +244,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         file.transient,
         physics.time.start,
     );
+    summary.axisymmetric = mesh.axisymmetric;
     output.mark_not_converged(summary.diagnosis.as_deref())?;
     // The conductance functions of the terms borrow the mesh, which the result takes.
     drop(terms);

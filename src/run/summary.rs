@@ -75,6 +75,10 @@ pub struct Summary {
     /// end.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub electrical_contacts: Vec<ElectricalContact>,
+    /// An axisymmetric run (`[mesh] axisymmetric`): its heats are per full revolution.
+    /// Written to the JSON only when true.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub axisymmetric: bool,
 }
 
 /// The linear solver of a run, the reason it was chosen, and its CG iterations.
@@ -183,6 +187,7 @@ impl Summary {
             diagnosis: history.last().and_then(|r| r.diagnosis.clone()),
             linear_solver: solved.linear_solver.clone(),
             electrical_contacts: electrical_contacts(terms, history.last()),
+            axisymmetric: false,
         }
     }
 }
