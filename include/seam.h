@@ -56,6 +56,11 @@
  *   SEAM_PYRAMID5 nodes 0 (-1,-1,0) 1 (1,-1,0) 2 (1,1,0) 3 (-1,1,0) 4 (0,0,1)
  *                 side 1: 0 1 4 | side 2: 1 2 4 | side 3: 2 3 4 | side 4: 0 4 3 |
  *                 side 5: 0 3 2 1
+ *   SEAM_QUAD4    nodes 0 (-1,-1) 1 (1,-1) 2 (1,1) 3 (-1,1), counter-clockwise in xy
+ *                 side 1: 0 1 | side 2: 1 2 | side 3: 2 3 | side 4: 3 0
+ *   SEAM_TRI3     nodes 0 (0,0) 1 (1,0) 2 (0,1), counter-clockwise in xy
+ *                 side 1: 0 1 | side 2: 1 2 | side 3: 2 0
+ * (A 2-D side's outward normal is its direction turned clockwise by 90 degrees.)
  * An element whose nodes come in another order is inverted or tangled: seam_embedding_new
  * refuses it with SEAM_ERR_MESH and names it, before any face is looked up.
  *
@@ -84,11 +89,13 @@ extern "C" {
 #define SEAM_CUTBACK 9           /* a conductance model or plugin asks for a smaller step (seam_cutback_factor) */
 #define SEAM_ERR_NOTHING_PAIRED 10 /* a flux interaction's search paired no point (seam_allow_unpaired) */
 
-/* Element topologies (3-D solids). */
+/* Element topologies: 3-D solids, or 2-D ones (a mesh in the xy plane, z = 0). */
 #define SEAM_HEX8 1
 #define SEAM_TET4 2
 #define SEAM_WEDGE6 3
 #define SEAM_PYRAMID5 4
+#define SEAM_QUAD4 5
+#define SEAM_TRI3 6
 
 /* Interaction models. */
 #define SEAM_CONDUCTANCE 1       /* q = h [u] on side A (contact resistance) */
@@ -122,11 +129,15 @@ int seam_builder_add_block(seam_builder *builder, const char *name, int topology
 /* A surface of (element, 1-based local side) pairs. */
 int seam_builder_add_side_set(seam_builder *builder, const char *name, const int64_t *elems,
                               const int *sides, size_t n_faces);
-/* A surface of faces by their corner nodes (3 or 4 per face, any order). */
+/* A surface of faces by their corner nodes (3 or 4 per face, any order; 2 per edge in a
+   2-D mesh). */
 int seam_builder_add_face_set(seam_builder *builder, const char *name,
                               const int64_t *face_nodes, size_t nodes_per_face, size_t n_faces);
 /* The host's dof of every node; negative: none (only for nodes of no block). */
 int seam_builder_set_dofs(seam_builder *builder, const int64_t *dofs, size_t n_nodes);
+/* on != 0: a 2-D mesh read as axisymmetric (x the radius r >= 0, y the axis): every
+   weight, heat and Jacobian entry is per full revolution (times 2 pi r). */
+int seam_builder_set_axisymmetric(seam_builder *builder, int on);
 /* Nodes the host prescribes (Dirichlet): mortar ties give them no multiplier. */
 int seam_builder_set_fixed_nodes(seam_builder *builder, const int64_t *nodes, size_t n);
 /* `order` 1 to 20. */

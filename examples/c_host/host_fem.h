@@ -1,5 +1,6 @@
 /*
- * The host's own finite-element pieces, shared by the C hosts main.c and sector.c: the
+ * The host's own finite-element pieces, shared by the C hosts main.c, sector.c and
+ * axisymmetric.c (each uses what it needs: the functions are inline): the
  * conduction matrix of a trilinear hexahedron and a dense linear solver. Nothing here
  * is seam's; a real host has its own.
  */
@@ -11,7 +12,7 @@
 #include <string.h>
 
 /* K_e of a trilinear hexahedron, 2x2x2 Gauss: k * integral of grad N_a . grad N_b. */
-static void hex8_conduction(const double x[8][3], double k, double ke[8][8]) {
+static inline void hex8_conduction(const double x[8][3], double k, double ke[8][8]) {
     static const double s[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                                    {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
     const double g = 1.0 / sqrt(3.0);
@@ -55,7 +56,7 @@ static void hex8_conduction(const double x[8][3], double k, double ke[8][8]) {
 }
 
 /* Solve A x = b in place (b becomes x) by Gaussian elimination with partial pivoting. */
-static int solve_dense(double *a, double *b, size_t n) {
+static inline int solve_dense(double *a, double *b, size_t n) {
     for (size_t c = 0; c < n; c++) {
         size_t p = c;
         for (size_t r = c + 1; r < n; r++)

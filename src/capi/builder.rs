@@ -28,10 +28,12 @@ fn topology(code: c_int) -> Result<Topology, Failure> {
         2 => Topology::Tet4,
         3 => Topology::Wedge6,
         4 => Topology::Pyramid5,
+        5 => Topology::Quad4,
+        6 => Topology::Tri3,
         other => {
             return Err(bad(
                 format!("unknown topology code {other}"),
-                "use SEAM_HEX8, SEAM_TET4, SEAM_WEDGE6 or SEAM_PYRAMID5",
+                "use SEAM_HEX8, SEAM_TET4, SEAM_WEDGE6 or SEAM_PYRAMID5 (3-D), SEAM_QUAD4 or SEAM_TRI3 (2-D)",
             ));
         }
     })
@@ -104,10 +106,10 @@ pub unsafe extern "C" fn seam_builder_add_face_set(
     guard(|| {
         let b = unsafe { handle(builder, "builder") }?;
         let name = unsafe { text(name, "name") }?;
-        if !matches!(nodes_per_face, 3 | 4) {
+        if !matches!(nodes_per_face, 2..=4) {
             return Err(bad(
                 format!("nodes_per_face = {nodes_per_face}"),
-                "faces are triangles (3) or quadrilaterals (4)",
+                "faces are triangles (3) or quadrilaterals (4), or in a 2-D mesh edges (2)",
             ));
         }
         let nodes = unsafe {
@@ -161,6 +163,20 @@ pub unsafe extern "C" fn seam_builder_set_fixed_nodes(
 
 /// `kind` 0: mortar segments, 1: Gauss quadrature on side A; `order` the rule's order,
 /// 1 to [`crate::search::pairing::MAX_ORDER`].
+/// `on` non-zero: the (2-D) mesh is axisymmetric, x the radius
+/// ([`crate::embed::EmbeddingBuilder::axisymmetric`]).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_builder_set_axisymmetric(
+    builder: *mut SeamBuilder,
+    on: c_int,
+) -> c_int {
+    guard(|| {
+        let b = unsafe { handle(builder, "builder") }?;
+        b.update(|x| x.axisymmetric(on != 0));
+        Ok(())
+    })
+}
+
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_builder_set_integration(
     builder: *mut SeamBuilder,

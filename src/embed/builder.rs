@@ -28,6 +28,7 @@ pub struct EmbeddingBuilder {
     dofs: Option<Vec<Option<usize>>>,
     fixed: Vec<usize>,
     integration: Integration,
+    axisymmetric: bool,
 }
 
 impl EmbeddingBuilder {
@@ -90,6 +91,14 @@ impl EmbeddingBuilder {
         self
     }
 
+    /// A 2-D mesh (Quad4, Tri3 blocks) read as axisymmetric: x the radius r ≥ 0, y the
+    /// axis; every weight, heat and Jacobian entry is then per full revolution (× 2πr),
+    /// as the host's own axisymmetric kernels must be.
+    pub fn axisymmetric(mut self, on: bool) -> Self {
+        self.axisymmetric = on;
+        self
+    }
+
     /// Check everything and make the embedding.
     pub fn build(self) -> Result<Embedding, EmbedError> {
         let n = self.coords.len();
@@ -105,8 +114,14 @@ impl EmbeddingBuilder {
                 "add the blocks whose faces make the interfaces with .block(…)",
             ));
         }
+        // 3-D solids, or 2-D ones (Quad4, Tri3) in the xy plane: the first block decides.
+        let dim = if self.blocks[0].topology.parametric_dim() == 3 {
+            3
+        } else {
+            2
+        };
         let mut mesh = Mesh {
-            dim: 3,
+            dim,
             coords: self.coords.clone(),
             node_numbers: (0..n as i64).collect(),
             ..Mesh::default()
@@ -114,13 +129,20 @@ impl EmbeddingBuilder {
         let mut conductivity = Vec::with_capacity(self.blocks.len());
         for (b, block) in self.blocks.iter().enumerate() {
             let nn = block.topology.node_count();
-            if block.topology.parametric_dim() != 3 || !block.topology.is_solid() {
+            let (kind, help) = match dim {
+                3 => ("3-D solids", "give Hex8, Tet4, Wedge6 or Pyramid5 blocks"),
+                _ => (
+                    "2-D solids, as the first block is",
+                    "give Quad4 or Tri3 blocks in a 2-D mesh (Hex8, Tet4, Wedge6 or Pyramid5 in a 3-D one), not both",
+                ),
+            };
+            if block.topology.parametric_dim() != dim || !block.topology.is_solid() {
                 return Err(mesh_error(
                     format!(
-                        "block `{}` has topology {:?}; interfaces are searched between 3-D solids",
+                        "block `{}` has topology {:?}; interfaces are searched between {kind}",
                         block.name, block.topology
                     ),
-                    "give Hex8, Tet4, Wedge6 or Pyramid5 blocks",
+                    help,
                 ));
             }
             if block.connectivity.len() % nn != 0 {
@@ -179,6 +201,19 @@ impl EmbeddingBuilder {
                 format!("{n} nodes, {} elements", mesh.num_elems()),
                 "seam numbers nodes and elements with 32-bit indices",
             ));
+        }
+        if dim == 2
+            && let Some((k, x)) = mesh.coords.iter().enumerate().find(|(_, x)| x[2] != 0.0)
+        {
+            return Err(mesh_error(
+                format!("node {k} of a 2-D mesh lies at z = {}", x[2]),
+                "a 2-D mesh lies in the xy plane: give every node z = 0",
+            ));
+        }
+        if self.axisymmetric
+            && let Err(e) = mesh.set_axisymmetric()
+        {
+            return Err(mesh_error(format!("axisymmetric: {e}"), e.help()));
         }
         // The elements first: a host whose node order differs from seam's gets
         // inverted or tangled elements, and that — not the faces it then fails to find —
@@ -323,10 +358,10 @@ fn sides_by_nodes(
     list.iter()
         .enumerate()
         .map(|(k, nodes)| {
-            if !matches!(nodes.len(), 3 | 4) || nodes.iter().any(|&n| n >= u32::MAX as usize) {
+            if !matches!(nodes.len(), 2..=4) || nodes.iter().any(|&n| n >= u32::MAX as usize) {
                 return Err(mesh_error(
-                    format!("surface `{name}`, face {k}: nodes {nodes:?} are no triangle or quadrilateral"),
-                    "give the 3 or 4 corner nodes of each face",
+                    format!("surface `{name}`, face {k}: nodes {nodes:?} are no edge, triangle or quadrilateral"),
+                    "give the 3 or 4 corner nodes of each face (the 2 end nodes of each edge of a 2-D mesh)",
                 ));
             }
             let key = face_key(nodes.iter().map(|&n| n as u32));
@@ -349,7 +384,7 @@ fn sides_by_nodes(
 }
 
 impl Embedding {
-    /// Start from the host's node coordinates (3-D).
+    /// Start from the host's node coordinates (xyz; a 2-D mesh has z = 0).
     pub fn builder(coords: &[[f64; 3]]) -> EmbeddingBuilder {
         EmbeddingBuilder {
             coords: coords.to_vec(),
@@ -358,6 +393,7 @@ impl Embedding {
             dofs: None,
             fixed: Vec::new(),
             integration: Integration::Segments { order: 5 },
+            axisymmetric: false,
         }
     }
 }

@@ -431,6 +431,8 @@ fn embed_header_side_table_is_seams() {
         ("SEAM_TET4", Topology::Tet4),
         ("SEAM_WEDGE6", Topology::Wedge6),
         ("SEAM_PYRAMID5", Topology::Pyramid5),
+        ("SEAM_QUAD4", Topology::Quad4),
+        ("SEAM_TRI3", Topology::Tri3),
     ] {
         let at = text.find(&format!(" *   {name} ")).expect(name);
         let block: String = text[at..]
