@@ -1,0 +1,239 @@
+//! Benchmark: a 2-D tied problem, speed per phase against error, and the share of
+//! contact — T = sin(πx) sin(πy/2) on [0,1] × [0,2] with its source (k = 1), T = 0 on
+//! the boundary; block A = [0,1]² with n × n Quad4, block B = [0,1] × [1,2] with m × m
+//! cells (m = 2n/3) split into Tri3, meshed apart and tied across y = 1 (weighted
+//! Nitsche on mortar segments, order 4); "conforming" is the same problem on one mesh of
+//! n × n Quad4 in both blocks, the cost floor.
+//!
+//! Phases (seconds, one run, release build): search (surfaces to contact points:
+//! geometry, tree, mortar segments), interface terms (the contact points' element
+//! pairs evaluated into dense blocks once, `InterfacePoints::new` + `evaluate`, timed
+//! apart here: the same work the assembly does for contact), assembly (volume and
+//! contact terms into the matrix), factor (or AMG set-up), solve. The contact share is
+//! (search + interface terms) / total. `cargo bench --bench twod` runs n = 90 and 300
+//! (about 1e4 and 1.3e5 unknowns); add `-- large` for n = 832 (about 1.0e6 unknowns
+//! tied, AMG-preconditioned CG). Opt-in: not run by `cargo test` or CI.
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use seam::assembly::DofMap;
+use seam::enforce::interface::{
+    DEFAULT_BETA, Form, HInput, HValue, InterfaceForm, InterfacePoints,
+};
+use seam::heat::steady::{ContactTerm, SteadyProblem, solve_steady};
+use seam::heat::{Material, error_norms};
+use seam::mesh::generate::{self, PlaneKind, RectSpec};
+use seam::mesh::{Mesh, NodeId};
+use seam::search::SearchSettings;
+use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
+
+fn exact(p: [f64; 3]) -> f64 {
+    (PI * p[0]).sin() * (0.5 * PI * p[1]).sin()
+}
+
+fn grad(p: [f64; 3]) -> [f64; 3] {
+    [
+        PI * (PI * p[0]).cos() * (0.5 * PI * p[1]).sin(),
+        0.5 * PI * (PI * p[0]).sin() * (0.5 * PI * p[1]).cos(),
+        0.0,
+    ]
+}
+
+fn boundary(mesh: &Mesh) -> Vec<(NodeId, f64)> {
+    (0..mesh.num_nodes())
+        .filter(|&i| {
+            let p = mesh.coords[i];
+            p[0] == 0.0 || p[0] == 1.0 || p[1] == 0.0 || p[1] == 2.0
+        })
+        .map(|i| (NodeId(i as u32), 0.0))
+        .collect()
+}
+
+fn errors(mesh: &Mesh, t: &[f64]) -> (f64, f64) {
+    let blocks: Vec<usize> = (0..mesh.blocks.len()).collect();
+    let n = error_norms(mesh, &blocks, t, &exact, &grad, 4).unwrap();
+    let max = (0..mesh.num_nodes())
+        .map(|i| (t[i] - exact(mesh.coords[i])).abs())
+        .fold(0.0, f64::max);
+    (n.l2, max)
+}
+
+struct Row {
+    label: String,
+    dofs: usize,
+    l2: f64,
+    max: f64,
+    search: f64,
+    interface: f64,
+    assembly: f64,
+    factor: f64,
+    solve: f64,
+}
+
+fn print(r: &Row) {
+    let total = r.search + r.assembly + r.factor + r.solve;
+    println!(
+        "{:<24} {:>9} {:>10.3e} {:>10.3e} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>7.2}%",
+        r.label,
+        r.dofs,
+        r.l2,
+        r.max,
+        r.search,
+        r.interface,
+        r.assembly,
+        r.factor,
+        r.solve,
+        total,
+        100.0 * (r.search + r.interface) / total
+    );
+}
+
+fn main() {
+    let large = std::env::args().any(|a| a == "large");
+    let sizes: &[usize] = if large { &[90, 300, 832] } else { &[90, 300] };
+    println!(
+        "{:<24} {:>9} {:>10} {:>10} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "case",
+        "unknowns",
+        "L2 error",
+        "max error",
+        "search",
+        "iface",
+        "assembly",
+        "factor",
+        "solve",
+        "total",
+        "contact"
+    );
+    let source = |p: [f64; 3]| 1.25 * PI * PI * exact(p);
+    let mat = [Material {
+        conductivity: 1.0,
+        rho_c: 1.0,
+    }; 2];
+    for &n in sizes {
+        let m = 2 * n / 3;
+        let iterative = n >= 200;
+        let conforming = generate::rectangles(
+            &[
+                RectSpec::quad([0.0, 0.0], [1.0, 1.0], [n, n], 1),
+                RectSpec::quad([0.0, 1.0], [1.0, 2.0], [n, n], 2),
+            ],
+            true,
+        );
+        let bc = boundary(&conforming);
+        let sol = solve_steady(&SteadyProblem {
+            mesh: &conforming,
+            materials: &mat,
+            source: Some(&source),
+            dirichlet: &bc,
+            face_bcs: &[],
+            ties: vec![],
+            contact: vec![],
+            interfaces: None,
+            reproducible: true,
+            iterative,
+            tolerance: 1e-10,
+            max_iterations: 3,
+        })
+        .unwrap();
+        let (l2, max) = errors(&conforming, &sol.temperature);
+        print(&Row {
+            label: format!("conforming n={n}"),
+            dofs: sol.dofs.len(),
+            l2,
+            max,
+            search: 0.0,
+            interface: 0.0,
+            assembly: sol.timing.assembly_s,
+            factor: sol.timing.factor_s,
+            solve: sol.timing.solve_s,
+        });
+        drop((conforming, sol));
+
+        let mesh = generate::rectangles(
+            &[
+                RectSpec::quad([0.0, 0.0], [1.0, 1.0], [n, n], 1).with_side_sets([0, 0, 0, 1]),
+                RectSpec {
+                    kind: PlaneKind::Tri3,
+                    ..RectSpec::quad([0.0, 1.0], [1.0, 2.0], [m, m], 2)
+                }
+                .with_side_sets([0, 0, 2, 0]),
+            ],
+            false,
+        );
+        let bc = boundary(&mesh);
+        let t = Instant::now();
+        let a = SurfaceGeometry::from_side_set(&mesh, 0).unwrap();
+        let b = SurfaceGeometry::from_side_set(&mesh, 1).unwrap();
+        let settings = SearchSettings::defaults(2);
+        let integration = Integration::Segments { order: 4 };
+        let r = Searcher::new(&b, &settings).search_points(&a, &b, &settings, integration, None);
+        let search = t.elapsed().as_secs_f64();
+        let k = [1.0, 1.0];
+        let tied = |_: &HInput| Ok(HValue::default());
+        let form = || InterfaceForm {
+            form: Form::TiedNitsche,
+            h: &tied,
+            offset: 0.0,
+            beta: DEFAULT_BETA,
+            conductivity: &k,
+        };
+        // The interface terms alone: what the assembly does for the contact points.
+        let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();
+        let t = Instant::now();
+        let points = InterfacePoints::new(
+            &mesh,
+            &dofs,
+            dofs.field("temperature").unwrap(),
+            &a,
+            &b,
+            &r.points,
+            &form(),
+        )
+        .unwrap();
+        let zero = vec![0.0; dofs.len()];
+        let system = points.evaluate(&form(), &zero).unwrap();
+        let interface = t.elapsed().as_secs_f64();
+        drop((points, system, dofs));
+        let sol = solve_steady(&SteadyProblem {
+            mesh: &mesh,
+            materials: &mat,
+            source: Some(&source),
+            dirichlet: &bc,
+            face_bcs: &[],
+            ties: vec![],
+            contact: vec![ContactTerm {
+                side_a: &a,
+                side_b: &b,
+                points: &r.points,
+                form: form(),
+                linear: true,
+            }],
+            interfaces: None,
+            reproducible: true,
+            iterative,
+            tolerance: 1e-10,
+            max_iterations: 3,
+        })
+        .unwrap();
+        let (l2, max) = errors(&mesh, &sol.temperature);
+        print(&Row {
+            label: format!("tied nitsche n={n}/{m}"),
+            dofs: sol.dofs.len(),
+            l2,
+            max,
+            search,
+            interface,
+            assembly: sol.timing.assembly_s,
+            factor: sol.timing.factor_s,
+            solve: sol.timing.solve_s,
+        });
+        println!(
+            "  ({} contact points on {} side-A edges; heat imbalance {:.1e})",
+            r.points.len(),
+            a.faces.len(),
+            sol.heat[0].0 + sol.heat[0].1
+        );
+    }
+}
