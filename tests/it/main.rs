@@ -9,6 +9,7 @@ mod conductance;
 mod docs;
 mod electric;
 mod embed;
+mod embed_2d;
 mod embed_api;
 mod enforce;
 mod examples;
