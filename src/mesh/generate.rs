@@ -530,3 +530,75 @@ pub fn disjoint_union(a: &Mesh, b: &Mesh) -> Mesh {
     }
     m
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The unit outward normal of a 2-D side: its direction turned clockwise by 90°.
+    fn outward(m: &Mesh, side: Side) -> [f64; 2] {
+        let n: Vec<[f64; 3]> = m.side_nodes(side).map(|n| m.coords[n.index()]).collect();
+        let (dx, dy) = (n[1][0] - n[0][0], n[1][1] - n[0][1]);
+        let l = dx.hypot(dy);
+        [dy / l, -dx / l]
+    }
+
+    /// Rectangles of Quad4 and Tri3: valid (counter-clockwise) elements, every edge of a
+    /// side set on its edge of the rectangle with the outward normal, the whole edge
+    /// covered (lengths sum to the side), and the element count of the kind.
+    #[test]
+    fn rectangles_are_valid_with_their_edge_sets() {
+        for (kind, per_cell) in [(PlaneKind::Quad4, 1), (PlaneKind::Tri3, 2)] {
+            let m = rectangles(
+                &[RectSpec {
+                    kind,
+                    ..RectSpec::quad([1.0, 2.0], [3.0, 3.5], [4, 3], 7)
+                }
+                .with_side_sets([1, 2, 3, 4])],
+                false,
+            );
+            m.validate().unwrap();
+            assert_eq!((m.dim, m.num_elems()), (2, 12 * per_cell));
+            let expect = [
+                (1, [-1.0, 0.0], 1.5),
+                (2, [1.0, 0.0], 1.5),
+                (3, [0.0, -1.0], 2.0),
+                (4, [0.0, 1.0], 2.0),
+            ];
+            for (id, normal, length) in expect {
+                let set = m.side_sets.iter().find(|s| s.id == id).unwrap();
+                let mut total = 0.0;
+                for &side in &set.sides {
+                    let n = outward(&m, side);
+                    assert!((n[0] - normal[0]).abs() < 1e-12 && (n[1] - normal[1]).abs() < 1e-12);
+                    let x: Vec<[f64; 3]> =
+                        m.side_nodes(side).map(|n| m.coords[n.index()]).collect();
+                    total += (x[1][0] - x[0][0]).hypot(x[1][1] - x[0][1]);
+                }
+                assert!((total - length).abs() < 1e-12, "{kind:?} set {id}: {total}");
+            }
+        }
+    }
+
+    /// A full 2-D ring closes (no node twice at θ = 0); a sector's edge sets face out.
+    #[test]
+    fn rings_close_and_face_out() {
+        let full = ring(1.0, 2.0, 360.0, [2, 8], PlaneKind::Quad4, 1, [1, 2, 0, 0]);
+        full.validate().unwrap();
+        assert_eq!(full.num_nodes(), 3 * 8);
+        let sector = ring(1.0, 2.0, 90.0, [2, 4], PlaneKind::Tri3, 1, [1, 2, 3, 4]);
+        sector.validate().unwrap();
+        for (id, outward_radially) in [(1, -1.0), (2, 1.0)] {
+            let set = sector.side_sets.iter().find(|s| s.id == id).unwrap();
+            for &side in &set.sides {
+                let c: Vec<[f64; 3]> = sector
+                    .side_nodes(side)
+                    .map(|n| sector.coords[n.index()])
+                    .collect();
+                let mid = [0.5 * (c[0][0] + c[1][0]), 0.5 * (c[0][1] + c[1][1])];
+                let n = outward(&sector, side);
+                assert!(outward_radially * (n[0] * mid[0] + n[1] * mid[1]) > 0.0);
+            }
+        }
+    }
+}

@@ -6,10 +6,14 @@
 use proptest::prelude::*;
 use seam::search::bvh::{Aabb, Bvh, QueryHint};
 use seam::search::mortar::{
-    clip_polygon_polygon, overlap_area_face_face, rule_triangle, segments_face_face,
-    segments_face_face_into, signed_area_polygon,
+    clip_polygon_polygon, overlap_area_face_face, overlap_length_line_line, rule_line,
+    rule_triangle, segments_face_face, segments_face_face_into, segments_line_line_into,
+    signed_area_polygon,
 };
-use seam::search::project::{map_quad4, project_point_quad4, project_point_tri3};
+use seam::search::project::{
+    map_line2, map_quad4, normal_line2, project_point_line2, project_point_quad4,
+    project_point_tri3,
+};
 
 type V3 = [f64; 3];
 
@@ -691,6 +695,103 @@ proptest! {
                 });
                 prop_assert!(hit, "probe {p:?} (moved {moved}) found no face");
             }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// (e) 2-D: edges (Line2) — projection against sampled distances and rigid motions of the
+// plane, 1-D overlaps against interval arithmetic and the monomials' exact integrals
+// ---------------------------------------------------------------------------------------
+
+/// A rotation by `angle` about z, then a translation and a scaling, in the xy plane.
+fn apply_2d(angle: f64, t: [f64; 2], s: f64, p: V3) -> V3 {
+    let (c, n) = (angle.cos(), angle.sin());
+    [
+        s * (c * p[0] - n * p[1]) + t[0],
+        s * (n * p[0] + c * p[1]) + t[1],
+        0.0,
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn line2_projection_is_closest_and_rigid_in_the_plane(
+        a in prop::array::uniform2(-1.0..1.0f64),
+        b in prop::array::uniform2(-1.0..1.0f64),
+        p in prop::array::uniform2(-2.0..2.0f64),
+        angle in -3.2..3.2f64,
+        t in prop::array::uniform2(-100.0..100.0f64),
+        s in prop_oneof![0.01..1.0f64, 1.0..100.0f64],
+    ) {
+        let x = [[a[0], a[1], 0.0], [b[0], b[1], 0.0]];
+        let p = [p[0], p[1], 0.0];
+        prop_assume!(norm(sub(x[1], x[0])) > 0.05);
+        let pr = project_point_line2(p, &x);
+        prop_assert!(!pr.degenerate && pr.xi[0].abs() <= 1.0 && pr.xi[1] == 0.0);
+        // The closest point of the closed edge, against 400 samples of it.
+        for k in 0..=400 {
+            let y = map_line2(&x, [-1.0 + k as f64 / 200.0, 0.0]);
+            prop_assert!(pr.distance <= norm(sub(p, y)) + 1e-12);
+        }
+        // |gap| is the distance when the foot lies on the edge; its sign is the side of
+        // the normal (t_y, −t_x).
+        let n = normal_line2(&x);
+        prop_assert!((norm(n) - 1.0).abs() < 1e-14);
+        if pr.inside {
+            prop_assert!((pr.gap.abs() - pr.distance).abs() < 1e-12);
+        }
+        // A rigid motion and scaling of the plane: the same ξ, gap scaled by s.
+        let m = |v: V3| apply_2d(angle, t, s, v);
+        let pr1 = project_point_line2(m(p), &[m(x[0]), m(x[1])]);
+        prop_assert!((pr1.xi[0] - pr.xi[0]).abs() < 1e-9, "{pr:?} {pr1:?}");
+        prop_assert!((pr1.gap - s * pr.gap).abs() < 1e-9 * s.max(1.0) + 1e-10);
+        // `inside` too, unless the foot lies at an end (within round-off of the tolerance).
+        let e = sub(x[1], x[0]);
+        let c = [0.5 * (x[0][0] + x[1][0]), 0.5 * (x[0][1] + x[1][1]), 0.0];
+        let free = 2.0 * (sub(p, c)[0] * e[0] + sub(p, c)[1] * e[1]) / (e[0] * e[0] + e[1] * e[1]);
+        if (free.abs() - 1.0).abs() > 1e-6 {
+            prop_assert_eq!(pr1.inside, pr.inside);
+            prop_assert_eq!(pr.inside, free.abs() <= 1.0);
+        }
+    }
+
+    #[test]
+    fn edges_overlap_as_intervals_with_exact_moments(
+        a0 in -2.0..2.0f64, la in 0.1..2.0f64,
+        b0 in -2.0..2.0f64, lb in 0.1..2.0f64,
+        gap in -0.5..0.5f64,
+        flip_b in any::<bool>(),
+        order in 1usize..9,
+    ) {
+        // A along +x at y = 0 (normal −y); B on y = −gap (open when gap > 0), either way.
+        let a = [[a0, 0.0, 0.0], [a0 + la, 0.0, 0.0]];
+        let mut b = [[b0, -gap, 0.0], [b0 + lb, -gap, 0.0]];
+        if flip_b {
+            b.reverse();
+        }
+        let (lo, hi) = (a0.max(b0), (a0 + la).min(b0 + lb));
+        let want = (hi - lo).max(0.0);
+        prop_assert!((overlap_length_line_line(&a, &b) - want).abs() < 1e-14);
+        let mut pts = Vec::new();
+        segments_line_line_into(&a, &b, &rule_line(order), &mut pts);
+        prop_assert_eq!(pts.is_empty(), want == 0.0);
+        // ∫ x^p over [lo, hi], exact up to the rule's degree.
+        for p in 0..=order as i32 {
+            let got: f64 = pts.iter().map(|m| m.weight * m.x_a[0].powi(p)).sum();
+            let exact = if want > 0.0 {
+                (hi.powi(p + 1) - lo.powi(p + 1)) / (p + 1) as f64
+            } else {
+                0.0
+            };
+            prop_assert!((got - exact).abs() <= 1e-12 * (1.0 + exact.abs()), "x^{p}: {got} vs {exact}");
+        }
+        for m in &pts {
+            prop_assert!((m.gap - gap).abs() < 1e-14);
+            prop_assert!((m.x_b[0] - m.x_a[0]).abs() < 1e-13);
+            prop_assert!((map_line2(&b, m.xi_b)[0] - m.x_a[0]).abs() < 1e-13);
         }
     }
 }
