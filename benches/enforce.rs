@@ -9,12 +9,15 @@
 //! runs n = 18 and 40 (about 1e4 and 1e5 unknowns, sparse Cholesky); add `-- large` for
 //! n = 88 (about 1e6, solved by AMG-preconditioned CG).
 
+#[path = "common/mod.rs"]
+mod common;
+
 use std::f64::consts::PI;
 use std::time::Instant;
 
 use seam::enforce::interface::{DEFAULT_BETA, Form, HInput, HValue, InterfaceForm};
+use seam::heat::Material;
 use seam::heat::steady::{ContactTerm, SteadyProblem, solve_steady};
-use seam::heat::{Material, error_norms};
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{Mesh, NodeId};
 use seam::search::SearchSettings;
@@ -76,12 +79,7 @@ fn print(r: &Row) {
 }
 
 fn errors(mesh: &Mesh, t: &[f64]) -> (f64, f64) {
-    let blocks: Vec<usize> = (0..mesh.blocks.len()).collect();
-    let n = error_norms(mesh, &blocks, t, &exact, &grad, 4).unwrap();
-    let max = (0..mesh.num_nodes())
-        .map(|i| (t[i] - exact(mesh.coords[i])).abs())
-        .fold(0.0, f64::max);
-    (n.l2, max)
+    common::errors(mesh, t, exact, grad)
 }
 
 fn main() {

@@ -14,6 +14,9 @@
 //! (about 1e4 and 1.3e5 unknowns); add `-- large` for n = 832 (about 1.0e6 unknowns
 //! tied, AMG-preconditioned CG). Opt-in: not run by `cargo test` or CI.
 
+#[path = "common/mod.rs"]
+mod common;
+
 use std::f64::consts::PI;
 use std::time::Instant;
 
@@ -21,8 +24,8 @@ use seam::assembly::DofMap;
 use seam::enforce::interface::{
     DEFAULT_BETA, Form, HInput, HValue, InterfaceForm, InterfacePoints,
 };
-use seam::heat::steady::{ContactTerm, SteadyProblem, solve_steady};
-use seam::heat::{Material, error_norms};
+use seam::heat::Material;
+use seam::heat::steady::{ContactTerm, SteadyProblem, SteadySolution, solve_steady};
 use seam::mesh::generate::{self, PlaneKind, RectSpec};
 use seam::mesh::{Mesh, NodeId};
 use seam::search::SearchSettings;
@@ -51,42 +54,42 @@ fn boundary(mesh: &Mesh) -> Vec<(NodeId, f64)> {
 }
 
 fn errors(mesh: &Mesh, t: &[f64]) -> (f64, f64) {
-    let blocks: Vec<usize> = (0..mesh.blocks.len()).collect();
-    let n = error_norms(mesh, &blocks, t, &exact, &grad, 4).unwrap();
-    let max = (0..mesh.num_nodes())
-        .map(|i| (t[i] - exact(mesh.coords[i])).abs())
-        .fold(0.0, f64::max);
-    (n.l2, max)
+    common::errors(mesh, t, exact, grad)
 }
 
-struct Row {
-    label: String,
-    dofs: usize,
-    l2: f64,
-    max: f64,
-    search: f64,
-    interface: f64,
-    assembly: f64,
-    factor: f64,
-    solve: f64,
-}
-
-fn print(r: &Row) {
-    let total = r.search + r.assembly + r.factor + r.solve;
+/// One line of the table: the case, its unknowns and errors, and the seconds of each
+/// phase — search, interface terms, assembly, factor (or AMG set-up), solve.
+fn print(label: &str, dofs: usize, (l2, max): (f64, f64), phases: [f64; 5]) {
+    let [search, interface, assembly, factor, solve] = phases;
+    let total = search + assembly + factor + solve;
     println!(
-        "{:<24} {:>9} {:>10.3e} {:>10.3e} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>8.3} {:>7.2}%",
-        r.label,
-        r.dofs,
-        r.l2,
-        r.max,
-        r.search,
-        r.interface,
-        r.assembly,
-        r.factor,
-        r.solve,
-        total,
-        100.0 * (r.search + r.interface) / total
+        "{label:<24} {dofs:>9} {l2:>10.3e} {max:>10.3e} {search:>8.3} {interface:>8.3} {assembly:>8.3} {factor:>8.3} {solve:>8.3} {total:>8.3} {:>7.2}%",
+        100.0 * (search + interface) / total
     );
+}
+
+/// The steady solve of `mesh` with the source, T = 0 on the boundary and `contact`.
+fn solve(mesh: &Mesh, contact: Vec<ContactTerm<'_>>, iterative: bool) -> SteadySolution {
+    let source = |p: [f64; 3]| 1.25 * PI * PI * exact(p);
+    let materials = [Material {
+        conductivity: 1.0,
+        rho_c: 1.0,
+    }; 2];
+    solve_steady(&SteadyProblem {
+        mesh,
+        materials: &materials,
+        source: Some(&source),
+        dirichlet: &boundary(mesh),
+        face_bcs: &[],
+        ties: vec![],
+        contact,
+        interfaces: None,
+        reproducible: true,
+        iterative,
+        tolerance: 1e-10,
+        max_iterations: 3,
+    })
+    .unwrap()
 }
 
 fn main() {
@@ -106,11 +109,6 @@ fn main() {
         "total",
         "contact"
     );
-    let source = |p: [f64; 3]| 1.25 * PI * PI * exact(p);
-    let mat = [Material {
-        conductivity: 1.0,
-        rho_c: 1.0,
-    }; 2];
     for &n in sizes {
         let m = 2 * n / 3;
         let iterative = n >= 200;
@@ -121,34 +119,14 @@ fn main() {
             ],
             true,
         );
-        let bc = boundary(&conforming);
-        let sol = solve_steady(&SteadyProblem {
-            mesh: &conforming,
-            materials: &mat,
-            source: Some(&source),
-            dirichlet: &bc,
-            face_bcs: &[],
-            ties: vec![],
-            contact: vec![],
-            interfaces: None,
-            reproducible: true,
-            iterative,
-            tolerance: 1e-10,
-            max_iterations: 3,
-        })
-        .unwrap();
-        let (l2, max) = errors(&conforming, &sol.temperature);
-        print(&Row {
-            label: format!("conforming n={n}"),
-            dofs: sol.dofs.len(),
-            l2,
-            max,
-            search: 0.0,
-            interface: 0.0,
-            assembly: sol.timing.assembly_s,
-            factor: sol.timing.factor_s,
-            solve: sol.timing.solve_s,
-        });
+        let sol = solve(&conforming, vec![], iterative);
+        let t = &sol.timing;
+        print(
+            &format!("conforming n={n}"),
+            sol.dofs.len(),
+            errors(&conforming, &sol.temperature),
+            [0.0, 0.0, t.assembly_s, t.factor_s, t.solve_s],
+        );
         drop((conforming, sol));
 
         let mesh = generate::rectangles(
@@ -162,7 +140,6 @@ fn main() {
             ],
             false,
         );
-        let bc = boundary(&mesh);
         let t = Instant::now();
         let a = SurfaceGeometry::from_side_set(&mesh, 0).unwrap();
         let b = SurfaceGeometry::from_side_set(&mesh, 1).unwrap();
@@ -196,39 +173,21 @@ fn main() {
         let system = points.evaluate(&form(), &zero).unwrap();
         let interface = t.elapsed().as_secs_f64();
         drop((points, system, dofs));
-        let sol = solve_steady(&SteadyProblem {
-            mesh: &mesh,
-            materials: &mat,
-            source: Some(&source),
-            dirichlet: &bc,
-            face_bcs: &[],
-            ties: vec![],
-            contact: vec![ContactTerm {
-                side_a: &a,
-                side_b: &b,
-                points: &r.points,
-                form: form(),
-                linear: true,
-            }],
-            interfaces: None,
-            reproducible: true,
-            iterative,
-            tolerance: 1e-10,
-            max_iterations: 3,
-        })
-        .unwrap();
-        let (l2, max) = errors(&mesh, &sol.temperature);
-        print(&Row {
-            label: format!("tied nitsche n={n}/{m}"),
-            dofs: sol.dofs.len(),
-            l2,
-            max,
-            search,
-            interface,
-            assembly: sol.timing.assembly_s,
-            factor: sol.timing.factor_s,
-            solve: sol.timing.solve_s,
-        });
+        let contact = vec![ContactTerm {
+            side_a: &a,
+            side_b: &b,
+            points: &r.points,
+            form: form(),
+            linear: true,
+        }];
+        let sol = solve(&mesh, contact, iterative);
+        let t = &sol.timing;
+        print(
+            &format!("tied nitsche n={n}/{m}"),
+            sol.dofs.len(),
+            errors(&mesh, &sol.temperature),
+            [search, interface, t.assembly_s, t.factor_s, t.solve_s],
+        );
         println!(
             "  ({} contact points on {} side-A edges; heat imbalance {:.1e})",
             r.points.len(),

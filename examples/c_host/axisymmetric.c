@@ -24,15 +24,6 @@
 #include "seam.h"
 #include "host_fem.h"
 
-#define CHECK(call)                                                                  \
-    do {                                                                             \
-        int status_ = (call);                                                        \
-        if (status_ != SEAM_OK) {                                                    \
-            fprintf(stderr, "%s failed (%d): %s\n", #call, status_, seam_last_error()); \
-            exit(1);                                                                 \
-        }                                                                            \
-    } while (0)
-
 enum { NR1 = 8, NZ1 = 6, NR2 = 12, NZ2 = 9 };
 static const double A = 0.5, C = 1.0, B = 2.0, H = 0.5, K1 = 2.0, K2 = 5.0, GAP_H = 3.0;
 static const double T_A = 400.0, T_B = 300.0, PI = 3.14159265358979323846;

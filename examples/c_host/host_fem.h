@@ -1,15 +1,29 @@
 /*
  * The host's own finite-element pieces, shared by the C hosts main.c, sector.c and
- * axisymmetric.c (each uses what it needs: the functions are inline): the
- * conduction matrix of a trilinear hexahedron and a dense linear solver. Nothing here
- * is seam's; a real host has its own.
+ * axisymmetric.c (each uses what it needs: the functions are inline): a CHECK of seam's
+ * status codes, the conduction matrix of a trilinear hexahedron and a dense linear
+ * solver. Nothing here is seam's; a real host has its own.
  */
 #ifndef HOST_FEM_H
 #define HOST_FEM_H
 
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "seam.h"
+
+/* Stop the host with seam's message when a call fails. */
+#define CHECK(call)                                                                  \
+    do {                                                                             \
+        int status_ = (call);                                                        \
+        if (status_ != SEAM_OK) {                                                    \
+            fprintf(stderr, "%s failed (%d): %s\n", #call, status_, seam_last_error()); \
+            exit(1);                                                                 \
+        }                                                                            \
+    } while (0)
 
 /* K_e of a trilinear hexahedron, 2x2x2 Gauss: k * integral of grad N_a . grad N_b. */
 static inline void hex8_conduction(const double x[8][3], double k, double ke[8][8]) {

@@ -23,15 +23,6 @@
 #include "seam.h"
 #include "host_fem.h"
 
-#define CHECK(call)                                                                  \
-    do {                                                                             \
-        int status_ = (call);                                                        \
-        if (status_ != SEAM_OK) {                                                    \
-            fprintf(stderr, "%s failed (%d): %s\n", #call, status_, seam_last_error()); \
-            exit(1);                                                                 \
-        }                                                                            \
-    } while (0)
-
 /* A structured box of nx*ny*nz Hex8, nodes appended to coords from `first`. */
 typedef struct {
     int nx, ny, nz;

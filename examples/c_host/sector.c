@@ -24,15 +24,6 @@
 #include "seam.h"
 #include "host_fem.h"
 
-#define CHECK(call)                                                                  \
-    do {                                                                             \
-        int status_ = (call);                                                        \
-        if (status_ != SEAM_OK) {                                                    \
-            fprintf(stderr, "%s failed (%d): %s\n", #call, status_, seam_last_error()); \
-            exit(1);                                                                 \
-        }                                                                            \
-    } while (0)
-
 enum { NR = 6, NT = 8, NZ = 2 };
 static const double R_IN = 0.10, R_OUT = 0.20, THICKNESS = 0.02;
 static const double PI = 3.14159265358979323846;

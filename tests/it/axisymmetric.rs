@@ -10,7 +10,9 @@ use seam::mesh::Mesh;
 use seam::mesh::generate::{self, PlaneKind, RectSpec};
 use seam::run::RunResult;
 
-use crate::twod::{run, scratch, write_mesh};
+use crate::twod::{
+    last_node_of_block_1, pair_deck, problem_text, run, scratch, worst_error_by_part, write_mesh,
+};
 
 /// The cylinders: inner part a < r < c (k₁), outer part c < r < b (k₂), height H, T = T_a
 /// on r = a and T_b on r = b, insulated ends, a gap conductance h at r = c.
@@ -82,22 +84,26 @@ fn section(g: &Cylinders, n: usize) -> Mesh {
 }
 
 fn problem(g: &Cylinders, axisymmetric: bool) -> String {
-    format!(
-        "[mesh]\nfile = \"mesh.exo\"\naxisymmetric = {axisymmetric}\n\
-         [[material]]\nblocks = [\"block_1\"]\nconductivity = {}\n\
-         [[material]]\nblocks = [\"block_2\"]\nconductivity = {}\n\
-         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = {}\n\
-         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = {}\n\
-         [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n",
-        g.k[0], g.k[1], g.t[0], g.t[1]
+    let (inner, outer) = (g.t[0].to_string(), g.t[1].to_string());
+    problem_text(
+        "mesh.exo",
+        axisymmetric,
+        &[("block_1", g.k[0]), ("block_2", g.k[1])],
+        &[("surface_1", &inner), ("surface_2", &outer)],
+        "",
     )
 }
 
-fn gap_deck(h: f64, extra: &str) -> String {
-    format!(
-        "begin contact definition\n contact surface inner contains surface_3\n contact surface outer contains surface_4\n{extra}\
-         begin interaction\n  side a inner\n  side b outer\n end\n\
-         begin enforcement\n  enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = {h}\n end\nend\n"
+/// A gap conductance `h` between the parts' side sets 3 (side A) and 4.
+fn gap_deck(h: f64) -> String {
+    let model = format!(
+        "enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = {h}"
+    );
+    pair_deck(
+        "contact surface a contains surface_3",
+        "surface_4",
+        "",
+        &model,
     )
 }
 
@@ -131,7 +137,7 @@ fn concentric_cylinders_converge_to_the_logarithmic_solution() {
     let dir = scratch("axi-cylinders");
     std::fs::write(dir.join("problem.toml"), problem(&g, true)).unwrap();
     std::fs::write(dir.join("plane.toml"), problem(&g, false)).unwrap();
-    std::fs::write(dir.join("contact.i"), gap_deck(g.h, "")).unwrap();
+    std::fs::write(dir.join("contact.i"), gap_deck(g.h)).unwrap();
     let exact_heat = g.heat();
     let (mut l2, mut nodal, mut heat) = (Vec::new(), Vec::new(), Vec::new());
     for n in [2, 4, 8, 16, 32] {
@@ -144,19 +150,7 @@ fn concentric_cylinders_converge_to_the_logarithmic_solution() {
             "imbalance {}",
             i.imbalance
         );
-        let block_1 = mesh.blocks[0]
-            .connectivity
-            .iter()
-            .map(|n| n.index())
-            .max()
-            .unwrap();
-        let worst = r
-            .solution
-            .temperature
-            .iter()
-            .enumerate()
-            .map(|(k, t)| (t - g.temperature(usize::from(k > block_1), mesh.coords[k][0]).0).abs())
-            .fold(0.0, f64::max);
+        let worst = worst_error_by_part(&r, |part, x| g.temperature(part, x[0]).0);
         let e = l2_error(&r, |b, x| g.temperature(b, x));
         let q = i.heat_side_a;
         eprintln!(
@@ -193,20 +187,15 @@ fn concentric_cylinders_converge_to_the_logarithmic_solution() {
 fn disc_heated_on_the_axis_matches_its_analytic_solution() {
     let (c, b, height, k, h, q, t_b) = (1.0, 2.0, 0.5, [2.0, 5.0], 4.0, 1000.0, 300.0);
     let dir = scratch("axi-disc");
-    std::fs::write(
-        dir.join("problem.toml"),
-        format!(
-            "[mesh]\nfile = \"mesh.exo\"\naxisymmetric = true\n\
-             [[material]]\nblocks = [\"block_1\"]\nconductivity = {}\n\
-             [[material]]\nblocks = [\"block_2\"]\nconductivity = {}\n\
-             [[source]]\nblocks = [\"block_1\"]\nvalue = {q}\n\
-             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = {t_b}\n\
-             [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n",
-            k[0], k[1]
-        ),
-    )
-    .unwrap();
-    std::fs::write(dir.join("contact.i"), gap_deck(h, "")).unwrap();
+    let problem = problem_text(
+        "mesh.exo",
+        true,
+        &[("block_1", k[0]), ("block_2", k[1])],
+        &[("surface_2", &t_b.to_string())],
+        &format!("[[source]]\nblocks = [\"block_1\"]\nvalue = {q}\n"),
+    );
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    std::fs::write(dir.join("contact.i"), gap_deck(h)).unwrap();
     let made = q * std::f64::consts::PI * c * c * height;
     let t_ring = |r: f64| t_b + q * c * c / (2.0 * k[1]) * (b / r).ln();
     let t_core = t_ring(c) + q * c / (2.0 * h);
@@ -282,14 +271,14 @@ fn wedge_with_cylindrical_periodicity_agrees_with_the_axisymmetric_model() {
         problem(&g, false).replace("contact.i", "wedge.i"),
     )
     .unwrap();
-    std::fs::write(dir.join("contact.i"), gap_deck(g.h, "")).unwrap();
+    std::fs::write(dir.join("contact.i"), gap_deck(g.h)).unwrap();
     std::fs::write(
         dir.join("wedge.i"),
         format!(
             "{}begin contact definition cuts\n contact surface start contains surface_5 surface_7\n contact surface stop contains surface_6 surface_8\n\
              periodicity for start = cylindrical axis = 0 0 1 center = 0 0 0 angle = 30\n\
              begin enforcement\n  enforcement for energy = tied\n  side b variable temperature to temperature\n end\nend\n",
-            gap_deck(g.h, "")
+            gap_deck(g.h)
         ),
     )
     .unwrap();
@@ -492,15 +481,10 @@ fn transient_axisymmetric_run_stores_what_the_source_makes() {
         ),
     )
     .unwrap();
-    std::fs::write(dir.join("contact.i"), gap_deck(4.0, "")).unwrap();
+    std::fs::write(dir.join("contact.i"), gap_deck(4.0)).unwrap();
     let r = run(&dir.join("problem.toml"));
     let m = lumped_per_revolution(&mesh);
-    let block_1 = mesh.blocks[0]
-        .connectivity
-        .iter()
-        .map(|n| n.index())
-        .max()
-        .unwrap();
+    let block_1 = last_node_of_block_1(&mesh);
     let stored: f64 = (0..mesh.coords.len())
         .map(|i| rho_c[usize::from(i > block_1)] * m[i] * (r.solution.temperature[i] - t0))
         .sum();
@@ -555,30 +539,24 @@ fn sphere_in_a_shell_on_gmsh_meshes_converges_axisymmetric() {
     let mut l2 = Vec::new();
     for level in 1..=3 {
         let path = fixtures.join(format!("spheres_axi_{level}.msh"));
-        std::fs::write(
-            dir.join("problem.toml"),
-            format!(
-                "[mesh]\nfile = {:?}\naxisymmetric = true\n\
-                 [[material]]\nblocks = [\"core\"]\nconductivity = {}\n\
-                 [[material]]\nblocks = [\"shell\"]\nconductivity = {}\n\
-                 [[source]]\nblocks = [\"core\"]\nvalue = {q}\n\
-                 [[bc]]\nkind = \"temperature\"\nsurfaces = [\"shell_outer\"]\nvalue = {t_b}\n\
-                 [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-13\n",
-                path.to_str().unwrap(),
-                k[0],
-                k[1]
-            ),
-        )
-        .unwrap();
-        std::fs::write(
-            dir.join("contact.i"),
-            format!(
-                "begin contact definition\n contact surface core_face contains core_surface\n contact surface shell_face contains shell_inner\n\
-                 begin interaction\n  side a core_face\n  side b shell_face\n end\n\
-                 begin enforcement\n  enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = {h}\n end\nend\n"
-            ),
-        )
-        .unwrap();
+        let problem = problem_text(
+            path.to_str().unwrap(),
+            true,
+            &[("core", k[0]), ("shell", k[1])],
+            &[("shell_outer", &t_b.to_string())],
+            &format!("[[source]]\nblocks = [\"core\"]\nvalue = {q}\n"),
+        );
+        std::fs::write(dir.join("problem.toml"), problem).unwrap();
+        let model = format!(
+            "enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = {h}"
+        );
+        let deck = pair_deck(
+            "contact surface a contains core_surface",
+            "shell_inner",
+            "",
+            &model,
+        );
+        std::fs::write(dir.join("contact.i"), deck).unwrap();
         let r = run(&dir.join("problem.toml"));
         let m = &r.mesh;
         let core = m.find_block("core").unwrap();

@@ -31,23 +31,21 @@ fn embed_2d_axisymmetric_hosts_match_seam_run() {
     // seam run.
     let dir = scratch("axisymmetric-host");
     crate::twod::write_mesh(&dir.join("mesh.exo"), &mesh);
-    std::fs::write(
-        dir.join("problem.toml"),
-        "[mesh]\nfile = \"mesh.exo\"\naxisymmetric = true\n\
-         [[material]]\nblocks = [\"block_1\"]\nconductivity = 2\n\
-         [[material]]\nblocks = [\"block_2\"]\nconductivity = 5\n\
-         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = 400\n\
-         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = 300\n\
-         [contact]\nfile = \"contact.i\"\n",
-    )
-    .unwrap();
-    std::fs::write(
-        dir.join("contact.i"),
-        "begin contact definition\n contact surface a contains surface_3\n contact surface b contains surface_4\n\
-         begin interaction\n  side a a\n  side b b\n end\n\
-         begin enforcement\n  enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = 3\n end\nend\n",
-    )
-    .unwrap();
+    let problem = crate::twod::problem_text(
+        "mesh.exo",
+        true,
+        &[("block_1", 2.0), ("block_2", 5.0)],
+        &[("surface_1", "400"), ("surface_2", "300")],
+        "",
+    );
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    let deck = crate::twod::pair_deck(
+        "contact surface a contains surface_3",
+        "surface_4",
+        "",
+        "enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = 3",
+    );
+    std::fs::write(dir.join("contact.i"), deck).unwrap();
     let reference = match seam::run::run(&dir.join("problem.toml")) {
         Ok(r) => r.summary.interactions[0].heat_side_a,
         Err(e) => panic!("seam run failed: {e:?}"),
