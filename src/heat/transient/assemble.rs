@@ -6,7 +6,7 @@ use std::cell::Cell;
 use rayon::prelude::*;
 
 use crate::assembly::Assembler;
-use crate::fem::MAX_NODES;
+use crate::fem::{MAX_NODES, Measure};
 use crate::heat::electric;
 use crate::heat::interfaces::InterfaceFailure;
 use crate::heat::kernel;
@@ -149,7 +149,7 @@ impl Context<'_, '_> {
                     &mut *je
                 };
                 kernel::face_load_with(
-                    crate::fem::Measure::of(mesh.axisymmetric),
+                    Measure::of(mesh.axisymmetric),
                     topo,
                     &x[..nn],
                     bc.side().side,
@@ -352,7 +352,8 @@ impl ElementCx<'_> {
             let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
             rs.fill(0.0);
             js.fill(0.0);
-            kernel::face_load(
+            kernel::face_load_with(
+                Measure::of(mesh.axisymmetric),
                 topo,
                 &x[..nn],
                 bc.side().side,
@@ -369,7 +370,8 @@ impl ElementCx<'_> {
             let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
             rs.fill(0.0);
             js.fill(0.0);
-            kernel::face_load(
+            kernel::face_load_with(
+                Measure::of(mesh.axisymmetric),
                 topo,
                 &x[..nn],
                 side.side,
