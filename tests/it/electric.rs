@@ -612,53 +612,63 @@ fn large_coupled_runs_take_block_amg_gmres_and_match_the_factorisation() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The coupling in an axisymmetric model: the same two bars as cylinders of radius 1
-/// along the axis, their (r, y) section in 2-D (Quad4, meshed apart: the contact edges at
-/// y = L1 do not match, 3 against 4), `Mesh::set_axisymmetric`. The field is still
-/// one-dimensional and the quads' integrals separate in r and y, so T (quadratic in y)
-/// and V at every node are the closed form's, as with the 3-D case's hexes (triangles
-/// would couple r and y and lose the nodal exactness) — which needs every term per
-/// revolution: the Joule heat
+/// The coupling in 2-D, plane and axisymmetric: the same two bars as a plane strip of
+/// unit width, and as cylinders of radius 1 along the axis (`Mesh::set_axisymmetric`),
+/// their (r, y) section in 2-D (Quad4, meshed apart: the contact edges at y = L1 do not
+/// match, 3 against 4). The field is still one-dimensional and the quads' integrals
+/// separate in r and y, so T (quadratic in y) and V at every node are the closed form's,
+/// as with the 3-D case's hexes (triangles would couple r and y and lose the nodal
+/// exactness) — which needs every term per revolution when axisymmetric: the Joule heat
 /// and charge in the elements, the current fed in and the convection at the ends (face
 /// loads × 2πr), the contact's current and heat (points × 2πr). The current through the
-/// contact is j₀ π per revolution.
+/// contact is j₀ per unit depth, j₀ π per revolution.
 #[test]
 fn series_bars_reproduce_the_closed_form_axisymmetric() {
     use seam::mesh::generate::RectSpec;
-    let mut mesh = generate::rectangles(
-        &[
-            RectSpec::quad([0.0, 0.0], [1.0, L1], [3, 4], 1).with_side_sets([0, 0, 1, 2]),
-            RectSpec::quad([0.0, L1], [1.0, L], [4, 5], 2).with_side_sets([0, 0, 3, 4]),
-        ],
-        false,
-    );
-    mesh.set_axisymmetric().unwrap();
-    let he = constant(BARS.h_e);
-    let (report, dofs, u) = run(&mesh, &BARS, [2e3, 1e3].map(Law::Constant), &he);
-    let (t, v) = (
-        dofs.field(TEMPERATURE).unwrap(),
-        dofs.field(VOLTAGE).unwrap(),
-    );
-    let (tn, vn) = (dofs.nodal_values(t, &u), dofs.nodal_values(v, &u));
-    let mut block_of = vec![0usize; mesh.num_nodes()];
-    for n in &mesh.blocks[1].connectivity {
-        block_of[n.index()] = 1;
+    for axisymmetric in [false, true] {
+        let mut mesh = generate::rectangles(
+            &[
+                RectSpec::quad([0.0, 0.0], [1.0, L1], [3, 4], 1).with_side_sets([0, 0, 1, 2]),
+                RectSpec::quad([0.0, L1], [1.0, L], [4, 5], 2).with_side_sets([0, 0, 3, 4]),
+            ],
+            false,
+        );
+        if axisymmetric {
+            mesh.set_axisymmetric().unwrap();
+        }
+        let he = constant(BARS.h_e);
+        let (report, dofs, u) = run(&mesh, &BARS, [2e3, 1e3].map(Law::Constant), &he);
+        let (t, v) = (
+            dofs.field(TEMPERATURE).unwrap(),
+            dofs.field(VOLTAGE).unwrap(),
+        );
+        let (tn, vn) = (dofs.nodal_values(t, &u), dofs.nodal_values(v, &u));
+        let mut block_of = vec![0usize; mesh.num_nodes()];
+        for n in &mesh.blocks[1].connectivity {
+            block_of[n.index()] = 1;
+        }
+        let (mut et, mut ev) = (0.0f64, 0.0f64);
+        for (i, x) in mesh.coords.iter().enumerate() {
+            let (ve, te) = BARS.exact(x[1], block_of[i]);
+            et = et.max((tn[i] - te).abs());
+            ev = ev.max((vn[i] - ve).abs());
+        }
+        // Through the unit width per unit depth (plane), the disc r < 1 (axisymmetric).
+        let current = report.electric[0].current;
+        let want = BARS.j0
+            * if axisymmetric {
+                std::f64::consts::PI
+            } else {
+                1.0
+            };
+        eprintln!(
+            "2-D bars, axisymmetric {axisymmetric}: worst T error {et:.1e} K, V error {ev:.1e} V; contact current {current:.10} A (exact {want:.10})"
+        );
+        assert!(et < 1e-9, "T error {et:e}");
+        assert!(ev < 1e-12, "V error {ev:e}");
+        assert!(
+            (current - want).abs() < 1e-9 * want,
+            "{current} against {want}"
+        );
     }
-    let (mut et, mut ev) = (0.0f64, 0.0f64);
-    for (i, x) in mesh.coords.iter().enumerate() {
-        let (ve, te) = BARS.exact(x[1], block_of[i]);
-        et = et.max((tn[i] - te).abs());
-        ev = ev.max((vn[i] - ve).abs());
-    }
-    let current = report.electric[0].current;
-    let want = BARS.j0 * std::f64::consts::PI;
-    eprintln!(
-        "axisymmetric bars: worst T error {et:.1e} K, V error {ev:.1e} V; contact current {current:.10} A (j0 π {want:.10})"
-    );
-    assert!(et < 1e-9, "T error {et:e}");
-    assert!(ev < 1e-12, "V error {ev:e}");
-    assert!(
-        (current - want).abs() < 1e-9 * want,
-        "{current} against {want}"
-    );
 }
