@@ -3,7 +3,7 @@
     xvfb-run -a pvbatch docs/render_paraview.py examples/electronics/out docs/images/electronics_paraview.png
 
 Reads results.exo (the Exodus II file, through ParaView's Exodus reader) at its last
-time step and colours the mesh by temperature; prints the time steps, the node count
+time step and colours the mesh by temperature (a 2-D mesh seen from +z); prints the time steps, the node count
 and the temperature range ParaView sees, so a run can be checked against seam's own
 summary. Needs ParaView (Debian: apt-get install paraview xvfb); not part of .ci/run.
 """
@@ -38,6 +38,7 @@ def main():
     data = servermanager.Fetch(reader)
     nodes = 0
     lo, hi = float("inf"), float("-inf")
+    z_lo, z_hi = float("inf"), float("-inf")
     it = data.NewIterator()
     it.InitTraversal()
     while not it.IsDoneWithTraversal():
@@ -47,6 +48,8 @@ def main():
             nodes += piece.GetNumberOfPoints()
             a, b = arr.GetRange()
             lo, hi = min(lo, a), max(hi, b)
+            box = piece.GetBounds()
+            z_lo, z_hi = min(z_lo, box[4]), max(z_hi, box[5])
         it.GoToNextItem()
     print(f"ParaView read {len(times)} time step(s), last t = {times[-1]}; "
           f"{nodes} points (summed over blocks); temperature {lo:.6f} .. {hi:.6f} K")
@@ -70,10 +73,16 @@ def main():
     bar.Title = "temperature (K)"
     bar.ComponentTitle = ""
     bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
-    # From below: the die's underside (where the power enters) and the sink's base.
-    view.CameraPosition = [0.05, -0.07, -0.05]
-    view.CameraFocalPoint = [0.0, 0.0, 0.004]
-    view.CameraViewUp = [0.0, 0.0, 1.0]
+    if z_lo == z_hi:
+        # 2-D data (z = 0; an axisymmetric section: x the radius, y the axis): from +z.
+        view.CameraPosition = [0.0, 0.0, 1.0]
+        view.CameraFocalPoint = [0.0, 0.0, 0.0]
+        view.CameraViewUp = [0.0, 1.0, 0.0]
+    else:
+        # From below: the die's underside (where the power enters) and the sink's base.
+        view.CameraPosition = [0.05, -0.07, -0.05]
+        view.CameraFocalPoint = [0.0, 0.0, 0.004]
+        view.CameraViewUp = [0.0, 0.0, 1.0]
     ResetCamera(view)
     SaveScreenshot(png, view, ImageResolution=[1000, 700])
     print(f"wrote {png}")
