@@ -616,3 +616,76 @@ fn sphere_in_a_shell_on_gmsh_meshes_converges_axisymmetric() {
     eprintln!("spheres: L2 rates {r:.2?}");
     assert!(r.iter().all(|&r| r > 1.8), "{r:?}");
 }
+
+/// `seam run`'s thermal–electrical coupling, axisymmetric: two copper-like cylinders of
+/// radius 1 stacked along the axis (Quad4, meshed apart, 3 against 4 edges at y = 0.6),
+/// a current density j₀ fed in at y = 0 and the top end at 0 V, a thermal and an
+/// electrical contact conductance between them, convection at both ends. The current is
+/// axial, so V is linear in each part with the drop j₀/h_e at the contact: at every node
+/// to round-off; the contact carries j₀ π per revolution and releases (j₀²/h_e) π as
+/// Joule heat.
+#[test]
+fn thermal_electrical_run_is_per_revolution() {
+    let (j0, sigma, h_e, l1, l) = (1e4, [2e3, 1e3], 5e3, 0.6, 1.5);
+    let dir = scratch("axi-electric");
+    let mesh = generate::rectangles(
+        &[
+            RectSpec::quad([0.0, 0.0], [1.0, l1], [3, 4], 1).with_side_sets([0, 0, 1, 2]),
+            RectSpec::quad([0.0, l1], [1.0, l], [4, 5], 2).with_side_sets([0, 0, 3, 4]),
+        ],
+        false,
+    );
+    write_mesh(&dir.join("mesh.exo"), &mesh);
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = \"mesh.exo\"\naxisymmetric = true\n\
+             [[material]]\nblocks = [\"block_1\"]\nconductivity = 5\nelectrical_conductivity = {}\n\
+             [[material]]\nblocks = [\"block_2\"]\nconductivity = 2\nelectrical_conductivity = {}\n\
+             [[bc]]\nkind = \"current\"\nsurfaces = [\"surface_1\"]\nvalue = {j0}\n\
+             [[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_4\"]\nvalue = 0\n\
+             [[bc]]\nkind = \"convection\"\nsurfaces = [\"surface_1\", \"surface_4\"]\nvalue = 10\nambient = 300\n\
+             [contact]\nfile = \"contact.i\"\n[solve]\nkind = \"steady\"\ntolerance = 1e-12\n",
+            sigma[0], sigma[1]
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition\n contact surface a contains surface_2\n contact surface b contains surface_3\n\
+             begin interaction\n  side a a\n  side b b\n end\n\
+             begin enforcement thermal\n  enforcement for energy = gap_conductance\n  gap conductance coefficient = constant h = 100\n end\n\
+             begin enforcement electrical\n  enforcement for voltage = gap_conductance\n  gap conductance coefficient = constant h = {h_e}\n end\nend\n"
+        ),
+    )
+    .unwrap();
+    let r = run(&dir.join("problem.toml"));
+    let c = &r.summary.electrical_contacts[0];
+    let pi = std::f64::consts::PI;
+    let (current, joule) = (j0 * pi, j0 * j0 / h_e * pi);
+    eprintln!(
+        "axisymmetric thermal-electrical: contact current {:.10} A (j0 π {current:.10}), Joule heat {:.10} W ({joule:.10})",
+        c.current, c.joule_heat
+    );
+    assert!((c.current - current).abs() <= 1e-9 * current);
+    assert!((c.joule_heat - joule).abs() <= 1e-9 * joule);
+    // V from the solution's dofs: the run's nodal voltage through its dof map.
+    let dofs = &r.solution.dofs;
+    let field = dofs.field("voltage").unwrap();
+    let v = dofs.nodal_values(field, &r.solution.u);
+    let last = last_node_of_block_1(&mesh);
+    let worst = (0..mesh.num_nodes())
+        .map(|n| {
+            let y = mesh.coords[n][1];
+            let exact = if n <= last {
+                j0 * ((l1 - y) / sigma[0] + 1.0 / h_e + (l - l1) / sigma[1])
+            } else {
+                j0 * (l - y) / sigma[1]
+            };
+            (v[n] - exact).abs()
+        })
+        .fold(0.0, f64::max);
+    eprintln!("axisymmetric thermal-electrical: worst nodal V error {worst:.1e} V");
+    assert!(worst <= 1e-9, "{worst}");
+}
