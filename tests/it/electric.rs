@@ -312,22 +312,7 @@ fn series_bars_reproduce_the_closed_form_at_the_nodes() {
         let mesh = bars_mesh(n1, m1, n2, m2);
         let he = constant(bars.h_e);
         let (report, dofs, u) = run(&mesh, &bars, [2e3, 1e3].map(Law::Constant), &he);
-        let (t, v) = (
-            dofs.field(TEMPERATURE).unwrap(),
-            dofs.field(VOLTAGE).unwrap(),
-        );
-        let (tn, vn) = (dofs.nodal_values(t, &u), dofs.nodal_values(v, &u));
-        let mut block_of = vec![0usize; mesh.num_nodes()];
-        for n in &mesh.blocks[1].connectivity {
-            block_of[n.index()] = 1;
-        }
-        let (mut et, mut ev) = (0.0f64, 0.0f64);
-        for (i, x) in mesh.coords.iter().enumerate() {
-            let side = block_of[i];
-            let (ve, te) = bars.exact(x[2], side);
-            et = et.max((tn[i] - te).abs());
-            ev = ev.max((vn[i] - ve).abs());
-        }
+        let ((et, ev), tn, vn) = nodal_errors(&mesh, &bars, &dofs, &u, 2);
         // Scales: ΔT ~ 100 K over 300 K, V ~ 2 V.
         assert!(et < 1e-9, "T error {et:e} (share {fraction_a})");
         assert!(ev < 1e-12, "V error {ev:e} (share {fraction_a})");
@@ -348,6 +333,33 @@ fn series_bars_reproduce_the_closed_form_at_the_nodes() {
             "power {power} W against {out} W leaving"
         );
     }
+}
+
+/// The largest nodal errors of T and V of a solve against the closed form along the
+/// coordinate `axis` (z in 3-D, y in 2-D), and the nodal T and V.
+fn nodal_errors(
+    mesh: &Mesh,
+    bars: &Bars,
+    dofs: &DofMap,
+    u: &[f64],
+    axis: usize,
+) -> ((f64, f64), Vec<f64>, Vec<f64>) {
+    let (t, v) = (
+        dofs.field(TEMPERATURE).unwrap(),
+        dofs.field(VOLTAGE).unwrap(),
+    );
+    let (tn, vn) = (dofs.nodal_values(t, u), dofs.nodal_values(v, u));
+    let mut block_of = vec![0usize; mesh.num_nodes()];
+    for n in &mesh.blocks[1].connectivity {
+        block_of[n.index()] = 1;
+    }
+    let (mut et, mut ev) = (0.0f64, 0.0f64);
+    for (i, x) in mesh.coords.iter().enumerate() {
+        let (ve, te) = bars.exact(x[axis], block_of[i]);
+        et = et.max((tn[i] - te).abs());
+        ev = ev.max((vn[i] - ve).abs());
+    }
+    ((et, ev), tn, vn)
 }
 
 fn bars_mesh(n1: usize, m1: usize, n2: usize, m2: usize) -> Mesh {
@@ -638,21 +650,7 @@ fn series_bars_reproduce_the_closed_form_axisymmetric() {
         }
         let he = constant(BARS.h_e);
         let (report, dofs, u) = run(&mesh, &BARS, [2e3, 1e3].map(Law::Constant), &he);
-        let (t, v) = (
-            dofs.field(TEMPERATURE).unwrap(),
-            dofs.field(VOLTAGE).unwrap(),
-        );
-        let (tn, vn) = (dofs.nodal_values(t, &u), dofs.nodal_values(v, &u));
-        let mut block_of = vec![0usize; mesh.num_nodes()];
-        for n in &mesh.blocks[1].connectivity {
-            block_of[n.index()] = 1;
-        }
-        let (mut et, mut ev) = (0.0f64, 0.0f64);
-        for (i, x) in mesh.coords.iter().enumerate() {
-            let (ve, te) = BARS.exact(x[1], block_of[i]);
-            et = et.max((tn[i] - te).abs());
-            ev = ev.max((vn[i] - ve).abs());
-        }
+        let ((et, ev), _, _) = nodal_errors(&mesh, &BARS, &dofs, &u, 1);
         // Through the unit width per unit depth (plane), the disc r < 1 (axisymmetric).
         let current = report.electric[0].current;
         let want = BARS.j0
