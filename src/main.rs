@@ -29,6 +29,10 @@ const EXIT_PLUGIN_FAULT: u8 = 3;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Threads to use (default: every core; `RAYON_NUM_THREADS=n` does the same). The
+    /// answers do not depend on it: every sum runs in a fixed order.
+    #[arg(long, global = true, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
 }
 
 #[derive(Subcommand)]
@@ -102,6 +106,16 @@ enum Command {
     /// Process`); not for direct use.
     #[command(name = "plugin-worker", hide = true)]
     PluginWorker,
+    /// Write a bundled scene (problem file, deck, mesh) into a folder, ready for
+    /// `seam run FOLDER/problem.toml`; with no name, list the scenes.
+    Example {
+        /// The scene: `two_blocks` (the default of `seam run`) or `busbar_joint`.
+        name: Option<String>,
+        /// The folder to write it into (default: a folder named after the scene). Files
+        /// already there are not overwritten: the command stops instead.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
     /// Validate a deck and print every diagnostic: everything `seam run` checks before
     /// it solves (enforcement models made, Lua compiled, plugins loaded). With --mesh its
     /// surfaces, interactions and search too; with --problem the whole problem file.
@@ -120,7 +134,16 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n as usize)
+            .build_global()
+    {
+        eprintln!("error: --threads {n}: {e}");
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
     match cli.command {
+        Command::Example { name, dir } => example(name.as_deref(), dir),
         Command::Surfaces {
             deck,
             mesh,
@@ -516,13 +539,26 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
     let path = match path {
         Some(p) => p,
         None => {
-            // The bundled scene, next to the executable's source tree or the working
-            // directory.
+            // The bundled scene, in the working directory's or the build's source tree,
+            // else written out of the binary into a folder of the system's temporary one.
             let here = Path::new(env!("CARGO_MANIFEST_DIR")).join(DEFAULT_SCENE);
             let p = if Path::new(DEFAULT_SCENE).exists() {
                 PathBuf::from(DEFAULT_SCENE)
-            } else {
+            } else if here.exists() {
                 here
+            } else {
+                let dir = std::env::temp_dir().join(format!(
+                    "seam-{}-{}",
+                    seam::run::bundled::DEFAULT,
+                    std::process::id()
+                ));
+                match seam::run::bundled::write(seam::run::bundled::DEFAULT, &dir) {
+                    Ok(p) => p,
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return ExitCode::from(EXIT_BAD_INPUT);
+                    }
+                }
             };
             if !json {
                 eprintln!(
@@ -855,4 +891,30 @@ fn parse_dead(text: &str, mesh: &Mesh) -> Result<HashSet<ElemId>, String> {
         }
     }
     Ok(out)
+}
+
+/// `seam example [NAME] [--dir DIR]`: write a bundled scene, or list them.
+fn example(name: Option<&str>, dir: Option<PathBuf>) -> ExitCode {
+    use seam::run::bundled;
+    let Some(name) = name else {
+        for s in bundled::SCENES {
+            println!("{:14} {}", s.name, s.about);
+        }
+        return ExitCode::SUCCESS;
+    };
+    let dir = dir.unwrap_or_else(|| PathBuf::from(name));
+    match bundled::write(name, &dir) {
+        Ok(problem) => {
+            println!(
+                "wrote {}: solve it with `seam run {}`",
+                dir.display(),
+                problem.display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+    }
 }

@@ -53,6 +53,7 @@
 //!
 //! [`ContactScene`]: crate::scene::ContactScene
 
+pub mod bundled;
 mod contact;
 mod fields;
 mod nodal_field;

@@ -260,3 +260,67 @@ fn example_run_gives_the_series_resistance_heat() {
             .is_file()
     );
 }
+
+/// `seam example` lists the bundled scenes and writes one out of the binary into a
+/// folder, which then runs as the source tree's scene does (the same heat, to the bit),
+/// and refuses to overwrite it a second time; an unknown name is a usage error.
+#[test]
+fn example_writes_a_bundled_scene_that_runs() {
+    let list = seam(&["example"]);
+    assert!(list.status.success());
+    let text = String::from_utf8_lossy(&list.stdout);
+    assert!(
+        text.contains("two_blocks") && text.contains("busbar_joint"),
+        "{text}"
+    );
+    let dir = std::env::temp_dir().join(format!("seam-example-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let wrote = seam(&["example", "two_blocks", "--dir", d]);
+    assert!(
+        wrote.status.success(),
+        "{}",
+        String::from_utf8_lossy(&wrote.stderr)
+    );
+    let problem = dir.join("problem.toml");
+    let copied = json(&seam(&["run", problem.to_str().unwrap(), "--json"]));
+    let tree = json(&seam(&[
+        "run",
+        "examples/two_blocks/problem.toml",
+        "--json",
+    ]));
+    assert_eq!(copied["interactions"], tree["interactions"]);
+    let again = seam(&["example", "two_blocks", "--dir", d]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("exists already"));
+    // Every bundled scene carries the files its problem file names.
+    let busbar = dir.join("busbar");
+    let b = busbar.to_str().unwrap();
+    assert!(
+        seam(&["example", "busbar_joint", "--dir", b])
+            .status
+            .success()
+    );
+    let run = json(&seam(&[
+        "run",
+        busbar.join("problem.toml").to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(run["electrical_contacts"][0]["side_a"], "a_joint");
+    let unknown = seam(&["example", "three_blocks", "--dir", d]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&unknown.stderr).contains("busbar_joint"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `--threads N` before or after the subcommand: the same answer on one thread and on
+/// two; zero threads is a usage error.
+#[test]
+fn threads_option_sets_the_pool_and_not_the_answer() {
+    let scene = "examples/two_blocks/problem.toml";
+    let one = json(&seam(&["--threads", "1", "run", scene, "--json"]));
+    let two = json(&seam(&["run", scene, "--json", "--threads", "2"]));
+    assert_eq!(one["interactions"], two["interactions"]);
+    let zero = seam(&["--threads", "0", "run", scene]);
+    assert_eq!(zero.status.code(), Some(2));
+}
