@@ -30,7 +30,7 @@ fn dir() -> PathBuf {
 fn compile(compiler: &str, flags: &[&str], sources: &[&str], out: &Path, modules: Option<&str>) {
     let mut cmd = Command::new(compiler);
     cmd.args(flags);
-    let modules = modules.map(|tag| dir().join(format!("mod-{tag}-{}", std::process::id())));
+    let modules = modules.map(|tag| dir().join(format!("mod-{tag}-{}", unique())));
     if let Some(m) = &modules {
         std::fs::create_dir_all(m).unwrap();
         cmd.arg("-J").arg(m);
@@ -51,6 +51,14 @@ fn compile(compiler: &str, flags: &[&str], sources: &[&str], out: &Path, modules
     }
 }
 
+/// A name no other compile of this test process uses at the same time (tests build the
+/// same plugin concurrently: one for its own checks, one for a scene).
+fn unique() -> String {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    format!("{}-{call}", std::process::id())
+}
+
 fn fortran() -> String {
     std::env::var("FC").unwrap_or_else(|_| "gfortran".into())
 }
@@ -62,7 +70,7 @@ pub(crate) const FORTRAN_LIBRARY: &str = "libseam_fortran_table.so";
 /// Build the Fortran example plugin into `dir`; returns its path.
 pub(crate) fn compile_fortran_table(dir: &Path) -> PathBuf {
     let out = dir.join(FORTRAN_LIBRARY);
-    let partial = dir.join(format!("{FORTRAN_LIBRARY}.{}.partial", std::process::id()));
+    let partial = dir.join(format!("{FORTRAN_LIBRARY}.{}.partial", unique()));
     let flags: Vec<&str> = FORTRAN_FLAGS
         .iter()
         .copied()
