@@ -101,6 +101,9 @@ enum Command {
         /// an `exit` in it is a FAILED check (exit 3) instead of the end of seam.
         #[arg(long)]
         isolate: bool,
+        /// Print one JSON object (`passed`, the descriptor, counts, failures) instead of text.
+        #[arg(long)]
+        json: bool,
     },
     /// Serve one plugin on standard input for an isolated host (`Plugin Isolation =
     /// Process`); not for direct use.
@@ -129,6 +132,9 @@ enum Command {
         /// Read the mesh given by --mesh as axisymmetric (a problem file says so itself).
         #[arg(long)]
         axisymmetric: bool,
+        /// Print one JSON object (`ok`, counts, `diagnostics`) instead of text.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -169,14 +175,22 @@ fn main() -> ExitCode {
             real,
             integer,
             isolate,
-        } => check_plugin(&path, &real, &integer, isolate),
+            json,
+        } => check_plugin(&path, &real, &integer, isolate, json),
         Command::PluginWorker => ExitCode::from(seam::plugin::serve_worker().clamp(0, 255) as u8),
         Command::Check {
             deck,
             mesh,
             problem,
             axisymmetric,
-        } => check(&deck, mesh.as_deref(), problem.as_deref(), axisymmetric),
+            json,
+        } => check(
+            &deck,
+            mesh.as_deref(),
+            problem.as_deref(),
+            axisymmetric,
+            json,
+        ),
     }
 }
 
@@ -185,32 +199,34 @@ fn load(
     deck_path: &Path,
     mesh_path: Option<&Path>,
     axisymmetric: bool,
+    json: bool,
 ) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
     let loaded = deck::load(deck_path);
+    let fail = |mut d: Diagnostics, extra: Option<Diagnostic>| {
+        d.0.extend(extra);
+        report_errors(json, &d, &loaded.sources);
+        Err(ExitCode::from(EXIT_BAD_INPUT))
+    };
     if loaded.diagnostics.has_errors() {
-        eprint!("{}", loaded.diagnostics.render(&loaded.sources));
-        return Err(ExitCode::from(EXIT_BAD_INPUT));
+        return fail(loaded.diagnostics.clone(), None);
     }
     let mesh = match mesh_path {
         None => None,
         Some(p) => match mesh::read(p) {
             Ok(mut m) => {
                 if axisymmetric && let Err(e) = m.set_axisymmetric() {
-                    eprint!("{}", loaded.diagnostics.render(&loaded.sources));
-                    eprintln!(
-                        "error[{}]: --axisymmetric, {}: {e}\n  = help: {}",
+                    let d = Diagnostic::error(
                         e.code(),
-                        p.display(),
-                        e.help()
-                    );
-                    return Err(ExitCode::from(EXIT_BAD_INPUT));
+                        format!("--axisymmetric, {}: {e}", p.display()),
+                    )
+                    .help(e.help());
+                    return fail(loaded.diagnostics.clone(), Some(d));
                 }
                 Some(m)
             }
             Err(e) => {
-                eprint!("{}", loaded.diagnostics.render(&loaded.sources));
-                eprintln!("error[E0400]: {e}");
-                return Err(ExitCode::from(EXIT_BAD_INPUT));
+                let d = Diagnostic::error("E0400", e.to_string());
+                return fail(loaded.diagnostics.clone(), Some(d));
             }
         },
     };
@@ -254,7 +270,7 @@ fn surfaces(
     dead: Option<&str>,
     axisymmetric: bool,
 ) -> ExitCode {
-    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric) {
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric, json) {
         Ok(x) => x,
         Err(code) => return code,
     };
@@ -361,7 +377,7 @@ fn search(
 ) -> ExitCode {
     use seam::scene::OutputRule;
     use seam::search::pairing::Integration;
-    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric) {
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric, json) {
         Ok(x) => x,
         Err(code) => return code,
     };
@@ -682,11 +698,13 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
             }
         }
         Err(seam::run::RunError::Input(d, sources)) => {
-            eprint!("{}", d.render(&sources));
+            report_errors(json, &d, &sources);
             ExitCode::from(EXIT_BAD_INPUT)
         }
         Err(seam::run::RunError::Solve(e)) => {
-            eprintln!("error[E0800]: {e}");
+            let mut d = Diagnostics::default();
+            d.push(Diagnostic::error("E0800", e.clone()));
+            report_errors(json, &d, &SourceMap::default());
             // A plugin whose worker process died stopped the run: a plugin fault.
             if e.contains(seam::plugin::isolate::PROCESS_DEATH) {
                 ExitCode::from(EXIT_PLUGIN_FAULT)
@@ -745,18 +763,28 @@ fn progress_printer(json: bool) -> Progress {
     (Box::new(steps), Box::new(phase))
 }
 
-fn check_plugin(path: &Path, real: &[f64], integer: &[i64], isolate: bool) -> ExitCode {
-    let mut stdout = std::io::stdout();
+fn check_plugin(path: &Path, real: &[f64], integer: &[i64], isolate: bool, json: bool) -> ExitCode {
+    let mut stdout: Box<dyn std::io::Write> = if json {
+        Box::new(std::io::sink())
+    } else {
+        Box::new(std::io::stdout())
+    };
     let isolation = if isolate {
         seam::plugin::Isolation::Process
     } else {
         seam::plugin::Isolation::None
     };
     match seam::plugin::check_plugin_with(path, real, integer, isolation, &mut stdout) {
-        Ok(report) if report.exit_code() == 0 => ExitCode::SUCCESS,
-        Ok(_) => ExitCode::from(EXIT_PLUGIN_FAULT),
+        Ok(report) => {
+            if json {
+                println!("{}", report.to_json());
+            }
+            ExitCode::from(report.exit_code() as u8)
+        }
         Err(e) => {
-            eprintln!("error[E0500]: {e}");
+            let mut d = Diagnostics::default();
+            d.push(Diagnostic::error("E0500", e.to_string()));
+            report_errors(json, &d, &SourceMap::default());
             ExitCode::from(EXIT_PLUGIN_FAULT)
         }
     }
@@ -772,8 +800,9 @@ fn check(
     mesh_path: Option<&Path>,
     problem: Option<&Path>,
     axisymmetric: bool,
+    json: bool,
 ) -> ExitCode {
-    let (loaded, mesh) = match load(deck_path, mesh_path, axisymmetric) {
+    let (loaded, mesh) = match load(deck_path, mesh_path, axisymmetric, json) {
         Ok(x) => x,
         Err(code) => return code,
     };
@@ -806,6 +835,7 @@ fn check(
     });
     let mut text = diags.render(&loaded.sources);
     let mut errors = diags.errors().count();
+    let mut all = diags.0.clone();
     if let Some(p) = problem {
         let (found, sources) = match seam::run::check(p) {
             Ok(c) => (c.diagnostics, c.sources),
@@ -826,6 +856,24 @@ fn check(
             }
         }
         text += &extra.render(&sources);
+        all.extend(extra.0);
+    }
+    let defs = loaded.deck.contact_definitions.len();
+    if json {
+        let report = serde_json::json!({
+            "ok": errors == 0,
+            "errors": errors,
+            "warnings": all.len() - errors,
+            "contact_definitions": defs,
+            "contact_surfaces": mesh.as_ref().map(|_| surfaces),
+            "diagnostics": all,
+        });
+        println!("{report}");
+        return if errors > 0 {
+            ExitCode::from(EXIT_BAD_INPUT)
+        } else {
+            ExitCode::SUCCESS
+        };
     }
     eprint!("{text}");
     if errors > 0 {
@@ -837,7 +885,6 @@ fn check(
         );
         return ExitCode::from(EXIT_BAD_INPUT);
     }
-    let defs = loaded.deck.contact_definitions.len();
     let problem_note = if problem.is_some() {
         ", problem ready to run"
     } else {
@@ -916,5 +963,16 @@ fn example(name: Option<&str>, dir: Option<PathBuf>) -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(EXIT_BAD_INPUT)
         }
+    }
+}
+
+/// Diagnostics that stop a command: rendered on stderr, or with `--json` one JSON object
+/// `{"ok": false, "diagnostics": [{severity, code, message, loc?, help?}, …]}` on stdout.
+fn report_errors(json: bool, diags: &Diagnostics, sources: &SourceMap) {
+    if json {
+        let report = serde_json::json!({ "ok": false, "diagnostics": diags.0 });
+        println!("{report}");
+    } else {
+        eprint!("{}", diags.render(sources));
     }
 }

@@ -23,6 +23,28 @@ impl CheckReport {
         self.conformance.passed() && self.host_fault.is_none()
     }
 
+    /// The findings as one JSON object (`seam check-plugin --json`): `passed`, the
+    /// descriptor (`name`, `model_version`, `capabilities`), the grid's counts, the
+    /// largest derivative error, the failures and seam's own fault, if any.
+    pub fn to_json(&self) -> serde_json::Value {
+        let c = &self.conformance;
+        serde_json::json!({
+            "passed": self.passed(),
+            "name": c.name,
+            "model_version": c.model_version,
+            "capabilities": c.capabilities,
+            "points": c.points,
+            "derivatives_checked": c.derivatives_checked,
+            "max_derivative_error": c.max_derivative_error,
+            "finite_difference_derivatives": self.finite_difference_derivatives,
+            "batch_checked": c.batch_checked,
+            "threads_checked": c.threads_checked,
+            "failures": c.failures,
+            "failure_count": c.failure_count,
+            "host_fault": self.host_fault,
+        })
+    }
+
     /// The command's exit code: 0 pass, 3 plugin fault. A load error (`Err` from
     /// [`check_plugin`]) is a plugin fault too: exit 3.
     pub fn exit_code(&self) -> i32 {

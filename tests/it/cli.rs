@@ -324,3 +324,45 @@ fn threads_option_sets_the_pool_and_not_the_answer() {
     let zero = seam(&["--threads", "0", "run", scene]);
     assert_eq!(zero.status.code(), Some(2));
 }
+
+/// `--json` on every subcommand that takes it: a failure is one JSON object on stdout,
+/// `{"ok": false, "diagnostics": [{severity, code, message, loc, help}]}`, with the exit
+/// code of the text mode; `seam check --json` reports counts and diagnostics when it
+/// passes too.
+#[test]
+fn json_mode_reports_diagnostics_as_json() {
+    let parse = |out: &Output| -> serde_json::Value {
+        serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stdout)))
+    };
+    let ok = seam(&["check", "examples/two_blocks/contact.i", "--json"]);
+    assert_eq!(ok.status.code(), Some(0));
+    let report = parse(&ok);
+    assert_eq!(report["ok"], true);
+    assert_eq!(report["errors"], 0);
+    let bad = seam(&["check", "tests/bad/refused_equation/deck.i", "--json"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let report = parse(&bad);
+    assert_eq!(report["ok"], false);
+    let d = &report["diagnostics"][0];
+    assert_eq!(d["code"], "E0219", "{report}");
+    assert_eq!(d["severity"], "error");
+    assert_eq!(d["loc"]["line"], 4, "{report}");
+    let missing = seam(&[
+        "search",
+        "examples/two_blocks/contact.i",
+        "--mesh",
+        "no/such/mesh.exo",
+        "--json",
+    ]);
+    assert_eq!(missing.status.code(), Some(2));
+    assert_eq!(parse(&missing)["diagnostics"][0]["code"], "E0400");
+    let run = seam(&["run", "no/such/problem.toml", "--json"]);
+    assert_eq!(run.status.code(), Some(2));
+    assert_eq!(parse(&run)["ok"], false);
+    assert!(
+        run.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}

@@ -955,6 +955,26 @@ fn check_plugin_command_exit_codes() {
     assert_eq!(out.status.code(), Some(3));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("ABI 2.0") && err.contains("ABI 1.0"), "{err}");
+    // --json: the same findings as one object on stdout, the same exit codes.
+    args.push("--json");
+    let out = seam(&args);
+    assert_eq!(out.status.code(), Some(0));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["passed"], true);
+    assert_eq!(report["name"], "c_table");
+    assert!(
+        report["derivatives_checked"].as_u64().unwrap() > 0,
+        "{report}"
+    );
+    let out = seam(&["check-plugin", faulty("NAN").to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(3));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["passed"], false);
+    assert!(report["failure_count"].as_u64().unwrap() > 0, "{report}");
+    let out = seam(&["check-plugin", faulty("MAJOR").to_str().unwrap(), "--json"]);
+    assert_eq!(out.status.code(), Some(3));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["diagnostics"][0]["code"], "E0500", "{report}");
 }
 
 /// Run a two-block problem whose interface enforcement is `enforcement` (the lines
