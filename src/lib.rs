@@ -7,7 +7,8 @@
 //! - foundations: [`mesh`] (Exodus II, Gmsh, generators, validation), [`deck`] (Sierra
 //!   syntax or TOML → typed spec), [`script`] (sandboxed Lua), [`periodic`] (maps),
 //!   [`solve`] (sparse direct and AMG-CG), [`assembly`] (dofs and sparse patterns),
-//!   [`output`] (Exodus, VTU, plots), [`diag`] (diagnostics);
+//!   [`output`] (Exodus, VTU, plots), [`diag`] (diagnostics), [`logging`] (the `log`
+//!   records the library writes instead of printing);
 //! - [`surface`]: contact surfaces by the Sierra rules;
 //! - [`search`]: contact search over typed settings (BVH, projection, mortar segments);
 //! - [`enforce`]: interface forms and conductance models at contact points;
@@ -28,6 +29,7 @@ pub mod enforce;
 pub mod error;
 pub mod fem;
 pub mod heat;
+pub mod logging;
 pub mod mesh;
 pub mod output;
 pub mod periodic;

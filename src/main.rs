@@ -18,6 +18,8 @@ use seam::mesh::{self, ElemId, Mesh};
 use seam::surface::SurfaceKind;
 
 const EXIT_BAD_INPUT: u8 = 2;
+/// `-q`: no progress lines and no warnings, only errors and the results.
+static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 const EXIT_PLUGIN_FAULT: u8 = 3;
 
 #[derive(Parser)]
@@ -33,6 +35,12 @@ struct Cli {
     /// answers do not depend on it: every sum runs in a fixed order.
     #[arg(long, global = true, value_parser = clap::value_parser!(u16).range(1..))]
     threads: Option<u16>,
+    /// Report what the library does on stderr: -v its phases, -vv each Newton iteration.
+    #[arg(short, long, global = true, action = clap::ArgAction::Count, conflicts_with = "quiet")]
+    verbose: u8,
+    /// Print only errors and the results (no progress, no warnings).
+    #[arg(short, long, global = true)]
+    quiet: bool,
 }
 
 #[derive(Subcommand)]
@@ -140,6 +148,13 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    seam::logging::init_stderr(match (cli.quiet, cli.verbose) {
+        (true, _) => log::LevelFilter::Error,
+        (false, 0) => log::LevelFilter::Warn,
+        (false, 1) => log::LevelFilter::Info,
+        _ => log::LevelFilter::Debug,
+    });
+    QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n as usize)
@@ -680,7 +695,9 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
             }
             use std::io::Write as _;
             let _ = std::io::stdout().flush();
-            eprint!("{}", r.warnings.render(&r.sources));
+            if !QUIET.load(std::sync::atomic::Ordering::Relaxed) {
+                eprint!("{}", r.warnings.render(&r.sources));
+            }
             if let Some(d) = &s.diagnosis {
                 eprintln!("error[E0800]: {d}");
                 if let Some(o) = &s.output {
@@ -725,8 +742,10 @@ type Progress = (
 /// in logs a line per phase from 2 s into the run and a step line at most every 5 s (nothing with
 /// `--json` off a terminal). Every line carries the time since the run started.
 fn progress_printer(json: bool) -> Progress {
+    let quiet = QUIET.load(std::sync::atomic::Ordering::Relaxed);
+    let json = json || quiet;
     use std::io::IsTerminal as _;
-    let terminal = std::io::stderr().is_terminal();
+    let terminal = std::io::stderr().is_terminal() && !quiet;
     let start = std::time::Instant::now();
     let last = std::cell::Cell::new(start);
     let phase = move |what: &str| {

@@ -190,6 +190,12 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     // Problem and physics: the file, its mesh, and what the file says on the mesh.
     let file = ProblemFile::read(path)?;
     let (mesh, mesh_s) = file.read_mesh(options)?;
+    log::info!(
+        "mesh read: {} nodes, {} elements, {} blocks ({mesh_s:.3} s)",
+        mesh.num_nodes(),
+        mesh.num_elems(),
+        mesh.blocks.len()
+    );
     let mut diags = Diagnostics::default();
     let mut physics = Physics::new(&file, &mesh, &mut diags);
     if diags.has_errors() {
@@ -217,6 +223,13 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     if !file.transient {
         posed::check_steady(&physics, &contact.pairings, &mut diags);
     }
+    log::info!(
+        "contact scene: {} interaction(s), {} electrical contact(s) (surfaces {:.3} s, search {:.3} s)",
+        contact.pairings.len(),
+        contact.electrical.len(),
+        contact.surfaces_s,
+        contact.search_s
+    );
     let couplings = Couplings::resolve(&file, &physics, &contact, &mut diags);
     if diags.has_errors() {
         return Err(RunError::Input(diags, contact.loaded.sources));
@@ -234,7 +247,17 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let solved = TimeLoop::new(&file, &physics, &terms, options).run(initial, &mut output)?;
     terms.report_quarantined(&mut diags);
     // Output: the final files and the summary.
+    log::info!(
+        "solved: {} unknowns, {} Newton iteration(s), linear solver {} ({} iterations)",
+        solved.solution.dofs.len(),
+        solved.solution.newton_iterations,
+        solved.linear_solver.name,
+        solved.linear_solver.iterations
+    );
     let written = output.write_final(&solved)?;
+    if let Some(w) = &written {
+        log::info!("wrote {}", w.display());
+    }
     summary::report_crosspoints(&mesh, &solved.solution, &mut diags);
     let timing = Timing::of(mesh_s, &contact, &solved.solution.timing, start);
     let mut summary = Summary::new(

@@ -139,6 +139,14 @@ impl<'a> TimeLoop<'a> {
             mesh.num_nodes()
         ));
         let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+        log::debug!(
+            "linear steady solve of {unknowns} unknowns: {:?}, {} CG iterations, assembly {:.3} s, set-up {:.3} s, solve {:.3} s",
+            solved.linear.method,
+            solved.linear.cg_iterations.iter().sum::<usize>(),
+            solved.timing.assembly_s,
+            solved.timing.factor_s,
+            solved.timing.solve_s
+        );
         let linear_solver = linear_solver_summary(
             requested,
             threshold,

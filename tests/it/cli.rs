@@ -366,3 +366,34 @@ fn json_mode_reports_diagnostics_as_json() {
         String::from_utf8_lossy(&run.stderr)
     );
 }
+
+/// `-v` shows the library's log records (its phases; `-vv` each solve),
+/// `-q` leaves standard error empty on a clean run, and the default shows no records;
+/// `-v` with `-q` is a usage error.
+#[test]
+fn verbose_and_quiet_choose_what_reaches_stderr() {
+    let scene = "examples/two_blocks/problem.toml";
+    let stderr = |args: &[&str]| {
+        let out = seam(args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    let verbose = stderr(&["-v", "run", scene]);
+    assert!(
+        verbose.contains("seam[INFO] seam::run: mesh read: 443 nodes"),
+        "{verbose}"
+    );
+    assert!(!verbose.contains("DEBUG"), "{verbose}");
+    let debug = stderr(&["run", scene, "-vv"]);
+    assert!(
+        debug.contains("seam[DEBUG]") && debug.contains("linear steady solve of 443 unknowns"),
+        "{debug}"
+    );
+    assert!(!stderr(&["run", scene]).contains("seam[INFO]"));
+    assert_eq!(stderr(&["-q", "run", scene]), "");
+    assert_eq!(seam(&["-v", "-q", "run", scene]).status.code(), Some(2));
+}

@@ -278,6 +278,10 @@ impl Context<'_, '_> {
                 }
                 Err(e) => return Err(e),
             };
+            log::debug!(
+                "t = {t}: Newton iteration {} from ‖R‖ = {rn:.3e}: linear set-up {factor_s:.3} s, solve {solve_s:.3} s, {cg} Krylov iterations",
+                it + 1
+            );
             report.factor_s += factor_s;
             report.solve_s += solve_s;
             report.cg_iterations += cg;
