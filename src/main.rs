@@ -723,7 +723,9 @@ fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode 
             d.push(Diagnostic::error("E0800", e.clone()));
             report_errors(json, &d, &SourceMap::default());
             // A plugin whose worker process died stopped the run: a plugin fault.
-            if e.contains(seam::plugin::isolate::PROCESS_DEATH) {
+            if e.contains(seam::plugin::isolate::PROCESS_DEATH)
+                || e.contains(seam::run::PLUGIN_FAULT)
+            {
                 ExitCode::from(EXIT_PLUGIN_FAULT)
             } else {
                 ExitCode::from(1)
@@ -961,21 +963,9 @@ fn parse_dead(text: &str, mesh: &Mesh) -> Result<HashSet<ElemId>, String> {
 
 /// `seam example [NAME] [--dir DIR]`: write a bundled scene, or list them.
 fn example(name: Option<&str>, dir: Option<PathBuf>) -> ExitCode {
-    use seam::run::bundled;
-    let Some(name) = name else {
-        for s in bundled::SCENES {
-            println!("{:14} {}", s.name, s.about);
-        }
-        return ExitCode::SUCCESS;
-    };
-    let dir = dir.unwrap_or_else(|| PathBuf::from(name));
-    match bundled::write(name, &dir) {
-        Ok(problem) => {
-            println!(
-                "wrote {}: solve it with `seam run {}`",
-                dir.display(),
-                problem.display()
-            );
+    match seam::run::bundled::command(name, dir) {
+        Ok(text) => {
+            println!("{text}");
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -91,3 +91,22 @@ pub fn write(name: &str, dir: &Path) -> Result<PathBuf, String> {
     }
     Ok(dir.join("problem.toml"))
 }
+
+/// What `seam example` does: with no name the list of scenes (a line each), with one the
+/// scene written into `dir` (default: a folder named after it) and how to run it.
+pub fn command(name: Option<&str>, dir: Option<PathBuf>) -> Result<String, String> {
+    let Some(name) = name else {
+        let lines: Vec<String> = SCENES
+            .iter()
+            .map(|s| format!("{:14} {}", s.name, s.about))
+            .collect();
+        return Ok(lines.join("\n"));
+    };
+    let dir = dir.unwrap_or_else(|| PathBuf::from(name));
+    let problem = write(name, &dir)?;
+    Ok(format!(
+        "wrote {}: solve it with `seam run {}`",
+        dir.display(),
+        problem.display()
+    ))
+}

@@ -91,6 +91,10 @@ use problem::ProblemFile;
 use solve::TimeLoop;
 use terms::ContactTerms;
 
+/// How a [`RunError::Solve`] message starts when a plugin failed at a point (an error
+/// status, a value that is not finite or negative): the `seam` binary exits with 3 then.
+pub const PLUGIN_FAULT: &str = "plugin fault";
+
 /// What went wrong: bad input (diagnostics) or a solve that failed.
 #[derive(Debug)]
 pub enum RunError {

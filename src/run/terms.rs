@@ -370,9 +370,13 @@ impl<'a> ContactTerms<'a> {
 fn failure(e: EmbedError) -> InterfaceFailure {
     match e {
         EmbedError::Cutback { .. } => InterfaceFailure::Cutback(e.to_string()),
-        EmbedError::Enforcement { .. } | EmbedError::Plugin { .. } => InterfaceFailure::Failed(
-            format!("{e} (add `Quarantine Faulty Points` to the enforcement to skip such points)"),
-        ),
+        EmbedError::Plugin { .. } => InterfaceFailure::Failed(format!(
+            "{}: {e} (add `Quarantine Faulty Points` to the enforcement to skip such points)",
+            super::PLUGIN_FAULT
+        )),
+        EmbedError::Enforcement { .. } => InterfaceFailure::Failed(format!(
+            "{e} (add `Quarantine Faulty Points` to the enforcement to skip such points)"
+        )),
         e => InterfaceFailure::Failed(e.to_string()),
     }
 }

@@ -1441,6 +1441,30 @@ fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
     dir
 }
 
+/// A plugin that returns a value that is not a number during `seam run` is a plugin
+/// fault: the message names the plugin and the point, and the exit code is 3 (as for a
+/// crash), in text and in `--json` mode.
+#[test]
+fn plugin_fault_during_a_run_exits_with_3() {
+    let lib = cc_shared("plugins/tests/faulty/faulty.c", &["-DFAULT_NAN"], "faulty_nan_run");
+    let dir = kill_problem(&lib, "nan-run", "");
+    for json in [false, true] {
+        let mut args = vec!["run", "problem.toml"];
+        if json {
+            args.push("--json");
+        }
+        let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .expect("seam runs");
+        let text = if json { &out.stdout } else { &out.stderr };
+        let text = String::from_utf8_lossy(text);
+        assert_eq!(out.status.code(), Some(3), "{text}");
+        assert!(text.contains("plugin fault") && text.contains("NaN"), "{text}");
+    }
+}
+
 /// `Plugin Isolation = Process` in `seam run`: a plugin that segfaults or calls `exit(0)`
 /// stops the run with an ordinary error naming the plugin, the interaction, the point and
 /// how its worker died, exit code 3; with `Quarantine Faulty Points` the run completes
