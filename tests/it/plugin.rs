@@ -1446,7 +1446,11 @@ fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
 /// crash), in text and in `--json` mode.
 #[test]
 fn plugin_fault_during_a_run_exits_with_3() {
-    let lib = cc_shared("plugins/tests/faulty/faulty.c", &["-DFAULT_NAN"], "faulty_nan_run");
+    let lib = cc_shared(
+        "plugins/tests/faulty/faulty.c",
+        &["-DFAULT_NAN"],
+        "faulty_nan_run",
+    );
     let dir = kill_problem(&lib, "nan-run", "");
     for json in [false, true] {
         let mut args = vec!["run", "problem.toml"];
@@ -1461,7 +1465,10 @@ fn plugin_fault_during_a_run_exits_with_3() {
         let text = if json { &out.stdout } else { &out.stderr };
         let text = String::from_utf8_lossy(text);
         assert_eq!(out.status.code(), Some(3), "{text}");
-        assert!(text.contains("plugin fault") && text.contains("NaN"), "{text}");
+        assert!(
+            text.contains("plugin fault") && text.contains("NaN"),
+            "{text}"
+        );
     }
 }
 
