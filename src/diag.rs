@@ -441,20 +441,9 @@ pub fn text_from_bytes(
     })
 }
 
-/// Levenshtein distance, for did-you-mean suggestions.
+/// Levenshtein distance (in characters), for did-you-mean suggestions.
 pub fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    let mut cur = vec![0; b.len() + 1];
-    for (i, ca) in a.chars().enumerate() {
-        cur[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let sub = prev[j] + usize::from(ca != cb);
-            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
-        }
-        std::mem::swap(&mut prev, &mut cur);
-    }
-    prev[b.len()]
+    strsim::levenshtein(a, b)
 }
 
 /// The candidate closest to `word`, if it is close enough to be a plausible misspelling
@@ -526,6 +515,24 @@ fn find_word(text: &str, word: &str, from: usize) -> Option<usize> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn edit_distance_counts_characters_and_suggests_near_words() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("ΔT", "dT"), 1);
+        assert_eq!(edit_distance("", "abc"), 3);
+        let names = ["gap_conductance", "conductance", "contact_resistance"];
+        assert_eq!(
+            did_you_mean("gap_conductence", names),
+            Some("gap_conductance")
+        );
+        assert_eq!(
+            did_you_mean("GAP_CONDUCTANCE", names),
+            Some("gap_conductance")
+        );
+        assert_eq!(did_you_mean("radiation", names), None);
+    }
+
     use super::*;
 
     #[test]
