@@ -45,6 +45,33 @@ impl CsrMatrix {
     }
 }
 
+/// With the `sprs` feature: the Jacobian as an `sprs` matrix, for Rust hosts that keep
+/// theirs in `sprs` (the CSR is taken as it is: the same pattern, zeros included).
+#[cfg(feature = "sprs")]
+impl CsrMatrix {
+    pub fn to_sprs(&self) -> sprs::CsMat<f64> {
+        sprs::CsMat::new(
+            (self.n, self.n),
+            self.row_offsets.clone(),
+            self.columns.clone(),
+            self.values.clone(),
+        )
+    }
+}
+
+/// With the `sprs` feature: the triplet Jacobian of [`super::Contributions`] as an
+/// `sprs` CSR matrix of size `n`, repeated entries summed.
+#[cfg(feature = "sprs")]
+impl super::Contributions {
+    pub fn jacobian_sprs(&self, n: usize) -> sprs::CsMat<f64> {
+        let mut t = sprs::TriMat::new((n, n));
+        for &(r, c, v) in &self.jacobian {
+            t.add_triplet(r, c, v);
+        }
+        t.to_csr()
+    }
+}
+
 /// The interface terms of every flux-type interaction at one field, in the host's
 /// numbering ([`Embedding::evaluate`]).
 #[derive(Clone, Debug, Default)]

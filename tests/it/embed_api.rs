@@ -748,3 +748,33 @@ fn embed_cutback_from_any_model() {
     );
     assert!(!seam.is_linear());
 }
+
+/// With the `sprs` feature the Jacobian comes as an `sprs` matrix: the CSR one holds the
+/// same entries as the embedding's own, and the triplets summed equal it.
+#[cfg(feature = "sprs")]
+#[test]
+fn embed_jacobian_as_sprs_matches_the_csr_and_the_triplets() {
+    let (mut seam, n) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(quadratic_h()),
+    );
+    let u = field(n, 0.0);
+    let from_triplets = seam.contributions(&u).unwrap().jacobian_sprs(n);
+    let csr = seam.evaluate(&u).unwrap().jacobian.clone();
+    let from_csr = csr.to_sprs();
+    assert_eq!(from_csr.shape(), (n, n));
+    assert_eq!(from_csr.nnz(), csr.values.len());
+    let scale = csr.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut checked = 0;
+    for (v, (i, j)) in from_csr.iter() {
+        assert_eq!(*v, csr.get(i, j));
+        let t = from_triplets.get(i, j).copied().unwrap_or(0.0);
+        assert!(
+            (t - v).abs() <= 1e-12 * scale,
+            "({i}, {j}): {t} against {v}"
+        );
+        checked += 1;
+    }
+    assert!(checked > 0);
+    assert!(from_triplets.nnz() <= from_csr.nnz());
+}
