@@ -39,6 +39,9 @@ struct JoulePoint {
 #[derive(Clone, Debug)]
 pub struct ElectricContact {
     points: Vec<JoulePoint>,
+    /// Runs of consecutive points on the same two faces (`start..end` into `points`):
+    /// one Jacobian block and one set of pattern couplings each.
+    groups: Vec<std::ops::Range<usize>>,
     /// Voltage offset ΔV (`Offset Voltage`), V.
     pub offset: f64,
     /// The share of the contact's Joule heat given to side A (0.5 by default).
@@ -105,8 +108,18 @@ impl ElectricContact {
             }
             out.push(jp);
         }
+        let mut groups: Vec<std::ops::Range<usize>> = Vec::new();
+        for (k, p) in out.iter().enumerate() {
+            match groups.last_mut() {
+                Some(g) if out[g.start].nodes == p.nodes && out[g.start].len == p.len => {
+                    g.end = k + 1
+                }
+                _ => groups.push(k..k + 1),
+            }
+        }
         Ok(ElectricContact {
             points: out,
+            groups,
             offset,
             fraction_a,
             dofs: Vec::new(),
@@ -151,11 +164,12 @@ impl ElectricContact {
         Ok(())
     }
 
-    /// Each point's `2 len` dofs (T then V), for the pattern: every pair among them.
+    /// Each group's `2 len` dofs (T then V), for the pattern: every pair among them.
     pub fn couplings(&self) -> Vec<(usize, usize)> {
         let mut out = Vec::new();
-        for (p, d) in self.points.iter().zip(&self.dofs) {
-            let list = point_dofs(p, d);
+        for g in &self.groups {
+            let (list, n) = point_dofs(&self.points[g.start], &self.dofs[g.start]);
+            let list = &list[..n];
             for i in 0..list.len() {
                 for j in i + 1..list.len() {
                     out.push((list[i] as usize, list[j] as usize));
@@ -190,9 +204,9 @@ impl ElectricContact {
         })
     }
 
-    /// The residual (added into `r`) and each point's Jacobian block, handed to
-    /// `block(dofs, matrix)` (row-major over the point's dofs: its T dofs, then its V
-    /// dofs), at `u`; returns the current and Joule heat.
+    /// The residual (added into `r`) and each group's Jacobian block (its points summed),
+    /// handed to `block(dofs, matrix)` (row-major over the group's dofs: its T dofs, then
+    /// its V dofs), at `u`; returns the current and Joule heat.
     pub fn evaluate(
         &self,
         u: &[f64],
@@ -202,78 +216,98 @@ impl ElectricContact {
     ) -> Result<ContactPower, String> {
         let mut power = ContactPower::default();
         let mut m = [0.0; 256];
-        for (p, d) in self.points.iter().zip(&self.dofs) {
-            let list = point_dofs(p, d);
-            let n = list.len();
-            let (len, na) = (p.len as usize, p.na as usize);
-            let (mut ta, mut tb, mut jump) = (0.0, 0.0, -self.offset);
-            for i in 0..len {
-                let (tv, vv) = (u[d[i] as usize], u[d[8 + i] as usize]);
-                if i < na {
-                    ta += p.s[i] * tv;
-                } else {
-                    tb -= p.s[i] * tv;
-                }
-                jump += p.s[i] * vv;
-            }
-            let hv = h(&HInput {
-                gap: p.gap,
-                temp_a: ta,
-                temp_b: tb,
-                x: p.x,
-                point: p.index as usize,
-            })?;
-            if !(hv.h.is_finite() && hv.dh_dtemp_a.is_finite() && hv.dh_dtemp_b.is_finite()) {
-                return Err(format!(
-                    "the electrical contact conductance is not finite at ({:.6}, {:.6}, {:.6}): h = {}",
-                    p.x[0], p.x[1], p.x[2], hv.h
-                ));
-            }
-            let w = p.weight;
-            let j = hv.h * jump;
-            power.current += w * j;
-            let q = hv.h * jump * jump;
-            power.joule += w * q;
-            // dh/dT_i through T_A (side A's nodes) or T_B (side B's), and the share of
-            // the heat row i gets.
-            let dh = |i: usize| {
-                if i < na {
-                    hv.dh_dtemp_a * p.s[i]
-                } else {
-                    -hv.dh_dtemp_b * p.s[i]
-                }
-            };
-            let share = |i: usize| {
-                if i < na {
-                    self.fraction_a * p.s[i]
-                } else {
-                    -(1.0 - self.fraction_a) * p.s[i]
-                }
-            };
-            // Local order: T dofs 0..len, V dofs len..2 len.
+        for g in &self.groups {
+            let (list, n) = point_dofs(&self.points[g.start], &self.dofs[g.start]);
             m[..n * n].fill(0.0);
-            for i in 0..len {
-                // Voltage rows: w h [V] s_i.
-                r[d[8 + i] as usize] += w * j * p.s[i];
-                // Temperature rows: −share_i w h [V]².
-                r[d[i] as usize] -= share(i) * w * q;
-                for c in 0..len {
-                    // V row: V column, T column (through h).
-                    m[(len + i) * n + len + c] += w * hv.h * p.s[i] * p.s[c];
-                    m[(len + i) * n + c] += w * jump * p.s[i] * dh(c);
-                    // T row: V column, T column (through h).
-                    m[i * n + len + c] -= share(i) * w * 2.0 * j * p.s[c];
-                    m[i * n + c] -= share(i) * w * jump * jump * dh(c);
-                }
+            for (p, d) in self.points[g.clone()].iter().zip(&self.dofs[g.clone()]) {
+                self.add_point((p, d), u, h, r, &mut m[..n * n], &mut power)?;
             }
-            block(&list, &m[..n * n]);
+            block(&list[..n], &m[..n * n]);
         }
         Ok(power)
     }
+
+    /// One point `p` (dofs `d`) at `u`: its residual into `r`, its Jacobian block added
+    /// into `m` (the group's, `2 len × 2 len`), its current and heat into `power`.
+    fn add_point(
+        &self,
+        (p, d): (&JoulePoint, &[u32; 16]),
+        u: &[f64],
+        h: &HFn<'_>,
+        r: &mut [f64],
+        m: &mut [f64],
+        power: &mut ContactPower,
+    ) -> Result<(), String> {
+        let (len, na) = (p.len as usize, p.na as usize);
+        let n = 2 * len;
+        let (mut ta, mut tb, mut jump) = (0.0, 0.0, -self.offset);
+        for i in 0..len {
+            let (tv, vv) = (u[d[i] as usize], u[d[8 + i] as usize]);
+            if i < na {
+                ta += p.s[i] * tv;
+            } else {
+                tb -= p.s[i] * tv;
+            }
+            jump += p.s[i] * vv;
+        }
+        let hv = h(&HInput {
+            gap: p.gap,
+            temp_a: ta,
+            temp_b: tb,
+            x: p.x,
+            point: p.index as usize,
+        })?;
+        if !(hv.h.is_finite() && hv.dh_dtemp_a.is_finite() && hv.dh_dtemp_b.is_finite()) {
+            return Err(format!(
+                "the electrical contact conductance is not finite at ({:.6}, {:.6}, {:.6}): h = {}",
+                p.x[0], p.x[1], p.x[2], hv.h
+            ));
+        }
+        let w = p.weight;
+        let j = hv.h * jump;
+        power.current += w * j;
+        let q = hv.h * jump * jump;
+        power.joule += w * q;
+        // dh/dT_i through T_A (side A's nodes) or T_B (side B's), and the share of
+        // the heat row i gets.
+        let dh = |i: usize| {
+            if i < na {
+                hv.dh_dtemp_a * p.s[i]
+            } else {
+                -hv.dh_dtemp_b * p.s[i]
+            }
+        };
+        let share = |i: usize| {
+            if i < na {
+                self.fraction_a * p.s[i]
+            } else {
+                -(1.0 - self.fraction_a) * p.s[i]
+            }
+        };
+        // Local order: T dofs 0..len, V dofs len..2 len.
+        for i in 0..len {
+            // Voltage rows: w h [V] s_i.
+            r[d[8 + i] as usize] += w * j * p.s[i];
+            // Temperature rows: −share_i w h [V]².
+            r[d[i] as usize] -= share(i) * w * q;
+            for c in 0..len {
+                // V row: V column, T column (through h).
+                m[(len + i) * n + len + c] += w * hv.h * p.s[i] * p.s[c];
+                m[(len + i) * n + c] += w * jump * p.s[i] * dh(c);
+                // T row: V column, T column (through h).
+                m[i * n + len + c] -= share(i) * w * 2.0 * j * p.s[c];
+                m[i * n + c] -= share(i) * w * jump * jump * dh(c);
+            }
+        }
+        Ok(())
+    }
 }
 
-/// A point's dofs in local order: its T dofs, then its V dofs.
-fn point_dofs(p: &JoulePoint, d: &[u32; 16]) -> Vec<u32> {
+/// A point's dofs in local order, its T dofs then its V dofs, and their count.
+fn point_dofs(p: &JoulePoint, d: &[u32; 16]) -> ([u32; 16], usize) {
     let len = p.len as usize;
-    d[..len].iter().chain(&d[8..8 + len]).copied().collect()
+    let mut out = [0u32; 16];
+    out[..len].copy_from_slice(&d[..len]);
+    out[len..2 * len].copy_from_slice(&d[8..8 + len]);
+    (out, 2 * len)
 }

@@ -279,12 +279,14 @@ impl ContactScene {
                 .enforcements
                 .iter()
                 .any(|e| e.models.iter().any(|m| m.equation == ENERGY));
+            // A voltage block that fails says so once, not once per pair.
+            let mut voltage_failed = false;
             for (pairing, map) in searched.pairings.into_iter().zip(maps) {
-                if let Some(v) = voltage
-                    && let Some(e) =
-                        electric::electrical(v, d, &pairing, deck_dir, &loaded.sources, diags)
-                {
-                    scene.electrical.push(e);
+                if let Some(v) = voltage.filter(|_| !voltage_failed) {
+                    match electric::electrical(v, d, &pairing, deck_dir, &loaded.sources, diags) {
+                        Some(e) => scene.electrical.push(e),
+                        None => voltage_failed = true,
+                    }
                 }
                 // A definition with a Voltage block and no Energy one joins no temperatures.
                 if voltage.is_some() && !energy {

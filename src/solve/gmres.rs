@@ -39,6 +39,9 @@ pub struct BlockGmres {
     a21: Csr,
     first: AmgCg,
     second: AmgCg,
+    /// The second block's right-hand side and `A₂₁ z₁`, kept between calls.
+    r2: Vec<f64>,
+    t2: Vec<f64>,
 }
 
 impl BlockGmres {
@@ -53,6 +56,8 @@ impl BlockGmres {
             a21: Csr::default(),
             first: AmgCg::new(options),
             second: AmgCg::new(options),
+            r2: Vec::new(),
+            t2: Vec::new(),
         }
     }
 
@@ -61,11 +66,12 @@ impl BlockGmres {
         let s = self.split;
         let (z1, z2) = z.split_at_mut(s);
         self.first.apply_vcycle(&r[..s], z1);
-        let mut r2 = r[s..].to_vec();
-        let mut t = vec![0.0; r2.len()];
-        self.a21.spmv(z1, &mut t);
-        r2.iter_mut().zip(&t).for_each(|(r, t)| *r -= t);
-        self.second.apply_vcycle(&r2, z2);
+        self.t2.resize(r.len() - s, 0.0);
+        self.a21.spmv(z1, &mut self.t2);
+        self.r2.clear();
+        self.r2
+            .extend(r[s..].iter().zip(&self.t2).map(|(r, t)| r - t));
+        self.second.apply_vcycle(&self.r2, z2);
     }
 
     /// GMRES on the factored matrix; `x` holds the initial guess and the result.
