@@ -197,7 +197,7 @@ impl<'a> TimeLoop<'a> {
             .collect();
         let sigma = &physics.materials.sigma;
         let voltage_blocks: Vec<usize> = (0..mesh.blocks.len())
-            .filter(|&b| sigma[b].is_some())
+            .filter(|&b| mesh.blocks[b].topology.is_solid() && sigma[b].is_some())
             .collect();
         if physics.materials.electric() {
             list.push((VOLTAGE, &voltage_blocks));

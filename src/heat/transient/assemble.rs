@@ -77,7 +77,7 @@ impl Context<'_, '_> {
         let keep = signature.is_some() && *self.element_matrices.borrow() == signature;
         asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
             let b = mesh.block_of(e);
-            if let Some(sigma) = sigmas.and_then(|s| s[b].as_ref()) {
+            if let Some(sigma) = sigmas.and_then(|s| s.get(b)?.as_ref()) {
                 if let Err(err) = cx.electric_element(e, sigma, re, je) {
                     errors.record(e, err);
                 }

@@ -44,7 +44,10 @@ impl Setup {
         // temperatures then its voltages.
         let voltage_blocks: Vec<usize> = p.electric.as_ref().map_or_else(Vec::new, |e| {
             (0..mesh.blocks.len())
-                .filter(|&b| e.conductivity.get(b).is_some_and(Option::is_some))
+                .filter(|&b| {
+                    mesh.blocks[b].topology.is_solid()
+                        && e.conductivity.get(b).is_some_and(Option::is_some)
+                })
                 .collect()
         });
         if p.electric.is_some() {
