@@ -60,7 +60,7 @@ impl<'a> Physics<'a> {
         check_bcs(problem, diags);
         let dirichlet = nodal_condition_nodes(problem, mesh, BcKind::Temperature, diags);
         let voltage = nodal_condition_nodes(problem, mesh, BcKind::Voltage, diags);
-        check_electric(problem, &materials, &voltage, diags);
+        check_electric(problem, &file.text, &materials, &voltage, diags);
         let face_sites = face_sites(problem, mesh, diags);
         let time = time_spec(problem, file.transient, diags);
         let block_source = block_sources(problem, mesh, &file.text, probe, time.start, diags);
@@ -389,6 +389,7 @@ fn materials(p: &Problem, mesh: &Mesh, probe: f64, diags: &mut Diagnostics) -> M
 /// condition somewhere (else the potential floats).
 fn check_electric(
     p: &Problem,
+    at: &ProblemText,
     materials: &Materials,
     voltage: &[(NodeId, usize)],
     diags: &mut Diagnostics,
@@ -408,6 +409,7 @@ fn check_electric(
                         p.bc[k].kind.name()
                     ),
                 )
+                .at(at.loc("bc", k, "kind"))
                 .help("give the conducting blocks' [[material]] an electrical_conductivity (S/m)"),
             );
         }
@@ -419,6 +421,11 @@ fn check_electric(
                 "E0706",
                 "blocks carry a voltage, but no [[bc]] of kind \"voltage\" fixes it anywhere: the potential would float",
             )
+            .at(p
+                .material
+                .iter()
+                .position(|m| m.electrical_conductivity.is_some())
+                .and_then(|i| at.loc("material", i, "electrical_conductivity")))
             .help("add a [[bc]] with kind = \"voltage\" (say value = 0 on the grounded face)"),
         );
     }

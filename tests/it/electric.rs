@@ -532,13 +532,33 @@ fn newton_converges_quadratically_with_sigma_of_t_and_a_temperature_dependent_co
 /// The busbar scene with `edit` applied to its problem file and `deck_edit` to its deck:
 /// the codes of `seam check`'s errors.
 fn check_codes(edit: impl Fn(&str) -> String, deck_edit: impl Fn(&str) -> String) -> Vec<String> {
+    check_errors(edit, deck_edit)
+        .into_iter()
+        .map(|(c, _)| c)
+        .collect()
+}
+
+/// As [`check_codes`], each with the file name and line it points at.
+fn check_errors(
+    edit: impl Fn(&str) -> String,
+    deck_edit: impl Fn(&str) -> String,
+) -> Vec<(String, Option<(String, u32)>)> {
     let dir = crate::examples::copy_scene_as("busbar_joint", "electric-check");
     let problem = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
     std::fs::write(dir.join("problem.toml"), edit(&problem)).unwrap();
     let deck = std::fs::read_to_string(dir.join("contact.i")).unwrap();
     std::fs::write(dir.join("contact.i"), deck_edit(&deck)).unwrap();
     let codes = match seam::run::check(&dir.join("problem.toml")) {
-        Err(seam::run::RunError::Input(d, _)) => d.errors().map(|d| d.code.to_string()).collect(),
+        Err(seam::run::RunError::Input(d, _)) => d
+            .errors()
+            .map(|d| {
+                let at = d.loc.as_ref().map(|l| {
+                    let file = std::path::Path::new(&*l.file).file_name().unwrap();
+                    (file.to_string_lossy().to_string(), l.line)
+                });
+                (d.code.to_string(), at)
+            })
+            .collect(),
         Ok(_) => Vec::new(),
         Err(e) => panic!("{e:?}"),
     };
@@ -566,7 +586,23 @@ fn electrical_input_that_cannot_be_solved_is_refused_with_its_reason() {
     assert_eq!(check_codes(no_sigma, same), ["E0431"]);
     // A voltage that floats: no voltage condition.
     let floating = |s: &str| s.replace("kind = \"voltage\"", "kind = \"current\"");
-    assert_eq!(check_codes(floating, same), ["E0706"]);
+    let problem = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/busbar_joint/problem.toml"),
+    )
+    .unwrap();
+    let sigma_line = problem
+        .lines()
+        .position(|l| l.starts_with("electrical_conductivity"))
+        .unwrap() as u32
+        + 1;
+    // At the line that gives the voltage, in the problem file.
+    assert_eq!(
+        check_errors(floating, same),
+        [(
+            "E0706".to_string(),
+            Some(("problem.toml".to_string(), sigma_line))
+        )]
+    );
     // One block claiming Energy and Voltage: its coefficient cannot be both.
     let mixed = |d: &str| {
         d.replace(
