@@ -34,8 +34,8 @@ pub struct ContactDefinition {
     pub visualize_contact: bool,
     #[serde(default)]
     pub output_rule: Option<OutputRule>,
-    /// `Update Search Every n Steps`: kept, though seam's meshes do not move in a run, so
-    /// a re-search finds the same pairs.
+    /// `Update Search Every n Steps`: the search schedule of surfaces that move (`seam
+    /// run` with a `[displacement]`, or a host that moves its nodes).
     #[serde(default)]
     pub update_search_every_n_steps: Option<u32>,
     #[serde(default)]

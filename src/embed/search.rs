@@ -23,7 +23,22 @@ impl Embedding {
 
     /// Pair every interaction's side-A points with side-B faces anew (a full search).
     pub fn search(&mut self) -> Result<(), EmbedError> {
-        for p in &mut self.pairs {
+        let all: Vec<usize> = (0..self.pairs.len()).collect();
+        self.search_some(&all)
+    }
+
+    /// Pair the side-A points of the interactions `which` anew (a full search of each),
+    /// keeping the others' pairings; after a [`Self::move_nodes`], the interactions
+    /// whose search schedule is due.
+    pub fn search_some(&mut self, which: &[usize]) -> Result<(), EmbedError> {
+        if let Some(&i) = which.iter().find(|&&i| i >= self.pairs.len()) {
+            return Err(argument(
+                format!("no interaction {i} ({} interactions)", self.pairs.len()),
+                "number the interactions from 0 in the order they were added",
+            ));
+        }
+        for &i in which {
+            let p = &mut self.pairs[i];
             if p.b.faces.is_empty() {
                 return Err(argument(
                     format!("side B `{}` has no faces", p.side_b.name),
@@ -166,6 +181,16 @@ impl Embedding {
             .get(i)
             .and_then(|p| p.result.as_ref())
             .map(|r| &r.stats)
+    }
+
+    /// Interaction `i`'s side-A geometry (for a periodic pair, the image), side-B
+    /// geometry and pairing, as the last search or move left them.
+    pub fn pairing_of(
+        &self,
+        i: usize,
+    ) -> Option<(&SurfaceGeometry, &SurfaceGeometry, &SearchResult)> {
+        let p = self.pairs.get(i)?;
+        Some((&p.a, &p.b, p.result.as_ref()?))
     }
 
     pub(super) fn searched(p: &Pair) -> Result<&SearchResult, EmbedError> {

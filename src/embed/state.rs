@@ -137,14 +137,14 @@ impl Embedding {
     }
 
     /// Add a pairing of `seam run`'s scene with its resolved enforcement over
-    /// `fields`; it is searched already (and not searched again: the run's mesh does
-    /// not move). Returns its index.
+    /// `fields`; it is searched already, and can be searched again after its nodes move
+    /// only with `again` (its surfaces and search options). Returns its index.
     pub(crate) fn add_resolved(
         &mut self,
         pairing: Pairing,
-        choice: &ModelChoice,
-        penalty_scale: f64,
+        (choice, penalty_scale): (&ModelChoice, f64),
         model: Option<Arc<dyn ConductanceModel>>,
+        again: Option<crate::scene::SearchAgain>,
         fields: FieldPair,
     ) -> usize {
         self.pairs.push(super::from_deck::resolved_pair(
@@ -152,7 +152,7 @@ impl Embedding {
             choice,
             penalty_scale,
             model,
-            None,
+            again,
             fields,
         ));
         if let Some(e) = &mut self.evaluation {

@@ -103,6 +103,14 @@ pub trait Interfaces {
     ) -> Result<Vec<(f64, f64)>, InterfaceFailure>;
     /// The heat of each flux term at `u` and `t`.
     fn heat(&self, u: &[f64], t: f64) -> Result<Vec<(f64, f64)>, InterfaceFailure>;
+    /// Before step `step` (1 = the first) is solved at time `t`, from the state `u`:
+    /// interfaces whose surfaces move are placed at `t` (and searched anew when their
+    /// schedule says so). True when their couplings changed, so the solver makes its
+    /// pattern again ([`Self::couplings`]); interfaces that do not move keep them.
+    fn advance(&self, u: &[f64], t: f64, step: u64) -> Result<bool, InterfaceFailure> {
+        let _ = (u, t, step);
+        Ok(false)
+    }
 }
 
 /// The interfaces of pairings a caller built itself: one field, always on.

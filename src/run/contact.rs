@@ -38,6 +38,12 @@ pub(super) struct RunContact {
     pub views: Vec<ContactView>,
     /// The electrical contacts (`Enforcement for Voltage`).
     pub electrical: Vec<crate::scene::electric::ElectricalEnforced>,
+    /// Per interaction, its definition's `Update Search Every n Steps` (or `Search
+    /// Update Frequency`), for surfaces that move.
+    pub search_every: Vec<Option<u32>>,
+    /// Per interaction, what searching it again takes (surfaces that move only); taken
+    /// by the run's embedding.
+    pub again: std::cell::RefCell<Vec<Option<crate::scene::SearchAgain>>>,
     /// Wall-clock seconds building the contact surfaces and searching.
     pub surfaces_s: f64,
     pub search_s: f64,
@@ -55,7 +61,10 @@ impl RunContact {
         diags: &mut Diagnostics,
     ) -> Result<RunContact, RunError> {
         let mut out = match &file.problem.contact {
-            Some(c) => Self::scene(c, &file.dir, mesh, field_names, options, diags)?,
+            Some(c) => {
+                let moving = file.problem.displacement.is_some();
+                Self::scene(c, &file.dir, mesh, field_names, options, moving, diags)?
+            }
             None => RunContact::default(),
         };
         out.loaded.sources.add(&file.text.file, &file.text.text);
@@ -75,6 +84,7 @@ impl RunContact {
         mesh: &Mesh,
         field_names: &[String],
         options: &RunOptions,
+        moving: bool,
         diags: &mut Diagnostics,
     ) -> Result<RunContact, RunError> {
         let deck_path = dir.join(&c.file);
@@ -115,7 +125,12 @@ impl RunContact {
         let phase = |what: &str| options.phase(what);
         // The scene's own diagnostics follow the run's notes on its definitions.
         let mut found = std::mem::take(diags);
-        let scene = ContactScene::build(
+        let build = if moving {
+            ContactScene::build_for_host
+        } else {
+            ContactScene::build
+        };
+        let scene = build(
             mesh,
             &loaded,
             &deck_dir,
@@ -140,14 +155,14 @@ impl RunContact {
                     .help("remove `Output Rule = none` (or `Visualize Contact`) to say which you mean"),
                 );
             }
-            if let Some(n) = def.search_every {
+            if let Some(n) = def.search_every.filter(|_| !moving) {
                 diags.push(
                     Diagnostic::warning(
                         "W0703",
                         format!("`Update Search Every {n} Steps` (or `Search Update Frequency`) has no effect in this run: the mesh does not move, so the first search holds for every step"),
                     )
                     .at(Some(def.at.clone()))
-                    .help("remove the line, or keep it for a run coupled to a code that moves the mesh"),
+                    .help("remove the line, or give the problem a [displacement] that moves the mesh"),
                 );
             }
         }
@@ -159,6 +174,13 @@ impl RunContact {
         };
         out.electrical = scene.electrical;
         for e in scene.entries {
+            out.again.get_mut().push(e.again);
+            out.search_every.push(
+                scene
+                    .definitions
+                    .get(e.definition)
+                    .and_then(|d| d.search_every),
+            );
             out.views.push(e.view);
             out.choices
                 .push((e.choice, e.penalty_scale, e.model.map(Arc::from)));

@@ -56,6 +56,7 @@
 pub mod bundled;
 mod contact;
 mod fields;
+mod motion;
 mod nodal_field;
 mod output;
 mod physics;
@@ -76,15 +77,17 @@ use crate::mesh::Mesh;
 
 pub use output::NOT_CONVERGED;
 pub use problem::{
-    BcKind, BcSpec, ContactSpec, InitialSpec, MAX_MAGNITUDE, MAX_TEMPERATURE, MaterialSpec,
-    MeshSpec, NodalFieldSpec, OutputSpec, Problem, RestartSpec, SolveSpec, SourceSpec, ToggleSpec,
-    Value,
+    BcKind, BcSpec, ContactSpec, DisplacementSpec, InitialSpec, MAX_MAGNITUDE, MAX_TEMPERATURE,
+    MaterialSpec, MeshSpec, NodalFieldSpec, OutputSpec, Problem, RestartSpec, SolveSpec,
+    SourceSpec, ToggleSpec, Value,
 };
 pub use summary::{
     InteractionHeat, LinearSolverSummary, Summary, Timing, TransientSummary, peak_memory_mib,
 };
+pub use terms::MotionCounts;
 
 use contact::{Couplings, RunContact};
+use motion::Motion;
 use output::Output;
 use physics::Physics;
 use problem::ProblemFile;
@@ -235,6 +238,17 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         contact.search_s
     );
     let couplings = Couplings::resolve(&file, &physics, &contact, &mut diags);
+    let motion = Motion::new(
+        file.problem.displacement.as_ref(),
+        &file.dir,
+        &mesh,
+        physics.time.start,
+        &file.text,
+        &mut diags,
+    );
+    if motion.is_some() {
+        motion::refuse_what_cannot_move(&file.text, &contact, &couplings, &mut diags);
+    }
     if diags.has_errors() {
         return Err(RunError::Input(diags, contact.loaded.sources));
     }
@@ -246,7 +260,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         }));
     }
     // Time loop: the contact terms over the scene, solved, each accepted step written.
-    let terms = ContactTerms::new(&physics, &contact, &couplings);
+    let terms = ContactTerms::new(&physics, &contact, &couplings, motion.as_ref());
     let mut output = Output::open(&file, &physics, &terms)?;
     let solved = TimeLoop::new(&file, &physics, &terms, options).run(initial, &mut output)?;
     terms.report_quarantined(&mut diags);
@@ -273,6 +287,15 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         physics.time.start,
     );
     summary.axisymmetric = mesh.axisymmetric;
+    summary.motion = terms.motion_counts();
+    if let Some(m) = &summary.motion {
+        log::info!(
+            "moving contact: {} search(es), {} refit(s), {} new pattern(s)",
+            m.searches,
+            m.refits,
+            m.repatterns
+        );
+    }
     output.mark_not_converged(summary.diagnosis.as_deref())?;
     // The conductance functions of the terms borrow the mesh, which the result takes.
     drop(terms);

@@ -52,6 +52,30 @@ pub struct Problem {
     /// Named nodal fields (e.g. a contact pressure for `Contact Pressure Variable`).
     #[serde(default)]
     pub nodal_field: Vec<NodalFieldSpec>,
+    /// A nodal displacement field that moves the contact surfaces in time.
+    #[serde(default)]
+    pub displacement: Option<DisplacementSpec>,
+}
+
+/// `[displacement]`: the nodes' displacement u(X, t) (m), from Lua expressions or from
+/// the nodal variables of an Exodus II result read over time. It moves the contact
+/// surfaces (gaps, projections, overlaps); conduction stays on the mesh as read.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DisplacementSpec {
+    /// One value per coordinate (two in a 2-D mesh): a number or a Lua expression of x,
+    /// y, z (the node's place in the mesh as read) and t. Either this or `file`.
+    #[serde(default)]
+    pub value: Option<Vec<Value>>,
+    /// An Exodus II result on the run's mesh (relative to the problem file) whose nodal
+    /// variables hold the displacement at its stored times, interpolated linearly in
+    /// between and held at the first and last stored times outside them.
+    #[serde(default)]
+    pub file: Option<PathBuf>,
+    /// The nodal variables of `file`, one per coordinate (default `DISPLX`, `DISPLY`
+    /// and, in 3-D, `DISPLZ`).
+    #[serde(default)]
+    pub variables: Option<Vec<String>>,
 }
 
 #[derive(Clone, Debug, Deserialize)]

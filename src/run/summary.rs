@@ -79,6 +79,9 @@ pub struct Summary {
     /// Written to the JSON only when true.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub axisymmetric: bool,
+    /// A run whose contact surfaces move (`[displacement]`): its searches and refits.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion: Option<super::terms::MotionCounts>,
 }
 
 /// The linear solver of a run, the reason it was chosen, and its CG iterations.
@@ -188,6 +191,7 @@ impl Summary {
             linear_solver: solved.linear_solver.clone(),
             electrical_contacts: electrical_contacts(terms, history.last()),
             axisymmetric: false,
+            motion: None,
         }
     }
 }

@@ -11,7 +11,7 @@
 //! The solvers order the terms contact terms first, then multiplier ties
 //! ([`ContactTerms::term_choice`] maps that order to the interactions').
 
-use std::cell::{OnceCell, RefCell};
+use std::cell::{OnceCell, Ref, RefCell};
 
 use crate::assembly::{Assembler, DofMap};
 use crate::diag::{Diagnostic, Diagnostics};
@@ -19,10 +19,12 @@ use crate::embed::{EmbedError, Embedding, TieConstraints};
 use crate::enforce::interface::{FieldPair, PointFlux};
 use crate::heat::interfaces::{InterfaceFailure, Interfaces, TieRows};
 use crate::mesh::NodeId;
-use crate::search::pairing::Integration;
+use crate::search::pairing::{Integration, SearchSchedule};
+use crate::search::scene::Pairing;
 
 use super::contact::{Couplings, RunContact};
 use super::fields::{self, Derived};
+use super::motion::Motion;
 use super::physics::Physics;
 
 /// Where an entry of the embedding's CSR Jacobian goes among the solver's couplings
@@ -63,6 +65,51 @@ pub(super) struct ContactTerms<'a> {
     pub mechanism_names: Vec<Vec<String>>,
     /// Made when the solve starts, over its dofs ([`Self::prepare`]).
     embedded: OnceCell<Embedded>,
+    /// The displacement that moves the contact surfaces, if any.
+    motion: Option<&'a Motion>,
+    /// What the moving surfaces did.
+    moving: RefCell<Moving>,
+}
+
+/// The record of moving contact surfaces.
+#[derive(Default)]
+struct Moving {
+    /// The last step whose due searches were done.
+    searched_step: Option<u64>,
+    /// Full searches (of one interaction or more) and refits, counted.
+    counts: MotionCounts,
+    /// The couplings the solver's pattern was last made with.
+    pairs: Vec<(usize, usize)>,
+    /// The pairings as the last move or search left them (made when asked for).
+    current: Option<Vec<Pairing>>,
+}
+
+/// The pairings of a state: the scene's, or those the surfaces' motion made.
+enum Pairings<'p> {
+    Scene(&'p [Pairing]),
+    Moved(Ref<'p, [Pairing]>),
+}
+
+impl std::ops::Deref for Pairings<'_> {
+    type Target = [Pairing];
+    fn deref(&self) -> &[Pairing] {
+        match self {
+            Pairings::Scene(p) => p,
+            Pairings::Moved(p) => p,
+        }
+    }
+}
+
+/// What moving contact surfaces did in a run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct MotionCounts {
+    /// Full searches: the one where the run starts, then each step at which the
+    /// schedule of some interaction was due (`Update Search Every n Steps`).
+    pub searches: usize,
+    /// Placements of the points on the moved faces with the pairing kept.
+    pub refits: usize,
+    /// Times the solver made its pattern again because a search changed the couplings.
+    pub repatterns: usize,
 }
 
 impl<'a> ContactTerms<'a> {
@@ -71,6 +118,7 @@ impl<'a> ContactTerms<'a> {
         physics: &'a Physics<'a>,
         contact: &'a RunContact,
         couplings: &'a Couplings,
+        motion: Option<&'a Motion>,
     ) -> Self {
         let choices = &contact.choices;
         let term_choice: Vec<usize> = (0..choices.len())
@@ -93,7 +141,91 @@ impl<'a> ContactTerms<'a> {
             term_choice,
             mechanism_names,
             embedded: OnceCell::new(),
+            motion,
+            moving: RefCell::new(Moving::default()),
         }
+    }
+
+    /// What the moving surfaces did (all zero when nothing moves).
+    pub(super) fn motion_counts(&self) -> Option<MotionCounts> {
+        self.motion.map(|_| self.moving.borrow().counts)
+    }
+
+    /// The pairings as they are now: as the scene found them, or, when the surfaces
+    /// move, as the last move or search of the embedding left them.
+    fn pairings(&self) -> Result<Pairings<'_>, String> {
+        if self.motion.is_none() {
+            return Ok(Pairings::Scene(&self.contact.pairings));
+        }
+        if self.moving.borrow().current.is_none() {
+            let e = self.embedded().map_err(|e| e.to_string())?;
+            let embedding = e.embedding.borrow();
+            let mut now = Vec::with_capacity(self.contact.pairings.len());
+            for (k, p) in self.contact.pairings.iter().enumerate() {
+                let (a, b, result) = embedding.pairing_of(k).ok_or_else(|| {
+                    format!("interaction {} / {} not searched", p.side_a, p.side_b)
+                })?;
+                now.push(Pairing {
+                    side_a_geometry: a.clone(),
+                    side_b_geometry: b.clone(),
+                    result: result.clone(),
+                    ..p.clone()
+                });
+            }
+            self.moving.borrow_mut().current = Some(now);
+        }
+        Ok(Pairings::Moved(Ref::map(self.moving.borrow(), |m| {
+            m.current.as_deref().expect("just made")
+        })))
+    }
+
+    /// The surfaces placed at time `t`, and the interactions whose schedule is due at
+    /// `step` searched anew (once per step). True when the couplings changed.
+    fn place(&self, e: &Embedded, u: &[f64], t: f64, step: u64) -> Result<bool, InterfaceFailure> {
+        let Some(motion) = self.motion else {
+            return Ok(false);
+        };
+        let coords = motion.coords_at(t).map_err(InterfaceFailure::Failed)?;
+        let mut moving = self.moving.borrow_mut();
+        {
+            let mut embedding = e.embedding.borrow_mut();
+            embedding.move_nodes(&coords).map_err(failure)?;
+            // A step taken again (a cutback, a new pattern) is placed again, not
+            // searched or counted again.
+            let again = moving.searched_step == Some(step);
+            let due: Vec<usize> = (0..self.contact.pairings.len())
+                .filter(|&k| !again && self.schedule(k).full_search(step))
+                .collect();
+            moving.searched_step = Some(step);
+            if !due.is_empty() {
+                embedding.search_some(&due).map_err(failure)?;
+                moving.counts.searches += 1;
+                log::debug!(
+                    "step {step}, t = {t}: {} interaction(s) searched anew",
+                    due.len()
+                );
+            } else if !again {
+                moving.counts.refits += 1;
+            }
+            moving.current = None;
+        }
+        if step == 0 {
+            // The solver asks for the couplings as it starts.
+            return Ok(false);
+        }
+        let before = std::mem::take(&mut moving.pairs);
+        drop(moving);
+        let after = self.couplings(u, t)?;
+        let changed = after != before;
+        if changed {
+            self.moving.borrow_mut().counts.repatterns += 1;
+        }
+        Ok(changed)
+    }
+
+    /// The search schedule of interaction `k`'s definition.
+    fn schedule(&self, k: usize) -> SearchSchedule {
+        SearchSchedule::new(self.contact.search_every.get(k).copied().flatten())
     }
 
     /// Hand the run's interactions to an embedding over the solve's `dofs` (the fields,
@@ -102,7 +234,10 @@ impl<'a> ContactTerms<'a> {
         match self.embedded.get() {
             None => {
                 let made = self.embed(dofs)?;
-                let _ = self.embedded.set(made);
+                let e = self.embedded.get_or_init(|| made);
+                // Moving surfaces start where the displacement puts them at the start.
+                self.place(e, &[], self.physics.time.start, 0)
+                    .map_err(|e| e.to_string())?;
             }
             Some(e) if e.dofs != dofs.len() => {
                 return Err(format!(
@@ -143,7 +278,13 @@ impl<'a> ContactTerms<'a> {
                 a: field(fa)?,
                 b: field(fb)?,
             };
-            embedding.add_resolved(p.clone(), c, *scale, model.clone(), fields);
+            let again = self
+                .contact
+                .again
+                .borrow_mut()
+                .get_mut(k)
+                .and_then(Option::take);
+            embedding.add_resolved(p.clone(), (c, *scale), model.clone(), again, fields);
             if let Some(v) = &self.couplings.pressures[k] {
                 embedding
                     .set_point_pressures(k, Some(v.clone()))
@@ -210,11 +351,8 @@ impl<'a> ContactTerms<'a> {
         time: f64,
         faces: bool,
     ) -> Result<Derived, String> {
-        let (pairings, choices, views) = (
-            &self.contact.pairings,
-            &self.contact.choices,
-            &self.contact.views,
-        );
+        let pairings = self.pairings()?;
+        let (choices, views) = (&self.contact.choices, &self.contact.views);
         let pressures = &self.couplings.pressures;
         let mut out = Derived::default();
         let e = self.embedded().map_err(|e| e.to_string())?;
@@ -280,10 +418,11 @@ impl<'a> ContactTerms<'a> {
 
     /// The contact faces of a derived state, when some interaction visualises contact.
     pub(super) fn contact_of(&self, d: &Derived) -> Option<fields::ContactFields> {
-        let (pairings, views) = (&self.contact.pairings, &self.contact.views);
+        let views = &self.contact.views;
         if !views.iter().any(|v| v.faces) {
             return None;
         }
+        let pairings = self.pairings().ok()?;
         let mut out = fields::ContactFields::default();
         for (k, p) in pairings.iter().enumerate().filter(|(k, _)| views[*k].faces) {
             fields::contact_faces(
@@ -448,6 +587,7 @@ impl Interfaces for ContactTerms<'_> {
         })?;
         *e.slots.borrow_mut() = (pattern, slots);
         drop(embedding);
+        self.moving.borrow_mut().pairs = pairs.clone();
         Ok(pairs)
     }
 
@@ -487,5 +627,11 @@ impl Interfaces for ContactTerms<'_> {
         self.at_time(e, t)?;
         let heat = e.embedding.borrow().heat(u).map_err(failure)?;
         Ok(self.flux_heat(&heat))
+    }
+
+    fn advance(&self, u: &[f64], t: f64, step: u64) -> Result<bool, InterfaceFailure> {
+        let e = self.embedded()?;
+        self.at_time(e, t)?;
+        self.place(e, u, t, step)
     }
 }

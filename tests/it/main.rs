@@ -22,6 +22,7 @@ mod interactions;
 mod linear_solver;
 mod manual;
 mod mesh_io;
+mod moving;
 mod node_surfaces;
 mod output;
 mod plugin;

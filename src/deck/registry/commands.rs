@@ -76,8 +76,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "update_search_every_n_steps",
         [CD],
         "[=] <n> [steps]",
-        "Redo the search every n steps (1: every step); the value is kept in the spec. Range: n >= 1 (else E0227).",
-        warns "seam's meshes do not move in `seam run`, so re-searching has no effect; a warning says so"
+        "Redo the search every n steps (1: every step). In `seam run` with a `[displacement]` that moves the mesh: a full search where the run starts and at every n-th step, the pairing kept and its points placed on the moved faces in between; without one the mesh does not move and warning W0703 says the line has no effect. Range: n >= 1 (else E0227)."
     ),
     cmd!(
         "opposed normal threshold angle",
@@ -358,8 +357,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "search_update_frequency",
         [SO],
         "[=] <n>",
-        "Redo the search every n steps (ELFEN: `Global_update_frequency`); the value is kept in the spec. Range: n >= 1 (else E0227).",
-        warns "seam's meshes do not move in `seam run`, so re-searching has no effect; a warning says so"
+        "Redo the search every n steps (ELFEN: `Global_update_frequency`), as `update search every`; `update search every` wins when both are given. Range: n >= 1 (else E0227)."
     ),
     // Contact Surface block (Sierra/SM).
     cmd!(

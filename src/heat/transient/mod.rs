@@ -325,157 +325,169 @@ pub fn solve(
         )));
     }
     let mesh = p.mesh;
-    // The pattern: elements, interface couplings (from a first evaluation), ties.
-    let mut pattern = Pattern::new(mesh, &setup.dofs);
-    let couplings = match p.interfaces {
-        Some(i) => i
-            .couplings(&state.u, state.time)
-            .map_err(|e| HeatError::Contact(e.to_string()))?,
-        None => Vec::new(),
-    };
-    let first = pattern.add_couplings(&couplings)?.start;
-    let mut tie_first = Vec::with_capacity(setup.ties.len());
-    for (t, tie) in setup.ties.iter().enumerate() {
-        let pairs: Vec<(usize, usize)> = tie
-            .entries
-            .iter()
-            .map(|&(k, d, _)| (d, setup.lambda_first[t] + k))
-            .collect();
-        tie_first.push(pattern.add_couplings(&pairs)?.start);
-    }
-    let mut electric_first = Vec::with_capacity(setup.electric.len());
-    for c in &setup.electric {
-        electric_first.push(pattern.add_couplings(&c.couplings())?.start);
-    }
-    pattern.build()?;
-    let mut solver = Solvers::new(&setup, p.reproducible);
-    let mut asm = Assembler::new(&pattern);
-    let ctx = Context {
-        p,
-        setup: &setup,
-        first,
-        element_matrices: RefCell::new(None),
-        tie_first: &tie_first,
-        electric_first: &electric_first,
-        power: RefCell::new(Vec::new()),
-        unconverged: RefCell::new(None),
-    };
-
     let mut steps = 0;
     let mut rejected_total = 0;
-    match mode {
-        TimeMode::Steady { time } => {
-            let mut guess = state.u.clone();
-            let r = ctx.newton(&mut asm, &mut solver, &mut guess, time, None)?;
-            let r = match r {
-                Ok(r) => r,
-                // Out of iterations: the last iterate goes on, marked not converged.
-                Err(msg) => ctx.unconverged.take().ok_or(HeatError::Step(msg))?,
-            };
-            state.u = guess;
-            state.time = time;
-            let report = StepReport {
-                step: 0,
-                time,
-                dt: 0.0,
-                rejected: 0,
-                error_estimate: None,
-                ..r
-            };
-            on_step(&report, &state, &setup.dofs)?;
-            steps = 1;
+    // Made again when moving interfaces change their couplings.
+    'pattern: loop {
+        // The pattern: elements, interface couplings (from a first evaluation), ties.
+        let mut pattern = Pattern::new(mesh, &setup.dofs);
+        let couplings = match p.interfaces {
+            Some(i) => i
+                .couplings(&state.u, state.time)
+                .map_err(|e| HeatError::Contact(e.to_string()))?,
+            None => Vec::new(),
+        };
+        let first = pattern.add_couplings(&couplings)?.start;
+        let mut tie_first = Vec::with_capacity(setup.ties.len());
+        for (t, tie) in setup.ties.iter().enumerate() {
+            let pairs: Vec<(usize, usize)> = tie
+                .entries
+                .iter()
+                .map(|&(k, d, _)| (d, setup.lambda_first[t] + k))
+                .collect();
+            tie_first.push(pattern.add_couplings(&pairs)?.start);
         }
-        TimeMode::Transient {
-            scheme,
-            end,
-            adaptive,
-            dt_min,
-        } => {
-            let eps = 1e-12 * end.abs().max(state.dt);
-            while state.time < end - eps {
-                let mut rejected = 0;
-                loop {
-                    let mut dt = state.dt.min(end - state.time);
-                    if let Some(a) = adaptive {
-                        dt = dt.min(a.dt_max);
-                    }
-                    // Do not leave a sliver of a step before the end.
-                    if end - state.time - dt < 1e-6 * dt {
-                        dt = end - state.time;
-                    }
-                    let t_new = state.time + dt;
-                    let dt_prev = state.past.first().map(|(t, _)| state.time - t);
-                    let alpha = weights(scheme, dt, dt_prev);
-                    let mut u = predictor(&state, dt, 1);
-                    let history = Some(History {
-                        dt,
-                        alpha,
-                        current: &state.u,
-                        previous: state.past.first().map(|(_, u)| u.as_slice()),
-                    });
-                    let attempt = ctx.newton(&mut asm, &mut solver, &mut u, t_new, history)?;
-                    let failure = match attempt {
-                        Err(msg) => Some(msg),
-                        Ok(mut report) => {
-                            let estimate = adaptive
-                                .and_then(|_| error_estimate(scheme, &state, &u, dt, &setup));
-                            let too_big = match (adaptive, estimate) {
-                                (Some(a), Some(e)) => e > a.tolerance,
-                                _ => false,
-                            };
-                            if too_big {
-                                let (a, e) = (adaptive.unwrap(), estimate.unwrap());
-                                state.dt = dt * factor(a.tolerance, e, scheme).clamp(0.2, 0.9);
+        let mut electric_first = Vec::with_capacity(setup.electric.len());
+        for c in &setup.electric {
+            electric_first.push(pattern.add_couplings(&c.couplings())?.start);
+        }
+        pattern.build()?;
+        let mut solver = Solvers::new(&setup, p.reproducible);
+        let mut asm = Assembler::new(&pattern);
+        let ctx = Context {
+            p,
+            setup: &setup,
+            first,
+            element_matrices: RefCell::new(None),
+            tie_first: &tie_first,
+            electric_first: &electric_first,
+            power: RefCell::new(Vec::new()),
+            unconverged: RefCell::new(None),
+        };
+
+        match mode {
+            TimeMode::Steady { time } => {
+                let mut guess = state.u.clone();
+                let r = ctx.newton(&mut asm, &mut solver, &mut guess, time, None)?;
+                let r = match r {
+                    Ok(r) => r,
+                    // Out of iterations: the last iterate goes on, marked not converged.
+                    Err(msg) => ctx.unconverged.take().ok_or(HeatError::Step(msg))?,
+                };
+                state.u = guess;
+                state.time = time;
+                let report = StepReport {
+                    step: 0,
+                    time,
+                    dt: 0.0,
+                    rejected: 0,
+                    error_estimate: None,
+                    ..r
+                };
+                on_step(&report, &state, &setup.dofs)?;
+                steps = 1;
+            }
+            TimeMode::Transient {
+                scheme,
+                end,
+                adaptive,
+                dt_min,
+            } => {
+                let eps = 1e-12 * end.abs().max(state.dt);
+                while state.time < end - eps {
+                    let mut rejected = 0;
+                    loop {
+                        let mut dt = state.dt.min(end - state.time);
+                        if let Some(a) = adaptive {
+                            dt = dt.min(a.dt_max);
+                        }
+                        // Do not leave a sliver of a step before the end.
+                        if end - state.time - dt < 1e-6 * dt {
+                            dt = end - state.time;
+                        }
+                        let t_new = state.time + dt;
+                        // Moving interfaces are placed at t_new; new couplings need a new
+                        // pattern, and the step is taken again over it.
+                        if let Some(i) = p.interfaces
+                            && i.advance(&state.u, t_new, state.step as u64 + 1)
+                                .map_err(|e| HeatError::Contact(e.to_string()))?
+                        {
+                            continue 'pattern;
+                        }
+                        let dt_prev = state.past.first().map(|(t, _)| state.time - t);
+                        let alpha = weights(scheme, dt, dt_prev);
+                        let mut u = predictor(&state, dt, 1);
+                        let history = Some(History {
+                            dt,
+                            alpha,
+                            current: &state.u,
+                            previous: state.past.first().map(|(_, u)| u.as_slice()),
+                        });
+                        let attempt = ctx.newton(&mut asm, &mut solver, &mut u, t_new, history)?;
+                        let failure = match attempt {
+                            Err(msg) => Some(msg),
+                            Ok(mut report) => {
+                                let estimate = adaptive
+                                    .and_then(|_| error_estimate(scheme, &state, &u, dt, &setup));
+                                let too_big = match (adaptive, estimate) {
+                                    (Some(a), Some(e)) => e > a.tolerance,
+                                    _ => false,
+                                };
+                                if too_big {
+                                    let (a, e) = (adaptive.unwrap(), estimate.unwrap());
+                                    state.dt = dt * factor(a.tolerance, e, scheme).clamp(0.2, 0.9);
+                                    rejected += 1;
+                                    rejected_total += 1;
+                                    if state.dt < a.dt_min {
+                                        return Err(HeatError::Step(format!(
+                                            "at t = {}: the local error {e:.3e} K stays above the tolerance {:.3e} K down to dt_min = {}",
+                                            state.time, a.tolerance, a.dt_min
+                                        )));
+                                    }
+                                    continue;
+                                }
+                                // Accept: shift the history and pick the next step.
+                                let old = std::mem::replace(&mut state.u, u);
+                                state.past.insert(0, (state.time, old));
+                                state.past.truncate(2);
+                                state.time = t_new;
+                                state.step += 1;
+                                state.dt = match (adaptive, estimate) {
+                                    (Some(a), Some(e)) => (dt
+                                        * factor(a.tolerance, e, scheme).clamp(0.2, 2.0))
+                                    .clamp(a.dt_min, a.dt_max),
+                                    _ => state.dt,
+                                };
+                                report.step = state.step;
+                                report.time = t_new;
+                                report.dt = dt;
+                                report.rejected = rejected;
+                                report.error_estimate = estimate;
+                                on_step(&report, &state, &setup.dofs)?;
+                                steps += 1;
+                                None
+                            }
+                        };
+                        match failure {
+                            None => break,
+                            Some(msg) => {
                                 rejected += 1;
                                 rejected_total += 1;
-                                if state.dt < a.dt_min {
+                                state.dt = dt * 0.5;
+                                let floor = adaptive.map_or(dt_min, |a| a.dt_min);
+                                if state.dt < floor {
                                     return Err(HeatError::Step(format!(
-                                        "at t = {}: the local error {e:.3e} K stays above the tolerance {:.3e} K down to dt_min = {}",
-                                        state.time, a.tolerance, a.dt_min
+                                        "at t = {}: {msg}; the step was cut to {} and may not go below {floor}",
+                                        state.time, state.dt
                                     )));
                                 }
-                                continue;
-                            }
-                            // Accept: shift the history and pick the next step.
-                            let old = std::mem::replace(&mut state.u, u);
-                            state.past.insert(0, (state.time, old));
-                            state.past.truncate(2);
-                            state.time = t_new;
-                            state.step += 1;
-                            state.dt = match (adaptive, estimate) {
-                                (Some(a), Some(e)) => (dt
-                                    * factor(a.tolerance, e, scheme).clamp(0.2, 2.0))
-                                .clamp(a.dt_min, a.dt_max),
-                                _ => state.dt,
-                            };
-                            report.step = state.step;
-                            report.time = t_new;
-                            report.dt = dt;
-                            report.rejected = rejected;
-                            report.error_estimate = estimate;
-                            on_step(&report, &state, &setup.dofs)?;
-                            steps += 1;
-                            None
-                        }
-                    };
-                    match failure {
-                        None => break,
-                        Some(msg) => {
-                            rejected += 1;
-                            rejected_total += 1;
-                            state.dt = dt * 0.5;
-                            let floor = adaptive.map_or(dt_min, |a| a.dt_min);
-                            if state.dt < floor {
-                                return Err(HeatError::Step(format!(
-                                    "at t = {}: {msg}; the step was cut to {} and may not go below {floor}",
-                                    state.time, state.dt
-                                )));
                             }
                         }
                     }
                 }
             }
         }
+        break 'pattern;
     }
     Ok(Outcome {
         crosspoints: setup.ties.iter().map(|t| t.crosspoints.clone()).collect(),
