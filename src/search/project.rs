@@ -392,7 +392,9 @@ pub fn project_point_quad4(p: [f64; 3], x: &[[f64; 3]; 4]) -> Projection {
         dot(cross(e_prev, e), area_normal) <= 0.0
     });
     let d_now = best.map_or(d2_edge, |b| b.2.min(d2_edge)).sqrt();
-    if !warped || folded || d_now * w_n > 0.25 * norm(va) {
+    // A first start that finds no stationary point inside says nothing about the
+    // others: restart too.
+    if !warped || folded || best.is_none() || d_now * w_n > 0.25 * norm(va) {
         for a in [-0.5, 0.0, 0.5] {
             for b in [-0.5, 0.0, 0.5] {
                 best = closer(best, stationary([a, b]));
