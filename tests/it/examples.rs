@@ -754,12 +754,15 @@ fn opening_gap_follows_its_one_dimensional_stack() {
     let solve = |mut a: Vec<Vec<f64>>, mut b: Vec<f64>| -> Vec<f64> {
         let m = b.len();
         for p in 0..m {
-            for i in p + 1..m {
-                let f = a[i][p] / a[p][p];
-                for j in p..m {
-                    a[i][j] -= f * a[p][j];
-                }
-                b[i] -= f * b[p];
+            let (upper, lower) = a.split_at_mut(p + 1);
+            let pivot = &upper[p];
+            for (i, row) in lower.iter_mut().enumerate() {
+                let f = row[p] / pivot[p];
+                row[p..]
+                    .iter_mut()
+                    .zip(&pivot[p..])
+                    .for_each(|(r, q)| *r -= f * q);
+                b[p + 1 + i] -= f * b[p];
             }
         }
         let mut x = vec![0.0; m];
