@@ -145,22 +145,7 @@ impl Embedding {
         }
         self.mesh.coords = coords.to_vec();
         for p in &mut self.pairs {
-            for (surface, geometry) in [(&p.side_a, &mut p.a), (&p.side_b, &mut p.b)] {
-                *geometry = SurfaceGeometry::from_surface(&self.mesh, surface, coords)
-                    .map_err(|e| argument(e.to_string(), "interfaces are searched in 3-D"))?;
-            }
-            // A periodic pair's side A is the image of the moved surface.
-            if let Some(image) = &mut p.image {
-                p.a = p.a.mapped(image.map.as_mut(), &image.name).map_err(|e| {
-                    argument(
-                        format!(
-                            "periodic interaction {} / {}: {e}",
-                            p.side_a.name, p.side_b.name
-                        ),
-                        "the map failed on the moved nodes of side A",
-                    )
-                })?;
-            }
+            Self::place(&self.mesh, p)?;
             if let Some(r) = &mut p.result {
                 r.update_geometry(&p.a, &p.b);
             }
@@ -171,6 +156,54 @@ impl Embedding {
             if let Some(s) = &mut p.searcher {
                 s.refit(&p.b);
             }
+        }
+        Ok(())
+    }
+
+    /// The geometry of `p`'s two surfaces on the mesh's present coordinates.
+    fn place(mesh: &crate::mesh::Mesh, p: &mut Pair) -> Result<(), EmbedError> {
+        for (surface, geometry) in [(&p.side_a, &mut p.a), (&p.side_b, &mut p.b)] {
+            *geometry = SurfaceGeometry::from_surface(mesh, surface, &mesh.coords)
+                .map_err(|e| argument(e.to_string(), "interfaces are searched in 3-D"))?;
+        }
+        // A periodic pair's side A is the image of the moved surface.
+        if let Some(image) = &mut p.image {
+            p.a = p.a.mapped(image.map.as_mut(), &image.name).map_err(|e| {
+                argument(
+                    format!(
+                        "periodic interaction {} / {}: {e}",
+                        p.side_a.name, p.side_b.name
+                    ),
+                    "the map failed on the moved nodes of side A",
+                )
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Interaction `i` takes the surfaces `side_a` and `side_b` (the same names, other
+    /// faces: element death made them again); its pairing is cleared until the next
+    /// search ([`Self::search_some`]).
+    pub(crate) fn replace_surfaces(
+        &mut self,
+        i: usize,
+        side_a: crate::surface::ContactSurface,
+        side_b: crate::surface::ContactSurface,
+    ) -> Result<(), EmbedError> {
+        let Some(p) = self.pairs.get_mut(i) else {
+            return Err(argument(
+                format!("no interaction {i}"),
+                "number the interactions from 0",
+            ));
+        };
+        p.side_a = side_a;
+        p.side_b = side_b;
+        Self::place(&self.mesh, p)?;
+        p.result = None;
+        p.searcher = None;
+        p.points = OnceLock::new();
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
         }
         Ok(())
     }

@@ -41,6 +41,8 @@ pub(super) struct RunContact {
     /// Per interaction, its definition's `Update Search Every n Steps` (or `Search
     /// Update Frequency`), for surfaces that move.
     pub search_every: Vec<Option<u32>>,
+    /// Per interaction, the index of its contact definition in the deck.
+    pub definition: Vec<usize>,
     /// Per interaction, what searching it again takes (surfaces that move only); taken
     /// by the run's embedding.
     pub again: std::cell::RefCell<Vec<Option<crate::scene::SearchAgain>>>,
@@ -62,7 +64,7 @@ impl RunContact {
     ) -> Result<RunContact, RunError> {
         let mut out = match &file.problem.contact {
             Some(c) => {
-                let moving = file.problem.displacement.is_some();
+                let moving = file.problem.displacement.is_some() || !file.problem.death.is_empty();
                 Self::scene(c, &file.dir, mesh, field_names, options, moving, diags)?
             }
             None => RunContact::default(),
@@ -175,6 +177,7 @@ impl RunContact {
         out.electrical = scene.electrical;
         for e in scene.entries {
             out.again.get_mut().push(e.again);
+            out.definition.push(e.definition);
             out.search_every.push(
                 scene
                     .definitions

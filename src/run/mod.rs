@@ -55,6 +55,7 @@
 
 pub mod bundled;
 mod contact;
+mod death;
 mod fields;
 mod motion;
 mod nodal_field;
@@ -77,9 +78,9 @@ use crate::mesh::Mesh;
 
 pub use output::NOT_CONVERGED;
 pub use problem::{
-    BcKind, BcSpec, ContactSpec, DisplacementSpec, InitialSpec, MAX_MAGNITUDE, MAX_TEMPERATURE,
-    MaterialSpec, MeshSpec, NodalFieldSpec, OutputSpec, Problem, RestartSpec, SolveSpec,
-    SourceSpec, ToggleSpec, Value,
+    BcKind, BcSpec, ContactSpec, DeathSpec, DisplacementSpec, InitialSpec, MAX_MAGNITUDE,
+    MAX_TEMPERATURE, MaterialSpec, MeshSpec, NodalFieldSpec, OutputSpec, Problem, RestartSpec,
+    SolveSpec, SourceSpec, ToggleSpec, Value,
 };
 pub use summary::{
     InteractionHeat, LinearSolverSummary, Summary, Timing, TransientSummary, peak_memory_mib,
@@ -87,6 +88,7 @@ pub use summary::{
 pub use terms::MotionCounts;
 
 use contact::{Couplings, RunContact};
+use death::Death;
 use motion::Motion;
 use output::Output;
 use physics::Physics;
@@ -246,7 +248,14 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         &file.text,
         &mut diags,
     );
-    if motion.is_some() {
+    let death = Death::new(
+        &file.problem.death,
+        &mesh,
+        file.transient,
+        &file.text,
+        &mut diags,
+    );
+    if motion.is_some() || death.is_some() {
         motion::refuse_what_cannot_move(&file.text, &contact, &couplings, &mut diags);
     }
     if diags.has_errors() {
@@ -260,7 +269,12 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         }));
     }
     // Time loop: the contact terms over the scene, solved, each accepted step written.
-    let terms = ContactTerms::new(&physics, &contact, &couplings, motion.as_ref());
+    let terms = ContactTerms::new(
+        &physics,
+        &contact,
+        &couplings,
+        (motion.as_ref(), death.as_ref()),
+    );
     let mut output = Output::open(&file, &physics, &terms)?;
     let solved = TimeLoop::new(&file, &physics, &terms, options).run(initial, &mut output)?;
     terms.report_quarantined(&mut diags);
@@ -290,10 +304,11 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     summary.motion = terms.motion_counts();
     if let Some(m) = &summary.motion {
         log::info!(
-            "moving contact: {} search(es), {} refit(s), {} new pattern(s)",
+            "moving contact: {} search(es), {} refit(s), {} new pattern(s), {} surface update(s)",
             m.searches,
             m.refits,
-            m.repatterns
+            m.repatterns,
+            m.surface_updates
         );
     }
     output.mark_not_converged(summary.diagnosis.as_deref())?;

@@ -55,6 +55,28 @@ pub struct Problem {
     /// A nodal displacement field that moves the contact surfaces in time.
     #[serde(default)]
     pub displacement: Option<DisplacementSpec>,
+    /// Element death in time.
+    #[serde(default)]
+    pub death: Vec<DeathSpec>,
+}
+
+/// `[[death]]`: blocks or elements that die at a time. From then on they add nothing,
+/// the nodes no live element holds keep their values, and the contact surfaces are
+/// made again: a skinned block gains the faces the death exposes, a side-set surface
+/// loses the faces of dead elements (the Sierra rule).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeathSpec {
+    /// Element blocks (names, or `block_<id>`) whose elements die.
+    #[serde(default)]
+    pub blocks: Vec<String>,
+    /// Elements that die, by their numbers in the mesh file (Exodus element ids, Gmsh
+    /// element tags).
+    #[serde(default)]
+    pub elements: Vec<i64>,
+    /// The time from which they are dead (s): a step ending at or after it is solved
+    /// without them.
+    pub time: f64,
 }
 
 /// `[displacement]`: the nodes' displacement u(X, t) (m), from Lua expressions or from

@@ -236,6 +236,7 @@ impl<'a> TimeLoop<'a> {
                     .map(|(e, h)| (e.contact.clone(), h as &transient::ContactConductance<'_>))
                     .collect(),
             }),
+            death: terms.death_times(),
         };
         let restart = match (&problem.restart, self.options.restart.as_ref()) {
             (_, Some(file)) => Some(steps::read_checkpoint(file)?),

@@ -23,6 +23,7 @@ use crate::search::pairing::{Integration, SearchSchedule};
 use crate::search::scene::Pairing;
 
 use super::contact::{Couplings, RunContact};
+use super::death::Death;
 use super::fields::{self, Derived};
 use super::motion::Motion;
 use super::physics::Physics;
@@ -67,6 +68,8 @@ pub(super) struct ContactTerms<'a> {
     embedded: OnceCell<Embedded>,
     /// The displacement that moves the contact surfaces, if any.
     motion: Option<&'a Motion>,
+    /// Element death, which makes the contact surfaces again.
+    death: Option<&'a Death>,
     /// What the moving surfaces did.
     moving: RefCell<Moving>,
 }
@@ -82,6 +85,10 @@ struct Moving {
     pairs: Vec<(usize, usize)>,
     /// The pairings as the last move or search left them (made when asked for).
     current: Option<Vec<Pairing>>,
+    /// How many elements were dead when the surfaces were last made.
+    dead: usize,
+    /// Interactions whose surfaces element death emptied: off from then on.
+    gone: Vec<bool>,
 }
 
 /// The pairings of a state: the scene's, or those the surfaces' motion made.
@@ -110,6 +117,8 @@ pub struct MotionCounts {
     pub refits: usize,
     /// Times the solver made its pattern again because a search changed the couplings.
     pub repatterns: usize,
+    /// Times element death made the contact surfaces again.
+    pub surface_updates: usize,
 }
 
 impl<'a> ContactTerms<'a> {
@@ -118,7 +127,7 @@ impl<'a> ContactTerms<'a> {
         physics: &'a Physics<'a>,
         contact: &'a RunContact,
         couplings: &'a Couplings,
-        motion: Option<&'a Motion>,
+        (motion, death): (Option<&'a Motion>, Option<&'a Death>),
     ) -> Self {
         let choices = &contact.choices;
         let term_choice: Vec<usize> = (0..choices.len())
@@ -142,19 +151,28 @@ impl<'a> ContactTerms<'a> {
             mechanism_names,
             embedded: OnceCell::new(),
             motion,
-            moving: RefCell::new(Moving::default()),
+            death,
+            moving: RefCell::new(Moving {
+                gone: vec![false; contact.pairings.len()],
+                ..Moving::default()
+            }),
         }
+    }
+
+    /// Per mesh element its death time, when elements die.
+    pub(super) fn death_times(&self) -> Option<&'a [f64]> {
+        self.death.map(|d| d.times.as_slice())
     }
 
     /// What the moving surfaces did (all zero when nothing moves).
     pub(super) fn motion_counts(&self) -> Option<MotionCounts> {
-        self.motion.map(|_| self.moving.borrow().counts)
+        (self.motion.is_some() || self.death.is_some()).then(|| self.moving.borrow().counts)
     }
 
     /// The pairings as they are now: as the scene found them, or, when the surfaces
     /// move, as the last move or search of the embedding left them.
     fn pairings(&self) -> Result<Pairings<'_>, String> {
-        if self.motion.is_none() {
+        if self.motion.is_none() && self.death.is_none() {
             return Ok(Pairings::Scene(&self.contact.pairings));
         }
         if self.moving.borrow().current.is_none() {
@@ -182,20 +200,35 @@ impl<'a> ContactTerms<'a> {
     /// The surfaces placed at time `t`, and the interactions whose schedule is due at
     /// `step` searched anew (once per step). True when the couplings changed.
     fn place(&self, e: &Embedded, u: &[f64], t: f64, step: u64) -> Result<bool, InterfaceFailure> {
-        let Some(motion) = self.motion else {
+        if self.motion.is_none() && self.death.is_none() {
             return Ok(false);
-        };
-        let coords = motion.coords_at(t).map_err(InterfaceFailure::Failed)?;
+        }
         let mut moving = self.moving.borrow_mut();
         {
             let mut embedding = e.embedding.borrow_mut();
-            embedding.move_nodes(&coords).map_err(failure)?;
+            if let Some(motion) = self.motion {
+                let coords = motion.coords_at(t).map_err(InterfaceFailure::Failed)?;
+                embedding.move_nodes(&coords).map_err(failure)?;
+            }
             // A step taken again (a cutback, a new pattern) is placed again, not
             // searched or counted again.
             let again = moving.searched_step == Some(step);
-            let due: Vec<usize> = (0..self.contact.pairings.len())
-                .filter(|&k| !again && self.schedule(k).full_search(step))
+            let mut due: Vec<usize> = (0..self.contact.pairings.len())
+                .filter(|&k| !again && self.motion.is_some() && self.schedule(k).full_search(step))
                 .collect();
+            // Element death makes the surfaces again, and they are searched.
+            if let Some(death) = self.death {
+                let dead = death.dead_at(t);
+                if dead.len() != moving.dead {
+                    let remade = self.remake_surfaces(&mut embedding, &dead, &mut moving.gone)?;
+                    due.extend(remade);
+                    due.sort_unstable();
+                    due.dedup();
+                    moving.dead = dead.len();
+                    moving.counts.surface_updates += 1;
+                }
+            }
+            due.retain(|&k| !moving.gone[k]);
             moving.searched_step = Some(step);
             if !due.is_empty() {
                 embedding.search_some(&due).map_err(failure)?;
@@ -204,7 +237,7 @@ impl<'a> ContactTerms<'a> {
                     "step {step}, t = {t}: {} interaction(s) searched anew",
                     due.len()
                 );
-            } else if !again {
+            } else if !again && self.motion.is_some() {
                 moving.counts.refits += 1;
             }
             moving.current = None;
@@ -221,6 +254,42 @@ impl<'a> ContactTerms<'a> {
             self.moving.borrow_mut().counts.repatterns += 1;
         }
         Ok(changed)
+    }
+
+    /// Every interaction's surfaces made again without the `dead` elements (by its
+    /// definition's rules); an interaction left without faces on a side is gone. The
+    /// interactions to search.
+    fn remake_surfaces(
+        &self,
+        embedding: &mut Embedding,
+        dead: &std::collections::HashSet<crate::mesh::ElemId>,
+        gone: &mut [bool],
+    ) -> Result<Vec<usize>, InterfaceFailure> {
+        let mesh = self.physics.mesh;
+        let sets = crate::scene::ContactScene::surfaces(mesh, &self.contact.loaded, dead);
+        let mut out = Vec::new();
+        for (k, p) in self.contact.pairings.iter().enumerate() {
+            if gone[k] {
+                continue;
+            }
+            let set = &sets[self.contact.definition[k]].1;
+            let side_a = &set.surfaces[p.side_a_surface];
+            let side_b = &set.surfaces[p.side_b_surface];
+            if side_a.faces.is_empty() && side_a.nodes.is_empty() || side_b.faces.is_empty() {
+                log::info!(
+                    "interaction {} / {}: element death left a side without faces; it is off from now on",
+                    p.side_a,
+                    p.side_b
+                );
+                gone[k] = true;
+                continue;
+            }
+            embedding
+                .replace_surfaces(k, side_a.clone(), side_b.clone())
+                .map_err(failure)?;
+            out.push(k);
+        }
+        Ok(out)
     }
 
     /// The search schedule of interaction `k`'s definition.
@@ -311,9 +380,10 @@ impl<'a> ContactTerms<'a> {
     fn at_time(&self, e: &Embedded, t: f64) -> Result<(), InterfaceFailure> {
         let mut embedding = e.embedding.borrow_mut();
         embedding.set_time(t).map_err(failure)?;
+        let moving = self.moving.borrow();
         for k in 0..self.contact.choices.len() {
             embedding
-                .set_active(k, self.couplings.on(k, t))
+                .set_active(k, self.couplings.on(k, t) && !moving.gone[k])
                 .map_err(failure)?;
         }
         Ok(())

@@ -265,6 +265,7 @@ fn run(
             conductivity: &sigma,
             contacts: vec![(contact, &h_e)],
         }),
+        death: None,
     };
     let initial = |_| bars.t_inf;
     let mut last = None;

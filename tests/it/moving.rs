@@ -266,3 +266,154 @@ fn what_cannot_move_is_refused_with_its_reason() {
     assert_eq!(refused[0].0, "E0731");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Block 1 in two layers under the lid at gap `G0`; at t = 5 its upper layer dies. With
+/// block 1 skinned for contact, the faces the death exposes at z = 0.5 join its surface
+/// and carry the heat across the wider gap; with the side set of its top instead, the
+/// surface loses its faces and the interaction carries nothing (the Sierra rule).
+fn dying(dir: &Path, side_a: &str) -> (PathBuf, Vec<i64>) {
+    let mesh = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, 1.0], [2, 2, 2], 1)
+                .with_side_sets([0, 0, 0, 0, 1, 2]),
+            BoxSpec::hex([0.0, 0.0, 1.0 + G0], [1.0, 1.0, 2.0 + G0], [3, 3, 2], 2)
+                .with_side_sets([0, 0, 0, 0, 3, 4]),
+        ],
+        false,
+    );
+    // The upper layer of block 1, by element number.
+    let upper: Vec<i64> = mesh.blocks[0]
+        .elems()
+        .filter(|&e| {
+            let z: f64 = mesh
+                .elem_nodes(e)
+                .iter()
+                .map(|n| mesh.coords[n.index()][2])
+                .sum();
+            z / 8.0 > 0.5
+        })
+        .map(|e| mesh.elem_numbers[e.index()])
+        .collect();
+    assert_eq!(upper.len(), 4);
+    ExodusWriter::create(&dir.join("mesh.exo"), &mesh, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    let numbers: Vec<String> = upper.iter().map(i64::to_string).collect();
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = \"mesh.exo\"\n\
+             [[material]]\nblocks = [\"block_1\", \"block_2\"]\nconductivity = 1.0\nrho_c = 1e-12\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n\
+             [initial]\ntemperature = 0.5\n\
+             [[death]]\nelements = [{}]\ntime = 5.0\n\
+             [contact]\nfile = \"contact.i\"\n\
+             [solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 1.0\nend_time = 10.0\ntolerance = 1e-12\n",
+            numbers.join(", ")
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition\n  contact surface a contains {side_a}\n  contact surface b contains surface_3\n\
+             begin search options\n    normal tolerance = 0.8\n  end\n\
+             begin interaction\n    side a a\n    side b b\n  end\n\
+             begin enforcement\n    enforcement for energy = gap_conductance\n    gap conductance coefficient = gas_gap k = {K_GAS} min_gap = 1e-4\n  end\nend\n"
+        ),
+    )
+    .unwrap();
+    (dir.join("problem.toml"), upper)
+}
+
+#[test]
+fn element_death_exposes_faces_of_a_skinned_block_and_removes_those_of_a_side_set() {
+    let dir = scratch("moving-death");
+    let (problem, _) = dying(&dir, "block_1");
+    let r = run(&problem);
+    let before = series_heat(G0);
+    // After: half of block 1 left, the gap 0.5 wider.
+    let after = 1.0 / (0.5 + (G0 + 0.5) / K_GAS + 1.0);
+    let mut worst = 0.0f64;
+    for s in &r.history {
+        let exact = if s.time >= 5.0 { after } else { before };
+        let (a, b) = s.heat[0];
+        let err = ((a - exact).abs()).max((-b - exact).abs()) / exact;
+        println!(
+            "t = {}: heat {a} / {}, exact {exact}, rel err {err:.1e}",
+            s.time, -b
+        );
+        worst = worst.max(err);
+    }
+    let m = r
+        .summary
+        .motion
+        .expect("a run with death reports its surface updates");
+    println!("{m:?}");
+    assert!(worst <= 1e-9, "{worst:e}");
+    assert_eq!(m.surface_updates, 1);
+    // The nodes the death left alone keep the temperature they had when it came: those
+    // at z = 1 on block 1, at t = 4's value.
+    let mesh = &r.mesh;
+    let top: Vec<usize> = mesh.blocks[0]
+        .connectivity
+        .iter()
+        .map(|n| n.index())
+        .filter(|&n| (mesh.coords[n][2] - 1.0).abs() < 1e-12)
+        .collect();
+    let t4 = 1.0 - 1.0 / (1.0 + G0 / K_GAS + 1.0) * 1.0;
+    for &n in &top {
+        let t = r.solution.temperature[n];
+        assert!((t - t4).abs() <= 1e-9, "node {n}: {t} against {t4}");
+    }
+    // The side set of block 1's top loses its faces: nothing crosses after t = 5.
+    let (problem, _) = dying(&dir, "surface_2");
+    let r = run(&problem);
+    for s in &r.history {
+        let (a, _) = s.heat[0];
+        if s.time >= 5.0 {
+            assert_eq!(a, 0.0, "t = {}", s.time);
+        } else {
+            assert!((a - before).abs() <= 1e-9 * before);
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn death_input_that_cannot_act_is_refused_at_its_line() {
+    let dir = scratch("moving-death-refused");
+    let (problem, _) = dying(&dir, "block_1");
+    let text = std::fs::read_to_string(&problem).unwrap();
+    let check = |edit: &str| -> Vec<(String, u32)> {
+        std::fs::write(&problem, edit).unwrap();
+        match seam::run::check(&problem) {
+            Ok(_) => Vec::new(),
+            Err(RunError::Input(d, _)) => {
+                d.0.iter()
+                    .filter(|d| d.severity == seam::diag::Severity::Error)
+                    .map(|d| (d.code.to_string(), d.loc.as_ref().map_or(0, |l| l.line)))
+                    .collect()
+            }
+            Err(e) => panic!("{e:?}"),
+        }
+    };
+    assert!(check(&text).is_empty());
+    let line =
+        |t: &str, what: &str| t.lines().position(|l| l.starts_with(what)).unwrap() as u32 + 1;
+    let unknown = text.replace("elements = [", "blocks = [\"block_9\"]\nelements = [");
+    assert_eq!(
+        check(&unknown),
+        [("E0732".into(), line(&unknown, "blocks = [\"block_9"))]
+    );
+    let number = text.replace("elements = [", "elements = [99999, ");
+    assert_eq!(
+        check(&number),
+        [("E0732".into(), line(&number, "elements = [99999"))]
+    );
+    let steady = text.replace("kind = \"transient\"", "kind = \"steady\"");
+    assert_eq!(check(&steady)[0].0, "E0732");
+    std::fs::remove_dir_all(&dir).ok();
+}

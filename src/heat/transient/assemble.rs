@@ -74,8 +74,20 @@ impl Context<'_, '_> {
                 .map(|f| (f.side().elem.0, f.side().side, f.outflow(0.0).1))
                 .collect()
         });
+        // Element death changes the matrices: the count of dead elements is part of the
+        // signature.
+        self.refresh_alive(t)?;
+        let signature = signature.map(|mut s| {
+            let dead = self.alive.borrow().as_ref().map_or(0, |a| a.dead);
+            s.push((u32::MAX, 0, dead as f64));
+            s
+        });
         let keep = signature.is_some() && *self.element_matrices.borrow() == signature;
+        let death = p.death;
         asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
+            if super::death::is_dead(death, e, t) {
+                return;
+            }
             let b = mesh.block_of(e);
             if let Some(sigma) = sigmas.and_then(|s| s.get(b)?.as_ref()) {
                 if let Err(err) = cx.electric_element(e, sigma, re, je) {
@@ -199,9 +211,10 @@ impl Context<'_, '_> {
         asm.reset_couplings();
         let mut r = asm.rhs();
         // Capacity (lumped): M(u)(α₀u + α₁uⁿ + α₂uⁿ⁻¹)/Δt on the diagonal.
+        let alive = self.alive.borrow();
         if let Some(h) = history {
-            let terms: Vec<Result<(usize, f64, f64), String>> = setup
-                .lumped
+            let lumped = alive.as_ref().map_or(&setup.lumped, |a| &a.lumped);
+            let terms: Vec<Result<(usize, f64, f64), String>> = lumped
                 .par_iter()
                 .with_min_len(4096)
                 .map(|&(d, b, w, xn)| {
@@ -221,6 +234,15 @@ impl Context<'_, '_> {
                 asm.add_diagonal(d, jv);
             }
         }
+        // The dofs no live element holds keep their value: u − uⁿ = 0 (a steady
+        // solve keeps u).
+        if let Some(a) = alive.as_ref() {
+            for &d in &a.orphans {
+                r[d] = history.map_or(0.0, |h| u[d] - h.current[d]);
+                asm.add_diagonal(d, 1.0);
+            }
+        }
+        drop(alive);
         // Interfaces.
         let heat = match p.interfaces {
             Some(i) => i

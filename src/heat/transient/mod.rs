@@ -41,6 +41,7 @@
 //! a state, the interface heat); this file holds the problem types and the time loop.
 
 mod assemble;
+mod death;
 mod newton;
 mod setup;
 
@@ -149,6 +150,9 @@ pub struct TransientProblem<'a> {
     /// The voltage field, its Joule heat and electrical contacts: the problem becomes a
     /// coupled thermal–electrical one, solved monolithically.
     pub electric: Option<Electric<'a>>,
+    /// Element death: per mesh element the time from which it is dead (∞: never). A
+    /// dead element adds nothing; the nodes no live element holds keep their values.
+    pub death: Option<&'a [f64]>,
 }
 
 /// Step-size control.
@@ -363,6 +367,7 @@ pub fn solve(
             electric_first: &electric_first,
             power: RefCell::new(Vec::new()),
             unconverged: RefCell::new(None),
+            alive: RefCell::new(None),
         };
 
         match mode {

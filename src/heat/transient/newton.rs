@@ -91,6 +91,8 @@ pub(super) struct Context<'c, 'a> {
     /// The report of the last Newton attempt that ran out of iterations (its
     /// `diagnosis` set), for a steady solve to hand on with its last iterate.
     pub(super) unconverged: RefCell<Option<StepReport>>,
+    /// The live part of the problem once elements have died.
+    pub(super) alive: RefCell<Option<super::death::Alive>>,
 }
 
 /// Why Newton ran out of iterations, from its residual history: the history itself and

@@ -85,7 +85,7 @@ impl Setup {
             .iter()
             .map(|t| dofs.add_extra(t.own.len()).start)
             .collect();
-        let lumped = lumped_weights(mesh, &dofs)?;
+        let lumped = lumped_weights(mesh, &dofs, &|_| true)?;
         let mut blocks: Vec<usize> = Vec::new();
         let mut rules = vec![None; mesh.blocks.len()];
         for &f in &fields {
@@ -170,7 +170,11 @@ pub(super) fn node_dofs(
 pub(super) type LumpedWeight = (u32, u32, f64, [f64; 3]);
 
 /// Lumped capacity weights `∫ N_a dV` per (dof, block), with the node's coordinates.
-pub(super) fn lumped_weights(mesh: &Mesh, dofs: &DofMap) -> Result<Vec<LumpedWeight>, HeatError> {
+pub(super) fn lumped_weights(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    live: &dyn Fn(crate::mesh::ElemId) -> bool,
+) -> Result<Vec<LumpedWeight>, HeatError> {
     let mut out: std::collections::BTreeMap<(u32, u32), f64> = Default::default();
     let mut elem_dofs = Vec::new();
     for (b, block) in mesh.blocks.iter().enumerate() {
@@ -187,6 +191,9 @@ pub(super) fn lumped_weights(mesh: &Mesh, dofs: &DofMap) -> Result<Vec<LumpedWei
         let mut me = vec![0.0; nn * nn];
         for k in 0..block.len() {
             let e = crate::mesh::ElemId(block.first_elem.0 + k as u32);
+            if !live(e) {
+                continue;
+            }
             let mut x = [[0.0; 3]; MAX_NODES];
             let m = elem_coords(mesh, e, &mut x);
             me.fill(0.0);
