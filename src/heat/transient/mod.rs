@@ -421,7 +421,7 @@ pub fn solve(
                         }
                         let dt_prev = state.past.first().map(|(t, _)| state.time - t);
                         let alpha = weights(scheme, dt, dt_prev);
-                        let mut u = predictor(&state, dt, 1);
+                        let mut u = predictor(&state, dt, scheme.order() as usize);
                         let history = Some(History {
                             dt,
                             alpha,
@@ -513,8 +513,21 @@ fn factor(tol: f64, err: f64, scheme: Scheme) -> f64 {
 }
 
 /// The starting guess of a step: the last state, extrapolated linearly when `order` ≥ 1
-/// and a history exists.
+/// and a history exists, quadratically (through the last three states) when `order` ≥ 2
+/// and two earlier states exist.
 fn predictor(state: &State, dt: f64, order: usize) -> Vec<f64> {
+    if let (2.., [(t1, u1), (t2, u2), ..]) = (order, state.past.as_slice())
+        && state.time > *t1
+        && *t1 > *t2
+    {
+        let (x0, x1, x2, x) = (state.time, *t1, *t2, state.time + dt);
+        let l0 = (x - x1) * (x - x2) / ((x0 - x1) * (x0 - x2));
+        let l1 = (x - x0) * (x - x2) / ((x1 - x0) * (x1 - x2));
+        let l2 = (x - x0) * (x - x1) / ((x2 - x0) * (x2 - x1));
+        return (state.u.iter().zip(u1).zip(u2))
+            .map(|((u0, u1), u2)| l0 * u0 + l1 * u1 + l2 * u2)
+            .collect();
+    }
     match (order, state.past.first()) {
         (1.., Some((t_prev, u_prev))) if state.time > *t_prev => {
             let s = dt / (state.time - t_prev);
