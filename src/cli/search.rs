@@ -1,0 +1,189 @@
+//! `seam search`: pair the deck's surfaces and report each pair's coverage.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use serde::Serialize;
+
+use seam::scene::{ContactScene, SceneOptions};
+
+use super::surfaces::Warning;
+use super::{EXIT_BAD_INPUT, format_number, load};
+
+#[derive(Serialize)]
+struct SearchReport {
+    interactions: Vec<seam::search::scene::PairingSummary>,
+    timing: seam::search::scene::Timing,
+    warnings: Vec<Warning>,
+}
+
+pub fn search(
+    deck_path: &Path,
+    mesh_path: &Path,
+    json: bool,
+    segments: bool,
+    order: usize,
+    axisymmetric: bool,
+) -> ExitCode {
+    use seam::scene::OutputRule;
+    use seam::search::pairing::Integration;
+    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric, json) {
+        Ok(x) => x,
+        Err(code) => return code,
+    };
+    let mesh = mesh.expect("a mesh path was given");
+    let deck_dir = deck_path.parent().unwrap_or(Path::new("."));
+    let integration = if segments {
+        Integration::Segments { order }
+    } else {
+        Integration::Quadrature { order }
+    };
+    let mut diags = loaded.diagnostics.clone();
+    let searched = ContactScene::search(
+        &mesh,
+        &loaded,
+        deck_dir,
+        &SceneOptions {
+            integration,
+            fields: None,
+            phase: None,
+            search_only: true,
+        },
+        &mut diags,
+    );
+    let mut summaries = Vec::new();
+    let mut timing = seam::search::scene::Timing::default();
+    let mut details = Vec::new();
+    let mut rule = OutputRule::Summary;
+    for s in &searched {
+        timing.build_s += s.timing.build_s;
+        timing.search_s += s.timing.search_s;
+        rule = s.view.rule;
+        for p in &s.pairings {
+            summaries.push(p.summary(s.view.visualize));
+            if matches!(rule, OutputRule::Verbose | OutputRule::MoreVerbose) {
+                details.push(point_details(p, rule == OutputRule::MoreVerbose));
+            }
+        }
+    }
+    if diags.has_errors() {
+        eprint!("{}", diags.render(&loaded.sources));
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    if json {
+        let report = SearchReport {
+            interactions: summaries,
+            timing,
+            warnings: diags
+                .warnings()
+                .map(|d| Warning {
+                    code: d.code,
+                    message: d.message.clone(),
+                })
+                .collect(),
+        };
+        println!(
+            "{}",
+            serde_json::to_string(&report).expect("plain data serialises")
+        );
+        return ExitCode::SUCCESS;
+    }
+    if rule != OutputRule::None {
+        print_search_table(&summaries);
+        println!(
+            "search: build {:.3} s, search {:.3} s",
+            timing.build_s, timing.search_s
+        );
+        for d in details {
+            print!("{d}");
+        }
+    }
+    use std::io::Write as _;
+    let _ = std::io::stdout().flush();
+    eprint!("{}", diags.render(&loaded.sources));
+    ExitCode::SUCCESS
+}
+
+fn print_search_table(rows: &[seam::search::scene::PairingSummary]) {
+    let width = rows
+        .iter()
+        .map(|r| r.side_a.len() + r.side_b.len() + 3)
+        .max()
+        .unwrap_or(11)
+        .max(11);
+    println!(
+        "{:<width$}  {:>8}  {:>8}  {:>9}  {:>8}  {:>8}  {:>13}  {:>13}  {:>11}  {:>11}",
+        "interaction",
+        "points",
+        "matched",
+        "unmatched",
+        "rej.dist",
+        "rej.angle",
+        "overlap area",
+        "side-A area",
+        "gap min",
+        "gap max"
+    );
+    for r in rows {
+        let name = format!(
+            "{} / {}{}",
+            r.side_a,
+            r.side_b,
+            if r.periodic { " (periodic)" } else { "" }
+        );
+        let gap = |g: Option<f64>| g.map_or("-".to_string(), |g| format!("{g:.3e}"));
+        println!(
+            "{:<width$}  {:>8}  {:>8}  {:>9}  {:>8}  {:>8}  {:>13}  {:>13}  {:>11}  {:>11}",
+            name,
+            r.stats.points,
+            r.stats.matched,
+            r.stats.unmatched,
+            r.stats.rejected_distance,
+            r.stats.rejected_angle,
+            format_number(r.stats.overlap_area),
+            format_number(r.stats.side_a_area),
+            gap(r.stats.gap_min),
+            gap(r.stats.gap_max)
+        );
+    }
+}
+
+/// The points that did not pair (verbose: the first 10 per interaction; more verbose:
+/// all), with where they are and why.
+fn point_details(p: &seam::search::scene::Pairing, all: bool) -> String {
+    use seam::search::pairing::PointStatus;
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let bad: Vec<_> = p
+        .result
+        .points
+        .iter()
+        .filter(|q| q.status != PointStatus::Matched)
+        .collect();
+    if bad.is_empty() {
+        return out;
+    }
+    let _ = writeln!(
+        out,
+        "{} / {}: {} point(s) not paired",
+        p.side_a,
+        p.side_b,
+        bad.len()
+    );
+    let shown = if all { bad.len() } else { bad.len().min(10) };
+    for q in &bad[..shown] {
+        let _ = writeln!(
+            out,
+            "  {:?} at ({:.6}, {:.6}, {:.6})",
+            q.status, q.x[0], q.x[1], q.x[2]
+        );
+    }
+    if shown < bad.len() {
+        let _ = writeln!(
+            out,
+            "  … {} more (Output Rule = more verbose lists all)",
+            bad.len() - shown
+        );
+    }
+    out
+}
