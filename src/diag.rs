@@ -3,7 +3,9 @@
 //! Every diagnostic has a stable code (`E…` errors, `W…` warnings), a message, an
 //! optional location (file, 1-based line and column, length of the offending text) and
 //! a help line. [`Diagnostics::render`] prints them rustc-style with the source line and
-//! a caret, from the sources registered in a [`SourceMap`]. Codes are an interface:
+//! a caret, from the sources registered in a [`SourceMap`], laid out by the
+//! `annotate-snippets` crate (rustc's own renderer); [`Diagnostics::render_styled`] adds
+//! colour for a terminal. Codes are an interface:
 //! tests and users match on them, so a code is never reused for another meaning.
 //! A render prints at most [`MAX_RENDERED`] diagnostics and then one line counting the
 //! rest: past that many, the first ones are what to fix.
@@ -20,6 +22,7 @@ use std::io::Read as _;
 use std::path::Path;
 use std::sync::Arc;
 
+use annotate_snippets::{Group, Renderer};
 use serde::Serialize;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
@@ -155,27 +158,39 @@ impl Diagnostics {
         self.0.len()
     }
 
-    /// Render the diagnostics, rustc-style, the first [`MAX_RENDERED`] of them and then
-    /// one line counting the rest (see [`Diagnostics::render_at_most`]):
+    /// Render the diagnostics as plain text, rustc-style, the first [`MAX_RENDERED`] of
+    /// them and then one line counting the rest (see [`Diagnostics::render_at_most`]):
     ///
     /// ```text
     /// error[E0103]: unknown keyword `contact surfce` in `begin contact definition`
-    ///   --> deck.i:4:3
-    ///    |
-    ///  4 |   Contact Surfce top Contains block_1
-    ///    |   ^^^^^^^^^^^^^^
-    ///    = help: did you mean `contact surface`?
+    ///  --> deck.i:4:3
+    ///   |
+    /// 4 |   Contact Surfce top Contains block_1
+    ///   |   ^^^^^^^^^^^^^^
+    ///   |
+    ///   = help: did you mean `contact surface`?
     /// ```
     pub fn render(&self, sources: &SourceMap) -> String {
         self.render_at_most(sources, MAX_RENDERED)
     }
 
+    /// The same text as [`Diagnostics::render`] with ANSI colour codes (severity, code,
+    /// gutter and caret), for a terminal; a caller decides whether its stream wants them.
+    pub fn render_styled(&self, sources: &SourceMap) -> String {
+        self.render_with(sources, MAX_RENDERED, &Renderer::styled())
+    }
+
     /// Render the first `max` diagnostics, then, if some are left, one line:
     /// `note: 9950 more diagnostics not shown (9950 errors); the first 50 are above`.
     pub fn render_at_most(&self, sources: &SourceMap, max: usize) -> String {
+        self.render_with(sources, max, &Renderer::plain())
+    }
+
+    fn render_with(&self, sources: &SourceMap, max: usize, renderer: &Renderer) -> String {
+        let renderer = renderer.clone().term_width(LINE_SHOWN);
         let mut out = String::new();
         for d in self.0.iter().take(max) {
-            render_one(d, sources, &mut out);
+            render_one(d, sources, &renderer, &mut out);
         }
         let rest = self.0.get(max..).unwrap_or_default();
         if !rest.is_empty() {
@@ -188,13 +203,14 @@ impl Diagnostics {
             if warnings > 0 {
                 kinds.push(plural(warnings, "warning"));
             }
-            let _ = writeln!(
-                out,
-                "note: {} more diagnostic{} not shown ({}); the first {max} are above",
+            let note = format!(
+                "{} more diagnostic{} not shown ({}); the first {max} are above",
                 rest.len(),
                 if rest.len() == 1 { "" } else { "s" },
                 kinds.join(", ")
             );
+            let title = annotate_snippets::Level::NOTE.primary_title(note);
+            let _ = writeln!(out, "{}", renderer.render(&[Group::with_title(title)]));
         }
         out
     }
@@ -206,61 +222,57 @@ impl Diagnostics {
 /// usually the cause of the others.
 pub const MAX_RENDERED: usize = 50;
 
-/// The most characters of a source line a diagnostic shows; a longer line is cut to a
-/// window around the caret.
+/// The width a diagnostic is laid out for: a source line longer than this is shown
+/// as a window around the caret, with `...` where it is cut.
 const LINE_SHOWN: usize = 160;
 
 fn plural(n: usize, what: &str) -> String {
     format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
 
-fn render_one(d: &Diagnostic, sources: &SourceMap, out: &mut String) {
-    let kind = match d.severity {
-        Severity::Error => "error",
-        Severity::Warning => "warning",
+fn render_one(d: &Diagnostic, sources: &SourceMap, renderer: &Renderer, out: &mut String) {
+    use annotate_snippets::{AnnotationKind, Level, Origin, Snippet};
+    let level = match d.severity {
+        Severity::Error => Level::ERROR,
+        Severity::Warning => Level::WARNING,
     };
-    let _ = writeln!(out, "{kind}[{}]: {}", d.code, d.message);
+    // A message that carries its own help lines (an error's text from a layer that has
+    // no help field, such as the mesh readers' `…\n  help: …`) shows them as help lines.
+    let mut parts = d.message.split("\n  help: ");
+    let title = parts.next().unwrap_or_default();
+    let mut group = Group::with_title(level.primary_title(title).id(d.code));
     if let Some(loc) = &d.loc {
-        let _ = writeln!(out, "  --> {loc}");
-        if let Some(text) = sources.line(&loc.file, loc.line) {
-            let num = loc.line.to_string();
-            let pad = " ".repeat(num.len());
-            let text = text.replace('\t', " ");
-            let count = text.chars().count();
-            let caret_at = (loc.col.saturating_sub(1) as usize).min(count);
-            let mut caret_len = (loc.len.max(1) as usize).min(LINE_SHOWN);
-            // A long line (minified, or a binary file read as text) is shown as a
-            // window around the caret, not in full.
-            let (text, caret_at) = if count <= LINE_SHOWN {
-                (text, caret_at)
-            } else {
-                let start = caret_at.saturating_sub(LINE_SHOWN / 3);
-                let window: String = text.chars().skip(start).take(LINE_SHOWN).collect();
-                let lead = if start > 0 { "…" } else { "" };
-                let tail = if start + LINE_SHOWN < count {
-                    "…"
-                } else {
-                    ""
+        group = match sources.line(&loc.file, loc.line) {
+            Some(text) => {
+                // The caret: `len` characters from `col`, kept on the line (a place past
+                // its end is shown at the end), at least one character wide.
+                let byte = |chars: usize| {
+                    text.char_indices()
+                        .nth(chars)
+                        .map_or(text.len(), |(i, _)| i)
                 };
-                caret_len = caret_len.min(LINE_SHOWN - (caret_at - start)).max(1);
-                (
-                    format!("{lead}{window}{tail}"),
-                    caret_at - start + usize::from(start > 0),
+                let at = loc.col.saturating_sub(1) as usize;
+                let start = byte(at);
+                let end = byte(at + loc.len.max(1) as usize);
+                group.element(
+                    Snippet::source(text)
+                        .line_start(loc.line as usize)
+                        .path(&*loc.file)
+                        .annotation(AnnotationKind::Primary.span(start..end)),
                 )
-            };
-            let _ = writeln!(out, " {pad} |");
-            let _ = writeln!(out, " {num} | {text}");
-            let _ = writeln!(
-                out,
-                " {pad} | {}{}",
-                " ".repeat(caret_at),
-                "^".repeat(caret_len)
-            );
-        }
+            }
+            None => group.element(
+                Origin::path(&*loc.file)
+                    .line(loc.line as usize)
+                    .char_column(loc.col as usize),
+            ),
+        };
     }
-    if let Some(help) = &d.help {
-        let _ = writeln!(out, "  = help: {help}");
+    for help in parts.chain(d.help.as_deref()) {
+        group = group.element(Level::HELP.message(help));
     }
+    out.push_str(&renderer.render(&[group]));
+    out.push('\n');
 }
 
 /// The display name of a file in messages: as given by the user, so it can be pasted.
@@ -548,9 +560,35 @@ mod tests {
         );
         let text = ds.render(&sources);
         let lines: Vec<&str> = text.lines().collect();
-        assert_eq!(lines[1], "  --> deck.i:2:3");
-        assert_eq!(lines[3], " 2 |   Contact Surfce top");
-        assert_eq!(lines[4], "   |   ^^^^^^^^^^^^^^");
+        assert_eq!(lines[0], "error[E0103]: unknown keyword");
+        assert_eq!(lines[1], " --> deck.i:2:3");
+        assert_eq!(lines[3], "2 |   Contact Surfce top");
+        assert_eq!(lines[4], "  |   ^^^^^^^^^^^^^^");
+        assert_eq!(lines[6], "  = help: did you mean `contact surface`?");
+        assert!(!text.contains('\x1b'), "{text}");
+        // Styled: the same words, with ANSI colour codes around them.
+        let styled = ds.render_styled(&sources);
+        assert!(styled.contains("\x1b["), "{styled:?}");
+        assert!(styled.contains("E0103") && styled.contains("Contact Surfce top"));
+    }
+
+    #[test]
+    fn a_place_without_its_text_or_past_the_line_end_is_still_shown() {
+        let file: Arc<str> = Arc::from("deck.i");
+        let mut sources = SourceMap::default();
+        sources.add(&file, "end\n");
+        let ds = Diagnostics(vec![
+            Diagnostic::warning("W0102", "past the end").at(Some(Loc::new(&file, 1, 9, 2))),
+            Diagnostic::error("E0103", "no text").at(Some(Loc::new(&file, 7, 4, 1))),
+        ]);
+        let text = ds.render(&sources);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines[0], "warning[W0102]: past the end");
+        assert_eq!(lines[1], " --> deck.i:1:4");
+        assert_eq!(lines[3], "1 | end");
+        assert_eq!(lines[4], "  |    ^");
+        assert_eq!(lines[5], "error[E0103]: no text");
+        assert_eq!(lines[6], "--> deck.i:7:4");
     }
 
     #[test]

@@ -9,7 +9,7 @@ use clap::Parser;
 
 mod cli;
 
-use cli::args::{Cli, Command};
+use cli::args::{Cli, ColorWhen, Command};
 use cli::{EXIT_BAD_INPUT, QUIET};
 
 fn main() -> ExitCode {
@@ -21,6 +21,11 @@ fn main() -> ExitCode {
         _ => log::LevelFilter::Debug,
     });
     QUIET.store(cli.quiet, std::sync::atomic::Ordering::Relaxed);
+    match cli.color {
+        ColorWhen::Auto => {} // anstream asks the terminal, NO_COLOR and CLICOLOR_FORCE
+        ColorWhen::Always => anstream::ColorChoice::Always.write_global(),
+        ColorWhen::Never => anstream::ColorChoice::Never.write_global(),
+    }
     if let Some(n) = cli.threads
         && let Err(e) = rayon::ThreadPoolBuilder::new()
             .num_threads(n as usize)

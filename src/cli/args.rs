@@ -23,6 +23,18 @@ pub struct Cli {
     /// Print only errors and the results (no progress, no warnings).
     #[arg(short, long, global = true)]
     pub quiet: bool,
+    /// When to colour diagnostics: `auto` colours them on a terminal unless `NO_COLOR`
+    /// is set (`CLICOLOR_FORCE=1` colours a pipe too); `always`; `never`.
+    #[arg(long, global = true, value_enum, value_name = "WHEN", default_value_t = ColorWhen::Auto)]
+    pub color: ColorWhen,
+}
+
+/// The choices of `--color`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ColorWhen {
+    Auto,
+    Always,
+    Never,
 }
 
 #[derive(Subcommand)]

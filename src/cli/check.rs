@@ -86,7 +86,7 @@ pub fn check(
         }
         new
     });
-    let mut text = diags.render(&loaded.sources);
+    let mut text = diags.render_styled(&loaded.sources);
     let mut errors = diags.errors().count();
     let mut all = diags.0.clone();
     if let Some(p) = problem {
@@ -108,7 +108,7 @@ pub fn check(
                 extra.push(d);
             }
         }
-        text += &extra.render(&sources);
+        text += &extra.render_styled(&sources);
         all.extend(extra.0);
     }
     let defs = loaded.deck.contact_definitions.len();
@@ -128,7 +128,7 @@ pub fn check(
             ExitCode::SUCCESS
         };
     }
-    eprint!("{text}");
+    anstream::eprint!("{text}");
     if errors > 0 {
         let name = problem.unwrap_or(deck_path);
         eprintln!(

@@ -78,6 +78,15 @@ pub fn report_errors(json: bool, diags: &Diagnostics, sources: &SourceMap) {
         let report = serde_json::json!({ "ok": false, "diagnostics": diags.0 });
         println!("{report}");
     } else {
-        eprint!("{}", diags.render(sources));
+        eprint_diagnostics(diags, sources);
+    }
+}
+
+/// Diagnostics on stderr, coloured where stderr wants colour: a terminal, unless
+/// `NO_COLOR` is set or `--color never` given (`CLICOLOR_FORCE=1` or `--color always`
+/// colour a pipe too). The words are the same either way.
+pub fn eprint_diagnostics(diags: &Diagnostics, sources: &SourceMap) {
+    if !diags.is_empty() {
+        anstream::eprint!("{}", diags.render_styled(sources));
     }
 }

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use seam::diag::{Diagnostic, Diagnostics, SourceMap};
 
-use super::{EXIT_BAD_INPUT, EXIT_PLUGIN_FAULT, QUIET, report_errors};
+use super::{EXIT_BAD_INPUT, EXIT_PLUGIN_FAULT, QUIET, eprint_diagnostics, report_errors};
 
 /// The scene `seam run` solves when given no problem file.
 const DEFAULT_SCENE: &str = "examples/two_blocks/problem.toml";
@@ -140,7 +140,7 @@ pub fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitC
             use std::io::Write as _;
             let _ = std::io::stdout().flush();
             if !QUIET.load(std::sync::atomic::Ordering::Relaxed) {
-                eprint!("{}", r.warnings.render(&r.sources));
+                eprint_diagnostics(&r.warnings, &r.sources);
             }
             if let Some(d) = &s.diagnosis {
                 eprintln!("error[E0800]: {d}");

@@ -8,7 +8,7 @@ use serde::Serialize;
 use seam::scene::{ContactScene, SceneOptions};
 
 use super::surfaces::Warning;
-use super::{EXIT_BAD_INPUT, format_number, load};
+use super::{EXIT_BAD_INPUT, eprint_diagnostics, format_number, load};
 
 #[derive(Serialize)]
 struct SearchReport {
@@ -67,7 +67,7 @@ pub fn search(
         }
     }
     if diags.has_errors() {
-        eprint!("{}", diags.render(&loaded.sources));
+        eprint_diagnostics(&diags, &loaded.sources);
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     if json {
@@ -100,7 +100,7 @@ pub fn search(
     }
     use std::io::Write as _;
     let _ = std::io::stdout().flush();
-    eprint!("{}", diags.render(&loaded.sources));
+    eprint_diagnostics(&diags, &loaded.sources);
     ExitCode::SUCCESS
 }
 

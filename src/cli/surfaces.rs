@@ -6,11 +6,12 @@ use std::process::ExitCode;
 
 use serde::Serialize;
 
+use seam::diag::{Diagnostic, Diagnostics, SourceMap};
 use seam::mesh::{ElemId, Mesh};
 use seam::scene::ContactScene;
 use seam::surface::SurfaceKind;
 
-use super::{EXIT_BAD_INPUT, format_number, load};
+use super::{EXIT_BAD_INPUT, eprint_diagnostics, format_number, load, report_errors};
 
 #[derive(Serialize)]
 struct SurfaceRow {
@@ -57,7 +58,8 @@ pub fn surfaces(
     let dead = match dead.map(|d| parse_dead(d, &mesh)).transpose() {
         Ok(d) => d.unwrap_or_default(),
         Err(e) => {
-            eprintln!("error[E0002]: --dead {e}");
+            let d = Diagnostic::error("E0002", format!("--dead {e}"));
+            report_errors(json, &Diagnostics(vec![d]), &SourceMap::default());
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     };
@@ -83,7 +85,7 @@ pub fn surfaces(
         }
     }
     if diags.has_errors() {
-        eprint!("{}", diags.render(&loaded.sources));
+        eprint_diagnostics(&diags, &loaded.sources);
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     if json {
@@ -105,7 +107,7 @@ pub fn surfaces(
         print_table(&rows);
         use std::io::Write as _;
         let _ = std::io::stdout().flush();
-        eprint!("{}", diags.render(&loaded.sources));
+        eprint_diagnostics(&diags, &loaded.sources);
     }
     ExitCode::SUCCESS
 }

@@ -24,6 +24,7 @@ fn bad_command_lines_give_their_snapshot_diagnostics() {
     for case in &cases {
         let args = std::fs::read_to_string(case.join("args")).expect("args readable");
         let out = Command::new(env!("CARGO_BIN_EXE_seam"))
+            .env_remove("CLICOLOR_FORCE") // the snapshots are the plain text
             .args(args.split_whitespace())
             .current_dir(case)
             .output()

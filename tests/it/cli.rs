@@ -10,6 +10,7 @@ fn root() -> PathBuf {
 
 fn seam(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_seam"))
+        .env_remove("CLICOLOR_FORCE")
         .args(args)
         .current_dir(root())
         .output()

@@ -158,12 +158,15 @@ fn source_files_stay_small_and_lib_lists_every_module() {
     assert!(long.is_empty(), "files over 1000 lines: {long:?}");
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    // The binary's own modules (`src/cli/`) are declared by main.rs, not the library.
+    let main = std::fs::read_to_string(src.join("main.rs")).unwrap();
     for entry in std::fs::read_dir(&src).unwrap() {
         let path = entry.unwrap().path();
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         if name == "lib"
             || name == "main"
             || (path.is_file() && path.extension().is_none_or(|e| e != "rs"))
+            || main.contains(&format!("mod {name};"))
         {
             continue;
         }

@@ -160,7 +160,7 @@ fn text_that_is_not_utf8_is_refused_at_its_line_and_column() {
     let shown = loaded.diagnostics.render(&loaded.sources);
     assert!(
         shown.contains(&format!("--> {}:2:22", path.display()))
-            && shown.contains(" 2 |   contact surface caf\u{fffd} contains block_1"),
+            && shown.contains("\n2 |   contact surface caf\u{fffd} contains block_1"),
         "{shown}"
     );
     // The same for a problem file.

@@ -5,6 +5,7 @@ mod bad_cli;
 mod bad_decks;
 mod cases;
 mod cli;
+mod cli_conventions;
 mod conductance;
 mod docs;
 mod electric;
