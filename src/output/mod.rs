@@ -6,11 +6,10 @@
 //! - [`vtu::write_vtu`], [`vtu::write_vtu_cells`]: VTK XML unstructured grids (`.vtu`)
 //!   with point and cell data; [`vtu::PvdSeries`] collects them into a ParaView time
 //!   series (`.pvd`).
-//! - [`plot::Plot`]: PNG line plots (residual histories, temperatures along a line) drawn
-//!   by seam itself, for a look without ParaView.
+//! - [`plot::Plot`]: line plots as SVG and PNG (residual histories, temperatures along a
+//!   line), laid out by `plotters`, for a look without ParaView.
 
 pub mod exodus;
-mod font;
 mod netcdf;
 pub mod plot;
 pub mod vtu;

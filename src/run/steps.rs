@@ -588,8 +588,10 @@ pub(super) fn final_solution(
     }
 }
 
-/// Quick-look plots in `plots/`: temperature along a line through the first
-/// interface, interface heat over time (transient runs), and Newton convergence.
+/// Quick-look plots in `plots/`, each as `.png` and `.svg`: temperature along a line
+/// through the first interface, interface heat over time (transient runs), and Newton
+/// convergence. Axes carry SI units; heats are per full revolution in an axisymmetric
+/// model and per unit depth (W/m) in a plane 2-D one. Returns the PNGs' paths.
 pub(super) fn write_plots(
     dir: &Path,
     mesh: &Mesh,
@@ -601,19 +603,24 @@ pub(super) fn write_plots(
     let plots = dir.join("plots");
     std::fs::create_dir_all(&plots)?;
     let mut written = Vec::new();
+    let mut write = |plot: Plot, name: &str| -> std::io::Result<()> {
+        let png = plots.join(format!("{name}.png"));
+        plot.write_png(&png)?;
+        plot.write_svg(&plots.join(format!("{name}.svg")))?;
+        written.push(png);
+        Ok(())
+    };
     if let Some((origin, axis)) = line {
         let series = line_samples(mesh, temperature, origin, axis);
         if !series.is_empty() {
-            let p = plots.join("temperature_line.png");
-            Plot {
+            let plot = Plot {
                 title: "Temperature along a line through the interface".into(),
-                x_label: "distance along the interface normal".into(),
-                y_label: "T".into(),
+                x_label: "distance along the interface normal (m)".into(),
+                y_label: "temperature T (K)".into(),
                 log_y: false,
                 series,
-            }
-            .write_png(&p)?;
-            written.push(p);
+            };
+            write(plot, "temperature_line")?;
         }
     }
     if history.len() > 1 && !labels.is_empty() {
@@ -628,26 +635,30 @@ pub(super) fn write_plots(
                     .collect(),
             })
             .collect();
-        let p = plots.join("interface_heat.png");
-        Plot {
+        let heat = if mesh.axisymmetric {
+            "heat (W per revolution)"
+        } else if mesh.dim == 2 {
+            "heat (W/m of depth)"
+        } else {
+            "heat (W)"
+        };
+        let plot = Plot {
             title: "Heat out of side A".into(),
-            x_label: "t".into(),
-            y_label: "W".into(),
+            x_label: "time t (s)".into(),
+            y_label: heat.into(),
             log_y: false,
             series,
-        }
-        .write_png(&p)?;
-        written.push(p);
+        };
+        write(plot, "interface_heat")?;
     }
     if let Some(last) = history.last().filter(|r| !r.residual_history.is_empty()) {
-        let p = plots.join("newton.png");
-        Plot {
+        let plot = Plot {
             title: "Newton convergence (last step)".into(),
-            x_label: "iteration".into(),
-            y_label: "residual norm".into(),
+            x_label: "Newton iteration".into(),
+            y_label: "residual 2-norm (W; A on voltage rows)".into(),
             log_y: true,
             series: vec![Series {
-                label: format!("step {} (t = {:e})", last.step, last.time),
+                label: format!("step {} (t = {:e} s)", last.step, last.time),
                 points: last
                     .residual_history
                     .iter()
@@ -655,9 +666,8 @@ pub(super) fn write_plots(
                     .map(|(i, r)| (i as f64, *r))
                     .collect(),
             }],
-        }
-        .write_png(&p)?;
-        written.push(p);
+        };
+        write(plot, "newton")?;
     }
     Ok(written)
 }

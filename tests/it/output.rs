@@ -778,11 +778,52 @@ fn output_plot_gives_each_series_its_colour_and_copes_with_awkward_data() {
     let (w, _, rgb) = decode_png(&dir.join("flat.png"));
     let px = pixels_of(w, &rgb, series_colour(0));
     let rows: std::collections::BTreeSet<usize> = px.iter().map(|p| p.1).collect();
+    // One band: a 2-pixel stroke whose edges fall inside pixels covers three rows.
     assert!(
-        px.len() > 500 && rows.len() <= 2,
+        px.len() > 500 && rows.len() <= 3 && rows.last().unwrap() - rows.first().unwrap() <= 2,
         "{} pixels in rows {rows:?}",
         px.len()
     );
+}
+
+/// The SVG twin keeps its text as text (title, axis labels with units, legend) and
+/// draws each series in its colour; the PNG of the same plot is its picture.
+#[test]
+fn output_plot_svg_keeps_text_as_text() {
+    use seam::output::plot::{Plot, Series, series_colour};
+    let dir = out_dir("output-plot");
+    let plot = Plot {
+        title: "Heat out of side A".into(),
+        x_label: "time t (s)".into(),
+        y_label: "heat (W)".into(),
+        log_y: false,
+        series: vec![Series {
+            label: "a / b (gap_conductance)".into(),
+            points: (0..20).map(|k| (k as f64, 10.0 - 0.5f64.powi(k))).collect(),
+        }],
+    };
+    let path = dir.join("heat.svg");
+    plot.write_svg(&path).unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    for text in [
+        "Heat out of side A",
+        "time t (s)",
+        "heat (W)",
+        "a / b (gap_conductance)",
+    ] {
+        assert!(
+            svg.contains(&format!(">\n{text}\n</text>")),
+            "no text `{text}`"
+        );
+    }
+    let [r, g, b] = series_colour(0);
+    assert!(
+        svg.contains(&format!("#{r:02X}{g:02X}{b:02X}")),
+        "no series colour"
+    );
+    let none = Plot::default();
+    assert!(none.write_svg(&dir.join("never.svg")).is_err());
 }
 
 #[test]
