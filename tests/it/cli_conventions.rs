@@ -84,3 +84,118 @@ fn diagnostics_are_coloured_only_when_asked_or_on_a_terminal() {
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(report["diagnostics"][0]["code"], "E0103");
 }
+
+/// Every subcommand's flags, as its `--help` must list them (the global ones too).
+const FLAGS: &[(&str, &[&str])] = &[
+    (
+        "surfaces",
+        &["--mesh", "--json", "--dead", "--axisymmetric"],
+    ),
+    (
+        "search",
+        &[
+            "--mesh",
+            "--json",
+            "--segments",
+            "--order",
+            "--axisymmetric",
+        ],
+    ),
+    ("run", &["--json", "--restart"]),
+    (
+        "check-plugin",
+        &["--real", "--integer", "--isolate", "--json"],
+    ),
+    ("example", &["--dir"]),
+    (
+        "check",
+        &["--mesh", "--problem", "--axisymmetric", "--json"],
+    ),
+];
+const GLOBAL: &[&str] = &["--threads", "--verbose", "--quiet", "--color", "--help"];
+
+/// The option lines of a `--help` text: (flag, its description), the description being
+/// the rest of the line (`-h`) or the lines indented under it (`--help`).
+fn options(help: &str) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for line in help.lines() {
+        let t = line.trim_start();
+        let indent = line.len() - t.len();
+        if (2..=6).contains(&indent) && t.starts_with('-') {
+            let flag = t
+                .split([' ', ',', '.', '<', '['])
+                .find(|w| w.starts_with("--"))
+                .unwrap_or_default()
+                .to_string();
+            let rest = t.split_once("  ").map_or("", |(_, r)| r.trim()).to_string();
+            out.push((flag, rest));
+        } else if indent > 6
+            && let Some(last) = out.last_mut()
+        {
+            last.1.push(' ');
+            last.1.push_str(t);
+        }
+    }
+    out
+}
+
+#[test]
+fn every_subcommand_help_documents_each_flag() {
+    let top = seam_with(&[], &["--help"]);
+    assert_eq!(top.status.code(), Some(0));
+    let top = String::from_utf8(top.stdout).expect("UTF-8 help");
+    // The exit codes, the plugin fault's 3 among them, and the environment.
+    for want in [
+        "Exit codes:",
+        "  0  ok",
+        "  1  ran but failed",
+        "  2  bad input or usage",
+        "  3  plugin fault",
+        "RAYON_NUM_THREADS",
+        "NO_COLOR",
+        "CLICOLOR_FORCE",
+    ] {
+        assert!(top.contains(want), "`seam --help` lacks `{want}`:\n{top}");
+    }
+    let listed: Vec<&str> = top
+        .split("Commands:")
+        .nth(1)
+        .and_then(|s| s.split("\n\n").next())
+        .unwrap_or_default()
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    let known: Vec<&str> = FLAGS.iter().map(|(c, _)| *c).collect();
+    assert_eq!(listed, known, "the subcommands `seam --help` lists");
+    for (sub, flags) in FLAGS {
+        for args in [vec![*sub, "--help"], vec!["help", *sub]] {
+            let out = seam_with(&[], &args);
+            assert_eq!(out.status.code(), Some(0), "seam {args:?}");
+            let help = String::from_utf8(out.stdout).expect("UTF-8 help");
+            let opts = options(&help);
+            for flag in flags.iter().chain(GLOBAL) {
+                let Some((_, text)) = opts.iter().find(|(f, _)| f == flag) else {
+                    panic!("`seam {sub} --help` does not list {flag}:\n{help}");
+                };
+                assert!(
+                    text.len() > 10,
+                    "`seam {sub} --help`: {flag} has no description"
+                );
+            }
+            // No flag the list above does not know of, each with its description.
+            for (flag, text) in &opts {
+                assert!(
+                    flags.contains(&flag.as_str()) || GLOBAL.contains(&flag.as_str()),
+                    "`seam {sub} --help` lists {flag}, unknown to this test"
+                );
+                assert!(!text.is_empty(), "{flag}");
+            }
+            // --threads names the variable that does the same.
+            assert!(help.contains("RAYON_NUM_THREADS"), "seam {sub} --help");
+        }
+    }
+    // The run's own help gives its exit codes, 3 for a plugin fault among them.
+    let run = String::from_utf8(seam_with(&[], &["run", "--help"]).stdout).unwrap();
+    assert!(run.contains("3 on a plugin fault"), "{run}");
+}
