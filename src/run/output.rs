@@ -240,7 +240,7 @@ impl<'a> Output<'a> {
             .iter()
             .map(|(name, v)| (name.as_str(), v.as_slice()))
             .collect();
-        steps::write_temperature_vtu(&file, mesh, &state, &extra)
+        steps::write_temperature_vtu(&file, mesh, &state, &extra, &self.physics.problem.output)
             .map_err(|e| RunError::Solve(format!("cannot write {}: {e}", file.display())))?;
         if let Some(c) = &contact {
             steps::write_contact_vtu(&dir.join("contact.vtu"), mesh, &solution.temperature, c)

@@ -371,6 +371,37 @@ pub struct OutputSpec {
     /// step's is always written as `checkpoint.seam`.
     #[serde(default)]
     pub checkpoint_every: Option<usize>,
+    /// How `.vtu` files store their arrays: `auto` (the default: decimal text up to
+    /// [`AUTO_BINARY_POINTS`] points, base64 binary above), `ascii` or `binary`.
+    #[serde(default)]
+    pub vtu_format: VtuFormat,
+}
+
+/// The storage of a `.vtu` file's arrays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum VtuFormat {
+    #[default]
+    Auto,
+    Ascii,
+    Binary,
+}
+
+/// Above this many points `vtu_format = "auto"` writes base64 binary: decimal text of a
+/// million-node field is three times the bytes and most of the time of a run's output.
+pub const AUTO_BINARY_POINTS: usize = 100_000;
+
+impl OutputSpec {
+    /// The encoding of a `.vtu` of `points` points.
+    pub fn vtu_encoding(&self, points: usize) -> crate::output::vtu::VtuEncoding {
+        use crate::output::vtu::VtuEncoding;
+        match self.vtu_format {
+            VtuFormat::Ascii => VtuEncoding::Ascii,
+            VtuFormat::Binary => VtuEncoding::Base64,
+            VtuFormat::Auto if points > AUTO_BINARY_POINTS => VtuEncoding::Base64,
+            VtuFormat::Auto => VtuEncoding::Ascii,
+        }
+    }
 }
 
 /// A problem file read: its typed form, its text (for diagnostics), its folder (the
@@ -581,4 +612,30 @@ pub(super) fn time_spec(p: &Problem, transient: bool, diags: &mut Diagnostics) -
         });
     }
     spec
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::output::vtu::VtuEncoding;
+
+    #[test]
+    fn vtu_format_auto_switches_to_binary_above_the_threshold() {
+        let spec = |text: &str| -> OutputSpec { toml::from_str(text).unwrap() };
+        let auto = spec("");
+        assert_eq!(auto.vtu_encoding(AUTO_BINARY_POINTS), VtuEncoding::Ascii);
+        assert_eq!(
+            auto.vtu_encoding(AUTO_BINARY_POINTS + 1),
+            VtuEncoding::Base64
+        );
+        assert_eq!(
+            spec("vtu_format = \"binary\"").vtu_encoding(8),
+            VtuEncoding::Base64
+        );
+        assert_eq!(
+            spec("vtu_format = \"ascii\"").vtu_encoding(10 * AUTO_BINARY_POINTS),
+            VtuEncoding::Ascii
+        );
+        assert!(toml::from_str::<OutputSpec>("vtu_format = \"hex\"").is_err());
+    }
 }

@@ -85,6 +85,8 @@ pub(super) struct StepWriter<'m> {
     /// `results.exo`: every step written, for ParaView and Sierra users.
     exodus: Option<ExodusWriter>,
     last_written: Option<usize>,
+    /// The `[output]` table (the `.vtu` format).
+    spec: OutputSpec,
 }
 
 /// The element variables of `results.exo`: the heat flux's components, x and y only in
@@ -116,6 +118,7 @@ impl<'m> StepWriter<'m> {
             contact_series: None,
             exodus: None,
             last_written: None,
+            spec: spec.clone(),
         }
     }
 
@@ -158,7 +161,7 @@ impl<'m> StepWriter<'m> {
         };
         if self.transient {
             let name = format!("temperature_{step:05}.vtu");
-            write_temperature_vtu(&dir.join(&name), self.mesh, fields, &[])?;
+            write_temperature_vtu(&dir.join(&name), self.mesh, fields, &[], &self.spec)?;
             self.series
                 .get_or_insert_with(|| PvdSeries::new(&dir.join("temperature.pvd")))
                 .add(time, Path::new(&name))?;
@@ -255,6 +258,7 @@ pub(super) fn write_temperature_vtu(
     mesh: &Mesh,
     fields: &StepFields<'_>,
     extra: &[(&str, &[f64])],
+    spec: &OutputSpec,
 ) -> std::io::Result<()> {
     let mut point = vec![Array::scalar("temperature", fields.temperature)];
     point.extend(extra.iter().map(|&(n, v)| Array::scalar(n, v)));
@@ -263,7 +267,8 @@ pub(super) fn write_temperature_vtu(
         point.push(Array::scalar("voltage", v));
         cell.push(Array::vector("current_density", j));
     }
-    write_vtu_arrays(path, mesh, &point, &cell, VtuEncoding::Ascii)
+    let encoding = spec.vtu_encoding(mesh.num_nodes());
+    write_vtu_arrays(path, mesh, &point, &cell, encoding)
 }
 
 /// `contact.vtu`: the contact faces as polygon cells over their own points (the mesh
