@@ -7,7 +7,7 @@ use serde::Serialize;
 
 use seam::scene::{ContactScene, SceneOptions};
 
-use super::surfaces::Warning;
+use super::surfaces::{Warning, print_json};
 use super::{EXIT_BAD_INPUT, eprint_diagnostics, format_number, load};
 
 #[derive(Serialize)]
@@ -71,21 +71,11 @@ pub fn search(
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     if json {
-        let report = SearchReport {
+        print_json(&SearchReport {
             interactions: summaries,
             timing,
-            warnings: diags
-                .warnings()
-                .map(|d| Warning {
-                    code: d.code,
-                    message: d.message.clone(),
-                })
-                .collect(),
-        };
-        println!(
-            "{}",
-            serde_json::to_string(&report).expect("plain data serialises")
-        );
+            warnings: Warning::all(&diags),
+        });
         return ExitCode::SUCCESS;
     }
     if rule != OutputRule::None {

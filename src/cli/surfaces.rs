@@ -37,6 +37,27 @@ pub struct Warning {
     pub message: String,
 }
 
+impl Warning {
+    /// The warnings of `diags`, as the `--json` reports list them.
+    pub fn all(diags: &seam::diag::Diagnostics) -> Vec<Warning> {
+        diags
+            .warnings()
+            .map(|d| Warning {
+                code: d.code,
+                message: d.message.clone(),
+            })
+            .collect()
+    }
+}
+
+/// A `--json` report on stdout, one line.
+pub fn print_json(report: &impl Serialize) {
+    println!(
+        "{}",
+        serde_json::to_string(report).expect("plain data serialises")
+    );
+}
+
 #[derive(Serialize)]
 struct SurfacesReport {
     surfaces: Vec<SurfaceRow>,
@@ -89,20 +110,10 @@ pub fn surfaces(
         return ExitCode::from(EXIT_BAD_INPUT);
     }
     if json {
-        let report = SurfacesReport {
+        print_json(&SurfacesReport {
             surfaces: rows,
-            warnings: diags
-                .warnings()
-                .map(|d| Warning {
-                    code: d.code,
-                    message: d.message.clone(),
-                })
-                .collect(),
-        };
-        println!(
-            "{}",
-            serde_json::to_string(&report).expect("plain data serialises")
-        );
+            warnings: Warning::all(&diags),
+        });
     } else {
         print_table(&rows);
         use std::io::Write as _;

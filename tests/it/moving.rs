@@ -45,20 +45,7 @@ fn closing(dir: &Path, displacement: &str, every: Option<u32>) -> PathBuf {
         .unwrap()
         .finish()
         .unwrap();
-    std::fs::write(
-        dir.join("problem.toml"),
-        format!(
-            "[mesh]\nfile = \"mesh.exo\"\n\
-             [[material]]\nblocks = [\"block_1\", \"block_2\"]\nconductivity = 1.0\nrho_c = 1e-12\n\
-             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
-             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n\
-             [initial]\ntemperature = 0.5\n\
-             {displacement}\
-             [contact]\nfile = \"contact.i\"\n\
-             [solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 1.0\nend_time = 10.0\ntolerance = 1e-12\n"
-        ),
-    )
-    .unwrap();
+    std::fs::write(dir.join("problem.toml"), stack_problem(displacement)).unwrap();
     let schedule = every.map_or(String::new(), |n| {
         format!("  update search every {n} steps\n")
     });
@@ -73,6 +60,22 @@ fn closing(dir: &Path, displacement: &str, every: Option<u32>) -> PathBuf {
     )
     .unwrap();
     dir.join("problem.toml")
+}
+
+/// The problem file of the two stacked blocks on `mesh.exo`: T = 1 on side set 1, T = 0
+/// on side set 4, k = 1, a capacity small enough that every step is steady to 1e-9, ten
+/// backward-Euler steps of 1 s, the deck `contact.i`, and `extra` tables.
+fn stack_problem(extra: &str) -> String {
+    format!(
+        "[mesh]\nfile = \"mesh.exo\"\n\
+         [[material]]\nblocks = [\"block_1\", \"block_2\"]\nconductivity = 1.0\nrho_c = 1e-12\n\
+         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
+         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n\
+         [initial]\ntemperature = 0.5\n\
+         {extra}\
+         [contact]\nfile = \"contact.i\"\n\
+         [solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 1.0\nend_time = 10.0\ntolerance = 1e-12\n"
+    )
 }
 
 fn run(problem: &Path) -> RunResult {
@@ -300,21 +303,11 @@ fn dying(dir: &Path, side_a: &str) -> (PathBuf, Vec<i64>) {
         .finish()
         .unwrap();
     let numbers: Vec<String> = upper.iter().map(i64::to_string).collect();
-    std::fs::write(
-        dir.join("problem.toml"),
-        format!(
-            "[mesh]\nfile = \"mesh.exo\"\n\
-             [[material]]\nblocks = [\"block_1\", \"block_2\"]\nconductivity = 1.0\nrho_c = 1e-12\n\
-             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
-             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n\
-             [initial]\ntemperature = 0.5\n\
-             [[death]]\nelements = [{}]\ntime = 5.0\n\
-             [contact]\nfile = \"contact.i\"\n\
-             [solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 1.0\nend_time = 10.0\ntolerance = 1e-12\n",
-            numbers.join(", ")
-        ),
-    )
-    .unwrap();
+    let death = format!(
+        "[[death]]\nelements = [{}]\ntime = 5.0\n",
+        numbers.join(", ")
+    );
+    std::fs::write(dir.join("problem.toml"), stack_problem(&death)).unwrap();
     std::fs::write(
         dir.join("contact.i"),
         format!(
