@@ -534,7 +534,56 @@ const MODEL_KEYS: &[(&str, &[&str], &str)] = &[
 ];
 
 /// The material properties seam supports, as a help line lists them.
-const SUPPORTED_PROPERTIES: &str = "seam supports `gap conductance coefficient`, `contact surface pressure` (or `contact pressure`), `offset temperature`, `offset voltage` and `contact gap temperature`";
+const SUPPORTED_PROPERTIES: &str = "seam supports `gap conductance coefficient`, `contact surface pressure` (or `contact pressure`), `offset temperature`, `offset voltage`, `offset species`, `partition coefficient` and `contact gap temperature`";
+
+/// The lines of an `Enforcement for Species` block: `Partition Coefficient` (finite and
+/// positive) and `Offset Species` (finite), each in a block that enforces Species — in
+/// another block they would be read and do nothing.
+fn check_species_lines(
+    d: usize,
+    k: usize,
+    e: &Enforcement,
+    who: &str,
+    locs: &Locs,
+    out: &mut Diagnostics,
+) {
+    let species = e.models.iter().any(|m| m.equation == "species");
+    for (what, key, value) in [
+        (
+            "partition coefficient",
+            "partition_coefficient",
+            e.partition_coefficient,
+        ),
+        ("offset species", "offset_species", e.offset_species),
+    ] {
+        let Some(v) = value else { continue };
+        let at = locs.or(&format!("{d}.enforcement.{k}.{key}"), &e.at);
+        if !species {
+            out.push(
+                Diagnostic::error(
+                    codes::NOT_THIS_EQUATION,
+                    format!("{who}: `{what}` in a block that does not enforce Species"),
+                )
+                .at(at.clone())
+                .help("it belongs to a block with `Enforcement for Species = …`: move it there, or add that line"),
+            );
+        }
+        let (ok, range_text, help) = if key == "partition_coefficient" {
+            (
+                positive(v),
+                "a finite number greater than 0",
+                "K is the ratio of the solubilities of side A and side B (c_A = K c_B at the interface); 1 joins equal concentrations",
+            )
+        } else {
+            (
+                v.is_finite(),
+                "finite",
+                "the offset is a concentration difference added across the interface (mol/m³)",
+            )
+        };
+        range(out, ok, who, what, v, range_text, at, help);
+    }
+}
 
 fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut Diagnostics) {
     let who = match &e.name {
@@ -601,6 +650,7 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
             "the share of the contact's Joule heat that goes to side A; the rest goes to side B",
         );
     }
+    check_species_lines(d, k, e, &who, locs, out);
     let mut first: HashMap<&str, usize> = HashMap::new();
     for (m, model) in e.models.iter().enumerate() {
         let eq = model.equation.as_str();
@@ -632,7 +682,7 @@ fn check_enforcement(d: usize, k: usize, e: &Enforcement, locs: &Locs, out: &mut
                     )
                     .at(at.clone())
                     .help(format!(
-                        "{hint}Aria's equations are {}; seam solves `energy` and `voltage`",
+                        "{hint}Aria's equations are {}; seam solves `energy`, `voltage` and `species`",
                         registry::EQUATIONS
                             .iter()
                             .map(|(n, _)| format!("`{n}`"))

@@ -48,6 +48,7 @@
 //! | E0225 | error    | unknown material property of an enforcement (TOML `property`), or one with its own field |
 //! | E0226 | error    | `begin toggle block`: in a contact deck, or used by an enforcement of a Sierra input file (its schedule cannot be read) |
 //! | E0227 | error    | a number outside its documented range (the range is in the message) |
+//! | E0228 | error    | a line of an equation's enforcement (`Partition Coefficient`, `Offset Species`) in a block that does not enforce that equation |
 //! | W0101 | warning  | deprecated alias (`Slave Variable`) |
 //! | W0102 | warning  | single-valued command given twice; the last one wins |
 //! | W0103 | warning  | blocks and lines of a Sierra input file skipped (not contact input) |
@@ -97,6 +98,7 @@ pub const ELFEN_REFUSED: &str = "E0224";
 pub const UNKNOWN_PROPERTY: &str = "E0225";
 pub const TOGGLE_BLOCK: &str = "E0226";
 pub const OUT_OF_RANGE: &str = "E0227";
+pub const NOT_THIS_EQUATION: &str = "E0228";
 pub const DEPRECATED_ALIAS: &str = "W0101";
 pub const REPEATED_COMMAND: &str = "W0102";
 pub const SKIPPED_BLOCKS: &str = "W0103";
@@ -148,6 +150,7 @@ pub const ALL: &[&str] = &[
     UNKNOWN_PROPERTY,
     TOGGLE_BLOCK,
     OUT_OF_RANGE,
+    NOT_THIS_EQUATION,
     DEPRECATED_ALIAS,
     REPEATED_COMMAND,
     SKIPPED_BLOCKS,

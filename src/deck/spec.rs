@@ -331,6 +331,14 @@ pub struct Enforcement {
     /// given to side A (0.5 when absent).
     #[serde(default)]
     pub joule_fraction_side_a: Option<f64>,
+    /// `Offset Species = dc`: the concentration jump of an `Enforcement for Species`
+    /// (mol/m³).
+    #[serde(default)]
+    pub offset_species: Option<f64>,
+    /// `Partition Coefficient = K`: c_A = K c_B across an `Enforcement for Species`
+    /// interface (1 when absent).
+    #[serde(default)]
+    pub partition_coefficient: Option<f64>,
     /// `Contact Pressure = p` (Pa), for pressure-dependent conductance models.
     #[serde(default)]
     pub contact_pressure: Option<f64>,

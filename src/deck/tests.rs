@@ -225,6 +225,8 @@ fn full_expected() -> Deck {
             offset_temperature: Some(273.15),
             offset_voltage: None,
             joule_fraction_side_a: None,
+            offset_species: None,
+            partition_coefficient: None,
             contact_pressure: None,
             quarantine_faulty_points: false,
             use_toggle_block: Some("tog".into()),

@@ -126,6 +126,8 @@ pub fn locate(file: &Arc<str>, text: &str, deck: &mut Deck) -> Locs {
                 "offset_temperature",
                 "offset_voltage",
                 "joule_fraction_side_a",
+                "offset_species",
+                "partition_coefficient",
                 "contact_pressure",
             ] {
                 put(format!("{d}.enforcement.{k}.{key}"), sub(n, key));

@@ -282,6 +282,7 @@ impl EmbeddingBuilder {
             host_dof,
             conductivity,
             fixed: self.fixed.iter().map(|&f| NodeId(f as u32)).collect(),
+            fixed_of: Vec::new(),
             integration: self.integration,
             pairs: Vec::new(),
             time: 0.0,

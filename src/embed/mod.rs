@@ -457,9 +457,17 @@ struct Pair {
     quarantined: Mutex<Vec<Quarantined>>,
     /// Switched off by the host ([`Embedding::set_active`]): no terms, no heat.
     active: bool,
+    /// The coefficient per block weighing this pair's Nitsche forms, instead of the
+    /// embedding's conductivity (`seam run`'s species interfaces: the diffusivity).
+    coefficient: Option<Vec<f64>>,
 }
 
 impl Pair {
+    /// The coefficient per block weighing this pair's forms.
+    fn coefficient<'c>(&'c self, embedding: &'c [f64]) -> &'c [f64] {
+        self.coefficient.as_deref().unwrap_or(embedding)
+    }
+
     /// A flux-type interaction (not a mortar tie).
     fn is_flux(&self) -> bool {
         matches!(self.enforcement, Enforcement::Flux { .. })
@@ -498,6 +506,7 @@ impl Pair {
             quarantine: false,
             quarantined: Mutex::new(Vec::new()),
             active: true,
+            coefficient: None,
         }
     }
 }
@@ -521,6 +530,8 @@ pub struct Embedding {
     host_dof: Vec<usize>,
     conductivity: Vec<f64>,
     fixed: Vec<NodeId>,
+    /// Per field, fixed nodes other than `fixed` (the field's own Dirichlet data).
+    fixed_of: Vec<(FieldId, Vec<NodeId>)>,
     integration: Integration,
     pairs: Vec<Pair>,
     /// The host's time, passed to conductance models and plugins (0 until set).

@@ -3,7 +3,7 @@
 //! quarantined points.
 
 use super::{EmbedError, Embedding, Pair, Quarantined, argument};
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::assembly::{DofMap, FieldId};
 use crate::enforce::conductance::ConductanceModel;
@@ -129,6 +129,7 @@ impl Embedding {
             dofs,
             conductivity,
             fixed,
+            fixed_of: Vec::new(),
             integration,
             pairs: Vec::new(),
             time: 0.0,
@@ -159,5 +160,25 @@ impl Embedding {
             e.outdate();
         }
         self.pairs.len() - 1
+    }
+
+    /// Weigh the forms of interaction `i` with `coefficient` per block instead of the
+    /// embedding's conductivity (a field other than the temperature, as `seam run`'s
+    /// species with its diffusivities).
+    pub(crate) fn set_coefficient(&mut self, i: usize, coefficient: Vec<f64>) {
+        if let Some(p) = self.pairs.get_mut(i) {
+            p.coefficient = Some(coefficient);
+            p.points = OnceLock::new();
+        }
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
+        }
+    }
+
+    /// The fixed nodes (Dirichlet data) of `field`, when they are not the embedding's
+    /// `fixed`: the mortar ties over that field give them no multiplier.
+    pub(crate) fn set_fixed_of(&mut self, field: FieldId, nodes: Vec<NodeId>) {
+        self.fixed_of.retain(|(f, _)| *f != field);
+        self.fixed_of.push((field, nodes));
     }
 }

@@ -109,7 +109,7 @@ impl Embedding {
             h: &h,
             offset: *offset,
             beta: *beta,
-            conductivity: &self.conductivity,
+            conductivity: p.coefficient(&self.conductivity),
         };
         let named = |source| EmbedError::Enforcement {
             side_a: p.side_a.name.clone(),

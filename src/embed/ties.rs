@@ -1,6 +1,7 @@
 use super::{Condensed, EmbedError, Embedding, Enforcement, Heat, Multipliers, argument};
 use std::collections::{BTreeMap, HashSet};
 
+use crate::assembly::FieldId;
 use crate::enforce::mortar::mortar_tie;
 use crate::mesh::NodeId;
 
@@ -116,7 +117,9 @@ impl Embedding {
     /// `condensed_too` (a host that solves for the multipliers does not need it, and a
     /// partly covered side A cannot be condensed).
     pub(crate) fn tie_rows(&self, condensed_too: bool) -> Result<Vec<TieConstraints>, EmbedError> {
-        let mut constrained: HashSet<NodeId> = self.fixed.iter().copied().collect();
+        // Per side-A field: its fixed nodes, then the nodes of its earlier ties.
+        let mut constrained: std::collections::HashMap<FieldId, HashSet<NodeId>> =
+            Default::default();
         let mut out = Vec::new();
         for (index, p) in self.pairs.iter().enumerate() {
             let result = Self::searched(p)?;
@@ -127,6 +130,13 @@ impl Embedding {
             else {
                 continue;
             };
+            let fixed = || {
+                let own = self.fixed_of.iter().find(|(f, _)| *f == p.fields.a);
+                own.map_or(&self.fixed, |(_, n)| n)
+                    .iter()
+                    .copied()
+                    .collect()
+            };
             let tie = mortar_tie(
                 &self.mesh,
                 &self.dofs,
@@ -134,8 +144,8 @@ impl Embedding {
                 &p.a,
                 &p.b,
                 &result.points,
-                &self.conductivity,
-                &mut constrained,
+                p.coefficient(&self.conductivity),
+                constrained.entry(p.fields.a).or_insert_with(fixed),
                 *multipliers,
             )
             .map_err(|source| EmbedError::Enforcement {

@@ -21,6 +21,7 @@ pub mod electric;
 pub mod interfaces;
 pub mod kernel;
 pub mod law;
+pub mod species;
 pub mod steady;
 pub mod transient;
 

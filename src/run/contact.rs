@@ -46,6 +46,8 @@ pub(super) struct RunContact {
     /// Per interaction, what searching it again takes (surfaces that move only); taken
     /// by the run's embedding.
     pub again: std::cell::RefCell<Vec<Option<crate::scene::SearchAgain>>>,
+    /// The species interfaces (`Enforcement for Species`).
+    pub species: Vec<super::species::Interface>,
     /// Wall-clock seconds building the contact surfaces and searching.
     pub surfaces_s: f64,
     pub search_s: f64,
@@ -175,6 +177,7 @@ impl RunContact {
             ..RunContact::default()
         };
         out.electrical = scene.electrical;
+        out.species = scene.species.into_iter().map(Into::into).collect();
         for e in scene.entries {
             out.again.get_mut().push(e.again);
             out.definition.push(e.definition);
@@ -250,7 +253,8 @@ impl RunContact {
 /// (`Use Toggle Block`), the fields of its two sides (`Side B Variable`) and the contact
 /// pressure at its points (`Contact Pressure Variable`).
 pub(super) struct Couplings {
-    /// The intervals in which the interaction is on (always, when `None`).
+    /// The intervals in which the interaction is on (always, when `None`): the energy
+    /// interactions, then the species interfaces.
     pub toggles: Vec<Option<Vec<(f64, f64)>>>,
     /// (side-A field, side-B field), as indices into the problem's field names.
     pub fields: Vec<(usize, usize)>,
@@ -267,7 +271,10 @@ impl Couplings {
         contact: &RunContact,
         diags: &mut Diagnostics,
     ) -> Couplings {
-        let toggles = resolve_toggles(&file.problem, &contact.choices, diags);
+        // The energy interactions', then the species interfaces' (the embedding's order).
+        let choices =
+            (contact.choices.iter().map(|c| &c.0)).chain(contact.species.iter().map(|s| &s.choice));
+        let toggles = resolve_toggles(&file.problem, choices, diags);
         let fields = interaction_fields(
             physics.mesh,
             &physics.materials,
@@ -298,14 +305,13 @@ impl Couplings {
 }
 
 /// Each interaction's toggle intervals (`Use Toggle Block` → `[[toggle]]`).
-fn resolve_toggles(
+fn resolve_toggles<'c>(
     p: &Problem,
-    choices: &[Choice],
+    choices: impl Iterator<Item = &'c ModelChoice>,
     diags: &mut Diagnostics,
 ) -> Vec<Option<Vec<(f64, f64)>>> {
     choices
-        .iter()
-        .map(|(c, _, _)| {
+        .map(|c| {
             let name = c.toggle.as_ref()?;
             match p.toggle.iter().find(|t| t.name.eq_ignore_ascii_case(name)) {
                 Some(t) => Some(t.on.clone()),

@@ -64,6 +64,7 @@ mod physics;
 mod posed;
 mod problem;
 mod solve;
+mod species;
 mod steps;
 mod summary;
 mod terms;
@@ -83,7 +84,8 @@ pub use problem::{
     SolveSpec, SourceSpec, ToggleSpec, Value,
 };
 pub use summary::{
-    InteractionHeat, LinearSolverSummary, Summary, Timing, TransientSummary, peak_memory_mib,
+    InteractionHeat, LinearSolverSummary, SpeciesContact, Summary, Timing, TransientSummary,
+    peak_memory_mib,
 };
 pub use terms::MotionCounts;
 
@@ -115,6 +117,12 @@ pub struct RunResult {
     pub solution: SteadySolution,
     /// Every accepted step (transient and nonlinear runs; empty for linear steady).
     pub history: Vec<StepReport>,
+    /// The nodal concentration of the final state (mol/m³; NaN at nodes without a
+    /// species), for a run with a species.
+    pub species: Option<Vec<f64>>,
+    /// Per accepted step (one for a steady run), each species interface's mass flux
+    /// (mol/s) leaving side A and side B, in the order of the summary's `species_contacts`.
+    pub species_flux: Vec<Vec<(f64, f64)>>,
     pub warnings: Diagnostics,
     pub sources: SourceMap,
 }
@@ -214,6 +222,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     // Scene: the contact, the face conditions it masks, what the file joins to it.
     let contact = RunContact::build(&file, &mesh, &physics.field_names, options, &mut diags)?;
     contact.mask_face_conditions(&mut physics.face_sites, &mut diags);
+    physics.resolve_species(&contact, &mut diags);
     if let Some(e) = contact.electrical.first()
         && !physics.materials.electric()
     {
@@ -312,6 +321,9 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         );
     }
     output.mark_not_converged(summary.diagnosis.as_deref())?;
+    let species = physics
+        .species
+        .nodal(&solved.solution.u, &solved.solution.dofs);
     // The conductance functions of the terms borrow the mesh, which the result takes.
     drop(terms);
     Ok(Outcome::Ran(Box::new(RunResult {
@@ -319,6 +331,8 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         mesh,
         solution: solved.solution,
         history: solved.history,
+        species,
+        species_flux: solved.species_flux,
         warnings: diags,
         sources: contact.loaded.sources,
     })))

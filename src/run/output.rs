@@ -99,6 +99,7 @@ impl<'a> Output<'a> {
             fields::element_heat_flux(self.physics.mesh, &self.physics.materials.laws, &t, time)?;
         let contact = self.terms.contact_of(&derived);
         let electric = self.electric_fields(u, dofs, &t, time)?;
+        let species = self.species_values(u, dofs);
         let fields = steps::StepFields {
             temperature: &t,
             heat_flux: &q,
@@ -106,6 +107,7 @@ impl<'a> Output<'a> {
             heat_names: &self.heat_names,
             heat,
             electric: electric.as_ref().map(|(v, j)| (v.as_slice(), j.as_slice())),
+            species: species.as_deref(),
         };
         self.writer
             .write_step(step, time, &fields)
@@ -129,6 +131,12 @@ impl<'a> Output<'a> {
         let j =
             fields::element_current_density(self.physics.mesh, sigma, temperature, &voltage, time)?;
         Ok(Some((voltage, j)))
+    }
+
+    /// A state's nodal concentration, c = S ĉ from the solved ĉ ([`super::species`]);
+    /// `None` for a run without a species.
+    fn species_values(&self, u: &[f64], dofs: &DofMap) -> Option<Vec<f64>> {
+        self.physics.species.nodal(u, dofs)
     }
 
     /// After an accepted step: its checkpoint, when one is due.
@@ -214,6 +222,7 @@ impl<'a> Output<'a> {
                 final_time,
             )
             .map_err(RunError::Solve)?;
+        let species = self.species_values(&solution.u, &solution.dofs);
         let state = steps::StepFields {
             temperature: &solution.temperature,
             heat_flux: &heat_flux,
@@ -221,6 +230,7 @@ impl<'a> Output<'a> {
             heat_names: &self.heat_names,
             heat: &steady_heat,
             electric: electric.as_ref().map(|(v, j)| (v.as_slice(), j.as_slice())),
+            species: species.as_deref(),
         };
         let file = dir.join("temperature.vtu");
         let per_field: Vec<(String, Vec<f64>)> = if field_names.len() > 1 {
@@ -284,6 +294,10 @@ impl<'a> Output<'a> {
                 .collect();
             if !contacts.is_empty() {
                 steps::write_electrical_contacts(dir, history, &contacts)?;
+            }
+            if !terms.contact.species.is_empty() {
+                let labels = super::species::labels(&terms.contact.species);
+                steps::write_species_contacts(dir, history, &solved.species_flux, &labels)?;
             }
             let rows: Vec<steps::HeatRow<'_>> = history
                 .iter()

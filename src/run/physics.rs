@@ -19,6 +19,7 @@ use super::nodal_field::check_nodal_fields;
 use super::problem::{
     BcKind, MAX_MAGNITUDE, Problem, ProblemFile, ProblemText, TimeSpec, Value, time_spec,
 };
+use super::species::Species;
 use super::{RunError, input_error};
 
 /// The physics of a run on its mesh, checked.
@@ -45,6 +46,8 @@ pub(super) struct Physics<'a> {
     pub probe: f64,
     /// The sandbox of the run's boundary and initial expressions.
     pub sandbox: SharedSandbox,
+    /// The species: its materials, conditions and solubility scales.
+    pub species: Species,
 }
 
 impl<'a> Physics<'a> {
@@ -61,6 +64,15 @@ impl<'a> Physics<'a> {
         let dirichlet = nodal_condition_nodes(problem, mesh, BcKind::Temperature, diags);
         let voltage = nodal_condition_nodes(problem, mesh, BcKind::Voltage, diags);
         check_electric(problem, &file.text, &materials, &voltage, diags);
+        let (diffusivity, capacity) = super::species::materials(problem, mesh, probe, diags);
+        let species = Species {
+            dirichlet: nodal_condition_nodes(problem, mesh, BcKind::Species, diags),
+            scale: vec![1.0; mesh.blocks.len()],
+            node_scale: vec![1.0; mesh.num_nodes()],
+            diffusivity,
+            capacity,
+        };
+        super::species::check_conditions(problem, &file.text, &species, file.transient, diags);
         let face_sites = face_sites(problem, mesh, diags);
         let time = time_spec(problem, file.transient, diags);
         let block_source = block_sources(problem, mesh, &file.text, probe, time.start, diags);
@@ -84,6 +96,7 @@ impl<'a> Physics<'a> {
             uniform,
             probe,
             sandbox: Default::default(),
+            species,
         }
     }
 
@@ -102,14 +115,19 @@ impl<'a> Physics<'a> {
 
     /// The boundary data at time t.
     pub(super) fn loads_at(&self, t: f64) -> Result<Loads, String> {
-        loads_at(
+        let mut loads = loads_at(
             self.problem,
             self.mesh,
-            (&self.dirichlet, &self.voltage),
+            (&self.dirichlet, &self.voltage, &self.species.dirichlet),
             &self.face_sites,
             &self.sandbox,
             t,
-        )
+        )?;
+        // The species unknown is c/S (the solubility scale of the node's blocks).
+        for (n, c) in &mut loads.species {
+            *c = super::species::scaled(*c, *n, &self.species);
+        }
+        Ok(loads)
     }
 
     /// The initial state, checked here (transient runs start from it; a steady run with
@@ -143,6 +161,42 @@ impl<'a> Physics<'a> {
             .first()
             .filter(|q| self.uniform && **q != Law::Constant(0.0))
             .map(|q| Box::new(source_of_x(q, self.time.start, failed)) as Box<_>)
+    }
+
+    /// The species interfaces of `contact` on the species blocks: each side carries a
+    /// species, the blocks' solubility scales follow from the partition coefficients,
+    /// and each side A has one scale; problems go to `diags`.
+    pub(super) fn resolve_species(
+        &mut self,
+        contact: &super::contact::RunContact,
+        diags: &mut Diagnostics,
+    ) {
+        let (mesh, entries) = (self.mesh, &contact.species);
+        if let (Some(e), Some(_)) = (entries.first(), &self.problem.displacement) {
+            diags.push(
+                Diagnostic::error(
+                    "E0432",
+                    "species interfaces on surfaces that move ([displacement]) are not supported yet: their pairs would keep the first search's points",
+                )
+                .at(Some(e.at.clone()))
+                .help("run the species on a mesh that does not move, or remove the `Enforcement for Species` block"),
+            );
+            return;
+        }
+        super::species::check_interfaces(mesh, &self.species, entries, diags);
+        if diags.has_errors() {
+            return;
+        }
+        self.species.resolve_scale(mesh, entries, diags);
+        for e in entries {
+            if let Err(m) = self.species.side_a_scale(mesh, e) {
+                diags.push(
+                    Diagnostic::error("E0432", format!("species interface: {m}"))
+                        .at(Some(e.at.clone()))
+                        .help("split side A into one surface per block of its own solubility"),
+                );
+            }
+        }
     }
 
     /// One conductivity per block, for the Nitsche weights: the law at the probe
@@ -207,7 +261,7 @@ impl Materials {
 
 /// A material value as a law of T: numbers, Lua expressions of T (x, y, z, t), tables
 /// in T; checked positive at `probe` (a Lua law only where it can be evaluated).
-fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law> {
+pub(super) fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law> {
     let law = match v {
         Value::Number(k) => Law::Constant(*k),
         Value::Expr(e) => match e.trim().parse::<f64>() {
@@ -251,7 +305,7 @@ fn law(v: &Value, what: &str, probe: f64, diags: &mut Diagnostics) -> Option<Law
     if let Some(m) = problem {
         diags.push(
             Diagnostic::error("E0704", format!("{what} {m}"))
-                .help("k in W/m/K, ρ in kg/m³, c_p in J/kg/K: positive numbers up to 1e100, tables or Lua expressions of T"),
+                .help("k in W/m/K, ρ in kg/m³, c_p in J/kg/K, D in m²/s: positive numbers up to 1e100, tables or Lua expressions of T"),
         );
         return None;
     }
@@ -431,8 +485,8 @@ fn check_electric(
     }
 }
 
-/// ρ·c_p(T) from c_p(T).
-fn scale_law(cp: Law, rho: f64) -> Law {
+/// ρ·c_p(T) from c_p(T) (and any law times a constant).
+pub(super) fn scale_law(cp: Law, rho: f64) -> Law {
     match cp {
         Law::Constant(c) => Law::Constant(rho * c),
         Law::Table(p) => Law::Table(p.into_iter().map(|(t, v)| (t, rho * v)).collect()),
@@ -604,16 +658,17 @@ pub(super) struct FaceSite {
 
 fn face_sites(p: &Problem, mesh: &Mesh, diags: &mut Diagnostics) -> Vec<FaceSite> {
     let mut out = Vec::new();
-    for (k, bc) in
-        p.bc.iter()
-            .enumerate()
-            .filter(|(_, b)| !matches!(b.kind, BcKind::Temperature | BcKind::Voltage))
-    {
+    for (k, bc) in p.bc.iter().enumerate().filter(|(_, b)| {
+        !matches!(
+            b.kind,
+            BcKind::Temperature | BcKind::Voltage | BcKind::Species
+        )
+    }) {
         for s in &bc.surfaces {
             let Some(i) = mesh.find_side_set(s) else {
                 diags.push(
                     Diagnostic::error("E0706", format!("[[bc]]: unknown side set `{s}`")).help(
-                        "flux, convection, radiation and current conditions act on side sets",
+                        "flux, convection, radiation, current and species_flux conditions act on side sets",
                     ),
                 );
                 continue;
@@ -645,13 +700,17 @@ type NodalSite = (NodeId, usize);
 fn loads_at(
     p: &Problem,
     mesh: &Mesh,
-    (dirichlet, voltage): (&[NodalSite], &[NodalSite]),
+    (dirichlet, voltage, species): (&[NodalSite], &[NodalSite], &[NodalSite]),
     faces: &[FaceSite],
     sandbox: &SharedSandbox,
     t: f64,
 ) -> Result<Loads, String> {
     let mut out = Loads::default();
-    for (nodes, kind) in [(dirichlet, BcKind::Temperature), (voltage, BcKind::Voltage)] {
+    for (nodes, kind) in [
+        (dirichlet, BcKind::Temperature),
+        (voltage, BcKind::Voltage),
+        (species, BcKind::Species),
+    ] {
         for &(n, k) in nodes {
             let v = evaluate(
                 &p.bc[k].value,
@@ -664,6 +723,7 @@ fn loads_at(
             in_range(kind, v, k, mesh.coords[n.index()], t)?;
             match kind {
                 BcKind::Voltage => out.voltage.push((n, v)),
+                BcKind::Species => out.species.push((n, v)),
                 _ => out.dirichlet.push((n, v)),
             }
         }
@@ -676,6 +736,10 @@ fn loads_at(
         let t_inf = bc.ambient.unwrap_or(0.0);
         if bc.kind == BcKind::Current {
             out.currents.push((f.side, v));
+            continue;
+        }
+        if bc.kind == BcKind::SpeciesFlux {
+            out.species_fluxes.push((f.side, v));
             continue;
         }
         out.faces.push(match bc.kind {

@@ -105,6 +105,10 @@ pub struct DisplacementSpec {
 pub struct InitialSpec {
     /// A number or a Lua expression of x, y, z.
     pub temperature: Value,
+    /// The initial concentration of a species (mol/m³; 0 when not given): a number or a
+    /// Lua expression of x, y, z.
+    #[serde(default)]
+    pub species: Option<Value>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -178,6 +182,14 @@ pub struct MaterialSpec {
     /// the blocks a `voltage` field, with its Joule heat σ|∇V|² in the temperature.
     #[serde(default)]
     pub electrical_conductivity: Option<Value>,
+    /// D (m²/s): a number, a Lua expression of T (and x, y, z, t), or a table in T.
+    /// Gives the blocks a `species` field (a concentration, mol/m³).
+    #[serde(default)]
+    pub diffusivity: Option<Value>,
+    /// φ, the factor of ∂c/∂t in the species equation (default 1: c per unit volume of
+    /// the body; the porosity for c per unit pore volume).
+    #[serde(default)]
+    pub species_capacity: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -193,6 +205,10 @@ pub enum BcKind {
     /// A current density into the body (A/m²) on faces of blocks with an
     /// `electrical_conductivity`.
     Current,
+    /// A nodal concentration (mol/m³), on blocks with a `diffusivity`.
+    Species,
+    /// A species flux into the body (mol/m²/s) on faces of blocks with a `diffusivity`.
+    SpeciesFlux,
 }
 
 /// Largest temperature (K) a problem file may give: far beyond any physical one, and
@@ -228,6 +244,14 @@ impl BcKind {
                 v.abs() <= MAX_MAGNITUDE,
                 "a current density is finite and within ±1e100 A/m²",
             ),
+            BcKind::Species => (
+                (0.0..=MAX_MAGNITUDE).contains(&v),
+                "a concentration is in [0, 1e100] mol/m³",
+            ),
+            BcKind::SpeciesFlux => (
+                v.abs() <= MAX_MAGNITUDE,
+                "a species flux is finite and within ±1e100 mol/m²/s",
+            ),
         };
         if ok { Ok(()) } else { Err(range) }
     }
@@ -241,6 +265,8 @@ impl BcKind {
             BcKind::Radiation => "radiation",
             BcKind::Voltage => "voltage",
             BcKind::Current => "current",
+            BcKind::Species => "species",
+            BcKind::SpeciesFlux => "species_flux",
         }
     }
 }

@@ -8,6 +8,7 @@ use crate::assembly::DofMap;
 use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::{HInput, HValue};
 use crate::heat::electric::VOLTAGE;
+use crate::heat::species::SPECIES;
 use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
 use crate::heat::transient::{
     self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
@@ -34,6 +35,9 @@ pub(super) struct Solved {
     pub linear_solver: LinearSolverSummary,
     /// Solved by the linear steady solver: one solve, no steps.
     pub linear_steady: bool,
+    /// Per accepted step, each species interface's mass flux (mol/s) leaving side A and
+    /// side B.
+    pub species_flux: Vec<Vec<(f64, f64)>>,
 }
 
 /// The solve of a run, over its physics and contact terms.
@@ -91,6 +95,7 @@ impl<'a> TimeLoop<'a> {
             && physics.materials.constant().is_some()
             && physics.field_names.len() == 1
             && !physics.materials.electric()
+            && !physics.species.any()
             && !self.terms.couplings.any_toggle()
             && (self.file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
     }
@@ -163,6 +168,7 @@ impl<'a> TimeLoop<'a> {
             mechanisms: Vec::new(),
             linear_solver,
             linear_steady: true,
+            species_flux: Vec::new(),
         })
     }
 
@@ -202,6 +208,10 @@ impl<'a> TimeLoop<'a> {
         if physics.materials.electric() {
             list.push((VOLTAGE, &voltage_blocks));
         }
+        let species_blocks = physics.species.blocks(mesh);
+        if physics.species.any() {
+            list.push((SPECIES, &species_blocks));
+        }
         let dofs = DofMap::new(mesh, &list).map_err(|e| RunError::Solve(e.to_string()))?;
         let interfaces = terms.prepare(&dofs).map_err(RunError::Solve)?;
         let contact_conductances: Vec<_> = terms
@@ -210,6 +220,23 @@ impl<'a> TimeLoop<'a> {
             .iter()
             .map(|e| electric_conductance(e.model.as_ref(), e.pressure))
             .collect();
+        let (diffusivity, capacity) = (
+            physics.species.scaled_diffusivity(),
+            physics.species.scaled_capacity(),
+        );
+        let species_initial = match physics.species.any() {
+            true => super::species::initial(&self.file.problem, mesh, &physics.sandbox, time.start)
+                .map_err(|e| {
+                    super::input_error(
+                        "E0707",
+                        format!("[initial] species: {e}"),
+                        "a number or a Lua expression of x, y, z",
+                    )
+                })?,
+            false => Vec::new(),
+        };
+        let species_at =
+            |n: NodeId| super::species::scaled(species_initial[n.index()], n, &physics.species);
         let tp = TransientProblem {
             mesh,
             fields,
@@ -237,6 +264,11 @@ impl<'a> TimeLoop<'a> {
                     .collect(),
             }),
             death: terms.death_times(),
+            species: physics.species.any().then(|| transient::Species {
+                diffusivity: &diffusivity,
+                capacity: &capacity,
+                initial: &species_at,
+            }),
         };
         let restart = match (&problem.restart, self.options.restart.as_ref()) {
             (_, Some(file)) => Some(steps::read_checkpoint(file)?),
@@ -275,6 +307,7 @@ impl<'a> TimeLoop<'a> {
             progress: self.options.progress.as_deref(),
             history: Vec::new(),
             mechanisms: Vec::new(),
+            species_flux: Vec::new(),
         };
         self.options.phase(&format!(
             "assembling and factorising the first step ({} nodes)",
@@ -287,6 +320,7 @@ impl<'a> TimeLoop<'a> {
             output,
             history,
             mechanisms,
+            species_flux,
             ..
         } = recorder;
         output.finish_steps(&outcome, &history)?;
@@ -295,7 +329,7 @@ impl<'a> TimeLoop<'a> {
             outcome,
             &history,
             &physics.field_names,
-            interfaces.flux_count(),
+            terms.energy_flux_count(),
         );
         Ok(Solved {
             solution,
@@ -303,6 +337,7 @@ impl<'a> TimeLoop<'a> {
             mechanisms,
             linear_solver,
             linear_steady: false,
+            species_flux,
         })
     }
 
@@ -366,10 +401,16 @@ struct Recorder<'o, 'a> {
     progress: Option<&'a dyn Fn(&StepReport)>,
     history: Vec<StepReport>,
     mechanisms: Vec<Vec<Vec<f64>>>,
+    species_flux: Vec<Vec<(f64, f64)>>,
 }
 
 impl Recorder<'_, '_> {
     fn record(&mut self, r: &StepReport, st: &State, dofs: &DofMap) -> Result<(), HeatError> {
+        // The species interfaces' mass flux apart from the energy terms' heat.
+        let mut r = r.clone();
+        self.species_flux
+            .push(self.terms.split_species(&mut r.heat));
+        let r = &r;
         if let Some(progress) = self.progress {
             progress(r);
         }

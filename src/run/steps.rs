@@ -51,6 +51,8 @@ pub(super) struct StepFields<'a> {
     /// A thermal–electrical run's nodal voltage and −σ∇V per element (x, y, z
     /// interleaved; NaN where there is none).
     pub electric: Option<(&'a [f64], &'a [f64])>,
+    /// A run with a species: its nodal concentration (mol/m³; NaN where there is none).
+    pub species: Option<&'a [f64]>,
 }
 
 /// The names of the global variables of `results.exo`: per term (side A, side B
@@ -185,6 +187,9 @@ impl<'m> StepWriter<'m> {
                 nodal.push("voltage");
                 element.extend(&CURRENT_DENSITY[..dims]);
             }
+            if fields.species.is_some() {
+                nodal.push("species");
+            }
             let global: Vec<&str> = fields.heat_names.iter().map(String::as_str).collect();
             self.exodus = Some(ExodusWriter::create_with_globals(
                 &dir.join("results.exo"),
@@ -212,6 +217,9 @@ impl<'m> StepWriter<'m> {
         if let Some((v, j)) = fields.electric {
             nodal.push(v.iter().map(|&v| finite(v)).collect());
             element.extend(components(j));
+        }
+        if let Some(c) = fields.species {
+            nodal.push(c.iter().map(|&v| finite(v)).collect());
         }
         let nodal: Vec<&[f64]> = nodal.iter().map(Vec::as_slice).collect();
         let element: Vec<&[f64]> = element.iter().map(Vec::as_slice).collect();
@@ -266,6 +274,9 @@ pub(super) fn write_temperature_vtu(
     if let Some((v, j)) = fields.electric {
         point.push(Array::scalar("voltage", v));
         cell.push(Array::vector("current_density", j));
+    }
+    if let Some(c) = fields.species {
+        point.push(Array::scalar("species", c));
     }
     let encoding = spec.vtu_encoding(mesh.num_nodes());
     write_vtu_arrays(path, mesh, &point, &cell, encoding)
@@ -493,6 +504,28 @@ pub(super) fn write_electrical_contacts(
         }
     }
     std::fs::write(dir.join("electrical_contacts.csv"), s)
+}
+
+/// `species_contacts.csv`: per step and species interface (`labels`: side A, side B,
+/// model) the mass flux leaving side A and side B (mol/s) and their sum.
+pub(super) fn write_species_contacts(
+    dir: &Path,
+    history: &[StepReport],
+    flux: &[Vec<(f64, f64)>],
+    labels: &[(String, String, String)],
+) -> std::io::Result<()> {
+    let mut s = String::from("step,time,side_a,side_b,model,flux_side_a,flux_side_b,imbalance\n");
+    for (r, step) in history.iter().zip(flux) {
+        for ((a, b, m), (qa, qb)) in labels.iter().zip(step) {
+            s.push_str(&format!(
+                "{},{:e},{a},{b},{m},{qa:e},{qb:e},{:e}\n",
+                r.step,
+                r.time,
+                qa + qb
+            ));
+        }
+    }
+    std::fs::write(dir.join("species_contacts.csv"), s)
 }
 
 /// One step's interface heat: per term (contact terms, then ties) the heat leaving

@@ -38,6 +38,19 @@ pub struct ElectricalContact {
     pub joule_heat: f64,
 }
 
+/// One species interface's line in the summary (`Enforcement for Species`).
+#[derive(Clone, Debug, Serialize)]
+pub struct SpeciesContact {
+    pub side_a: String,
+    pub side_b: String,
+    pub model: String,
+    /// The mass flux leaving side A through the interface (mol/s).
+    pub flux_side_a: f64,
+    /// The mass flux leaving side B (mol/s): −`flux_side_a` to round-off.
+    pub flux_side_b: f64,
+    pub imbalance: f64,
+}
+
 #[derive(Clone, Copy, Debug, Default, Serialize)]
 pub struct Timing {
     /// Reading the mesh.
@@ -75,6 +88,9 @@ pub struct Summary {
     /// end.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub electrical_contacts: Vec<ElectricalContact>,
+    /// Runs with a species: each species interface's mass flux at the end.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub species_contacts: Vec<SpeciesContact>,
     /// An axisymmetric run (`[mesh] axisymmetric`): its heats are per full revolution.
     /// Written to the JSON only when true.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
@@ -190,6 +206,18 @@ impl Summary {
             diagnosis: history.last().and_then(|r| r.diagnosis.clone()),
             linear_solver: solved.linear_solver.clone(),
             electrical_contacts: electrical_contacts(terms, history.last()),
+            species_contacts: super::species::labels(&terms.contact.species)
+                .into_iter()
+                .zip(solved.species_flux.last().map_or(&[][..], Vec::as_slice))
+                .map(|((side_a, side_b, model), &(a, b))| SpeciesContact {
+                    side_a,
+                    side_b,
+                    model,
+                    flux_side_a: a,
+                    flux_side_b: b,
+                    imbalance: a + b,
+                })
+                .collect(),
             axisymmetric: false,
             motion: None,
         }

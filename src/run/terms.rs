@@ -129,10 +129,14 @@ impl<'a> ContactTerms<'a> {
         couplings: &'a Couplings,
         (motion, death): (Option<&'a Motion>, Option<&'a Death>),
     ) -> Self {
+        // The embedding's interactions: the energy ones, then the species interfaces.
+        let mortar: Vec<bool> = (contact.choices.iter().map(|c| c.0.mortar))
+            .chain(contact.species.iter().map(|s| s.choice.mortar))
+            .collect();
         let choices = &contact.choices;
-        let term_choice: Vec<usize> = (0..choices.len())
-            .filter(|&k| !choices[k].0.mortar)
-            .chain((0..choices.len()).filter(|&k| choices[k].0.mortar))
+        let term_choice: Vec<usize> = (0..mortar.len())
+            .filter(|&k| !mortar[k])
+            .chain((0..mortar.len()).filter(|&k| mortar[k]))
             .collect();
         let mechanism_names = choices
             .iter()
@@ -146,7 +150,7 @@ impl<'a> ContactTerms<'a> {
             contact,
             couplings,
             conductivity: physics.conductivity(),
-            flux_count: choices.iter().filter(|c| !c.0.mortar).count(),
+            flux_count: mortar.iter().filter(|m| !**m).count(),
             term_choice,
             mechanism_names,
             embedded: OnceCell::new(),
@@ -360,6 +364,27 @@ impl<'a> ContactTerms<'a> {
                     .map_err(|e| e.to_string())?;
             }
         }
+        let species = &physics.species;
+        if !self.contact.species.is_empty() {
+            let field = dofs
+                .field(crate::heat::species::SPECIES)
+                .ok_or("no dofs of field `species`")?;
+            let coefficient = species.coefficient(physics.probe, physics.time.start);
+            let fixed: Vec<NodeId> = species.dirichlet.iter().map(|&(n, _)| n).collect();
+            embedding.set_fixed_of(field, fixed);
+            for s in &self.contact.species {
+                let s_a = species.side_a_scale(physics.mesh, s)?;
+                let (choice, model) = s.scaled(s_a);
+                let k = embedding.add_resolved(
+                    s.pairing.clone(),
+                    (&choice, s.penalty_scale),
+                    model,
+                    None,
+                    field.into(),
+                );
+                embedding.set_coefficient(k, coefficient.clone());
+            }
+        }
         Ok(Embedded {
             embedding: RefCell::new(embedding),
             slots: RefCell::new((0, Vec::new())),
@@ -381,9 +406,11 @@ impl<'a> ContactTerms<'a> {
         let mut embedding = e.embedding.borrow_mut();
         embedding.set_time(t).map_err(failure)?;
         let moving = self.moving.borrow();
-        for k in 0..self.contact.choices.len() {
+        for k in 0..self.term_choice.len() {
+            // The species interfaces (after the energy ones) do not move.
+            let gone = moving.gone.get(k).copied().unwrap_or(false);
             embedding
-                .set_active(k, self.couplings.on(k, t) && !moving.gone[k])
+                .set_active(k, self.couplings.on(k, t) && !gone)
                 .map_err(failure)?;
         }
         Ok(())
@@ -506,19 +533,53 @@ impl<'a> ContactTerms<'a> {
         Some(out)
     }
 
-    /// Mechanism heats in the solver's term order.
-    pub(super) fn term_mechanisms(&self, d: &Derived) -> Vec<Vec<f64>> {
+    /// The energy interactions in the solver's term order (the species interfaces, after
+    /// them in the embedding, left out).
+    fn energy_terms(&self) -> impl Iterator<Item = usize> + '_ {
+        let energy = self.contact.choices.len();
         self.term_choice
             .iter()
-            .map(|&k| d.mechanisms[k].clone())
+            .copied()
+            .filter(move |&k| k < energy)
+    }
+
+    /// How many of the energy terms are flux terms (the rest are ties).
+    pub(super) fn energy_flux_count(&self) -> usize {
+        let energy = self.contact.choices.len();
+        self.term_choice[..self.flux_count]
+            .iter()
+            .filter(|&&k| k < energy)
+            .count()
+    }
+
+    /// A step's heat per solver term split into the energy terms' (kept in `heat`, in
+    /// their order) and the species interfaces' mass flux (returned, in the order of
+    /// `contact.species`): (mol/s leaving side A, leaving side B).
+    pub(super) fn split_species(&self, heat: &mut Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+        let energy = self.contact.choices.len();
+        let mut species = vec![(f64::NAN, f64::NAN); self.contact.species.len()];
+        let mut kept = Vec::with_capacity(heat.len());
+        for (&k, &h) in self.term_choice.iter().zip(heat.iter()) {
+            match k.checked_sub(energy) {
+                Some(s) => species[s] = h,
+                None => kept.push(h),
+            }
+        }
+        *heat = kept;
+        species
+    }
+
+    /// Mechanism heats in the solver's term order.
+    pub(super) fn term_mechanisms(&self, d: &Derived) -> Vec<Vec<f64>> {
+        self.energy_terms()
+            .map(|k| d.mechanisms[k].clone())
             .collect()
     }
 
     /// Per solver term, (side A, side B) surface names.
     pub(super) fn term_sides(&self) -> Vec<(&str, &str)> {
-        self.term_choice
-            .iter()
-            .map(|&k| {
+        self.energy_terms()
+            .map(|k| {
                 let p = &self.contact.pairings[k];
                 (p.side_a.as_str(), p.side_b.as_str())
             })
@@ -527,9 +588,8 @@ impl<'a> ContactTerms<'a> {
 
     /// Per solver term, (side A, side B, model) for the heat histories.
     pub(super) fn term_labels(&self) -> Vec<(String, String, String)> {
-        self.term_choice
-            .iter()
-            .map(|&k| {
+        self.energy_terms()
+            .map(|k| {
                 let p = &self.contact.pairings[k];
                 (
                     p.side_a.clone(),
@@ -542,9 +602,8 @@ impl<'a> ContactTerms<'a> {
 
     /// Per solver term, the names of its conductance's mechanisms.
     pub(super) fn term_mechanism_names(&self) -> Vec<Vec<String>> {
-        self.term_choice
-            .iter()
-            .map(|&k| self.mechanism_names[k].clone())
+        self.energy_terms()
+            .map(|k| self.mechanism_names[k].clone())
             .collect()
     }
 
@@ -597,10 +656,10 @@ impl Interfaces for ContactTerms<'_> {
 
     fn is_linear(&self) -> bool {
         // A conductance independent of T keeps the system linear and symmetric.
-        self.contact
-            .choices
-            .iter()
-            .all(|(c, _, m)| c.mortar || m.as_ref().is_none_or(|m| !m.depends_on_temperature()))
+        let species = self.contact.species.iter().map(|s| (&s.choice, &s.model));
+        (self.contact.choices.iter().map(|(c, _, m)| (c, m)))
+            .chain(species)
+            .all(|(c, m)| c.mortar || m.as_ref().is_none_or(|m| !m.depends_on_temperature()))
     }
 
     fn ties(&self) -> Result<Vec<TieRows>, String> {

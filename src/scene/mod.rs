@@ -28,6 +28,7 @@ pub mod enforcement;
 pub mod interaction;
 pub mod plugin;
 pub mod search;
+pub mod species;
 pub mod surfaces;
 
 use std::path::Path;
@@ -188,6 +189,8 @@ pub struct ContactScene {
     pub entries: Vec<Enforced>,
     /// The electrical contacts of the definitions' `Enforcement for Voltage` blocks.
     pub electrical: Vec<electric::ElectricalEnforced>,
+    /// The species interfaces of the definitions' `Enforcement for Species` blocks.
+    pub species: Vec<species::SpeciesEnforced>,
     /// Per contact definition of the deck, in deck order.
     pub definitions: Vec<DefinitionNotes>,
     /// Number of contact surfaces built, over every definition.
@@ -275,12 +278,16 @@ impl ContactScene {
                 diags.push(e);
                 None
             });
+            let species_block = species::species_block(def).unwrap_or_else(|e| {
+                diags.push(e);
+                None
+            });
             let energy = def
                 .enforcements
                 .iter()
                 .any(|e| e.models.iter().any(|m| m.equation == ENERGY));
-            // A voltage block that fails says so once, not once per pair.
-            let mut voltage_failed = false;
+            // A voltage or species block that fails says so once, not once per pair.
+            let (mut voltage_failed, mut species_failed) = (false, false);
             for (pairing, map) in searched.pairings.into_iter().zip(maps) {
                 if let Some(v) = voltage.filter(|_| !voltage_failed) {
                     match electric::electrical(v, d, &pairing, deck_dir, &loaded.sources, diags) {
@@ -288,13 +295,22 @@ impl ContactScene {
                         None => voltage_failed = true,
                     }
                 }
-                // A definition with a Voltage block and no Energy one joins no temperatures.
-                if voltage.is_some() && !energy {
-                    continue;
-                }
                 let interaction = list
                     .iter()
                     .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
+                if let Some(s) = species_block.filter(|_| !species_failed) {
+                    let scale = interaction.map_or(1.0, |i| i.penalty_scale);
+                    let sources = &loaded.sources;
+                    match species::species(s, d, &pairing, scale, deck_dir, sources, diags) {
+                        Some(e) => scene.species.push(e),
+                        None => species_failed = true,
+                    }
+                }
+                // A definition with a Voltage or Species block and no Energy one joins no
+                // temperatures.
+                if (voltage.is_some() || species_block.is_some()) && !energy {
+                    continue;
+                }
                 let named = interaction.and_then(|i| i.enforcement.as_deref());
                 let pair = (pairing.side_a.as_str(), pairing.side_b.as_str());
                 let enf = match enforcement_for(def, named, pair) {
@@ -697,12 +713,18 @@ pub fn check_enforcements(
             Ok(None) => {}
             Err(e) => diags.push(e),
         }
+        match species::species_block(def) {
+            Ok(Some(enf)) => {
+                let name = enf.name.as_deref().unwrap_or("(check)");
+                let _ = species::species_model(enf, deck_dir, &loaded.sources, (name, name), diags);
+            }
+            Ok(None) => {}
+            Err(e) => diags.push(e),
+        }
         for enf in &def.enforcements {
-            if enf
-                .models
-                .iter()
-                .any(|m| m.equation == electric::VOLTAGE_EQUATION)
-            {
+            if enf.models.iter().any(|m| {
+                m.equation == electric::VOLTAGE_EQUATION || m.equation == species::SPECIES_EQUATION
+            }) {
                 continue;
             }
             match resolve_for(enf, fields) {

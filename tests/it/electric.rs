@@ -247,6 +247,7 @@ fn run(
             faces,
             voltage: ground.iter().map(|&n| (n, 0.0)).collect(),
             currents: left.iter().map(|&s| (s, b.j0)).collect(),
+            ..Loads::default()
         })
     };
     let problem = TransientProblem {
@@ -266,6 +267,7 @@ fn run(
             contacts: vec![(contact, &h_e)],
         }),
         death: None,
+        species: None,
     };
     let initial = |_| bars.t_inf;
     let mut last = None;

@@ -32,6 +32,7 @@ mod run_fields;
 mod search;
 mod search_kernels;
 mod sources;
+mod species;
 mod surfaces;
 mod transient;
 mod twod;

@@ -429,7 +429,6 @@ fn equations_of_arias_list_other_than_energy_are_refused() {
         "Momentum",
         "Porous_Enthalpy",
         "Porous_Species",
-        "Species",
     ] {
         let lower = eq.to_lowercase();
         let text = in_enforcement(&format!("Enforcement For {eq} = Tied"));
@@ -448,7 +447,7 @@ fn equations_of_arias_list_other_than_energy_are_refused() {
             d.0[0]
                 .help
                 .as_deref()
-                .is_some_and(|h| h.starts_with("seam solves Energy and Voltage only")),
+                .is_some_and(|h| h.starts_with("seam solves Energy, Voltage and Species only")),
             "{eq}"
         );
         // The spec still carries the line.
@@ -630,11 +629,6 @@ fn material_models_that_seam_refuses() {
             "Offset Solid Displacements = Constant Value = 1",
             "offset solid displacements",
             "solid mechanics",
-        ),
-        (
-            "Offset Species = Constant Value = 1",
-            "offset species",
-            "species transport",
         ),
         (
             "Offset Velocity = Constant Value = 1",
@@ -1146,10 +1140,10 @@ equation = "energy"
 model = "gap_conductance"
 args = [{ key = "h", value = "5" }]
 [[contact_definition.enforcement.model]]
-equation = "species"
+equation = "porous_species"
 model = "tied"
 [[contact_definition.enforcement.property]]
-property = "offset_species"
+property = "offset_velocity"
 model = "constant"
 [[contact_definition.enforcement.property]]
 property = "gap_conductence_coefficient"
@@ -1202,4 +1196,19 @@ fn voltage_enforcements_are_read() {
     ));
     assert_eq!(diags(&d).len(), 1, "{:?}", diags(&d));
     assert_eq!(diags(&d)[0].0, "E0227");
+}
+
+/// `Enforcement For Species`, `Partition Coefficient` and `Offset Species` are read:
+/// the species interface and its jump c_A = K c_B + Δc.
+#[test]
+fn species_enforcements_are_read() {
+    let text = in_enforcement(
+        "Enforcement For Species = Tied_Species\n    Partition Coefficient = 2.5\n    Offset Species = Constant Value = 0.25",
+    );
+    let (deck, d) = parse(&text);
+    assert!(diags(&d).is_empty(), "{:?}", diags(&d));
+    let e = &deck.contact_definitions[0].enforcements[0];
+    assert_eq!(e.models[0].equation, "species");
+    assert_eq!(e.partition_coefficient, Some(2.5));
+    assert_eq!(e.offset_species, Some(0.25));
 }

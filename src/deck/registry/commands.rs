@@ -213,7 +213,7 @@ pub static COMMANDS: &[CommandSpec] = &[
     refused!(
         "offset darcy potential",
         "offset_darcy_potential",
-        "porous flow (Darcy potential), which seam does not solve (seam solves energy and voltage only)"
+        "porous flow (Darcy potential), which seam does not solve (seam solves energy, voltage and species only)"
     ),
     refused!(
         "offset mesh displacements",
@@ -223,22 +223,31 @@ pub static COMMANDS: &[CommandSpec] = &[
     refused!(
         "offset pressure",
         "offset_pressure",
-        "fluid flow (pressure), which seam does not solve (seam solves energy and voltage only)"
+        "fluid flow (pressure), which seam does not solve (seam solves energy, voltage and species only)"
     ),
     refused!(
         "offset solid displacements",
         "offset_solid_displacements",
         "solid mechanics (displacements), which seam does not solve (its meshes do not move)"
     ),
-    refused!(
+    cmd!(
         "offset species",
         "offset_species",
-        "species transport, which seam does not solve (seam solves energy and voltage only)"
+        [ENF],
+        "= [constant [value =]] <dc>",
+        "Concentration jump across the interface of an `Enforcement for Species` (mol/m³; material model `Offset Species = Constant Value = <dc>`): a tie holds c_A = K c_B + dc, a mass-transfer interface carries j = h (c_A - K c_B - dc). Range: finite (else E0227)."
+    ),
+    cmd!(
+        "partition coefficient",
+        "partition_coefficient",
+        [ENF],
+        "= [constant [value =]] <K>",
+        "seam: the partition coefficient K of an `Enforcement for Species` interface (the ratio of the two sides' solubilities): a tie holds c_A = K c_B, a mass-transfer interface carries j = h (c_A - K c_B). Default 1. Range: finite and > 0 (else E0227)."
     ),
     refused!(
         "offset velocity",
         "offset_velocity",
-        "fluid flow (velocity), which seam does not solve (seam solves energy and voltage only)"
+        "fluid flow (velocity), which seam does not solve (seam solves energy, voltage and species only)"
     ),
     cmd!(
         "offset voltage",

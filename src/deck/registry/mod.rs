@@ -233,13 +233,13 @@ pub static EQUATIONS: &[(&str, Status)] = &[
     ("momentum", Status::Refused(NOT_ENERGY)),
     ("porous_enthalpy", Status::Refused(NOT_ENERGY)),
     ("porous_species", Status::Refused(NOT_ENERGY)),
-    ("species", Status::Refused(NOT_ENERGY)),
+    ("species", Status::Implemented),
     ("voltage", Status::Implemented),
 ];
 
-const NOT_ENERGY: &str = "seam solves Energy and Voltage only";
+const NOT_ENERGY: &str = "seam solves Energy, Voltage and Species only";
 const CVFEM: &str =
-    "seam solves Energy and Voltage only, with finite elements (no control-volume form)";
+    "seam solves Energy, Voltage and Species only, with finite elements (no control-volume form)";
 
 /// The status of equation `name` (lower case), `None` if it is not in Aria's list.
 pub fn equation(name: &str) -> Option<Status> {
@@ -436,7 +436,11 @@ mod tests {
             Some(("contact_pressure", 3))
         );
         assert!(elfen_refused("corner_REGION_size").is_some());
-        assert_eq!(equation("species"), Some(Status::Refused(NOT_ENERGY)));
+        assert_eq!(equation("species"), Some(Status::Implemented));
+        assert_eq!(
+            equation("porous_species"),
+            Some(Status::Refused(NOT_ENERGY))
+        );
         assert_eq!(equation("voltage"), Some(Status::Implemented));
         assert_eq!(equation("energy"), Some(Status::Implemented));
         assert_eq!(equation("enrgy"), None);

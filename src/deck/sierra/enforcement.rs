@@ -151,6 +151,25 @@ impl Lower {
                             .set(format!("{d}.enforcement.{k}.joule_fraction_side_a"), v_at);
                     }
                 }
+                "offset_species" => {
+                    self.once(&mut seen, &c);
+                    if let Some((v, v_at)) =
+                        self.constant_value(&mut c, "a concentration difference")
+                    {
+                        e.offset_species = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.offset_species"), v_at);
+                    }
+                }
+                "partition_coefficient" => {
+                    self.once(&mut seen, &c);
+                    if let Some((v, v_at)) = self.constant_value(&mut c, "a partition coefficient")
+                    {
+                        e.partition_coefficient = Some(v);
+                        self.locs
+                            .set(format!("{d}.enforcement.{k}.partition_coefficient"), v_at);
+                    }
+                }
                 "offset_temperature" => {
                     self.once(&mut seen, &c);
                     if let Some((v, v_at)) = self.constant_value(&mut c, "a temperature difference")

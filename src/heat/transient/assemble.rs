@@ -49,6 +49,13 @@ impl Context<'_, '_> {
             .map(|(k, (side, _))| (side.elem.0, k))
             .collect();
         currents.sort_unstable();
+        let mut species_fluxes: Vec<(u32, usize)> = loads
+            .species_fluxes
+            .iter()
+            .enumerate()
+            .map(|(k, (side, _))| (side.elem.0, k))
+            .collect();
+        species_fluxes.sort_unstable();
         let errors = FirstError::new();
         let (laws, source, block_source) = (p.laws, p.source, p.block_source);
         let sigmas = p.electric.as_ref().map(|el| el.conductivity);
@@ -62,6 +69,7 @@ impl Context<'_, '_> {
             loads,
             faces: &faces,
             currents: &currents,
+            species_fluxes: &species_fluxes,
         };
         // A linear problem's element matrices (conduction, and the faces' dg/dT) stay
         // the same while the face conditions' derivatives do: then they are kept in
@@ -82,12 +90,14 @@ impl Context<'_, '_> {
             s.push((u32::MAX, 0, dead as f64));
             s
         });
-        let keep = signature.is_some() && *self.element_matrices.borrow() == signature;
+        // A species block's element matrix holds the thermal one inside a wider one: it
+        // is computed each time (no kept matrices with a species).
+        let diffusivity = p.species.as_ref().map(|s| s.diffusivity);
+        let keep = diffusivity.is_none()
+            && signature.is_some()
+            && *self.element_matrices.borrow() == signature;
         let death = p.death;
-        asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
-            if super::death::is_dead(death, e, t) {
-                return;
-            }
+        let thermal = |e: crate::mesh::ElemId, je: &mut [f64], re: &mut [f64]| {
             let b = mesh.block_of(e);
             if let Some(sigma) = sigmas.and_then(|s| s.get(b)?.as_ref()) {
                 if let Err(err) = cx.electric_element(e, sigma, re, je) {
@@ -102,7 +112,7 @@ impl Context<'_, '_> {
             let mut elem_dofs = Vec::with_capacity(nn);
             dofs.elem_dofs(mesh, e, &mut elem_dofs);
             let mut te = [0.0; MAX_NODES];
-            for (k, d) in elem_dofs.iter().enumerate() {
+            for (k, d) in elem_dofs.iter().take(nn).enumerate() {
                 te[k] = u[*d as usize];
             }
             // Linear: the matrix at T = 0, then the residual from it.
@@ -202,6 +212,20 @@ impl Context<'_, '_> {
                 return;
             }
             re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
+        };
+        asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
+            if super::death::is_dead(death, e, t) {
+                return;
+            }
+            let d = diffusivity.and_then(|d| d.get(mesh.block_of(e))?.as_ref());
+            match d {
+                Some(d) => {
+                    if let Err(err) = cx.species_element(e, d, &thermal, re, je) {
+                        errors.record(e, err);
+                    }
+                }
+                None => thermal(e, je, re),
+            }
         });
         errors.into_result()?;
         if !keep {
@@ -212,6 +236,9 @@ impl Context<'_, '_> {
         let mut r = asm.rhs();
         // Capacity (lumped): M(u)(α₀u + α₁uⁿ + α₂uⁿ⁻¹)/Δt on the diagonal.
         let alive = self.alive.borrow();
+        // The species has its own capacity, φ per block.
+        let species = setup.species.map(|c| setup.dofs.field_range(c));
+        let phi = p.species.as_ref().map(|s| s.capacity);
         if let Some(h) = history {
             let lumped = alive.as_ref().map_or(&setup.lumped, |a| &a.lumped);
             let terms: Vec<Result<(usize, f64, f64), String>> = lumped
@@ -219,7 +246,10 @@ impl Context<'_, '_> {
                 .with_min_len(4096)
                 .map(|&(d, b, w, xn)| {
                     let d = d as usize;
-                    let (c, dc) = p.laws[b as usize].capacity.eval(u[d], xn, t)?;
+                    let (c, dc) = match (&species, phi) {
+                        (Some(r), Some(phi)) if r.contains(&d) => (phi[b as usize], 0.0),
+                        _ => p.laws[b as usize].capacity.eval(u[d], xn, t)?,
+                    };
                     let mut rate = h.alpha[0] * u[d] + h.alpha[1] * h.current[d];
                     if let Some(prev) = h.previous {
                         rate += h.alpha[2] * prev[d];
@@ -307,6 +337,9 @@ impl Context<'_, '_> {
     }
 }
 
+/// An element kernel: `(element, matrix, vector)`, as [`Assembler::elements_with`] calls it.
+type ElementKernel<'k> = dyn Fn(crate::mesh::ElemId, &mut [f64], &mut [f64]) + Sync + 'k;
+
 /// What an element of a block with a voltage needs (shared by the element threads).
 struct ElementCx<'c> {
     mesh: &'c crate::mesh::Mesh,
@@ -319,6 +352,7 @@ struct ElementCx<'c> {
     /// `(element, index)` of the face conditions and of the currents, sorted.
     faces: &'c [(u32, usize)],
     currents: &'c [(u32, usize)],
+    species_fluxes: &'c [(u32, usize)],
 }
 
 impl ElementCx<'_> {
@@ -422,6 +456,89 @@ impl ElementCx<'_> {
                 return Err(HeatError::Source { block, message });
             }
             add(0, rs, js);
+        }
+        Ok(())
+    }
+}
+
+impl ElementCx<'_> {
+    /// One element of a block with a species: its thermal (or thermal–electrical) part
+    /// by `thermal` into the leading rows and columns, then the concentration's rows
+    /// (diffusion with D(T) and its T-derivative, the species fluxes into its faces) at
+    /// the end of the element's dofs ([`crate::heat::species`]).
+    fn species_element(
+        &self,
+        e: crate::mesh::ElemId,
+        diffusivity: &Law,
+        thermal: &ElementKernel<'_>,
+        re: &mut [f64],
+        je: &mut [f64],
+    ) -> Result<(), HeatError> {
+        let (setup, mesh, u, t, loads) = (self.setup, self.mesh, self.u, self.t, self.loads);
+        let b = mesh.block_of(e);
+        let topo = mesh.blocks[b].topology;
+        let rule = setup.rules[b].as_ref().expect("rule of a field block");
+        let mut x = [[0.0; 3]; MAX_NODES];
+        let nn = elem_coords(mesh, e, &mut x);
+        let mut elem_dofs = Vec::with_capacity(3 * nn);
+        setup.dofs.elem_dofs(mesh, e, &mut elem_dofs);
+        let w = elem_dofs.len();
+        let off = w - nn;
+        // The thermal part, then placed in the leading `off × off` block.
+        let mut rb = vec![0.0; off];
+        let mut jb = vec![0.0; off * off];
+        thermal(e, &mut jb, &mut rb);
+        for i in 0..off {
+            re[i] += rb[i];
+            for j in 0..off {
+                je[i * w + j] += jb[i * off + j];
+            }
+        }
+        let mut te = [0.0; MAX_NODES];
+        let mut ce = [0.0; MAX_NODES];
+        for k in 0..nn {
+            te[k] = u[elem_dofs[k] as usize];
+            ce[k] = u[elem_dofs[off + k] as usize];
+        }
+        let failed = Cell::new(None);
+        let d = checked(diffusivity, "diffusivity", t, &failed);
+        crate::heat::species::species_residual_jacobian(
+            rule,
+            &x[..nn],
+            &te[..nn],
+            &ce[..nn],
+            d,
+            (off, w),
+            re,
+            je,
+        )
+        .map_err(|bad| bad_jacobian(mesh, e, bad))?;
+        if let Some(message) = failed.take() {
+            let block = mesh.blocks[b].id;
+            return Err(HeatError::Material { block, message });
+        }
+        let fluxes = self.species_fluxes;
+        let start = fluxes.partition_point(|f| f.0 < e.0);
+        let mut rs = [0.0; MAX_NODES];
+        let mut js = [0.0; MAX_NODES * MAX_NODES];
+        for &(_, k) in fluxes[start..].iter().take_while(|f| f.0 == e.0) {
+            let (side, j) = loads.species_fluxes[k];
+            let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
+            rs.fill(0.0);
+            js.fill(0.0);
+            kernel::face_load_with(
+                Measure::of(mesh.axisymmetric),
+                topo,
+                &x[..nn],
+                side.side,
+                &ce[..nn],
+                |_, _| (-j, 0.0),
+                rs,
+                js,
+            );
+            for a in 0..nn {
+                re[off + a] += rs[a];
+            }
         }
         Ok(())
     }

@@ -19,7 +19,8 @@
 //! A step is rejected and retried with half the step when Newton fails or a
 //! conductance model (a plugin) asks for a smaller step; with adaptive steps also when
 //! the local error estimate — the distance to the polynomial predictor, scaled by the
-//! scheme's error constant — exceeds the tolerance. Only accepted steps reach the
+//! scheme's error constant — exceeds the tolerance (over the temperatures and voltages;
+//! a species is integrated on the steps they choose). Only accepted steps reach the
 //! caller's `on_step`, so contact state and output are committed on accepted steps
 //! only.
 //!
@@ -98,6 +99,22 @@ pub struct Loads {
     /// Current densities into the body (A/m²) on element sides, with
     /// [`TransientProblem::electric`].
     pub currents: Vec<(crate::mesh::Side, f64)>,
+    /// Nodal concentrations (in the unknown of [`TransientProblem::species`]), with it.
+    pub species: Vec<(NodeId, f64)>,
+    /// Species fluxes into the body (mol/m²/s) on element sides, with
+    /// [`TransientProblem::species`].
+    pub species_fluxes: Vec<(crate::mesh::Side, f64)>,
+}
+
+/// The species of a problem ([`crate::heat::species`]): its field, numbered after every
+/// other, on the blocks with a diffusivity.
+pub struct Species<'a> {
+    /// D(T) per mesh block (m²/s); `None`: the block carries no species.
+    pub diffusivity: &'a [Option<Law>],
+    /// The capacity φ per mesh block (the factor of ∂c/∂t).
+    pub capacity: &'a [f64],
+    /// The concentration at each node at the start of a fresh run.
+    pub initial: &'a dyn Fn(NodeId) -> f64,
 }
 
 /// The electrical part of a thermal–electrical problem ([`crate::heat::electric`]).
@@ -153,6 +170,8 @@ pub struct TransientProblem<'a> {
     /// Element death: per mesh element the time from which it is dead (∞: never). A
     /// dead element adds nothing; the nodes no live element holds keep their values.
     pub death: Option<&'a [f64]>,
+    /// A diffusing species beside the temperature, solved in the same Newton.
+    pub species: Option<Species<'a>>,
 }
 
 /// Step-size control.
@@ -312,6 +331,13 @@ pub fn solve(
                 }
             }
             // The voltage starts at 0 (a linear equation: Newton's first step solves it).
+            if let (Some(sp), Some(f)) = (&p.species, setup.species) {
+                for node in (0..p.mesh.num_nodes()).map(|n| NodeId(n as u32)) {
+                    if let Some(d) = setup.dofs.dof(f, node) {
+                        u[d.index()] = (sp.initial)(node);
+                    }
+                }
+            }
             State {
                 step: 0,
                 time,
@@ -553,7 +579,9 @@ fn error_estimate(
     dt: f64,
     setup: &Setup,
 ) -> Option<f64> {
-    let n = setup.n_primal;
+    // The step follows the temperature (and voltage): the species, in other units, is
+    // integrated on the same steps.
+    let n = setup.species_start();
     match scheme {
         Scheme::BackwardEuler => {
             let (t1, _) = state.past.first()?;

@@ -304,7 +304,12 @@ impl Context<'_, '_> {
             report.solve_s += solve_s;
             report.cg_iterations += cg;
             report.newton_iterations += 1;
-            let step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            // The update relative to the field's size: the species (other units) apart
+            // from the temperatures, voltages and multipliers.
+            let species = setup.species_start()..setup.n_primal;
+            let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let step = largest(&rhs[..species.start]).max(largest(&rhs[species.end..]));
+            let species_step = largest(&rhs[species.clone()]);
             for (ui, d) in u.iter_mut().zip(&rhs) {
                 *ui += d;
             }
@@ -320,11 +325,9 @@ impl Context<'_, '_> {
                 report.assembly_s += clock.elapsed().as_secs_f64();
             }
             solvers.matrix = Some(jac);
-            let u_max = u[..setup.n_primal]
-                .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()))
-                .max(f64::MIN_POSITIVE);
-            last_update = step / u_max;
+            let u_max = largest(&u[..species.start]).max(f64::MIN_POSITIVE);
+            let c_max = largest(&u[species]).max(f64::MIN_POSITIVE);
+            last_update = (step / u_max).max(species_step / c_max);
         }
         unreachable!("the loop returns at its last iteration")
     }
@@ -343,5 +346,7 @@ impl Context<'_, '_> {
             && self.p.interfaces.is_none_or(|i| i.is_linear())
             && (self.p.block_source).is_none_or(|s| s.iter().all(|q| !q.uses_temperature()))
             && self.p.electric.is_none()
+            && (self.p.species.as_ref())
+                .is_none_or(|s| s.diffusivity.iter().flatten().all(|d| d.is_constant()))
     }
 }

@@ -11,6 +11,7 @@ use crate::mesh::{Mesh, NodeId};
 
 use super::{Loads, TransientProblem};
 use crate::heat::electric::{ElectricContact, VOLTAGE};
+use crate::heat::species::SPECIES;
 
 /// What does not change over a run: dofs, ties, the pattern's couplings, the lumped
 /// capacity weights.
@@ -30,6 +31,8 @@ pub(super) struct Setup {
     pub(super) voltage: Option<FieldId>,
     /// Its electrical contacts, bound to the dofs.
     pub(super) electric: Vec<ElectricContact>,
+    /// The species field, numbered last.
+    pub(super) species: Option<FieldId>,
 }
 
 impl Setup {
@@ -53,8 +56,21 @@ impl Setup {
         if p.electric.is_some() {
             list.push((VOLTAGE, voltage_blocks.as_slice()));
         }
+        // The species is numbered last: an element's species dofs close its list.
+        let species_blocks: Vec<usize> = p.species.as_ref().map_or_else(Vec::new, |s| {
+            (0..mesh.blocks.len())
+                .filter(|&b| {
+                    mesh.blocks[b].topology.is_solid()
+                        && s.diffusivity.get(b).is_some_and(Option::is_some)
+                })
+                .collect()
+        });
+        if p.species.is_some() {
+            list.push((SPECIES, species_blocks.as_slice()));
+        }
         let mut dofs = DofMap::new(mesh, &list)?;
         let voltage = p.electric.as_ref().and_then(|_| dofs.field(VOLTAGE));
+        let species = p.species.as_ref().and_then(|_| dofs.field(SPECIES));
         let fields: Vec<FieldId> = specs
             .iter()
             .map(|f| dofs.field(&f.name).expect("field just made"))
@@ -67,6 +83,9 @@ impl Setup {
             .collect();
         if let Some(v) = voltage {
             dirichlet_dofs.extend(voltage_dofs(mesh, &dofs, v, &loads.voltage)?.map(|(d, _)| d));
+        }
+        if let Some(c) = species {
+            dirichlet_dofs.extend(species_dofs(mesh, &dofs, c, &loads.species)?.map(|(d, _)| d));
         }
         let mut electric = Vec::new();
         if let (Some(e), Some(v)) = (&p.electric, voltage) {
@@ -110,7 +129,14 @@ impl Setup {
             rules,
             voltage,
             electric,
+            species,
         })
+    }
+
+    /// Where the species dofs start (the end of the fields without one).
+    pub(super) fn species_start(&self) -> usize {
+        self.species
+            .map_or(self.n_primal, |c| self.dofs.field_range(c).start)
     }
 
     /// The Dirichlet dofs and values of `loads`: the temperatures on whichever thermal
@@ -123,6 +149,9 @@ impl Setup {
         let mut out = node_dofs(mesh, &self.dofs, &self.fields, &loads.dirichlet)?;
         if let Some(v) = self.voltage {
             out.extend(voltage_dofs(mesh, &self.dofs, v, &loads.voltage)?);
+        }
+        if let Some(c) = self.species {
+            out.extend(species_dofs(mesh, &self.dofs, c, &loads.species)?);
         }
         Ok(out)
     }
@@ -144,6 +173,25 @@ fn voltage_dofs<'d>(
     Ok(data
         .iter()
         .map(move |&(n, val)| (dofs.dof(v, n).expect("checked above").index(), val)))
+}
+
+/// `(dof, value)` of nodal concentrations; a node without a species is an error that
+/// names it.
+fn species_dofs<'d>(
+    mesh: &'d Mesh,
+    dofs: &'d DofMap,
+    c: FieldId,
+    data: &'d [(NodeId, f64)],
+) -> Result<impl Iterator<Item = (usize, f64)> + 'd, HeatError> {
+    if let Some(&(n, _)) = data.iter().find(|(n, _)| dofs.dof(c, *n).is_none()) {
+        return Err(HeatError::Step(format!(
+            "node {} has a species condition but no species: its blocks have no diffusivity",
+            mesh.node_number(n)
+        )));
+    }
+    Ok(data
+        .iter()
+        .map(move |&(n, val)| (dofs.dof(c, n).expect("checked above").index(), val)))
 }
 
 /// `(dof, value)` of nodal data on whichever field the node carries.

@@ -1,6 +1,6 @@
 begin contact definition
   begin enforcement electric
     Enforcement For Voltage = Tied_Voltage
-    Enforcement For Species Tied_Species
+    Enforcement For Porous_Species Tied_Species
   end
 end
