@@ -198,3 +198,225 @@ fn a_partition_coefficient_tie_gives_the_exact_jump_across_a_non_matching_interf
         std::fs::remove_dir_all(&dir).ok();
     }
 }
+
+#[test]
+fn a_mass_transfer_interface_and_an_offset_match_the_closed_form() {
+    let mesh = bars([3, 2], [3, 4]);
+    // (species lines, K, Δc, h).
+    let h = 4e-3;
+    let cases = [
+        (
+            format!("  enforcement for species = conductance\n  gap conductance coefficient = constant h = {h}\n  partition coefficient = 2"),
+            2.0,
+            0.0,
+            h,
+        ),
+        (
+            format!("  enforcement for species = gap_conductance\n  gap conductance coefficient = constant h = {h}\n  partition coefficient = 0.5\n  offset species = 1.5"),
+            0.5,
+            1.5,
+            h,
+        ),
+        (
+            format!("  enforcement for species = contact_resistance h = {h}"),
+            1.0,
+            0.0,
+            h,
+        ),
+        (
+            "  enforcement for species = tied_species\n  partition coefficient = 2\n  offset species = constant value = -2.5".to_string(),
+            2.0,
+            -2.5,
+            f64::INFINITY,
+        ),
+        (
+            "  enforcement for species = tied multipliers = dual\n  side b variable species to species\n  offset species = 3".to_string(),
+            1.0,
+            3.0,
+            f64::INFINITY,
+        ),
+    ];
+    for (i, (lines, k, dc, h)) in cases.iter().enumerate() {
+        let (r, dir) = run_case(
+            &format!("transfer-{i}"),
+            &mesh,
+            &deck(lines),
+            &problem(&held_ends(), STEADY),
+        );
+        let (exact, j) = closed_form(*k, *dc, *h);
+        let err = worst_error(&r, &exact);
+        let ((ca, cb), _) = at_interface(&r);
+        let flux = &r.summary.species_contacts[0];
+        // The interface law at the solution: a tie holds c_A − K c_B = Δc, a transfer
+        // interface carries h (c_A − K c_B − Δc).
+        let law = if h.is_finite() {
+            (h * (ca - k * cb - dc) - flux.flux_side_a).abs() / j
+        } else {
+            (ca - k * cb - dc).abs() / C0
+        };
+        eprintln!(
+            "case {i} (K = {k}, Δc = {dc}, h = {h}): worst nodal error {err:.1e} (of c0); c_A = {ca:.12}, c_B = {cb:.12}, interface law off by {law:.1e}; flux {:.12e} mol/s (exact {j:.12e})",
+            flux.flux_side_a
+        );
+        assert!(err < 1e-12, "case {i}: worst nodal error {err:e}");
+        assert!(law < 1e-12, "case {i}: interface law off by {law:e}");
+        assert!(
+            (flux.flux_side_a - j).abs() < 1e-10 * j.abs(),
+            "case {i}: flux"
+        );
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
+
+/// ∫ φ c dV over each block of a run's final concentration (trilinear hexes on boxes:
+/// the volume times the mean of the eight nodal values is exact).
+fn block_mass(r: &RunResult, phi: [f64; 2]) -> [f64; 2] {
+    let c = r.species.as_ref().expect("a species field");
+    let mesh = &r.mesh;
+    let mut out = [0.0; 2];
+    for (b, block) in mesh.blocks.iter().enumerate() {
+        for k in 0..block.len() {
+            let e = seam::mesh::ElemId(block.first_elem.0 + k as u32);
+            let nodes: Vec<_> = mesh.elem_nodes(e).to_vec();
+            let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+            for n in &nodes {
+                for d in 0..3 {
+                    lo[d] = lo[d].min(mesh.coords[n.index()][d]);
+                    hi[d] = hi[d].max(mesh.coords[n.index()][d]);
+                }
+            }
+            let volume: f64 = (0..3).map(|d| hi[d] - lo[d]).product();
+            let mean = nodes.iter().map(|n| c[n.index()]).sum::<f64>() / nodes.len() as f64;
+            out[b] += phi[b] * volume * mean;
+        }
+    }
+    out
+}
+
+#[test]
+fn what_enters_leaves_steady_and_a_transient_run_keeps_its_mass() {
+    let mesh = bars([2, 3], [3, 3]);
+    let j0 = 0.02;
+    let inflow =
+        format!("[[bc]]\nkind = \"species_flux\"\nsurfaces = [\"surface_1\"]\nvalue = {j0}\n");
+    let tie = "  enforcement for species = tied_species\n  partition coefficient = 3";
+    // Steady: j0 enters at z = 0 through the unit section, crosses the interface and
+    // leaves through the held end.
+    let held = format!("[[bc]]\nkind = \"species\"\nsurfaces = [\"surface_4\"]\nvalue = {CL}\n");
+    let (r, dir) = run_case(
+        "balance",
+        &mesh,
+        &deck(tie),
+        &problem(&(inflow.clone() + &held), STEADY),
+    );
+    let flux = &r.summary.species_contacts[0];
+    eprintln!(
+        "steady: {j0} mol/s enters, {:.15e} crosses (side B {:.15e}, imbalance {:.1e})",
+        flux.flux_side_a, flux.flux_side_b, flux.imbalance
+    );
+    assert!((flux.flux_side_a - j0).abs() < 1e-12 * j0);
+    assert!(flux.imbalance.abs() < 1e-14 * j0);
+    std::fs::remove_dir_all(&dir).ok();
+    // Transient, from c = 0, nothing leaving: the mass in the bars is j0 t at every
+    // step (backward Euler with a lumped capacity conserves it exactly), and block 2
+    // gains what crosses the interface, Σ Δt j_Γ.
+    let phi = [0.5, 1.0];
+    let text = problem(
+        &inflow,
+        "[solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 20.0\nend_time = 100.0\ntolerance = 1e-13\n[initial]\ntemperature = 350.0\n",
+    )
+    .replacen("diffusivity = ", "species_capacity = 0.5\ndiffusivity = ", 1);
+    let (r, dir) = run_case("mass", &mesh, &deck(tie), &text);
+    let mass = block_mass(&r, phi);
+    let t = r.history.last().unwrap().time;
+    let total = mass[0] + mass[1];
+    let crossing: f64 = r.species_flux.iter().map(|s| 20.0 * s[0].0).sum();
+    let ((ca, cb), _) = at_interface(&r);
+    eprintln!(
+        "transient to t = {t}: mass {total:.15e} mol against j0 t = {:.15e} (relative {:.1e}); block 2 holds {:.15e}, Σ dt·flux = {crossing:.15e}; c_A/c_B = {:.6} (a Nitsche tie holds the jump weakly where c is not linear)",
+        j0 * t,
+        (total - j0 * t).abs() / (j0 * t),
+        mass[1],
+        ca / cb
+    );
+    assert!(
+        (total - j0 * t).abs() < 1e-10 * j0 * t,
+        "mass {total} against {}",
+        j0 * t
+    );
+    assert!((mass[1] - crossing).abs() < 1e-10 * mass[1], "block 2");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `seam check` of the two-bar case with `edit` applied to the problem file and the
+/// species block `species`: each error's code with the file name and line it points at.
+fn check_errors(
+    edit: impl Fn(&str) -> String,
+    species: &str,
+) -> Vec<(String, Option<(String, u32)>)> {
+    let dir = scratch("check");
+    crate::twod::write_mesh(&dir.join("bars.exo"), &bars([2, 3], [2, 2]));
+    std::fs::write(dir.join("contact.i"), deck(species)).unwrap();
+    let text = edit(&problem(&held_ends(), STEADY));
+    std::fs::write(dir.join("problem.toml"), text).unwrap();
+    let out = match seam::run::check(&dir.join("problem.toml")) {
+        Err(RunError::Input(d, _)) => d
+            .errors()
+            .map(|d| {
+                let at = d.loc.as_ref().map(|l| {
+                    let file = Path::new(&*l.file).file_name().unwrap();
+                    (file.to_string_lossy().to_string(), l.line)
+                });
+                (d.code.to_string(), at)
+            })
+            .collect(),
+        Ok(_) => Vec::new(),
+        Err(e) => panic!("{e:?}"),
+    };
+    std::fs::remove_dir_all(&dir).ok();
+    out
+}
+
+#[test]
+fn species_input_that_cannot_be_solved_is_refused_where_it_is_written() {
+    let same = |s: &str| s.to_string();
+    let tie = "  enforcement for species = tied_species\n  partition coefficient = 2";
+    assert!(check_errors(same, tie).is_empty(), "the case itself checks");
+    // The deck's lines: the species block opens on line 11 (`begin enforcement mass`),
+    // its model on 12, its partition coefficient on 13.
+    let at = |line: u32| Some(("contact.i".to_string(), line));
+    // Block 2 without a diffusivity, named by the species interface: at the block.
+    let bare = |s: &str| s.replacen("diffusivity = 0.0005\n", "", 1);
+    let found = check_errors(bare, tie);
+    eprintln!("missing diffusivity: {found:?}");
+    assert!(found.contains(&("E0432".to_string(), at(11))), "{found:?}");
+    // A negative partition coefficient: at its value.
+    let negative = "  enforcement for species = tied_species\n  partition coefficient = -2";
+    assert_eq!(
+        check_errors(same, negative),
+        [("E0227".to_string(), at(13))]
+    );
+    // Porous species is not solved: at the equation.
+    let porous = "  enforcement for porous_species = tied_species";
+    assert_eq!(check_errors(same, porous), [("E0219".to_string(), at(12))]);
+    // A temperature-dependent mass-transfer coefficient: at the model line.
+    let gas = "  enforcement for species = gap_conductance\n  gap conductance coefficient = lua \"1e-3 + 1e-6 * temp_a\"";
+    let found = check_errors(same, gas);
+    eprintln!("T-dependent coefficient: {found:?}");
+    assert_eq!(found, [("E0432".to_string(), at(12))]);
+    // A species condition where no block carries a species: at its kind.
+    let none = |s: &str| {
+        s.replace("diffusivity = 0.002\n", "")
+            .replace("diffusivity = 0.0005\n", "")
+    };
+    let found = check_errors(none, "  enforcement for energy = tied_temperature");
+    eprintln!("no species: {found:?}");
+    assert_eq!(found.first().map(|f| f.0.as_str()), Some("E0706"));
+    assert_eq!(
+        found
+            .first()
+            .and_then(|f| f.1.as_ref())
+            .map(|f| f.0.as_str()),
+        Some("problem.toml")
+    );
+}

@@ -38,7 +38,7 @@ impl Context<'_, '_> {
         let mesh = self.p.mesh;
         let dofs = &self.setup.dofs;
         let live = |e: ElemId| !is_dead(Some(death), e, t);
-        let lumped = lumped_weights(mesh, dofs, &live)?;
+        let lumped = lumped_weights(mesh, dofs, self.setup.species, &live)?;
         let mut held = vec![false; mesh.num_nodes()];
         for &b in &self.setup.blocks {
             for e in mesh.blocks[b].elems().filter(|&e| live(e)) {
@@ -55,7 +55,7 @@ impl Context<'_, '_> {
                 }
             }
         }
-        if let Some(v) = self.setup.voltage {
+        for v in self.setup.voltage.into_iter().chain(self.setup.species) {
             for (n, _) in held.iter().enumerate().filter(|(_, h)| !**h) {
                 if let Some(d) = dofs.dof(v, crate::mesh::NodeId(n as u32)) {
                     orphans.push(d.index());

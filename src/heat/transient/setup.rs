@@ -104,7 +104,7 @@ impl Setup {
             .iter()
             .map(|t| dofs.add_extra(t.own.len()).start)
             .collect();
-        let lumped = lumped_weights(mesh, &dofs, &|_| true)?;
+        let lumped = lumped_weights(mesh, &dofs, species, &|_| true)?;
         let mut blocks: Vec<usize> = Vec::new();
         let mut rules = vec![None; mesh.blocks.len()];
         for &f in &fields {
@@ -217,10 +217,13 @@ pub(super) fn node_dofs(
 /// (dof, block, ∫N_a dV over that block's elements at the node, node coordinates).
 pub(super) type LumpedWeight = (u32, u32, f64, [f64; 3]);
 
-/// Lumped capacity weights `∫ N_a dV` per (dof, block), with the node's coordinates.
+/// Lumped capacity weights `∫ N_a dV` per (dof, block) over the `live` elements, with
+/// the node's coordinates: for each block's first field (its temperature) and, where it
+/// lives, the `species` (the last of the block's fields); a voltage has none.
 pub(super) fn lumped_weights(
     mesh: &Mesh,
     dofs: &DofMap,
+    species: Option<FieldId>,
     live: &dyn Fn(crate::mesh::ElemId) -> bool,
 ) -> Result<Vec<LumpedWeight>, HeatError> {
     let mut out: std::collections::BTreeMap<(u32, u32), f64> = Default::default();
@@ -236,6 +239,7 @@ pub(super) fn lumped_weights(
                 topology: block.topology,
             })?;
         let nn = block.topology.node_count();
+        let with_species = species.is_some_and(|c| dofs.block_fields(b).contains(&c));
         let mut me = vec![0.0; nn * nn];
         for k in 0..block.len() {
             let e = crate::mesh::ElemId(block.first_elem.0 + k as u32);
@@ -250,6 +254,10 @@ pub(super) fn lumped_weights(
             dofs.elem_dofs(mesh, e, &mut elem_dofs);
             for a in 0..nn {
                 *out.entry((elem_dofs[a], b as u32)).or_default() += me[a * nn + a];
+                if with_species {
+                    let d = elem_dofs[elem_dofs.len() - nn + a];
+                    *out.entry((d, b as u32)).or_default() += me[a * nn + a];
+                }
             }
         }
     }
