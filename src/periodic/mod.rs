@@ -120,23 +120,6 @@ pub fn align_surface(
     ))
 }
 
-/// Rodrigues' formula: R = I + sin θ K + (1 − cos θ) K², K the cross-product matrix of
-/// the unit axis k. The hand-written rotation `Rotation3` replaces; kept until the
-/// comparison test has shown they agree.
-#[cfg(test)]
-fn rodrigues(k: Vec3, theta: f64) -> [[f64; 3]; 3] {
-    let (s, c) = theta.sin_cos();
-    let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
-    let mut r = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            let k2: f64 = (0..3).map(|m| kx[i][m] * kx[m][j]).sum();
-            r[i][j] = f64::from(u8::from(i == j)) + s * kx[i][j] + (1.0 - c) * k2;
-        }
-    }
-    r
-}
-
 /// Where a `Mapped` component comes from.
 #[derive(Clone, Debug, PartialEq)]
 pub enum MapSource {
@@ -346,6 +329,22 @@ mod tests {
             [1.0, 0.0, 0.0],
             1e-15
         ));
+    }
+
+    /// The rotation this module computed before nalgebra, kept as the property tests'
+    /// reference: Rodrigues' formula R = I + sin θ K + (1 − cos θ) K², K the
+    /// cross-product matrix of the unit axis k.
+    fn rodrigues(k: Vec3, theta: f64) -> [[f64; 3]; 3] {
+        let (s, c) = theta.sin_cos();
+        let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+        let mut r = [[0.0; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                let k2: f64 = (0..3).map(|m| kx[i][m] * kx[m][j]).sum();
+                r[i][j] = f64::from(u8::from(i == j)) + s * kx[i][j] + (1.0 - c) * k2;
+            }
+        }
+        r
     }
 
     /// `x ↦ R (x − c) + c + t` with the old matrix `r`, as the old map computed it.
