@@ -10,8 +10,9 @@ use seam::mesh::Mesh;
 use seam::mesh::generate::{self, PlaneKind, RectSpec};
 use seam::run::RunResult;
 
+use crate::scratch;
 use crate::twod::{
-    last_node_of_block_1, pair_deck, problem_text, run, scratch, worst_error_by_part, write_mesh,
+    last_node_of_block_1, pair_deck, problem_text, run, worst_error_by_part, write_mesh,
 };
 
 /// The cylinders: inner part a < r < c (k₁), outer part c < r < b (k₂), height H, T = T_a
@@ -134,7 +135,8 @@ fn rates(errors: &[f64]) -> Vec<f64> {
 #[test]
 fn concentric_cylinders_converge_to_the_logarithmic_solution() {
     let g = CYLINDERS;
-    let dir = scratch("axi-cylinders");
+    let tmp = scratch("axi-cylinders");
+    let dir = tmp.path();
     std::fs::write(dir.join("problem.toml"), problem(&g, true)).unwrap();
     std::fs::write(dir.join("plane.toml"), problem(&g, false)).unwrap();
     std::fs::write(dir.join("contact.i"), gap_deck(g.h)).unwrap();
@@ -186,7 +188,8 @@ fn concentric_cylinders_converge_to_the_logarithmic_solution() {
 #[test]
 fn disc_heated_on_the_axis_matches_its_analytic_solution() {
     let (c, b, height, k, h, q, t_b) = (1.0, 2.0, 0.5, [2.0, 5.0], 4.0, 1000.0, 300.0);
-    let dir = scratch("axi-disc");
+    let tmp = scratch("axi-disc");
+    let dir = tmp.path();
     let problem = problem_text(
         "mesh.exo",
         true,
@@ -263,7 +266,8 @@ fn disc_heated_on_the_axis_matches_its_analytic_solution() {
 #[test]
 fn wedge_with_cylindrical_periodicity_agrees_with_the_axisymmetric_model() {
     let g = CYLINDERS;
-    let dir = scratch("axi-wedge");
+    let tmp = scratch("axi-wedge");
+    let dir = tmp.path();
     let exact = g.heat();
     std::fs::write(dir.join("axi.toml"), problem(&g, true)).unwrap();
     std::fs::write(
@@ -351,7 +355,8 @@ fn wedge_with_cylindrical_periodicity_agrees_with_the_axisymmetric_model() {
 /// carries the periodic field.
 #[test]
 fn axisymmetric_refusals_say_why() {
-    let dir = scratch("axi-refusals");
+    let tmp = scratch("axi-refusals");
+    let dir = tmp.path();
     let render = |problem: &str| match seam::run::run(&dir.join(problem)) {
         Err(seam::run::RunError::Input(d, s)) => d.render(&s),
         Err(seam::run::RunError::Solve(e)) => panic!("{e}"),
@@ -454,7 +459,8 @@ fn lumped_per_revolution(mesh: &Mesh) -> Vec<f64> {
 fn transient_axisymmetric_run_stores_what_the_source_makes() {
     let (c, b, height, q, t0, t_end) = (1.0, 2.0, 0.5, 1000.0, 300.0, 1.0);
     let rho_c = [3.0, 7.0];
-    let dir = scratch("axi-transient");
+    let tmp = scratch("axi-transient");
+    let dir = tmp.path();
     let mesh = generate::rectangles(
         &[
             RectSpec::quad([0.0, 0.0], [c, height], [4, 3], 1).with_side_sets([0, 3, 0, 0]),
@@ -532,7 +538,8 @@ fn sphere_in_a_shell_on_gmsh_meshes_converges_axisymmetric() {
         (t, [g * x[0], g * x[1], 0.0])
     };
     let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
-    let dir = scratch("axi-spheres");
+    let tmp = scratch("axi-spheres");
+    let dir = tmp.path();
     let expected: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(fixtures.join("expected_2d.json")).unwrap())
             .unwrap();
@@ -627,7 +634,8 @@ fn sphere_in_a_shell_on_gmsh_meshes_converges_axisymmetric() {
 #[test]
 fn thermal_electrical_run_is_per_revolution() {
     let (j0, sigma, h_e, l1, l) = (1e4, [2e3, 1e3], 5e3, 0.6, 1.5);
-    let dir = scratch("axi-electric");
+    let tmp = scratch("axi-electric");
+    let dir = tmp.path();
     let mesh = generate::rectangles(
         &[
             RectSpec::quad([0.0, 0.0], [1.0, l1], [3, 4], 1).with_side_sets([0, 0, 1, 2]),

@@ -123,8 +123,8 @@ fn verification_cases_meet_their_requirements() {
 /// `no_coverage_flux = true`.
 #[test]
 fn face_conditions_on_faces_in_contact_are_masked_unless_asked() {
-    let dir = std::env::temp_dir().join(format!("seam-mask-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("cases-mask");
+    let dir = tmp.path();
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
     std::fs::write(
         dir.join("contact.i"),
@@ -175,5 +175,4 @@ fn face_conditions_on_faces_in_contact_are_masked_unless_asked() {
         diff(&plain, &kept) > 0.1,
         "an unmasked hot convection heats the interface"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }

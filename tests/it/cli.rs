@@ -168,9 +168,8 @@ fn check_passes_the_example_and_a_deck_with_a_toggle() {
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("5 contact surface(s)"));
 
-    let dir = std::env::temp_dir().join(format!("seam-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let deck = dir.join("deck.i");
+    let dir = crate::scratch("cli-toggle");
+    let deck = dir.path().join("deck.i");
     std::fs::write(
         &deck,
         "begin contact definition\n  skin all blocks = on\n  begin enforcement\n    enforcement for energy = tied_temperature\n    use toggle block = warm_up\n  end\nend\n",
@@ -188,7 +187,6 @@ fn check_passes_the_example_and_a_deck_with_a_toggle() {
     let out = seam(&["surfaces", deck.to_str().unwrap(), "--mesh", EXAMPLE_MESH]);
     assert_eq!(out.status.code(), Some(0));
     assert!(!String::from_utf8_lossy(&out.stderr).contains("W0900"));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The Gmsh fixture is two unit cubes stacked and meshed conformingly (blocks `lower`
@@ -196,9 +194,8 @@ fn check_passes_the_example_and_a_deck_with_a_toggle() {
 /// interior, so each skin has area 5, and the side set still gives the interface.
 #[test]
 fn gmsh_meshes_work_end_to_end() {
-    let dir = std::env::temp_dir().join(format!("seam-gmsh-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let deck = dir.join("deck.i");
+    let dir = crate::scratch("cli-gmsh");
+    let deck = dir.path().join("deck.i");
     std::fs::write(
         &deck,
         "begin contact definition\n  contact surface iface contains interface\n  skin all blocks = on\nend\n",
@@ -224,7 +221,6 @@ fn gmsh_meshes_work_end_to_end() {
         reports[0], reports[1],
         "ASCII and binary give the same surfaces"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The bundled run: 1-D through the two blocks (insulated sides), so the heat through the
@@ -274,8 +270,9 @@ fn example_writes_a_bundled_scene_that_runs() {
         text.contains("two_blocks") && text.contains("busbar_joint"),
         "{text}"
     );
-    let dir = std::env::temp_dir().join(format!("seam-example-test-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    // A folder that does not exist yet, inside a scratch folder: `seam example` makes it.
+    let tmp = crate::scratch("cli-example");
+    let dir = tmp.path().join("two_blocks");
     let d = dir.to_str().unwrap();
     let wrote = seam(&["example", "two_blocks", "--dir", d]);
     assert!(
@@ -311,7 +308,6 @@ fn example_writes_a_bundled_scene_that_runs() {
     let unknown = seam(&["example", "three_blocks", "--dir", d]);
     assert_eq!(unknown.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&unknown.stderr).contains("busbar_joint"));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `--threads N` before or after the subcommand: the same answer on one thread and on

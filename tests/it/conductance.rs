@@ -462,8 +462,8 @@ fn lua_faults_are_errors_that_name_the_point() {
 
 #[test]
 fn lua_file_functions_work_and_report_syntax_errors_with_file_and_line() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("conductance-lua");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("conductance-lua");
+    let dir = tmp.path();
     let good = dir.join("h.lua");
     std::fs::write(
         &good,
@@ -605,8 +605,8 @@ fn several_deck_lines_add_up() {
 
 #[test]
 fn deck_lua_file_is_taken_from_the_deck_directory() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("conductance-deck");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("conductance-deck");
+    let dir = tmp.path();
     std::fs::write(
         dir.join("h.lua"),
         "function h_of(gap, ta, tb)\n  return 3 + gap\nend\n",
@@ -614,7 +614,7 @@ fn deck_lua_file_is_taken_from_the_deck_directory() {
     .unwrap();
     let (e, sources) =
         enforcement("    Gap Conductance Coefficient = Lua File = \"h.lua\" Function = h_of\n");
-    let (m, d) = from_properties(&e, &dir, &sources);
+    let (m, d) = from_properties(&e, dir, &sources);
     assert!(d.is_empty(), "{}", d.render(&sources));
     let c = m.unwrap().evaluate(&state(0.5, 0.0, 1.0, 1.0)).unwrap();
     assert!(

@@ -546,12 +546,13 @@ fn check_errors(
     edit: impl Fn(&str) -> String,
     deck_edit: impl Fn(&str) -> String,
 ) -> Vec<(String, Option<(String, u32)>)> {
-    let dir = crate::examples::copy_scene_as("busbar_joint", "electric-check");
+    let tmp = crate::examples::copy_scene_as("busbar_joint", "electric-check");
+    let dir = tmp.path();
     let problem = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
     std::fs::write(dir.join("problem.toml"), edit(&problem)).unwrap();
     let deck = std::fs::read_to_string(dir.join("contact.i")).unwrap();
     std::fs::write(dir.join("contact.i"), deck_edit(&deck)).unwrap();
-    let codes = match seam::run::check(&dir.join("problem.toml")) {
+    match seam::run::check(&dir.join("problem.toml")) {
         Err(seam::run::RunError::Input(d, _)) => d
             .errors()
             .map(|d| {
@@ -564,9 +565,7 @@ fn check_errors(
             .collect(),
         Ok(_) => Vec::new(),
         Err(e) => panic!("{e:?}"),
-    };
-    std::fs::remove_dir_all(&dir).ok();
-    codes
+    }
 }
 
 #[test]
@@ -628,7 +627,8 @@ fn electrical_input_that_cannot_be_solved_is_refused_with_its_reason() {
 /// temperature and voltage blocks' AMG, and gets the factorisation's answer.
 #[test]
 fn large_coupled_runs_take_block_amg_gmres_and_match_the_factorisation() {
-    let dir = crate::examples::copy_scene_as("busbar_joint", "electric-gmres");
+    let tmp = crate::examples::copy_scene_as("busbar_joint", "electric-gmres");
+    let dir = tmp.path();
     let problem = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
     let solve = |extra: &str, name: &str| {
         let text = problem.replace("tolerance = 1e-12", &format!("tolerance = 1e-12\n{extra}"));
@@ -660,7 +660,6 @@ fn large_coupled_runs_take_block_amg_gmres_and_match_the_factorisation() {
     };
     assert!(diff(&t1, &t0) < 1e-10, "temperature {:e}", diff(&t1, &t0));
     assert!(diff(&v1, &v0) < 1e-9, "voltage {:e}", diff(&v1, &v0));
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The coupling in 2-D, plane and axisymmetric: the same two bars as a plane strip of

@@ -14,6 +14,8 @@ use std::process::Command;
 
 use seam::embed::{EmbedError, Embedding, Interaction, Model, Multipliers, Periodic, Topology};
 
+use crate::scratch;
+
 #[path = "../../examples/embed.rs"]
 #[allow(dead_code)]
 pub(crate) mod example;
@@ -24,16 +26,11 @@ fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks")
 }
 
-pub(crate) fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("seam-embed-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 /// `seam run` on the two-block problem with the contact deck `deck` (text), written
 /// to a scratch folder without output; returns (heat side A, heat side B).
 fn seam_run(name: &str, deck: &str) -> (f64, f64) {
-    let dir = scratch(name);
+    let tmp = scratch(&format!("embed-{name}"));
+    let dir = tmp.path();
     let problem = std::fs::read_to_string(scene().join("problem.toml")).unwrap();
     let mesh = scene().join("two_blocks.exo");
     let problem = problem
@@ -53,7 +50,6 @@ fn seam_run(name: &str, deck: &str) -> (f64, f64) {
         Ok(r) => r,
         Err(e) => panic!("seam run failed: {e:?}"),
     };
-    let _ = std::fs::remove_dir_all(&dir);
     let i = &result.summary.interactions[0];
     (i.heat_side_a, i.heat_side_b)
 }
@@ -100,8 +96,8 @@ pub(crate) fn run_c_host(source: &str) -> String {
         "libseam.so"
     });
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let dir = scratch(source);
-    let out = dir.join("host");
+    let tmp = scratch(&format!("embed-{source}"));
+    let out = tmp.path().join("host");
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let build = Command::new(&cc)
         .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-O2", "-I"])
@@ -133,7 +129,6 @@ pub(crate) fn run_c_host(source: &str) -> String {
         "{stdout}{}",
         String::from_utf8_lossy(&run.stderr)
     );
-    let _ = std::fs::remove_dir_all(&dir);
     stdout
 }
 
@@ -298,7 +293,8 @@ fn tie_fields_match_seam_run(
         "  visualize contact\n  output rule = more verbose\n  begin interaction",
         1,
     );
-    let out = crate::embed_api::seam_run_with_output(name, &visual);
+    let run = crate::embed_api::seam_run_with_output(name, &visual);
+    let out = run.path().join("out");
     let xml = std::fs::read_to_string(out.join("contact_points.vtu")).unwrap();
     let file = crate::run_fields::vtu_array(&xml, "interface_flux");
     let points = seam.tie_point_fields(tie, lambda).unwrap();
@@ -330,7 +326,6 @@ fn tie_fields_match_seam_run(
         "{sum} {}",
         heat.side_a
     );
-    let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
 /// The two-block interface tied by mortar with `multipliers` (`dual` or `standard`).
@@ -914,16 +909,15 @@ fn run_scene_with(
         section.insert("dir".into(), out.display().to_string().into());
         table.insert("output".into(), section.into());
     }
-    let dir = scratch(&format!("run-{problem}"));
+    let dir = scratch(&format!("embed-run-{problem}"));
     let name = deck_dir.file_name().unwrap().to_string_lossy().into_owned();
-    let path = dir.join(format!("{name}-{problem}"));
+    let path = dir.path().join(format!("{name}-{problem}"));
     std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
     let result = match seam::run::run(&path) {
         Ok(r) => r,
         Err(seam::run::RunError::Input(d, s)) => panic!("{}", d.render(&s)),
         Err(seam::run::RunError::Solve(e)) => panic!("seam run failed: {e}"),
     };
-    let _ = std::fs::remove_file(&path);
     assert!(result.summary.converged);
     result
 }
@@ -1058,7 +1052,8 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
     assert!(heat.side_a.abs() > 1.0, "{}", heat.side_a);
     // The multiplier field on the periodic image, point by point, against `seam run`'s
     // contact_points.vtu of the same deck.
-    let deck_dir = scratch("turbine-points-deck");
+    let deck_tmp = scratch("embed-turbine-points-deck");
+    let deck_dir = deck_tmp.path();
     let deck = std::fs::read_to_string(turbine().join("contact.i")).unwrap();
     std::fs::write(
         deck_dir.join("contact.i"),
@@ -1069,9 +1064,9 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
         ),
     )
     .unwrap();
-    let out = scratch("turbine-points");
-    run_scene_into(&turbine(), &deck_dir, "problem.toml", &out);
-    let xml = std::fs::read_to_string(out.join("contact_points.vtu")).unwrap();
+    let out = scratch("embed-turbine-points");
+    run_scene_into(&turbine(), deck_dir, "problem.toml", out.path());
+    let xml = std::fs::read_to_string(out.path().join("contact_points.vtu")).unwrap();
     let file = crate::run_fields::vtu_array(&xml, "interface_flux");
     let points = by_deck.tie_point_fields(&ties[0], &lambda).unwrap();
     assert_eq!(points.len(), file.len());
@@ -1091,8 +1086,6 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
         points.len()
     );
     assert!(worst <= 1e-9, "{worst:.3e}");
-    let _ = std::fs::remove_dir_all(&out);
-    let _ = std::fs::remove_dir_all(&deck_dir);
 
     // The same periodicity built in code, on the side sets themselves.
     let mut by_code = builder();
@@ -1182,9 +1175,10 @@ fn embed_turbine_sector_periodic_tie_matches_seam_run() {
 #[test]
 fn embed_plugin_conductance_matches_seam_run() {
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/plugin_conductance");
-    let deck_dir = crate::examples::copy_scene_as("plugin_conductance", "embed-plugin");
-    crate::examples::compile_c_table(&deck_dir);
-    let reference = run_scene(&scene, &deck_dir, "problem.toml");
+    let deck_tmp = crate::examples::copy_scene_as("plugin_conductance", "embed-plugin");
+    let deck_dir = deck_tmp.path();
+    crate::examples::compile_c_table(deck_dir);
+    let reference = run_scene(&scene, deck_dir, "problem.toml");
     let i = &reference.summary.interactions[0];
 
     let mesh = seam::mesh::read(&scene.join("plugin_conductance.exo")).unwrap();
@@ -1218,9 +1212,9 @@ fn embed_plugin_conductance_matches_seam_run() {
         ),
     )
     .unwrap();
-    let out = scratch("plugin-points");
-    run_scene_into(&scene, &deck_dir, "problem.toml", &out);
-    let xml = std::fs::read_to_string(out.join("contact_points.vtu")).unwrap();
+    let out = scratch("embed-plugin-points");
+    run_scene_into(&scene, deck_dir, "problem.toml", out.path());
+    let xml = std::fs::read_to_string(out.path().join("contact_points.vtu")).unwrap();
     let file = crate::run_fields::vtu_array(&xml, "interface_flux");
     let points = seam.point_fields(0, &u).unwrap();
     assert_eq!(points.len(), file.len());
@@ -1245,8 +1239,6 @@ fn embed_plugin_conductance_matches_seam_run() {
         points.len()
     );
     assert!(worst <= 1e-9, "{worst:.3e}");
-    let _ = std::fs::remove_dir_all(&out);
-    let _ = std::fs::remove_dir_all(&deck_dir);
 }
 
 /// Compile the faulty test plugin with FAULT_<fault> (faults strike points with contact

@@ -17,6 +17,9 @@ use seam::embed::{
     Conductance, EmbedError, Embedding, FnConductance, Interaction, Model, PointState, Topology,
     UnpairedReason,
 };
+use tempfile::TempDir;
+
+use crate::scratch;
 
 use crate::embed::example;
 
@@ -24,11 +27,11 @@ fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks")
 }
 
-/// `seam run` on the two-block problem with `deck`, output into a scratch folder;
-/// returns that folder.
-pub(crate) fn seam_run_with_output(name: &str, deck: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("seam-embed-api-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// `seam run` on the two-block problem with `deck`, in a scratch folder whose `out/`
+/// receives the output; returns that folder.
+pub(crate) fn seam_run_with_output(name: &str, deck: &str) -> TempDir {
+    let tmp = scratch(&format!("embed-api-{name}"));
+    let dir = tmp.path();
     let problem = std::fs::read_to_string(scene().join("problem.toml")).unwrap();
     let mesh = scene().join("two_blocks.exo");
     let problem = problem.replace(
@@ -40,7 +43,7 @@ pub(crate) fn seam_run_with_output(name: &str, deck: &str) -> PathBuf {
     if let Err(e) = seam::run::run(&dir.join("problem.toml")) {
         panic!("seam run failed: {e:?}");
     }
-    dir.join("out")
+    tmp
 }
 
 fn vtu(path: &Path, name: &str) -> Vec<f64> {
@@ -81,7 +84,8 @@ fn embed_point_and_face_fields_match_seam_run() {
     let deck = std::fs::read_to_string(scene().join("contact_run.i"))
         .unwrap()
         .replace("output rule = verbose", "output rule = more verbose");
-    let out = seam_run_with_output("fields", &deck);
+    let run = seam_run_with_output("fields", &deck);
+    let out = run.path().join("out");
     let (seam, u) = host_solution(&deck);
 
     // Per point, in the pairing's order: flux (NaN where unpaired in the file) and gap.
@@ -148,7 +152,6 @@ fn embed_point_and_face_fields_match_seam_run() {
     );
     let (lo, hi) = c.gap_range.unwrap();
     assert!(lo.abs() < 1e-12 && hi.abs() < 1e-12, "{lo} {hi}");
-    let _ = std::fs::remove_dir_all(out.parent().unwrap());
 }
 
 /// Side A is the base's bottom, side B the lid's top: half a metre apart, facing away.
@@ -475,8 +478,8 @@ fn embed_reads_a_deck_as_seam_run_does() {
         err.contains("E0428") && err.contains("did you mean `temperature`"),
         "{err}"
     );
-    let dir = std::env::temp_dir().join(format!("seam-embed-api-field-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("embed-api-field");
+    let dir = tmp.path();
     let problem = std::fs::read_to_string(scene().join("problem.toml"))
         .unwrap()
         .replace(
@@ -495,7 +498,6 @@ fn embed_reads_a_deck_as_seam_run_does() {
         Ok(c) => assert!(c.diagnostics.0.iter().any(|x| x.code == "E0428")),
         Err(e) => panic!("{e:?}"),
     }
-    let _ = std::fs::remove_dir_all(&dir);
     let toggled = deck.replace(
         "gap conductance coefficient = constant h = 500",
         "gap conductance coefficient = constant h = 500\n    use toggle block on_off",

@@ -2,11 +2,11 @@
 //! does and is checked against a physics invariant (a reference solution, a periodicity,
 //! a heat balance), with its tolerance and the reason for it.
 //!
-//! Each scene is copied into its own directory under `$CARGO_TARGET_TMPDIR` and run
-//! there, so the results (`out/`) stay out of the source tree. Heat flows are integrated
-//! here from the nodal temperatures, independently of seam's assembly: a 2 × 2 Gauss rule
-//! on each bilinear face (exact for h (T − T∞) on the flat faces these meshes have) and a
-//! 2 × 2 × 2 rule for element volumes (exact for trilinear hexes).
+//! Each scene is copied into a scratch folder of its own under `$CARGO_TARGET_TMPDIR`
+//! and run there, so the results (`out/`) stay out of the source tree. Heat flows are
+//! integrated here from the nodal temperatures, independently of seam's assembly: a
+//! 2 × 2 Gauss rule on each bilinear face (exact for h (T − T∞) on the flat faces these
+//! meshes have) and a 2 × 2 × 2 rule for element volumes (exact for trilinear hexes).
 //!
 //! The balances hold to round-off in the discrete problem itself: conduction rows of a
 //! conforming element sum to zero, and seam integrates sources, fluxes and convection
@@ -20,6 +20,7 @@ use std::process::Command;
 
 use seam::mesh::{Mesh, NodeId, Side};
 use seam::run::{RunError, RunResult};
+use tempfile::TempDir;
 
 /// Relative tolerance of every discrete heat balance (see the module comment).
 const BALANCE: f64 = 1e-9;
@@ -28,26 +29,21 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// A fresh copy of the files (not the subdirectories) of `examples/<scene>`.
-fn copy_scene(scene: &str) -> PathBuf {
+/// A fresh copy of the files (not the subdirectories) of `examples/<scene>`, in a
+/// scratch folder removed when the returned value is dropped.
+fn copy_scene(scene: &str) -> TempDir {
     copy_scene_as(scene, scene)
 }
 
-/// As [`copy_scene`], into a folder named after `tag` and the call (tests that copy
-/// the same scene at the same time each get their own).
-pub(crate) fn copy_scene_as(scene: &str, tag: &str) -> PathBuf {
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+/// As [`copy_scene`], into a scratch folder named after `tag` (tests that copy the same
+/// scene at the same time each get their own).
+pub(crate) fn copy_scene_as(scene: &str, tag: &str) -> TempDir {
     let from = root().join("examples").join(scene);
-    let to = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("examples")
-        .join(format!("{tag}-{}-{call}", std::process::id()));
-    std::fs::remove_dir_all(&to).ok();
-    std::fs::create_dir_all(&to).unwrap();
+    let to = crate::scratch(&format!("examples-{tag}"));
     for entry in std::fs::read_dir(&from).unwrap() {
         let path = entry.unwrap().path();
         if path.is_file() {
-            std::fs::copy(&path, to.join(path.file_name().unwrap())).unwrap();
+            std::fs::copy(&path, to.path().join(path.file_name().unwrap())).unwrap();
         }
     }
     to
@@ -295,9 +291,10 @@ fn turbine_sector_equals_the_full_ring() {
     let _turn = crate::TURBINE_RUNS
         .lock()
         .unwrap_or_else(|e| e.into_inner());
-    let dir = copy_scene("turbine_sector");
-    let sector = run_apart(&dir, "problem.toml", "out");
-    let ring = run_apart(&dir, "ring_problem.toml", "out/ring");
+    let tmp = copy_scene("turbine_sector");
+    let dir = tmp.path();
+    let sector = run_apart(dir, "problem.toml", "out");
+    let ring = run_apart(dir, "ring_problem.toml", "out/ring");
     let problem = problem_table(&dir.join("problem.toml"));
 
     // Node by node on the sector (positions keyed to 1e-9 of the outer radius).
@@ -374,7 +371,6 @@ fn turbine_sector_equals_the_full_ring() {
         "the cut carries {cut_heat} W: the load should not be symmetric within the sector"
     );
     assert!(cut_imbalance.abs() <= BALANCE * cut_heat.abs());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Twisted channel: the outlet's temperatures equal the inlet's at the image under the
@@ -388,7 +384,8 @@ fn turbine_sector_equals_the_full_ring() {
 /// so the twist is what is tested.
 #[test]
 fn twisted_channel_is_periodic_under_its_lua_map() {
-    let dir = copy_scene("twisted_channel");
+    let tmp = copy_scene("twisted_channel");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     let problem = problem_table(&dir.join("problem.toml"));
     let t = &r.solution.temperature;
@@ -427,7 +424,6 @@ fn twisted_channel_is_periodic_under_its_lua_map() {
     );
     assert!((heat_in - heat_out).abs() <= BALANCE * heat_in);
     assert!(cut.imbalance.abs() <= BALANCE * heat_in);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The library name the plugin scene's deck asks for, next to the deck.
@@ -492,10 +488,11 @@ fn table_at(pairs: &[f64], p: f64) -> f64 {
 /// is left: the balance tolerance, 1e-9 relative.
 #[test]
 fn plugin_conductance_carries_the_series_heat_flow() {
-    let dir = copy_scene("plugin_conductance");
+    let tmp = copy_scene("plugin_conductance");
+    let dir = tmp.path();
     let deck = std::fs::read_to_string(dir.join("contact.i")).unwrap();
     assert!(deck.contains(&format!("\"{PLUGIN_LIBRARY}\"")));
-    compile_c_table(&dir);
+    compile_c_table(dir);
     let r = run(&dir.join("problem.toml"));
     let problem = problem_table(&dir.join("problem.toml"));
 
@@ -558,7 +555,6 @@ fn plugin_conductance_carries_the_series_heat_flow() {
     assert!((i.heat_side_a - expected).abs() <= BALANCE * expected);
     assert!((h * a * jump - i.heat_side_a).abs() <= BALANCE * expected);
     assert!(i.imbalance.abs() <= BALANCE * expected);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Electronics: the die's power (the flux on its active face times its area) leaves the
@@ -566,7 +562,8 @@ fn plugin_conductance_carries_the_series_heat_flow() {
 /// other faces are insulated). Discrete balances, to the balance tolerance.
 #[test]
 fn electronics_power_leaves_by_convection() {
-    let dir = copy_scene("electronics");
+    let tmp = copy_scene("electronics");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     let problem = problem_table(&dir.join("problem.toml"));
     let power = number(&bc(&problem, "chip_bottom")["value"]) * area(&r.mesh, "chip_bottom");
@@ -586,7 +583,6 @@ fn electronics_power_leaves_by_convection() {
     assert!((convected - power).abs() <= BALANCE * power);
     assert!((i.heat_side_a - power).abs() <= BALANCE * power);
     assert!(i.imbalance.abs() <= BALANCE * power);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `electronics/transient.toml`: the warm-up. Heat crosses the interface in balance at
@@ -599,7 +595,8 @@ fn electronics_power_leaves_by_convection() {
 #[test]
 fn electronics_warms_up_toward_its_steady_state() {
     // Its own copy: the steady test copies (and at its end removes) this scene too.
-    let dir = copy_scene_as("electronics", "electronics-transient");
+    let tmp = copy_scene_as("electronics", "electronics-transient");
+    let dir = tmp.path();
     let steady = run(&dir.join("problem.toml"));
     let r = run(&dir.join("transient.toml"));
     assert_eq!(r.history.len(), 80);
@@ -638,7 +635,8 @@ fn electronics_warms_up_toward_its_steady_state() {
 /// balances, to the balance tolerance.
 #[test]
 fn busbar_joint_power_leaves_as_heat() {
-    let dir = copy_scene("busbar_joint");
+    let tmp = copy_scene("busbar_joint");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     let problem = problem_table(&dir.join("problem.toml"));
     let j0 = number(&bc(&problem, "a_end")["value"]);
@@ -668,7 +666,6 @@ fn busbar_joint_power_leaves_as_heat() {
     assert!((c.current - current).abs() <= BALANCE * current);
     assert!((out - power).abs() <= BALANCE * power);
     assert!(c.joule_heat > 0.0 && c.joule_heat < power);
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The shrink-fitted sleeve (axisymmetric): the field is radial, so it has a closed
@@ -681,7 +678,8 @@ fn busbar_joint_power_leaves_as_heat() {
 /// tests/it/axisymmetric.rs shows the axis converging).
 #[test]
 fn shrink_fit_matches_its_closed_form() {
-    let dir = copy_scene("shrink_fit");
+    let tmp = copy_scene("shrink_fit");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     let (q, c, b, length, k1, k2, h, t_inf) = (2e6, 0.020, 0.035, 0.060, 45.0, 60.0, 500.0, 300.0);
     let k_s = 2.0 * k1 * k2 / (k1 + k2);
@@ -730,7 +728,8 @@ fn shrink_fit_matches_its_closed_form() {
 /// that varies along z alone is the 3-D solution, so the two agree to round-off.
 #[test]
 fn opening_gap_follows_its_one_dimensional_stack() {
-    let dir = copy_scene("opening_gap");
+    let tmp = copy_scene("opening_gap");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     const MM: f64 = 1e-3;
     let (area, k_air, g0, speed, t_lift) = (0.04 * 0.04, 0.026, 0.01 * MM, 1e-5, 120.0);
@@ -871,7 +870,8 @@ fn opening_gap_follows_its_one_dimensional_stack() {
 #[test]
 fn spot_weld_conserves_charge_and_energy_every_step() {
     use seam::mesh::exodus;
-    let dir = copy_scene("spot_weld");
+    let tmp = copy_scene("spot_weld");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     let problem = problem_table(&dir.join("problem.toml"));
     let j0 = number(&bc(&problem, "feed")["value"]);
@@ -958,7 +958,6 @@ fn spot_weld_conserves_charge_and_energy_every_step() {
         (7e-3..=13e-3).contains(&x[0]) && (7e-3..=13e-3).contains(&x[1]),
         "{x:?}"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The hydrogen wall: the steady permeation flux through the coated wall against the
@@ -972,7 +971,8 @@ fn spot_weld_conserves_charge_and_energy_every_step() {
 /// round-off, whatever the mesh.
 #[test]
 fn hydrogen_wall_permeation_matches_its_closed_form() {
-    let dir = copy_scene("hydrogen_wall");
+    let tmp = copy_scene("hydrogen_wall");
+    let dir = tmp.path();
     let r = run(&dir.join("problem.toml"));
     let mm = 1e-3;
     let (t_gas, t_vac, k1, k2) = (600.0, 500.0, 20.0, 40.0);
@@ -1025,5 +1025,4 @@ fn hydrogen_wall_permeation_matches_its_closed_form() {
     // The concentration is written with the temperature.
     let vtu = std::fs::read_to_string(dir.join("out/temperature.vtu")).unwrap();
     assert!(vtu.contains("Name=\"species\""), "no species point data");
-    std::fs::remove_dir_all(&dir).ok();
 }

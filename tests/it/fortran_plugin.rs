@@ -25,15 +25,14 @@ fn dir() -> PathBuf {
 }
 
 /// Compile `sources` (under the repository's root) with `compiler` and `flags` into
-/// `out`; a Fortran compile (`modules`: a tag) writes its module files into a folder of
-/// its own, so builds do not meet.
+/// `out`; a Fortran compile (`modules`: a tag) writes its module files into a scratch
+/// folder of its own, so builds do not meet.
 fn compile(compiler: &str, flags: &[&str], sources: &[&str], out: &Path, modules: Option<&str>) {
     let mut cmd = Command::new(compiler);
     cmd.args(flags);
-    let modules = modules.map(|tag| dir().join(format!("mod-{tag}-{}", unique())));
+    let modules = modules.map(|tag| crate::scratch(&format!("fortran-mod-{tag}")));
     if let Some(m) = &modules {
-        std::fs::create_dir_all(m).unwrap();
-        cmd.arg("-J").arg(m);
+        cmd.arg("-J").arg(m.path());
     }
     let status = cmd
         .arg("-I")
@@ -46,13 +45,10 @@ fn compile(compiler: &str, flags: &[&str], sources: &[&str], out: &Path, modules
             panic!("cannot run `{compiler}` (gfortran: apt-get install gfortran): {e}")
         });
     assert!(status.success(), "`{compiler}` failed on {sources:?}");
-    if let Some(m) = modules {
-        let _ = std::fs::remove_dir_all(m);
-    }
 }
 
-/// A name no other compile of this test process uses at the same time (tests build the
-/// same plugin concurrently: one for its own checks, one for a scene).
+/// A file name no other compile of this test process uses at the same time (tests build
+/// the same plugin concurrently: one for its own checks, one for a scene).
 fn unique() -> String {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -265,10 +261,11 @@ fn fortran_table_passes_check_plugin_and_refuses_bad_data_with_its_message() {
 #[test]
 fn fortran_table_carries_the_heat_of_the_c_table_in_a_run() {
     let scene = root().join("examples/plugin_conductance");
-    let deck_dir = crate::examples::copy_scene_as("plugin_conductance", "fortran-plugin");
-    crate::examples::compile_c_table(&deck_dir);
-    compile_fortran_table(&deck_dir);
-    let c = crate::embed::run_scene(&scene, &deck_dir, "problem.toml");
+    let tmp = crate::examples::copy_scene_as("plugin_conductance", "fortran-plugin");
+    let deck_dir = tmp.path();
+    crate::examples::compile_c_table(deck_dir);
+    compile_fortran_table(deck_dir);
+    let c = crate::embed::run_scene(&scene, deck_dir, "problem.toml");
     let deck = std::fs::read_to_string(deck_dir.join("contact.i")).unwrap();
     let fortran_deck = deck
         .replace(
@@ -278,7 +275,7 @@ fn fortran_table_carries_the_heat_of_the_c_table_in_a_run() {
         .replace("    real data =", "    integer data = 1\n    real data =");
     assert_ne!(deck, fortran_deck);
     std::fs::write(deck_dir.join("contact.i"), fortran_deck).unwrap();
-    let f = crate::embed::run_scene(&scene, &deck_dir, "problem.toml");
+    let f = crate::embed::run_scene(&scene, deck_dir, "problem.toml");
     let (qc, qf) = (
         c.summary.interactions[0].heat_side_a,
         f.summary.interactions[0].heat_side_a,
@@ -286,5 +283,4 @@ fn fortran_table_carries_the_heat_of_the_c_table_in_a_run() {
     println!("plugin conductance: C table {qc:.15e} W, Fortran table {qf:.15e} W");
     assert!(qc > 0.0);
     assert!((qf - qc).abs() <= 1e-12 * qc.abs(), "{qf} vs {qc}");
-    let _ = std::fs::remove_dir_all(&deck_dir);
 }

@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 
 use seam::periodic::{LuaMap, MapSource, PeriodicMap};
 use seam::script::{Limits, Sandbox};
+use tempfile::TempDir;
 
 /// Every regression input runs in well under a second in a debug build; a hang is a
 /// run of minutes, so a generous bound keeps a loaded CI machine from false alarms.
@@ -24,13 +25,8 @@ fn root() -> PathBuf {
 }
 
 /// A scratch folder for the inputs the readers take as files.
-fn scratch(target: &str, name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "seam-fuzz-regression-{}-{target}-{name}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).expect("scratch folder");
-    dir
+fn scratch(target: &str, name: &str) -> TempDir {
+    crate::scratch(&format!("fuzz-{target}-{name}"))
 }
 
 fn deck_outcome(diags: &seam::diag::Diagnostics) -> String {
@@ -65,7 +61,8 @@ fn replay(target: &str, name: &str, data: &[u8]) -> String {
         "deck_sierra" => deck_outcome(&seam::deck::parse_sierra(&Arc::from("fuzz.i"), &text).1),
         "deck_toml" => deck_outcome(&seam::deck::parse_toml(&Arc::from("fuzz.toml"), &text).1),
         "problem" => {
-            let dir = scratch(target, name);
+            let tmp = scratch(target, name);
+            let dir = tmp.path();
             let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks");
             for file in ["two_blocks.exo", "contact_run.i", "contact.i"] {
                 std::fs::copy(example.join(file), dir.join(file)).expect("copy the example");
@@ -73,7 +70,6 @@ fn replay(target: &str, name: &str, data: &[u8]) -> String {
             let path = dir.join("problem.toml");
             std::fs::write(&path, data).expect("write the problem");
             let r = seam::run::check(&path);
-            let _ = std::fs::remove_dir_all(&dir);
             match r {
                 Ok(_) => "ok".into(),
                 Err(seam::run::RunError::Input(diags, _)) => deck_outcome(&diags),
@@ -81,7 +77,8 @@ fn replay(target: &str, name: &str, data: &[u8]) -> String {
             }
         }
         "mesh_exodus" | "mesh_gmsh" => {
-            let dir = scratch(target, name);
+            let tmp = scratch(target, name);
+            let dir = tmp.path();
             let ext = if target == "mesh_exodus" {
                 "exo"
             } else {
@@ -90,7 +87,6 @@ fn replay(target: &str, name: &str, data: &[u8]) -> String {
             let path = dir.join(format!("mesh.{ext}"));
             std::fs::write(&path, data).expect("write the mesh");
             let r = seam::mesh::read(&path).map(|_| ());
-            let _ = std::fs::remove_dir_all(&dir);
             outcome(r)
         }
         "lua_map" => {
@@ -106,8 +102,9 @@ fn replay(target: &str, name: &str, data: &[u8]) -> String {
             let mut lines = text.lines().map(MapSource::parse);
             let maps: [Option<MapSource>; 3] = std::array::from_fn(|_| lines.next());
             let refs = [maps[0].as_ref(), maps[1].as_ref(), maps[2].as_ref()];
-            let dir = scratch(target, name);
-            out.push(match LuaMap::new(refs, &dir, "fuzz.i:1", 1.0) {
+            let tmp = scratch(target, name);
+            let dir = tmp.path();
+            out.push(match LuaMap::new(refs, dir, "fuzz.i:1", 1.0) {
                 Ok(mut map) => outcome(
                     map.map_point([0.25, -1.5, 3.0])
                         .and_then(|_| map.map_vector([0.25, -1.5, 3.0], [1.0, 0.0, 0.0]))
@@ -115,7 +112,6 @@ fn replay(target: &str, name: &str, data: &[u8]) -> String {
                 ),
                 Err(e) => outcome(Err::<(), _>(e)),
             });
-            let _ = std::fs::remove_dir_all(&dir);
             out.join("\n")
         }
         other => panic!("tests/fuzz_regressions/{other}: no fuzz target of that name"),

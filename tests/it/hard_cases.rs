@@ -7,7 +7,9 @@
 //! discrete heat must be the series value 100 / (1/k_A + 1/h + 0.5/k_B) to round-off,
 //! on both sides of the interface.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use crate::scratch;
 
 /// The conductances swept: every few decades from 0 to ∞.
 pub(crate) const H_SWEEP: [f64; 16] = [
@@ -25,18 +27,12 @@ pub(crate) fn exact_heat(h: f64, k_a: f64, k_b: f64) -> f64 {
     100.0 / (1.0 / k_a + 1.0 / h + 0.5 / k_b)
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("hard-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
 /// Solve the two-block case with `enforcement` (the lines inside `begin enforcement`);
 /// returns the heat into side A (the base) and out of side B (the lid), both positive
 /// when heat flows down.
 pub(crate) fn two_block_heat(name: &str, k_a: f64, k_b: f64, enforcement: &str) -> (f64, f64) {
-    let dir = scratch(name);
+    let tmp = scratch(&format!("hard-{name}"));
+    let dir = tmp.path();
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
     std::fs::write(
         dir.join("problem.toml"),
@@ -150,7 +146,8 @@ fn lua_conductance_heat_is_exact_for_every_finite_h() {
 /// that converges in the same folder removes the mark.
 #[test]
 fn a_run_that_does_not_converge_says_so_and_why() {
-    let dir = scratch("not_converged");
+    let tmp = scratch("hard-not_converged");
+    let dir = tmp.path();
     let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
     let problem = |iterations: usize| {
         format!(
@@ -169,7 +166,7 @@ fn a_run_that_does_not_converge_says_so_and_why() {
     std::fs::write(dir.join("problem.toml"), problem(2)).unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_seam"))
         .args(["run", "problem.toml", "--json"])
-        .current_dir(&dir)
+        .current_dir(dir)
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
@@ -188,7 +185,7 @@ fn a_run_that_does_not_converge_says_so_and_why() {
     std::fs::write(dir.join("problem.toml"), problem(50)).unwrap();
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_seam"))
         .args(["run", "problem.toml", "--json"])
-        .current_dir(&dir)
+        .current_dir(dir)
         .output()
         .unwrap();
     assert_eq!(
@@ -228,7 +225,8 @@ fn gas_gap_heat_is_exact_for_tiny_zero_and_negative_gaps() {
                 x[2] += delta;
             }
         }
-        let dir = scratch(&format!("gap-{delta:e}"));
+        let tmp = scratch(&format!("hard-gap-{delta:e}"));
+        let dir = tmp.path();
         let path = dir.join("shifted.exo");
         ExodusWriter::create(&path, &mesh, &[], &[])
             .unwrap()
@@ -273,7 +271,8 @@ fn gas_gap_heat_is_exact_for_tiny_zero_and_negative_gaps() {
 #[test]
 fn contact_flux_per_face_is_exact_for_huge_h() {
     for h in ["1e8", "1e20", "1e300", "inf"] {
-        let dir = scratch(&format!("faces-{h}"));
+        let tmp = scratch(&format!("hard-faces-{h}"));
+        let dir = tmp.path();
         let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
         std::fs::write(
             dir.join("problem.toml"),

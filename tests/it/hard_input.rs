@@ -13,18 +13,13 @@ use std::time::{Duration, Instant};
 use seam::deck::{self, codes, parse_sierra};
 use seam::diag::{MAX_RENDERED, SourceMap};
 
+use crate::scratch;
+
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 const MESH: &str = "examples/two_blocks/two_blocks.exo";
-
-/// A scratch directory of its own for each test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("seam-hard-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("scratch directory");
-    dir
-}
 
 /// `seam` with `args` from the repository root, killed (and the test failed) if it
 /// has not finished within 60 s: the point of several tests is that it finishes.
@@ -60,7 +55,8 @@ fn codes_of(text: &str) -> Vec<&'static str> {
 
 #[test]
 fn a_deck_over_the_limit_is_refused_with_its_size_and_the_limit() {
-    let dir = scratch("limit");
+    let tmp = scratch("hard-input-limit");
+    let dir = tmp.path();
     let path = dir.join("big.i");
     let line = "begin contact definition\n  skin all blocks = on\nend\n";
     std::fs::write(&path, line.repeat(100)).unwrap();
@@ -123,9 +119,9 @@ fn dev_zero_as_a_deck_stops_at_the_limit() {
 #[cfg(unix)]
 #[test]
 fn a_lua_file_that_never_ends_is_refused() {
-    let dir = scratch("lua-zero");
+    let tmp = scratch("hard-input-lua-zero");
+    let dir = tmp.path();
     let link = dir.join("zero.lua");
-    let _ = std::fs::remove_file(&link);
     std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
     let deck = dir.join("deck.i");
     std::fs::write(
@@ -144,7 +140,8 @@ fn a_lua_file_that_never_ends_is_refused() {
 
 #[test]
 fn text_that_is_not_utf8_is_refused_at_its_line_and_column() {
-    let dir = scratch("latin1");
+    let tmp = scratch("hard-input-latin1");
+    let dir = tmp.path();
     let path = dir.join("deck.i");
     std::fs::write(
         &path,
@@ -179,7 +176,8 @@ fn text_that_is_not_utf8_is_refused_at_its_line_and_column() {
 
 #[test]
 fn a_byte_order_mark_reads_as_without_it() {
-    let dir = scratch("bom");
+    let tmp = scratch("hard-input-bom");
+    let dir = tmp.path();
     let text = std::fs::read_to_string(root().join("examples/two_blocks/contact.i")).unwrap();
     for (name, body) in [
         ("plain.i", text.clone()),
@@ -231,7 +229,8 @@ fn a_byte_order_mark_reads_as_without_it() {
 
 #[test]
 fn ten_thousand_unclosed_blocks_give_a_short_report() {
-    let dir = scratch("unclosed");
+    let tmp = scratch("hard-input-unclosed");
+    let dir = tmp.path();
     let path = dir.join("deck.i");
     std::fs::write(&path, "begin contact definition\n".repeat(10_000)).unwrap();
     let out = seam(&["check", path.to_str().unwrap()]);
@@ -372,7 +371,8 @@ fn toml_ranges_refuse_infinities_and_nan() {
 /// Search the two-block example with the bottom made periodic by `transform` (Lua files
 /// from `files`), in a scratch directory.
 fn search_periodic(name: &str, transform: &str, files: &[(&str, &str)]) -> Output {
-    let dir = scratch(name);
+    let tmp = scratch(&format!("hard-input-{name}"));
+    let dir = tmp.path();
     for (file, text) in files {
         std::fs::write(dir.join(file), text).unwrap();
     }

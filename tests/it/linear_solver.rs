@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use seam::run::{RunError, RunResult};
+use tempfile::TempDir;
 
 /// Agreement of AMG-CG and Cholesky answers (see the module comment).
 const AGREE: f64 = 1e-8;
@@ -25,20 +26,22 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// A copy of `examples/two_blocks` whose `[solve]` table gets `extra` (TOML lines).
-fn two_blocks_with(tag: &str, extra: &str) -> PathBuf {
+/// A copy of `examples/two_blocks` whose `[solve]` table gets `extra` (TOML lines): the
+/// scratch folder holding it and its problem file.
+fn two_blocks_with(tag: &str, extra: &str) -> (TempDir, PathBuf) {
     scene_with("two_blocks", tag, extra)
 }
 
-/// A copy of `examples/<scene>` whose `[solve]` table gets `extra` (TOML lines).
-fn scene_with(scene: &str, tag: &str, extra: &str) -> PathBuf {
+/// A copy of `examples/<scene>` whose `[solve]` table gets `extra` (TOML lines): the
+/// scratch folder holding it and its problem file.
+fn scene_with(scene: &str, tag: &str, extra: &str) -> (TempDir, PathBuf) {
     scene_file_with(scene, "problem.toml", tag, extra)
 }
 
 /// As [`scene_with`], for the scene's problem file `file`.
-fn scene_file_with(scene: &str, file: &str, tag: &str, extra: &str) -> PathBuf {
+fn scene_file_with(scene: &str, file: &str, tag: &str, extra: &str) -> (TempDir, PathBuf) {
     let dir = crate::examples::copy_scene_as(scene, tag);
-    let path = dir.join(file);
+    let path = dir.path().join(file);
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(text.contains("[solve]\n"), "the scene has a [solve] table");
     std::fs::write(
@@ -46,7 +49,7 @@ fn scene_file_with(scene: &str, file: &str, tag: &str, extra: &str) -> PathBuf {
         text.replace("[solve]\n", &format!("[solve]\n{extra}\n")),
     )
     .unwrap();
-    path
+    (dir, path)
 }
 
 fn run(problem: &Path) -> RunResult {
@@ -72,7 +75,8 @@ fn max_abs(v: &[f64]) -> f64 {
 
 #[test]
 fn auto_factors_a_small_problem() {
-    let r = run(&two_blocks_with("auto-small", ""));
+    let (_scene, problem) = two_blocks_with("auto-small", "");
+    let r = run(&problem);
     let ls = &r.summary.linear_solver;
     assert_eq!(ls.name, "Cholesky");
     assert!(
@@ -88,16 +92,18 @@ fn auto_factors_a_small_problem() {
 
 #[test]
 fn auto_uses_amg_above_the_threshold_and_agrees_with_cholesky() {
-    let direct = run(&scene_with(
+    let (_direct_scene, problem) = scene_with(
         "electronics",
         "auto-direct",
         "linear_solver = \"direct\"\nauto_threshold = 1",
-    ));
+    );
+    let direct = run(&problem);
     let d = &direct.summary.linear_solver;
     assert_eq!(d.name, "Cholesky");
     assert_eq!(d.reason, "requested by linear_solver");
 
-    let amg = run(&scene_with("electronics", "auto-amg", "auto_threshold = 1"));
+    let (_amg_scene, problem) = scene_with("electronics", "auto-amg", "auto_threshold = 1");
+    let amg = run(&problem);
     let a = &amg.summary.linear_solver;
     assert_eq!(a.name, "AMG-CG");
     assert!(
@@ -145,7 +151,8 @@ fn auto_uses_amg_above_the_threshold_and_agrees_with_cholesky() {
 
 #[test]
 fn amg_can_be_requested_on_a_small_problem() {
-    let r = run(&two_blocks_with("request-amg", "linear_solver = \"amg\""));
+    let (_scene, problem) = two_blocks_with("request-amg", "linear_solver = \"amg\"");
+    let r = run(&problem);
     let ls = &r.summary.linear_solver;
     assert_eq!(ls.name, "AMG-CG");
     assert_eq!(ls.reason, "requested by linear_solver");
@@ -170,10 +177,8 @@ fn multipliers_keep_the_direct_saddle_point_solver() {
         .unwrap()
         .insert("auto_threshold".into(), toml::Value::Integer(1));
     table.remove("output");
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("auto-lagrange-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("problem.toml");
+    let dir = crate::scratch("auto-lagrange");
+    let path = dir.path().join("problem.toml");
     std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
     let r = run(&path);
     let ls = &r.summary.linear_solver;
@@ -187,7 +192,7 @@ fn multipliers_keep_the_direct_saddle_point_solver() {
 
 #[test]
 fn the_json_summary_and_the_text_name_the_solver() {
-    let path = two_blocks_with("auto-json", "auto_threshold = 1");
+    let (_scene, path) = two_blocks_with("auto-json", "auto_threshold = 1");
     let seam = |json: bool| {
         let mut c = Command::new(env!("CARGO_BIN_EXE_seam"));
         c.arg("run").arg(&path);
@@ -229,19 +234,17 @@ fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
     // positive definite, so above the threshold each step is one AMG-CG solve, the
     // hierarchy set up again only when the matrix changes (the first two steps).
     let file = "transient.toml";
-    let direct = run(&scene_file_with(
+    let (_direct_scene, problem) = scene_file_with(
         "electronics",
         file,
         "transient-direct",
         "linear_solver = \"direct\"\nauto_threshold = 1",
-    ));
+    );
+    let direct = run(&problem);
     assert_eq!(direct.summary.linear_solver.name, "direct");
-    let amg = run(&scene_file_with(
-        "electronics",
-        file,
-        "transient-amg",
-        "auto_threshold = 1",
-    ));
+    let (_amg_scene, problem) =
+        scene_file_with("electronics", file, "transient-amg", "auto_threshold = 1");
+    let amg = run(&problem);
     let a = &amg.summary.linear_solver;
     assert_eq!(a.name, "AMG-CG");
     assert!(a.reason.starts_with("auto: "), "{}", a.reason);

@@ -44,3 +44,14 @@ mod twod;
 /// share, is not found yet; until it is, they take turns so the suite checks the
 /// numbers and not the race.
 pub(crate) static TURBINE_RUNS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// A scratch folder for one test, under cargo's `target/tmp` and named `NAME-xxxxxx`:
+/// removed when the value is dropped — at the end of the test, or while a failing test
+/// unwinds — and never shared by two tests that run at once. Keep the value alive for as
+/// long as the folder is used (`let dir = scratch(..); .. dir.path() ..`).
+pub(crate) fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("{name}-"))
+        .tempdir_in(env!("CARGO_TARGET_TMPDIR"))
+        .unwrap_or_else(|e| panic!("cannot make a scratch folder for {name}: {e}"))
+}

@@ -527,8 +527,8 @@ fn exodus_reference_library_records_and_variables_read_in_every_flavour() {
 #[test]
 fn exodus_writer_round_trips_the_reference_meshes() {
     let r = reference();
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("exodus-writer");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("exodus-writer");
+    let dir = tmp.path();
     for key in ["ref3d", "ref2d", "contact2d"] {
         let input = reference_dir().join(format!("{key}_offset64.exo"));
         let m = mesh::read(&input).unwrap();
@@ -706,15 +706,13 @@ fn gmsh_ascii_errors_give_the_line() {
     let bad_line = nodes + 5; // 1-based line number of that coordinate line
     let mut broken: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
     broken[bad_line - 1] = "0 zero 0".into();
-    let dir = std::env::temp_dir().join(format!("seam-mesh-io-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("broken.msh");
+    let dir = crate::scratch("mesh-io-gmsh-line");
+    let path = dir.path().join("broken.msh");
     std::fs::write(&path, broken.join("\n")).unwrap();
     let msg = mesh::read(&path).unwrap_err().to_string();
     assert!(msg.contains("broken.msh"), "{msg}");
     assert!(msg.contains(&format!("line {bad_line}")), "{msg}");
     assert!(msg.contains("`zero`"), "{msg}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]

@@ -10,7 +10,7 @@ use seam::mesh::generate::{self, BoxSpec};
 use seam::output::exodus::ExodusWriter;
 use seam::run::{RunError, RunResult};
 
-use super::embed::scratch;
+use crate::scratch;
 
 /// Block 1 `[0,1]² × [0,1]` (3 × 3 × 4 hexes) and block 2 `[0,1]² × [1 + g0, 2 + g0]` (4 ×
 /// 4 × 3), meshed apart. Side sets: 1 block 1's bottom, 2 its top, 3 block 2's bottom, 4
@@ -115,12 +115,13 @@ fn worst_against_gap_law(r: &RunResult) -> f64 {
 
 #[test]
 fn a_closing_gap_follows_the_gap_law_step_by_step() {
-    let dir = scratch("moving-closing");
-    let r = run(&closing(&dir, LUA_DOWN, None));
+    let tmp = scratch("moving-closing");
+    let dir = tmp.path();
+    let r = run(&closing(dir, LUA_DOWN, None));
     let worst = worst_against_gap_law(&r);
     assert!(worst <= 1e-8, "{worst:e}");
     // Without the motion the heat stays that of the first gap: the check can fail.
-    let still = run(&closing(&dir, "", None));
+    let still = run(&closing(dir, "", None));
     let last = still.history.last().unwrap().heat[0].0;
     assert!((last - series_heat(G0)).abs() <= 1e-8 * series_heat(G0));
     assert!((last - series_heat(G0 - 10.0 * SPEED)).abs() > 0.1 * last);
@@ -128,27 +129,27 @@ fn a_closing_gap_follows_the_gap_law_step_by_step() {
     let m = r.summary.motion.expect("a moving run reports its searches");
     assert_eq!((m.searches, m.refits), (11, 0), "{m:?}");
     assert!(still.summary.motion.is_none());
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn searches_follow_the_schedule_and_refits_keep_the_gap_law() {
-    let dir = scratch("moving-schedule");
-    let r = run(&closing(&dir, LUA_DOWN, Some(3)));
+    let tmp = scratch("moving-schedule");
+    let dir = tmp.path();
+    let r = run(&closing(dir, LUA_DOWN, Some(3)));
     // Steps 3, 6 and 9 search, besides the start; the other seven steps refit.
     let m = r.summary.motion.unwrap();
     assert_eq!((m.searches, m.refits), (4, 7), "{m:?}");
     let worst = worst_against_gap_law(&r);
     assert!(worst <= 1e-8, "{worst:e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The same motion as a structural result would give it: `DISPLX`, `DISPLY`, `DISPLZ`
 /// stored at t = 0, 5 and 10 (linear in t, so interpolation is exact).
 #[test]
 fn a_displacement_read_from_an_exodus_result_moves_the_surfaces_as_the_lua_one() {
-    let dir = scratch("moving-exodus");
-    let problem = closing(&dir, LUA_DOWN, Some(2));
+    let tmp = scratch("moving-exodus");
+    let dir = tmp.path();
+    let problem = closing(dir, LUA_DOWN, Some(2));
     let lua = run(&problem);
     let mesh = parts(G0);
     let down: Vec<bool> = mesh.coords.iter().map(|x| x[2] > 1.05).collect();
@@ -180,7 +181,6 @@ fn a_displacement_read_from_an_exodus_result_moves_the_surfaces_as_the_lua_one()
     }
     println!("Lua against Exodus displacement: heats within {worst:.1e}");
     assert!(worst <= 1e-12, "{worst:e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Block 2 slides 0.3 along x over ten steps: the searches pair side-A points with other
@@ -188,14 +188,15 @@ fn a_displacement_read_from_an_exodus_result_moves_the_surfaces_as_the_lua_one()
 /// last step's heat is that of a mesh built where block 2 ends up.
 #[test]
 fn a_sliding_part_is_searched_anew_and_ends_as_a_mesh_built_there() {
-    let dir = scratch("moving-sliding");
+    let tmp = scratch("moving-sliding");
+    let dir = tmp.path();
     let slide = "[displacement]\nvalue = [\"z > 1.05 and 0.03*t or 0\", 0.0, 0.0]\n";
-    let moving = run(&closing(&dir, slide, None));
+    let moving = run(&closing(dir, slide, None));
     let m = moving.summary.motion.unwrap();
     assert!(m.repatterns >= 1, "{m:?}");
     let (a, b) = moving.history.last().unwrap().heat[0];
     // A mesh built where block 2 ends up, searched once.
-    let problem = closing(&dir, "", None);
+    let problem = closing(dir, "", None);
     ExodusWriter::create(&dir.join("mesh.exo"), &parts_at(G0, 0.3), &[], &[])
         .unwrap()
         .finish()
@@ -210,13 +211,13 @@ fn a_sliding_part_is_searched_anew_and_ends_as_a_mesh_built_there() {
     // Less overlap, less heat than the full faces at that gap.
     assert!(a0 < 0.8 * series_heat(G0), "{a0}");
     assert!(diff <= 1e-9, "{diff:e}");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn what_cannot_move_is_refused_with_its_reason() {
-    let dir = scratch("moving-refused");
-    let problem = closing(&dir, LUA_DOWN, None);
+    let tmp = scratch("moving-refused");
+    let dir = tmp.path();
+    let problem = closing(dir, LUA_DOWN, None);
     let codes = |edit: &dyn Fn(&str) -> String| -> Vec<(String, Option<u32>)> {
         let text = std::fs::read_to_string(&problem).unwrap();
         let changed = dir.join("changed.toml");
@@ -267,7 +268,6 @@ fn what_cannot_move_is_refused_with_its_reason() {
     let refused = codes(&tie);
     assert_eq!(refused.len(), 1, "{refused:?}");
     assert_eq!(refused[0].0, "E0731");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Block 1 in two layers under the lid at gap `G0`; at t = 5 its upper layer dies. With
@@ -323,8 +323,9 @@ fn dying(dir: &Path, side_a: &str) -> (PathBuf, Vec<i64>) {
 
 #[test]
 fn element_death_exposes_faces_of_a_skinned_block_and_removes_those_of_a_side_set() {
-    let dir = scratch("moving-death");
-    let (problem, _) = dying(&dir, "block_1");
+    let tmp = scratch("moving-death");
+    let dir = tmp.path();
+    let (problem, _) = dying(dir, "block_1");
     let r = run(&problem);
     let before = series_heat(G0);
     // After: half of block 1 left, the gap 0.5 wider.
@@ -362,7 +363,7 @@ fn element_death_exposes_faces_of_a_skinned_block_and_removes_those_of_a_side_se
         assert!((t - t4).abs() <= 1e-9, "node {n}: {t} against {t4}");
     }
     // The side set of block 1's top loses its faces: nothing crosses after t = 5.
-    let (problem, _) = dying(&dir, "surface_2");
+    let (problem, _) = dying(dir, "surface_2");
     let r = run(&problem);
     for s in &r.history {
         let (a, _) = s.heat[0];
@@ -372,13 +373,13 @@ fn element_death_exposes_faces_of_a_skinned_block_and_removes_those_of_a_side_se
             assert!((a - before).abs() <= 1e-9 * before);
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn death_input_that_cannot_act_is_refused_at_its_line() {
-    let dir = scratch("moving-death-refused");
-    let (problem, _) = dying(&dir, "block_1");
+    let tmp = scratch("moving-death-refused");
+    let dir = tmp.path();
+    let (problem, _) = dying(dir, "block_1");
     let text = std::fs::read_to_string(&problem).unwrap();
     let check = |edit: &str| -> Vec<(String, u32)> {
         std::fs::write(&problem, edit).unwrap();
@@ -408,5 +409,4 @@ fn death_input_that_cannot_act_is_refused_at_its_line() {
     );
     let steady = text.replace("kind = \"transient\"", "kind = \"steady\"");
     assert_eq!(check(&steady)[0].0, "E0732");
-    std::fs::remove_dir_all(&dir).ok();
 }

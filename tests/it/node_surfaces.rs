@@ -546,9 +546,8 @@ fn node_points_meet_the_normal_angle_check() {
 #[test]
 fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
     use seam::output::exodus::ExodusWriter;
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("node-surfaces-run");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("node-surfaces-run");
+    let dir = tmp.path();
     let mesh = slabs(3, 3, SolidKind::Hex8);
     ExodusWriter::create(&dir.join("slabs.exo"), &mesh, &[], &[])
         .unwrap()
@@ -652,7 +651,6 @@ fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
             );
         }
     }
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// Aria's masking reaches node surfaces: a convection condition on the faces under a
@@ -661,9 +659,8 @@ fn seam_run_with_a_contact_node_set_carries_the_face_heat() {
 #[test]
 fn face_conditions_under_a_contact_node_set_are_masked() {
     use seam::output::exodus::ExodusWriter;
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("node-surfaces-mask");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("node-surfaces-mask");
+    let dir = tmp.path();
     let mesh = slabs(3, 3, SolidKind::Hex8);
     ExodusWriter::create(&dir.join("slabs.exo"), &mesh, &[], &[])
         .unwrap()
@@ -715,7 +712,6 @@ fn face_conditions_under_a_contact_node_set_are_masked() {
         diff(&plain, &kept) > 0.1,
         "an unmasked hot convection heats the interface"
     );
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// The Jacobian of the node-to-face form with a temperature-dependent conductance
@@ -798,9 +794,8 @@ fn node_point_jacobian_matches_finite_differences() {
 #[test]
 fn transient_run_through_a_contact_node_set_matches_the_face_surface() {
     use seam::output::exodus::ExodusWriter;
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("node-surfaces-transient");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("node-surfaces-transient");
+    let dir = tmp.path();
     let mesh = slabs(3, 3, SolidKind::Hex8);
     ExodusWriter::create(&dir.join("slabs.exo"), &mesh, &[], &[])
         .unwrap()
@@ -853,5 +848,4 @@ fn transient_run_through_a_contact_node_set_matches_the_face_surface() {
     assert!(q_face.abs() > 0.1, "heat crosses: {q_face}");
     assert!(worst < 1e-12, "{worst:e}");
     assert!(diff <= 1e-10, "{diff:e}");
-    std::fs::remove_dir_all(&dir).ok();
 }

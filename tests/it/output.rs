@@ -10,11 +10,7 @@ use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{self, Mesh, NodeId, NodeSet, Topology};
 use seam::output::exodus::ExodusWriter;
 
-fn out_dir(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use crate::scratch;
 
 /// A hex box and a tet box meshed apart, with named blocks, side sets and node sets
 /// (one of them empty, as the Exodus library writes a "NULL" set).
@@ -87,7 +83,8 @@ fn bits(v: &[f64]) -> Vec<u64> {
 #[test]
 fn output_exodus_round_trip_mesh_times_and_variables() {
     let m = two_part_mesh();
-    let path = out_dir("output-exodus").join("two_parts.exo");
+    let dir = scratch("output-exodus");
+    let path = dir.path().join("two_parts.exo");
     let times = [0.0, 0.25, 1.0 / 3.0];
     let mut w = ExodusWriter::create(&path, &m, &["temperature", "flux_x"], &["source"]).unwrap();
     for (s, &t) in times.iter().enumerate() {
@@ -133,7 +130,8 @@ fn output_exodus_round_trip_mesh_times_and_variables() {
 #[test]
 fn output_exodus_is_readable_after_every_step() {
     let m = generate::single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [2, 2, 2], 4));
-    let path = out_dir("output-exodus").join("steps.exo");
+    let dir = scratch("output-exodus");
+    let path = dir.path().join("steps.exo");
     let mut w = ExodusWriter::create(&path, &m, &["temperature"], &[]).unwrap();
     assert!(mesh::exodus::read_times(&path).unwrap().is_empty());
     assert_same_mesh(&m, &mesh::read(&path).unwrap());
@@ -154,7 +152,8 @@ fn output_exodus_is_readable_after_every_step() {
 #[test]
 fn output_exodus_refuses_wrong_lengths_and_names() {
     let m = generate::unit_hex();
-    let path = out_dir("output-exodus").join("bad.exo");
+    let dir = scratch("output-exodus");
+    let path = dir.path().join("bad.exo");
     let mut w = ExodusWriter::create(&path, &m, &["temperature"], &["q"]).unwrap();
     let e = w.write_step(0.0, &[&[1.0; 7]], &[&[0.0]]).unwrap_err();
     assert_eq!(e.kind(), ErrorKind::InvalidInput);
@@ -211,7 +210,8 @@ fn output_exodus_refuses_wrong_lengths_and_names() {
 #[test]
 fn output_exodus_global_variables_per_step() {
     let m = generate::unit_hex();
-    let path = out_dir("output-exodus").join("globals.exo");
+    let dir = scratch("output-exodus");
+    let path = dir.path().join("globals.exo");
     let mut w = ExodusWriter::create_with_globals(
         &path,
         &m,
@@ -248,7 +248,8 @@ fn output_exodus_round_trip_shell_thickness() {
     let top: Vec<NodeId> = m.blocks[0].elem_nodes(0)[4..].to_vec();
     m.push_block(20, "skin", Topology::Shell4, top, None);
     m.blocks[1].thickness = Some(0.0125);
-    let path = out_dir("output-exodus").join("shell.exo");
+    let dir = scratch("output-exodus");
+    let path = dir.path().join("shell.exo");
     ExodusWriter::create(&path, &m, &[], &[])
         .unwrap()
         .finish()
@@ -276,7 +277,8 @@ fn output_exodus_round_trip_2d() {
     };
     m.push_block(3, "quads", Topology::Quad4, ids(&[0, 1, 2, 3]), None);
     m.push_block(8, "", Topology::Tri3, ids(&[1, 4, 2]), None);
-    let path = out_dir("output-exodus").join("flat.exo");
+    let dir = scratch("output-exodus");
+    let path = dir.path().join("flat.exo");
     let mut w = ExodusWriter::create(&path, &m, &["u"], &[]).unwrap();
     w.write_step(1.0, &[&[1.0, 2.0, 3.0, 4.0, f64::NAN]], &[])
         .unwrap();
@@ -401,7 +403,8 @@ fn output_vtu_cell_data_follows_element_order_in_both_encodings() {
     use seam::mesh::ElemId;
     use seam::output::vtu::{write_vtu, write_vtu_cells};
     let m = two_part_mesh();
-    let dir = out_dir("output-vtu");
+    let tmp = scratch("output-vtu");
+    let dir = tmp.path();
     let t = nodal_values(&m, 2, 0);
     let index: Vec<f64> = (0..m.num_elems()).map(|e| e as f64).collect();
     let src = element_values(&m, 1);
@@ -457,7 +460,8 @@ fn output_vtu_cell_data_follows_element_order_in_both_encodings() {
 fn output_vtu_vectors_and_polygon_grids_read_back() {
     use seam::output::vtu::{Array, VtuEncoding, write_vtu_arrays, write_vtu_polygons};
     let m = two_part_mesh();
-    let dir = out_dir("output-vtu");
+    let tmp = scratch("output-vtu");
+    let dir = tmp.path();
     let t = nodal_values(&m, 0, 0);
     let q: Vec<f64> = (0..3 * m.num_elems())
         .map(|i| (i as f64 * 0.3).sin())
@@ -553,7 +557,8 @@ fn output_vtu_vectors_and_polygon_grids_read_back() {
 fn output_vtu_refuses_wrong_lengths() {
     use seam::output::vtu::write_vtu_cells;
     let m = generate::unit_hex();
-    let path = out_dir("output-vtu").join("bad.vtu");
+    let dir = scratch("output-vtu");
+    let path = dir.path().join("bad.vtu");
     let e = write_vtu_cells(&path, &m, &[("temperature", &[0.0; 5])], &[]).unwrap_err();
     assert_eq!(e.kind(), ErrorKind::InvalidInput);
     assert!(
@@ -572,7 +577,8 @@ fn output_vtu_refuses_wrong_lengths() {
 fn output_pvd_is_a_complete_series_after_every_add() {
     use seam::output::vtu::{PvdSeries, write_vtu};
     let m = generate::unit_hex();
-    let dir = out_dir("output-pvd");
+    let tmp = scratch("output-pvd");
+    let dir = tmp.path();
     std::fs::create_dir_all(dir.join("steps")).unwrap();
     let mut series = PvdSeries::new(&dir.join("run.pvd"));
     let times = [0.0, 0.5, 1.25];
@@ -651,7 +657,8 @@ fn output_plot_draws_known_lines_where_they_belong() {
         log_y: false,
         series: vec![diagonal, level],
     };
-    let path = out_dir("output-plot").join("lines.png");
+    let dir = scratch("output-plot");
+    let path = dir.path().join("lines.png");
     plot.write_png(&path).unwrap();
     let (w, h, rgb) = decode_png(&path);
     assert_eq!((w, h), (960, 640));
@@ -714,7 +721,8 @@ fn output_plot_draws_known_lines_where_they_belong() {
 #[test]
 fn output_plot_gives_each_series_its_colour_and_copes_with_awkward_data() {
     use seam::output::plot::{Plot, Series, series_colour};
-    let dir = out_dir("output-plot");
+    let tmp = scratch("output-plot");
+    let dir = tmp.path();
     // Five series: constant data, a single point, NaN and infinity inside, negative
     // values on a log axis; every one must show in its own colour.
     let series = vec![
@@ -791,7 +799,8 @@ fn output_plot_gives_each_series_its_colour_and_copes_with_awkward_data() {
 #[test]
 fn output_plot_svg_keeps_text_as_text() {
     use seam::output::plot::{Plot, Series, series_colour};
-    let dir = out_dir("output-plot");
+    let tmp = scratch("output-plot");
+    let dir = tmp.path();
     let plot = Plot {
         title: "Heat out of side A".into(),
         x_label: "time t (s)".into(),
@@ -829,7 +838,8 @@ fn output_plot_svg_keeps_text_as_text() {
 #[test]
 fn output_plot_refuses_what_it_cannot_draw() {
     use seam::output::plot::{Plot, Series};
-    let path = out_dir("output-plot").join("never.png");
+    let dir = scratch("output-plot");
+    let path = dir.path().join("never.png");
     let none = Plot {
         title: "empty".into(),
         ..Plot::default()
@@ -935,9 +945,9 @@ fn python_check(python: &str, dir: &Path) -> (i32, String) {
 #[test]
 fn output_sample_results_pass_the_python_check() {
     let m = two_part_mesh();
-    let root = out_dir("output-sample");
+    let tmp = scratch("output-sample");
+    let root = tmp.path();
     let good = root.join("good");
-    let _ = std::fs::remove_dir_all(&good);
     write_sample(&good, &m, 3, false);
     let exo = good.join("results.exo");
     assert_eq!(mesh::exodus::read_times(&exo).unwrap(), vec![0.0, 0.5, 1.0]);
@@ -960,14 +970,12 @@ fn output_sample_results_pass_the_python_check() {
     );
 
     let nan = root.join("nan");
-    let _ = std::fs::remove_dir_all(&nan);
     write_sample(&nan, &m, 2, true);
     let (code, out) = python_check(&python, &nan);
     assert_eq!(code, 1, "{out}");
     assert!(out.contains("not finite"), "{out}");
 
     let mixed = root.join("mixed");
-    let _ = std::fs::remove_dir_all(&mixed);
     write_sample(&mixed, &m, 1, false);
     let other = generate::unit_hex();
     seam::output::vtu::write_vtu(
@@ -994,7 +1002,8 @@ fn output_large_mesh_write_times() {
         m.num_nodes(),
         t0.elapsed().as_secs_f64()
     );
-    let dir = out_dir("output-large");
+    let tmp = scratch("output-large");
+    let dir = tmp.path();
     let path = dir.join("large.exo");
     let t = nodal_values(&m, 0, 0);
     let t0 = Instant::now();

@@ -17,6 +17,7 @@ use seam::plugin::{
     StepContext, check_plugin,
 };
 use seam_plugin_testkit::{Config, Grid};
+use tempfile::TempDir;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -328,10 +329,9 @@ fn c_header_matches_the_rust_abi() {
         "  printf(\"SEAM_PLUGIN_ENTRY_SYMBOL %s\\n\", SEAM_PLUGIN_ENTRY_SYMBOL);\n  return 0;\n}\n";
     let entry = std::str::from_utf8(&ENTRY_SYMBOL[..ENTRY_SYMBOL.len() - 1]).unwrap();
     expected.push(format!("SEAM_PLUGIN_ENTRY_SYMBOL {entry}"));
-    let dir = tmp().join("plugins-c");
-    std::fs::create_dir_all(&dir).unwrap();
-    let src = dir.join(format!("layout.{}.c", std::process::id()));
-    let exe = dir.join(format!("layout.{}", std::process::id()));
+    let dir = crate::scratch("plugin-layout");
+    let src = dir.path().join("layout.c");
+    let exe = dir.path().join("layout");
     std::fs::write(&src, c).unwrap();
     let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
     let status = Command::new(compiler)
@@ -980,8 +980,8 @@ fn check_plugin_command_exit_codes() {
 /// Run a two-block problem whose interface enforcement is `enforcement` (the lines
 /// inside `begin enforcement`), with the bottom at `t_low` and the top at `t_high`.
 fn run_with(enforcement: &str, t_low: f64, t_high: f64, tag: &str) -> Vec<f64> {
-    let dir = tmp().join(format!("run-{tag}"));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch(&format!("plugin-run-{tag}"));
+    let dir = tmp.path();
     let mesh = root().join("examples/two_blocks/two_blocks.exo");
     std::fs::write(
         dir.join("problem.toml"),
@@ -1123,8 +1123,8 @@ fn deck_data_arrives_at_the_plugin_as_written() {
 #[test]
 fn faulty_plugin_in_a_run_stops_it_or_is_quarantined() {
     let nan = faulty("NAN").to_str().unwrap().to_string();
-    let dir = tmp().join("run-faulty");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("plugin-run-faulty");
+    let dir = tmp.path();
     let mesh = root().join("examples/two_blocks/two_blocks.exo");
     std::fs::write(
         dir.join("problem.toml"),
@@ -1203,8 +1203,8 @@ model = [{ equation = "energy", model = "plugin", args = [{ key = "library", val
 #[test]
 fn plugin_without_derivatives_in_a_run_is_noted_once() {
     let smooth = c_plugins().smooth.to_str().unwrap().to_string();
-    let dir = tmp().join("run-smooth");
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch("plugin-run-smooth");
+    let dir = tmp.path();
     let mesh = root().join("examples/two_blocks/two_blocks.exo");
     std::fs::write(
         dir.join("problem.toml"),
@@ -1411,14 +1411,14 @@ fn isolated_load_errors_are_the_in_process_ones() {
 }
 
 /// Write the two-block problem whose enforcement uses `lib` at contact pressure 1000
-/// plus `extra` lines (e.g. `plugin isolation = process`); the directory.
+/// plus `extra` lines (e.g. `plugin isolation = process`) into a scratch folder; that
+/// folder.
 const ISOLATED: &str = "  plugin isolation = process\n";
 
-fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
+fn kill_problem(lib: &Path, tag: &str, extra: &str) -> TempDir {
     let mesh = root().join("examples/two_blocks/two_blocks.exo");
-    let dir = tmp().join(format!("run-isolated-{tag}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = crate::scratch(&format!("plugin-run-isolated-{tag}"));
+    let dir = tmp.path();
     std::fs::write(
         dir.join("problem.toml"),
         format!(
@@ -1438,7 +1438,7 @@ fn kill_problem(lib: &Path, tag: &str, extra: &str) -> PathBuf {
         ),
     )
     .unwrap();
-    dir
+    tmp
 }
 
 /// A plugin that returns a value that is not a number during `seam run` is a plugin

@@ -6,19 +6,18 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use seam::run::RunError;
+use tempfile::TempDir;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// A scratch folder with the bundled two-block mesh in it.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("preflight-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+fn scratch(name: &str) -> TempDir {
+    let d = crate::scratch(&format!("preflight-{name}"));
     std::fs::copy(
         root().join("examples/two_blocks/two_blocks.exo"),
-        d.join("two_blocks.exo"),
+        d.path().join("two_blocks.exo"),
     )
     .unwrap();
     d
@@ -101,15 +100,16 @@ fn check_refuses_what_run_refuses_with_the_same_code() {
         ),
     ];
     for (name, enforcement, code) in cases {
-        let dir = scratch(name);
-        problem(&dir, &deck(enforcement, ""), "400.0");
-        let (exit, text) = seam(&dir, &["check", "deck.i"]);
+        let tmp = scratch(name);
+        let dir = tmp.path();
+        problem(dir, &deck(enforcement, ""), "400.0");
+        let (exit, text) = seam(dir, &["check", "deck.i"]);
         assert_eq!(exit, Some(2), "{name}: seam check passed:\n{text}");
         assert!(text.contains(code), "{name}: check lacks {code}:\n{text}");
-        let (exit, text) = seam(&dir, &["check", "deck.i", "--mesh", "two_blocks.exo"]);
+        let (exit, text) = seam(dir, &["check", "deck.i", "--mesh", "two_blocks.exo"]);
         assert_eq!(exit, Some(2), "{name}: seam check --mesh passed:\n{text}");
         assert!(text.contains(code), "{name}: check --mesh lacks {code}");
-        let (exit, text) = seam(&dir, &["run", "problem.toml"]);
+        let (exit, text) = seam(dir, &["run", "problem.toml"]);
         assert_eq!(exit, Some(2), "{name}: seam run did not refuse:\n{text}");
         assert!(text.contains(code), "{name}: run lacks {code}:\n{text}");
     }
@@ -117,21 +117,22 @@ fn check_refuses_what_run_refuses_with_the_same_code() {
 
 #[test]
 fn check_with_a_problem_runs_the_problem_file_checks() {
-    let dir = scratch("problem");
+    let tmp = scratch("problem");
+    let dir = tmp.path();
     let good =
         "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n";
-    problem(&dir, &deck(good, ""), "\"400 + nonsense(\"");
+    problem(dir, &deck(good, ""), "\"400 + nonsense(\"");
     // The deck alone is fine; the problem file's Lua boundary value is not.
-    let (exit, text) = seam(&dir, &["check", "deck.i"]);
+    let (exit, text) = seam(dir, &["check", "deck.i"]);
     assert_eq!(exit, Some(0), "{text}");
-    let (exit, text) = seam(&dir, &["check", "deck.i", "--problem", "problem.toml"]);
+    let (exit, text) = seam(dir, &["check", "deck.i", "--problem", "problem.toml"]);
     assert_eq!(exit, Some(2), "{text}");
     assert!(text.contains("E0707"), "{text}");
-    let (exit, _) = seam(&dir, &["run", "problem.toml"]);
+    let (exit, _) = seam(dir, &["run", "problem.toml"]);
     assert_eq!(exit, Some(2));
 
-    let p = problem(&dir, &deck(good, ""), "400.0");
-    let (exit, text) = seam(&dir, &["check", "deck.i", "--problem", "problem.toml"]);
+    let p = problem(dir, &deck(good, ""), "400.0");
+    let (exit, text) = seam(dir, &["check", "deck.i", "--problem", "problem.toml"]);
     assert_eq!(exit, Some(0), "{text}");
     assert!(text.contains("problem ready to run"), "{text}");
     // The pre-flight writes nothing.
@@ -151,9 +152,10 @@ const TWO_BLOCKS: &str = "  begin enforcement low\n    enforcement for energy = 
 
 #[test]
 fn two_energy_blocks_need_an_interaction_to_name_one() {
-    let dir = scratch("two_blocks");
-    let p = problem(&dir, &deck(TWO_BLOCKS, ""), "400.0");
-    let (exit, text) = seam(&dir, &["check", "deck.i"]);
+    let tmp = scratch("two_blocks");
+    let dir = tmp.path();
+    let p = problem(dir, &deck(TWO_BLOCKS, ""), "400.0");
+    let (exit, text) = seam(dir, &["check", "deck.i"]);
     assert_eq!(exit, Some(2), "{text}");
     assert!(text.contains("E0429"), "{text}");
     match seam::run::run(&p) {
@@ -164,11 +166,11 @@ fn two_energy_blocks_need_an_interaction_to_name_one() {
     // Named, each block applies with its own conductance.
     for (name, h) in [("low", 5.0), ("high", 500.0)] {
         let p = problem(
-            &dir,
+            dir,
             &deck(TWO_BLOCKS, &format!("    enforcement = {name}\n")),
             "400.0",
         );
-        let (exit, text) = seam(&dir, &["check", "deck.i"]);
+        let (exit, text) = seam(dir, &["check", "deck.i"]);
         assert_eq!(exit, Some(0), "{text}");
         let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
         // Heat flows from the hot lid (side B) into the base (side A).
@@ -183,7 +185,8 @@ fn two_energy_blocks_need_an_interaction_to_name_one() {
 
 #[test]
 fn update_search_on_a_fixed_mesh_warns_that_it_does_nothing() {
-    let dir = scratch("update_search");
+    let tmp = scratch("update_search");
+    let dir = tmp.path();
     let d = deck(
         "  begin enforcement\n    enforcement for energy = contact_resistance h = 5\n  end\n",
         "",
@@ -197,7 +200,7 @@ fn update_search_on_a_fixed_mesh_warns_that_it_does_nothing() {
         "  begin search options\n    Global_update_frequency = 3\n  end\n",
     );
     for text in [d, elfen] {
-        let p = problem(&dir, &text, "400.0");
+        let p = problem(dir, &text, "400.0");
         let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{e:?}"));
         let w: Vec<_> = r
             .warnings
@@ -219,7 +222,8 @@ fn an_interaction_that_pairs_nothing_says_why() {
         ("same", "base_top", "base_top", "the same surface"),
     ];
     for (name, a, b, why) in cases {
-        let dir = scratch(name);
+        let tmp = scratch(name);
+        let dir = tmp.path();
         let d = deck(enforcement, "")
             .replace("contains base_top", &format!("contains {a}"))
             .replace("contains lid_bottom", &format!("contains {b}"));
@@ -228,7 +232,7 @@ fn an_interaction_that_pairs_nothing_says_why() {
         } else {
             d
         };
-        let p = problem(&dir, &d, "400.0");
+        let p = problem(dir, &d, "400.0");
         let r = seam::run::run(&p).unwrap_or_else(|e| panic!("{name}: {e:?}"));
         let w: Vec<_> = r
             .warnings
@@ -238,7 +242,7 @@ fn an_interaction_that_pairs_nothing_says_why() {
         assert_eq!(w.len(), 1, "{name}: {:?}", r.warnings);
         assert!(w[0].message.contains(why), "{name}: {}", w[0].message);
         assert_eq!(r.summary.interactions[0].heat_side_a, 0.0);
-        let (exit, text) = seam(&dir, &["check", "deck.i", "--mesh", "two_blocks.exo"]);
+        let (exit, text) = seam(dir, &["check", "deck.i", "--mesh", "two_blocks.exo"]);
         assert_eq!(exit, Some(0), "{text}");
         assert!(text.contains("W0428"), "{name}: {text}");
     }
@@ -247,7 +251,8 @@ fn an_interaction_that_pairs_nothing_says_why() {
 /// Runs the two-block problem with `[[bc]]`, `[[material]]` and `[initial]` text of its
 /// own (and the h = 5 resistance), returning the exit code and what seam printed.
 fn run_problem(name: &str, body: &str) -> (Option<i32>, String) {
-    let dir = scratch(name);
+    let tmp = scratch(name);
+    let dir = tmp.path();
     std::fs::write(
         dir.join("deck.i"),
         deck(
@@ -261,8 +266,8 @@ fn run_problem(name: &str, body: &str) -> (Option<i32>, String) {
         format!("[mesh]\nfile = \"two_blocks.exo\"\n{body}[contact]\nfile = \"deck.i\"\n"),
     )
     .unwrap();
-    let (check, text) = seam(&dir, &["check", "deck.i", "--problem", "problem.toml"]);
-    let (run, run_text) = seam(&dir, &["run", "problem.toml"]);
+    let (check, text) = seam(dir, &["check", "deck.i", "--problem", "problem.toml"]);
+    let (run, run_text) = seam(dir, &["run", "problem.toml"]);
     assert_eq!(
         check, run,
         "{name}: check and run disagree:\n{text}\n---\n{run_text}"
@@ -377,7 +382,8 @@ fn a_steady_problem_with_a_floating_part_is_named_before_the_solve() {
         );
     }
     // The same with the contact resistance but the interface apart: the base floats.
-    let dir = scratch("base_floats");
+    let tmp = scratch("base_floats");
+    let dir = tmp.path();
     std::fs::write(
         dir.join("deck.i"),
         deck(
@@ -396,7 +402,7 @@ fn a_steady_problem_with_a_floating_part_is_named_before_the_solve() {
         ),
     )
     .unwrap();
-    let (code, text) = seam(&dir, &["run", "problem.toml"]);
+    let (code, text) = seam(dir, &["run", "problem.toml"]);
     assert_eq!(code, Some(2), "{text}");
     assert!(text.contains("block(s) base meet no"), "{text}");
     // A transient problem has its heat capacity: it runs.
@@ -409,9 +415,10 @@ fn a_steady_problem_with_a_floating_part_is_named_before_the_solve() {
 
 /// The heat from the lid into the base with these enforcement lines.
 fn heat_with(name: &str, enforcement: &str) -> f64 {
-    let dir = scratch(name);
+    let tmp = scratch(name);
+    let dir = tmp.path();
     let p = problem(
-        &dir,
+        dir,
         &deck(&format!("  begin enforcement\n{enforcement}  end\n"), ""),
         "400.0",
     );

@@ -3,20 +3,15 @@
 //! `Visualize Contact` and `Output Rule` ask, and `interface_heat.csv` split by
 //! mechanism for a summed conductance.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{self, Mesh};
 use seam::output::exodus::ExodusWriter;
 use seam::run::{RunError, RunResult};
+use tempfile::TempDir;
 
-/// A scratch directory for one case, emptied.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("run-fields-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::scratch;
 
 fn write_mesh(path: &Path, m: &Mesh) {
     ExodusWriter::create(path, m, &[], &[])
@@ -95,7 +90,8 @@ fn element_variable(path: &Path, m: &Mesh, var: usize, step: usize) -> Vec<f64> 
 /// `temperature.vtu` and in `results.exo`; the conductivity used is each block's own.
 #[test]
 fn run_heat_flux_is_k_dt_over_l_on_a_linear_field() {
-    let dir = scratch("heat-flux");
+    let tmp = scratch("run-fields-heat-flux");
+    let dir = tmp.path();
     let m = generate::boxes(
         &[
             BoxSpec::hex([0.0; 3], [1.0, 1.0, 1.0], [2, 2, 2], 1)
@@ -164,8 +160,9 @@ fn two_blocks(dir: &Path) {
 /// 0 elsewhere. With `SEAM_PYTHON` set, meshio reads the output and finds every array.
 #[test]
 fn run_contact_flux_sums_to_the_interface_heat() {
-    let dir = scratch("two-blocks");
-    two_blocks(&dir);
+    let tmp = scratch("run-fields-two-blocks");
+    let dir = tmp.path();
+    two_blocks(dir);
     let r = run(&dir.join("problem.toml"));
     let out = dir.join("out");
     let rows = heat_rows(&out.join("interface_heat.csv"));
@@ -303,14 +300,16 @@ end
     )
 }
 
-/// Run the short cover with the contact-definition `lines`; the output directory.
-fn run_short(name: &str, lines: &str) -> (PathBuf, RunResult) {
-    let dir = scratch(name);
-    short_cover(&dir);
+/// Run the short cover with the contact-definition `lines`; the scratch folder it ran
+/// in (the output in its `out/`).
+fn run_short(name: &str, lines: &str) -> (TempDir, RunResult) {
+    let tmp = scratch(&format!("run-fields-{name}"));
+    let dir = tmp.path();
+    short_cover(dir);
     std::fs::write(dir.join("contact.i"), short_deck(lines)).unwrap();
     std::fs::write(dir.join("problem.toml"), SHORT_PROBLEM).unwrap();
     let r = run(&dir.join("problem.toml"));
-    (dir.join("out"), r)
+    (tmp, r)
 }
 
 /// Contact fraction on the short cover: the side-A faces whose x-extent lies under the
@@ -320,7 +319,8 @@ fn run_short(name: &str, lines: &str) -> (PathBuf, RunResult) {
 /// fluxes still integrate to the interface heat (1e-10 relative).
 #[test]
 fn run_contact_fraction_is_below_one_on_a_face_partly_outside() {
-    let (out, r) = run_short("short", "  visualize contact");
+    let (dir, r) = run_short("short", "  visualize contact");
+    let out = dir.path().join("out");
     let xml = std::fs::read_to_string(out.join("contact.vtu")).unwrap();
     let fraction = vtu_array(&xml, "contact_fraction");
     let flux = vtu_array(&xml, "interface_flux");
@@ -428,7 +428,8 @@ fn run_output_rule_decides_the_contact_output() {
             false,
         ),
     ] {
-        let (out, r) = run_short(&format!("rule-{name}"), lines);
+        let (dir, r) = run_short(&format!("rule-{name}"), lines);
+        let out = dir.path().join("out");
         assert_eq!(out.join("contact.vtu").exists(), faces, "{name}");
         assert_eq!(has_contact_vars(&out), faces, "{name}");
         assert_eq!(out.join("contact_points.vtu").exists(), points, "{name}");
@@ -470,8 +471,9 @@ fn run_output_rule_decides_the_contact_output() {
 /// steps as the temperature).
 #[test]
 fn run_interface_heat_splits_a_summed_conductance_by_mechanism() {
-    let dir = scratch("mechanisms");
-    two_blocks(&dir);
+    let tmp = scratch("run-fields-mechanisms");
+    let dir = tmp.path();
+    two_blocks(dir);
     let deck = std::fs::read_to_string(dir.join("contact_run.i"))
         .unwrap()
         .replace(
@@ -543,8 +545,9 @@ fn run_tie_flux_is_the_multiplier_and_sums_to_the_heat() {
             "[initial]\ntemperature = 300.0\n[solve]\nkind = \"transient\"\ndt = 0.1\nend_time = 0.2\n",
         ),
     ] {
-        let dir = scratch(&format!("tie-{name}"));
-        two_blocks(&dir);
+        let tmp = scratch(&format!("run-fields-tie-{name}"));
+        let dir = tmp.path();
+        two_blocks(dir);
         let deck = format!(
             "begin contact definition tie
   contact surface interface_base contains base_top

@@ -5,19 +5,13 @@
 //!
 //! Meshes are generated here and written with seam's own Exodus writer.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use seam::mesh::generate::{self, BoxSpec};
 use seam::output::exodus::ExodusWriter;
 use seam::run::{RunError, RunResult};
 
-/// A scratch directory for one case.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("sources-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::scratch;
 
 /// Hex8 boxes (merged into one conforming mesh) written as `<dir>/<name>.exo`.
 fn write_mesh(dir: &Path, name: &str, boxes: &[BoxSpec]) -> seam::mesh::Mesh {
@@ -59,13 +53,14 @@ value = 300.0
 /// and on the general Newton solver alike (k written as a Lua law sends the run there).
 #[test]
 fn lua_source_gives_the_exact_cubic_of_a_slab() {
-    let dir = scratch("cubic");
-    let mesh = slab(&dir, 8);
+    let tmp = scratch("sources-cubic");
+    let dir = tmp.path();
+    let mesh = slab(dir, 8);
     let (k, q0) = (2.0, 600.0);
     let exact = |x: f64| 300.0 + q0 * (x - x * x * x) / (6.0 * k);
     for (conductivity, linear) in [("2.0", true), ("\"2 + 0*T\"", false)] {
         let r = run(
-            &dir,
+            dir,
             &format!(
                 "[[material]]\nblocks = [\"block_1\"]\nconductivity = {conductivity}\n{SLAB_BCS}[[source]]\nblocks = [\"block_1\"]\nvalue = \"{q0}*x\"\n"
             ),
@@ -85,15 +80,16 @@ fn lua_source_gives_the_exact_cubic_of_a_slab() {
 /// nodal error falls at rate 2 (1.9 to 2.1) as the grid is halved from 8 × 8 to 32 × 32.
 #[test]
 fn lua_source_converges_at_second_order() {
-    let dir = scratch("rate");
+    let tmp = scratch("sources-rate");
+    let dir = tmp.path();
     let errors: Vec<f64> = [4, 8, 16, 32]
         .iter()
         .map(|&n| {
             let b = BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.1], [n, n, 1], 1)
                 .with_side_sets([1, 2, 3, 4, 0, 0]);
-            let mesh = write_mesh(&dir, "mesh", &[b]);
+            let mesh = write_mesh(dir, "mesh", &[b]);
             let r = run(
-                &dir,
+                dir,
                 "[[material]]
 blocks = [\"block_1\"]
 conductivity = 1.0
@@ -152,12 +148,13 @@ fn nodal_volumes(mesh: &seam::mesh::Mesh) -> Vec<f64> {
 /// plateau of the table are all crossed.
 #[test]
 fn source_table_in_time_balances_the_stored_energy() {
-    let dir = scratch("table");
+    let tmp = scratch("sources-table");
+    let dir = tmp.path();
     let boxes = [
         BoxSpec::hex([0.0; 3], [0.5, 0.1, 0.1], [5, 1, 1], 1),
         BoxSpec::hex([0.5, 0.0, 0.0], [1.0, 0.1, 0.1], [5, 1, 1], 2),
     ];
-    let mesh = write_mesh(&dir, "mesh", &boxes);
+    let mesh = write_mesh(dir, "mesh", &boxes);
     assert_eq!(mesh.blocks.len(), 2);
     let (rho_c, dt) = (2e3, 0.1);
     let table = [(0.0, 0.0), (0.3, 5e3), (0.6, 1e3), (1.0, 1e3)];
@@ -171,7 +168,7 @@ fn source_table_in_time_balances_the_stored_energy() {
         a.1 + (b.1 - a.1) * ((t - a.0) / (b.0 - a.0)).min(1.0)
     };
     run(
-        &dir,
+        dir,
         &format!(
             "[[material]]
 blocks = [\"block_1\", \"block_2\"]
@@ -235,13 +232,14 @@ dir = \"out\"
 /// rate 2 (1.9 to 2.1) from 16 to 32 cells.
 #[test]
 fn temperature_dependent_source_converges_in_newton() {
-    let dir = scratch("newton");
+    let tmp = scratch("sources-newton");
+    let dir = tmp.path();
     let errors: Vec<f64> = [16, 32]
         .iter()
         .map(|&n| {
-            let mesh = slab(&dir, n);
+            let mesh = slab(dir, n);
             let r = run(
-                &dir,
+                dir,
                 &format!(
                     "[[material]]\nblocks = [\"block_1\"]\nconductivity = 1.0\n{SLAB_BCS}[[source]]\nblocks = [\"block_1\"]\nvalue = \"200 - 0.1*((T - 300)^2 - (100*x*(1 - x))^2)\"\n"
                 ),
@@ -278,15 +276,16 @@ fn temperature_dependent_source_converges_in_newton() {
 /// with the point (and the block and time).
 #[test]
 fn bad_sources_are_reported_at_their_line() {
-    let dir = scratch("bad");
-    slab(&dir, 2);
+    let tmp = scratch("sources-bad");
+    let dir = tmp.path();
+    slab(dir, 2);
     for (value, expect) in [
         ("\"600*\"", "syntax error"),
         ("\"q0*x\"", "q0"),
         ("{ table = [[1.0, 1.0], [0.5, 2.0]] }", "increase"),
     ] {
         let e = run(
-            &dir,
+            dir,
             &format!(
                 "[[material]]\nblocks = [\"block_1\"]\nconductivity = 1.0\n{SLAB_BCS}[[source]]\nblocks = [\"block_1\"]\nvalue = {value}\n"
             ),
@@ -306,7 +305,7 @@ fn bad_sources_are_reported_at_their_line() {
     }
     let materials = "[[material]]\nblocks = [\"block_1\"]\nconductivity = 1.0\nrho_c = 1.0\n";
     let e = run(
-        &dir,
+        dir,
         &format!("{materials}{SLAB_BCS}[[source]]\nblocks = [\"block_1\"]\nvalue = \"x < 0.5 and 1 or 0/0\"\n"),
     )
     .err()
@@ -316,7 +315,7 @@ fn bad_sources_are_reported_at_their_line() {
         "{e}"
     );
     let e = run(
-        &dir,
+        dir,
         &format!("{materials}{SLAB_BCS}[[source]]\nblocks = [\"block_1\"]\nvalue = \"t < 0.25 and 1 or nil\"\n[initial]\ntemperature = 300.0\n[solve]\nkind = \"transient\"\ndt = 0.1\nend_time = 1.0\n"),
     )
     .err()

@@ -9,16 +9,10 @@ use std::path::{Path, PathBuf};
 
 use seam::run::{RunError, RunResult};
 
+use crate::scratch;
+
 fn mesh() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo")
-}
-
-/// A scratch directory for one case.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("transient-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 const GAP_DECK: &str = "begin contact definition
@@ -104,12 +98,13 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 /// coarser halvings: the backward-Euler start step and the next error term).
 #[test]
 fn backward_euler_is_first_order_and_bdf2_second() {
-    let dir = scratch("order");
+    let tmp = scratch("transient-order");
+    let dir = tmp.path();
     for (scheme, order, above) in [("backward_euler", 1.0, 0.15), ("bdf2", 2.0, 0.25)] {
         let runs: Vec<Vec<f64>> = [8.0, 16.0, 32.0, 64.0, 128.0]
             .iter()
             .map(|n| {
-                let r = transient(&dir, scheme, 1.0 / n, 1.0, "");
+                let r = transient(dir, scheme, 1.0 / n, 1.0, "");
                 assert_eq!(r.history.len(), *n as usize, "{scheme}: one step per dt");
                 r.solution.temperature
             })
@@ -130,9 +125,10 @@ fn backward_euler_is_first_order_and_bdf2_second() {
 /// conductance balances to round-off (1e-12 of the heat).
 #[test]
 fn interface_heat_balances_every_step() {
-    let dir = scratch("balance");
+    let tmp = scratch("transient-balance");
+    let dir = tmp.path();
     let r = transient(
-        &dir,
+        dir,
         "bdf2",
         0.05,
         0.5,
@@ -171,9 +167,10 @@ fn interface_heat_balances_every_step() {
 /// where the uninterrupted run ends, for BDF2 (whose state holds two past steps).
 #[test]
 fn restart_reproduces_the_run_bit_for_bit() {
-    let dir = scratch("restart");
+    let tmp = scratch("transient-restart");
+    let dir = tmp.path();
     let full = transient(
-        &dir,
+        dir,
         "bdf2",
         0.05,
         0.6,
@@ -182,7 +179,7 @@ fn restart_reproduces_the_run_bit_for_bit() {
     let checkpoint = dir.join("out/checkpoint_00007.seam");
     assert!(checkpoint.exists());
     let again = transient(
-        &dir,
+        dir,
         "bdf2",
         0.05,
         0.6,
@@ -198,7 +195,7 @@ fn restart_reproduces_the_run_bit_for_bit() {
     // A checkpoint of another problem is refused with a clear error.
     std::fs::write(dir.join("bad.seam"), b"SEAMCKP1 too short").unwrap();
     let e = run_case(
-        &dir,
+        dir,
         GAP_DECK,
         &format!("{MATERIALS}{WARMING}[solve]\nkind = \"transient\"\ndt = 0.1\nend_time = 1\n[restart]\nfile = \"bad.seam\"\n"),
     )
@@ -211,7 +208,8 @@ fn restart_reproduces_the_run_bit_for_bit() {
 /// steps before and heat crosses after; an unknown toggle name is an input error.
 #[test]
 fn toggle_switches_the_enforcement_in_time() {
-    let dir = scratch("toggle");
+    let tmp = scratch("transient-toggle");
+    let dir = tmp.path();
     let deck = GAP_DECK.replace(
         "    gap conductance coefficient = constant h = 500\n",
         "    gap conductance coefficient = constant h = 500\n    use toggle block = later\n",
@@ -219,7 +217,7 @@ fn toggle_switches_the_enforcement_in_time() {
     let problem = format!(
         "{MATERIALS}{WARMING}[[toggle]]\nname = \"later\"\non = [[0.3, 10.0]]\n[solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 0.1\nend_time = 0.6\n"
     );
-    let r = ok(&dir, &deck, &problem);
+    let r = ok(dir, &deck, &problem);
     for s in &r.history {
         let (a, _) = s.heat[0];
         if s.time < 0.3 - 1e-9 {
@@ -229,7 +227,7 @@ fn toggle_switches_the_enforcement_in_time() {
         }
     }
     let e = run_case(
-        &dir,
+        dir,
         &deck,
         &problem.replace("name = \"later\"", "name = \"latter\""),
     )
@@ -244,7 +242,8 @@ fn toggle_switches_the_enforcement_in_time() {
 /// order); a missing or wrong mapping is an input error naming both fields.
 #[test]
 fn side_b_variable_joins_two_fields() {
-    let dir = scratch("fields");
+    let tmp = scratch("transient-fields");
+    let dir = tmp.path();
     let tie = |map: &str| {
         format!(
             "begin contact definition
@@ -264,7 +263,7 @@ end
     };
     let bcs = "[[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n";
     let one = ok(
-        &dir,
+        dir,
         &tie("side b variable temperature to temperature"),
         &format!(
             "[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n[[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\n{bcs}"
@@ -274,7 +273,7 @@ end
         "[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n[[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\nfield = \"temp_lid\"\n{bcs}"
     );
     let two = ok(
-        &dir,
+        dir,
         &tie("side b variable temp_lid to temperature"),
         &two_fields,
     );
@@ -288,14 +287,14 @@ end
     );
     assert!((a + b).abs() < 1e-10 * a.abs() && a.abs() > 1.0, "{a} {b}");
     let e = run_case(
-        &dir,
+        dir,
         &tie("side b variable temperature to temp_lid"),
         &two_fields,
     )
     .err()
     .unwrap();
     assert!(e.contains("E0428") && e.contains("temp_lid"), "{e}");
-    let e = run_case(&dir, &tie(""), &two_fields).err().unwrap();
+    let e = run_case(dir, &tie(""), &two_fields).err().unwrap();
     assert!(
         e.contains("E0428") && e.contains("Side B Variable temp_lid To temperature"),
         "{e}"
@@ -323,11 +322,12 @@ end
 /// pressure), so the field is really interpolated; an unknown name is an input error.
 #[test]
 fn contact_pressure_from_a_nodal_field() {
-    let dir = scratch("pressure");
+    let tmp = scratch("transient-pressure");
+    let dir = tmp.path();
     let base = "[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n[[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n";
     let heat = |pressure_line: &str, field: &str| {
         let r = ok(
-            &dir,
+            dir,
             &CMY_DECK.replace("PRESSURE", pressure_line),
             &format!("{base}{field}"),
         );
@@ -353,7 +353,7 @@ fn contact_pressure_from_a_nodal_field() {
         "{low} {ramp} {high}"
     );
     let e = run_case(
-        &dir,
+        dir,
         &CMY_DECK.replace("PRESSURE", "contact pressure variable = q"),
         &format!("{base}[[nodal_field]]\nname = \"p\"\nvalue = 1\n"),
     )
@@ -372,12 +372,13 @@ fn contact_pressure_from_a_nodal_field() {
 #[test]
 fn contact_pressure_from_an_exodus_variable() {
     use seam::output::exodus::ExodusWriter;
-    let dir = scratch("pressure-exodus");
+    let tmp = scratch("transient-pressure-exodus");
+    let dir = tmp.path();
     let base = "[[material]]\nblocks = [\"base\"]\nconductivity = 16.0\n[[material]]\nblocks = [\"lid\"]\nconductivity = 200.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"base_bottom\"]\nvalue = 300.0\n[[bc]]\nkind = \"temperature\"\nsurfaces = [\"lid_top\"]\nvalue = 400.0\n";
     let deck = CMY_DECK.replace("PRESSURE", "contact pressure variable = p");
     let heat = |field: &str| {
         ok(
-            &dir,
+            dir,
             &deck,
             &format!("{base}[[nodal_field]]\nname = \"p\"\n{field}"),
         )
@@ -436,7 +437,7 @@ fn contact_pressure_from_an_exodus_variable() {
         "reversed: {exo} vs {lua}"
     );
     let e = run_case(
-        &dir,
+        dir,
         &deck,
         &format!(
             "{base}[[nodal_field]]\nname = \"p\"\nfile = \"moved.exo\"\nvariable = \"pressure\"\n"
@@ -495,7 +496,7 @@ fn contact_pressure_from_an_exodus_variable() {
         };
         let field = format!("file = \"{file}\"\nvariable = \"{variable}\"\n{time}");
         let e = run_case(
-            &dir,
+            dir,
             &deck,
             &format!("{base}[[nodal_field]]\nname = \"p\"\n{field}"),
         )
@@ -513,7 +514,7 @@ fn contact_pressure_from_an_exodus_variable() {
         );
     }
     let e = run_case(
-        &dir,
+        dir,
         &deck,
         &format!("{base}[[nodal_field]]\nname = \"p\"\nfile = \"pressure.exo\"\nvalue = 1.0\n"),
     )
@@ -533,9 +534,10 @@ fn contact_pressure_from_an_exodus_variable() {
 /// (to 2e-2: the face integral here is a nodal trapezoid rule, seam's a Gauss rule).
 #[test]
 fn nonlinear_conductivity_and_radiation() {
-    let dir = scratch("radiation");
+    let tmp = scratch("transient-radiation");
+    let dir = tmp.path();
     let r = ok(
-        &dir,
+        dir,
         GAP_DECK,
         "[[material]]
 blocks = [\"base\", \"lid\"]
@@ -568,7 +570,7 @@ ambient = 300.0
     );
     // A table law in T is accepted and bad ones are refused with the material named.
     let e = run_case(
-        &dir,
+        dir,
         GAP_DECK,
         "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = { table = [[300.0, 10.0], [200.0, 20.0]] }\n",
     )
@@ -582,7 +584,8 @@ ambient = 300.0
 /// temperature condition, an emissivity outside (0, 1].
 #[test]
 fn boundary_fields_are_checked_against_their_kind() {
-    let dir = scratch("bc-fields");
+    let tmp = scratch("transient-bc-fields");
+    let dir = tmp.path();
     let materials = "[[material]]\nblocks = [\"base\", \"lid\"]\nconductivity = 1.0\n";
     for (bc, expect) in [
         (
@@ -598,7 +601,7 @@ fn boundary_fields_are_checked_against_their_kind() {
             "emissivity 1.5",
         ),
     ] {
-        let e = run_case(&dir, GAP_DECK, &format!("{materials}[[bc]]\n{bc}"))
+        let e = run_case(dir, GAP_DECK, &format!("{materials}[[bc]]\n{bc}"))
             .err()
             .unwrap();
         assert!(e.contains("E0706") && e.contains(expect), "{e}");
@@ -619,8 +622,12 @@ fn linear_steps_carry_their_residual_exactly() {
     let problem = format!(
         "{MATERIALS}{WARMING}[solve]\nkind = \"transient\"\nscheme = \"bdf2\"\ndt = 0.1\nend_time = 1.0\ntolerance = 1e-12\n"
     );
-    let linear = ok(&scratch("carry-linear"), GAP_DECK, &problem);
-    let newton = ok(&scratch("carry-newton"), &lua_deck, &problem);
+    let linear = ok(scratch("transient-carry-linear").path(), GAP_DECK, &problem);
+    let newton = ok(
+        scratch("transient-carry-newton").path(),
+        &lua_deck,
+        &problem,
+    );
     assert_eq!(linear.history.len(), newton.history.len());
     for (l, n) in linear.history.iter().zip(&newton.history) {
         assert_eq!(l.newton_iterations, 1, "step {}: linear", l.step);
@@ -685,7 +692,11 @@ end_time = 1.0
 tolerance = 1e-13
 "
         );
-        ok(&scratch(name), GAP_DECK, &problem)
+        ok(
+            scratch(&format!("transient-{name}")).path(),
+            GAP_DECK,
+            &problem,
+        )
     };
     let kept = case("16.0", "kept-constant");
     let newton = case("\"16 + 0*T\"", "kept-lua");

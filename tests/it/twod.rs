@@ -11,13 +11,7 @@ use seam::mesh::generate::{self, PlaneKind, RectSpec};
 use seam::output::exodus::ExodusWriter;
 use seam::run::{RunError, RunResult};
 
-/// A scratch directory for one case, emptied.
-pub(crate) fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("twod-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use crate::scratch;
 
 pub(crate) fn write_mesh(path: &Path, m: &Mesh) {
     ExodusWriter::create(path, m, &[], &[])
@@ -212,7 +206,8 @@ fn assert_periodic_rates(label: &str, ns: &[usize], errors: &[Vec<f64>]) {
 /// off by 4.6e-2: the test can fail.)
 #[test]
 fn linear_field_crosses_non_matching_2d_ties_exactly() {
-    let dir = scratch("patch-ties");
+    let tmp = scratch("twod-patch-ties");
+    let dir = tmp.path();
     let exact = |x: [f64; 3]| 1.0 + 2.0 * x[0] + 3.0 * x[1];
     let ties = [
         ("nitsche", "enforcement for energy = tied_temperature"),
@@ -269,7 +264,8 @@ fn linear_field_crosses_non_matching_2d_ties_exactly() {
 /// non-matching Quad4 and Tri3 meshes, and the interface heat per unit depth is q × 1.
 #[test]
 fn piecewise_linear_field_crosses_a_2d_gap_conductance_exactly() {
-    let dir = scratch("patch-gap");
+    let tmp = scratch("twod-patch-gap");
+    let dir = tmp.path();
     let (k1, k2, h) = (1.0, 5.0, 10.0);
     let q = 1.0 / (1.0 / k1 + 1.0 / h + 1.0 / k2);
     let problem = problem_text(
@@ -374,9 +370,10 @@ fn series_heat_error(
 /// is left is round-off and Newton's tolerance: 1e-9 relative.
 #[test]
 fn every_model_carries_the_series_heat_in_2d() {
-    let dir = scratch("every-model");
+    let tmp = scratch("twod-every-model");
+    let dir = tmp.path();
     let k = [1.0, 5.0];
-    crate::examples::compile_c_table(&dir);
+    crate::examples::compile_c_table(dir);
     let rectangles = (["block_1", "block_2"], ["surface_5", "surface_6"]);
     let problem = series_problem("rects.exo", false, rectangles.0, rectangles.1, k, "");
     std::fs::write(dir.join("problem.toml"), problem).unwrap();
@@ -467,7 +464,7 @@ fn every_model_carries_the_series_heat_in_2d() {
         for (model, lines, h) in cases {
             let deck = rectangles_deck(&lines);
             let label = format!("2-D {model:<20} {name} (W/m)");
-            let (_, err) = series_heat_error(&dir, &deck, k, h, 1.0, &label);
+            let (_, err) = series_heat_error(dir, &deck, k, h, 1.0, &label);
             assert!(err <= 1e-9, "{model}, {name}: {err:e}");
             worst = worst.max(err);
         }
@@ -485,7 +482,8 @@ fn every_model_carries_the_series_heat_in_2d() {
 /// and the heat's error is printed.
 #[test]
 fn contact_node_set_carries_the_series_heat_in_2d() {
-    let dir = scratch("node-set");
+    let tmp = scratch("twod-node-set");
+    let dir = tmp.path();
     let k = [1.0, 5.0];
     let (blocks, sets) = (["block_1", "block_2"], ["surface_5", "surface_6"]);
     let problem = series_problem("rects.exo", false, blocks, sets, k, "");
@@ -509,7 +507,7 @@ fn contact_node_set_carries_the_series_heat_in_2d() {
                 "2-D contact node set, 3 / {n2} edges, {} (W/m)",
                 model.lines().next().unwrap()
             );
-            let (r, err) = series_heat_error(&dir, &deck, k, |_, _| h, 1.0, &label);
+            let (r, err) = series_heat_error(dir, &deck, k, |_, _| h, 1.0, &label);
             let (i, q) = (&r.summary.interactions[0], series_flux(k, |_, _| h));
             if n2 == 3 {
                 assert!(err <= 1e-10, "{model}: {err:e}");
@@ -531,7 +529,8 @@ fn contact_node_set_carries_the_series_heat_in_2d() {
 /// "x + 1"`) gives the same field to round-off.
 #[test]
 fn rectangular_periodicity_converges_in_2d() {
-    let dir = scratch("periodic");
+    let tmp = scratch("twod-periodic");
+    let dir = tmp.path();
     let tau = std::f64::consts::TAU;
     let exact = move |x: [f64; 3]| (tau * x[0]).sin() * (tau * (1.0 - x[1])).sinh() / tau.sinh();
     std::fs::write(
@@ -611,7 +610,8 @@ fn rectangular_periodicity_converges_in_2d() {
 /// edges instead it stays put.
 #[test]
 fn cylindrical_periodicity_converges_in_plane_2d() {
-    let dir = scratch("periodic-ring");
+    let tmp = scratch("twod-periodic-ring");
+    let dir = tmp.path();
     let exact = |x: [f64; 3]| {
         let (r, t) = (x[0].hypot(x[1]), x[1].atan2(x[0]));
         (4.0 * t).sin() * (r.powi(4) - 256.0 / r.powi(4)) / (1.0 - 256.0)
@@ -674,7 +674,8 @@ fn exodus_writer_2d_runs_on_the_libexodus_contact_mesh() {
         Some(d) if !d.is_empty() => PathBuf::from(d),
         _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/reference"),
     };
-    let dir = scratch("libexodus-contact2d");
+    let tmp = scratch("twod-libexodus-contact2d");
+    let dir = tmp.path();
     let k = [1.0, 5.0];
     for flavour in ["classic", "offset64", "nc4"] {
         // Absolute: the problem file's paths are relative to its own folder.
@@ -702,7 +703,7 @@ fn exodus_writer_2d_runs_on_the_libexodus_contact_mesh() {
                     "contact2d_{flavour}, axisymmetric {axisymmetric}, {} (W)",
                     model.lines().next().unwrap()
                 );
-                let (_, err) = series_heat_error(&dir, &deck, k, |_, _| h, area, &label);
+                let (_, err) = series_heat_error(dir, &deck, k, |_, _| h, area, &label);
                 assert!(err <= 1e-12, "{err:e}");
                 if let Some(checker) = std::env::var_os("SEAM_EXODUS_CHECKER") {
                     let o = std::process::Command::new(checker)
@@ -745,7 +746,8 @@ fn gmsh_2d_contact_mesh_reads_and_runs() {
         let set = m.side_sets.iter().find(|s| s.name == *name).unwrap();
         assert_eq!(set.sides.len() as u64, n.as_u64().unwrap(), "{name}");
     }
-    let dir = scratch("gmsh-contact2d");
+    let tmp = scratch("twod-gmsh-contact2d");
+    let dir = tmp.path();
     let k = [1.0, 5.0];
     let problem = series_problem(path.to_str().unwrap(), false, PARTS.0, PARTS.1, k, "");
     std::fs::write(dir.join("problem.toml"), problem).unwrap();
@@ -757,7 +759,7 @@ fn gmsh_2d_contact_mesh_reads_and_runs() {
             model,
         );
         let label = format!("gmsh contact2d, {} (W/m)", model.lines().next().unwrap());
-        let (_, err) = series_heat_error(&dir, &deck, k, |_, _| h, 1.0, &label);
+        let (_, err) = series_heat_error(dir, &deck, k, |_, _| h, 1.0, &label);
         assert!(err <= 1e-12, "{err:e}");
     }
 }
