@@ -9,7 +9,7 @@
 //! bar, so the trilinear hexes hold it exactly and every node must match the closed
 //! form to round-off.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use seam::mesh::Mesh;
 use seam::mesh::generate::{self, BoxSpec};
@@ -32,14 +32,6 @@ fn bars(n: [usize; 2], m: [usize; 2]) -> Mesh {
         ],
         false,
     )
-}
-
-/// A scratch directory for one case, emptied.
-fn scratch(name: &str) -> PathBuf {
-    let d = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("species-{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// The deck: an Energy tie and the species block `species` (its lines).
@@ -77,18 +69,18 @@ fn held_ends() -> String {
 
 const STEADY: &str = "[solve]\nkind = \"steady\"\ntolerance = 1e-13\n";
 
-/// Write the case `name` (mesh, deck, problem) and run it.
-fn run_case(name: &str, mesh: &Mesh, deck: &str, problem: &str) -> (RunResult, PathBuf) {
-    let dir = scratch(name);
+/// Write the case `name` (mesh, deck, problem) into a scratch folder and run it.
+fn run_case(name: &str, mesh: &Mesh, deck: &str, problem: &str) -> RunResult {
+    let scratch = crate::scratch(&format!("species-{name}"));
+    let dir = scratch.path();
     crate::twod::write_mesh(&dir.join("bars.exo"), mesh);
     std::fs::write(dir.join("contact.i"), deck).unwrap();
     std::fs::write(dir.join("problem.toml"), problem).unwrap();
-    let r = match seam::run::run(&dir.join("problem.toml")) {
+    match seam::run::run(&dir.join("problem.toml")) {
         Ok(r) => r,
         Err(RunError::Input(d, s)) => panic!("{}", d.render(&s)),
         Err(RunError::Solve(e)) => panic!("{e}"),
-    };
-    (r, dir)
+    }
 }
 
 /// The largest difference between the run's nodal concentration and `exact(z, side)`
@@ -169,7 +161,7 @@ fn a_partition_coefficient_tie_gives_the_exact_jump_across_a_non_matching_interf
     ] {
         let species = format!("  enforcement for species = {model}\n  partition coefficient = {k}");
         let name = format!("tie-{}", model.len() + (k * 4.0) as usize);
-        let (r, dir) = run_case(
+        let r = run_case(
             &name,
             &mesh,
             &deck(&species),
@@ -195,7 +187,6 @@ fn a_partition_coefficient_tie_gives_the_exact_jump_across_a_non_matching_interf
         assert!(err < 1e-12, "{model}: worst nodal error {err:e}");
         assert!(flux_err < 1e-10, "{model}: flux error {flux_err:e}");
         assert!(flux.imbalance.abs() < 1e-12 * j, "{model}: imbalance");
-        std::fs::remove_dir_all(&dir).ok();
     }
 }
 
@@ -237,7 +228,7 @@ fn a_mass_transfer_interface_and_an_offset_match_the_closed_form() {
         ),
     ];
     for (i, (lines, k, dc, h)) in cases.iter().enumerate() {
-        let (r, dir) = run_case(
+        let r = run_case(
             &format!("transfer-{i}"),
             &mesh,
             &deck(lines),
@@ -264,7 +255,6 @@ fn a_mass_transfer_interface_and_an_offset_match_the_closed_form() {
             (flux.flux_side_a - j).abs() < 1e-10 * j.abs(),
             "case {i}: flux"
         );
-        std::fs::remove_dir_all(&dir).ok();
     }
 }
 
@@ -303,7 +293,7 @@ fn what_enters_leaves_steady_and_a_transient_run_keeps_its_mass() {
     // Steady: j0 enters at z = 0 through the unit section, crosses the interface and
     // leaves through the held end.
     let held = format!("[[bc]]\nkind = \"species\"\nsurfaces = [\"surface_4\"]\nvalue = {CL}\n");
-    let (r, dir) = run_case(
+    let r = run_case(
         "balance",
         &mesh,
         &deck(tie),
@@ -316,7 +306,6 @@ fn what_enters_leaves_steady_and_a_transient_run_keeps_its_mass() {
     );
     assert!((flux.flux_side_a - j0).abs() < 1e-12 * j0);
     assert!(flux.imbalance.abs() < 1e-14 * j0);
-    std::fs::remove_dir_all(&dir).ok();
     // Transient, from c = 0, nothing leaving: the mass in the bars is j0 t at every
     // step (backward Euler with a lumped capacity conserves it exactly), and block 2
     // gains what crosses the interface, Σ Δt j_Γ.
@@ -326,7 +315,7 @@ fn what_enters_leaves_steady_and_a_transient_run_keeps_its_mass() {
         "[solve]\nkind = \"transient\"\nscheme = \"backward_euler\"\ndt = 20.0\nend_time = 100.0\ntolerance = 1e-13\n[initial]\ntemperature = 350.0\n",
     )
     .replacen("diffusivity = ", "species_capacity = 0.5\ndiffusivity = ", 1);
-    let (r, dir) = run_case("mass", &mesh, &deck(tie), &text);
+    let r = run_case("mass", &mesh, &deck(tie), &text);
     let mass = block_mass(&r, phi);
     let t = r.history.last().unwrap().time;
     let total = mass[0] + mass[1];
@@ -345,7 +334,6 @@ fn what_enters_leaves_steady_and_a_transient_run_keeps_its_mass() {
         j0 * t
     );
     assert!((mass[1] - crossing).abs() < 1e-10 * mass[1], "block 2");
-    std::fs::remove_dir_all(&dir).ok();
 }
 
 /// `seam check` of the two-bar case with `edit` applied to the problem file and the
@@ -354,12 +342,13 @@ fn check_errors(
     edit: impl Fn(&str) -> String,
     species: &str,
 ) -> Vec<(String, Option<(String, u32)>)> {
-    let dir = scratch("check");
+    let scratch = crate::scratch("species-check");
+    let dir = scratch.path();
     crate::twod::write_mesh(&dir.join("bars.exo"), &bars([2, 3], [2, 2]));
     std::fs::write(dir.join("contact.i"), deck(species)).unwrap();
     let text = edit(&problem(&held_ends(), STEADY));
     std::fs::write(dir.join("problem.toml"), text).unwrap();
-    let out = match seam::run::check(&dir.join("problem.toml")) {
+    match seam::run::check(&dir.join("problem.toml")) {
         Err(RunError::Input(d, _)) => d
             .errors()
             .map(|d| {
@@ -372,9 +361,7 @@ fn check_errors(
             .collect(),
         Ok(_) => Vec::new(),
         Err(e) => panic!("{e:?}"),
-    };
-    std::fs::remove_dir_all(&dir).ok();
-    out
+    }
 }
 
 #[test]
