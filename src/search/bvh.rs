@@ -5,7 +5,8 @@
 //! [`Aabb::intersects`], [`Aabb::union`]), [`Bvh::build`], [`Bvh::refit`],
 //! [`Bvh::query`], [`Bvh::query_with_box`] (hands the candidate's box to the narrow
 //! phase), [`Bvh::query_with_hint`] (for coherent streams of queries, starts at the
-//! previous query's leaf) and [`Bvh::query_point_within`].
+//! previous query's leaf), [`Bvh::query_point_within`] and [`Bvh::query_by`] (any
+//! monotone box predicate).
 //!
 //! Construction: a top-down median split on the longest axis of the item centroids'
 //! bounds, down to leaves of at most [`LEAF_SIZE`] items. Splitting at the median of the
@@ -277,6 +278,23 @@ impl Bvh {
         );
     }
 
+    /// Calls `visit(i, b)` for every item `i` whose box `b` the predicate `accept` takes,
+    /// descending only into the nodes whose box it takes, in leaf order. `accept` must be
+    /// monotone: a box it rejects holds no box it takes (as "intersects a query box" or
+    /// "comes within a distance of a point" are), so a rejected node hides nothing. This
+    /// lets a caller that knows more than the boxes prune by it — the contact search
+    /// shrinks every box by its margin again to test the faces' own boxes against its
+    /// reach. Allocates nothing.
+    pub fn query_by(&self, accept: impl Fn(&Aabb) -> bool, mut visit: impl FnMut(usize, &Aabb)) {
+        self.traverse_from(0, &accept, |_, boxes, items| {
+            for (b, &i) in boxes.iter().zip(items) {
+                if accept(b) {
+                    visit(i as usize, b);
+                }
+            }
+        });
+    }
+
     /// Like [`Bvh::query_with_box`], for a stream of nearby queries: the search starts
     /// at the leaf where the previous query found its first item (kept in `hint`) and
     /// climbs to the root, testing at each level the sibling of the subtree already
@@ -348,7 +366,7 @@ impl Bvh {
     /// Depth-first traversal of the subtree at node `start` (left before right),
     /// descending into nodes accepted by `enter` and handing the node index, boxes and
     /// items of every accepted leaf to `leaf`. Does nothing for an empty tree.
-    #[inline]
+    #[inline(always)]
     fn traverse_from(
         &self,
         start: usize,
@@ -532,6 +550,29 @@ mod tests {
                 assert_eq!(got, want);
             }
         }
+    }
+
+    /// A predicate that prunes harder than box intersection (here: a box whose centre
+    /// is within 2 of a point, monotone as required) finds what testing every item does.
+    #[test]
+    fn query_by_equals_testing_every_item() {
+        let items: Vec<Aabb> = (0..300)
+            .map(|i| unit_box(((i * 37) % 41) as f64 * 0.7, ((i * 11) % 13) as f64, 0.0))
+            .collect();
+        let bvh = Bvh::build(&items);
+        let p = [9.0, 5.5, 0.5];
+        // Within 2 of p once shrunk by 0.5 on every side (monotone: a box inside a box
+        // that fails fails too).
+        let accept = |b: &Aabb| b.inflate(-0.5).distance2_to_point(p) <= 4.0;
+        let mut got = Vec::new();
+        bvh.query_by(accept, |i, b| {
+            assert_eq!(*b, items[i]);
+            got.push(i);
+        });
+        got.sort_unstable();
+        let want: Vec<usize> = (0..items.len()).filter(|&i| accept(&items[i])).collect();
+        assert!(!want.is_empty() && want.len() < items.len());
+        assert_eq!(got, want);
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Geometric kernels of the contact search: a bounding-volume hierarchy over boxes
 //! ([`bvh`]), closest-point projection of a point onto a face ([`project`]) and the
-//! segment geometry of mortar integration ([`mortar`]).
+//! segment geometry of mortar integration ([`mortar`], with the overlap areas of one
+//! face against many in `overlap`).
 //!
 //! The kernels take plain coordinates (`[f64; 3]`), not seam's mesh types, so they can be
 //! tested and used anywhere; they are stateless apart from the [`bvh::Bvh`] itself.
@@ -53,6 +54,7 @@
 
 pub mod bvh;
 pub mod mortar;
+mod overlap;
 pub mod project;
 
 pub mod pairing;

@@ -380,10 +380,11 @@ pub(super) fn face_normal_jacobian(face: &FaceGeom, xi: [f64; 2]) -> V3 {
     }
 }
 
-/// Gauss rule on a face's reference element: (ξ, weight on the reference element); an
-/// edge takes `order` Gauss points (1 to 3) on `[-1, 1]`, as each direction of a quad.
-pub(super) fn face_rule(face: &FaceGeom, order: usize) -> Vec<([f64; 2], f64)> {
-    match face.len {
+/// Gauss rule on the reference element of a face of `len` nodes: (ξ, weight on the
+/// reference element); an edge takes `order` Gauss points (1 to 3) on `[-1, 1]`, as
+/// each direction of a quad.
+pub(super) fn face_rule(len: u8, order: usize) -> Vec<([f64; 2], f64)> {
+    match len {
         2 => {
             let (xs, ws) = gauss_legendre(order.clamp(1, 3));
             xs.iter().zip(ws).map(|(&x, w)| ([x, 0.0], w)).collect()

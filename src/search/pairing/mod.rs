@@ -49,7 +49,7 @@ use super::bvh::{Aabb, Bvh};
 use super::settings::{Overclosure, SearchSettings};
 use crate::vec3::{V3, dot, scale, sub};
 
-use points::Ctx;
+use points::{BFace, Ctx, Rules, Scratch};
 
 /// The highest integration order accepted from input. A segment rule of order p on a
 /// triangle has ((p + 2)/2)² points built in O(p³) work, so an order in the thousands
@@ -244,6 +244,17 @@ impl Searcher {
         subdomain: Option<Sphere>,
         overlap: bool,
     ) -> SearchResult {
+        // The overlap tests each side-B face for several side-A faces: its normal,
+        // centroid and distance limit once.
+        let b_faces: Vec<BFace> =
+            if overlap && matches!(integration, Integration::Quadrature { .. }) {
+                b.faces
+                    .par_iter()
+                    .map(|f| BFace::new(f, settings))
+                    .collect()
+            } else {
+                Vec::new()
+            };
         let ctx = Ctx {
             bvh: &self.bvh,
             margin: self.margin,
@@ -255,8 +266,10 @@ impl Searcher {
             cos_opposed: settings
                 .cull_opposed_normals
                 .then(|| settings.opposed_normal_threshold_angle.to_radians().cos()),
+            b_faces: &b_faces,
         };
         let mut result = SearchResult::default();
+        let rules = Rules::new(integration, a.axisymmetric);
         // Faces, in fixed chunks, in parallel; each chunk gives its points and, per face,
         // the matched weight, total weight and overlap area.
         let chunks: Vec<ChunkOut> = (0..a.faces.len())
@@ -265,20 +278,27 @@ impl Searcher {
             .into_par_iter()
             .map(|start| {
                 let end = (start + CHUNK).min(a.faces.len());
-                let mut points = Vec::new();
+                let per_point = rules.quadrature(4).len().max(1);
+                let mut points = Vec::with_capacity((end - start) * per_point);
                 let mut per_face = Vec::with_capacity(end - start);
-                let mut scratch = Vec::new();
-                let mut candidates = Vec::new();
+                let mut scratch = Scratch::default();
                 for fa in start..end {
                     let before = points.len();
-                    match integration {
-                        Integration::Quadrature { order } => {
-                            ctx.quadrature_points(a, fa, order, &mut points)
+                    let area = match &rules {
+                        Rules::Quadrature(_) => {
+                            let rule = rules.quadrature(a.faces[fa].len);
+                            ctx.quadrature_face(a, fa, rule, overlap, &mut points, &mut scratch)
                         }
-                        Integration::Segments { order } => {
-                            ctx.segment_points(a, fa, order, &mut points, &mut scratch)
+                        Rules::Segments { line, triangle } => {
+                            ctx.segment_points(a, fa, (line, triangle), &mut points, &mut scratch);
+                            // The matched points' weights sum to the overlap exactly.
+                            points[before..]
+                                .iter()
+                                .filter(|p| p.status == PointStatus::Matched)
+                                .map(|p| p.weight)
+                                .sum()
                         }
-                    }
+                    };
                     let (mut hit, mut total) = (0.0, 0.0);
                     for p in &points[before..] {
                         total += p.weight;
@@ -286,16 +306,14 @@ impl Searcher {
                             hit += p.weight;
                         }
                     }
-                    let area = if overlap || matches!(integration, Integration::Segments { .. }) {
-                        ctx.overlap_of(a, fa, &points[before..], integration, &mut candidates)
-                    } else {
-                        0.0
-                    };
                     per_face.push((hit, total, area));
                 }
                 (points, per_face)
             })
             .collect();
+        let total: usize = chunks.iter().map(|(points, _)| points.len()).sum();
+        result.points.reserve_exact(total + a.nodes.len());
+        result.contact_fraction.reserve_exact(a.faces.len());
         for (points, per_face) in chunks {
             result.points.extend(points);
             for (hit, total, overlap) in per_face {

@@ -1,10 +1,17 @@
 //! One chunk of side-A points paired with side B: the candidate faces from the tree,
 //! the acceptance tests of the module documentation and the best face per point, for
 //! quadrature points, mortar segment points and node points.
+//!
+//! The tree holds the side-B faces' boxes inflated by the margin. A face farther than
+//! the reach from a point cannot pair with it, so every query shrinks the tree's boxes
+//! by the margin again and prunes by the reach (`Ctx::near`): a face of side A makes
+//! one query, for all its points and its overlap at once, which visits the few faces
+//! within the reach instead of the many within the margin. The exact tests on each
+//! candidate are those of a query per point, so the pairing does not change.
 
 use crate::search::bvh::{Aabb, Bvh};
 use crate::search::mortar::{
-    FaceOverlap, MortarPoint, overlap_length_line_line, rule_line, rule_triangle,
+    FaceOverlap, MortarPoint, TriangleRule, overlap_length_line_line, rule_line, rule_triangle,
     segments_face_face_into, segments_line_line_into,
 };
 use crate::search::settings::SearchSettings;
@@ -22,6 +29,29 @@ pub(super) struct Ctx<'a> {
     pub(super) subdomain: Option<Sphere>,
     pub(super) cos_check: f64,
     pub(super) cos_opposed: Option<f64>,
+    /// Per side-B face, what the overlap diagnostic tests it by (empty when no overlap
+    /// is computed).
+    pub(super) b_faces: &'a [BFace],
+}
+
+/// What the overlap diagnostic asks of a side-B face, made once per search rather than
+/// once for each side-A face near it: its unit normal, centroid and acceptance distance
+/// ([`Ctx::distance_limit`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BFace {
+    normal: V3,
+    centroid: V3,
+    limit: f64,
+}
+
+impl BFace {
+    pub(super) fn new(face: &FaceGeom, settings: &SearchSettings) -> BFace {
+        BFace {
+            normal: face.normal(),
+            centroid: face.centroid(),
+            limit: distance_limit(settings, face),
+        }
+    }
 }
 
 /// The best acceptable side-B face for one point so far, and the best reason for
@@ -36,29 +66,107 @@ pub(super) struct Best {
 /// (rank key: outside, |gap|, face), ξ_B, gap, n_B.
 pub(super) type Candidate = ((bool, f64, u32), [f64; 2], f64, V3);
 
+/// The reference rules of one search, made once for all its faces.
+pub(super) enum Rules {
+    /// Gauss rules of edges, triangles and quads ([`face_rule`]).
+    Quadrature([Vec<([f64; 2], f64)>; 3]),
+    /// The rules on the overlap intervals of edges and the overlap triangles.
+    Segments {
+        line: (Vec<f64>, Vec<f64>),
+        triangle: TriangleRule,
+    },
+}
+
+impl Rules {
+    pub(super) fn new(integration: Integration, axisymmetric: bool) -> Rules {
+        match integration {
+            Integration::Quadrature { order } => {
+                Rules::Quadrature([2, 3, 4].map(|len| face_rule(len, order)))
+            }
+            // Edges: a Gauss rule on the overlap interval, one degree higher when the
+            // weight carries 2πr, so that it stays exact for the same integrands.
+            Integration::Segments { order } => Rules::Segments {
+                line: rule_line(order + usize::from(axisymmetric)),
+                triangle: rule_triangle(order),
+            },
+        }
+    }
+
+    /// The quadrature rule of a face of `len` nodes (as [`face_rule`]: 2 an edge, 3 a
+    /// triangle, else a quad).
+    pub(super) fn quadrature(&self, len: u8) -> &[([f64; 2], f64)] {
+        match self {
+            Rules::Quadrature(r) => &r[usize::from(len.clamp(2, 4)) - 2],
+            Rules::Segments { .. } => &[],
+        }
+    }
+}
+
+/// One side-A point of a face: ξ_A, x, weight, outside the subdomain.
+type FacePoint = ([f64; 2], V3, f64, bool);
+
+/// Buffers of one thread's faces, kept from face to face so that the search allocates
+/// only when a face needs more room than any before it.
+#[derive(Default)]
+pub(super) struct Scratch {
+    points: Vec<FacePoint>,
+    /// Side-B faces (index, tree box) from the face's one query.
+    near: Vec<(usize, Aabb)>,
+    /// The overlap's candidates, ascending.
+    overlap: Vec<usize>,
+    clip: Option<FaceOverlap>,
+    pub(super) mortar: Vec<MortarPoint>,
+}
+
 impl Ctx<'_> {
-    /// Side-B faces whose own box comes within the reach of `face`'s box, ascending.
+    /// Calls `visit(j, tree box)` for (at least) the side-B faces whose own box comes
+    /// within the reach of the query box `q`, which every exact test below requires.
+    ///
+    /// The own box of a face is its tree box shrunk by the margin (`own_box`): it meets
+    /// `q` grown by the reach when the tree box meets `q` grown by `reach − margin` (a
+    /// shrunk box if negative; the interval tests hold all the same). A node's box holds
+    /// its faces' boxes, so testing it prunes nothing that passes. The grown query is
+    /// widened by a slack far above the rounding of those sums (ε times the coordinates
+    /// near `q`), and the reach by a relative and an absolute slack above the rounding of
+    /// the squared distance it is compared as.
+    fn near(&self, q: &Aabb, mut visit: impl FnMut(usize, &Aabb)) {
+        let reach = self.reach2.sqrt() * (1.0 + 1e-9) + 1e-150;
+        let size = q
+            .min
+            .iter()
+            .chain(&q.max)
+            .fold(0.0f64, |s, v| s.max(v.abs()));
+        let slack = 1e-12 * (size + self.margin + reach);
+        // Infinite margin and reach (no pruning possible) give NaN: then take all.
+        let grow = reach - self.margin + slack;
+        let grown = q.inflate(if grow.is_nan() { f64::INFINITY } else { grow });
+        self.bvh
+            .query_by(|tree| tree.intersects(&grown), |j, tree| visit(j, tree));
+    }
+
+    /// Side-B faces whose tree box meets `face`'s box and whose own box comes within
+    /// the reach of it, ascending.
     pub(super) fn face_candidates(&self, face: &FaceGeom, out: &mut Vec<usize>) {
         out.clear();
-        let reach = self.reach2.sqrt();
-        let near = face.aabb().inflate(reach);
-        let m = self.margin;
-        self.bvh.query_with_box(&face.aabb(), |j, inflated| {
-            let own = Aabb {
-                min: inflated.min.map(|v| v + m),
-                max: inflated.max.map(|v| v - m),
-            };
-            if own.intersects(&near) {
+        let faces = face.aabb();
+        self.near(&faces, |j, tree| {
+            if self.overlap_candidate(&faces, tree) {
                 out.push(j);
             }
         });
         out.sort_unstable();
     }
 
+    /// Whether a side-B face with tree box `tree` is a candidate of the overlap of a
+    /// side-A face with box `faces`: its tree box meets it, and its own box comes
+    /// within the reach of it.
+    fn overlap_candidate(&self, faces: &Aabb, tree: &Aabb) -> bool {
+        let near = faces.inflate(self.reach2.sqrt());
+        tree.intersects(faces) && own_box(tree, self.margin).intersects(&near)
+    }
+
     pub(super) fn distance_limit(&self, face: &FaceGeom) -> f64 {
-        self.settings
-            .normal_tolerance
-            .unwrap_or(self.settings.field_factor * face.size())
+        distance_limit(self.settings, face)
     }
 
     /// Normals acceptable? `n_a` zero (node points) skips the test.
@@ -89,37 +197,57 @@ impl Ctx<'_> {
             rejected: PointStatus::Unmatched,
         };
         let query = Aabb::from_point(x);
-        let m = self.margin;
-        self.bvh.query_with_box(&query, |j, inflated| {
-            // The face's own box is the tree's box less the margin.
-            let own = Aabb {
-                min: inflated.min.map(|v| v + m),
-                max: inflated.max.map(|v| v - m),
-            };
-            if own.distance2_to_point(x) > self.reach2 {
-                return;
-            }
-            let face = &self.b.faces[j];
-            let pr = face.project(x);
-            if pr.degenerate || !(pr.inside || self.within_tangential(face, &pr.point, x)) {
-                return;
-            }
-            if !self.normals_ok(n_a, pr.normal) {
-                best.rejected = PointStatus::RejectedAngle;
-                return;
-            }
-            if pr.gap.abs() > self.distance_limit(face) {
-                if best.rejected != PointStatus::RejectedAngle {
-                    best.rejected = PointStatus::RejectedDistance;
-                }
-                return;
-            }
-            let key = (!pr.inside, pr.gap.abs(), j as u32);
-            if best.found.is_none_or(|(k, ..)| key < k) {
-                best.found = Some((key, pr.xi, pr.gap, pr.normal));
+        self.near(&query, |j, tree| {
+            if tree.intersects(&query) {
+                self.consider(j, tree, x, n_a, &mut best);
             }
         });
         best
+    }
+
+    /// Pair `x` among the candidates of a query that covered it: the same tests as
+    /// [`Self::pair`] on the same faces.
+    fn pair_among(&self, x: V3, n_a: V3, near: &[(usize, Aabb)]) -> Best {
+        let mut best = Best {
+            found: None,
+            rejected: PointStatus::Unmatched,
+        };
+        let query = Aabb::from_point(x);
+        for (j, tree) in near {
+            if tree.intersects(&query) {
+                self.consider(*j, tree, x, n_a, &mut best);
+            }
+        }
+        best
+    }
+
+    /// The acceptance tests of side-B face `j` (tree box `tree`) for the point `x`, and
+    /// `best` updated with it.
+    #[inline]
+    fn consider(&self, j: usize, tree: &Aabb, x: V3, n_a: V3, best: &mut Best) {
+        // Farther from the face's own box than the reach: no projection can pass.
+        if own_box(tree, self.margin).distance2_to_point(x) > self.reach2 {
+            return;
+        }
+        let face = &self.b.faces[j];
+        let pr = face.project(x);
+        if pr.degenerate || !(pr.inside || self.within_tangential(face, &pr.point, x)) {
+            return;
+        }
+        if !self.normals_ok(n_a, pr.normal) {
+            best.rejected = PointStatus::RejectedAngle;
+            return;
+        }
+        if pr.gap.abs() > self.distance_limit(face) {
+            if best.rejected != PointStatus::RejectedAngle {
+                best.rejected = PointStatus::RejectedDistance;
+            }
+            return;
+        }
+        let key = (!pr.inside, pr.gap.abs(), j as u32);
+        if best.found.is_none_or(|(k, ..)| key < k) {
+            best.found = Some((key, pr.xi, pr.gap, pr.normal));
+        }
     }
 
     /// A point that did not project inside may still pair if it lies within the
@@ -144,36 +272,8 @@ impl Ctx<'_> {
         w: f64,
         n_a: V3,
     ) -> ContactPoint {
-        let mut p = ContactPoint {
-            a_face,
-            a_node,
-            xi_a,
-            x,
-            weight: w,
-            status: PointStatus::Unmatched,
-            b_face: None,
-            xi_b: [0.0; 2],
-            gap: 0.0,
-            offset: 0.0,
-            normal_a: n_a,
-            normal_b: [0.0; 3],
-        };
-        if self.outside(x) {
-            p.status = PointStatus::RejectedSubdomain;
-            return p;
-        }
-        let best = self.pair(x, n_a);
-        match best.found {
-            Some(((_, _, j), xi_b, gap, n_b)) => {
-                p.status = PointStatus::Matched;
-                p.b_face = Some(j);
-                p.xi_b = xi_b;
-                p.gap = gap;
-                p.normal_b = n_b;
-            }
-            None => p.status = best.rejected,
-        }
-        p
+        let best = (!self.outside(x)).then(|| self.pair(x, n_a));
+        contact_point(a_face, a_node, xi_a, x, w, n_a, best)
     }
 
     /// A node point: its tributary area is its weight, its normal that of the faces
@@ -185,51 +285,83 @@ impl Ctx<'_> {
         self.point(None, Some(k as u32), [0.0; 2], x, w, n)
     }
 
-    pub(super) fn quadrature_points(
+    /// The points of side-A face `fa` (`rule`: its Gauss rule on the reference face),
+    /// paired and appended to `out`; returns the face's overlap area (see
+    /// [`Self::overlap_among`]) when `overlap`, else 0. One tree query serves the
+    /// points and the overlap: its box holds them all, and each keeps the candidates
+    /// its own query would have found.
+    pub(super) fn quadrature_face(
         &self,
         a: &SurfaceGeometry,
         fa: usize,
-        order: usize,
+        rule: &[([f64; 2], f64)],
+        overlap: bool,
         out: &mut Vec<ContactPoint>,
-    ) {
+        s: &mut Scratch,
+    ) -> f64 {
         let face = &a.faces[fa];
         let n_a = face.normal();
-        for (xi, w) in face_rule(face, order) {
+        let mut query = Aabb::EMPTY;
+        s.points.clear();
+        for &(xi, w) in rule {
             let x = face.map(xi);
             let w = w * face_jacobian(face, xi) * revolution(a.axisymmetric, x);
-            out.push(self.point(Some(fa as u32), None, xi, x, w, n_a));
+            let outside = self.outside(x);
+            if !outside {
+                query = query.union(&Aabb::from_point(x));
+            }
+            s.points.push((xi, x, w, outside));
         }
+        let area_wanted = overlap && !self.outside(face.centroid());
+        let faces = face.aabb();
+        if area_wanted {
+            query = query.union(&faces);
+        }
+        s.near.clear();
+        if !query.is_empty() {
+            self.near(&query, |j, tree| s.near.push((j, *tree)));
+        }
+        let a_face = Some(fa as u32);
+        for &(xi, x, w, outside) in &s.points {
+            let best = (!outside).then(|| self.pair_among(x, n_a, &s.near));
+            out.push(contact_point(a_face, None, xi, x, w, n_a, best));
+        }
+        if !area_wanted {
+            return 0.0;
+        }
+        s.overlap.clear();
+        for (j, tree) in &s.near {
+            if self.overlap_candidate(&faces, tree) {
+                s.overlap.push(*j);
+            }
+        }
+        sort_small(&mut s.overlap);
+        self.overlap_among(a, fa, &s.overlap, &mut s.clip)
     }
 
+    /// The mortar segment points of side-A face `fa` against the side-B faces near it
+    /// (`line`, `triangle`: the rules of [`Rules::Segments`]), appended to `out`.
     pub(super) fn segment_points(
         &self,
         a: &SurfaceGeometry,
         fa: usize,
-        order: usize,
+        (line, triangle): (&(Vec<f64>, Vec<f64>), &TriangleRule),
         out: &mut Vec<ContactPoint>,
-        scratch: &mut Vec<MortarPoint>,
+        s: &mut Scratch,
     ) {
         let face = &a.faces[fa];
         let n_a = face.normal();
-        // Edges: a Gauss rule on the overlap interval, one degree higher when the weight
-        // carries 2πr, so that it stays exact for the same integrands.
-        let (line, triangle) = match face.len {
-            2 => (Some(rule_line(order + usize::from(a.axisymmetric))), None),
-            _ => (None, Some(rule_triangle(order))),
-        };
-        let mut candidates = Vec::new();
-        self.face_candidates(face, &mut candidates);
+        self.face_candidates(face, &mut s.overlap);
         let outside = self.outside(face.centroid());
-        for j in candidates {
+        for &j in &s.overlap {
             let fb = &self.b.faces[j];
+            let scratch = &mut s.mortar;
             scratch.clear();
-            match (&line, &triangle) {
-                (Some(line), _) => {
-                    segments_line_line_into(face.coords(), fb.coords(), line, scratch)
-                }
-                (_, Some(tri)) => segments_face_face_into(face.coords(), fb.coords(), tri, scratch),
-                _ => 0,
-            };
+            if face.len == 2 {
+                segments_line_line_into(face.coords(), fb.coords(), line, scratch);
+            } else {
+                segments_face_face_into(face.coords(), fb.coords(), triangle, scratch);
+            }
             if scratch.is_empty() {
                 continue;
             }
@@ -264,45 +396,42 @@ impl Ctx<'_> {
         }
     }
 
-    /// Overlap area of side-A face `fa` with side B. In segment mode the matched points'
-    /// weights sum to it exactly. In quadrature mode it is the clipped overlap with every
-    /// side-B face the pairing would accept for that face: opposed normals, and a
-    /// centroid within the acceptance distance of the face's plane.
-    pub(super) fn overlap_of(
+    /// Overlap area of side-A face `fa` (its centroid inside the subdomain) with side B
+    /// in quadrature mode: the clipped overlap with every side-B face among
+    /// `candidates` (ascending) the pairing would accept for that face: opposed
+    /// normals, and a centroid within the acceptance distance of the face's plane.
+    /// (In segment mode the matched points' weights sum to it exactly.) `clip` keeps
+    /// the clipping buffers from face to face.
+    fn overlap_among(
         &self,
         a: &SurfaceGeometry,
         fa: usize,
-        points: &[ContactPoint],
-        integration: Integration,
-        candidates: &mut Vec<usize>,
+        candidates: &[usize],
+        clip: &mut Option<FaceOverlap>,
     ) -> f64 {
-        if let Integration::Segments { .. } = integration {
-            return points
-                .iter()
-                .filter(|p| p.status == PointStatus::Matched)
-                .map(|p| p.weight)
-                .sum();
-        }
         let face = &a.faces[fa];
-        if self.outside(face.centroid()) {
-            return 0.0;
-        }
         let mut clip = match face.len {
             2 => None,
-            _ => match FaceOverlap::new(face.coords()) {
-                Some(c) => Some(c),
-                None => return 0.0,
-            },
+            _ => {
+                let clip = clip.get_or_insert_with(FaceOverlap::default);
+                if !clip.set_face(face.coords()) {
+                    return 0.0;
+                }
+                Some(clip)
+            }
         };
         let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
         let mut scratch = Vec::new();
         let midpoint = rule_line(1);
-        self.face_candidates(face, candidates);
-        for &j in candidates.iter() {
+        for &j in candidates {
             let fb = &self.b.faces[j];
-            if !self.normals_ok(n_a, fb.normal())
-                || dot(sub(fb.centroid(), c_a), n_a).abs() > self.distance_limit(fb)
+            let data = match self.b_faces.get(j) {
+                Some(data) => *data,
+                None => BFace::new(fb, self.settings),
+            };
+            if !self.normals_ok(n_a, data.normal)
+                || dot(sub(data.centroid, c_a), n_a).abs() > data.limit
             {
                 continue;
             }
@@ -322,4 +451,74 @@ impl Ctx<'_> {
         }
         area
     }
+}
+
+/// The largest |gap| accepted on side-B face `face`: the normal tolerance, or the field
+/// factor times the face's size.
+fn distance_limit(settings: &SearchSettings, face: &FaceGeom) -> f64 {
+    settings
+        .normal_tolerance
+        .unwrap_or(settings.field_factor * face.size())
+}
+
+/// Ascending order of a short list (a face's half-dozen candidates), by insertion.
+fn sort_small(v: &mut [usize]) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut k = i;
+        while k > 0 && v[k - 1] > x {
+            v[k] = v[k - 1];
+            k -= 1;
+        }
+        v[k] = x;
+    }
+}
+
+/// The own box of a side-B face from its tree box: shrunk by the margin again.
+#[inline]
+fn own_box(tree: &Aabb, margin: f64) -> Aabb {
+    Aabb {
+        min: tree.min.map(|v| v + margin),
+        max: tree.max.map(|v| v - margin),
+    }
+}
+
+/// A side-A point with the outcome of its pairing (`None`: outside the subdomain).
+fn contact_point(
+    a_face: Option<u32>,
+    a_node: Option<u32>,
+    xi_a: [f64; 2],
+    x: V3,
+    w: f64,
+    n_a: V3,
+    best: Option<Best>,
+) -> ContactPoint {
+    let mut p = ContactPoint {
+        a_face,
+        a_node,
+        xi_a,
+        x,
+        weight: w,
+        status: PointStatus::RejectedSubdomain,
+        b_face: None,
+        xi_b: [0.0; 2],
+        gap: 0.0,
+        offset: 0.0,
+        normal_a: n_a,
+        normal_b: [0.0; 3],
+    };
+    let Some(best) = best else {
+        return p;
+    };
+    match best.found {
+        Some(((_, _, j), xi_b, gap, n_b)) => {
+            p.status = PointStatus::Matched;
+            p.b_face = Some(j);
+            p.xi_b = xi_b;
+            p.gap = gap;
+            p.normal_b = n_b;
+        }
+        None => p.status = best.rejected,
+    }
+    p
 }
