@@ -226,8 +226,22 @@ impl Ctx<'_> {
     #[inline]
     fn consider(&self, j: usize, tree: &Aabb, x: V3, n_a: V3, best: &mut Best) {
         // Farther from the face's own box than the reach: no projection can pass.
-        if own_box(tree, self.margin).distance2_to_point(x) > self.reach2 {
+        let d2 = own_box(tree, self.margin).distance2_to_point(x);
+        if d2 > self.reach2 {
             return;
+        }
+        // A face that has the point inside loses only to another that has it inside at
+        // a smaller or equal |gap|, which is then the distance to that face, at least
+        // the distance to its box. The slack covers the rounding of the own box (ε of
+        // the coordinates), a foot of the perpendicular up to `INSIDE_TOL` past an edge
+        // (1e-10 of a face, and the reach is at least 1e-3 of one by default) and that
+        // of the |gap| itself; only `found` decides a point that has one.
+        if let Some(((false, g, _), ..)) = best.found {
+            let size = x.iter().fold(self.margin, |s, v| s.max(v.abs()));
+            let bound = g * (1.0 + 1e-9) + 1e-6 * self.reach2.sqrt() + 1e-12 * size;
+            if d2 > bound * bound {
+                return;
+            }
         }
         let face = &self.b.faces[j];
         let pr = face.project(x);
