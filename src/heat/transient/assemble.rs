@@ -390,6 +390,12 @@ impl ElementCx<'_> {
         if let Some(message) = failed.take() {
             return Err(HeatError::Material { block, message });
         }
+        // The currents fed in: R_V,a −= ∫ j N_a dA (no Jacobian).
+        let start = currents.partition_point(|f| f.0 < e.0);
+        for &(_, k) in currents[start..].iter().take_while(|f| f.0 == e.0) {
+            let (side, j) = loads.currents[k];
+            influx(mesh, topo, &x[..nn], side.side, j, &mut re[nn..2 * nn]);
+        }
         // The temperature and voltage blocks of the element matrix, nn × nn each.
         let w = 2 * nn;
         let mut add = |off: usize, rs: &[f64], js: &[f64]| {
@@ -419,24 +425,6 @@ impl ElementCx<'_> {
                 js,
             );
             add(0, rs, js);
-        }
-        let start = currents.partition_point(|f| f.0 < e.0);
-        for &(_, k) in currents[start..].iter().take_while(|f| f.0 == e.0) {
-            let (side, j) = loads.currents[k];
-            let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
-            rs.fill(0.0);
-            js.fill(0.0);
-            kernel::face_load_with(
-                Measure::of(mesh.axisymmetric),
-                topo,
-                &x[..nn],
-                side.side,
-                &ve[..nn],
-                |_, _| (-j, 0.0),
-                rs,
-                js,
-            );
-            add(nn, rs, js);
         }
         if let Some(qb) = self.block_source {
             let q_failed = Cell::new(None);
@@ -519,29 +507,28 @@ impl ElementCx<'_> {
         }
         let fluxes = self.species_fluxes;
         let start = fluxes.partition_point(|f| f.0 < e.0);
-        let mut rs = [0.0; MAX_NODES];
-        let mut js = [0.0; MAX_NODES * MAX_NODES];
         for &(_, k) in fluxes[start..].iter().take_while(|f| f.0 == e.0) {
             let (side, j) = loads.species_fluxes[k];
-            let (rs, js) = (&mut rs[..nn], &mut js[..nn * nn]);
-            rs.fill(0.0);
-            js.fill(0.0);
-            kernel::face_load_with(
-                Measure::of(mesh.axisymmetric),
-                topo,
-                &x[..nn],
-                side.side,
-                &ce[..nn],
-                |_, _| (-j, 0.0),
-                rs,
-                js,
-            );
-            for a in 0..nn {
-                re[off + a] += rs[a];
-            }
+            influx(mesh, topo, &x[..nn], side.side, j, &mut re[off..off + nn]);
         }
         Ok(())
     }
+}
+
+/// A prescribed influx `j` (per area, into the body) on `side` of an element: its
+/// residual rows get `−∫ j N_a dA`; it adds nothing to the Jacobian.
+fn influx(
+    mesh: &crate::mesh::Mesh,
+    topo: crate::mesh::Topology,
+    x: &[[f64; 3]],
+    side: u8,
+    j: f64,
+    re: &mut [f64],
+) {
+    let mut f = [0.0; MAX_NODES];
+    let f = &mut f[..x.len()];
+    kernel::face_flux_with(Measure::of(mesh.axisymmetric), topo, x, side, |_| j, f);
+    re.iter_mut().zip(f.iter()).for_each(|(r, f)| *r -= f);
 }
 
 /// A material law as a kernel calls it: a failure or a non-finite value is kept in
