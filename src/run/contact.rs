@@ -48,6 +48,9 @@ pub(super) struct RunContact {
     pub again: std::cell::RefCell<Vec<Option<crate::scene::SearchAgain>>>,
     /// The species interfaces (`Enforcement for Species`).
     pub species: Vec<super::species::Interface>,
+    /// The voltage ties (`Enforcement for Voltage` with a tie model), after the species
+    /// interfaces in the embedding.
+    pub voltage_ties: Vec<super::species::Interface>,
     /// Wall-clock seconds building the contact surfaces and searching.
     pub surfaces_s: f64,
     pub search_s: f64,
@@ -178,6 +181,7 @@ impl RunContact {
         };
         out.electrical = scene.electrical;
         out.species = scene.species.into_iter().map(Into::into).collect();
+        out.voltage_ties = scene.voltage_ties.into_iter().map(Into::into).collect();
         for e in scene.entries {
             out.again.get_mut().push(e.again);
             out.definition.push(e.definition);
@@ -271,9 +275,11 @@ impl Couplings {
         contact: &RunContact,
         diags: &mut Diagnostics,
     ) -> Couplings {
-        // The energy interactions', then the species interfaces' (the embedding's order).
-        let choices =
-            (contact.choices.iter().map(|c| &c.0)).chain(contact.species.iter().map(|s| &s.choice));
+        // The energy interactions', then the species interfaces' and the voltage ties'
+        // (the embedding's order).
+        let choices = (contact.choices.iter().map(|c| &c.0))
+            .chain(contact.species.iter().map(|s| &s.choice))
+            .chain(contact.voltage_ties.iter().map(|s| &s.choice));
         let toggles = resolve_toggles(&file.problem, choices, diags);
         let fields = interaction_fields(
             physics.mesh,

@@ -223,20 +223,26 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     let contact = RunContact::build(&file, &mesh, &physics.field_names, options, &mut diags)?;
     contact.mask_face_conditions(&mut physics.face_sites, &mut diags);
     physics.resolve_species(&contact, &mut diags);
-    if let Some(e) = contact.electrical.first()
+    let electrical = (contact
+        .electrical
+        .iter()
+        .map(|e| (&e.side_a, &e.side_b, &e.at)))
+    .chain((contact.voltage_ties.iter()).map(|t| (&t.pairing.side_a, &t.pairing.side_b, &t.at)));
+    if let Some((a, b, at)) = electrical.into_iter().next()
         && !physics.materials.electric()
     {
         diags.push(
             Diagnostic::error(
                 "E0431",
-                format!(
-                    "electrical contact {} / {}: no block of the problem carries a voltage",
-                    e.side_a, e.side_b
-                ),
+                format!("electrical contact {a} / {b}: no block of the problem carries a voltage"),
             )
-            .at(Some(e.at.clone()))
+            .at(Some(at.clone()))
             .help("give the blocks on both sides an electrical_conductivity (S/m) in their [[material]]"),
         );
+    } else {
+        let carries = |b: usize| physics.materials.sigma[b].is_some();
+        let field = ("voltage", "E0431", "an electrical_conductivity (S/m)");
+        species::check_sides(&mesh, &contact.voltage_ties, &carries, field, &mut diags);
     }
     if !file.transient {
         posed::check_steady(&physics, &contact.pairings, &mut diags);

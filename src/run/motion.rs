@@ -259,12 +259,11 @@ pub(super) fn refuse_what_cannot_move(
             );
         }
     }
-    if let Some(e) = contact.electrical.first() {
+    let electrical = (contact.electrical.iter().map(|e| (&e.side_a, &e.side_b)))
+        .chain((contact.voltage_ties.iter()).map(|t| (&t.pairing.side_a, &t.pairing.side_b)));
+    if let Some((a, b)) = electrical.into_iter().next() {
         refuse(
-            format!(
-                "electrical contact {} / {} keeps the pairing of the first search",
-                e.side_a, e.side_b
-            ),
+            format!("electrical contact {a} / {b} keeps the pairing of the first search"),
             "remove the [displacement], or the `Enforcement for Voltage` block",
         );
     }

@@ -289,9 +289,7 @@ impl<'a> Output<'a> {
         let names = terms.term_mechanism_names();
         if !history.is_empty() {
             steps::write_steps(dir, history)?;
-            let contacts: Vec<(&str, &str)> = (terms.contact.electrical.iter())
-                .map(|e| (e.side_a.as_str(), e.side_b.as_str()))
-                .collect();
+            let contacts = terms.electrical_labels();
             if !contacts.is_empty() {
                 steps::write_electrical_contacts(dir, history, &contacts)?;
             }

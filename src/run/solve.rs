@@ -7,7 +7,7 @@
 use crate::assembly::DofMap;
 use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::{HInput, HValue};
-use crate::heat::electric::VOLTAGE;
+use crate::heat::electric::{ContactPower, VOLTAGE};
 use crate::heat::species::SPECIES;
 use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
 use crate::heat::transient::{
@@ -406,10 +406,16 @@ struct Recorder<'o, 'a> {
 
 impl Recorder<'_, '_> {
     fn record(&mut self, r: &StepReport, st: &State, dofs: &DofMap) -> Result<(), HeatError> {
-        // The species interfaces' mass flux apart from the energy terms' heat.
+        // The species interfaces' mass flux and the voltage ties' current apart from the
+        // energy terms' heat; a tie releases no contact Joule heat.
         let mut r = r.clone();
-        self.species_flux
-            .push(self.terms.split_species(&mut r.heat));
+        let [species, ties] = self.terms.split_fields(&mut r.heat);
+        self.species_flux.push(species);
+        let ties = ties.iter().map(|&(current, _)| ContactPower {
+            current,
+            joule: 0.0,
+        });
+        r.electric.extend(ties);
         let r = &r;
         if let Some(progress) = self.progress {
             progress(r);

@@ -31,7 +31,7 @@ use crate::enforce::conductance::{Conductance, ConductanceError, ConductanceMode
 use crate::enforce::model::{ConductanceLaw, ModelChoice};
 use crate::heat::law::Law;
 use crate::mesh::{Mesh, NodeId};
-use crate::scene::species::SpeciesEnforced;
+use crate::scene::species::FieldEnforced;
 
 use super::physics::law;
 use super::problem::{BcKind, Problem, ProblemText, Value};
@@ -350,25 +350,39 @@ pub(super) fn check_interfaces(
     entries: &[Interface],
     diags: &mut Diagnostics,
 ) {
+    let carries = |b: usize| species.diffusivity[b].is_some();
+    let field = ("species", "E0432", "a diffusivity (m²/s)");
+    check_sides(mesh, entries, &carries, field, diags);
+}
+
+/// Every face of `entries`' two sides lies in a block that `carries` the field (its
+/// name, the code of the refusal, and the property that gives the field to a block).
+pub(super) fn check_sides(
+    mesh: &Mesh,
+    entries: &[Interface],
+    carries: &dyn Fn(usize) -> bool,
+    (field, code, property): (&str, &'static str, &str),
+    diags: &mut Diagnostics,
+) {
     for e in entries {
         let p = &e.pairing;
         let faces = (p.side_a_geometry.faces.iter()).chain(&p.side_b_geometry.faces);
         let bare = faces
             .map(|f| mesh.block_of(f.side.elem))
-            .find(|&b| species.diffusivity[b].is_none());
+            .find(|&b| !carries(b));
         if let Some(b) = bare {
             let name = mesh.blocks[b].sierra_name();
             diags.push(
                 Diagnostic::error(
-                    "E0432",
+                    code,
                     format!(
-                        "species interface {} / {}: block {name} carries no species",
+                        "{field} interface {} / {}: block {name} carries no {field}",
                         p.side_a, p.side_b
                     ),
                 )
                 .at(Some(e.at.clone()))
                 .help(format!(
-                    "give block {name}'s [[material]] a diffusivity (m²/s), or take its surface out of the species interaction"
+                    "give block {name}'s [[material]] {property}, or take its surface out of the {field} interaction"
                 )),
             );
         }
@@ -404,7 +418,8 @@ pub(super) fn initial(
     mesh.coords.iter().map(|x| value(*x)).collect()
 }
 
-/// A species interface of the run (the scene's, its model shared with the terms).
+/// An interface of the run on a field other than the temperature — a species interface,
+/// or a voltage tie (K = 1) — the scene's, its model shared with the terms.
 pub(super) struct Interface {
     pub pairing: crate::search::scene::Pairing,
     pub choice: ModelChoice,
@@ -412,12 +427,12 @@ pub(super) struct Interface {
     pub model: Option<Arc<dyn ConductanceModel>>,
     /// The partition coefficient K.
     pub partition: f64,
-    /// The species enforcement block.
+    /// The enforcement block.
     pub at: crate::diag::Loc,
 }
 
-impl From<SpeciesEnforced> for Interface {
-    fn from(e: SpeciesEnforced) -> Self {
+impl From<FieldEnforced> for Interface {
+    fn from(e: FieldEnforced) -> Self {
         Interface {
             pairing: e.pairing,
             choice: e.choice,

@@ -258,13 +258,12 @@ pub(super) fn electrical_contacts(
 ) -> Vec<ElectricalContact> {
     let power = last.map_or(&[][..], |r| r.electric.as_slice());
     terms
-        .contact
-        .electrical
-        .iter()
+        .electrical_labels()
+        .into_iter()
         .zip(power)
-        .map(|(e, p)| ElectricalContact {
-            side_a: e.side_a.clone(),
-            side_b: e.side_b.clone(),
+        .map(|((side_a, side_b), p)| ElectricalContact {
+            side_a: side_a.to_string(),
+            side_b: side_b.to_string(),
             current: p.current,
             joule_heat: p.joule,
         })

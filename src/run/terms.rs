@@ -129,9 +129,11 @@ impl<'a> ContactTerms<'a> {
         couplings: &'a Couplings,
         (motion, death): (Option<&'a Motion>, Option<&'a Death>),
     ) -> Self {
-        // The embedding's interactions: the energy ones, then the species interfaces.
+        // The embedding's interactions: the energy ones, then the species interfaces,
+        // then the voltage ties.
         let mortar: Vec<bool> = (contact.choices.iter().map(|c| c.0.mortar))
             .chain(contact.species.iter().map(|s| s.choice.mortar))
+            .chain(contact.voltage_ties.iter().map(|s| s.choice.mortar))
             .collect();
         let choices = &contact.choices;
         let term_choice: Vec<usize> = (0..mortar.len())
@@ -385,6 +387,32 @@ impl<'a> ContactTerms<'a> {
                 embedding.set_coefficient(k, coefficient.clone());
             }
         }
+        if !self.contact.voltage_ties.is_empty() {
+            let field = dofs
+                .field(crate::heat::electric::VOLTAGE)
+                .ok_or("no dofs of field `voltage`")?;
+            // The Nitsche forms weigh the jump with σ at the probe temperature.
+            let (probe, t0) = (physics.probe, physics.time.start);
+            let coefficient: Vec<f64> = (physics.materials.sigma.iter())
+                .map(|s| {
+                    s.as_ref()
+                        .and_then(|s| s.eval(probe, [0.0; 3], t0).ok())
+                        .map_or(1.0, |v| v.0)
+                })
+                .collect();
+            let fixed: Vec<NodeId> = physics.voltage.iter().map(|&(n, _)| n).collect();
+            embedding.set_fixed_of(field, fixed);
+            for v in &self.contact.voltage_ties {
+                let k = embedding.add_resolved(
+                    v.pairing.clone(),
+                    (&v.choice, v.penalty_scale),
+                    v.model.clone(),
+                    None,
+                    field.into(),
+                );
+                embedding.set_coefficient(k, coefficient.clone());
+            }
+        }
         Ok(Embedded {
             embedding: RefCell::new(embedding),
             slots: RefCell::new((0, Vec::new())),
@@ -407,7 +435,7 @@ impl<'a> ContactTerms<'a> {
         embedding.set_time(t).map_err(failure)?;
         let moving = self.moving.borrow();
         for k in 0..self.term_choice.len() {
-            // The species interfaces (after the energy ones) do not move.
+            // The species interfaces and voltage ties (after the energy ones) do not move.
             let gone = moving.gone.get(k).copied().unwrap_or(false);
             embedding
                 .set_active(k, self.couplings.on(k, t) && !gone)
@@ -553,20 +581,36 @@ impl<'a> ContactTerms<'a> {
     }
 
     /// A step's heat per solver term split into the energy terms' (kept in `heat`, in
-    /// their order) and the species interfaces' mass flux (returned, in the order of
-    /// `contact.species`): (mol/s leaving side A, leaving side B).
-    pub(super) fn split_species(&self, heat: &mut Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    /// their order), the species interfaces' mass flux (in the order of
+    /// `contact.species`: mol/s leaving side A, leaving side B) and the voltage ties'
+    /// current (in the order of `contact.voltage_ties`: A leaving side A, side B).
+    pub(super) fn split_fields(&self, heat: &mut Vec<(f64, f64)>) -> [Vec<(f64, f64)>; 2] {
         let energy = self.contact.choices.len();
-        let mut species = vec![(f64::NAN, f64::NAN); self.contact.species.len()];
+        let species = self.contact.species.len();
+        let mut out = [
+            vec![(f64::NAN, f64::NAN); species],
+            vec![(f64::NAN, f64::NAN); self.contact.voltage_ties.len()],
+        ];
         let mut kept = Vec::with_capacity(heat.len());
         for (&k, &h) in self.term_choice.iter().zip(heat.iter()) {
             match k.checked_sub(energy) {
-                Some(s) => species[s] = h,
+                Some(s) if s < species => out[0][s] = h,
+                Some(s) => out[1][s - species] = h,
                 None => kept.push(h),
             }
         }
         *heat = kept;
-        species
+        out
+    }
+
+    /// The electrical contacts' and voltage ties' (side A, side B) names, in the order
+    /// of a step's `electric` powers once [`Self::split_fields`] has added the ties'.
+    pub(super) fn electrical_labels(&self) -> Vec<(&str, &str)> {
+        let contacts = self.contact.electrical.iter();
+        let contacts = contacts.map(|e| (e.side_a.as_str(), e.side_b.as_str()));
+        let ties = self.contact.voltage_ties.iter();
+        let ties = ties.map(|t| (t.pairing.side_a.as_str(), t.pairing.side_b.as_str()));
+        contacts.chain(ties).collect()
     }
 
     /// Mechanism heats in the solver's term order.
@@ -657,8 +701,14 @@ impl Interfaces for ContactTerms<'_> {
     fn is_linear(&self) -> bool {
         // A conductance independent of T keeps the system linear and symmetric.
         let species = self.contact.species.iter().map(|s| (&s.choice, &s.model));
+        let ties = self
+            .contact
+            .voltage_ties
+            .iter()
+            .map(|s| (&s.choice, &s.model));
         (self.contact.choices.iter().map(|(c, _, m)| (c, m)))
             .chain(species)
+            .chain(ties)
             .all(|(c, m)| c.mortar || m.as_ref().is_none_or(|m| !m.depends_on_temperature()))
     }
 

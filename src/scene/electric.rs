@@ -1,12 +1,19 @@
 //! `Enforcement for Voltage`: a definition's electrical contact on each of its pairings.
 //!
 //! The voltage block of a definition (one at most) applies to every pair of the
-//! definition, beside the Energy block. Its model is a contact conductance
-//! (`Gap_Conductance` or `Conductance`) whose `Gap Conductance Coefficient` lines give
-//! the electrical contact conductance h_e (S/m²) — every coefficient model, plugins
-//! included, as for Energy: the temperatures they see are the thermal ones at the point.
-//! `Offset Voltage` is the jump ΔV in `j = h_e (V_A − V_B − ΔV)`, `Joule Heat Fraction
-//! Side A` the share of the contact's Joule heat given to side A (0.5 by default).
+//! definition, beside the Energy block. Its model is either
+//!
+//! - a contact conductance (`Gap_Conductance`, `Conductance` or `Contact_Resistance`)
+//!   whose `Gap Conductance Coefficient` lines give the electrical contact conductance
+//!   h_e (S/m²) — every coefficient model, plugins included, as for Energy: the
+//!   temperatures they see are the thermal ones at the point. `Offset Voltage` is the
+//!   jump ΔV in `j = h_e (V_A − V_B − ΔV)`, `Joule Heat Fraction Side A` the share of the
+//!   contact's Joule heat given to side A (0.5 by default); or
+//! - a tie, any tie of the Energy equation with the voltage in place of the
+//!   temperature: `Tied_Voltage` and `Tied_Ip_Voltage` (Nitsche), `Tied` with `Side B
+//!   Variable voltage To voltage` (mortar multipliers, standard or dual) and `Dash`,
+//!   holding `V_A = V_B + ΔV` (`Offset Voltage`). A tie is a perfect electrical joint: it
+//!   has no contact resistance and releases no contact Joule heat.
 
 use std::path::Path;
 
@@ -17,6 +24,7 @@ use crate::enforce::electric::ElectricContact;
 use crate::search::scene::Pairing;
 
 use super::enforcement::resolve_for;
+use super::species::{FieldBlock, FieldEnforced, field_model};
 
 /// The equation of an electrical contact.
 pub const VOLTAGE_EQUATION: &str = "voltage";
@@ -64,17 +72,79 @@ pub(super) fn voltage_block(def: &ContactDefinition) -> Result<Option<&Enforceme
     }
 }
 
-/// The electrical contact of `pairing` under the voltage block `enf` of definition `d`,
-/// or `None` with the reasons in `diags`.
+/// What a voltage block makes of a pairing.
+pub enum Electrical {
+    /// A contact conductance, with its Joule heat.
+    Contact(ElectricalEnforced),
+    /// A tie of the voltage field (through the embedding, as a species interface).
+    Tie(Box<FieldEnforced>),
+}
+
+/// Whether the voltage block `enf` joins its sides by a contact conductance (else by a
+/// tie).
+fn is_conductance(enf: &Enforcement) -> bool {
+    enf.models
+        .iter()
+        .find(|m| m.equation == VOLTAGE_EQUATION)
+        .is_some_and(|line| {
+            matches!(
+                line.model.to_ascii_lowercase().as_str(),
+                "gap_conductance" | "conductance" | "contact_resistance"
+            )
+        })
+}
+
+/// The lowering of a voltage tie: the Energy equation's, with the voltage.
+fn tie_block(enf: &Enforcement) -> FieldBlock {
+    FieldBlock {
+        equation: VOLTAGE_EQUATION,
+        offset: enf.offset_voltage,
+        code: "E0431",
+        coefficient: "electrical contact conductance",
+        tie_help: "write `Side B Variable voltage To voltage` (mortar multipliers), or leave the line out for a Nitsche tie",
+        sees: "voltages",
+    }
+}
+
+/// Check the voltage block `enf` alone (the deck check, without pairings).
+pub(super) fn check_voltage_block(
+    enf: &Enforcement,
+    deck_dir: &Path,
+    sources: &SourceMap,
+    pair: (&str, &str),
+    diags: &mut Diagnostics,
+) {
+    if is_conductance(enf) {
+        let _ = voltage_model(enf, deck_dir, sources, pair, diags);
+    } else {
+        let _ = field_model(enf, &tie_block(enf), deck_dir, sources, pair, diags);
+    }
+}
+
+/// The electrical contact or voltage tie of `pairing` under the voltage block `enf` of
+/// definition `d` (the interaction's penalty scale `penalty_scale`), or `None` with the
+/// reasons in `diags`.
 pub(super) fn electrical(
     enf: &Enforcement,
-    d: usize,
+    (d, penalty_scale): (usize, f64),
     pairing: &Pairing,
     deck_dir: &Path,
     sources: &SourceMap,
     diags: &mut Diagnostics,
-) -> Option<ElectricalEnforced> {
+) -> Option<Electrical> {
     let pair = (pairing.side_a.as_str(), pairing.side_b.as_str());
+    if !is_conductance(enf) {
+        let (choice, model) = field_model(enf, &tie_block(enf), deck_dir, sources, pair, diags)?;
+        return Some(Electrical::Tie(Box::new(FieldEnforced {
+            pairing: pairing.clone(),
+            choice,
+            penalty_scale,
+            model,
+            partition: 1.0,
+            definition: d,
+            at: enf.at.clone(),
+        })));
+    }
     let (conductance, pressure) = voltage_model(enf, deck_dir, sources, pair, diags)?;
     let fraction = enf.joule_fraction_side_a.unwrap_or(0.5);
     let contact = match ElectricContact::new(
@@ -100,7 +170,7 @@ pub(super) fn electrical(
             return None;
         }
     };
-    Some(ElectricalEnforced {
+    Some(Electrical::Contact(ElectricalEnforced {
         side_a: pairing.side_a.clone(),
         side_b: pairing.side_b.clone(),
         contact,
@@ -108,13 +178,13 @@ pub(super) fn electrical(
         pressure,
         definition: d,
         at: enf.at.clone(),
-    })
+    }))
 }
 
 /// The electrical contact conductance of the voltage block `enf` and its contact
 /// pressure, lowered as an Energy block's conductance is (the same models and checks);
 /// `None` with the reasons in `diags`.
-pub(super) fn voltage_model(
+fn voltage_model(
     enf: &Enforcement,
     deck_dir: &Path,
     sources: &SourceMap,
@@ -122,18 +192,6 @@ pub(super) fn voltage_model(
     diags: &mut Diagnostics,
 ) -> Option<(Box<dyn ConductanceModel>, f64)> {
     let line = enf.models.iter().find(|m| m.equation == VOLTAGE_EQUATION)?;
-    let model = line.model.to_ascii_lowercase();
-    if !matches!(model.as_str(), "gap_conductance" | "conductance") {
-        diags.push(
-            Diagnostic::error(
-                "E0431",
-                format!("`Enforcement for Voltage = {model}`: seam joins voltages across a contact by a contact conductance only"),
-            )
-            .at(Some(line.at.clone()))
-            .help("write `Enforcement for Voltage = Gap_Conductance` with a `Gap Conductance Coefficient` (S/m²); a tied voltage is not supported yet"),
-        );
-        return None;
-    }
     let mut as_energy = enf.clone();
     as_energy.models = vec![crate::deck::spec::EnforcementModel {
         equation: "energy".into(),

@@ -190,7 +190,10 @@ pub struct ContactScene {
     /// The electrical contacts of the definitions' `Enforcement for Voltage` blocks.
     pub electrical: Vec<electric::ElectricalEnforced>,
     /// The species interfaces of the definitions' `Enforcement for Species` blocks.
-    pub species: Vec<species::SpeciesEnforced>,
+    pub species: Vec<species::FieldEnforced>,
+    /// The voltage ties of the definitions' `Enforcement for Voltage` blocks (a tie model
+    /// in place of a contact conductance).
+    pub voltage_ties: Vec<species::FieldEnforced>,
     /// Per contact definition of the deck, in deck order.
     pub definitions: Vec<DefinitionNotes>,
     /// Number of contact surfaces built, over every definition.
@@ -289,15 +292,18 @@ impl ContactScene {
             // A voltage or species block that fails says so once, not once per pair.
             let (mut voltage_failed, mut species_failed) = (false, false);
             for (pairing, map) in searched.pairings.into_iter().zip(maps) {
-                if let Some(v) = voltage.filter(|_| !voltage_failed) {
-                    match electric::electrical(v, d, &pairing, deck_dir, &loaded.sources, diags) {
-                        Some(e) => scene.electrical.push(e),
-                        None => voltage_failed = true,
-                    }
-                }
                 let interaction = list
                     .iter()
                     .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
+                if let Some(v) = voltage.filter(|_| !voltage_failed) {
+                    let scale = interaction.map_or(1.0, |i| i.penalty_scale);
+                    let sources = &loaded.sources;
+                    match electric::electrical(v, (d, scale), &pairing, deck_dir, sources, diags) {
+                        Some(electric::Electrical::Contact(e)) => scene.electrical.push(e),
+                        Some(electric::Electrical::Tie(t)) => scene.voltage_ties.push(*t),
+                        None => voltage_failed = true,
+                    }
+                }
                 if let Some(s) = species_block.filter(|_| !species_failed) {
                     let scale = interaction.map_or(1.0, |i| i.penalty_scale);
                     let sources = &loaded.sources;
@@ -707,8 +713,7 @@ pub fn check_enforcements(
         match electric::voltage_block(def) {
             Ok(Some(enf)) => {
                 let name = enf.name.as_deref().unwrap_or("(check)");
-                let _ =
-                    electric::voltage_model(enf, deck_dir, &loaded.sources, (name, name), diags);
+                electric::check_voltage_block(enf, deck_dir, &loaded.sources, (name, name), diags);
             }
             Ok(None) => {}
             Err(e) => diags.push(e),

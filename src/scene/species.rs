@@ -35,20 +35,23 @@ pub const SPECIES_EQUATION: &str = "species";
 /// The code of a species enforcement that cannot be solved.
 const CODE: &str = "E0432";
 
-/// A pairing's species interface.
-pub struct SpeciesEnforced {
+/// A pairing's interface on a field other than the temperature by an Energy model: a
+/// species interface, or a voltage tie (`Enforcement for Voltage = Tied_Voltage`, …, see
+/// [`super::electric`]).
+pub struct FieldEnforced {
     pub pairing: Pairing,
-    /// The model, lowered as an Energy block's is; its `offset` is Δc (mol/m³).
+    /// The model, lowered as an Energy block's is; its `offset` is the jump of the field
+    /// (Δc in mol/m³, ΔV in V).
     pub choice: ModelChoice,
     /// The interaction's penalty scale, 1 by default.
     pub penalty_scale: f64,
     /// The mass-transfer coefficient h (m/s) of a `Conductance`/`Gap_Conductance` model.
     pub model: Option<Box<dyn ConductanceModel>>,
-    /// The partition coefficient K: `c_A = K c_B`.
+    /// The partition coefficient K: `c_A = K c_B` (1 for a voltage).
     pub partition: f64,
     /// Index of the contact definition in the deck.
     pub definition: usize,
-    /// The species block, for messages.
+    /// The enforcement block, for messages.
     pub at: Loc,
 }
 
@@ -92,10 +95,10 @@ pub(super) fn species(
     deck_dir: &Path,
     sources: &SourceMap,
     diags: &mut Diagnostics,
-) -> Option<SpeciesEnforced> {
+) -> Option<FieldEnforced> {
     let pair = (pairing.side_a.as_str(), pairing.side_b.as_str());
     let (choice, model) = species_model(enf, deck_dir, sources, pair, diags)?;
-    Some(SpeciesEnforced {
+    Some(FieldEnforced {
         pairing: pairing.clone(),
         choice,
         penalty_scale,
@@ -116,35 +119,76 @@ pub(super) fn species_model(
     pair: (&str, &str),
     diags: &mut Diagnostics,
 ) -> Option<(ModelChoice, Option<Box<dyn ConductanceModel>>)> {
-    let line = enf.models.iter().find(|m| m.equation == SPECIES_EQUATION)?;
+    let field = FieldBlock {
+        equation: SPECIES_EQUATION,
+        offset: enf.offset_species,
+        code: CODE,
+        coefficient: "mass-transfer coefficient",
+        tie_help: "write `Side B Variable species To species` (mortar multipliers), or leave the line out for a Nitsche tie",
+        sees: "concentrations",
+    };
+    field_model(enf, &field, deck_dir, sources, pair, diags)
+}
+
+/// What lowering a block of a field other than the temperature needs to know.
+pub(super) struct FieldBlock {
+    /// The equation its `Enforcement for` names.
+    pub equation: &'static str,
+    /// The jump its `Offset <field>` gives.
+    pub offset: Option<f64>,
+    /// The code of its refusals.
+    pub code: &'static str,
+    /// What its `Gap Conductance Coefficient` is, for messages.
+    pub coefficient: &'static str,
+    /// The help of a `Side B Variable` that maps another field.
+    pub tie_help: &'static str,
+    /// What its forms see, for messages ("concentrations").
+    pub sees: &'static str,
+}
+
+/// The model of the `field` block `enf`, lowered as an Energy block's is (the same
+/// models and checks) with the field in place of the temperature, and its coefficient
+/// model; `None` with the reasons in `diags`.
+pub(super) fn field_model(
+    enf: &Enforcement,
+    field: &FieldBlock,
+    deck_dir: &Path,
+    sources: &SourceMap,
+    pair: (&str, &str),
+    diags: &mut Diagnostics,
+) -> Option<(ModelChoice, Option<Box<dyn ConductanceModel>>)> {
+    let name = field.equation;
+    let line = enf.models.iter().find(|m| m.equation == name)?;
     let refuse = |diags: &mut Diagnostics, at: &Loc, message: String, help: &str| {
         diags.push(
-            Diagnostic::error(CODE, message)
+            Diagnostic::error(field.code, message)
                 .at(Some(at.clone()))
                 .help(help),
         );
     };
     if let Some(map) = &enf.side_b_variable
-        && !(map.side_a.eq_ignore_ascii_case(SPECIES_EQUATION)
-            && map.side_b.eq_ignore_ascii_case(SPECIES_EQUATION))
+        && !(map.side_a.eq_ignore_ascii_case(name) && map.side_b.eq_ignore_ascii_case(name))
     {
         refuse(
             diags,
             &enf.at,
             format!(
-                "`Side B Variable {} To {}` in a species block: a species tie joins the species field to itself",
+                "`Side B Variable {} To {}` in a {name} block: a {name} tie joins the {name} field to itself",
                 map.side_b, map.side_a
             ),
-            "write `Side B Variable species To species` (mortar multipliers), or leave the line out for a Nitsche tie",
+            field.tie_help,
         );
         return None;
     }
-    if let Some(name) = &enf.contact_pressure_variable {
+    if let Some(variable) = &enf.contact_pressure_variable {
         refuse(
             diags,
             &enf.at,
-            format!("`Contact Pressure Variable = {name}` in a species block is not supported"),
-            "give a constant `Contact Pressure = p` for a pressure-dependent mass-transfer coefficient",
+            format!("`Contact Pressure Variable = {variable}` in a {name} block is not supported"),
+            &format!(
+                "give a constant `Contact Pressure = p` for a pressure-dependent {}",
+                field.coefficient
+            ),
         );
         return None;
     }
@@ -153,7 +197,7 @@ pub(super) fn species_model(
         equation: "energy".into(),
         ..line.clone()
     }];
-    as_energy.offset_temperature = enf.offset_species;
+    as_energy.offset_temperature = field.offset;
     let choice = match resolve_for(&as_energy, None) {
         Ok(c) => c,
         Err(ds) => {
@@ -170,10 +214,14 @@ pub(super) fn species_model(
             diags,
             &line.at,
             format!(
-                "the mass-transfer coefficient `{}` of this species block depends on the temperature, which a species interface does not see",
+                "the {} `{}` of this {name} block depends on the temperature, which a {name} interface does not see",
+                field.coefficient,
                 m.name()
             ),
-            "give a coefficient of the gap, position or time (`Constant H = …`, a table or Lua expression without T); at a species interface the forms see concentrations",
+            &format!(
+                "give a coefficient of the gap, position or time (`Constant H = …`, a table or Lua expression without T); at a {name} interface the forms see {}",
+                field.sees
+            ),
         );
         return None;
     }

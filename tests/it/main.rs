@@ -36,6 +36,7 @@ mod species;
 mod surfaces;
 mod transient;
 mod twod;
+mod voltage_ties;
 
 /// Held by the tests that run the turbine sector in this process. Two of them running at
 /// once give wrong answers (sector against ring, embedding against `seam run`) in about

@@ -254,7 +254,7 @@ pub static COMMANDS: &[CommandSpec] = &[
         "offset_voltage",
         [ENF],
         "= [constant [value =]] <v>",
-        "Voltage offset across the interface of an `Enforcement for Voltage` (material model `Offset Voltage = Constant Value = <v>`): the current is h_e (V_A - V_B - v). Range: finite (else E0227)."
+        "Voltage offset across the interface of an `Enforcement for Voltage` (material model `Offset Voltage = Constant Value = <v>`): the current is h_e (V_A - V_B - v) through a contact conductance; a voltage tie holds V_A = V_B + v. Range: finite (else E0227)."
     ),
     cmd!(
         "joule heat fraction side a",

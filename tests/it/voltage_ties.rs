@@ -1,0 +1,242 @@
+//! Voltage ties through `seam run`: two bars in series, meshed apart (non-matching across
+//! the interface), whose voltage is joined by every tie of the Energy equation —
+//! `Tied_Voltage` and `Tied_Ip_Voltage` (Nitsche), `Tied` with `Side B Variable voltage
+//! To voltage` (mortar multipliers, standard and dual), `Dash` — against the 1-D closed
+//! form at every node, with Joule heat in the bulk, the current through the tie, and the
+//! electrical power against the heat leaving.
+//!
+//! The bars: [0,1]² × [0, L1] (block 1, σ1, k1) and [0,1]² × [L1, L] (block 2, σ2, k2).
+//! Side sets: 1 the end z = 0, 2 block 1's interface face, 3 block 2's, 4 the end z = L.
+//! V is held at V0 at z = 0 and 0 at z = L; both ends lose heat by convection to T∞.
+//! With a perfect joint (`V_A = V_B + ΔV`) the current density is
+//! `j = (V0 − ΔV) / (L1/σ1 + L2/σ2)`, V is linear in each bar, and the temperature
+//! solves `−k T'' = j²/σ`: piecewise quadratic, continuous with continuous flux across
+//! the thermal mortar tie. Linear elements in 1-D hold both at the nodes, so every node
+//! must match to round-off.
+
+use seam::mesh::Mesh;
+use seam::mesh::generate::{self, BoxSpec};
+use seam::run::{RunError, RunResult};
+
+const L1: f64 = 0.6;
+const L: f64 = 1.5;
+const SIGMA: [f64; 2] = [2e3, 1e3];
+const K: [f64; 2] = [5.0, 2.0];
+const V0: f64 = 0.9;
+const H_C: f64 = 10.0;
+const T_INF: f64 = 300.0;
+
+/// The bars with `n` cells across and `m` along, per block.
+fn bars(n: [usize; 2], m: [usize; 2]) -> Mesh {
+    generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, L1], [n[0], n[0], m[0]], 1)
+                .with_side_sets([0, 0, 0, 0, 1, 2]),
+            BoxSpec::hex([0.0, 0.0, L1], [1.0, 1.0, L], [n[1], n[1], m[1]], 2)
+                .with_side_sets([0, 0, 0, 0, 3, 4]),
+        ],
+        false,
+    )
+}
+
+/// The deck: a thermal mortar tie and the voltage block `voltage` (its lines).
+fn deck(voltage: &str) -> String {
+    format!(
+        "begin contact definition bars\n contact surface a contains surface_2\n contact surface b contains surface_3\n\
+         begin interaction\n  side a a\n  side b b\n end\n\
+         begin enforcement thermal\n  enforcement for energy = tied\n  side b variable temperature to temperature\n end\n\
+         begin enforcement electrical\n{voltage}\n end\nend\n"
+    )
+}
+
+const PROBLEM: &str = "[mesh]\nfile = \"bars.exo\"\n\
+    [[material]]\nblocks = [\"block_1\"]\nconductivity = 5.0\nelectrical_conductivity = 2e3\n\
+    [[material]]\nblocks = [\"block_2\"]\nconductivity = 2.0\nelectrical_conductivity = 1e3\n\
+    [[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_1\"]\nvalue = 0.9\n\
+    [[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n\
+    [[bc]]\nkind = \"convection\"\nsurfaces = [\"surface_1\", \"surface_4\"]\nvalue = 10.0\nambient = 300.0\n\
+    [contact]\nfile = \"contact.i\"\n\
+    [solve]\nkind = \"steady\"\ntolerance = 1e-13\n";
+
+/// Write the case `name` (mesh, deck, problem) into a scratch folder and run it.
+fn run_case(name: &str, mesh: &Mesh, deck: &str) -> RunResult {
+    let scratch = crate::scratch(&format!("voltage-tie-{name}"));
+    let dir = scratch.path();
+    crate::twod::write_mesh(&dir.join("bars.exo"), mesh);
+    std::fs::write(dir.join("contact.i"), deck).unwrap();
+    std::fs::write(dir.join("problem.toml"), PROBLEM).unwrap();
+    match seam::run::run(&dir.join("problem.toml")) {
+        Ok(r) => r,
+        Err(RunError::Input(d, s)) => panic!("{}", d.render(&s)),
+        Err(RunError::Solve(e)) => panic!("{e}"),
+    }
+}
+
+/// The closed form: the current density j, and V(z, side), T(z, side) with side 0 in
+/// block 1 and 1 in block 2, for the jump `dv` = V_A − V_B.
+fn closed_form(dv: f64) -> (f64, impl Fn(f64, usize) -> (f64, f64)) {
+    let l2 = L - L1;
+    let j = (V0 - dv) / (L1 / SIGMA[0] + l2 / SIGMA[1]);
+    // The heat q_i = j²/σ_i per unit volume; T_i = a_i + b_i s − q_i s²/(2 k_i) with s
+    // the distance from each bar's outer end (s = z in bar 1, s = L − z in bar 2).
+    let q = [j * j / SIGMA[0], j * j / SIGMA[1]];
+    // Ends: k_i T_i'(0) = h_c (T_i(0) − T∞) (heat leaving by convection) gives
+    // a_i = T∞ + k_i b_i / h_c. At the interface, T_1(L1) = T_2(l2) and
+    // k_1 T_1'(L1) = −k_2 T_2'(l2) (the flux is continuous; s runs opposite ways).
+    // Unknowns b1, b2:
+    //   (T∞ + k1 b1/h + b1 L1 − q1 L1²/(2k1)) − (T∞ + k2 b2/h + b2 l2 − q2 l2²/(2k2)) = 0
+    //   k1 b1 − q1 L1 + k2 b2 − q2 l2 = 0
+    let (h, [k1, k2]) = (H_C, K);
+    let (a11, a12) = (k1 / h + L1, -(k2 / h + l2));
+    let r1 = q[0] * L1 * L1 / (2.0 * k1) - q[1] * l2 * l2 / (2.0 * k2);
+    let (a21, a22, r2) = (k1, k2, q[0] * L1 + q[1] * l2);
+    let det = a11 * a22 - a12 * a21;
+    let b1 = (r1 * a22 - a12 * r2) / det;
+    let b2 = (a11 * r2 - r1 * a21) / det;
+    let exact = move |z: f64, side: usize| {
+        let (s, k, b, q, v) = match side {
+            0 => (z, k1, b1, q[0], V0 - j * z / SIGMA[0]),
+            _ => (L - z, k2, b2, q[1], j * (L - z) / SIGMA[1]),
+        };
+        let t = T_INF + k * b / h + b * s - q * s * s / (2.0 * k);
+        (v, t)
+    };
+    (j, exact)
+}
+
+/// The largest nodal errors of V (relative to V0) and T (relative to the temperature
+/// rise) of a run against `exact`, and the nodal V and T.
+fn nodal_errors(
+    r: &RunResult,
+    exact: impl Fn(f64, usize) -> (f64, f64),
+) -> ((f64, f64), Vec<f64>, Vec<f64>) {
+    let dofs = &r.solution.dofs;
+    let v = dofs.nodal_values(dofs.field("voltage").unwrap(), &r.solution.u);
+    let t = dofs.nodal_values(dofs.field("temperature").unwrap(), &r.solution.u);
+    let mesh = &r.mesh;
+    let rise = (t.iter().copied().fold(f64::MIN, f64::max) - T_INF).max(1e-300);
+    let (mut ev, mut et) = (0.0f64, 0.0f64);
+    for (b, block) in mesh.blocks.iter().enumerate() {
+        for k in 0..block.len() {
+            let e = seam::mesh::ElemId(block.first_elem.0 + k as u32);
+            for n in mesh.elem_nodes(e) {
+                let (ve, te) = exact(mesh.coords[n.index()][2], b);
+                ev = ev.max((v[n.index()] - ve).abs() / V0);
+                et = et.max((t[n.index()] - te).abs() / rise);
+            }
+        }
+    }
+    ((ev, et), v, t)
+}
+
+/// The mean of nodal `f` over the nodes at z = `z`.
+fn mean_at(mesh: &Mesh, f: &[f64], z: f64) -> f64 {
+    let at: Vec<f64> = (mesh.coords.iter().zip(f))
+        .filter(|(x, _)| (x[2] - z).abs() < 1e-12)
+        .map(|(_, v)| *v)
+        .collect();
+    at.iter().sum::<f64>() / at.len() as f64
+}
+
+#[test]
+fn every_voltage_tie_reproduces_the_series_bars_at_the_nodes() {
+    let mortar = "  enforcement for voltage = tied\n  side b variable voltage to voltage";
+    let dual =
+        "  enforcement for voltage = tied multipliers = dual\n  side b variable voltage to voltage";
+    let cases = [
+        (
+            "nitsche",
+            "  enforcement for voltage = tied_voltage".to_string(),
+        ),
+        (
+            "interior-penalty",
+            "  enforcement for voltage = tied_ip_voltage".to_string(),
+        ),
+        ("mortar", mortar.to_string()),
+        ("dual", dual.to_string()),
+        (
+            "dash",
+            "  enforcement for voltage = dash\n  dash penalty factor = 1e8".to_string(),
+        ),
+        (
+            "offset",
+            "  enforcement for voltage = tied_voltage\n  offset voltage = 0.2".to_string(),
+        ),
+    ];
+    let mesh = bars([3, 4], [4, 5]);
+    for (name, lines) in cases {
+        let dv = if name == "offset" { 0.2 } else { 0.0 };
+        let (j, exact) = closed_form(dv);
+        let r = run_case(name, &mesh, &deck(&lines));
+        let ((ev, et), v, t) = nodal_errors(&r, exact);
+        eprintln!("{name}: V error {ev:.1e}, T error {et:.1e}");
+        // Dash is a penalty: it holds the tie to its penalty's accuracy, not exactly.
+        let (tol_v, tol_t) = if name == "dash" {
+            (1e-5, 1e-5)
+        } else {
+            (1e-12, 1e-11)
+        };
+        assert!(ev < tol_v, "{name}: V error {ev:e}");
+        assert!(et < tol_t, "{name}: T error {et:e}");
+        // The current through the tie (A over the unit section) in the summary.
+        let c = &r.summary.electrical_contacts;
+        assert_eq!(
+            c.len(),
+            1,
+            "{name}: one electrical interface in the summary"
+        );
+        let tol_i = if name == "dash" { 1e-7 } else { 1e-10 };
+        assert!(
+            (c[0].current - j).abs() <= tol_i * j,
+            "{name}: current {} A against {j} A",
+            c[0].current
+        );
+        assert_eq!(
+            c[0].joule_heat, 0.0,
+            "{name}: a tie releases no contact heat"
+        );
+        // The electrical power fed at z = 0 (j V0 over the unit section) leaves as heat
+        // by convection at the two ends, less the jump's share for an offset.
+        let power = j * (mean_at(&r.mesh, &v, 0.0) - mean_at(&r.mesh, &v, L)) - j * dv;
+        let out =
+            H_C * (mean_at(&r.mesh, &t, 0.0) - T_INF) + H_C * (mean_at(&r.mesh, &t, L) - T_INF);
+        let tol_p = if name == "dash" { 1e-7 } else { 1e-10 };
+        assert!(
+            (power - out).abs() <= tol_p * power,
+            "{name}: power {power} W against {out} W leaving"
+        );
+    }
+}
+
+#[test]
+fn a_voltage_tie_refuses_another_field_and_a_side_without_a_voltage() {
+    let mesh = bars([2, 3], [2, 3]);
+    let scratch = crate::scratch("voltage-tie-refusals");
+    let dir = scratch.path();
+    crate::twod::write_mesh(&dir.join("bars.exo"), &mesh);
+    let check = |deck: &str, problem: &str| -> Vec<String> {
+        std::fs::write(dir.join("contact.i"), deck).unwrap();
+        std::fs::write(dir.join("problem.toml"), problem).unwrap();
+        match seam::run::check(&dir.join("problem.toml")) {
+            Err(RunError::Input(d, _)) => d.errors().map(|d| d.code.to_string()).collect(),
+            Ok(_) => Vec::new(),
+            Err(e) => panic!("{e:?}"),
+        }
+    };
+    let tied = deck("  enforcement for voltage = tied_voltage");
+    assert!(check(&tied, PROBLEM).is_empty(), "the tie itself checks");
+    // A voltage tie mapping the temperature.
+    let other = deck("  enforcement for voltage = tied\n  side b variable temperature to voltage");
+    assert_eq!(check(&other, PROBLEM), ["E0431"]);
+    // Block 2 without an electrical conductivity: its side of the tie carries no voltage.
+    let bare = PROBLEM.replacen(
+        "conductivity = 2.0\nelectrical_conductivity = 1e3\n",
+        "conductivity = 2.0\n",
+        1,
+    );
+    let bare = bare.replace(
+        "[[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n",
+        "",
+    );
+    assert_eq!(check(&tied, &bare), ["E0431"]);
+}
