@@ -474,6 +474,7 @@ fn assembly(table_path: &Path) {
             h: c.h,
             dh_dtemp_a: c.dh_dtemp_a,
             dh_dtemp_b: c.dh_dtemp_b,
+            ..HValue::default()
         })
     };
     let time_form = |h: &HFn<'_>| -> f64 {
@@ -536,6 +537,7 @@ fn assembly(table_path: &Path) {
                     h: outputs[i].value,
                     dh_dtemp_a: outputs[i].d_temp_a,
                     dh_dtemp_b: outputs[i].d_temp_b,
+                    ..HValue::default()
                 })
             };
             let f = InterfaceForm {

@@ -360,6 +360,11 @@ pub struct Enforcement {
     /// temperature-dependent conductance sees at a contact point.
     #[serde(default)]
     pub contact_gap_temperature: Option<GapTemperature>,
+    /// `Contact Gap Voltage = side_a | side_b | mean`: the voltage a voltage-dependent
+    /// electrical contact conductance sees at a contact point (an `Enforcement for
+    /// Voltage` block only).
+    #[serde(default)]
+    pub contact_gap_voltage: Option<GapTemperature>,
     /// `Plugin Isolation = Process | None`: run the enforcement's plugin in a worker
     /// process (a crash is an ordinary fault) or in seam's own process (the default).
     #[serde(default)]
@@ -379,14 +384,16 @@ pub enum PluginIsolation {
     Process,
 }
 
-/// Which temperature a temperature-dependent conductance sees at a contact point:
-/// side A's, side B's (interpolated at the projection), or their mean.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// Which temperature (or voltage) a temperature-dependent (voltage-dependent)
+/// conductance sees at a contact point: side A's, side B's (interpolated at the
+/// projection), their mean, or a constant.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum GapTemperature {
     SideA,
     SideB,
     Mean,
+    Constant(f64),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -232,6 +232,7 @@ fn full_expected() -> Deck {
             use_toggle_block: Some("tog".into()),
             toggle_element_blocks: vec![],
             contact_gap_temperature: None,
+            contact_gap_voltage: None,
             plugin_isolation: Default::default(),
             contact_pressure_variable: None,
             at: Default::default(),

@@ -84,6 +84,7 @@ impl Embedding {
                     h: c.h,
                     dh_dtemp_a: c.dh_dtemp_a,
                     dh_dtemp_b: c.dh_dtemp_b,
+                    ..HValue::default()
                 }),
                 // Quarantined: the point contributes nothing; each Newton step meets it
                 // again, so it is kept once.

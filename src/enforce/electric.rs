@@ -240,24 +240,29 @@ impl ElectricContact {
     ) -> Result<(), String> {
         let (len, na) = (p.len as usize, p.na as usize);
         let n = 2 * len;
-        let (mut ta, mut tb, mut jump) = (0.0, 0.0, -self.offset);
+        let (mut ta, mut tb, mut va, mut vb) = (0.0, 0.0, 0.0, 0.0);
         for i in 0..len {
             let (tv, vv) = (u[d[i] as usize], u[d[8 + i] as usize]);
             if i < na {
                 ta += p.s[i] * tv;
+                va += p.s[i] * vv;
             } else {
                 tb -= p.s[i] * tv;
+                vb -= p.s[i] * vv;
             }
-            jump += p.s[i] * vv;
         }
+        let jump = va - vb - self.offset;
         let hv = h(&HInput {
             gap: p.gap,
             temp_a: ta,
             temp_b: tb,
+            volt_a: va,
+            volt_b: vb,
             x: p.x,
             point: p.index as usize,
         })?;
-        if !(hv.h.is_finite() && hv.dh_dtemp_a.is_finite() && hv.dh_dtemp_b.is_finite()) {
+        let derivatives = [hv.dh_dtemp_a, hv.dh_dtemp_b, hv.dh_dvolt_a, hv.dh_dvolt_b];
+        if !(hv.h.is_finite() && derivatives.iter().all(|d| d.is_finite())) {
             return Err(format!(
                 "the electrical contact conductance is not finite at ({:.6}, {:.6}, {:.6}): h = {}",
                 p.x[0], p.x[1], p.x[2], hv.h
@@ -268,13 +273,20 @@ impl ElectricContact {
         power.current += w * j;
         let q = hv.h * jump * jump;
         power.joule += w * q;
-        // dh/dT_i through T_A (side A's nodes) or T_B (side B's), and the share of
-        // the heat row i gets.
+        // dh/dT_i and dh/dV_i through T_A, V_A (side A's nodes) or T_B, V_B (side
+        // B's), and the share of the heat row i gets.
         let dh = |i: usize| {
             if i < na {
                 hv.dh_dtemp_a * p.s[i]
             } else {
                 -hv.dh_dtemp_b * p.s[i]
+            }
+        };
+        let dhv = |i: usize| {
+            if i < na {
+                hv.dh_dvolt_a * p.s[i]
+            } else {
+                -hv.dh_dvolt_b * p.s[i]
             }
         };
         let share = |i: usize| {
@@ -291,11 +303,11 @@ impl ElectricContact {
             // Temperature rows: −share_i w h [V]².
             r[d[i] as usize] -= share(i) * w * q;
             for c in 0..len {
-                // V row: V column, T column (through h).
-                m[(len + i) * n + len + c] += w * hv.h * p.s[i] * p.s[c];
+                // V row: V column (directly and through h), T column (through h).
+                m[(len + i) * n + len + c] += w * (hv.h * p.s[c] + jump * dhv(c)) * p.s[i];
                 m[(len + i) * n + c] += w * jump * p.s[i] * dh(c);
-                // T row: V column, T column (through h).
-                m[i * n + len + c] -= share(i) * w * 2.0 * j * p.s[c];
+                // T row: V column (directly and through h), T column (through h).
+                m[i * n + len + c] -= share(i) * w * (2.0 * j * p.s[c] + jump * jump * dhv(c));
                 m[i * n + c] -= share(i) * w * jump * jump * dh(c);
             }
         }

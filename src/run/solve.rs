@@ -481,26 +481,29 @@ fn linear_solver_summary(
 }
 
 /// An electrical contact's conductance model as the solver calls it: h_e at a point's
-/// gap and temperatures, the contact pressure and the time.
+/// gap, temperatures and voltages, the contact pressure and the time.
 fn electric_conductance(
     model: &dyn ConductanceModel,
     pressure: f64,
 ) -> impl Fn(&HInput, f64) -> Result<HValue, String> + '_ {
     move |i, time| {
-        let c = model
-            .evaluate(&PointState {
-                gap: i.gap,
-                pressure,
-                temp_a: i.temp_a,
-                temp_b: i.temp_b,
-                x: i.x,
-                time,
-            })
+        let state = PointState {
+            gap: i.gap,
+            pressure,
+            temp_a: i.temp_a,
+            temp_b: i.temp_b,
+            x: i.x,
+            time,
+        };
+        let (c, [dva, dvb]) = model
+            .evaluate_with_voltage(&state, [i.volt_a, i.volt_b])
             .map_err(|e| format!("electrical contact conductance `{}`: {e}", model.name()))?;
         Ok(HValue {
             h: c.h,
             dh_dtemp_a: c.dh_dtemp_a,
             dh_dtemp_b: c.dh_dtemp_b,
+            dh_dvolt_a: dva,
+            dh_dvolt_b: dvb,
         })
     }
 }

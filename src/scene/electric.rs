@@ -217,5 +217,44 @@ fn voltage_model(
         );
         return None;
     };
+    // `Contact Gap Voltage`: the voltage a voltage-dependent conductance sees.
+    let model = super::enforcement::seen_voltage(enf).wrap_voltage(model);
     Some((model, choice.pressure))
+}
+
+/// Refuse, at a block that is not an electrical contact (Energy, Species, a voltage
+/// tie), a `Contact Gap Voltage` line and a coefficient that names the voltages: only an
+/// electrical contact conductance sees them. Whether it refused.
+pub(super) fn refuse_voltage(
+    enf: &Enforcement,
+    model: Option<&dyn ConductanceModel>,
+    diags: &mut Diagnostics,
+) -> bool {
+    let help = "voltages are seen by an electrical contact conductance only: give the voltage-dependent coefficient in a `begin Enforcement` block of its own with `Enforcement for Voltage = Gap_Conductance`";
+    if enf.contact_gap_voltage.is_some() {
+        diags.push(
+            Diagnostic::error(
+                "E0431",
+                "`Contact Gap Voltage` in a block that is not an electrical contact conductance: no model of this block sees a voltage",
+            )
+            .at(Some(enf.at.clone()))
+            .help(help),
+        );
+        return true;
+    }
+    if let Some(m) = model.filter(|m| m.depends_on_voltage()) {
+        diags.push(
+            Diagnostic::error(
+                "E0431",
+                format!(
+                    "the coefficient `{}` names the voltages (`volt_a`, `volt_b`), but this block is not an electrical contact conductance",
+                    m.name()
+                ),
+            )
+            .at(Some(enf.at.clone()))
+            .help(help),
+        );
+        return true;
+    }
+    false
 }

@@ -199,6 +199,17 @@ fn conductance(e: &Enforcement, m: &EnforcementModel) -> Result<ConductanceLaw, 
     ])
 }
 
+/// The voltage the block's electrical contact conductance sees (`Contact Gap Voltage`).
+pub fn seen_voltage(e: &Enforcement) -> SeenTemperature {
+    match e.contact_gap_voltage {
+        None => SeenTemperature::Both,
+        Some(GapTemperature::SideA) => SeenTemperature::SideA,
+        Some(GapTemperature::SideB) => SeenTemperature::SideB,
+        Some(GapTemperature::Mean) => SeenTemperature::Mean,
+        Some(GapTemperature::Constant(v)) => SeenTemperature::Constant(v),
+    }
+}
+
 /// The temperature the block's conductance models see (`Contact Gap Temperature`).
 pub fn seen_temperature(e: &Enforcement) -> SeenTemperature {
     match e.contact_gap_temperature {
@@ -206,5 +217,6 @@ pub fn seen_temperature(e: &Enforcement) -> SeenTemperature {
         Some(GapTemperature::SideA) => SeenTemperature::SideA,
         Some(GapTemperature::SideB) => SeenTemperature::SideB,
         Some(GapTemperature::Mean) => SeenTemperature::Mean,
+        Some(GapTemperature::Constant(v)) => SeenTemperature::Constant(v),
     }
 }

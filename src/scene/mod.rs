@@ -383,6 +383,9 @@ impl ContactScene {
                     }
                     continue;
                 };
+                if electric::refuse_voltage(enf, model.as_deref(), diags) {
+                    continue;
+                }
                 let again = keep.then(|| SearchAgain {
                     side_a: set.surfaces[pairing.side_a_surface].clone(),
                     side_b: set.surfaces[pairing.side_b_surface].clone(),
@@ -735,14 +738,11 @@ pub fn check_enforcements(
             match resolve_for(enf, fields) {
                 Ok(choice) => {
                     let name = enf.name.as_deref().unwrap_or("(check)");
-                    let _ = conductance_model(
-                        enf,
-                        &choice,
-                        deck_dir,
-                        &loaded.sources,
-                        (name, name),
-                        diags,
-                    );
+                    let sources = &loaded.sources;
+                    let pair = (name, name);
+                    if let Ok(m) = conductance_model(enf, &choice, deck_dir, sources, pair, diags) {
+                        electric::refuse_voltage(enf, m.as_deref(), diags);
+                    }
                 }
                 Err(ds) => ds.into_iter().for_each(|d| diags.push(d)),
             }

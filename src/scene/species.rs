@@ -207,6 +207,9 @@ pub(super) fn field_model(
     };
     let model =
         super::conductance_model(&as_energy, &choice, deck_dir, sources, pair, diags).ok()?;
+    if super::electric::refuse_voltage(enf, model.as_deref(), diags) {
+        return None;
+    }
     if let Some(m) = &model
         && m.depends_on_temperature()
     {

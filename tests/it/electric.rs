@@ -451,15 +451,28 @@ fn the_electrical_contact_jacobian_matches_central_differences() {
         dofs.field(TEMPERATURE).unwrap(),
         dofs.field(VOLTAGE).unwrap(),
     );
-    for fraction_a in [0.5, 0.8] {
+    // The second case also depends on the voltages (`Contact Gap Voltage`).
+    for (fraction_a, volts) in [(0.5, false), (0.8, false), (0.5, true), (0.3, true)] {
         let mut c = ElectricContact::new(&p.a, &p.b, &p.points, 0.05, fraction_a).unwrap();
         c.bind(&mesh, &dofs, tf, vf).unwrap();
-        // h_e(T_A, T_B) = 2e3 (1 + 3e-3 (T_A − 300) − 1e-3 (T_B − 300)).
+        // h_e(T_A, T_B) = 2e3 (1 + 3e-3 (T_A − 300) − 1e-3 (T_B − 300)), times
+        // (1 + 0.4 V_A² − 0.3 V_B) when it sees the voltages.
         let h = |i: &HInput| {
+            let ht = 2e3 * (1.0 + 3e-3 * (i.temp_a - 300.0) - 1e-3 * (i.temp_b - 300.0));
+            let (f, dfa, dfb) = match volts {
+                true => (
+                    1.0 + 0.4 * i.volt_a * i.volt_a - 0.3 * i.volt_b,
+                    0.8 * i.volt_a,
+                    -0.3,
+                ),
+                false => (1.0, 0.0, 0.0),
+            };
             Ok(HValue {
-                h: 2e3 * (1.0 + 3e-3 * (i.temp_a - 300.0) - 1e-3 * (i.temp_b - 300.0)),
-                dh_dtemp_a: 2e3 * 3e-3,
-                dh_dtemp_b: -2e3 * 1e-3,
+                h: ht * f,
+                dh_dtemp_a: 2e3 * 3e-3 * f,
+                dh_dtemp_b: -2e3 * 1e-3 * f,
+                dh_dvolt_a: ht * dfa,
+                dh_dvolt_b: ht * dfb,
             })
         };
         let n = dofs.len();
@@ -495,7 +508,7 @@ fn the_electrical_contact_jacobian_matches_central_differences() {
         });
         assert!(
             worst < 1e-6,
-            "largest relative difference {worst:e} (share {fraction_a})"
+            "largest relative difference {worst:e} (share {fraction_a}, voltages {volts})"
         );
     }
 }
@@ -509,6 +522,7 @@ fn newton_converges_quadratically_with_sigma_of_t_and_a_temperature_dependent_co
             h: 2e3 * (1.0 + 2e-3 * (tm - 300.0)),
             dh_dtemp_a: 2e3 * 1e-3,
             dh_dtemp_b: 2e3 * 1e-3,
+            ..HValue::default()
         })
     };
     let sigma = |s0: f64| Law::Lua {

@@ -528,6 +528,7 @@ fn interface_jacobian_matches_finite_differences() {
             h: h0 * (1.0 + gamma * tm),
             dh_dtemp_a: 0.5 * h0 * gamma,
             dh_dtemp_b: 0.5 * h0 * gamma,
+            ..HValue::default()
         })
     };
     let k = [2.0, 0.7];
@@ -647,6 +648,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
                 h: c.h,
                 dh_dtemp_a: c.dh_dtemp_a,
                 dh_dtemp_b: c.dh_dtemp_b,
+                ..HValue::default()
             })
         };
         let k = [1.0, 1.0];

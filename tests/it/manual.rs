@@ -567,6 +567,14 @@ fn material_models_that_seam_lowers() {
         ("Contact Gap Temperature = Mean", GapTemperature::Mean),
         ("Contact Gap Temperature = Average", GapTemperature::Mean),
         ("Contact Gap Temperature = avg", GapTemperature::Mean),
+        (
+            "Contact Gap Temperature = Constant Value = 350",
+            GapTemperature::Constant(350.0),
+        ),
+        (
+            "Contact Gap Temperature = 350",
+            GapTemperature::Constant(350.0),
+        ),
     ] {
         assert_eq!(
             enforcement_line(line).contact_gap_temperature,
@@ -574,6 +582,23 @@ fn material_models_that_seam_lowers() {
             "{line}"
         );
     }
+    // Contact Gap Voltage: the same choices, for the voltage.
+    for (line, want) in [
+        ("Contact Gap Voltage = Side_B", GapTemperature::SideB),
+        ("Contact Gap Voltage = mean", GapTemperature::Mean),
+        (
+            "Contact Gap Voltage = Constant Value = 1",
+            GapTemperature::Constant(1.0),
+        ),
+    ] {
+        let e = enforcement_line(line);
+        assert_eq!(e.contact_gap_voltage, Some(want), "{line}");
+        assert_eq!(e.contact_gap_temperature, None, "{line}");
+    }
+    assert_eq!(
+        refusal(&in_enforcement("Contact Gap Voltage = sidea")),
+        [("E0217", "unknown contact gap voltage `sidea`".to_string())]
+    );
     assert_eq!(
         refusal(&in_enforcement("Contact Gap Temperature = Sid_B")),
         [(
@@ -605,11 +630,6 @@ fn contact_pressure_given_twice_ways_is_an_error() {
 #[test]
 fn material_models_that_seam_refuses() {
     for (line, phrase, why) in [
-        (
-            "Contact Gap Voltage = Constant Value = 1",
-            "contact gap voltage",
-            "a conductance that depends on the voltage",
-        ),
         (
             "Offset Darcy Potential = Constant Value = 1",
             "offset darcy potential",

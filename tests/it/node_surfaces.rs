@@ -732,6 +732,7 @@ fn node_point_jacobian_matches_finite_differences() {
             h: 2.0 + 0.5 * i.temp_a + 0.25 * i.temp_b * i.temp_b,
             dh_dtemp_a: 0.5,
             dh_dtemp_b: 0.5 * i.temp_b,
+            ..HValue::default()
         })
     };
     for form in [Form::Conductance, Form::GapConductance] {

@@ -1,4 +1,4 @@
-//! Voltage ties through `seam run`: two bars in series, meshed apart (non-matching across
+//! Voltage ties and voltage-dependent electrical contacts through `seam run`: two bars in series, meshed apart (non-matching across
 //! the interface), whose voltage is joined by every tie of the Energy equation —
 //! `Tied_Voltage` and `Tied_Ip_Voltage` (Nitsche), `Tied` with `Side B Variable voltage
 //! To voltage` (mortar multipliers, standard and dual), `Dash` — against the 1-D closed
@@ -12,7 +12,8 @@
 //! `j = (V0 − ΔV) / (L1/σ1 + L2/σ2)`, V is linear in each bar, and the temperature
 //! solves `−k T'' = j²/σ`: piecewise quadratic, continuous with continuous flux across
 //! the thermal mortar tie. Linear elements in 1-D hold both at the nodes, so every node
-//! must match to round-off.
+//! must match to round-off. An electrical contact conductance that depends on the
+//! voltage (`Contact Gap Voltage`) gives the current of the scalar closed form.
 
 use seam::mesh::Mesh;
 use seam::mesh::generate::{self, BoxSpec};
@@ -239,4 +240,145 @@ fn a_voltage_tie_refuses_another_field_and_a_side_without_a_voltage() {
         "",
     );
     assert_eq!(check(&tied, &bare), ["E0431"]);
+}
+
+/// The current density through the contact of the bars when h_e = 500 (1 + 2 V_s), with
+/// V_s the voltage `seen` gives of (V_A, V_B): the root of h_e(V_s) (V_A − V_B) = j with
+/// V_A = V0 − j L1/σ1 and V_B = j L2/σ2, by bisection.
+fn contact_current(seen: impl Fn(f64, f64) -> f64) -> f64 {
+    let l2 = L - L1;
+    let excess = |j: f64| {
+        let (va, vb) = (V0 - j * L1 / SIGMA[0], j * l2 / SIGMA[1]);
+        500.0 * (1.0 + 2.0 * seen(va, vb)) * (va - vb) - j
+    };
+    let (mut lo, mut hi) = (0.0, V0 / (L1 / SIGMA[0] + l2 / SIGMA[1]));
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if excess(mid) > 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The voltage a contact conductance sees of (V_A, V_B).
+type Seen = dyn Fn(f64, f64) -> f64;
+
+#[test]
+fn contact_gap_voltage_chooses_the_voltage_a_contact_conductance_sees() {
+    let mesh = bars([3, 4], [4, 5]);
+    let side_a = |a: f64, _: f64| a;
+    let cases: [(&str, &str, &Seen); 5] = [
+        ("both", "", &side_a),
+        ("side_a", "contact gap voltage = side_a", &side_a),
+        ("side_b", "contact gap voltage = side_b", &|_, b| b),
+        ("mean", "contact gap voltage = mean", &|a, b| 0.5 * (a + b)),
+        (
+            "constant",
+            "contact gap voltage = constant value = 0.1",
+            &|_, _| 0.1,
+        ),
+    ];
+    let mut currents = Vec::new();
+    for (name, line, seen) in cases {
+        let j = contact_current(seen);
+        let block = format!(
+            "  enforcement for voltage = gap_conductance\n  gap conductance coefficient = lua \"500 * (1 + 2 * volt_a)\"\n  {line}"
+        );
+        let r = run_case(&format!("seen-{name}"), &mesh, &deck(&block));
+        let c = &r.summary.electrical_contacts[0];
+        assert!(
+            (c.current - j).abs() <= 1e-10 * j,
+            "{name}: current {} A against {j} A",
+            c.current
+        );
+        // V is linear in each bar: every node on the closed form with the jump j/h_e.
+        let exact = |z: f64, side: usize| match side {
+            0 => (V0 - j * z / SIGMA[0], 0.0),
+            _ => (j * (L - z) / SIGMA[1], 0.0),
+        };
+        let dofs = &r.solution.dofs;
+        let v = dofs.nodal_values(dofs.field("voltage").unwrap(), &r.solution.u);
+        let t = dofs.nodal_values(dofs.field("temperature").unwrap(), &r.solution.u);
+        let mut ev = 0.0f64;
+        for (b, block) in r.mesh.blocks.iter().enumerate() {
+            for k in 0..block.len() {
+                let e = seam::mesh::ElemId(block.first_elem.0 + k as u32);
+                for n in r.mesh.elem_nodes(e) {
+                    let (ve, _) = exact(r.mesh.coords[n.index()][2], b);
+                    ev = ev.max((v[n.index()] - ve).abs() / V0);
+                }
+            }
+        }
+        assert!(ev < 1e-10, "{name}: V error {ev:e}");
+        // The power fed leaves as heat: the bulk's and the contact's Joule heat.
+        let power = j * (mean_at(&r.mesh, &v, 0.0) - mean_at(&r.mesh, &v, L));
+        let out =
+            H_C * (mean_at(&r.mesh, &t, 0.0) - T_INF) + H_C * (mean_at(&r.mesh, &t, L) - T_INF);
+        assert!(
+            (power - out).abs() <= 1e-10 * power,
+            "{name}: power {power} W against {out} W leaving"
+        );
+        assert!(c.joule_heat > 0.0, "{name}: the contact heats");
+        eprintln!(
+            "contact gap voltage {name}: current {:.12} A (closed form {j:.12}), V error {ev:.1e}, Newton {}",
+            c.current, r.solution.newton_iterations
+        );
+        currents.push(j);
+    }
+    // The choices differ (so each check above tells them apart), and `side_a` is what an
+    // expression of volt_a sees without the line.
+    assert!((currents[1] - currents[0]).abs() < 1e-12 * currents[0]);
+    assert!((currents[2] - currents[1]).abs() > 1e-3 * currents[1]);
+    assert!((currents[3] - currents[1]).abs() > 1e-3 * currents[1]);
+    assert!((currents[4] - currents[1]).abs() > 1e-3 * currents[1]);
+}
+
+#[test]
+fn only_an_electrical_contact_sees_voltages() {
+    let mesh = bars([2, 3], [2, 3]);
+    let scratch = crate::scratch("voltage-seen-refusals");
+    let dir = scratch.path();
+    crate::twod::write_mesh(&dir.join("bars.exo"), &mesh);
+    let check = |deck: &str| -> Vec<String> {
+        std::fs::write(dir.join("contact.i"), deck).unwrap();
+        std::fs::write(dir.join("problem.toml"), PROBLEM).unwrap();
+        match seam::run::check(&dir.join("problem.toml")) {
+            Err(RunError::Input(d, _)) => d.errors().map(|d| d.code.to_string()).collect(),
+            Ok(_) => Vec::new(),
+            Err(e) => panic!("{e:?}"),
+        }
+    };
+    let energy = |lines: &str| {
+        format!(
+            "begin contact definition bars\n contact surface a contains surface_2\n contact surface b contains surface_3\n\
+             begin interaction\n  side a a\n  side b b\n end\n\
+             begin enforcement thermal\n  enforcement for energy = gap_conductance\n{lines}\n end\n\
+             begin enforcement electrical\n  enforcement for voltage = tied_voltage\n end\nend\n"
+        )
+    };
+    let plain = energy("  gap conductance coefficient = constant h = 100");
+    assert!(check(&plain).is_empty(), "the deck itself checks");
+    // A thermal conductance naming the voltage.
+    assert_eq!(
+        check(&energy(
+            "  gap conductance coefficient = lua \"100 + volt_a\""
+        )),
+        ["E0431"]
+    );
+    // `Contact Gap Voltage` in the Energy block, and in a voltage tie's.
+    assert_eq!(
+        check(&energy(
+            "  gap conductance coefficient = constant h = 100\n  contact gap voltage = mean"
+        )),
+        ["E0431"]
+    );
+    assert_eq!(
+        check(&deck(
+            "  enforcement for voltage = tied_voltage\n  contact gap voltage = side_a"
+        )),
+        ["E0431"]
+    );
 }

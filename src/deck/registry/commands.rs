@@ -205,10 +205,12 @@ pub static COMMANDS: &[CommandSpec] = &[
         "= side_a|side_b|mean",
         "The temperature a temperature-dependent conductance sees at a contact point: side A's, side B's, or their mean (`average`)."
     ),
-    refused!(
+    cmd!(
         "contact gap voltage",
         "contact_gap_voltage",
-        "a conductance that depends on the voltage, which seam's conductance models do not (an electrical contact conductance sees the two sides' temperatures, as `contact gap temperature` says)"
+        [ENF],
+        "= side_a|side_b|mean",
+        "The voltage a voltage-dependent electrical contact conductance (a Lua coefficient naming `volt_a`/`volt_b`) sees at a contact point: side A's, side B's, or their mean (`average`). In an `Enforcement for Voltage` block only (else E0431)."
     ),
     refused!(
         "offset darcy potential",

@@ -211,38 +211,13 @@ impl Lower {
                             .set(format!("{d}.enforcement.{k}.contact_pressure"), v_at);
                     }
                 }
-                "contact_gap_temperature" => {
+                "contact_gap_temperature" | "contact_gap_voltage" => {
                     self.once(&mut seen, &c);
-                    c.skip_sep();
-                    let rest = c.rest();
-                    c.pos = line.tokens.len();
-                    let words: Vec<String> =
-                        rest.iter().map(|t| t.lower.replace('_', " ")).collect();
-                    let value = words.join(" ");
-                    let choice = match value.as_str() {
-                        "side a" => Some(GapTemperature::SideA),
-                        "side b" => Some(GapTemperature::SideB),
-                        "mean" | "average" | "avg" => Some(GapTemperature::Mean),
-                        _ => None,
-                    };
-                    match choice {
-                        Some(g) => e.contact_gap_temperature = Some(g),
-                        None if rest.is_empty() => self.missing(&c, "`side_a`, `side_b` or `mean`"),
-                        None => {
-                            let hint = did_you_mean(&value, ["side a", "side b", "mean"])
-                                .map(|s| format!("did you mean `{}`? ", s.replace(' ', "_")))
-                                .unwrap_or_default();
-                            self.push(
-                                Diagnostic::error(
-                                    codes::BAD_CHOICE,
-                                    format!("unknown contact gap temperature `{value}`"),
-                                )
-                                .at(self.span(rest))
-                                .help(format!(
-                                    "{hint}the choices are `side_a`, `side_b` and `mean` (the temperature a temperature-dependent conductance sees)"
-                                )),
-                            );
-                        }
+                    let voltage = c.cmd.key == "contact_gap_voltage";
+                    let choice = self.gap_choice(&mut c, voltage);
+                    match voltage {
+                        true => e.contact_gap_voltage = choice,
+                        false => e.contact_gap_temperature = choice,
                     }
                 }
                 "plugin_isolation" => {
@@ -304,6 +279,47 @@ impl Lower {
 
     /// `= [constant [value =]] <number>`: the material-model form `Constant Value = v`
     /// and the plain `= v`.
+    /// The value of a `Contact Gap Temperature` (or, `voltage`, `Contact Gap Voltage`)
+    /// line: `side_a`, `side_b`, `mean` (`average`), or `[constant [value =]] <v>`.
+    fn gap_choice(&mut self, c: &mut Cur, voltage: bool) -> Option<GapTemperature> {
+        let what = if voltage { "voltage" } else { "temperature" };
+        c.skip_sep();
+        if c.peek()
+            .is_some_and(|t| t.lower == "constant" || t.lower.parse::<f64>().is_ok())
+        {
+            let fixed = self.constant_value(c, &format!("a {what}"));
+            return fixed.map(|(v, _)| GapTemperature::Constant(v));
+        }
+        let rest = c.rest();
+        c.pos = c.line.tokens.len();
+        let words: Vec<String> = rest.iter().map(|t| t.lower.replace('_', " ")).collect();
+        let value = words.join(" ");
+        match value.as_str() {
+            "side a" => return Some(GapTemperature::SideA),
+            "side b" => return Some(GapTemperature::SideB),
+            "mean" | "average" | "avg" => return Some(GapTemperature::Mean),
+            _ => {}
+        }
+        if rest.is_empty() {
+            self.missing(c, "`side_a`, `side_b`, `mean` or `constant value = <v>`");
+            return None;
+        }
+        let hint = did_you_mean(&value, ["side a", "side b", "mean"])
+            .map(|s| format!("did you mean `{}`? ", s.replace(' ', "_")))
+            .unwrap_or_default();
+        self.push(
+            Diagnostic::error(
+                codes::BAD_CHOICE,
+                format!("unknown contact gap {what} `{value}`"),
+            )
+            .at(self.span(rest))
+            .help(format!(
+                "{hint}the choices are `side_a`, `side_b`, `mean` and `constant value = <v>` (the {what} a {what}-dependent conductance sees)"
+            )),
+        );
+        None
+    }
+
     pub(super) fn constant_value(&mut self, c: &mut Cur, what: &str) -> Option<(f64, Loc)> {
         c.skip_sep();
         if c.peek()

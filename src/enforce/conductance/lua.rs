@@ -15,10 +15,15 @@ pub const FD_FLOOR_TEMPERATURE: f64 = 1.0;
 pub const FD_FLOOR_PRESSURE: f64 = 1.0;
 pub const FD_FLOOR_GAP: f64 = 1e-9;
 
+/// Floor of the finite-difference step in a voltage (V).
+pub const FD_FLOOR_VOLTAGE: f64 = 1e-3;
+
 /// The parameters of an expression, in call order. `T_A`/`T_B` are aliases of
-/// `temp_a`/`temp_b` (the same values are passed twice).
-const PARAMS: [&str; 10] = [
-    "gap", "temp_a", "temp_b", "pressure", "x", "y", "z", "t", "T_A", "T_B",
+/// `temp_a`/`temp_b` (the same values are passed twice), `V_A`/`V_B` of
+/// `volt_a`/`volt_b`, which only an electrical contact passes (elsewhere they are nil).
+const PARAMS: [&str; 14] = [
+    "gap", "temp_a", "temp_b", "pressure", "x", "y", "z", "t", "T_A", "T_B", "volt_a", "volt_b",
+    "V_A", "V_B",
 ];
 
 /// Which of (gap, pressure, temp_a, temp_b) the code may depend on: an expression
@@ -31,6 +36,8 @@ struct Uses {
     pressure: bool,
     temp_a: bool,
     temp_b: bool,
+    volt_a: bool,
+    volt_b: bool,
 }
 
 impl Uses {
@@ -39,6 +46,8 @@ impl Uses {
         pressure: true,
         temp_a: true,
         temp_b: true,
+        volt_a: true,
+        volt_b: true,
     };
 
     fn of_expression(expr: &str) -> Uses {
@@ -52,13 +61,16 @@ impl Uses {
             pressure: named(&["pressure"]),
             temp_a: named(&["temp_a", "T_A"]),
             temp_b: named(&["temp_b", "T_B"]),
+            volt_a: named(&["volt_a", "V_A"]),
+            volt_b: named(&["volt_b", "V_B"]),
         }
     }
 }
 
 /// h from Lua: an expression in `gap, temp_a, temp_b, pressure, x, y, z, t` (with
-/// `T_A`, `T_B` as aliases), or a global function of a file called with
-/// `(gap, temp_a, temp_b, pressure, x, y, z, t)`.
+/// `T_A`, `T_B` as aliases) and, at an electrical contact, `volt_a, volt_b` (`V_A`,
+/// `V_B`), or a global function of a file called with `(gap, temp_a, temp_b, pressure,
+/// x, y, z, t)`, and `volt_a, volt_b` after them at an electrical contact.
 ///
 /// One sandbox per model (limits [`Limits::default`]: 16 MiB, 10⁷ instructions per
 /// call). Not `Send`: the Lua state stays on the thread that built the model; build
@@ -133,14 +145,24 @@ impl LuaConductance {
         })
     }
 
-    fn call(&self, s: &PointState) -> Result<f64, ConductanceError> {
-        let args = [
+    fn call(&self, (s, volts): (&PointState, Option<[f64; 2]>)) -> Result<f64, ConductanceError> {
+        let [va, vb] = volts.unwrap_or([0.0; 2]);
+        let all = [
             s.gap, s.temp_a, s.temp_b, s.pressure, s.x[0], s.x[1], s.x[2], s.time, s.temp_a,
-            s.temp_b,
+            s.temp_b, va, vb, va, vb,
         ];
-        let n = if self.alias_args { 10 } else { 8 };
+        let file = [
+            s.gap, s.temp_a, s.temp_b, s.pressure, s.x[0], s.x[1], s.x[2], s.time, va, vb,
+        ];
+        // Without voltages the voltage parameters are left out: nil to the code.
+        let args: &[f64] = match (self.alias_args, volts.is_some()) {
+            (true, true) => &all,
+            (true, false) => &all[..10],
+            (false, true) => &file,
+            (false, false) => &file[..8],
+        };
         self.sandbox
-            .call(&self.f, &args[..n])
+            .call(&self.f, args)
             .map_err(|e| ConductanceError::Evaluation {
                 model: self.label.clone(),
                 state: *s,
@@ -148,22 +170,72 @@ impl LuaConductance {
             })
     }
 
-    /// Central difference in the variable `get`/`set` select.
+    /// Central difference in the variable `field` selects.
     fn central(
         &self,
-        s: &PointState,
+        at: (&PointState, Option<[f64; 2]>),
         floor: f64,
-        field: fn(&mut PointState) -> &mut f64,
+        field: fn(&mut (PointState, [f64; 2])) -> &mut f64,
     ) -> Result<f64, ConductanceError> {
-        let mut p = *s;
+        let mut p = (*at.0, at.1.unwrap_or([0.0; 2]));
+        let volts = at.1.is_some();
         let x = *field(&mut p);
         let step = f64::EPSILON.cbrt() * x.abs().max(floor);
         let step = (x + step) - x;
         *field(&mut p) = x + step;
-        let up = self.call(&p)?;
+        let up = self.call((&p.0, volts.then_some(p.1)))?;
         *field(&mut p) = x - step;
-        let down = self.call(&p)?;
+        let down = self.call((&p.0, volts.then_some(p.1)))?;
         Ok((up - down) / (2.0 * step))
+    }
+
+    /// h and its derivatives at `s` (with the voltages, at an electrical contact).
+    fn evaluate_at(
+        &self,
+        s: &PointState,
+        volts: Option<[f64; 2]>,
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        let at = (s, volts);
+        let mut c = Conductance {
+            h: self.call(at)?,
+            ..Conductance::default()
+        };
+        if c.h < 0.0 {
+            return check(self, s, c).map(|c| (c, [0.0; 2]));
+        }
+        if self.uses.gap {
+            c.dh_dgap = self.central(at, FD_FLOOR_GAP, |p| &mut p.0.gap)?;
+        }
+        if self.uses.pressure {
+            c.dh_dpressure = self.central(at, FD_FLOOR_PRESSURE, |p| &mut p.0.pressure)?;
+        }
+        if self.uses.temp_a {
+            c.dh_dtemp_a = self.central(at, FD_FLOOR_TEMPERATURE, |p| &mut p.0.temp_a)?;
+        }
+        if self.uses.temp_b {
+            c.dh_dtemp_b = self.central(at, FD_FLOOR_TEMPERATURE, |p| &mut p.0.temp_b)?;
+        }
+        let mut dv = [0.0; 2];
+        if volts.is_some() {
+            if self.uses.volt_a {
+                dv[0] = self.central(at, FD_FLOOR_VOLTAGE, |p| &mut p.1[0])?;
+            }
+            if self.uses.volt_b {
+                dv[1] = self.central(at, FD_FLOOR_VOLTAGE, |p| &mut p.1[1])?;
+            }
+            if let Some((what, &value)) = (["dh/dV_A", "dh/dV_B"].iter())
+                .zip(&dv)
+                .find(|(_, v)| !v.is_finite())
+            {
+                return Err(ConductanceError::NotFinite {
+                    model: self.name(),
+                    state: *s,
+                    what,
+                    value,
+                });
+            }
+        }
+        Ok((check(self, s, c)?, dv))
     }
 }
 
@@ -180,33 +252,30 @@ impl ConductanceModel for LuaConductance {
 
     fn value(&self, s: &PointState) -> Result<f64, ConductanceError> {
         let c = Conductance {
-            h: self.call(s)?,
+            h: self.call((s, None))?,
             ..Conductance::default()
         };
         check(self, s, c).map(|c| c.h)
     }
 
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
-        let mut c = Conductance {
-            h: self.call(s)?,
-            ..Conductance::default()
-        };
-        if c.h < 0.0 {
-            return check(self, s, c);
-        }
-        if self.uses.gap {
-            c.dh_dgap = self.central(s, FD_FLOOR_GAP, |p| &mut p.gap)?;
-        }
-        if self.uses.pressure {
-            c.dh_dpressure = self.central(s, FD_FLOOR_PRESSURE, |p| &mut p.pressure)?;
-        }
-        if self.uses.temp_a {
-            c.dh_dtemp_a = self.central(s, FD_FLOOR_TEMPERATURE, |p| &mut p.temp_a)?;
-        }
-        if self.uses.temp_b {
-            c.dh_dtemp_b = self.central(s, FD_FLOOR_TEMPERATURE, |p| &mut p.temp_b)?;
-        }
-        check(self, s, c)
+        self.evaluate_at(s, None).map(|(c, _)| c)
+    }
+
+    /// An expression that names `volt_a`/`volt_b` (`V_A`/`V_B`). A file function is not
+    /// known to: it is passed the voltages (and differentiated in them) at an electrical
+    /// contact, and gets nil for them elsewhere, so using them there is a Lua error that
+    /// names the model and the point.
+    fn depends_on_voltage(&self) -> bool {
+        self.alias_args && (self.uses.volt_a || self.uses.volt_b)
+    }
+
+    fn evaluate_with_voltage(
+        &self,
+        s: &PointState,
+        volts: [f64; 2],
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        self.evaluate_at(s, Some(volts))
     }
 }
 

@@ -177,10 +177,29 @@ pub trait ConductanceModel {
     fn mechanisms(&self) -> &[Box<dyn ConductanceModel>] {
         &[]
     }
+
+    /// Whether h may change with the voltages of the two sides (an electrical contact
+    /// conductance of `Contact Gap Voltage`): only a Lua model that names them does.
+    fn depends_on_voltage(&self) -> bool {
+        false
+    }
+
+    /// h and its derivatives at `state` with the voltages `volts` = [V_A, V_B] of an
+    /// electrical contact, and [dh/dV_A, dh/dV_B]. A model that does not see voltages
+    /// ignores them.
+    fn evaluate_with_voltage(
+        &self,
+        state: &PointState,
+        volts: [f64; 2],
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        let _ = volts;
+        Ok((self.evaluate(state)?, [0.0; 2]))
+    }
 }
 
-/// Which temperature a conductance sees at a point (`Contact Gap Temperature`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Which temperature a conductance sees at a point (`Contact Gap Temperature`), or which
+/// voltage (`Contact Gap Voltage`, [`SeenTemperature::wrap_voltage`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum SeenTemperature {
     /// Both sides' temperatures, each model using them as it defines (most take the
     /// mean; radiation takes both).
@@ -192,6 +211,9 @@ pub enum SeenTemperature {
     SideB,
     /// The mean (T_A + T_B)/2, as both T_A and T_B.
     Mean,
+    /// A constant, as both T_A and T_B (the conductance then does not change with the
+    /// temperatures).
+    Constant(f64),
 }
 
 impl SeenTemperature {
@@ -203,13 +225,68 @@ impl SeenTemperature {
         }
     }
 
+    /// `model` seeing this voltage on both sides (itself for [`SeenTemperature::Both`]).
+    pub fn wrap_voltage(self, model: Box<dyn ConductanceModel>) -> Box<dyn ConductanceModel> {
+        match self {
+            SeenTemperature::Both => model,
+            seen => Box::new(SeeingVoltage { inner: model, seen }),
+        }
+    }
+
     /// The temperature seen and its derivatives with respect to T_A and T_B.
     fn of(self, s: &PointState) -> (f64, f64, f64) {
+        self.of_pair(s.temp_a, s.temp_b)
+    }
+
+    /// The value seen of the sides' `a` and `b`, and its derivatives with respect to
+    /// them.
+    fn of_pair(self, a: f64, b: f64) -> (f64, f64, f64) {
         match self {
-            SeenTemperature::Both | SeenTemperature::Mean => (s.mean_temperature(), 0.5, 0.5),
-            SeenTemperature::SideA => (s.temp_a, 1.0, 0.0),
-            SeenTemperature::SideB => (s.temp_b, 0.0, 1.0),
+            SeenTemperature::Both | SeenTemperature::Mean => (0.5 * (a + b), 0.5, 0.5),
+            SeenTemperature::SideA => (a, 1.0, 0.0),
+            SeenTemperature::SideB => (b, 0.0, 1.0),
+            SeenTemperature::Constant(v) => (v, 0.0, 0.0),
         }
+    }
+}
+
+/// A model evaluated at one voltage V_s on both sides; by the chain rule
+/// dh/dV_A = (∂h/∂V_A + ∂h/∂V_B) dV_s/dV_A, and the same for B.
+struct SeeingVoltage {
+    inner: Box<dyn ConductanceModel>,
+    seen: SeenTemperature,
+}
+
+impl ConductanceModel for SeeingVoltage {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+
+    fn evaluate(&self, state: &PointState) -> Result<Conductance, ConductanceError> {
+        self.inner.evaluate(state)
+    }
+
+    fn value(&self, state: &PointState) -> Result<f64, ConductanceError> {
+        self.inner.value(state)
+    }
+
+    fn depends_on_temperature(&self) -> bool {
+        self.inner.depends_on_temperature()
+    }
+
+    fn depends_on_voltage(&self) -> bool {
+        self.inner.depends_on_voltage()
+    }
+
+    fn evaluate_with_voltage(
+        &self,
+        state: &PointState,
+        [va, vb]: [f64; 2],
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        let (v, da, db) = self.seen.of_pair(va, vb);
+        let (c, [dva, dvb]) = self.inner.evaluate_with_voltage(state, [v, v])?;
+        let d = dva + dvb;
+        Ok((c, [d * da, d * db]))
     }
 }
 
@@ -256,7 +333,27 @@ impl ConductanceModel for Seeing {
     }
 
     fn depends_on_temperature(&self) -> bool {
-        self.inner.depends_on_temperature()
+        !matches!(self.seen, SeenTemperature::Constant(_)) && self.inner.depends_on_temperature()
+    }
+
+    fn depends_on_voltage(&self) -> bool {
+        self.inner.depends_on_voltage()
+    }
+
+    fn evaluate_with_voltage(
+        &self,
+        state: &PointState,
+        volts: [f64; 2],
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        let (seen, da, db) = self.state(state);
+        let (c, dv) = self.inner.evaluate_with_voltage(&seen, volts)?;
+        let d = c.dh_dtemp_a + c.dh_dtemp_b;
+        let c = Conductance {
+            dh_dtemp_a: d * da,
+            dh_dtemp_b: d * db,
+            ..c
+        };
+        Ok((c, dv))
     }
 }
 
@@ -704,6 +801,22 @@ impl ConductanceModel for Sum {
     }
     fn mechanisms(&self) -> &[Box<dyn ConductanceModel>] {
         &self.parts
+    }
+    fn depends_on_voltage(&self) -> bool {
+        self.parts.iter().any(|p| p.depends_on_voltage())
+    }
+    fn evaluate_with_voltage(
+        &self,
+        s: &PointState,
+        volts: [f64; 2],
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        let (mut total, mut dv) = (Conductance::default(), [0.0; 2]);
+        for p in &self.parts {
+            let (c, d) = p.evaluate_with_voltage(s, volts)?;
+            total = total + c;
+            dv = [dv[0] + d[0], dv[1] + d[1]];
+        }
+        Ok((check(self, s, total)?, dv))
     }
 }
 

@@ -92,6 +92,10 @@ pub struct HValue {
     pub h: f64,
     pub dh_dtemp_a: f64,
     pub dh_dtemp_b: f64,
+    /// dh/dV_A and dh/dV_B: an electrical contact conductance that sees the voltages
+    /// (`Contact Gap Voltage`); 0 for every other.
+    pub dh_dvolt_a: f64,
+    pub dh_dvolt_b: f64,
 }
 
 /// What the conductance may depend on at a point.
@@ -100,6 +104,10 @@ pub struct HInput {
     pub gap: f64,
     pub temp_a: f64,
     pub temp_b: f64,
+    /// The voltages on side A and at the projection on side B, at an electrical
+    /// contact; 0 at a thermal one.
+    pub volt_a: f64,
+    pub volt_b: f64,
     pub x: [f64; 3],
     /// Index of the point in the pairing's point list (for per-point data such as a
     /// nodal contact pressure).
@@ -688,6 +696,8 @@ impl InterfacePoints {
                 gap: p.gap,
                 temp_a,
                 temp_b,
+                volt_a: 0.0,
+                volt_b: 0.0,
                 x: p.x,
                 point: p.index as usize,
             })

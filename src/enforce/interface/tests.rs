@@ -45,6 +45,7 @@ static H: fn(&HInput) -> Result<HValue, String> = |p| {
         h: 50.0 + 0.1 * p.temp_a + 0.2 * p.temp_b,
         dh_dtemp_a: 0.1,
         dh_dtemp_b: 0.2,
+        ..HValue::default()
     })
 };
 
