@@ -180,8 +180,18 @@ impl RunContact {
             ..RunContact::default()
         };
         out.electrical = scene.electrical;
-        out.species = scene.species.into_iter().map(Into::into).collect();
-        out.voltage_ties = scene.voltage_ties.into_iter().map(Into::into).collect();
+        let field = |e: crate::scene::species::FieldEnforced| {
+            let every = scene
+                .definitions
+                .get(e.definition)
+                .and_then(|d| d.search_every);
+            super::species::Interface {
+                search_every: every,
+                ..e.into()
+            }
+        };
+        out.species = scene.species.into_iter().map(field).collect();
+        out.voltage_ties = scene.voltage_ties.into_iter().map(field).collect();
         for e in scene.entries {
             out.again.get_mut().push(e.again);
             out.definition.push(e.definition);

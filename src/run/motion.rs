@@ -259,12 +259,34 @@ pub(super) fn refuse_what_cannot_move(
             );
         }
     }
-    let electrical = (contact.electrical.iter().map(|e| (&e.side_a, &e.side_b)))
-        .chain((contact.voltage_ties.iter()).map(|t| (&t.pairing.side_a, &t.pairing.side_b)));
-    if let Some((a, b)) = electrical.into_iter().next() {
+    if let Some(e) = contact.electrical.first() {
         refuse(
-            format!("electrical contact {a} / {b} keeps the pairing of the first search"),
-            "remove the [displacement], or the `Enforcement for Voltage` block",
+            format!(
+                "electrical contact {} / {} keeps the pairing of the first search",
+                e.side_a, e.side_b
+            ),
+            "remove the [displacement], or join the voltages by a Nitsche tie (`Enforcement for Voltage = Tied_Voltage`), which moves",
         );
+    }
+    // Species interfaces and voltage ties move as the Energy interactions do, except
+    // multiplier ties and periodic pairs.
+    let fields = (contact.species.iter().map(|s| ("species interface", s)))
+        .chain(contact.voltage_ties.iter().map(|t| ("voltage tie", t)));
+    for (what, f) in fields {
+        let p = &f.pairing;
+        if f.choice.mortar {
+            refuse(
+                format!(
+                    "{what} {} / {} is a tie with Lagrange multipliers ({}), whose rows are made once for the run",
+                    p.side_a, p.side_b, f.choice.name
+                ),
+                "tie moving surfaces with Nitsche (`Tied_Species`, `Tied_Voltage`), or remove the [displacement]",
+            );
+        } else if p.periodic {
+            refuse(
+                format!("{what} {} / {} is a periodic pair", p.side_a, p.side_b),
+                "periodic species and voltage interfaces do not move yet: remove the [displacement]",
+            );
+        }
     }
 }

@@ -172,17 +172,6 @@ impl<'a> Physics<'a> {
         diags: &mut Diagnostics,
     ) {
         let (mesh, entries) = (self.mesh, &contact.species);
-        if let (Some(e), Some(_)) = (entries.first(), &self.problem.displacement) {
-            diags.push(
-                Diagnostic::error(
-                    "E0432",
-                    "species interfaces on surfaces that move ([displacement]) are not supported yet: their pairs would keep the first search's points",
-                )
-                .at(Some(e.at.clone()))
-                .help("run the species on a mesh that does not move, or remove the `Enforcement for Species` block"),
-            );
-            return;
-        }
         super::species::check_interfaces(mesh, &self.species, entries, diags);
         if diags.has_errors() {
             return;

@@ -429,6 +429,10 @@ pub(super) struct Interface {
     pub partition: f64,
     /// The enforcement block.
     pub at: crate::diag::Loc,
+    /// What searching it again takes, when the surfaces move; taken by the embedding.
+    pub again: std::cell::RefCell<Option<crate::scene::SearchAgain>>,
+    /// Its definition's `Update Search Every n Steps`, when the surfaces move.
+    pub search_every: Option<u32>,
 }
 
 impl From<FieldEnforced> for Interface {
@@ -440,6 +444,8 @@ impl From<FieldEnforced> for Interface {
             model: e.model.map(Arc::from),
             partition: e.partition,
             at: e.at,
+            again: std::cell::RefCell::new(e.again),
+            search_every: None,
         }
     }
 }

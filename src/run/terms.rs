@@ -219,7 +219,9 @@ impl<'a> ContactTerms<'a> {
             // A step taken again (a cutback, a new pattern) is placed again, not
             // searched or counted again.
             let again = moving.searched_step == Some(step);
-            let mut due: Vec<usize> = (0..self.contact.pairings.len())
+            // Every interaction of the embedding: the Energy ones, then the species
+            // interfaces and voltage ties.
+            let mut due: Vec<usize> = (0..self.term_choice.len())
                 .filter(|&k| !again && self.motion.is_some() && self.schedule(k).full_search(step))
                 .collect();
             // Element death makes the surfaces again, and they are searched.
@@ -234,7 +236,7 @@ impl<'a> ContactTerms<'a> {
                     moving.counts.surface_updates += 1;
                 }
             }
-            due.retain(|&k| !moving.gone[k]);
+            due.retain(|&k| !moving.gone.get(k).copied().unwrap_or(false));
             moving.searched_step = Some(step);
             if !due.is_empty() {
                 embedding.search_some(&due).map_err(failure)?;
@@ -299,8 +301,17 @@ impl<'a> ContactTerms<'a> {
     }
 
     /// The search schedule of interaction `k`'s definition.
+    /// The search schedule of embedding interaction `k`: an Energy interaction's, or
+    /// a species interface's or voltage tie's (after them).
     fn schedule(&self, k: usize) -> SearchSchedule {
-        SearchSchedule::new(self.contact.search_every.get(k).copied().flatten())
+        let energy = self.contact.search_every.len();
+        let species = self.contact.species.len();
+        let every = match k.checked_sub(energy) {
+            None => self.contact.search_every[k],
+            Some(s) if s < species => self.contact.species[s].search_every,
+            Some(s) => (self.contact.voltage_ties.get(s - species)).and_then(|v| v.search_every),
+        };
+        SearchSchedule::new(every)
     }
 
     /// Hand the run's interactions to an embedding over the solve's `dofs` (the fields,
@@ -381,7 +392,7 @@ impl<'a> ContactTerms<'a> {
                     s.pairing.clone(),
                     (&choice, s.penalty_scale),
                     model,
-                    None,
+                    s.again.borrow_mut().take(),
                     field.into(),
                 );
                 embedding.set_coefficient(k, coefficient.clone());
@@ -407,7 +418,7 @@ impl<'a> ContactTerms<'a> {
                     v.pairing.clone(),
                     (&v.choice, v.penalty_scale),
                     v.model.clone(),
-                    None,
+                    v.again.borrow_mut().take(),
                     field.into(),
                 );
                 embedding.set_coefficient(k, coefficient.clone());

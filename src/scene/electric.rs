@@ -143,6 +143,7 @@ pub(super) fn electrical(
             partition: 1.0,
             definition: d,
             at: enf.at.clone(),
+            again: None,
         })));
     }
     let (conductance, pressure) = voltage_model(enf, deck_dir, sources, pair, diags)?;

@@ -47,6 +47,7 @@ use crate::surface;
 
 use enforcement::{resolve_for, seen_temperature};
 use interaction::Interaction;
+use species::FieldEnforced;
 
 /// The equation every supported enforcement applies to.
 const ENERGY: &str = "energy";
@@ -190,10 +191,10 @@ pub struct ContactScene {
     /// The electrical contacts of the definitions' `Enforcement for Voltage` blocks.
     pub electrical: Vec<electric::ElectricalEnforced>,
     /// The species interfaces of the definitions' `Enforcement for Species` blocks.
-    pub species: Vec<species::FieldEnforced>,
+    pub species: Vec<FieldEnforced>,
     /// The voltage ties of the definitions' `Enforcement for Voltage` blocks (a tie model
     /// in place of a contact conductance).
-    pub voltage_ties: Vec<species::FieldEnforced>,
+    pub voltage_ties: Vec<FieldEnforced>,
     /// Per contact definition of the deck, in deck order.
     pub definitions: Vec<DefinitionNotes>,
     /// Number of contact surfaces built, over every definition.
@@ -295,12 +296,23 @@ impl ContactScene {
                 let interaction = list
                     .iter()
                     .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
+                // What searching a species interface or voltage tie again takes (surfaces
+                // that move; a periodic pair's map stays with its Energy entry).
+                let field_again = || {
+                    (keep && !pairing.periodic)
+                        .then(|| search_again((&set, def, mesh), &pairing, interaction, None))
+                };
                 if let Some(v) = voltage.filter(|_| !voltage_failed) {
                     let scale = interaction.map_or(1.0, |i| i.penalty_scale);
                     let sources = &loaded.sources;
                     match electric::electrical(v, (d, scale), &pairing, deck_dir, sources, diags) {
                         Some(electric::Electrical::Contact(e)) => scene.electrical.push(e),
-                        Some(electric::Electrical::Tie(t)) => scene.voltage_ties.push(*t),
+                        Some(electric::Electrical::Tie(t)) => {
+                            scene.voltage_ties.push(FieldEnforced {
+                                again: field_again(),
+                                ..*t
+                            })
+                        }
                         None => voltage_failed = true,
                     }
                 }
@@ -308,7 +320,10 @@ impl ContactScene {
                     let scale = interaction.map_or(1.0, |i| i.penalty_scale);
                     let sources = &loaded.sources;
                     match species::species(s, d, &pairing, scale, deck_dir, sources, diags) {
-                        Some(e) => scene.species.push(e),
+                        Some(e) => scene.species.push(FieldEnforced {
+                            again: field_again(),
+                            ..e
+                        }),
                         None => species_failed = true,
                     }
                 }
@@ -386,20 +401,8 @@ impl ContactScene {
                 if electric::refuse_voltage(enf, model.as_deref(), diags) {
                     continue;
                 }
-                let again = keep.then(|| SearchAgain {
-                    side_a: set.surfaces[pairing.side_a_surface].clone(),
-                    side_b: set.surfaces[pairing.side_b_surface].clone(),
-                    settings: match (interaction, pairing.periodic) {
-                        (Some(i), false) => i.settings.clone(),
-                        _ => search::base_settings(def, mesh.dim),
-                    },
-                    overclosure: match (interaction, pairing.periodic) {
-                        (Some(i), false) => Some(i.overclosure),
-                        _ => None,
-                    },
-                    subdomain: search::subdomain(def),
-                    map,
-                });
+                let again =
+                    keep.then(|| search_again((&set, def, mesh), &pairing, interaction, map));
                 scene.entries.push(Enforced {
                     pairing,
                     choice,
@@ -638,6 +641,30 @@ fn double_claim(
 /// A model that could not be made; the diagnostics say why.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Refused;
+
+/// What searching `pairing` of definition `def` again takes, with its surfaces from
+/// `set`, its interaction's settings and, for a periodic pair, its `map`.
+fn search_again(
+    (set, def, mesh): (&surface::SurfaceSet, &ContactDefinition, &Mesh),
+    pairing: &Pairing,
+    interaction: Option<&Interaction>,
+    map: Option<Box<dyn crate::periodic::PeriodicMap>>,
+) -> SearchAgain {
+    SearchAgain {
+        side_a: set.surfaces[pairing.side_a_surface].clone(),
+        side_b: set.surfaces[pairing.side_b_surface].clone(),
+        settings: match (interaction, pairing.periodic) {
+            (Some(i), false) => i.settings.clone(),
+            _ => search::base_settings(def, mesh.dim),
+        },
+        overclosure: match (interaction, pairing.periodic) {
+            (Some(i), false) => Some(i.overclosure),
+            _ => None,
+        },
+        subdomain: search::subdomain(def),
+        map,
+    }
+}
 
 /// The conductance model of an enforcement: from its `Gap Conductance Coefficient` lines
 /// (Lua compiled, tables checked) or its plugin (loaded and probed). `Err` when it could

@@ -53,6 +53,8 @@ pub struct FieldEnforced {
     pub definition: usize,
     /// The enforcement block, for messages.
     pub at: Loc,
+    /// What searching it again takes, when the surfaces move (as an Energy entry's).
+    pub again: Option<super::SearchAgain>,
 }
 
 /// The species block of `def`, if it has one; two, or one that claims another equation
@@ -106,6 +108,7 @@ pub(super) fn species(
         partition: enf.partition_coefficient.unwrap_or(1.0),
         definition: d,
         at: enf.at.clone(),
+        again: None,
     })
 }
 

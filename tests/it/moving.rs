@@ -410,3 +410,91 @@ fn death_input_that_cannot_act_is_refused_at_its_line() {
     let steady = text.replace("kind = \"transient\"", "kind = \"steady\"");
     assert_eq!(check(&steady)[0].0, "E0732");
 }
+
+/// The two blocks carrying a species and a voltage beside the temperature, block 2
+/// coming down as in [`LUA_DOWN`]: the species crosses a mass-transfer interface whose
+/// coefficient is the gap law `0.05 / gap` (m/s), the voltage a Nitsche tie. c = 1 and V
+/// = 1 at z = 0, c = 0 and V = 0 on block 2's top, D = σ = 1, capacities small enough
+/// that every step is steady. Each step's mass flux must follow the series law at that
+/// step's gap, 1 / (1 + g/0.05 + 1) — the heat law of [`series_heat`] — and the current
+/// through the tie stays 1/(1 + 1) A whatever the gap.
+#[test]
+fn species_interfaces_and_voltage_ties_move_with_the_surfaces() {
+    let tmp = scratch("moving-fields");
+    let dir = tmp.path();
+    ExodusWriter::create(&dir.join("mesh.exo"), &parts(G0), &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    let problem = stack_problem(&format!(
+        "{LUA_DOWN}\
+         [[bc]]\nkind = \"species\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
+         [[bc]]\nkind = \"species\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n\
+         [[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
+         [[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n"
+    ))
+    .replace(
+        "conductivity = 1.0\nrho_c = 1e-12\n",
+        "conductivity = 1.0\nrho_c = 1e-12\ndiffusivity = 1.0\nspecies_capacity = 1e-12\nelectrical_conductivity = 1.0\n",
+    );
+    std::fs::write(dir.join("problem.toml"), problem).unwrap();
+    let deck = |every: &str| {
+        format!(
+            "begin contact definition\n  contact surface a contains surface_2\n  contact surface b contains surface_3\n{every}\
+             begin search options\n    normal tolerance = 0.3\n  end\n\
+             begin interaction\n    side a a\n    side b b\n  end\n\
+             begin enforcement thermal\n    enforcement for energy = gap_conductance\n    gap conductance coefficient = gas_gap k = {K_GAS} min_gap = 1e-4\n  end\n\
+             begin enforcement mass\n    enforcement for species = gap_conductance\n    gap conductance coefficient = lua \"{K_GAS} / gap\"\n  end\n\
+             begin enforcement electrical\n    enforcement for voltage = tied_voltage\n  end\nend\n"
+        )
+    };
+    for every in ["", "  update search every 3 steps\n"] {
+        std::fs::write(dir.join("contact.i"), deck(every)).unwrap();
+        let r = run(&dir.join("problem.toml"));
+        assert_eq!(r.history.len(), 10, "ten steps");
+        let mut worst = (0.0f64, 0.0f64);
+        for (s, flux) in r.history.iter().zip(&r.species_flux) {
+            let exact = series_heat(G0 - SPEED * s.time);
+            let (a, b) = flux[0];
+            worst.0 = worst
+                .0
+                .max((a - exact).abs().max((-b - exact).abs()) / exact);
+            let current = s.electric[0].current;
+            worst.1 = worst.1.max((current - 0.5).abs() / 0.5);
+        }
+        eprintln!(
+            "moving species and voltage tie (schedule {every:?}): worst mass flux {:.1e}, worst current {:.1e}",
+            worst.0, worst.1
+        );
+        assert!(
+            worst.0 <= 1e-8,
+            "mass flux against the gap law: {:e}",
+            worst.0
+        );
+        assert!(worst.1 <= 1e-10, "current through the tie: {:e}", worst.1);
+        let m = r.summary.motion.expect("a moving run reports its searches");
+        let searches = if every.is_empty() { 11 } else { 4 };
+        assert_eq!(m.searches, searches, "{m:?}");
+    }
+    // What does not move yet: a multiplier tie of the species (its rows are made once),
+    // and species interfaces or voltage ties under element death (their surfaces are
+    // not made again).
+    let check = |problem: &str, deck: &str| -> Vec<String> {
+        std::fs::write(dir.join("checked.toml"), problem).unwrap();
+        std::fs::write(dir.join("contact.i"), deck).unwrap();
+        match seam::run::check(&dir.join("checked.toml")) {
+            Ok(_) => Vec::new(),
+            Err(RunError::Input(d, _)) => d.errors().map(|d| d.code.to_string()).collect(),
+            Err(e) => panic!("{e:?}"),
+        }
+    };
+    let problem = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
+    let mortar = deck("").replace(
+        "enforcement for species = gap_conductance\n    gap conductance coefficient = lua \"0.05 / gap\"",
+        "enforcement for species = tied multipliers = dual\n    side b variable species to species",
+    );
+    assert!(mortar.contains("multipliers"), "the deck was edited");
+    assert_eq!(check(&problem, &mortar), ["E0731"]);
+    let dying = problem.replace(LUA_DOWN, "[[death]]\nblocks = [\"block_2\"]\ntime = 5.0\n");
+    assert_eq!(check(&dying, &deck("")), ["E0732"]);
+}
