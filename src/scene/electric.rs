@@ -3,10 +3,11 @@
 //! The voltage block of a definition (one at most) applies to every pair of the
 //! definition, beside the Energy block. Its model is either
 //!
-//! - a contact conductance (`Gap_Conductance`, `Conductance` or `Contact_Resistance`)
-//!   whose `Gap Conductance Coefficient` lines give the electrical contact conductance
-//!   h_e (S/m²) — every coefficient model, plugins included, as for Energy: the
-//!   temperatures they see are the thermal ones at the point. `Offset Voltage` is the
+//! - a contact conductance (`Gap_Conductance`, `Conductance`, `Contact_Resistance` or a
+//!   `Plugin`) whose `Gap Conductance Coefficient` lines give the electrical contact
+//!   conductance h_e (S/m²) — every coefficient model, plugins included, as for Energy:
+//!   the temperatures they see are the thermal ones at the point, and a model may see
+//!   the voltages too (`Contact Gap Voltage`; a plugin gets (V_A, V_B) as its fields). `Offset Voltage` is the
 //!   jump ΔV in `j = h_e (V_A − V_B − ΔV)`, `Joule Heat Fraction Side A` the share of the
 //!   contact's Joule heat given to side A (0.5 by default); or
 //! - a tie, any tie of the Energy equation with the voltage in place of the
@@ -89,7 +90,7 @@ fn is_conductance(enf: &Enforcement) -> bool {
         .is_some_and(|line| {
             matches!(
                 line.model.to_ascii_lowercase().as_str(),
-                "gap_conductance" | "conductance" | "contact_resistance"
+                "gap_conductance" | "conductance" | "contact_resistance" | "plugin"
             )
         })
 }

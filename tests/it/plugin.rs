@@ -36,7 +36,7 @@ fn dll(dir: &Path, stem: &str) -> PathBuf {
 }
 
 /// Compile one C file into a shared library with the CI flags; returns its path.
-fn cc_shared(source: &str, defines: &[&str], stem: &str) -> PathBuf {
+pub(crate) fn cc_shared(source: &str, defines: &[&str], stem: &str) -> PathBuf {
     let dir = tmp().join("plugins-c");
     std::fs::create_dir_all(&dir).expect("create plugins-c");
     let out = dll(&dir, stem);

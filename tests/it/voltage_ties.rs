@@ -270,11 +270,18 @@ type Seen = dyn Fn(f64, f64) -> f64;
 fn contact_gap_voltage_chooses_the_voltage_a_contact_conductance_sees() {
     let mesh = bars([3, 4], [4, 5]);
     let side_a = |a: f64, _: f64| a;
-    let cases: [(&str, &str, &Seen); 5] = [
+    // The same law from a C plugin, which reads V_A from the point's fields.
+    let plugin = crate::plugin::cc_shared("plugins/tests/c/volt_contact.c", &[], "volt_contact");
+    let cases: [(&str, &str, &Seen); 6] = [
         ("both", "", &side_a),
         ("side_a", "contact gap voltage = side_a", &side_a),
         ("side_b", "contact gap voltage = side_b", &|_, b| b),
         ("mean", "contact gap voltage = mean", &|a, b| 0.5 * (a + b)),
+        (
+            "plugin",
+            "contact gap voltage = mean\n  real data 500 2",
+            &|a, b| 0.5 * (a + b),
+        ),
         (
             "constant",
             "contact gap voltage = constant value = 0.1",
@@ -284,9 +291,15 @@ fn contact_gap_voltage_chooses_the_voltage_a_contact_conductance_sees() {
     let mut currents = Vec::new();
     for (name, line, seen) in cases {
         let j = contact_current(seen);
-        let block = format!(
-            "  enforcement for voltage = gap_conductance\n  gap conductance coefficient = lua \"500 * (1 + 2 * volt_a)\"\n  {line}"
-        );
+        let block = match name {
+            "plugin" => format!(
+                "  enforcement for voltage = plugin library = \"{}\"\n  {line}",
+                plugin.display()
+            ),
+            _ => format!(
+                "  enforcement for voltage = gap_conductance\n  gap conductance coefficient = lua \"500 * (1 + 2 * volt_a)\"\n  {line}"
+            ),
+        };
         let r = run_case(&format!("seen-{name}"), &mesh, &deck(&block));
         let c = &r.summary.electrical_contacts[0];
         assert!(
@@ -333,7 +346,8 @@ fn contact_gap_voltage_chooses_the_voltage_a_contact_conductance_sees() {
     assert!((currents[1] - currents[0]).abs() < 1e-12 * currents[0]);
     assert!((currents[2] - currents[1]).abs() > 1e-3 * currents[1]);
     assert!((currents[3] - currents[1]).abs() > 1e-3 * currents[1]);
-    assert!((currents[4] - currents[1]).abs() > 1e-3 * currents[1]);
+    assert!((currents[5] - currents[1]).abs() > 1e-3 * currents[1]);
+    assert!((currents[4] - currents[3]).abs() < 1e-12 * currents[3]);
 }
 
 #[test]

@@ -86,10 +86,50 @@ impl ConductanceModel for PluginConductance {
     }
 
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
+        self.evaluate_fields(s, &[])
+    }
+
+    /// At an electrical contact the plugin gets the voltages (V_A, V_B) as its two
+    /// `fields`; h's derivatives in them are central differences (four calls more,
+    /// exactly 0 for a plugin that does not read them).
+    fn evaluate_with_voltage(
+        &self,
+        s: &PointState,
+        volts: [f64; 2],
+    ) -> Result<(Conductance, [f64; 2]), ConductanceError> {
+        let c = self.evaluate_fields(s, &volts)?;
+        let mut dv = [0.0; 2];
+        for (i, d) in dv.iter_mut().enumerate() {
+            let v = volts[i];
+            let step = f64::EPSILON.cbrt() * v.abs().max(super::lua::FD_FLOOR_VOLTAGE);
+            let step = (v + step) - v;
+            let mut up = volts;
+            up[i] = v + step;
+            let mut down = volts;
+            down[i] = v - step;
+            let (hu, hd) = (
+                self.evaluate_fields(s, &up)?.h,
+                self.evaluate_fields(s, &down)?.h,
+            );
+            *d = (hu - hd) / (2.0 * step);
+        }
+        Ok((c, dv))
+    }
+}
+
+impl PluginConductance {
+    /// h at `s` with `fields` as the point's other fields.
+    fn evaluate_fields(
+        &self,
+        s: &PointState,
+        fields: &[f64],
+    ) -> Result<Conductance, ConductanceError> {
         let ctx = StepContext {
             surface_a: &self.surface_a,
             surface_b: &self.surface_b,
             time: s.time,
+            fields,
+            n_fields: fields.len(),
             ..StepContext::default()
         };
         let point = ContactPoint {
