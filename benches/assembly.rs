@@ -228,6 +228,7 @@ fn interface(n: usize, reps: usize) {
         offset: 0.0,
         beta: DEFAULT_BETA,
         conductivity: &k,
+        conductivity_of_t: None,
     };
     let mut points = None;
     let t_new = timed(reps, || {

@@ -190,6 +190,7 @@ fn main() {
                             offset: 0.0,
                             beta: DEFAULT_BETA,
                             conductivity: &k,
+                            conductivity_of_t: None,
                         },
                         linear: true,
                     }],

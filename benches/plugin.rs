@@ -484,6 +484,7 @@ fn assembly(table_path: &Path) {
             offset: 0.0,
             beta: DEFAULT_BETA,
             conductivity: &k,
+            conductivity_of_t: None,
         };
         let mut best = f64::INFINITY;
         for _ in 0..3 {
@@ -546,6 +547,7 @@ fn assembly(table_path: &Path) {
                 offset: 0.0,
                 beta: DEFAULT_BETA,
                 conductivity: &k,
+                conductivity_of_t: None,
             };
             let s =
                 interface_terms(&mesh, &dofs, field, &a, &b, &r.points, &f, &u).expect("assembly");

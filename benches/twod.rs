@@ -155,6 +155,7 @@ fn main() {
             offset: 0.0,
             beta: DEFAULT_BETA,
             conductivity: &k,
+            conductivity_of_t: None,
         };
         // The interface terms alone: what the assembly does for the contact points.
         let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();

@@ -287,6 +287,7 @@ impl EmbeddingBuilder {
             pairs: Vec::new(),
             time: 0.0,
             evaluation: None,
+            conductivity_law: None,
         })
     }
 }

@@ -539,7 +539,14 @@ pub struct Embedding {
     /// The last [`Embedding::evaluate`]: its CSR pattern is kept until the next search
     /// or move, its values are refreshed in place.
     evaluation: Option<Evaluation>,
+    /// k(T, x, t) per block, when the Nitsche forms of the temperature weigh the flux
+    /// with the conductivity at each point's temperatures (`None`: `conductivity`).
+    conductivity_law: Option<std::sync::Arc<ConductivityOfT>>,
 }
+
+/// k and dk/dT of block `b` at temperature `t`, point `x` and time `time`.
+pub(crate) type ConductivityOfT =
+    dyn Fn(usize, f64, [f64; 3], f64) -> Result<(f64, f64), String> + Send + Sync;
 
 mod add;
 mod builder;

@@ -134,6 +134,7 @@ impl Embedding {
             pairs: Vec::new(),
             time: 0.0,
             evaluation: None,
+            conductivity_law: None,
         }
     }
 
@@ -160,6 +161,20 @@ impl Embedding {
             e.outdate();
         }
         self.pairs.len() - 1
+    }
+
+    /// Weigh the Nitsche forms of the temperature's interactions with k(T) of each block
+    /// at each point's temperatures (the embedding's `conductivity` being k at a probe
+    /// temperature): consistent for a conductivity that changes with T, with the
+    /// derivatives in the Jacobian.
+    pub(crate) fn set_conductivity_law(&mut self, law: std::sync::Arc<super::ConductivityOfT>) {
+        self.conductivity_law = Some(law);
+        for p in &mut self.pairs {
+            p.points = OnceLock::new();
+        }
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
+        }
     }
 
     /// Weigh the forms of interaction `i` with `coefficient` per block instead of the

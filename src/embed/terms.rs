@@ -11,7 +11,8 @@ use std::cell::Cell;
 
 use crate::enforce::conductance::{ConductanceError, ConductanceModel, PointState};
 use crate::enforce::interface::{
-    HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints, InterfaceSystem,
+    ConductivityLaw, HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints,
+    InterfaceSystem,
 };
 
 impl Embedding {
@@ -105,12 +106,19 @@ impl Embedding {
                 }
             }
         };
+        // k(T) at the embedding's time, for the temperature's interactions (a species
+        // interface or voltage tie has a coefficient of its own).
+        let time = self.time;
+        let k_of_t = (self.conductivity_law.as_deref())
+            .filter(|_| p.coefficient.is_none())
+            .map(|law| move |b: usize, t: f64, x: [f64; 3]| law(b, t, x, time));
         let form = InterfaceForm {
             form: *form,
             h: &h,
             offset: *offset,
             beta: *beta,
             conductivity: p.coefficient(&self.conductivity),
+            conductivity_of_t: k_of_t.as_ref().map(|l| l as &ConductivityLaw<'_>),
         };
         let named = |source| EmbedError::Enforcement {
             side_a: p.side_a.name.clone(),

@@ -352,6 +352,19 @@ impl<'a> ContactTerms<'a> {
             fixed,
             Integration::Segments { order: 5 },
         );
+        // A conductivity that is not one number (of T, or of x by Lua): the Nitsche forms
+        // take it at each point's temperature and position.
+        let laws: Vec<crate::heat::law::Law> = (physics.materials.laws.iter())
+            .map(|l| l.conductivity.clone())
+            .collect();
+        if laws
+            .iter()
+            .any(|l| !matches!(l, crate::heat::law::Law::Constant(_)))
+        {
+            embedding.set_conductivity_law(std::sync::Arc::new(move |b, t, x, time| {
+                laws[b].eval(t, x, time)
+            }));
+        }
         let field = |i: usize| {
             let name = &physics.field_names[i];
             dofs.field(name)

@@ -217,6 +217,7 @@ fn run(
             offset: 0.0,
             beta: DEFAULT_BETA,
             conductivity: &bars.k,
+            conductivity_of_t: None,
         },
         linear: true,
     }];

@@ -97,6 +97,7 @@ fn solve(
                 offset: 0.0,
                 beta: DEFAULT_BETA,
                 conductivity: &k,
+                conductivity_of_t: None,
             },
             linear: true,
         }],
@@ -253,6 +254,7 @@ fn point_flux_is_the_exact_flux_and_sums_to_the_heat() {
             offset: 0.0,
             beta: DEFAULT_BETA,
             conductivity: &k,
+            conductivity_of_t: None,
         };
         let field = sol.dofs.field("temperature").unwrap();
         let q = point_flux(&s.mesh, &sol.dofs, field, &s.a, &s.b, &s.points, &f, &sol.u).unwrap();
@@ -516,11 +518,6 @@ fn gap_conductance_is_robust_over_h_and_conductivity_contrast() {
 /// agrees with central differences of the interface residual to 1e-6 relative.
 #[test]
 fn interface_jacobian_matches_finite_differences() {
-    use seam::assembly::DofMap;
-    use seam::enforce::interface::interface_terms;
-    let s = setup(3, 2, SolidKind::Hex8);
-    let dofs = DofMap::new(&s.mesh, &[("temperature", &[0, 1])]).unwrap();
-    let field = dofs.field("temperature").unwrap();
     let (h0, gamma) = (5.0, 0.3);
     let hf = move |p: &HInput| {
         let tm = 0.5 * (p.temp_a + p.temp_b);
@@ -531,6 +528,61 @@ fn interface_jacobian_matches_finite_differences() {
             ..HValue::default()
         })
     };
+    for form in [Form::Conductance, Form::GapConductance] {
+        assert_interface_jacobian(form, &hf, None);
+    }
+}
+
+/// With a conductivity that changes with the temperature, k_1 = 2 (1 + 0.3 T) and k_2 =
+/// 0.7 (1 + 0.5 T + 0.1 T²), every form weighs its flux and penalty with k at the
+/// point's temperatures: the Jacobian, with those derivatives, agrees with central
+/// differences for every form — the ties, Dash, a conductance below and above the
+/// resistance limit (h = 5(1 + 0.3 T̄) and 1e5) and the Robin–Nitsche gap conductance.
+#[test]
+fn interface_jacobian_with_a_conductivity_of_t_matches_finite_differences() {
+    let law = |b: usize, t: f64, _x: [f64; 3]| -> Result<(f64, f64), String> {
+        Ok(match b {
+            0 => (2.0 * (1.0 + 0.3 * t), 0.6),
+            _ => (0.7 * (1.0 + 0.5 * t + 0.1 * t * t), 0.7 * (0.5 + 0.2 * t)),
+        })
+    };
+    let varying = |p: &HInput| {
+        let tm = 0.5 * (p.temp_a + p.temp_b);
+        Ok(HValue {
+            h: 5.0 * (1.0 + 0.3 * tm),
+            dh_dtemp_a: 0.75,
+            dh_dtemp_b: 0.75,
+            ..HValue::default()
+        })
+    };
+    let stiff = |_: &HInput| {
+        Ok(HValue {
+            h: 1e5,
+            ..HValue::default()
+        })
+    };
+    for form in [Form::TiedNitsche, Form::TiedInteriorPenalty, Form::Penalty] {
+        assert_interface_jacobian(form, &stiff, Some(&law));
+    }
+    for form in [Form::Conductance, Form::GapConductance] {
+        assert_interface_jacobian(form, &varying, Some(&law));
+        assert_interface_jacobian(form, &stiff, Some(&law));
+    }
+}
+
+/// The interface Jacobian of `form` (conductance `hf`, conductivities 2 and 0.7 or
+/// `k_of_t`) on the two-slab setup against central differences of its residual, at a
+/// smooth non-trivial field, to 1e-6 relative.
+fn assert_interface_jacobian(
+    form: Form,
+    hf: &(dyn Fn(&HInput) -> Result<HValue, String> + Sync),
+    k_of_t: Option<&seam::enforce::interface::ConductivityLaw<'_>>,
+) {
+    use seam::assembly::DofMap;
+    use seam::enforce::interface::interface_terms;
+    let s = setup(3, 2, SolidKind::Hex8);
+    let dofs = DofMap::new(&s.mesh, &[("temperature", &[0, 1])]).unwrap();
+    let field = dofs.field("temperature").unwrap();
     let k = [2.0, 0.7];
     // A smooth, non-trivial field.
     let u: Vec<f64> = (0..dofs.len())
@@ -539,58 +591,59 @@ fn interface_jacobian_matches_finite_differences() {
             1.0 + 0.3 * p[0] - 0.2 * p[1] * p[1] + 0.5 * p[2] + 0.1 * (3.0 * p[0]).sin()
         })
         .collect();
-    for form in [Form::Conductance, Form::GapConductance] {
-        let f = InterfaceForm {
-            form,
-            h: &hf,
-            offset: 0.1,
-            beta: DEFAULT_BETA,
-            conductivity: &k,
-        };
-        let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, &u).unwrap();
-        let residual = |u: &[f64]| {
-            let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, u).unwrap();
-            let mut r = vec![0.0; u.len()];
-            for (d, v) in t.residual {
-                r[d as usize] += v;
-            }
-            r
-        };
-        // The assembled Jacobian, dense (small problem).
-        let n = dofs.len();
-        let mut jac = vec![0.0; n * n];
-        for (ds, m) in &t.blocks {
-            let l = ds.len();
-            for a in 0..l {
-                for c in 0..l {
-                    jac[ds[a] as usize * n + ds[c] as usize] += m[a * l + c];
-                }
+    let f = InterfaceForm {
+        form,
+        h: hf,
+        offset: 0.1,
+        beta: DEFAULT_BETA,
+        conductivity: &k,
+        conductivity_of_t: k_of_t,
+    };
+    let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, &u).unwrap();
+    let residual = |u: &[f64]| {
+        let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, u).unwrap();
+        let mut r = vec![0.0; u.len()];
+        for (d, v) in t.residual {
+            r[d as usize] += v;
+        }
+        r
+    };
+    // The assembled Jacobian, dense (small problem).
+    let n = dofs.len();
+    let mut jac = vec![0.0; n * n];
+    for (ds, m) in &t.blocks {
+        let l = ds.len();
+        for a in 0..l {
+            for c in 0..l {
+                jac[ds[a] as usize * n + ds[c] as usize] += m[a * l + c];
             }
         }
-        let mut checked = 0;
-        for j in t.side_a_dofs.iter().chain(&t.side_b_dofs).step_by(3) {
-            let j = *j as usize;
-            let eps = 1e-6;
-            let (mut up, mut dn) = (u.clone(), u.clone());
-            up[j] += eps;
-            dn[j] -= eps;
-            let (rp, rm) = (residual(&up), residual(&dn));
-            for i in 0..n {
-                let fd = (rp[i] - rm[i]) / (2.0 * eps);
-                let an = jac[i * n + j];
-                // Relative to the entry, with a floor of 1e-3 (entries here are O(1)–O(100)):
-                // structurally zero entries are then held to 1e-9 absolute, above the
-                // central-difference round-off ε/δ ≈ 1e-10 of this residual.
-                let scale = an.abs().max(fd.abs()).max(1e-3);
-                assert!(
-                    (fd - an).abs() <= 1e-6 * scale,
-                    "{form:?} J[{i}][{j}]: analytic {an} vs FD {fd}"
-                );
-            }
-            checked += 1;
-        }
-        assert!(checked > 10);
     }
+    let mut checked = 0;
+    // The central differences' round-off is about ε/δ ≈ 2e-10 of the residual, whose
+    // size is the largest entry's: entries are held to 1e-6 of themselves, with a floor
+    // of 1e-3 of the largest (1e-3 when all are smaller than 1).
+    let largest = jac.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    for j in t.side_a_dofs.iter().chain(&t.side_b_dofs).step_by(3) {
+        let j = *j as usize;
+        let eps = 1e-6;
+        let (mut up, mut dn) = (u.clone(), u.clone());
+        up[j] += eps;
+        dn[j] -= eps;
+        let (rp, rm) = (residual(&up), residual(&dn));
+        for i in 0..n {
+            let fd = (rp[i] - rm[i]) / (2.0 * eps);
+            let an = jac[i * n + j];
+            let scale = an.abs().max(fd.abs()).max(1e-3 * largest);
+            assert!(
+                (fd - an).abs() <= 1e-6 * scale,
+                "{form:?} (k(T): {}) J[{i}][{j}]: analytic {an} vs FD {fd}",
+                k_of_t.is_some()
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked > 10);
 }
 
 /// A gas-gap conductance k_g / max(g, g_min) across gaps of 1e-12, 0 and −1e-9 (a slight
@@ -669,6 +722,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
                     offset: 0.0,
                     beta: DEFAULT_BETA,
                     conductivity: &k,
+                    conductivity_of_t: None,
                 },
                 linear: false,
             }],
@@ -811,6 +865,7 @@ fn dash_penalty_error_is_the_predicted_one() {
                     offset: 0.0,
                     beta: factor,
                     conductivity: &k,
+                    conductivity_of_t: None,
                 },
                 linear: true,
             }],
@@ -1001,6 +1056,7 @@ fn amg_cg_path_matches_the_direct_solve() {
                     offset: 0.0,
                     beta: DEFAULT_BETA,
                     conductivity: &k,
+                    conductivity_of_t: None,
                 },
                 linear: true,
             }],

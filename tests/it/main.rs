@@ -7,6 +7,7 @@ mod cases;
 mod cli;
 mod cli_conventions;
 mod conductance;
+mod conductivity_of_t;
 mod docs;
 mod electric;
 mod embed;

@@ -171,6 +171,7 @@ fn solve_form(
                 offset: 0.0,
                 beta: DEFAULT_BETA,
                 conductivity: &k,
+                conductivity_of_t: None,
             },
             linear: true,
         }],
@@ -742,6 +743,7 @@ fn node_point_jacobian_matches_finite_differences() {
             offset: 0.1,
             beta: DEFAULT_BETA,
             conductivity: &k,
+            conductivity_of_t: None,
         };
         let points =
             InterfacePoints::new(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f).unwrap();

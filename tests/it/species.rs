@@ -15,14 +15,15 @@ use seam::mesh::Mesh;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::run::{RunError, RunResult};
 
-const L1: f64 = 0.6;
-const L: f64 = 1.5;
+pub(crate) const L1: f64 = 0.6;
+pub(crate) const L: f64 = 1.5;
 const D: [f64; 2] = [2e-3, 5e-4];
 const C0: f64 = 10.0;
 const CL: f64 = 1.0;
 
-/// The bars with `n` cells across and `m` along, per block.
-fn bars(n: [usize; 2], m: [usize; 2]) -> Mesh {
+/// The bars with `n` cells across and `m` along, per block (also the voltage and k(T)
+/// bars of `voltage_ties.rs` and `conductivity_of_t.rs`).
+pub(crate) fn bars(n: [usize; 2], m: [usize; 2]) -> Mesh {
     generate::boxes(
         &[
             BoxSpec::hex([0.0; 3], [1.0, 1.0, L1], [n[0], n[0], m[0]], 1)
@@ -70,7 +71,7 @@ fn held_ends() -> String {
 const STEADY: &str = "[solve]\nkind = \"steady\"\ntolerance = 1e-13\n";
 
 /// Write the case `name` (mesh, deck, problem) into a scratch folder and run it.
-fn run_case(name: &str, mesh: &Mesh, deck: &str, problem: &str) -> RunResult {
+pub(crate) fn run_case(name: &str, mesh: &Mesh, deck: &str, problem: &str) -> RunResult {
     let scratch = crate::scratch(&format!("species-{name}"));
     let dir = scratch.path();
     crate::twod::write_mesh(&dir.join("bars.exo"), mesh);

@@ -16,29 +16,15 @@
 //! voltage (`Contact Gap Voltage`) gives the current of the scalar closed form.
 
 use seam::mesh::Mesh;
-use seam::mesh::generate::{self, BoxSpec};
 use seam::run::{RunError, RunResult};
 
-const L1: f64 = 0.6;
-const L: f64 = 1.5;
+use crate::species::{L, L1, bars};
+
 const SIGMA: [f64; 2] = [2e3, 1e3];
 const K: [f64; 2] = [5.0, 2.0];
 const V0: f64 = 0.9;
 const H_C: f64 = 10.0;
 const T_INF: f64 = 300.0;
-
-/// The bars with `n` cells across and `m` along, per block.
-fn bars(n: [usize; 2], m: [usize; 2]) -> Mesh {
-    generate::boxes(
-        &[
-            BoxSpec::hex([0.0; 3], [1.0, 1.0, L1], [n[0], n[0], m[0]], 1)
-                .with_side_sets([0, 0, 0, 0, 1, 2]),
-            BoxSpec::hex([0.0, 0.0, L1], [1.0, 1.0, L], [n[1], n[1], m[1]], 2)
-                .with_side_sets([0, 0, 0, 0, 3, 4]),
-        ],
-        false,
-    )
-}
 
 /// The deck: a thermal mortar tie and the voltage block `voltage` (its lines).
 fn deck(voltage: &str) -> String {
@@ -59,18 +45,9 @@ const PROBLEM: &str = "[mesh]\nfile = \"bars.exo\"\n\
     [contact]\nfile = \"contact.i\"\n\
     [solve]\nkind = \"steady\"\ntolerance = 1e-13\n";
 
-/// Write the case `name` (mesh, deck, problem) into a scratch folder and run it.
+/// Run the case `name` (mesh, deck) with [`PROBLEM`].
 fn run_case(name: &str, mesh: &Mesh, deck: &str) -> RunResult {
-    let scratch = crate::scratch(&format!("voltage-tie-{name}"));
-    let dir = scratch.path();
-    crate::twod::write_mesh(&dir.join("bars.exo"), mesh);
-    std::fs::write(dir.join("contact.i"), deck).unwrap();
-    std::fs::write(dir.join("problem.toml"), PROBLEM).unwrap();
-    match seam::run::run(&dir.join("problem.toml")) {
-        Ok(r) => r,
-        Err(RunError::Input(d, s)) => panic!("{}", d.render(&s)),
-        Err(RunError::Solve(e)) => panic!("{e}"),
-    }
+    crate::species::run_case(&format!("voltage-{name}"), mesh, deck, PROBLEM)
 }
 
 /// The closed form: the current density j, and V(z, side), T(z, side) with side 0 in

@@ -43,6 +43,18 @@
 //! are linear on side A's faces (matching or nested meshes), not on arbitrary
 //! non-matching ones: the one-pass node-to-segment limitation.
 //!
+//! **Conductivity of the temperature.** The local vectors are made once per search with
+//! each block's k at a probe temperature (`conductivity`). A conductivity that changes
+//! with T ([`InterfaceForm::conductivity_of_t`]) changes the weights, the flux average
+//! and α at each point: the flux average is only consistent (`{k∂u} = q` for the exact
+//! field) with k at the point's own temperatures, else the form transmits `k0/k(T)`
+//! times the flux and the tie converges at first order. So each evaluation takes k_A =
+//! k(T_A) and k_B = k(T_B) at the point and scales the made vectors: with the weights
+//! above every flux entry carries `κ = k_A k_B/(k_A+k_B)` and `α ∝ κ`, so both scale by
+//! `κ/κ0`; `Tied_Ip` scales side A's entries by `k_A/k_A0`, side B's by `k_B/k_B0` and α
+//! by `(k_A+k_B)/(k_A0+k_B0)`; a node point scales by `k_B/k_B0`. The Jacobian carries
+//! the derivatives of the three scales through T_A and T_B (P, θ, S through α).
+//!
 //! Heat accounting: with `v = 1` on all of side A (0 on B), the form gives the heat
 //! leaving side A, `∫ P([u] − ΔT) − θ{k∂u}`; with `v = 1` on side B, minus the same. So
 //! the heat through each side is read off the assembled interface residual, and their
@@ -61,8 +73,11 @@ use crate::mesh::{Mesh, Topology};
 use crate::search::pairing::{ContactPoint, SurfaceGeometry};
 use crate::vec3::dot;
 
+mod coefficients;
 mod side;
 
+pub use coefficients::RESISTANCE_LIMIT;
+use coefficients::{Scale, alpha_derivatives, coefficients};
 use side::FaceElement;
 pub use side::{SideEval, side_eval};
 
@@ -146,7 +161,15 @@ pub struct InterfaceForm<'a> {
     pub beta: f64,
     /// Conductivity of each block (by block index).
     pub conductivity: &'a [f64],
+    /// k(T) per block, when the Nitsche forms weigh the flux with the conductivity at
+    /// each point's temperatures (module docs, "Conductivity of the temperature");
+    /// `None`: `conductivity` as given. The form's field must be the temperature.
+    pub conductivity_of_t: Option<&'a ConductivityLaw<'a>>,
 }
+
+/// k and dk/dT of block `b` at the temperature `t` and the point `x`.
+pub type ConductivityLaw<'a> =
+    dyn Fn(usize, f64, [f64; 3]) -> Result<(f64, f64), String> + Sync + 'a;
 
 /// Why an interface could not be set up.
 #[derive(Debug, thiserror::Error)]
@@ -204,41 +227,6 @@ pub(crate) fn node_dof(
             surface: surface.to_string(),
             field: dofs.field_name(field).to_string(),
         })
-}
-
-/// Above this many times the penalty scale α, a resistance (`P = h`) gives way to the
-/// Robin–Nitsche coefficients. The resistance form's matrix grows with h, so its heat
-/// `h [u]` loses about `log10(h/α) + 2` digits to round-off in `[u]` (a 1e20 conductance
-/// reports nothing meaningful); the Robin–Nitsche form is a consistent discretisation of
-/// the same condition `q = h [u]` whose coefficients stay bounded by α for every h up to
-/// ∞. Where h is 100 α the interface is practically tied: both forms are exact for fields
-/// the elements hold (patch tests, one-dimensional heat), and elsewhere differ at the
-/// discretisation error, the resistance form tending to a tie that locks on non-matching
-/// meshes and the Robin–Nitsche one to the Nitsche tie that does not.
-pub const RESISTANCE_LIMIT: f64 = 100.0;
-
-/// The coefficients (P, θ, S) and their derivatives with respect to h.
-fn coefficients(form: Form, h: f64, alpha: f64) -> ([f64; 3], [f64; 3]) {
-    match form {
-        Form::Conductance if h <= RESISTANCE_LIMIT * alpha => ([h, 0.0, 0.0], [1.0, 0.0, 0.0]),
-        Form::TiedNitsche | Form::TiedInteriorPenalty => ([alpha, 1.0, 0.0], [0.0; 3]),
-        Form::Penalty => ([alpha, 0.0, 0.0], [0.0; 3]),
-        Form::Conductance | Form::GapConductance => robin_nitsche(h, alpha),
-    }
-}
-
-/// `P = hα/(h+α)`, `θ = h/(h+α)`, `S = 1/(h+α)` and their h-derivatives, written so that
-/// no product overflows for any h up to ∞ (the tie `(α, 1, 0)` at ∞).
-fn robin_nitsche(h: f64, alpha: f64) -> ([f64; 3], [f64; 3]) {
-    if !h.is_finite() {
-        return ([alpha, 1.0, 0.0], [0.0; 3]);
-    }
-    let d = h + alpha;
-    let (theta, r) = (h / d, alpha / d); // θ = h/(h+α), r = α/(h+α): both in [0, 1]
-    (
-        [alpha * theta, theta, 1.0 / d],
-        [r * r, r / d, -(1.0 / d) / d],
-    )
 }
 
 /// Per-point local vectors: jump and flux-average of each local basis function (side
@@ -319,13 +307,17 @@ fn local_node(dof: u32, b: &SideEval, beta: f64) -> Local {
 /// One point's values at a field: see [`InterfacePoints::at_point`].
 struct PointEval<'a> {
     jump: &'a [f64],
+    /// The flux entries as made (at the conductivities `k0`); `scale` scales them.
     flux: &'a [f64],
-    /// `[u] − ΔT` and `{k∂u}` at the point.
+    /// `[u] − ΔT` and `{k∂u}` at the point (scaled).
     jump_u: f64,
     flux_u: f64,
+    /// Side A's and side B's parts of `{k∂u}` before scaling.
+    flux_parts: [f64; 2],
     hv: HValue,
     temp_a: f64,
     temp_b: f64,
+    scale: Scale,
 }
 
 /// Where the entries of an interaction's blocks go in an [`Assembler`]: see
@@ -425,6 +417,10 @@ struct CachedPoint {
     gap: f64,
     x: [f64; 3],
     alpha: f64,
+    /// The blocks of the side-A element (of the node's side-B element for a node point)
+    /// and the side-B element, and the conductivities the local vectors were made with.
+    blocks: [u32; 2],
+    k0: [f64; 2],
 }
 
 impl InterfacePoints {
@@ -460,7 +456,8 @@ impl InterfacePoints {
             };
             let eb = face_element(&mut face_b, k_b, fields.b, b.faces[k_b].side)
                 .eval(mesh, dofs, p.xi_b)?;
-            let (key, l, elem, side) = if let Some((a_node, _)) = p.matched_node() {
+            let block_b = mesh.block_of(eb.elem);
+            let (key, l, elem, side, (block_a, k_a)) = if let Some((a_node, _)) = p.matched_node() {
                 let Some(&(node, _)) = a.nodes.get(a_node) else {
                     continue;
                 };
@@ -469,7 +466,8 @@ impl InterfacePoints {
                 }
                 let dof = node_dof(mesh, dofs, fields.a, node, &a.name)?;
                 let l = local_node(dof, &eb, form.beta);
-                ((1u8, node.0, eb.elem.0), l, mesh.node_number(node), 0)
+                let key = (1u8, node.0, eb.elem.0);
+                (key, l, mesh.node_number(node), 0, (block_b, eb.k))
             } else {
                 let Some((k_a, _)) = p.matched_faces() else {
                     continue;
@@ -479,7 +477,8 @@ impl InterfacePoints {
                     face_element(&mut face_a, k_a, fields.a, fa.side).eval(mesh, dofs, p.xi_a)?;
                 let l = local(&ea, &eb, form.form, form.beta);
                 let key = (0u8, ea.elem.0, eb.elem.0);
-                (key, l, mesh.elem_number(fa.side.elem), fa.side.side)
+                let a_at = (mesh.block_of(ea.elem), ea.k);
+                (key, l, mesh.elem_number(fa.side.elem), fa.side.side, a_at)
             };
             let point = CachedPoint {
                 index: index as u32,
@@ -491,6 +490,8 @@ impl InterfacePoints {
                 gap: p.gap - p.offset,
                 x: p.x,
                 alpha: l.alpha,
+                blocks: [block_a as u32, block_b as u32],
+                k0: [k_a, eb.k],
             };
             keys.push((key, evaluated.len() as u32));
             evaluated.push((point, l));
@@ -686,11 +687,14 @@ impl InterfacePoints {
         let flux = &self.values[at + nl..at + 2 * nl];
         let value = |v: &[f64]| -> f64 { (0..nl).map(|i| v[i] * u[dofs[i] as usize]).sum() };
         let jump_u = value(jump) - form.offset;
-        let flux_u = value(flux);
-        let temp_a: f64 = (0..p.na as usize)
-            .map(|i| jump[i] * u[dofs[i] as usize])
-            .sum();
+        let na = p.na as usize;
+        let part =
+            |r: std::ops::Range<usize>| -> f64 { r.map(|i| flux[i] * u[dofs[i] as usize]).sum() };
+        let flux_parts = [part(0..na), part(na..nl)];
+        let temp_a: f64 = (0..na).map(|i| jump[i] * u[dofs[i] as usize]).sum();
         let temp_b = temp_a - (jump_u + form.offset);
+        let scale = self.scale(p, form, temp_a, temp_b)?;
+        let flux_u = scale.flux[0] * flux_parts[0] + scale.flux[1] * flux_parts[1];
         let hv = match form.form {
             Form::Conductance | Form::GapConductance => (form.h)(&HInput {
                 gap: p.gap,
@@ -701,19 +705,7 @@ impl InterfacePoints {
                 x: p.x,
                 point: p.index as usize,
             })
-            .map_err(|message| match p.side {
-                0 => InterfaceError::ConductanceAtNode {
-                    at: p.x,
-                    node: p.elem,
-                    message,
-                },
-                side => InterfaceError::Conductance {
-                    at: p.x,
-                    elem: p.elem,
-                    side,
-                    message,
-                },
-            })?,
+            .map_err(|message| point_error(p, message))?,
             _ => HValue::default(),
         };
         Ok(PointEval {
@@ -721,9 +713,11 @@ impl InterfacePoints {
             flux,
             jump_u,
             flux_u,
+            flux_parts,
             hv,
             temp_a,
             temp_b,
+            scale,
         })
     }
 
@@ -741,7 +735,7 @@ impl InterfacePoints {
             let dofs = self.group(g);
             for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
                 let e = self.at_point(p, dofs, form, u)?;
-                let ([cp, ct, _], _) = coefficients(form.form, e.hv.h, p.alpha);
+                let ([cp, ct, _], _) = coefficients(form.form, e.hv.h, p.alpha * e.scale.alpha);
                 out[p.index as usize] = Some(PointFlux {
                     q: cp * e.jump_u - ct * e.flux_u,
                     temp_a: e.temp_a,
@@ -814,15 +808,39 @@ impl InterfacePoints {
             for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
                 let PointEval {
                     jump,
-                    flux,
+                    flux: flux0,
                     jump_u,
                     flux_u,
+                    flux_parts,
                     hv,
+                    scale,
                     ..
                 } = self.at_point(p, dofs, form, u)?;
                 let na = p.na as usize;
-                let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, p.alpha);
+                let alpha = p.alpha * scale.alpha;
+                let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, alpha);
                 let w = p.weight;
+                // The flux entries at the point's conductivities.
+                let mut scaled = [0.0; 2 * MAX_NODES];
+                for j in 0..nl {
+                    scaled[j] = flux0[j] * scale.flux[usize::from(j >= na)];
+                }
+                let flux = &scaled[..nl];
+                // With k(T): the derivatives of the three scales by u_j (T_A = Σ_A N u,
+                // T_B = Σ_B N u), and ∂r_i/∂scale below.
+                let mut dscale = [[0.0; 2 * MAX_NODES]; 3];
+                if scale.varies {
+                    for (c, d) in dscale.iter_mut().enumerate() {
+                        for j in 0..nl {
+                            d[j] = if j < na {
+                                scale.d[c][0] * jump[j]
+                            } else {
+                                -scale.d[c][1] * jump[j]
+                            };
+                        }
+                    }
+                }
+                let [da_p, da_t, da_s] = alpha_derivatives(form.form, hv.h, alpha);
                 // dh/du_j: T_A = Σ_A N u, T_B = Σ_B N u (jump entries of B are −N).
                 let nonlinear = hv.dh_dtemp_a != 0.0 || hv.dh_dtemp_b != 0.0;
                 for j in 0..nl {
@@ -863,6 +881,28 @@ impl InterfacePoints {
                             row[j] += wj * a[j] - wf * b[j];
                         }
                     }
+                    if scale.varies {
+                        // ∂r_i/∂(flux scale of side A, of side B, α scale).
+                        let own = |side: usize| {
+                            if usize::from(i >= na) == side {
+                                flux0[i]
+                            } else {
+                                0.0
+                            }
+                        };
+                        let g = |side: usize| {
+                            let (f0, part) = (own(side), flux_parts[side]);
+                            -ct * (f0 * jump_u + ji * part) - cs * (f0 * flux_u + fi * part)
+                        };
+                        let g_alpha = p.alpha
+                            * (da_p * ji * jump_u
+                                - da_t * (fi * jump_u + ji * flux_u)
+                                - da_s * fi * flux_u);
+                        let (ga, gb, gal) = (w * g(0), w * g(1), w * g_alpha);
+                        for j in 0..nl {
+                            row[j] += ga * dscale[0][j] + gb * dscale[1][j] + gal * dscale[2][j];
+                        }
+                    }
                 }
             }
             block(dofs, m);
@@ -876,6 +916,23 @@ impl InterfacePoints {
             side_a_dofs: self.side_a_dofs.clone(),
             side_b_dofs: self.side_b_dofs.clone(),
         })
+    }
+}
+
+/// An error of the models at point `p` (a node point names its node).
+fn point_error(p: &CachedPoint, message: String) -> InterfaceError {
+    match p.side {
+        0 => InterfaceError::ConductanceAtNode {
+            at: p.x,
+            node: p.elem,
+            message,
+        },
+        side => InterfaceError::Conductance {
+            at: p.x,
+            elem: p.elem,
+            side,
+            message,
+        },
     }
 }
 

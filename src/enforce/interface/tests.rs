@@ -56,6 +56,7 @@ fn form<'a>(h: &'a HFn<'a>) -> InterfaceForm<'a> {
         offset: 0.5,
         beta: DEFAULT_BETA,
         conductivity: &[16.0, 200.0],
+        conductivity_of_t: None,
     }
 }
 
