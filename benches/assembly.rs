@@ -229,6 +229,7 @@ fn interface(n: usize, reps: usize) {
         beta: DEFAULT_BETA,
         conductivity: &k,
         conductivity_of_t: None,
+        temperature_field: None,
     };
     let mut points = None;
     let t_new = timed(reps, || {

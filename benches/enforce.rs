@@ -191,6 +191,7 @@ fn main() {
                             beta: DEFAULT_BETA,
                             conductivity: &k,
                             conductivity_of_t: None,
+                            temperature_field: None,
                         },
                         linear: true,
                     }],

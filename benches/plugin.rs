@@ -485,6 +485,7 @@ fn assembly(table_path: &Path) {
             beta: DEFAULT_BETA,
             conductivity: &k,
             conductivity_of_t: None,
+            temperature_field: None,
         };
         let mut best = f64::INFINITY;
         for _ in 0..3 {
@@ -548,6 +549,7 @@ fn assembly(table_path: &Path) {
                 beta: DEFAULT_BETA,
                 conductivity: &k,
                 conductivity_of_t: None,
+                temperature_field: None,
             };
             let s =
                 interface_terms(&mesh, &dofs, field, &a, &b, &r.points, &f, &u).expect("assembly");

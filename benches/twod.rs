@@ -156,6 +156,7 @@ fn main() {
             beta: DEFAULT_BETA,
             conductivity: &k,
             conductivity_of_t: None,
+            temperature_field: None,
         };
         // The interface terms alone: what the assembly does for the contact points.
         let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();

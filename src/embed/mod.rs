@@ -460,6 +460,9 @@ struct Pair {
     /// The coefficient per block weighing this pair's Nitsche forms, instead of the
     /// embedding's conductivity (`seam run`'s species interfaces: the diffusivity).
     coefficient: Option<Vec<f64>>,
+    /// That coefficient as a law of the temperature, and the temperature's field (D(T),
+    /// σ(T)): the forms take it at each point's temperatures.
+    coefficient_law: Option<(std::sync::Arc<ConductivityOfT>, FieldId)>,
 }
 
 impl Pair {
@@ -507,6 +510,7 @@ impl Pair {
             quarantined: Mutex::new(Vec::new()),
             active: true,
             coefficient: None,
+            coefficient_law: None,
         }
     }
 }

@@ -177,6 +177,23 @@ impl Embedding {
         }
     }
 
+    /// Take interaction `i`'s coefficient ([`Self::set_coefficient`], its value at a
+    /// probe temperature) as `law` of the temperature in `field` at each point.
+    pub(crate) fn set_coefficient_law(
+        &mut self,
+        i: usize,
+        law: std::sync::Arc<super::ConductivityOfT>,
+        field: FieldId,
+    ) {
+        if let Some(p) = self.pairs.get_mut(i) {
+            p.coefficient_law = Some((law, field));
+            p.points = OnceLock::new();
+        }
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
+        }
+    }
+
     /// Weigh the forms of interaction `i` with `coefficient` per block instead of the
     /// embedding's conductivity (a field other than the temperature, as `seam run`'s
     /// species with its diffusivities).

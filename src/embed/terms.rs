@@ -109,9 +109,12 @@ impl Embedding {
         // k(T) at the embedding's time, for the temperature's interactions (a species
         // interface or voltage tie has a coefficient of its own).
         let time = self.time;
-        let k_of_t = (self.conductivity_law.as_deref())
-            .filter(|_| p.coefficient.is_none())
-            .map(|law| move |b: usize, t: f64, x: [f64; 3]| law(b, t, x, time));
+        let (k_law, temperature_field) = match (&p.coefficient, &p.coefficient_law) {
+            (None, _) => (self.conductivity_law.as_deref(), None),
+            (Some(_), Some((law, field))) => (Some(law.as_ref()), Some(*field)),
+            (Some(_), None) => (None, None),
+        };
+        let k_of_t = k_law.map(|law| move |b: usize, t: f64, x: [f64; 3]| law(b, t, x, time));
         let form = InterfaceForm {
             form: *form,
             h: &h,
@@ -119,6 +122,7 @@ impl Embedding {
             beta: *beta,
             conductivity: p.coefficient(&self.conductivity),
             conductivity_of_t: k_of_t.as_ref().map(|l| l as &ConductivityLaw<'_>),
+            temperature_field,
         };
         let named = |source| EmbedError::Enforcement {
             side_a: p.side_a.name.clone(),

@@ -390,6 +390,10 @@ impl<'a> ContactTerms<'a> {
                     .map_err(|e| e.to_string())?;
             }
         }
+        // D(T) and σ(T) weigh the species and voltage forms at each point's temperature.
+        let temperature = dofs
+            .field(crate::heat::TEMPERATURE)
+            .ok_or("no dofs of field `temperature`");
         let species = &physics.species;
         if !self.contact.species.is_empty() {
             let field = dofs
@@ -409,6 +413,9 @@ impl<'a> ContactTerms<'a> {
                     field.into(),
                 );
                 embedding.set_coefficient(k, coefficient.clone());
+                if let Some(law) = field_law(&species.scaled_diffusivity()) {
+                    embedding.set_coefficient_law(k, law, temperature?);
+                }
             }
         }
         if !self.contact.voltage_ties.is_empty() {
@@ -435,6 +442,9 @@ impl<'a> ContactTerms<'a> {
                     field.into(),
                 );
                 embedding.set_coefficient(k, coefficient.clone());
+                if let Some(law) = field_law(&physics.materials.sigma) {
+                    embedding.set_coefficient_law(k, law, temperature?);
+                }
             }
         }
         Ok(Embedded {
@@ -837,4 +847,20 @@ impl Interfaces for ContactTerms<'_> {
         self.at_time(e, t)?;
         self.place(e, u, t, step)
     }
+}
+
+/// A per-block coefficient law (D S or σ; 1 where a block has none) as the embedding takes
+/// it, when some block's law is not one number.
+fn field_law(
+    laws: &[Option<crate::heat::law::Law>],
+) -> Option<std::sync::Arc<crate::embed::ConductivityOfT>> {
+    use crate::heat::law::Law;
+    if laws.iter().flatten().all(|l| matches!(l, Law::Constant(_))) {
+        return None;
+    }
+    let laws = laws.to_vec();
+    Some(std::sync::Arc::new(move |b, t, x, time| match &laws[b] {
+        Some(law) => law.eval(t, x, time),
+        None => Ok((1.0, 0.0)),
+    }))
 }

@@ -218,6 +218,7 @@ fn run(
             beta: DEFAULT_BETA,
             conductivity: &bars.k,
             conductivity_of_t: None,
+            temperature_field: None,
         },
         linear: true,
     }];

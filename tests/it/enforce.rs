@@ -98,6 +98,7 @@ fn solve(
                 beta: DEFAULT_BETA,
                 conductivity: &k,
                 conductivity_of_t: None,
+                temperature_field: None,
             },
             linear: true,
         }],
@@ -255,6 +256,7 @@ fn point_flux_is_the_exact_flux_and_sums_to_the_heat() {
             beta: DEFAULT_BETA,
             conductivity: &k,
             conductivity_of_t: None,
+            temperature_field: None,
         };
         let field = sol.dofs.field("temperature").unwrap();
         let q = point_flux(&s.mesh, &sol.dofs, field, &s.a, &s.b, &s.points, &f, &sol.u).unwrap();
@@ -598,6 +600,7 @@ fn assert_interface_jacobian(
         beta: DEFAULT_BETA,
         conductivity: &k,
         conductivity_of_t: k_of_t,
+        temperature_field: None,
     };
     let t = interface_terms(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f, &u).unwrap();
     let residual = |u: &[f64]| {
@@ -723,6 +726,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
                     beta: DEFAULT_BETA,
                     conductivity: &k,
                     conductivity_of_t: None,
+                    temperature_field: None,
                 },
                 linear: false,
             }],
@@ -866,6 +870,7 @@ fn dash_penalty_error_is_the_predicted_one() {
                     beta: factor,
                     conductivity: &k,
                     conductivity_of_t: None,
+                    temperature_field: None,
                 },
                 linear: true,
             }],
@@ -1057,6 +1062,7 @@ fn amg_cg_path_matches_the_direct_solve() {
                     beta: DEFAULT_BETA,
                     conductivity: &k,
                     conductivity_of_t: None,
+                    temperature_field: None,
                 },
                 linear: true,
             }],

@@ -172,6 +172,7 @@ fn solve_form(
                 beta: DEFAULT_BETA,
                 conductivity: &k,
                 conductivity_of_t: None,
+                temperature_field: None,
             },
             linear: true,
         }],
@@ -744,6 +745,7 @@ fn node_point_jacobian_matches_finite_differences() {
             beta: DEFAULT_BETA,
             conductivity: &k,
             conductivity_of_t: None,
+            temperature_field: None,
         };
         let points =
             InterfacePoints::new(&s.mesh, &dofs, field, &s.a, &s.b, &s.points, &f).unwrap();

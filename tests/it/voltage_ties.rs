@@ -373,3 +373,64 @@ fn only_an_electrical_contact_sees_voltages() {
         ["E0431"]
     );
 }
+
+/// σ(T) = σ0 / (1 + 0.001 (T − 300)) across a voltage tie, 750 A/m² fed at z = 0: the
+/// Nitsche forms weigh the jump with σ at each point's temperature, so the Nitsche tie
+/// approaches the mortar tie's answer (whose multiplier needs no weights) at about second
+/// order; with σ at a probe temperature it is first order and 26–40× farther.
+#[test]
+fn a_nitsche_voltage_tie_follows_sigma_of_t() {
+    let problem = PROBLEM
+        .replace(
+            "electrical_conductivity = 2e3\n",
+            "electrical_conductivity = \"2e3 / (1 + 0.001 * (T - 300))\"\n",
+        )
+        .replace(
+            "electrical_conductivity = 1e3\n",
+            "electrical_conductivity = \"1e3 / (1 + 0.001 * (T - 300))\"\n",
+        )
+        .replace(
+            "kind = \"voltage\"\nsurfaces = [\"surface_1\"]\nvalue = 0.9",
+            "kind = \"current\"\nsurfaces = [\"surface_1\"]\nvalue = 750.0",
+        );
+    let mortar = "  enforcement for voltage = tied\n  side b variable voltage to voltage";
+    let nitsche = "  enforcement for voltage = tied_voltage";
+    let mut gaps = Vec::new();
+    for n in [1, 2] {
+        let mesh = bars([3 * n, 4 * n], [4 * n, 5 * n]);
+        let run = |name: &str, lines: &str| {
+            crate::species::run_case(
+                &format!("sigma-t-{name}-{n}"),
+                &mesh,
+                &deck(lines),
+                &problem,
+            )
+        };
+        let (a, b) = (run("mortar", mortar), run("nitsche", nitsche));
+        assert!(a.solution.converged && b.solution.converged);
+        let volt = |r: &RunResult| {
+            let dofs = &r.solution.dofs;
+            dofs.nodal_values(dofs.field("voltage").unwrap(), &r.solution.u)
+        };
+        let (va, vb) = (volt(&a), volt(&b));
+        let gap = va
+            .iter()
+            .zip(&vb)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0, f64::max)
+            / V0;
+        let (ia, ib) = (
+            a.summary.electrical_contacts[0].current,
+            b.summary.electrical_contacts[0].current,
+        );
+        eprintln!(
+            "σ(T) voltage tie, {n}: Nitsche against mortar {gap:.2e} V0, currents {ia:.12} / {ib:.12} A"
+        );
+        assert!((ia - ib).abs() <= 1e-6 * ia, "currents {ia} and {ib}");
+        gaps.push(gap);
+    }
+    // Measured: 1.1e-5 and 3.7e-6 V0; with σ at a probe temperature 3.0e-4 and 1.5e-4
+    // (first order).
+    assert!(gaps[0] <= 5e-5, "{gaps:?}");
+    assert!(gaps[1] <= gaps[0] / 2.8, "{gaps:?}");
+}

@@ -74,6 +74,7 @@ use crate::search::pairing::{ContactPoint, SurfaceGeometry};
 use crate::vec3::dot;
 
 mod coefficients;
+mod pattern;
 mod side;
 
 pub use coefficients::RESISTANCE_LIMIT;
@@ -165,6 +166,11 @@ pub struct InterfaceForm<'a> {
     /// each point's temperatures (module docs, "Conductivity of the temperature");
     /// `None`: `conductivity` as given. The form's field must be the temperature.
     pub conductivity_of_t: Option<&'a ConductivityLaw<'a>>,
+    /// The field whose values `conductivity_of_t` takes when it is not the form's own (a
+    /// species interface or voltage tie weighed with D(T) or σ(T)): its derivatives then
+    /// stay out of the Jacobian, whose columns are the form's field (Newton lags the
+    /// coefficient by one iteration; the converged answer is the consistent one).
+    pub temperature_field: Option<FieldId>,
 }
 
 /// k and dk/dT of block `b` at the temperature `t` and the point `x`.
@@ -327,22 +333,6 @@ pub struct Scatter {
     slots: Vec<ExtraSlot>,
 }
 
-/// Calls `f(i, j)` for every pair of distinct values of `items` with i < j (a group's
-/// dof positions, each pair once per group it appears in).
-fn for_each_pair<'a>(
-    items: impl Iterator<Item = &'a u32> + Clone,
-    mut f: impl FnMut(usize, usize),
-) {
-    let mut rest = items;
-    while let Some(&i) = rest.next() {
-        for &j in rest.clone() {
-            if i != j {
-                f(i.min(j) as usize, i.max(j) as usize);
-            }
-        }
-    }
-}
-
 /// The assembled interface terms of one interaction: for each pair of elements
 /// (A, B) met by some point, a dense block over their dofs, and a right-hand side.
 #[derive(Clone, Debug, Default)]
@@ -390,6 +380,9 @@ pub fn interface_terms(
 pub struct InterfacePoints {
     /// The groups' dof lists, concatenated (`group_dofs[g]..group_dofs[g+1]`).
     dofs: Vec<u32>,
+    /// With [`InterfaceForm::temperature_field`]: the temperature dof at the node of
+    /// each entry of `dofs` (empty otherwise).
+    t_dofs: Vec<u32>,
     group_dofs: Vec<usize>,
     /// The groups' points (`group_points[g]..group_points[g+1]` into `points`).
     group_points: Vec<usize>,
@@ -450,6 +443,17 @@ impl InterfacePoints {
         // points (1, node, element B).
         let mut keys: Vec<((u8, u32, u32), u32)> = Vec::with_capacity(points.len());
         let mut evaluated: Vec<(CachedPoint, Local)> = Vec::with_capacity(points.len());
+        // The temperature dofs of each point's nodes, when the coefficient takes the
+        // temperature of another field.
+        let foreign = form
+            .temperature_field
+            .filter(|_| form.conductivity_of_t.is_some());
+        let t_dof = |node: crate::mesh::NodeId| {
+            foreign
+                .and_then(|t| dofs.dof(t, node))
+                .map_or(u32::MAX, |d| d.0)
+        };
+        let mut point_t_dofs: Vec<Vec<u32>> = Vec::new();
         for (index, p) in points.iter().enumerate() {
             let Some(k_b) = p.matched_b_face() else {
                 continue;
@@ -466,6 +470,10 @@ impl InterfacePoints {
                 }
                 let dof = node_dof(mesh, dofs, fields.a, node, &a.name)?;
                 let l = local_node(dof, &eb, form.beta);
+                if foreign.is_some() {
+                    let b_nodes = mesh.elem_nodes(eb.elem).iter().map(|&n| t_dof(n));
+                    point_t_dofs.push(std::iter::once(t_dof(node)).chain(b_nodes).collect());
+                }
                 let key = (1u8, node.0, eb.elem.0);
                 (key, l, mesh.node_number(node), 0, (block_b, eb.k))
             } else {
@@ -476,6 +484,10 @@ impl InterfacePoints {
                 let ea =
                     face_element(&mut face_a, k_a, fields.a, fa.side).eval(mesh, dofs, p.xi_a)?;
                 let l = local(&ea, &eb, form.form, form.beta);
+                if foreign.is_some() {
+                    let nodes = (mesh.elem_nodes(ea.elem).iter()).chain(mesh.elem_nodes(eb.elem));
+                    point_t_dofs.push(nodes.map(|&n| t_dof(n)).collect());
+                }
                 let key = (0u8, ea.elem.0, eb.elem.0);
                 let a_at = (mesh.block_of(ea.elem), ea.k);
                 (key, l, mesh.elem_number(fa.side.elem), fa.side.side, a_at)
@@ -518,6 +530,9 @@ impl InterfacePoints {
                     out.group_points.push(out.points.len());
                 }
                 out.dofs.extend_from_slice(l.dofs());
+                if let Some(t) = point_t_dofs.get(at as usize) {
+                    out.t_dofs.extend_from_slice(t);
+                }
                 last_key = Some(key);
             }
             let at = out.values.len() as u32;
@@ -565,122 +580,27 @@ impl InterfacePoints {
         self.points.is_empty()
     }
 
+    /// The temperature dofs of group `g`, parallel to [`Self::group`], when the
+    /// coefficient takes another field's temperature.
+    fn group_t_dofs(&self, g: usize) -> Option<&[u32]> {
+        (!self.t_dofs.is_empty()).then(|| &self.t_dofs[self.group_dofs[g]..self.group_dofs[g + 1]])
+    }
+
     /// The dofs of group `g` (side A's element, then side B's): the rows and columns
     /// of the `g`-th block [`Self::for_each_block`] gives, without evaluating anything.
     pub fn group(&self, g: usize) -> &[u32] {
         &self.dofs[self.group_dofs[g]..self.group_dofs[g + 1]]
     }
 
-    /// The dof pairs (i < j) the groups couple, for [`Pattern::add_couplings`].
-    ///
-    /// [`Pattern::add_couplings`]: crate::assembly::Pattern::add_couplings
-    pub fn couplings(&self) -> Vec<(usize, usize)> {
-        // Each pair (i < j) under row i, rows made by counting, then each short row
-        // sorted and freed of repeats: no sort of all pairs at once.
-        let rows = self.touched.len();
-        let row_of = |g: usize| self.position[self.group_dofs[g]..self.group_dofs[g + 1]].iter();
-        let mut start = vec![0usize; rows + 1];
-        for g in 0..self.groups() {
-            for_each_pair(row_of(g), |i, _| start[i + 1] += 1);
-        }
-        for i in 0..rows {
-            start[i + 1] += start[i];
-        }
-        let mut partners = vec![0u32; start[rows]];
-        let mut next = start.clone();
-        for g in 0..self.groups() {
-            for_each_pair(row_of(g), |i, j| {
-                partners[next[i]] = j as u32;
-                next[i] += 1;
-            });
-        }
-        let mut out = Vec::new();
-        for i in 0..rows {
-            let row = &mut partners[start[i]..start[i + 1]];
-            row.sort_unstable();
-            let mut last = None;
-            for &j in row.iter() {
-                if last != Some(j) {
-                    out.push((self.touched[i] as usize, self.touched[j as usize] as usize));
-                    last = Some(j);
-                }
-            }
-        }
-        out
-    }
-
-    /// Where every block entry goes in an assembler whose pattern holds `couplings`
-    /// (as returned by [`Self::couplings`], registered at `first` onwards): worked out
-    /// once, so [`InterfaceSystem::add_scattered`] adds without searching.
-    pub fn scatter(&self, couplings: &[(usize, usize)], first: usize) -> Scatter {
-        // The couplings are sorted by (i, j): each i's partners j are one run, found
-        // through `row[i]..row[i + 1]`.
-        let rows = couplings.last().map_or(0, |c| c.0 + 1);
-        let mut row = vec![0usize; rows + 1];
-        for c in couplings {
-            row[c.0 + 1] += 1;
-        }
-        for i in 0..rows {
-            row[i + 1] += row[i];
-        }
-        let mut slots = Vec::with_capacity(
-            self.group_dofs
-                .windows(2)
-                .map(|w| (w[1] - w[0]).pow(2))
-                .sum(),
-        );
-        let mut order = [0usize; 2 * MAX_NODES];
-        for g in 0..self.groups() {
-            let dofs = self.group(g);
-            let nl = dofs.len();
-            let block = slots.len();
-            slots.resize(block + nl * nl, ExtraSlot::diagonal(0));
-            // The group's entries by ascending dof: the partners of each dof are then
-            // met in the order of its run of couplings, which one pass walks through
-            // (no search). Entry (a, b) and its transpose (b, a) share one coupling.
-            let order = &mut order[..nl];
-            for (k, o) in order.iter_mut().enumerate() {
-                *o = k;
-            }
-            order.sort_unstable_by_key(|&k| dofs[k]);
-            for (p, &a) in order.iter().enumerate() {
-                let lo = dofs[a] as usize;
-                slots[block + a * nl + a] = ExtraSlot::diagonal(lo);
-                let run = match row.get(lo..lo + 2) {
-                    Some(&[start, end]) => &couplings[start..end],
-                    _ => &[],
-                };
-                let mut r = 0;
-                for &b in &order[p + 1..] {
-                    let hi = dofs[b] as usize;
-                    if hi == lo {
-                        slots[block + a * nl + b] = ExtraSlot::diagonal(lo);
-                        slots[block + b * nl + a] = ExtraSlot::diagonal(lo);
-                        continue;
-                    }
-                    while run[r].1 < hi {
-                        r += 1;
-                    }
-                    assert_eq!(run[r].1, hi, "coupling registered from the same groups");
-                    let k = first + row[lo] + r;
-                    // (a, b) is (lo, hi), the coupling as registered; (b, a) its transpose.
-                    slots[block + a * nl + b] = ExtraSlot::coupling(k, false);
-                    slots[block + b * nl + a] = ExtraSlot::coupling(k, true);
-                }
-            }
-        }
-        Scatter { slots }
-    }
-
     /// The local vectors of point `p` (of a group with `dofs`), the jump and
     /// flux-average of the field there, and h.
     fn at_point(
         &self,
-        p: &CachedPoint,
-        dofs: &[u32],
+        (g, p): (usize, &CachedPoint),
         form: &InterfaceForm<'_>,
         u: &[f64],
     ) -> Result<PointEval<'_>, InterfaceError> {
+        let dofs = self.group(g);
         let nl = dofs.len();
         let at = p.at as usize;
         let jump = &self.values[at..at + nl];
@@ -693,7 +613,24 @@ impl InterfacePoints {
         let flux_parts = [part(0..na), part(na..nl)];
         let temp_a: f64 = (0..na).map(|i| jump[i] * u[dofs[i] as usize]).sum();
         let temp_b = temp_a - (jump_u + form.offset);
-        let scale = self.scale(p, form, temp_a, temp_b)?;
+        let scale = match self.group_t_dofs(g) {
+            // The temperatures of another field: T_A = Σ_A N T, T_B = Σ_B N T.
+            Some(t) => {
+                let at = |i: usize| {
+                    if t[i] == u32::MAX {
+                        0.0
+                    } else {
+                        u[t[i] as usize]
+                    }
+                };
+                let value = |r: std::ops::Range<usize>| -> f64 { r.map(|i| jump[i] * at(i)).sum() };
+                let (ta, tb) = (value(0..na), -value(na..nl));
+                let mut scale = self.scale(p, form, ta, tb)?;
+                scale.varies = false;
+                scale
+            }
+            None => self.scale(p, form, temp_a, temp_b)?,
+        };
         let flux_u = scale.flux[0] * flux_parts[0] + scale.flux[1] * flux_parts[1];
         let hv = match form.form {
             Form::Conductance | Form::GapConductance => (form.h)(&HInput {
@@ -732,9 +669,8 @@ impl InterfacePoints {
     ) -> Result<Vec<Option<PointFlux>>, InterfaceError> {
         let mut out = vec![None; count];
         for g in 0..self.groups() {
-            let dofs = self.group(g);
             for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
-                let e = self.at_point(p, dofs, form, u)?;
+                let e = self.at_point((g, p), form, u)?;
                 let ([cp, ct, _], _) = coefficients(form.form, e.hv.h, p.alpha * e.scale.alpha);
                 out[p.index as usize] = Some(PointFlux {
                     q: cp * e.jump_u - ct * e.flux_u,
@@ -815,7 +751,7 @@ impl InterfacePoints {
                     hv,
                     scale,
                     ..
-                } = self.at_point(p, dofs, form, u)?;
+                } = self.at_point((g, p), form, u)?;
                 let na = p.na as usize;
                 let alpha = p.alpha * scale.alpha;
                 let ([cp, ct, cs], [dp, dt, ds]) = coefficients(form.form, hv.h, alpha);

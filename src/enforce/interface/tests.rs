@@ -57,6 +57,7 @@ fn form<'a>(h: &'a HFn<'a>) -> InterfaceForm<'a> {
         beta: DEFAULT_BETA,
         conductivity: &[16.0, 200.0],
         conductivity_of_t: None,
+        temperature_field: None,
     }
 }
 
@@ -73,7 +74,7 @@ fn evaluated_blocks_are_the_form() {
         let nl = dofs.len();
         let mut want = vec![0.0; nl * nl];
         for p in &points.points[points.group_points[g]..points.group_points[g + 1]] {
-            let e = points.at_point(p, dofs, &f, &u).unwrap();
+            let e = points.at_point((g, p), &f, &u).unwrap();
             let ([cp, ct, cs], [dp, dt, ds]) = coefficients(f.form, e.hv.h, p.alpha);
             for i in 0..nl {
                 let (ji, fi) = (e.jump[i], e.flux[i]);
