@@ -460,9 +460,12 @@ struct Pair {
     /// The coefficient per block weighing this pair's Nitsche forms, instead of the
     /// embedding's conductivity (`seam run`'s species interfaces: the diffusivity).
     coefficient: Option<Vec<f64>>,
-    /// That coefficient as a law of the temperature, and the temperature's field (D(T),
-    /// σ(T)): the forms take it at each point's temperatures.
-    coefficient_law: Option<(std::sync::Arc<ConductivityOfT>, FieldId)>,
+    /// The temperature field, when it is not this pair's own (a species interface or a
+    /// voltage tie): its models see it, and `coefficient_law` takes it.
+    temperature_field: Option<FieldId>,
+    /// That coefficient as a law of the temperature (D(T), σ(T)): the forms take it at
+    /// each point's temperatures.
+    coefficient_law: Option<std::sync::Arc<ConductivityOfT>>,
 }
 
 impl Pair {
@@ -510,6 +513,7 @@ impl Pair {
             quarantined: Mutex::new(Vec::new()),
             active: true,
             coefficient: None,
+            temperature_field: None,
             coefficient_law: None,
         }
     }

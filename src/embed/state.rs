@@ -177,16 +177,19 @@ impl Embedding {
         }
     }
 
-    /// Take interaction `i`'s coefficient ([`Self::set_coefficient`], its value at a
-    /// probe temperature) as `law` of the temperature in `field` at each point.
-    pub(crate) fn set_coefficient_law(
+    /// Interaction `i` (on a field other than the temperature) sees the temperature of
+    /// `field` at its points: its conductance models take it, and its coefficient
+    /// ([`Self::set_coefficient`], the value at a probe temperature) follows `law` of it
+    /// when given.
+    pub(crate) fn set_temperature_of(
         &mut self,
         i: usize,
-        law: std::sync::Arc<super::ConductivityOfT>,
         field: FieldId,
+        law: Option<std::sync::Arc<super::ConductivityOfT>>,
     ) {
         if let Some(p) = self.pairs.get_mut(i) {
-            p.coefficient_law = Some((law, field));
+            p.temperature_field = Some(field);
+            p.coefficient_law = law;
             p.points = OnceLock::new();
         }
         if let Some(e) = &mut self.evaluation {

@@ -109,10 +109,9 @@ impl Embedding {
         // k(T) at the embedding's time, for the temperature's interactions (a species
         // interface or voltage tie has a coefficient of its own).
         let time = self.time;
-        let (k_law, temperature_field) = match (&p.coefficient, &p.coefficient_law) {
-            (None, _) => (self.conductivity_law.as_deref(), None),
-            (Some(_), Some((law, field))) => (Some(law.as_ref()), Some(*field)),
-            (Some(_), None) => (None, None),
+        let (k_law, temperature_field) = match &p.coefficient {
+            None => (self.conductivity_law.as_deref(), None),
+            Some(_) => (p.coefficient_law.as_deref(), p.temperature_field),
         };
         let k_of_t = k_law.map(|law| move |b: usize, t: f64, x: [f64; 3]| law(b, t, x, time));
         let form = InterfaceForm {

@@ -413,9 +413,8 @@ impl<'a> ContactTerms<'a> {
                     field.into(),
                 );
                 embedding.set_coefficient(k, coefficient.clone());
-                if let Some(law) = field_law(&species.scaled_diffusivity()) {
-                    embedding.set_coefficient_law(k, law, temperature?);
-                }
+                let law = field_law(&species.scaled_diffusivity());
+                embedding.set_temperature_of(k, temperature?, law);
             }
         }
         if !self.contact.voltage_ties.is_empty() {
@@ -442,9 +441,8 @@ impl<'a> ContactTerms<'a> {
                     field.into(),
                 );
                 embedding.set_coefficient(k, coefficient.clone());
-                if let Some(law) = field_law(&physics.materials.sigma) {
-                    embedding.set_coefficient_law(k, law, temperature?);
-                }
+                let law = field_law(&physics.materials.sigma);
+                embedding.set_temperature_of(k, temperature?, law);
             }
         }
         Ok(Embedded {

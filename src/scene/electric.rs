@@ -103,7 +103,6 @@ fn tie_block(enf: &Enforcement) -> FieldBlock {
         code: "E0431",
         coefficient: "electrical contact conductance",
         tie_help: "write `Side B Variable voltage To voltage` (mortar multipliers), or leave the line out for a Nitsche tie",
-        sees: "voltages",
     }
 }
 

@@ -15,9 +15,8 @@
 //!
 //! What the host does with K (the scene only carries it): see [`crate::run`]'s species,
 //! which solves for c/S with a solubility scale S per block so that every model here
-//! applies unchanged. A coefficient model that depends on the temperature (gas gap,
-//! radiation, tables or Lua of T, plugins that say so) is refused: at a species
-//! interface the forms see concentrations, not temperatures.
+//! applies unchanged. A coefficient model that depends on the temperature (tables or
+//! Lua of T, plugins) sees the temperature field at the point, as at a thermal contact.
 
 use std::path::Path;
 
@@ -128,7 +127,6 @@ pub(super) fn species_model(
         code: CODE,
         coefficient: "mass-transfer coefficient",
         tie_help: "write `Side B Variable species To species` (mortar multipliers), or leave the line out for a Nitsche tie",
-        sees: "concentrations",
     };
     field_model(enf, &field, deck_dir, sources, pair, diags)
 }
@@ -145,8 +143,6 @@ pub(super) struct FieldBlock {
     pub coefficient: &'static str,
     /// The help of a `Side B Variable` that maps another field.
     pub tie_help: &'static str,
-    /// What its forms see, for messages ("concentrations").
-    pub sees: &'static str,
 }
 
 /// The model of the `field` block `enf`, lowered as an Energy block's is (the same
@@ -211,24 +207,6 @@ pub(super) fn field_model(
     let model =
         super::conductance_model(&as_energy, &choice, deck_dir, sources, pair, diags).ok()?;
     if super::electric::refuse_voltage(enf, model.as_deref(), diags) {
-        return None;
-    }
-    if let Some(m) = &model
-        && m.depends_on_temperature()
-    {
-        refuse(
-            diags,
-            &line.at,
-            format!(
-                "the {} `{}` of this {name} block depends on the temperature, which a {name} interface does not see",
-                field.coefficient,
-                m.name()
-            ),
-            &format!(
-                "give a coefficient of the gap, position or time (`Constant H = …`, a table or Lua expression without T); at a {name} interface the forms see {}",
-                field.sees
-            ),
-        );
         return None;
     }
     Some((choice, model))

@@ -166,10 +166,11 @@ pub struct InterfaceForm<'a> {
     /// each point's temperatures (module docs, "Conductivity of the temperature");
     /// `None`: `conductivity` as given. The form's field must be the temperature.
     pub conductivity_of_t: Option<&'a ConductivityLaw<'a>>,
-    /// The field whose values `conductivity_of_t` takes when it is not the form's own (a
-    /// species interface or voltage tie weighed with D(T) or σ(T)): its derivatives then
-    /// stay out of the Jacobian, whose columns are the form's field (Newton lags the
-    /// coefficient by one iteration; the converged answer is the consistent one).
+    /// The temperature field, when it is not the form's own (a species interface or a
+    /// voltage tie): `conductivity_of_t` (D(T), σ(T)) and the conductance `h` then take
+    /// its values at the point, and their derivatives stay out of the Jacobian, whose
+    /// columns are the form's field (Newton lags them by one iteration; the converged
+    /// answer is the consistent one).
     pub temperature_field: Option<FieldId>,
 }
 
@@ -443,11 +444,9 @@ impl InterfacePoints {
         // points (1, node, element B).
         let mut keys: Vec<((u8, u32, u32), u32)> = Vec::with_capacity(points.len());
         let mut evaluated: Vec<(CachedPoint, Local)> = Vec::with_capacity(points.len());
-        // The temperature dofs of each point's nodes, when the coefficient takes the
+        // The temperature dofs of each point's nodes, when the models see the
         // temperature of another field.
-        let foreign = form
-            .temperature_field
-            .filter(|_| form.conductivity_of_t.is_some());
+        let foreign = form.temperature_field;
         let t_dof = |node: crate::mesh::NodeId| {
             foreign
                 .and_then(|t| dofs.dof(t, node))
@@ -580,8 +579,8 @@ impl InterfacePoints {
         self.points.is_empty()
     }
 
-    /// The temperature dofs of group `g`, parallel to [`Self::group`], when the
-    /// coefficient takes another field's temperature.
+    /// The temperature dofs of group `g`, parallel to [`Self::group`], when the models
+    /// see the temperature of another field.
     fn group_t_dofs(&self, g: usize) -> Option<&[u32]> {
         (!self.t_dofs.is_empty()).then(|| &self.t_dofs[self.group_dofs[g]..self.group_dofs[g + 1]])
     }
@@ -613,36 +612,45 @@ impl InterfacePoints {
         let flux_parts = [part(0..na), part(na..nl)];
         let temp_a: f64 = (0..na).map(|i| jump[i] * u[dofs[i] as usize]).sum();
         let temp_b = temp_a - (jump_u + form.offset);
-        let scale = match self.group_t_dofs(g) {
-            // The temperatures of another field: T_A = Σ_A N T, T_B = Σ_B N T.
-            Some(t) => {
-                let at = |i: usize| {
-                    if t[i] == u32::MAX {
-                        0.0
-                    } else {
-                        u[t[i] as usize]
-                    }
-                };
-                let value = |r: std::ops::Range<usize>| -> f64 { r.map(|i| jump[i] * at(i)).sum() };
-                let (ta, tb) = (value(0..na), -value(na..nl));
-                let mut scale = self.scale(p, form, ta, tb)?;
-                scale.varies = false;
-                scale
-            }
-            None => self.scale(p, form, temp_a, temp_b)?,
-        };
+        // The temperatures the models see: the form's own field's, or those of the
+        // temperature field beside it (T_A = Σ_A N T, T_B = Σ_B N T), whose derivatives
+        // lie outside the form's columns and are left to Newton's next iteration.
+        let foreign = self.group_t_dofs(g).map(|t| {
+            let at = |i: usize| {
+                if t[i] == u32::MAX {
+                    0.0
+                } else {
+                    u[t[i] as usize]
+                }
+            };
+            let value = |r: std::ops::Range<usize>| -> f64 { r.map(|i| jump[i] * at(i)).sum() };
+            (value(0..na), -value(na..nl))
+        });
+        let (seen_a, seen_b) = foreign.unwrap_or((temp_a, temp_b));
+        let mut scale = self.scale(p, form, seen_a, seen_b)?;
+        scale.varies &= foreign.is_none();
         let flux_u = scale.flux[0] * flux_parts[0] + scale.flux[1] * flux_parts[1];
         let hv = match form.form {
-            Form::Conductance | Form::GapConductance => (form.h)(&HInput {
-                gap: p.gap,
-                temp_a,
-                temp_b,
-                volt_a: 0.0,
-                volt_b: 0.0,
-                x: p.x,
-                point: p.index as usize,
-            })
-            .map_err(|message| point_error(p, message))?,
+            Form::Conductance | Form::GapConductance => {
+                let hv = (form.h)(&HInput {
+                    gap: p.gap,
+                    temp_a: seen_a,
+                    temp_b: seen_b,
+                    volt_a: 0.0,
+                    volt_b: 0.0,
+                    x: p.x,
+                    point: p.index as usize,
+                })
+                .map_err(|message| point_error(p, message))?;
+                match foreign {
+                    Some(_) => HValue {
+                        dh_dtemp_a: 0.0,
+                        dh_dtemp_b: 0.0,
+                        ..hv
+                    },
+                    None => hv,
+                }
+            }
             _ => HValue::default(),
         };
         Ok(PointEval {
