@@ -17,7 +17,8 @@
 //!   mesh into surfaces, interactions, searches and enforcements;
 //! - hosts: [`embed`] (the public host API) and [`capi`] (its C face), [`heat`] (seam's
 //!   conduction solvers, which take interfaces through [`heat::interfaces::Interfaces`])
-//!   and [`run`] (`seam run`, itself a host of [`embed`]); the binary's CLI on top;
+//!   and [`run`] (`seam run`, itself a host of [`embed`]), which [`parallel`] runs on
+//!   MPI and PETSc (`--features mpi`); the binary's CLI on top;
 //! - [`error`]: [`Error`], wrapping every module's own error.
 
 pub mod assembly;
@@ -32,6 +33,7 @@ pub mod heat;
 pub mod logging;
 pub mod mesh;
 pub mod output;
+pub mod parallel;
 pub mod periodic;
 pub mod plugin;
 pub mod run;

@@ -1,0 +1,110 @@
+//! `seam run` on MPI (`--features mpi`, started by `mpirun`): the mesh's elements
+//! partitioned by METIS, each rank assembling its own elements' conduction and the
+//! interface rows of the dofs it owns into a PETSc distributed matrix, the solve by PETSc
+//! (CG + GAMG, or MUMPS LU), the solution gathered so that rank 0 writes what a serial
+//! run writes. What is and is not distributed is listed in `docs/parallel.md`.
+//!
+//! Entry points: [`start`] (the binary, before a run), then the hooks the run calls —
+//! [`is_root`] (who writes files and prints), [`steady`] (the linear or
+//! Newton-nonlinear steady solve), [`not_distributed`] (what a run under MPI refuses)
+//! and [`describe`] (the summary's linear solver).
+//!
+//! Without the feature, or without a launcher, every hook is the serial path: one
+//! process, rank 0, nothing refused.
+
+use crate::diag::Diagnostic;
+use crate::heat::HeatError;
+use crate::heat::steady::{SteadyProblem, SteadySolution};
+use crate::run::LinearSolverSummary;
+
+#[cfg(feature = "mpi")]
+mod layout;
+#[cfg(feature = "mpi")]
+pub mod petsc;
+#[cfg(feature = "mpi")]
+mod session;
+#[cfg(feature = "mpi")]
+mod steady;
+
+#[cfg(feature = "mpi")]
+pub use session::{Session, start};
+
+/// This process's rank and the number of ranks, when a run is distributed.
+pub fn world() -> Option<(usize, usize)> {
+    #[cfg(feature = "mpi")]
+    {
+        session::world()
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        None
+    }
+}
+
+/// Whether this process writes the results and prints the summary: rank 0, or a run
+/// that is not distributed.
+pub fn is_root() -> bool {
+    world().is_none_or(|(rank, _)| rank == 0)
+}
+
+/// The distributed steady solve when the run is distributed, else `None` (the caller
+/// solves serially).
+pub fn steady(p: &SteadyProblem<'_>) -> Option<Result<SteadySolution, HeatError>> {
+    #[cfg(feature = "mpi")]
+    {
+        world().map(|_| steady::solve(p))
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        let _ = p;
+        None
+    }
+}
+
+/// Under MPI, the diagnostic refusing a run the distributed solve does not cover: one
+/// that the general (stepped) solver would solve — a transient run, or a steady one with
+/// temperature-dependent materials, several fields, a voltage or a species, radiation,
+/// toggles. `None` when the run is not distributed.
+pub fn not_distributed(transient: bool) -> Option<Diagnostic> {
+    let (_, size) = world()?;
+    let what = if transient {
+        "a transient run"
+    } else {
+        "a steady run the general solver takes (temperature-dependent materials, several fields, a voltage or a species, radiation, toggles)"
+    };
+    Some(
+        Diagnostic::error(
+            "E0901",
+            format!("{what} is not yet distributed: under MPI ({size} rank(s)) seam solves steady single-field conduction with constant materials"),
+        )
+        .help("run it without mpirun (serially); docs/parallel.md lists what is distributed today"),
+    )
+}
+
+/// The summary's linear solver as the distributed solve ran it (PETSc's method and the
+/// ranks), or `serial` unchanged.
+pub fn describe(serial: LinearSolverSummary) -> LinearSolverSummary {
+    #[cfg(feature = "mpi")]
+    {
+        match (world(), steady::last_method()) {
+            (Some((_, size)), Some(method)) => LinearSolverSummary {
+                name: method.name().into(),
+                reason: format!(
+                    "MPI, {size} rank(s): {}",
+                    match method {
+                        petsc::Method::CgGamg =>
+                            "symmetric positive definite, at or above the AMG threshold → CG + GAMG",
+                        petsc::Method::MumpsLu =>
+                            "below the AMG threshold, or an unsymmetric Newton Jacobian → MUMPS LU",
+                    }
+                ),
+                ..serial
+            },
+            _ => serial,
+        }
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        serial
+    }
+}

@@ -1,0 +1,516 @@
+//! PETSc through its C API: the few calls the distributed solve makes (a distributed AIJ
+//! matrix, vectors, a KSP), declared by hand and wrapped so that every error code becomes
+//! a [`PetscError`] naming the call, and every object is destroyed when dropped.
+//!
+//! Bound against Debian's `petsc-dev` (PETSc 3.18, `libpetsc_real`: real double
+//! scalars, 32-bit `PetscInt` — `petscconf.h` has no `PETSC_USE_64BIT_INDICES`).
+//! Linking `petsc_real` by name rules out a complex build; [`initialize`] asks the
+//! library for its `PetscInt` width and refuses any other than 4 bytes, so a
+//! 64-bit-index PETSc found at run time is an error, not a silent misread of indices.
+//! No crate binds this PETSc (the Rust crates that exist build their own PETSc or
+//! generate bindings with a PETSc they download), hence our own small declarations.
+
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
+
+use mpi::ffi::MPI_Comm;
+
+/// `PetscInt` of Debian's build (checked at start by [`initialize`]).
+pub type PetscInt = i32;
+type PetscErrorCode = c_int;
+type Object = *mut c_void;
+
+// The enum values below are those of PETSc 3.18's headers.
+const INSERT_VALUES: c_int = 1;
+const ADD_VALUES: c_int = 2;
+const MAT_FINAL_ASSEMBLY: c_int = 0;
+const NORM_2: c_int = 1;
+/// `PetscDataType` `PETSC_INT`.
+const PETSC_INT: c_int = 16;
+/// `PETSC_DEFAULT`: keep PETSc's value of a tolerance.
+const PETSC_DEFAULT: f64 = -2.0;
+
+#[link(name = "petsc_real")]
+unsafe extern "C" {
+    fn PetscInitializeNoArguments() -> PetscErrorCode;
+    fn PetscFinalize() -> PetscErrorCode;
+    fn PetscDataTypeGetSize(t: c_int, size: *mut usize) -> PetscErrorCode;
+    fn PetscErrorMessage(
+        code: PetscErrorCode,
+        text: *mut *const c_char,
+        specific: *mut *mut c_char,
+    ) -> PetscErrorCode;
+    fn PetscPushErrorHandler(
+        handler: Option<
+            unsafe extern "C" fn(
+                MPI_Comm,
+                c_int,
+                *const c_char,
+                *const c_char,
+                PetscErrorCode,
+                c_int,
+                *const c_char,
+                *mut c_void,
+            ) -> PetscErrorCode,
+        >,
+        ctx: *mut c_void,
+    ) -> PetscErrorCode;
+    fn PetscReturnErrorHandler(
+        comm: MPI_Comm,
+        line: c_int,
+        fun: *const c_char,
+        file: *const c_char,
+        n: PetscErrorCode,
+        p: c_int,
+        mess: *const c_char,
+        ctx: *mut c_void,
+    ) -> PetscErrorCode;
+
+    fn MatCreate(comm: MPI_Comm, mat: *mut Object) -> PetscErrorCode;
+    fn MatSetSizes(
+        mat: Object,
+        m: PetscInt,
+        n: PetscInt,
+        mm: PetscInt,
+        nn: PetscInt,
+    ) -> PetscErrorCode;
+    fn MatSetType(mat: Object, t: *const c_char) -> PetscErrorCode;
+    fn MatSeqAIJSetPreallocation(mat: Object, nz: PetscInt, nnz: *const PetscInt)
+    -> PetscErrorCode;
+    fn MatMPIAIJSetPreallocation(
+        mat: Object,
+        d_nz: PetscInt,
+        d_nnz: *const PetscInt,
+        o_nz: PetscInt,
+        o_nnz: *const PetscInt,
+    ) -> PetscErrorCode;
+    fn MatSetValues(
+        mat: Object,
+        m: PetscInt,
+        rows: *const PetscInt,
+        n: PetscInt,
+        cols: *const PetscInt,
+        v: *const f64,
+        mode: c_int,
+    ) -> PetscErrorCode;
+    fn MatAssemblyBegin(mat: Object, t: c_int) -> PetscErrorCode;
+    fn MatAssemblyEnd(mat: Object, t: c_int) -> PetscErrorCode;
+    fn MatZeroEntries(mat: Object) -> PetscErrorCode;
+    fn MatZeroRowsColumns(
+        mat: Object,
+        n: PetscInt,
+        rows: *const PetscInt,
+        diag: f64,
+        x: Object,
+        b: Object,
+    ) -> PetscErrorCode;
+    fn MatDestroy(mat: *mut Object) -> PetscErrorCode;
+
+    fn VecCreateMPI(comm: MPI_Comm, n: PetscInt, nn: PetscInt, v: *mut Object) -> PetscErrorCode;
+    fn VecDuplicate(v: Object, out: *mut Object) -> PetscErrorCode;
+    fn VecSetValues(
+        v: Object,
+        n: PetscInt,
+        ix: *const PetscInt,
+        y: *const f64,
+        mode: c_int,
+    ) -> PetscErrorCode;
+    fn VecAssemblyBegin(v: Object) -> PetscErrorCode;
+    fn VecAssemblyEnd(v: Object) -> PetscErrorCode;
+    fn VecZeroEntries(v: Object) -> PetscErrorCode;
+    fn VecNorm(v: Object, t: c_int, out: *mut f64) -> PetscErrorCode;
+    fn VecGetArray(v: Object, a: *mut *mut f64) -> PetscErrorCode;
+    fn VecRestoreArray(v: Object, a: *mut *mut f64) -> PetscErrorCode;
+    fn VecDestroy(v: *mut Object) -> PetscErrorCode;
+
+    fn KSPCreate(comm: MPI_Comm, ksp: *mut Object) -> PetscErrorCode;
+    fn KSPSetOperators(ksp: Object, a: Object, p: Object) -> PetscErrorCode;
+    fn KSPSetType(ksp: Object, t: *const c_char) -> PetscErrorCode;
+    fn KSPGetPC(ksp: Object, pc: *mut Object) -> PetscErrorCode;
+    fn PCSetType(pc: Object, t: *const c_char) -> PetscErrorCode;
+    fn PCFactorSetMatSolverType(pc: Object, t: *const c_char) -> PetscErrorCode;
+    fn KSPSetTolerances(
+        ksp: Object,
+        rtol: f64,
+        abstol: f64,
+        dtol: f64,
+        maxits: PetscInt,
+    ) -> PetscErrorCode;
+    fn KSPSetFromOptions(ksp: Object) -> PetscErrorCode;
+    fn KSPSetUp(ksp: Object) -> PetscErrorCode;
+    fn KSPSolve(ksp: Object, b: Object, x: Object) -> PetscErrorCode;
+    fn KSPGetIterationNumber(ksp: Object, its: *mut PetscInt) -> PetscErrorCode;
+    fn KSPGetConvergedReason(ksp: Object, reason: *mut c_int) -> PetscErrorCode;
+    fn KSPDestroy(ksp: *mut Object) -> PetscErrorCode;
+}
+
+/// A PETSc call that returned an error code.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("PETSc {call} failed (error {code}: {message})")]
+pub struct PetscError {
+    pub call: &'static str,
+    pub code: i32,
+    pub message: String,
+}
+
+fn check(call: &'static str, code: PetscErrorCode) -> Result<(), PetscError> {
+    if code == 0 {
+        return Ok(());
+    }
+    let mut text: *const c_char = std::ptr::null();
+    // SAFETY: PetscErrorMessage writes a pointer to a static string (or leaves null).
+    unsafe { PetscErrorMessage(code, &mut text, std::ptr::null_mut()) };
+    let message = if text.is_null() {
+        "no message".to_string()
+    } else {
+        // SAFETY: non-null, a NUL-terminated static string of PETSc's.
+        unsafe { CStr::from_ptr(text) }
+            .to_string_lossy()
+            .into_owned()
+    };
+    Err(PetscError {
+        call,
+        code,
+        message,
+    })
+}
+
+/// Start PETSc on an MPI already initialised (PETSc then leaves MPI to its owner), with
+/// errors returned as codes rather than printed tracebacks, and check that the library's
+/// `PetscInt` is the 32-bit integer these declarations assume.
+pub fn initialize() -> Result<(), PetscError> {
+    // SAFETY: plain calls; MPI is initialised by the caller (rsmpi).
+    unsafe {
+        check("PetscInitialize", PetscInitializeNoArguments())?;
+        check(
+            "PetscPushErrorHandler",
+            PetscPushErrorHandler(Some(PetscReturnErrorHandler), std::ptr::null_mut()),
+        )?;
+    }
+    let mut size = 0usize;
+    // SAFETY: writes one size_t.
+    check("PetscDataTypeGetSize", unsafe {
+        PetscDataTypeGetSize(PETSC_INT, &mut size)
+    })?;
+    if size != std::mem::size_of::<PetscInt>() {
+        return Err(PetscError {
+            call: "PetscDataTypeGetSize",
+            code: 0,
+            message: format!(
+                "this PETSc has {size}-byte PetscInt; seam is bound to Debian's 4-byte build (libpetsc_real)"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// End PETSc (before MPI ends).
+pub fn finalize() {
+    // SAFETY: called once, after every PETSc object is dropped.
+    unsafe { PetscFinalize() };
+}
+
+fn c_name(s: &str) -> CString {
+    CString::new(s).expect("no NUL in a PETSc type name")
+}
+
+/// A distributed AIJ matrix with rows `[start, start + local)` on this rank.
+pub struct Mat(Object);
+
+impl Mat {
+    /// A square `global × global` matrix, `local` rows here, preallocated exactly:
+    /// `diagonal[i]` entries of local row `i` in the local column block, `off[i]` outside.
+    pub fn aij(
+        comm: MPI_Comm,
+        local: usize,
+        global: usize,
+        diagonal: &[PetscInt],
+        off: &[PetscInt],
+    ) -> Result<Mat, PetscError> {
+        let mut m: Object = std::ptr::null_mut();
+        let aij = c_name("aij");
+        // SAFETY: the preallocation arrays have `local` entries each.
+        unsafe {
+            check("MatCreate", MatCreate(comm, &mut m))?;
+            let mat = Mat(m);
+            check(
+                "MatSetSizes",
+                MatSetSizes(
+                    m,
+                    local as PetscInt,
+                    local as PetscInt,
+                    global as _,
+                    global as _,
+                ),
+            )?;
+            check("MatSetType", MatSetType(m, aij.as_ptr()))?;
+            // Only the call matching the matrix's actual type (one rank: sequential) acts.
+            check(
+                "MatSeqAIJSetPreallocation",
+                MatSeqAIJSetPreallocation(m, 0, diagonal.as_ptr()),
+            )?;
+            check(
+                "MatMPIAIJSetPreallocation",
+                MatMPIAIJSetPreallocation(m, 0, diagonal.as_ptr(), 0, off.as_ptr()),
+            )?;
+            Ok(mat)
+        }
+    }
+
+    /// Add `values[k]` at `(rows[k], col)` (global indices, any rank's rows).
+    pub fn add_column(
+        &mut self,
+        rows: &[PetscInt],
+        col: PetscInt,
+        values: &[f64],
+    ) -> Result<(), PetscError> {
+        debug_assert_eq!(rows.len(), values.len());
+        // SAFETY: `rows` and `values` have the length passed; one column.
+        check("MatSetValues", unsafe {
+            MatSetValues(
+                self.0,
+                rows.len() as PetscInt,
+                rows.as_ptr(),
+                1,
+                &col,
+                values.as_ptr(),
+                ADD_VALUES,
+            )
+        })
+    }
+
+    pub fn zero(&mut self) -> Result<(), PetscError> {
+        // SAFETY: a valid matrix.
+        check("MatZeroEntries", unsafe { MatZeroEntries(self.0) })
+    }
+
+    /// Finish the values set so far (collective: off-rank entries travel here).
+    pub fn assemble(&mut self) -> Result<(), PetscError> {
+        // SAFETY: a valid matrix; collective on every rank.
+        unsafe {
+            check(
+                "MatAssemblyBegin",
+                MatAssemblyBegin(self.0, MAT_FINAL_ASSEMBLY),
+            )?;
+            check("MatAssemblyEnd", MatAssemblyEnd(self.0, MAT_FINAL_ASSEMBLY))
+        }
+    }
+
+    /// Rows and columns `rows` (global, owned here) replaced by the identity's: the
+    /// Dirichlet rows of an increment, symmetry kept.
+    pub fn zero_rows_columns(&mut self, rows: &[PetscInt]) -> Result<(), PetscError> {
+        // SAFETY: `rows` has the length passed; null x and b leave vectors alone.
+        check("MatZeroRowsColumns", unsafe {
+            MatZeroRowsColumns(
+                self.0,
+                rows.len() as PetscInt,
+                rows.as_ptr(),
+                1.0,
+                std::ptr::null_mut(),
+                std::ptr::null_mut(),
+            )
+        })
+    }
+}
+
+impl Drop for Mat {
+    fn drop(&mut self) {
+        // SAFETY: destroyed once.
+        unsafe { MatDestroy(&mut self.0) };
+    }
+}
+
+/// A distributed vector.
+pub struct Vector(Object);
+
+impl Vector {
+    pub fn new(comm: MPI_Comm, local: usize, global: usize) -> Result<Vector, PetscError> {
+        let mut v: Object = std::ptr::null_mut();
+        // SAFETY: writes one handle.
+        check("VecCreateMPI", unsafe {
+            VecCreateMPI(comm, local as PetscInt, global as PetscInt, &mut v)
+        })?;
+        Ok(Vector(v))
+    }
+
+    pub fn duplicate(&self) -> Result<Vector, PetscError> {
+        let mut v: Object = std::ptr::null_mut();
+        // SAFETY: writes one handle.
+        check("VecDuplicate", unsafe { VecDuplicate(self.0, &mut v) })?;
+        Ok(Vector(v))
+    }
+
+    pub fn zero(&mut self) -> Result<(), PetscError> {
+        // SAFETY: a valid vector.
+        check("VecZeroEntries", unsafe { VecZeroEntries(self.0) })
+    }
+
+    /// Add `values[k]` at global index `at[k]` (any rank's entries).
+    pub fn add(&mut self, at: &[PetscInt], values: &[f64]) -> Result<(), PetscError> {
+        debug_assert_eq!(at.len(), values.len());
+        // SAFETY: both slices have the length passed.
+        check("VecSetValues", unsafe {
+            VecSetValues(
+                self.0,
+                at.len() as PetscInt,
+                at.as_ptr(),
+                values.as_ptr(),
+                ADD_VALUES,
+            )
+        })
+    }
+
+    /// Set `values[k]` at global index `at[k]`.
+    pub fn set(&mut self, at: &[PetscInt], values: &[f64]) -> Result<(), PetscError> {
+        // SAFETY: both slices have the length passed.
+        check("VecSetValues", unsafe {
+            VecSetValues(
+                self.0,
+                at.len() as PetscInt,
+                at.as_ptr(),
+                values.as_ptr(),
+                INSERT_VALUES,
+            )
+        })
+    }
+
+    /// Finish the values set so far (collective).
+    pub fn assemble(&mut self) -> Result<(), PetscError> {
+        // SAFETY: a valid vector; collective on every rank.
+        unsafe {
+            check("VecAssemblyBegin", VecAssemblyBegin(self.0))?;
+            check("VecAssemblyEnd", VecAssemblyEnd(self.0))
+        }
+    }
+
+    /// ‖v‖₂ over every rank (collective).
+    pub fn norm(&self) -> Result<f64, PetscError> {
+        let mut n = 0.0;
+        // SAFETY: writes one real.
+        check("VecNorm", unsafe { VecNorm(self.0, NORM_2, &mut n) })?;
+        Ok(n)
+    }
+
+    /// The entries this rank owns, handed to `f` to read or change.
+    pub fn with_local<R>(
+        &mut self,
+        local: usize,
+        f: impl FnOnce(&mut [f64]) -> R,
+    ) -> Result<R, PetscError> {
+        let mut a: *mut f64 = std::ptr::null_mut();
+        // SAFETY: PETSc hands the local array (`local` entries, the size the vector was
+        // made with) until VecRestoreArray; nothing else touches the vector meanwhile.
+        unsafe {
+            check("VecGetArray", VecGetArray(self.0, &mut a))?;
+            let r = f(if local == 0 {
+                &mut []
+            } else {
+                std::slice::from_raw_parts_mut(a, local)
+            });
+            check("VecRestoreArray", VecRestoreArray(self.0, &mut a))?;
+            Ok(r)
+        }
+    }
+}
+
+impl Drop for Vector {
+    fn drop(&mut self) {
+        // SAFETY: destroyed once.
+        unsafe { VecDestroy(&mut self.0) };
+    }
+}
+
+/// Which Krylov method and preconditioner a [`Ksp`] runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// CG preconditioned by PETSc's smoothed-aggregation AMG (symmetric positive definite).
+    CgGamg,
+    /// A direct LU factorisation by MUMPS (small, unsymmetric or indefinite systems).
+    MumpsLu,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::CgGamg => "PETSc CG + GAMG",
+            Method::MumpsLu => "PETSc MUMPS LU",
+        }
+    }
+}
+
+/// A linear solver over one matrix (PETSc options such as `-ksp_type` given in
+/// `PETSC_OPTIONS` override the choice).
+pub struct Ksp(Object);
+
+impl Ksp {
+    pub fn new(comm: MPI_Comm, a: &Mat, method: Method, rtol: f64) -> Result<Ksp, PetscError> {
+        let mut k: Object = std::ptr::null_mut();
+        let mut pc: Object = std::ptr::null_mut();
+        // SAFETY: plain calls on handles PETSc made; the names are NUL-terminated.
+        unsafe {
+            check("KSPCreate", KSPCreate(comm, &mut k))?;
+            let ksp = Ksp(k);
+            check("KSPSetOperators", KSPSetOperators(k, a.0, a.0))?;
+            check("KSPGetPC", KSPGetPC(k, &mut pc))?;
+            match method {
+                Method::CgGamg => {
+                    check("KSPSetType", KSPSetType(k, c_name("cg").as_ptr()))?;
+                    check("PCSetType", PCSetType(pc, c_name("gamg").as_ptr()))?;
+                    check(
+                        "KSPSetTolerances",
+                        KSPSetTolerances(k, rtol, 1e-300, PETSC_DEFAULT, 10_000),
+                    )?;
+                }
+                Method::MumpsLu => {
+                    check("KSPSetType", KSPSetType(k, c_name("preonly").as_ptr()))?;
+                    check("PCSetType", PCSetType(pc, c_name("lu").as_ptr()))?;
+                    check(
+                        "PCFactorSetMatSolverType",
+                        PCFactorSetMatSolverType(pc, c_name("mumps").as_ptr()),
+                    )?;
+                }
+            }
+            check("KSPSetFromOptions", KSPSetFromOptions(k))?;
+            Ok(ksp)
+        }
+    }
+
+    /// The preconditioner or factorisation made (collective).
+    pub fn set_up(&mut self) -> Result<(), PetscError> {
+        // SAFETY: a valid KSP with operators.
+        check("KSPSetUp", unsafe { KSPSetUp(self.0) })
+    }
+
+    /// Solve `A x = b`; the iterations taken, or an error when the method diverged.
+    pub fn solve(&mut self, b: &Vector, x: &mut Vector) -> Result<usize, PetscError> {
+        let (mut its, mut reason) = (0 as PetscInt, 0 as c_int);
+        // SAFETY: valid handles; b and x have the matrix's layout.
+        unsafe {
+            check("KSPSolve", KSPSolve(self.0, b.0, x.0))?;
+            check(
+                "KSPGetIterationNumber",
+                KSPGetIterationNumber(self.0, &mut its),
+            )?;
+            check(
+                "KSPGetConvergedReason",
+                KSPGetConvergedReason(self.0, &mut reason),
+            )?;
+        }
+        if reason < 0 {
+            return Err(PetscError {
+                call: "KSPSolve",
+                code: reason,
+                message: format!(
+                    "the Krylov solve diverged after {its} iterations (KSPConvergedReason {reason})"
+                ),
+            });
+        }
+        Ok(its.max(0) as usize)
+    }
+}
+
+impl Drop for Ksp {
+    fn drop(&mut self) {
+        // SAFETY: destroyed once.
+        unsafe { KSPDestroy(&mut self.0) };
+    }
+}

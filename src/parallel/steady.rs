@@ -1,0 +1,430 @@
+//! The steady solve on MPI: the Newton iteration of [`crate::heat::steady`] (the same
+//! residual, Jacobian, Dirichlet rows on the increment and stopping tests) with the
+//! system distributed.
+//!
+//! Each rank assembles the conduction of its own elements (a mesh of only those,
+//! [`Layout::local_mesh`]) with the serial kernels and adds every entry it made — rows of
+//! any rank: PETSc sends those to their owners at assembly. The interface terms come from
+//! the run's embedding, evaluated on every rank over the whole interface; each rank adds
+//! only the rows of the dofs it owns, so every term enters once. The increment is solved by
+//! PETSc and gathered whole on every rank (each rank's interface evaluation needs the
+//! field at its side-B nodes). Mortar ties with multipliers are refused.
+
+use std::cell::Cell;
+use std::time::Instant;
+
+use mpi::datatype::PartitionMut;
+use mpi::traits::{AsRaw, CommunicatorCollectives};
+
+use crate::assembly::{Assembler, DofMap, Pattern};
+use crate::heat::interfaces::InterfaceFailure;
+use crate::heat::steady::{
+    AMG_TOLERANCE, LinearMethod, LinearSolves, STEADY_AMG_TOLERANCE, SolveTiming, SteadyProblem,
+    SteadySolution,
+};
+use crate::heat::{FaceBc, HeatError, TEMPERATURE, assemble_conduction, dirichlet_dofs};
+use crate::mesh::{ElemId, Mesh, Side};
+use crate::solve::spmv_ref;
+use faer::sparse::SparseColMatRef;
+
+use super::layout::Layout;
+use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
+use super::session;
+
+thread_local! {
+    /// The method of the last distributed solve, for the run's summary.
+    static LAST: Cell<Option<Method>> = const { Cell::new(None) };
+}
+
+pub(super) fn last_method() -> Option<Method> {
+    LAST.with(Cell::get)
+}
+
+fn petsc_err(e: PetscError) -> HeatError {
+    HeatError::Contact(format!("distributed solve: {e}"))
+}
+
+/// Solve `p` over the MPI world; every rank returns the whole solution.
+pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> {
+    let mesh = p.mesh;
+    let world = session::comm();
+    let comm = world.as_raw();
+    let blocks: Vec<usize> = (0..mesh.blocks.len())
+        .filter(|&b| mesh.blocks[b].topology.is_solid())
+        .collect();
+    let dofs = DofMap::new(mesh, &[(TEMPERATURE, &blocks)])?;
+    let field = dofs
+        .field(TEMPERATURE)
+        .ok_or(HeatError::NoTemperatureField)?;
+    let n = dofs.len();
+    let bcs = dirichlet_dofs(mesh, &dofs, field, p.dirichlet)?;
+    let iface = match p.interfaces {
+        Some(i) if p.contact.is_empty() && p.ties.is_empty() => Some(i),
+        None if p.contact.is_empty() && p.ties.is_empty() => None,
+        _ => {
+            return Err(refused(
+                "interface terms given as ContactTerm/TieTerm lists",
+            ));
+        }
+    };
+    if let Some(i) = iface
+        && !i.ties().map_err(HeatError::Contact)?.is_empty()
+    {
+        return Err(refused(
+            "mortar ties with Lagrange multipliers (`Tied` with `Side B Variable`, standard or dual)",
+        ));
+    }
+    let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
+    let mut timing = SolveTiming::default();
+    let t = Instant::now();
+    let layout =
+        Layout::new(mesh, &dofs, field, dofs.field_blocks(field)).map_err(HeatError::Contact)?;
+    let rows = layout.rows();
+    let mut u = vec![0.0; n];
+    for &(d, g) in &bcs {
+        u[d] = g;
+    }
+
+    // This rank's conduction: its elements, their face conditions, once (it is linear).
+    let (local, to_local) = layout.local_mesh(mesh);
+    let faces = local_faces(p.face_bcs, &to_local);
+    let mut pattern = Pattern::new(&local, &dofs);
+    pattern.build_direct()?;
+    let k_sym = pattern.symbolic().expect("built").clone();
+    let mut asm = Assembler::direct(&pattern)?;
+    assemble_conduction(&mut asm, &local, &dofs, p.materials, p.source, &faces)?;
+    let f_local = asm.rhs();
+    let k_local = asm.take_values()?;
+    drop(asm);
+    // The dofs whose residual this rank adds to: its elements' and its own.
+    let mut touched: Vec<usize> = local
+        .blocks
+        .iter()
+        .flat_map(|b| b.connectivity.iter())
+        .filter_map(|&node| dofs.dof(field, node).map(|d| d.index()))
+        .chain(layout.owned.iter().copied())
+        .collect();
+    touched.sort_unstable();
+    touched.dedup();
+    let touched_petsc: Vec<PetscInt> = touched.iter().map(|&d| layout.petsc[d]).collect();
+
+    // The interface terms: a pattern of their couplings alone (no elements).
+    let empty = empty_mesh(mesh);
+    let mut ipattern = Pattern::new(&empty, &dofs);
+    let pairs = match iface {
+        Some(i) => i.couplings(&u, 0.0).map_err(failed)?,
+        None => Vec::new(),
+    };
+    let first = ipattern.add_couplings(&pairs)?.start;
+    ipattern.build_direct()?;
+    let i_sym = ipattern.symbolic().expect("built").clone();
+    let mut iasm = Assembler::direct(&ipattern)?;
+
+    if layout.rank == 0 {
+        // How the partition meets the interfaces: couplings whose two dofs sit on
+        // different ranks are those a per-rank solve would get wrong.
+        let across = pairs
+            .iter()
+            .filter(|&&(i, j)| layout.owner(i) != layout.owner(j))
+            .count();
+        let mut elems = vec![0usize; layout.starts.len() - 1];
+        layout
+            .part
+            .iter()
+            .filter(|&&p| p != super::layout::NO_PART)
+            .for_each(|&p| elems[p as usize] += 1);
+        let dofs_per: Vec<usize> = layout.starts.windows(2).map(|w| w[1] - w[0]).collect();
+        log::info!(
+            "distributed over {} rank(s): elements per rank {elems:?}, dofs per rank {dofs_per:?}; {across} of {} interface couplings join dofs of different ranks",
+            elems.len(),
+            pairs.len()
+        );
+    }
+    let (diagonal, off) = preallocation(mesh, &dofs, field, &layout, &pairs);
+    let local_rows = rows.len();
+    let mut a = Mat::aij(comm, local_rows, n, &diagonal, &off).map_err(petsc_err)?;
+    let mut r_vec = Vector::new(comm, local_rows, n).map_err(petsc_err)?;
+    let mut du_vec = r_vec.duplicate().map_err(petsc_err)?;
+    let bc_rows: Vec<PetscInt> = bcs
+        .iter()
+        .filter(|&&(d, _)| layout.owns(d))
+        .map(|&(d, _)| layout.petsc[d])
+        .collect();
+    let bc_local: Vec<usize> = bc_rows.iter().map(|&i| i as usize - rows.start).collect();
+    // ‖F‖ over every rank, the scale of the stopping test.
+    let f_values: Vec<f64> = touched.iter().map(|&d| f_local[d]).collect();
+    r_vec.zero().map_err(petsc_err)?;
+    r_vec.add(&touched_petsc, &f_values).map_err(petsc_err)?;
+    r_vec.assemble().map_err(petsc_err)?;
+    let f_norm = r_vec.norm().map_err(petsc_err)?;
+    timing.assembly_s += t.elapsed().as_secs_f64();
+
+    let symmetric = iface.is_none_or(|i| i.is_linear());
+    let method = if symmetric && p.iterative {
+        Method::CgGamg
+    } else {
+        Method::MumpsLu
+    };
+    let tolerance = if method == Method::CgGamg {
+        STEADY_AMG_TOLERANCE
+    } else {
+        AMG_TOLERANCE
+    };
+    let mut ksp = Ksp::new(comm, &a, method, tolerance).map_err(petsc_err)?;
+    let mut linear = LinearSolves::default();
+    let (mut history, mut heat) = (Vec::new(), Vec::new());
+    let (mut converged, mut iterations, mut target) = (false, 0, None);
+    let mut last_step = f64::INFINITY;
+    let counts: Vec<i32> = (0..layout.starts.len() - 1)
+        .map(|r| (layout.starts[r + 1] - layout.starts[r]) as i32)
+        .collect();
+    let displs: Vec<i32> = layout.starts[..counts.len()]
+        .iter()
+        .map(|&s| s as i32)
+        .collect();
+    for it in 0..=p.max_iterations {
+        let t = Instant::now();
+        // R = K u − F + Σ R_Γ: this rank's elements, and its own rows of the interfaces.
+        let mut r = vec![0.0; n];
+        spmv_ref(SparseColMatRef::new(k_sym.as_ref(), &k_local), &u, &mut r);
+        for (ri, fi) in r.iter_mut().zip(&f_local) {
+            *ri -= fi;
+        }
+        iasm.reset_couplings();
+        if let Some(i) = iface {
+            let mut r_iface = vec![0.0; n];
+            heat = i
+                .assemble(&u, 0.0, &mut r_iface, &mut iasm, first)
+                .map_err(failed)?;
+            for &d in &layout.owned {
+                r[d] += r_iface[d];
+            }
+        }
+        let values: Vec<f64> = touched.iter().map(|&d| r[d]).collect();
+        r_vec.zero().map_err(petsc_err)?;
+        r_vec.add(&touched_petsc, &values).map_err(petsc_err)?;
+        r_vec.assemble().map_err(petsc_err)?;
+        r_vec
+            .with_local(local_rows, |v| bc_local.iter().for_each(|&i| v[i] = 0.0))
+            .map_err(petsc_err)?;
+        let rn = r_vec.norm().map_err(petsc_err)?;
+        history.push(rn);
+        let scale = f_norm.max(rn).max(1e-300);
+        let goal = *target.get_or_insert(p.tolerance * scale);
+        timing.assembly_s += t.elapsed().as_secs_f64();
+        // The serial solve's stopping tests (crate::heat::steady::solve_steady).
+        let u_max = u
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(f64::MIN_POSITIVE);
+        if (rn <= goal && (symmetric || it != 1))
+            || (it > 0 && last_step <= 1e-13 * u_max)
+            || (it > 0 && symmetric && rn <= 1e-8 * scale)
+        {
+            converged = true;
+            break;
+        }
+        if it == p.max_iterations {
+            break;
+        }
+        iterations += 1;
+        // J = K + J_Γ: every entry this rank made, the interface rows it owns.
+        let t = Instant::now();
+        a.zero().map_err(petsc_err)?;
+        add_columns(&mut a, &k_sym, &k_local, &layout, |_| true)?;
+        let mut i_values = Vec::new();
+        iasm.values_into(&mut i_values)?;
+        add_columns(&mut a, &i_sym, &i_values, &layout, |d| layout.owns(d))?;
+        a.assemble().map_err(petsc_err)?;
+        a.zero_rows_columns(&bc_rows).map_err(petsc_err)?;
+        timing.assembly_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        ksp.set_up().map_err(petsc_err)?;
+        timing.factor_s += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        // The increment: J Δu = −R (Δu = 0 on the Dirichlet rows, whose R is 0).
+        r_vec
+            .with_local(local_rows, |v| v.iter_mut().for_each(|x| *x = -*x))
+            .map_err(petsc_err)?;
+        let its = ksp.solve(&r_vec, &mut du_vec).map_err(petsc_err)?;
+        let mine = du_vec
+            .with_local(local_rows, |v| v.to_vec())
+            .map_err(petsc_err)?;
+        let mut whole = vec![0.0; n];
+        {
+            let mut gathered = PartitionMut::new(&mut whole[..], &counts[..], &displs[..]);
+            world.all_gather_varcount_into(&mine[..], &mut gathered);
+        }
+        last_step = 0.0;
+        for (d, ui) in u.iter_mut().enumerate() {
+            let du = whole[layout.petsc[d] as usize];
+            *ui += du;
+            last_step = last_step.max(du.abs());
+        }
+        timing.solve_s += t.elapsed().as_secs_f64();
+        linear.method = Some(match method {
+            Method::CgGamg => LinearMethod::AmgCg,
+            Method::MumpsLu => LinearMethod::Lu,
+        });
+        if method == Method::CgGamg {
+            linear.cg_iterations.push(its);
+        }
+    }
+    LAST.with(|l| l.set(Some(method)));
+    let temperature = dofs.nodal_values(field, &u);
+    Ok(SteadySolution {
+        dofs,
+        u,
+        temperature,
+        newton_iterations: iterations,
+        converged,
+        residual_history: history,
+        heat,
+        tie_heat: Vec::new(),
+        crosspoints: Vec::new(),
+        timing,
+        linear,
+    })
+}
+
+/// The error refusing what the distributed solve does not do yet.
+fn refused(what: &str) -> HeatError {
+    HeatError::Contact(format!(
+        "[E0902] {what}: not yet distributed under MPI (help: run without mpirun; docs/parallel.md lists what is distributed)"
+    ))
+}
+
+/// The face conditions of this rank's elements, on its local mesh.
+fn local_faces(faces: &[FaceBc], to_local: &[Option<ElemId>]) -> Vec<FaceBc> {
+    faces
+        .iter()
+        .filter_map(|f| {
+            let s = f.side();
+            let elem = to_local.get(s.elem.index()).copied().flatten()?;
+            let side = Side { elem, side: s.side };
+            Some(match *f {
+                FaceBc::Flux { q, .. } => FaceBc::Flux { side, q },
+                FaceBc::Convection { h, t_inf, .. } => FaceBc::Convection { side, h, t_inf },
+                FaceBc::Radiation {
+                    emissivity, t_inf, ..
+                } => FaceBc::Radiation {
+                    side,
+                    emissivity,
+                    t_inf,
+                },
+            })
+        })
+        .collect()
+}
+
+/// `mesh` without elements: the pattern of the interface couplings alone.
+fn empty_mesh(mesh: &Mesh) -> Mesh {
+    Mesh {
+        dim: mesh.dim,
+        coords: Vec::new(),
+        node_numbers: Vec::new(),
+        elem_numbers: Vec::new(),
+        blocks: mesh
+            .blocks
+            .iter()
+            .map(|b| crate::mesh::Block {
+                id: b.id,
+                name: b.name.clone(),
+                topology: b.topology,
+                connectivity: Vec::new(),
+                first_elem: ElemId(0),
+                thickness: b.thickness,
+            })
+            .collect(),
+        side_sets: Vec::new(),
+        node_sets: Vec::new(),
+        assemblies: Vec::new(),
+        source: None,
+        axisymmetric: mesh.axisymmetric,
+    }
+}
+
+/// Add the CSC matrix (`sym`, `values`; serial dofs) to `a`, rows where `keep` holds.
+fn add_columns(
+    a: &mut Mat,
+    sym: &faer::sparse::SymbolicSparseColMat<usize>,
+    values: &[f64],
+    layout: &Layout,
+    keep: impl Fn(usize) -> bool,
+) -> Result<(), HeatError> {
+    let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+    let (mut rows, mut vals) = (Vec::new(), Vec::new());
+    for j in 0..sym.ncols() {
+        rows.clear();
+        vals.clear();
+        for k in col_ptr[j]..col_ptr[j + 1] {
+            let i = row_idx[k];
+            if values[k] != 0.0 && keep(i) {
+                rows.push(layout.petsc[i]);
+                vals.push(values[k]);
+            }
+        }
+        if !rows.is_empty() {
+            a.add_column(&rows, layout.petsc[j], &vals)
+                .map_err(petsc_err)?;
+        }
+    }
+    Ok(())
+}
+
+/// Exact preallocation of this rank's rows: per row, the columns of every element (of any
+/// rank) at its node, and its interface couplings, counted inside and outside the rank's
+/// column block.
+fn preallocation(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    field: crate::assembly::FieldId,
+    layout: &Layout,
+    pairs: &[(usize, usize)],
+) -> (Vec<PetscInt>, Vec<PetscInt>) {
+    let rows = layout.rows();
+    let mut cols: Vec<Vec<usize>> = vec![Vec::new(); rows.len()];
+    let local_row = |d: usize| -> Option<usize> {
+        let i = layout.petsc[d] as usize;
+        rows.contains(&i).then(|| i - rows.start)
+    };
+    let mut buf = Vec::new();
+    for &b in dofs.field_blocks(field) {
+        let nn = mesh.blocks[b].topology.node_count();
+        for (k, _) in mesh.blocks[b].elems().enumerate() {
+            buf.clear();
+            buf.extend(
+                mesh.blocks[b].connectivity[k * nn..(k + 1) * nn]
+                    .iter()
+                    .filter_map(|&node| dofs.dof(field, node).map(|d| d.index())),
+            );
+            for &d in &buf {
+                if let Some(i) = local_row(d) {
+                    cols[i].extend_from_slice(&buf);
+                }
+            }
+        }
+    }
+    for &(i, j) in pairs {
+        if let Some(r) = local_row(i) {
+            cols[r].push(j);
+        }
+        if let Some(r) = local_row(j) {
+            cols[r].push(i);
+        }
+    }
+    let (mut diagonal, mut off) = (vec![0; rows.len()], vec![0; rows.len()]);
+    for (r, c) in cols.iter_mut().enumerate() {
+        c.push(layout.owned[r]);
+        c.sort_unstable();
+        c.dedup();
+        for &d in c.iter() {
+            if rows.contains(&(layout.petsc[d] as usize)) {
+                diagonal[r] += 1;
+            } else {
+                off[r] += 1;
+            }
+        }
+    }
+    (diagonal, off)
+}
