@@ -11,7 +11,49 @@ use super::{EXIT_BAD_INPUT, EXIT_PLUGIN_FAULT, QUIET, eprint_diagnostics, report
 const DEFAULT_SCENE: &str = "examples/two_blocks/problem.toml";
 
 pub fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitCode {
-    let path = match path {
+    // Under an MPI launcher (`--features mpi`): MPI and PETSc up for the run, rank 0
+    // alone printing (docs/parallel.md).
+    #[cfg(feature = "mpi")]
+    let _session = match seam::parallel::start() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error[E0903]: cannot start MPI and PETSc: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    if !seam::parallel::is_root() {
+        return run_quietly(path, restart);
+    }
+    let path = match problem_path(path, json) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    run_path(&path, json, restart)
+}
+
+/// A rank other than 0 of a distributed run: the same run, printing nothing (rank 0
+/// reports), with the same exit code.
+fn run_quietly(path: Option<PathBuf>, restart: Option<PathBuf>) -> ExitCode {
+    log::set_max_level(log::LevelFilter::Error);
+    let path = match problem_path(path, true) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let options = seam::run::RunOptions {
+        restart,
+        ..Default::default()
+    };
+    match seam::run::run_with(&path, &options) {
+        Ok(r) if r.summary.converged => ExitCode::SUCCESS,
+        Ok(_) => ExitCode::from(1),
+        Err(seam::run::RunError::Input(..)) => ExitCode::from(EXIT_BAD_INPUT),
+        Err(seam::run::RunError::Solve(_)) => ExitCode::from(1),
+    }
+}
+
+/// The problem file to solve: `path`, else the bundled scene.
+fn problem_path(path: Option<PathBuf>, json: bool) -> Result<PathBuf, ExitCode> {
+    Ok(match path {
         Some(p) => p,
         None => {
             // The bundled scene, in the working directory's or the build's source tree,
@@ -31,7 +73,7 @@ pub fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitC
                     Ok(p) => p,
                     Err(e) => {
                         eprintln!("error: {e}");
-                        return ExitCode::from(EXIT_BAD_INPUT);
+                        return Err(ExitCode::from(EXIT_BAD_INPUT));
                     }
                 }
             };
@@ -43,8 +85,10 @@ pub fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitC
             }
             p
         }
-    };
-    let path = path.as_path();
+    })
+}
+
+fn run_path(path: &Path, json: bool, restart: Option<PathBuf>) -> ExitCode {
     let (progress, phase) = progress_printer(json);
     let options = seam::run::RunOptions {
         restart,

@@ -46,8 +46,9 @@ impl<'a> Output<'a> {
         physics: &'a Physics<'a>,
         terms: &'a ContactTerms<'a>,
     ) -> Result<Self, RunError> {
+        // Under MPI, rank 0 alone writes (every rank holds the whole solution).
         let dir = match &file.problem.output.dir {
-            Some(d) => {
+            Some(d) if crate::parallel::is_root() => {
                 let out_dir = file.dir.join(d);
                 std::fs::create_dir_all(&out_dir).map_err(|e| {
                     RunError::Solve(format!("cannot create {}: {e}", out_dir.display()))
@@ -56,7 +57,7 @@ impl<'a> Output<'a> {
                 let _ = std::fs::remove_file(out_dir.join(NOT_CONVERGED));
                 Some(out_dir)
             }
-            None => None,
+            _ => None,
         };
         let writer = steps::StepWriter::new(
             dir.as_deref(),

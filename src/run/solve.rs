@@ -81,6 +81,10 @@ impl<'a> TimeLoop<'a> {
     ) -> Result<Solved, RunError> {
         if self.is_linear_steady() {
             self.linear_steady()
+        } else if let Some(d) = crate::parallel::not_distributed(self.file.transient) {
+            let mut diags = crate::diag::Diagnostics::default();
+            diags.push(d);
+            Err(RunError::Input(diags, Default::default()))
         } else {
             self.steps(initial, output)
         }
@@ -143,7 +147,10 @@ impl<'a> TimeLoop<'a> {
             "assembling and solving ({} nodes)",
             mesh.num_nodes()
         ));
-        let solved = solve_steady(&steady).map_err(|e| RunError::Solve(e.to_string()))?;
+        // Under MPI the distributed solve (crate::parallel), else the serial one.
+        let solved = crate::parallel::steady(&steady)
+            .unwrap_or_else(|| solve_steady(&steady))
+            .map_err(|e| RunError::Solve(e.to_string()))?;
         log::debug!(
             "linear steady solve of {unknowns} unknowns: {:?}, {} CG iterations, assembly {:.3} s, set-up {:.3} s, solve {:.3} s",
             solved.linear.method,
@@ -152,13 +159,13 @@ impl<'a> TimeLoop<'a> {
             solved.timing.factor_s,
             solved.timing.solve_s
         );
-        let linear_solver = linear_solver_summary(
+        let linear_solver = crate::parallel::describe(linear_solver_summary(
             requested,
             threshold,
             unknowns,
             !solved.tie_heat.is_empty(),
             &solved.linear,
-        );
+        ));
         if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
             return Err(RunError::Solve(format!("[[source]]: {e}")));
         }
