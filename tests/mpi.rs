@@ -1,0 +1,365 @@
+//! `seam run` under `mpirun -n 1, 2, 3, 4` (oversubscribed) against the serial run of the
+//! same problem: the nodal temperatures of `results.exo` and every interaction's heat in
+//! the `--json` summary must agree to round-off, on the bundled steady scenes the
+//! distributed solve covers and on generated cases whose interface the partition cuts
+//! (rank 0's log must say that interface couplings join dofs of different ranks).
+//! A run the distributed solve does not cover must be refused (E0901, E0902), writing
+//! nothing.
+//!
+//! Built only with `--features mpi` (OpenMPI's `mpirun` and Debian's PETSc); run by
+//! `.ci/run`: `cargo test --features mpi --test mpi`.
+
+#![cfg(feature = "mpi")]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use seam::mesh::Mesh;
+use seam::mesh::generate::{self, BoxSpec};
+use seam::output::exodus::ExodusWriter;
+
+/// Largest difference allowed, relative to the largest |value| of the serial run: the
+/// serial and the distributed runs solve with different methods (faer's Cholesky, LU or
+/// AMG-CG against MUMPS LU or PETSc's CG + GAMG to 1e-13), which on these systems of up
+/// to 10⁴ unknowns leave round-off of 1e-13–1e-11 relative; 1e-9 keeps two orders of
+/// margin and still fails any term missed or counted twice (those move the field by
+/// percents).
+const REL: f64 = 1e-9;
+
+const RANKS: [usize; 4] = [1, 2, 3, 4];
+
+/// A run's results: the summary, the nodal temperature, rank 0's log.
+struct Ran {
+    summary: serde_json::Value,
+    temperature: Vec<f64>,
+    log: String,
+}
+
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("mpi-{name}-"))
+        .tempdir_in(env!("CARGO_TARGET_TMPDIR"))
+        .unwrap_or_else(|e| panic!("cannot make a scratch folder for {name}: {e}"))
+}
+
+/// `seam -v run --json problem` serially (`ranks` None) or under `mpirun -n ranks`.
+fn launch(problem: &Path, ranks: Option<usize>) -> Output {
+    let seam = env!("CARGO_BIN_EXE_seam");
+    let mut cmd = match ranks {
+        None => Command::new(seam),
+        Some(n) => {
+            let mut c = Command::new("mpirun");
+            c.args(["--oversubscribe", "-n", &n.to_string(), seam]);
+            c
+        }
+    };
+    cmd.args(["-v", "run", "--json"])
+        .arg(problem)
+        // One thread per rank: the ranks share the machine's cores.
+        .env("RAYON_NUM_THREADS", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    cmd.output()
+        .unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"))
+}
+
+/// Run `problem` (its output in `out/`, moved to `out_<label>/` afterwards).
+fn run(problem: &Path, ranks: Option<usize>) -> Ran {
+    let out = launch(problem, ranks);
+    let log = String::from_utf8_lossy(&out.stderr).into_owned();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{} on {ranks:?} ranks failed ({}):\n{stdout}\n{log}",
+        problem.display(),
+        out.status
+    );
+    // Rank 0 alone prints: one JSON line.
+    let lines: Vec<&str> = stdout.lines().filter(|l| l.starts_with('{')).collect();
+    assert_eq!(lines.len(), 1, "one summary, got:\n{stdout}");
+    let summary: serde_json::Value = serde_json::from_str(lines[0]).expect("JSON summary");
+    let dir = problem.parent().unwrap();
+    let label = ranks.map_or("serial".to_string(), |n| format!("n{n}"));
+    let moved = dir.join(format!("out_{label}"));
+    std::fs::rename(dir.join("out"), &moved).expect("the run wrote out/");
+    let temperature =
+        seam::mesh::exodus::read_nodal_variable(&moved.join("results.exo"), "temperature", 0)
+            .expect("temperature in results.exo");
+    Ran {
+        summary,
+        temperature,
+        log,
+    }
+}
+
+fn heats(summary: &serde_json::Value) -> Vec<f64> {
+    summary["interactions"]
+        .as_array()
+        .expect("interactions")
+        .iter()
+        .flat_map(|i| {
+            [
+                i["heat_side_a"].as_f64().unwrap(),
+                i["heat_side_b"].as_f64().unwrap(),
+            ]
+        })
+        .collect()
+}
+
+fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Largest |a − b|, and the scale (largest |a|).
+fn difference(a: &[f64], b: &[f64]) -> (f64, f64) {
+    assert_eq!(a.len(), b.len());
+    let d = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    (d, max_abs(a))
+}
+
+/// Couplings that join dofs of different ranks, from rank 0's log.
+fn couplings_across(log: &str) -> Option<usize> {
+    let line = log
+        .lines()
+        .find(|l| l.contains("interface couplings join dofs of different ranks"))?;
+    // "…; K of M interface couplings join dofs of different ranks"
+    let head = line.split(" interface couplings join").next()?;
+    let k = head.rsplit("; ").next()?.split(" of ").next()?;
+    k.trim().parse().ok()
+}
+
+/// The serial run and `mpirun -n 1..4` of `problem`: equal temperatures and heats. With
+/// `cut`, the interface must be cut by the partition from 2 ranks on.
+fn compare(problem: &Path, cut: bool) {
+    let serial = run(problem, None);
+    assert!(serial.summary["converged"].as_bool().unwrap());
+    let heat = heats(&serial.summary);
+    for n in RANKS {
+        let par = run(problem, Some(n));
+        assert!(par.summary["converged"].as_bool().unwrap());
+        assert!(
+            par.summary["linear_solver"]["name"]
+                .as_str()
+                .unwrap()
+                .starts_with("PETSc"),
+            "the distributed solve ran: {}",
+            par.summary["linear_solver"]
+        );
+        let (dt, t_scale) = difference(&serial.temperature, &par.temperature);
+        let (dq, q_scale) = difference(&heat, &heats(&par.summary));
+        let across = couplings_across(&par.log);
+        eprintln!(
+            "{} on {n} rank(s): max |ΔT| {dt:.2e} (of {t_scale:.3e}), max |Δheat| {dq:.2e} (of {q_scale:.3e}), interface couplings across ranks {across:?}",
+            problem.display()
+        );
+        assert!(
+            dt <= REL * t_scale,
+            "temperature differs by {dt:e} on {n} ranks"
+        );
+        assert!(
+            dq <= REL * q_scale,
+            "interface heat differs by {dq:e} on {n} ranks"
+        );
+        if cut && n > 1 {
+            assert!(
+                across.is_some_and(|k| k > 0),
+                "the partition should cut the interface on {n} ranks:\n{}",
+                par.log
+            );
+        }
+    }
+}
+
+/// Copy an example folder (files only, no earlier output) into a scratch folder.
+fn example(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let tmp = scratch(name);
+    let src = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name);
+    for entry in std::fs::read_dir(&src).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_file() {
+            std::fs::copy(&p, tmp.path().join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let problem = tmp.path().join("problem.toml");
+    (tmp, problem)
+}
+
+#[test]
+fn two_blocks_equals_serial_on_1_to_4_ranks() {
+    let (_tmp, problem) = example("two_blocks");
+    compare(&problem, true);
+}
+
+/// Refused under MPI with `code` (exit `status`): what is not yet distributed is named,
+/// never solved wrongly.
+fn refused(problem: &Path, status: i32, code: &str, what: &str) {
+    let out = launch(problem, Some(2));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(status), "{stdout}");
+    assert!(stdout.contains(code) && stdout.contains(what), "{stdout}");
+    assert!(!problem.parent().unwrap().join("out/results.exo").exists());
+}
+
+/// Mortar ties with multipliers (here a periodic one) are not distributed yet.
+#[test]
+fn turbine_sector_periodic_mortar_tie_is_refused() {
+    let (_tmp, problem) = example("turbine_sector");
+    refused(
+        &problem,
+        1,
+        "E0902",
+        "mortar ties with Lagrange multipliers",
+    );
+}
+
+/// An example whose multiplier tie is switched to the Nitsche tie (`Tied_Temperature`,
+/// no multipliers).
+fn nitsche_example(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let (tmp, problem) = example(name);
+    let deck = tmp.path().join("contact.i");
+    let text = std::fs::read_to_string(&deck).unwrap();
+    let (tied, side_b) = (
+        "    enforcement for energy = tied\n",
+        "    side b variable temperature to temperature\n",
+    );
+    assert!(text.contains(tied) && text.contains(side_b), "{text}");
+    let text = text
+        .replace(tied, "    enforcement for energy = tied_temperature\n")
+        .replace(side_b, "");
+    std::fs::write(&deck, text).unwrap();
+    (tmp, problem)
+}
+
+/// The periodic pair of the sector (a cylindrical image) tied by Nitsche: its two cut
+/// faces sit at the sector's two ends, so from 2 ranks on the pair straddles ranks.
+#[test]
+fn turbine_sector_periodic_nitsche_tie_equals_serial_on_1_to_4_ranks() {
+    let (_tmp, problem) = nitsche_example("turbine_sector");
+    compare(&problem, true);
+}
+
+/// A periodic pair whose image is a Lua map (a twisted channel), tied by Nitsche.
+#[test]
+fn twisted_channel_lua_periodic_nitsche_tie_equals_serial_on_1_to_4_ranks() {
+    let (_tmp, problem) = nitsche_example("twisted_channel");
+    compare(&problem, true);
+}
+
+/// A source in one block only takes the general (stepped) solver, not distributed yet.
+#[test]
+fn shrink_fit_block_source_is_refused() {
+    let (_tmp, problem) = example("shrink_fit");
+    refused(&problem, 2, "E0901", "not yet distributed");
+}
+
+/// Two long non-matching boxes side by side, joined at x = 1: the partition of a long
+/// bar cuts across it, so the interface's side-A and side-B faces are spread over ranks.
+fn write_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
+    let m: Mesh = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
+                .with_side_sets([1, 3, 0, 0, 0, 0]),
+            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
+                .with_side_sets([4, 2, 0, 0, 0, 0]),
+        ],
+        false,
+    );
+    ExodusWriter::create(&dir.join("bar.exo"), &m, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        format!(
+            "begin contact definition cut\n\
+             contact surface a contains surface_3\n\
+             contact surface b contains surface_4\n\
+             begin interaction\n side a a\n side b b\n end\n\
+             begin enforcement\n enforcement for energy = gap_conductance\n {enforcement}\n end\n\
+             end\n"
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("problem.toml"),
+        format!(
+            "[mesh]\nfile = \"bar.exo\"\n\
+             [[material]]\nblocks = [\"block_1\"]\nconductivity = 5.0\n\
+             [[material]]\nblocks = [\"block_2\"]\nconductivity = 40.0\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = \"300 + 10*y\"\n\
+             [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = 500.0\n\
+             [[source]]\nblocks = [\"block_1\", \"block_2\"]\nvalue = \"2e3*y\"\n\
+             [contact]\nfile = \"contact.i\"\n\
+             [solve]\nkind = \"steady\"\n{solve}\n\
+             [output]\ndir = \"out\"\n"
+        ),
+    )
+    .unwrap();
+    dir.join("problem.toml")
+}
+
+/// A constant conductance, solved directly (MUMPS) on every rank count.
+#[test]
+fn cut_interface_constant_conductance_equals_serial() {
+    let tmp = scratch("cut-direct");
+    let problem = write_cut_case(
+        tmp.path(),
+        "gap conductance coefficient = constant h = 2000",
+        "",
+    );
+    compare(&problem, true);
+}
+
+/// The same, solved by AMG-preconditioned CG (serial: seam's AMG-CG; MPI: CG + GAMG).
+#[test]
+fn cut_interface_by_amg_cg_equals_serial() {
+    let tmp = scratch("cut-amg");
+    let problem = write_cut_case(
+        tmp.path(),
+        "gap conductance coefficient = constant h = 2000",
+        "linear_solver = \"amg\"",
+    );
+    compare(&problem, true);
+}
+
+/// A conductance that depends on temperature: Newton with an unsymmetric Jacobian.
+#[test]
+fn cut_interface_newton_equals_serial() {
+    let tmp = scratch("cut-newton");
+    let problem = write_cut_case(
+        tmp.path(),
+        "gap conductance coefficient = table of temperature = 300 1e3 600 4e3",
+        "",
+    );
+    compare(&problem, true);
+}
+
+/// A transient run is refused under MPI, with the code that names what is missing.
+#[test]
+fn transient_is_refused_under_mpi() {
+    let tmp = scratch("transient");
+    let problem = write_cut_case(
+        tmp.path(),
+        "gap conductance coefficient = constant h = 2000",
+        "",
+    );
+    let text = std::fs::read_to_string(&problem)
+        .unwrap()
+        .replace(
+            "kind = \"steady\"\n",
+            "kind = \"transient\"\ndt = 0.1\nend_time = 0.2\n",
+        )
+        .replace(
+            "conductivity = ",
+            "density = 1000.0\nspecific_heat = 500.0\nconductivity = ",
+        )
+        + "[initial]\ntemperature = 300.0\n";
+    std::fs::write(&problem, text).unwrap();
+    refused(&problem, 2, "E0901", "transient run is not yet distributed");
+}
