@@ -7,7 +7,7 @@
 //! Entry points: [`start`] (the binary, before a run), then the hooks the run calls —
 //! [`is_root`] (who writes files and prints), [`steady`] (the linear or
 //! Newton-nonlinear steady solve), [`not_distributed`] (what a run under MPI refuses)
-//! and [`describe`] (the summary's linear solver).
+//! and [`linear_solver`] (the summary's linear solver).
 //!
 //! Without the feature, or without a launcher, every hook is the serial path: one
 //! process, rank 0, nothing refused.
@@ -15,7 +15,6 @@
 use crate::diag::Diagnostic;
 use crate::heat::HeatError;
 use crate::heat::steady::{SteadyProblem, SteadySolution};
-use crate::run::LinearSolverSummary;
 
 #[cfg(feature = "mpi")]
 mod layout;
@@ -81,30 +80,25 @@ pub fn not_distributed(transient: bool) -> Option<Diagnostic> {
     )
 }
 
-/// The summary's linear solver as the distributed solve ran it (PETSc's method and the
-/// ranks), or `serial` unchanged.
-pub fn describe(serial: LinearSolverSummary) -> LinearSolverSummary {
+/// The name and the reason of the linear solver the last distributed solve ran (PETSc's
+/// method and the ranks), for the run's summary; `None` when the run is not distributed.
+pub fn linear_solver() -> Option<(String, String)> {
     #[cfg(feature = "mpi")]
     {
-        match (world(), steady::last_method()) {
-            (Some((_, size)), Some(method)) => LinearSolverSummary {
-                name: method.name().into(),
-                reason: format!(
-                    "MPI, {size} rank(s): {}",
-                    match method {
-                        petsc::Method::CgGamg =>
-                            "symmetric positive definite, at or above the AMG threshold → CG + GAMG",
-                        petsc::Method::MumpsLu =>
-                            "below the AMG threshold, or an unsymmetric Newton Jacobian → MUMPS LU",
-                    }
-                ),
-                ..serial
-            },
-            _ => serial,
-        }
+        let (_, size) = world()?;
+        let method = steady::last_method()?;
+        let why = match method {
+            petsc::Method::CgGamg => {
+                "symmetric positive definite, at or above the AMG threshold → CG + GAMG"
+            }
+            petsc::Method::MumpsLu => {
+                "below the AMG threshold, or an unsymmetric Newton Jacobian → MUMPS LU"
+            }
+        };
+        Some((method.name().into(), format!("MPI, {size} rank(s): {why}")))
     }
     #[cfg(not(feature = "mpi"))]
     {
-        serial
+        None
     }
 }

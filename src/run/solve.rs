@@ -159,13 +159,16 @@ impl<'a> TimeLoop<'a> {
             solved.timing.factor_s,
             solved.timing.solve_s
         );
-        let linear_solver = crate::parallel::describe(linear_solver_summary(
+        let mut linear_solver = linear_solver_summary(
             requested,
             threshold,
             unknowns,
             !solved.tie_heat.is_empty(),
             &solved.linear,
-        ));
+        );
+        if let Some((name, reason)) = crate::parallel::linear_solver() {
+            (linear_solver.name, linear_solver.reason) = (name, reason);
+        }
         if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
             return Err(RunError::Solve(format!("[[source]]: {e}")));
         }
