@@ -79,6 +79,8 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let t = Instant::now();
     let layout =
         Layout::new(mesh, &dofs, field, dofs.field_blocks(field)).map_err(HeatError::Contact)?;
+    let mut phases = Phases::default();
+    phases.mark("partition", t);
     let rows = layout.rows();
     let mut u = vec![0.0; n];
     for &(d, g) in &bcs {
@@ -96,6 +98,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let f_local = asm.rhs();
     let k_local = asm.take_values()?;
     drop(asm);
+    phases.mark("own elements", t);
     // The dofs whose residual this rank adds to: its elements' and its own.
     let mut touched: Vec<usize> = local
         .blocks
@@ -140,7 +143,9 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             pairs.len()
         );
     }
+    phases.mark("interface pattern", t);
     let (diagonal, off) = preallocation(mesh, &dofs, field, &layout, &pairs);
+    phases.mark("preallocation", t);
     let local_rows = rows.len();
     let mut a = Mat::aij(comm, local_rows, n, &diagonal, &off).map_err(petsc_err)?;
     let mut r_vec = Vector::new(comm, local_rows, n).map_err(petsc_err)?;
@@ -158,6 +163,13 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     r_vec.assemble().map_err(petsc_err)?;
     let f_norm = r_vec.norm().map_err(petsc_err)?;
     timing.assembly_s += t.elapsed().as_secs_f64();
+    phases.mark("PETSc objects", t);
+    if layout.rank == 0 {
+        log::info!(
+            "distributed set-up on rank 0 (s from its start): {}",
+            phases.0
+        );
+    }
 
     let symmetric = iface.is_none_or(|i| i.is_linear());
     let method = if symmetric && p.iterative {
@@ -285,6 +297,20 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing,
         linear,
     })
+}
+
+/// The set-up's phases, as seconds from its start, for the log.
+#[derive(Default)]
+struct Phases(String);
+
+impl Phases {
+    fn mark(&mut self, what: &str, since: Instant) {
+        if !self.0.is_empty() {
+            self.0.push_str(", ");
+        }
+        self.0
+            .push_str(&format!("{what} {:.3}", since.elapsed().as_secs_f64()));
+    }
 }
 
 /// The error refusing what the distributed solve does not do yet.
