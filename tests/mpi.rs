@@ -251,6 +251,19 @@ fn twisted_channel_lua_periodic_nitsche_tie_equals_serial_on_1_to_4_ranks() {
     compare(&problem, true);
 }
 
+/// A 2-D axisymmetric pair (quadrilaterals, ring faces): the shrink fit with its source
+/// given to both blocks (in one block only it takes the stepped solver, refused below).
+#[test]
+fn shrink_fit_axisymmetric_equals_serial_on_1_to_4_ranks() {
+    let (_tmp, problem) = example("shrink_fit");
+    let text = std::fs::read_to_string(&problem).unwrap();
+    let one = "[[source]]\nblocks = [\"shaft\"]\n";
+    assert!(text.contains(one), "{text}");
+    let both = "[[source]]\nblocks = [\"shaft\", \"sleeve\"]\n";
+    std::fs::write(&problem, text.replace(one, both)).unwrap();
+    compare(&problem, true);
+}
+
 /// A source in one block only takes the general (stepped) solver, not distributed yet.
 #[test]
 fn shrink_fit_block_source_is_refused() {
