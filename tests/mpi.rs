@@ -273,11 +273,13 @@ fn shrink_fit_block_source_is_refused() {
 
 /// Two long non-matching boxes side by side, joined at x = 1: the partition of a long
 /// bar cuts across it, so the interface's side-A and side-B faces are spread over ranks.
+/// `enforcement`: the lines of its enforcement block; `solve`: more of `[solve]`.
+/// Side set 5 (side A's box bottom, z = 0) is left for a test to use.
 fn write_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
     let m: Mesh = generate::boxes(
         &[
             BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
-                .with_side_sets([1, 3, 0, 0, 0, 0]),
+                .with_side_sets([1, 3, 0, 0, 5, 0]),
             BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
                 .with_side_sets([4, 2, 0, 0, 0, 0]),
         ],
@@ -294,7 +296,7 @@ fn write_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
              contact surface a contains surface_3\n\
              contact surface b contains surface_4\n\
              begin interaction\n side a a\n side b b\n end\n\
-             begin enforcement\n enforcement for energy = gap_conductance\n {enforcement}\n end\n\
+             begin enforcement\n {enforcement}\n end\n\
              end\n"
         ),
     )
@@ -323,7 +325,7 @@ fn cut_interface_constant_conductance_equals_serial() {
     let tmp = scratch("cut-direct");
     let problem = write_cut_case(
         tmp.path(),
-        "gap conductance coefficient = constant h = 2000",
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
         "",
     );
     compare(&problem, true);
@@ -335,7 +337,7 @@ fn cut_interface_by_amg_cg_equals_serial() {
     let tmp = scratch("cut-amg");
     let problem = write_cut_case(
         tmp.path(),
-        "gap conductance coefficient = constant h = 2000",
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
         "linear_solver = \"amg\"",
     );
     compare(&problem, true);
@@ -347,9 +349,22 @@ fn cut_interface_newton_equals_serial() {
     let tmp = scratch("cut-newton");
     let problem = write_cut_case(
         tmp.path(),
-        "gap conductance coefficient = table of temperature = 300 1e3 600 4e3",
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = table of temperature = 300 1e3 600 4e3",
         "",
     );
+    compare(&problem, true);
+}
+
+/// Crosspoints on rank boundaries: side A's bottom edge (x = 1, z = 0) is also held at a
+/// fixed temperature along the bar's whole length, so wherever the partition cuts the
+/// bar it cuts through fixed interface nodes; a Nitsche tie joins the two boxes.
+#[test]
+fn cut_interface_crosspoints_on_rank_boundaries_equal_serial() {
+    let tmp = scratch("cut-crosspoints");
+    let problem = write_cut_case(tmp.path(), "enforcement for energy = tied_temperature", "");
+    let mut text = std::fs::read_to_string(&problem).unwrap();
+    text.push_str("[[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_5\"]\nvalue = 350.0\n");
+    std::fs::write(&problem, text).unwrap();
     compare(&problem, true);
 }
 
@@ -359,7 +374,7 @@ fn transient_is_refused_under_mpi() {
     let tmp = scratch("transient");
     let problem = write_cut_case(
         tmp.path(),
-        "gap conductance coefficient = constant h = 2000",
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
         "",
     );
     let text = std::fs::read_to_string(&problem)
