@@ -86,13 +86,16 @@ pub fn linear_solver() -> Option<(String, String)> {
     #[cfg(feature = "mpi")]
     {
         let (_, size) = world()?;
-        let method = steady::last_method()?;
-        let why = match method {
-            petsc::Method::CgGamg => {
+        let (method, symmetric) = steady::last_method()?;
+        let why = match (method, symmetric) {
+            (petsc::Method::CgGamg, _) => {
                 "symmetric positive definite, at or above the AMG threshold → CG + GAMG"
             }
-            petsc::Method::MumpsLu => {
-                "below the AMG threshold, or an unsymmetric Newton Jacobian → MUMPS LU"
+            (petsc::Method::MumpsLu, true) => {
+                "below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
+            }
+            (petsc::Method::MumpsLu, false) => {
+                "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
             }
         };
         Some((method.name().into(), format!("MPI, {size} rank(s): {why}")))

@@ -32,11 +32,12 @@ use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::session;
 
 thread_local! {
-    /// The method of the last distributed solve, for the run's summary.
-    static LAST: Cell<Option<Method>> = const { Cell::new(None) };
+    /// The method of the last distributed solve and whether its system was symmetric,
+    /// for the run's summary.
+    static LAST: Cell<Option<(Method, bool)>> = const { Cell::new(None) };
 }
 
-pub(super) fn last_method() -> Option<Method> {
+pub(super) fn last_method() -> Option<(Method, bool)> {
     LAST.with(Cell::get)
 }
 
@@ -282,7 +283,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             linear.cg_iterations.push(its);
         }
     }
-    LAST.with(|l| l.set(Some(method)));
+    LAST.with(|l| l.set(Some((method, symmetric))));
     let temperature = dofs.nodal_values(field, &u);
     Ok(SteadySolution {
         dofs,
