@@ -1,0 +1,223 @@
+//! The AMG's own sparse storage: compressed sparse rows with 32-bit column indices,
+//! built from faer's CSC (copying, or transposing the values of a structurally
+//! symmetric matrix in place), with the products the set-up needs (`spmv`, Gustavson's
+//! row-by-row `matmul`, `transpose`).
+
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use rayon::prelude::*;
+
+/// A compressed sparse row matrix, the AMG's own storage (row access for smoothing).
+#[derive(Clone, Debug, Default)]
+pub struct Csr {
+    pub nrows: usize,
+    pub ncols: usize,
+    pub ptr: Vec<usize>,
+    /// Column indices, 32 bits (a dof is 32 bits): a third less memory traffic per
+    /// stored entry than `usize` in every product and smoothing sweep.
+    pub idx: Vec<u32>,
+    pub val: Vec<f64>,
+}
+
+impl Csr {
+    /// Row storage of a faer CSC matrix (a transpose of index arrays).
+    pub fn from_csc(a: SparseColMatRef<'_, usize, f64>) -> Csr {
+        let s = a.symbolic();
+        let (m, n) = (a.nrows(), a.ncols());
+        let mut ptr = vec![0usize; m + 1];
+        for j in 0..n {
+            for &i in &s.row_idx()[s.col_range(j)] {
+                ptr[i + 1] += 1;
+            }
+        }
+        for i in 0..m {
+            ptr[i + 1] += ptr[i];
+        }
+        let nnz = ptr[m];
+        let mut idx = vec![0; nnz];
+        let mut val = vec![0.0; nnz];
+        let mut next = ptr.clone();
+        for j in 0..n {
+            for p in s.col_range(j) {
+                let i = s.row_idx()[p];
+                idx[next[i]] = j as u32;
+                val[next[i]] = a.val()[p];
+                next[i] += 1;
+            }
+        }
+        Csr {
+            nrows: m,
+            ncols: n,
+            ptr,
+            idx,
+            val,
+        }
+    }
+
+    /// Row storage of a CSC matrix given as its structure and values, taking the
+    /// values. A structurally symmetric matrix (each stored `(i, j)` has its `(j, i)`,
+    /// as assembled patterns do) has its columns' structure as rows: its values are
+    /// transposed in place, pair by pair, and nothing else is copied but the indices.
+    /// Any other matrix goes through [`Self::from_csc`]. The same result either way.
+    pub fn from_csc_values(sym: SymbolicSparseColMatRef<'_, usize>, mut val: Vec<f64>) -> Csr {
+        assert_eq!(sym.row_idx().len(), val.len(), "one value per stored entry");
+        let n = sym.ncols();
+        let (ptr, ri) = (sym.col_ptr(), sym.row_idx());
+        // Each stored (i, j) below the diagonal meets its (j, i) in column i: the rows
+        // asked of column i come in increasing j, so one cursor per column suffices.
+        let walk = |val: Option<&mut [f64]>| -> bool {
+            let mut cursor: Vec<usize> = ptr[..n].to_vec();
+            let (mut lower, mut upper) = (0usize, 0usize);
+            let mut val = val;
+            for j in 0..n {
+                for p in ptr[j]..ptr[j + 1] {
+                    let i = ri[p];
+                    if i < j {
+                        upper += 1;
+                        continue;
+                    }
+                    if i == j {
+                        continue;
+                    }
+                    lower += 1;
+                    let end = ptr[i + 1];
+                    while cursor[i] < end && ri[cursor[i]] < j {
+                        cursor[i] += 1;
+                    }
+                    if cursor[i] == end || ri[cursor[i]] != j {
+                        return false;
+                    }
+                    if let Some(v) = val.as_deref_mut() {
+                        v.swap(p, cursor[i]);
+                    }
+                }
+            }
+            lower == upper
+        };
+        let square = sym.nrows() == n && sym.col_nnz().is_none();
+        if !(square && walk(None)) {
+            return Csr::from_csc(SparseColMatRef::new(sym, &val));
+        }
+        walk(Some(&mut val));
+        Csr {
+            nrows: n,
+            ncols: n,
+            ptr: ptr.to_vec(),
+            idx: ri.iter().map(|&i| i as u32).collect(),
+            val,
+        }
+    }
+
+    pub fn nnz(&self) -> usize {
+        self.idx.len()
+    }
+
+    pub fn transpose(&self) -> Csr {
+        let mut ptr = vec![0usize; self.ncols + 1];
+        for &j in &self.idx {
+            ptr[j as usize + 1] += 1;
+        }
+        for j in 0..self.ncols {
+            ptr[j + 1] += ptr[j];
+        }
+        let mut idx = vec![0; self.nnz()];
+        let mut val = vec![0.0; self.nnz()];
+        let mut next = ptr.clone();
+        for i in 0..self.nrows {
+            for p in self.ptr[i]..self.ptr[i + 1] {
+                let j = self.idx[p] as usize;
+                idx[next[j]] = i as u32;
+                val[next[j]] = self.val[p];
+                next[j] += 1;
+            }
+        }
+        Csr {
+            nrows: self.ncols,
+            ncols: self.nrows,
+            ptr,
+            idx,
+            val,
+        }
+    }
+
+    /// `y = A x`, rows in parallel.
+    pub fn spmv(&self, x: &[f64], y: &mut [f64]) {
+        y.par_iter_mut()
+            .with_min_len(1024)
+            .enumerate()
+            .for_each(|(i, yi)| {
+                let mut s = 0.0;
+                for p in self.ptr[i]..self.ptr[i + 1] {
+                    s += self.val[p] * x[self.idx[p] as usize];
+                }
+                *yi = s;
+            });
+    }
+
+    /// `self · b` by Gustavson's row-by-row product; rows in parallel chunks,
+    /// concatenated in order (deterministic).
+    pub fn matmul(&self, b: &Csr) -> Csr {
+        self.matmul_rows(None, b)
+    }
+
+    /// Rows `rows` (all when `None`) of `self · b`, each made as [`Self::matmul`]
+    /// makes it.
+    pub(super) fn matmul_rows(&self, rows: Option<&[u32]>, b: &Csr) -> Csr {
+        const CHUNK: usize = 2048;
+        let m = rows.map_or(self.nrows, <[u32]>::len);
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..m.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let rows = (c * CHUNK..((c + 1) * CHUNK).min(m))
+                    .map(|k| rows.map_or(k, |r| r[k] as usize));
+                let mut marker = vec![usize::MAX; b.ncols];
+                let mut acc = vec![0.0; b.ncols];
+                let (mut lens, mut idx, mut val) = (Vec::new(), Vec::new(), Vec::new());
+                for i in rows {
+                    let start = idx.len();
+                    for p in self.ptr[i]..self.ptr[i + 1] {
+                        let (k, aik) = (self.idx[p] as usize, self.val[p]);
+                        for q in b.ptr[k]..b.ptr[k + 1] {
+                            let j = b.idx[q] as usize;
+                            if marker[j] != i {
+                                marker[j] = i;
+                                acc[j] = 0.0;
+                                idx.push(j as u32);
+                            }
+                            acc[j] += aik * b.val[q];
+                        }
+                    }
+                    idx[start..].sort_unstable();
+                    val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
+                    lens.push(idx.len() - start);
+                }
+                (lens, idx, val)
+            })
+            .collect();
+        let mut out = Csr {
+            nrows: m,
+            ncols: b.ncols,
+            ptr: Vec::with_capacity(m + 1),
+            ..Csr::default()
+        };
+        out.ptr.push(0);
+        for (lens, idx, val) in chunks {
+            for l in lens {
+                let last = *out.ptr.last().unwrap();
+                out.ptr.push(last + l);
+            }
+            out.idx.extend(idx);
+            out.val.extend(val);
+        }
+        out
+    }
+
+    pub(super) fn diagonal(&self) -> Vec<f64> {
+        (0..self.nrows)
+            .map(|i| {
+                (self.ptr[i]..self.ptr[i + 1])
+                    .find(|&p| self.idx[p] as usize == i)
+                    .map_or(0.0, |p| self.val[p])
+            })
+            .collect()
+    }
+}
