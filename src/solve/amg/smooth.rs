@@ -17,11 +17,11 @@ pub(super) const PENALTY_ROW_SHARE: f64 = 0.05;
 /// group (each side's values held to the other's trace); a point smoother changes one
 /// value at a time and so barely moves an error that keeps the constraint but is rough
 /// for the bulk operator, in the interface nodes and the layer next to them, and the
-/// aggregates cannot represent it either. Sweeping those few rows again each way
+/// aggregates cannot represent it either. Sweeping those few rows once more each way
 /// costs little (they are a surface in a volume: 64 000 of 1.16 M rows in the tied
 /// 120:80 boxes of `benches/peers.sh`) and takes that case's CG from 40 iterations to
-/// 19 with two sweeps (from 44 to 27 with one and without the filtered prolongator of
-/// `coarsen`).
+/// 20 (from 44 to 27 without the filtered prolongator of `coarsen`). A second sweep
+/// changes nothing there.
 pub(super) fn penalty_rows(a: &Csr, diag: &[f64]) -> Vec<u32> {
     let n = a.nrows;
     let mut mark = vec![false; n];
@@ -34,13 +34,24 @@ pub(super) fn penalty_rows(a: &Csr, diag: &[f64]) -> Vec<u32> {
             mark[i] = true;
         }
     }
-    let seeds: Vec<usize> = (0..n).filter(|&i| mark[i]).collect();
-    for i in seeds {
+    let seeds: Vec<u32> = (0..n).filter(|&i| mark[i]).map(|i| i as u32).collect();
+    with_neighbours(a, &seeds)
+}
+
+/// `rows` and every row they couple to in `a`, ascending.
+fn with_neighbours(a: &Csr, rows: &[u32]) -> Vec<u32> {
+    let mut mark = vec![false; a.nrows];
+    for &i in rows {
+        let i = i as usize;
+        mark[i] = true;
         for p in a.ptr[i]..a.ptr[i + 1] {
             mark[a.idx[p] as usize] = true;
         }
     }
-    (0..n).filter(|&i| mark[i]).map(|i| i as u32).collect()
+    (0..a.nrows)
+        .filter(|&i| mark[i])
+        .map(|i| i as u32)
+        .collect()
 }
 
 /// One Gauss–Seidel sweep, `x_i ← x_i + (b_i − (Ax)_i)/a_ii`, rows ascending or
