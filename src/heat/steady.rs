@@ -42,6 +42,30 @@ pub const AMG_TOLERANCE: f64 = 1e-11;
 /// after 44 — round-off level for about 20% more CG time.
 pub const STEADY_AMG_TOLERANCE: f64 = 1e-13;
 
+/// The steady Newton's stopping test at iteration `it` (0 before any step), with the
+/// residual norm `rn`, its `goal` and `scale`, the last step's largest change and the
+/// field `u`; `symmetric`: a linear problem (one solve leaves only round-off). Shared by
+/// the serial and the distributed solves, so they stop alike.
+pub(crate) fn newton_converged(
+    it: usize,
+    (rn, goal, scale): (f64, f64, f64),
+    last_step: f64,
+    u: &[f64],
+    symmetric: bool,
+) -> bool {
+    let u_max = u
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs()))
+        .max(f64::MIN_POSITIVE);
+    // A problem solved by Newton (a conductance that may depend on T) takes a second
+    // step even when the first meets the goal: the goal is relative to the first
+    // residual, which the Dirichlet lifting can make huge (k = 1e8), and the second step
+    // refines the LU solution to round-off (heat to ~1e-12, not 1e-7).
+    (rn <= goal && (symmetric || it != 1))
+        || (it > 0 && last_step <= 1e-13 * u_max)
+        || (it > 0 && symmetric && rn <= 1e-8 * scale)
+}
+
 /// Size (unknowns) from which `seam run`'s `linear_solver = "auto"` solves a symmetric
 /// positive definite system by AMG-preconditioned CG instead of sparse Cholesky.
 ///
@@ -303,18 +327,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         // by round-off only (stiff interface terms floor the residual well above
         // 1e-13 ‖F‖ while the solution is exact); or the problem is linear and one
         // step has left only round-off.
-        let u_max = u
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()))
-            .max(f64::MIN_POSITIVE);
-        // A problem solved by Newton (a conductance that may depend on T) takes a
-        // second step even when the first meets the goal: the goal is relative to the
-        // first residual, which the Dirichlet lifting can make huge (k = 1e8), and the
-        // second step refines the LU solution to round-off (heat to ~1e-12, not 1e-7).
-        if (rn <= goal && (symmetric || it != 1))
-            || (it > 0 && last_step <= 1e-13 * u_max)
-            || (it > 0 && symmetric && rn <= 1e-8 * scale)
-        {
+        if newton_converged(it, (rn, goal, scale), last_step, &u, symmetric) {
             converged = true;
             break;
         }

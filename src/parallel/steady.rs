@@ -225,15 +225,8 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         let scale = f_norm.max(rn).max(1e-300);
         let goal = *target.get_or_insert(p.tolerance * scale);
         timing.assembly_s += t.elapsed().as_secs_f64();
-        // The serial solve's stopping tests (crate::heat::steady::solve_steady).
-        let u_max = u
-            .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()))
-            .max(f64::MIN_POSITIVE);
-        if (rn <= goal && (symmetric || it != 1))
-            || (it > 0 && last_step <= 1e-13 * u_max)
-            || (it > 0 && symmetric && rn <= 1e-8 * scale)
-        {
+        // The serial solve's stopping tests.
+        if crate::heat::steady::newton_converged(it, (rn, goal, scale), last_step, &u, symmetric) {
             converged = true;
             break;
         }
