@@ -319,6 +319,9 @@ pub fn solve(
         Start::Restart(s) => s.time,
     };
     let setup = Setup::new(p, time0)?;
+    // A fresh start's voltage is not a solution yet (see `Context::newton`).
+    let settle_voltage =
+        std::cell::Cell::new(p.electric.is_some() && matches!(start, Start::Fresh { .. }));
     let mut state = match start {
         Start::Restart(s) => s,
         Start::Fresh { time, dt, initial } => {
@@ -394,6 +397,7 @@ pub fn solve(
             power: RefCell::new(Vec::new()),
             unconverged: RefCell::new(None),
             alive: RefCell::new(None),
+            settle_voltage: &settle_voltage,
         };
 
         match mode {

@@ -93,6 +93,9 @@ pub(super) struct Context<'c, 'a> {
     pub(super) unconverged: RefCell<Option<StepReport>>,
     /// The live part of the problem once elements have died.
     pub(super) alive: RefCell<Option<super::death::Alive>>,
+    /// The voltage has not been solved yet (a fresh start): the next Newton iteration
+    /// solves for the voltages alone, the temperatures held (see [`Context::newton`]).
+    pub(super) settle_voltage: &'c std::cell::Cell<bool>,
 }
 
 /// Why Newton ran out of iterations, from its residual history: the history itself and
@@ -157,6 +160,17 @@ impl Context<'_, '_> {
             diagnosis: None,
         };
         let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
+        // A fresh voltage is 0 inside and its boundary values at the ends, and Joule
+        // heat linearised about that jump is far from the truth (a first Newton step
+        // from it overshoots the temperatures by hundreds of kelvin, enough to turn a
+        // σ(T) negative). So the first iteration solves the current's equations alone
+        // at the starting temperatures, which is linear for a conductivity that does
+        // not depend on V; Newton goes on from that voltage.
+        let mut settle = self.settle_voltage.take().then(|| {
+            let mut held = zero.clone();
+            held.extend(setup.outside_voltage().into_iter().map(|d| (d, 0.0)));
+            held
+        });
         // The last Newton update relative to max|u|.
         let mut last_update = f64::INFINITY;
         // A linear step's residual after its solve, and its interface systems.
@@ -210,7 +224,8 @@ impl Context<'_, '_> {
                 None => asm.matrix()?,
             };
             let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-            apply_dirichlet(&mut jac, &mut rhs, &zero)?;
+            let settling = settle.take();
+            apply_dirichlet(&mut jac, &mut rhs, settling.as_ref().unwrap_or(&zero))?;
             report.assembly_s += clock.elapsed().as_secs_f64();
             let symmetric = linear;
             // AMG-CG for a symmetric positive definite step system from the threshold on.
@@ -328,6 +343,10 @@ impl Context<'_, '_> {
             let u_max = largest(&u[..species.start]).max(f64::MIN_POSITIVE);
             let c_max = largest(&u[species]).max(f64::MIN_POSITIVE);
             last_update = (step / u_max).max(species_step / c_max);
+            if settling.is_some() {
+                // Only the voltages moved: no measure of the temperatures' convergence.
+                last_update = f64::INFINITY;
+            }
         }
         unreachable!("the loop returns at its last iteration")
     }

@@ -133,6 +133,27 @@ impl Setup {
         })
     }
 
+    /// The dofs held still while a fresh voltage settles (every dof but the voltages
+    /// and the multipliers of voltage ties): see [`Context::newton`].
+    ///
+    /// [`Context::newton`]: super::newton::Context::newton
+    pub(super) fn outside_voltage(&self) -> Vec<usize> {
+        let Some(v) = self.voltage else {
+            return Vec::new();
+        };
+        let volts = self.dofs.field_range(v);
+        let mut free = vec![false; self.n];
+        free[volts.clone()].iter_mut().for_each(|f| *f = true);
+        for (tie, &first) in self.ties.iter().zip(&self.lambda_first) {
+            if tie.own.first().is_some_and(|d| volts.contains(d)) {
+                free[first..first + tie.own.len()]
+                    .iter_mut()
+                    .for_each(|f| *f = true);
+            }
+        }
+        (0..self.n).filter(|&d| !free[d]).collect()
+    }
+
     /// Where the species dofs start (the end of the fields without one).
     pub(super) fn species_start(&self) -> usize {
         self.species
