@@ -271,20 +271,12 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         &mut diags,
     );
     if motion.is_some() || death.is_some() {
-        motion::refuse_what_cannot_move(&file.text, &contact, &couplings, &mut diags);
-    }
-    let fields = contact.species.iter().chain(&contact.voltage_ties);
-    if let (Some(f), Some(_)) = (fields.into_iter().next(), &death) {
-        diags.push(
-            Diagnostic::error(
-                "E0732",
-                format!(
-                    "[[death]] remakes the contact surfaces, but species interfaces and voltage ties keep theirs ({} / {})",
-                    f.pairing.side_a, f.pairing.side_b
-                ),
-            )
-            .at(file.text.loc("death", 0, "time"))
-            .help("remove the [[death]], or the `Enforcement for Species` / `Enforcement for Voltage` tie"),
+        motion::refuse_what_cannot_move(
+            &file.text,
+            &contact,
+            &couplings,
+            motion.is_some(),
+            &mut diags,
         );
     }
     if diags.has_errors() {

@@ -226,16 +226,28 @@ pub(super) fn refuse_what_cannot_move(
     text: &ProblemText,
     contact: &RunContact,
     couplings: &Couplings,
+    displaced: bool,
     diags: &mut Diagnostics,
 ) {
+    // The surfaces move under a [displacement], or element death makes them again.
+    let (why, cause, at) = if displaced {
+        (
+            "[displacement] moves the contact surfaces",
+            "the [displacement]",
+            text.loc_in_table("displacement", ""),
+        )
+    } else {
+        (
+            "[[death]] makes the contact surfaces again",
+            "the [[death]]",
+            text.loc("death", 0, "time"),
+        )
+    };
     let mut refuse = |what: String, help: &str| {
         diags.push(
-            Diagnostic::error(
-                "E0731",
-                format!("[displacement] moves the contact surfaces, but {what}"),
-            )
-            .at(text.loc_in_table("displacement", ""))
-            .help(help.to_string()),
+            Diagnostic::error("E0731", format!("{why}, but {what}"))
+                .at(at.clone())
+                .help(help.replace("the [displacement]", cause)),
         );
     };
     for (k, (choice, _, _)) in contact.choices.iter().enumerate() {

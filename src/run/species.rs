@@ -433,6 +433,8 @@ pub(super) struct Interface {
     pub again: std::cell::RefCell<Option<crate::scene::SearchAgain>>,
     /// Its definition's `Update Search Every n Steps`, when the surfaces move.
     pub search_every: Option<u32>,
+    /// Its contact definition (whose rules make its surfaces again under death).
+    pub definition: usize,
 }
 
 impl From<FieldEnforced> for Interface {
@@ -446,6 +448,7 @@ impl From<FieldEnforced> for Interface {
             at: e.at,
             again: std::cell::RefCell::new(e.again),
             search_every: None,
+            definition: e.definition,
         }
     }
 }

@@ -159,7 +159,7 @@ impl<'a> ContactTerms<'a> {
             motion,
             death,
             moving: RefCell::new(Moving {
-                gone: vec![false; contact.pairings.len()],
+                gone: vec![false; mortar.len()],
                 ..Moving::default()
             }),
         }
@@ -276,11 +276,17 @@ impl<'a> ContactTerms<'a> {
         let mesh = self.physics.mesh;
         let sets = crate::scene::ContactScene::surfaces(mesh, &self.contact.loaded, dead);
         let mut out = Vec::new();
-        for (k, p) in self.contact.pairings.iter().enumerate() {
+        // The embedding's interactions in its order: the Energy ones, then the species
+        // interfaces and voltage ties, each with its definition.
+        let fields = (self.contact.species.iter()).chain(&self.contact.voltage_ties);
+        let every = (self.contact.pairings.iter())
+            .zip(self.contact.definition.iter().copied())
+            .chain(fields.map(|f| (&f.pairing, f.definition)));
+        for (k, (p, definition)) in every.enumerate() {
             if gone[k] {
                 continue;
             }
-            let set = &sets[self.contact.definition[k]].1;
+            let set = &sets[definition].1;
             let side_a = &set.surfaces[p.side_a_surface];
             let side_b = &set.surfaces[p.side_b_surface];
             if side_a.faces.is_empty() && side_a.nodes.is_empty() || side_b.faces.is_empty() {
@@ -467,7 +473,6 @@ impl<'a> ContactTerms<'a> {
         embedding.set_time(t).map_err(failure)?;
         let moving = self.moving.borrow();
         for k in 0..self.term_choice.len() {
-            // The species interfaces and voltage ties (after the energy ones) do not move.
             let gone = moving.gone.get(k).copied().unwrap_or(false);
             embedding
                 .set_active(k, self.couplings.on(k, t) && !gone)
