@@ -111,6 +111,14 @@ pub trait Interfaces {
         let _ = (u, t, step);
         Ok(false)
     }
+    /// The problem's electrical contacts as the last [`Self::advance`] left their
+    /// surfaces (moved, searched anew or made again by element death), in the problem's
+    /// order; `None` while they are as the problem gave them.
+    fn electric_contacts(
+        &self,
+    ) -> Result<Option<Vec<crate::enforce::electric::ElectricContact>>, InterfaceFailure> {
+        Ok(None)
+    }
 }
 
 /// The interfaces of pairings a caller built itself: one field, always on.

@@ -51,6 +51,10 @@ pub(super) struct RunContact {
     /// The voltage ties (`Enforcement for Voltage` with a tie model), after the species
     /// interfaces in the embedding.
     pub voltage_ties: Vec<super::species::Interface>,
+    /// Per electrical contact, its definition's `Update Search Every n Steps`.
+    pub electrical_every: Vec<Option<u32>>,
+    /// How the scene integrated its interfaces (a search anew does the same).
+    pub integration: Option<Integration>,
     /// Wall-clock seconds building the contact surfaces and searching.
     pub surfaces_s: f64,
     pub search_s: f64,
@@ -179,6 +183,15 @@ impl RunContact {
             search_s: scene.timing.search_s,
             ..RunContact::default()
         };
+        out.integration = Some(integration);
+        out.electrical_every = (scene.electrical.iter())
+            .map(|e| {
+                scene
+                    .definitions
+                    .get(e.definition)
+                    .and_then(|d| d.search_every)
+            })
+            .collect();
         out.electrical = scene.electrical;
         let field = |e: crate::scene::species::FieldEnforced| {
             let every = scene

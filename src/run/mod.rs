@@ -56,6 +56,7 @@
 pub mod bundled;
 mod contact;
 mod death;
+mod electric_search;
 mod fields;
 mod motion;
 mod nodal_field;

@@ -219,9 +219,10 @@ fn stored(file: &Path, names: &[String], mesh: &Mesh) -> Result<Source, (String,
     Ok(Source::Stored { times, values })
 }
 
-/// What seam does not move yet, refused at the `[displacement]`: multiplier ties (their
-/// rows are made once), electrical contacts (their pairing is the scene's), and contact
-/// pressures given per point from a `[[nodal_field]]` (a search makes new points).
+/// What seam does not move yet, refused at the `[displacement]` (or the `[[death]]`):
+/// multiplier ties (their rows are made once), periodic pairs of the species, voltage
+/// and electrical contacts, and contact pressures given per point from a
+/// `[[nodal_field]]` (a search makes new points).
 pub(super) fn refuse_what_cannot_move(
     text: &ProblemText,
     contact: &RunContact,
@@ -271,13 +272,14 @@ pub(super) fn refuse_what_cannot_move(
             );
         }
     }
-    if let Some(e) = contact.electrical.first() {
+    // Electrical contacts move as the Energy interactions do, except periodic ones.
+    if let Some(e) = contact.electrical.iter().find(|e| e.pairing.periodic) {
         refuse(
             format!(
-                "electrical contact {} / {} keeps the pairing of the first search",
+                "electrical contact {} / {} is a periodic pair",
                 e.side_a, e.side_b
             ),
-            "remove the [displacement], or join the voltages by a Nitsche tie (`Enforcement for Voltage = Tied_Voltage`), which moves",
+            "periodic electrical contacts do not move yet: remove the [displacement]",
         );
     }
     // Species interfaces and voltage ties move as the Energy interactions do, except

@@ -24,9 +24,11 @@ use crate::search::scene::Pairing;
 
 use super::contact::{Couplings, RunContact};
 use super::death::Death;
+use super::electric_search::ElectricSearch;
 use super::fields::{self, Derived};
 use super::motion::Motion;
 use super::physics::Physics;
+use crate::enforce::electric::ElectricContact;
 
 /// Where an entry of the embedding's CSR Jacobian goes among the solver's couplings
 /// (numbered from the interfaces' first).
@@ -48,6 +50,8 @@ struct Embedded {
     ties: OnceCell<Result<Vec<TieConstraints>, String>>,
     /// The number of dofs (fields, no multipliers) it was made over.
     dofs: usize,
+    /// The electrical contacts' pairings, when the surfaces move or die.
+    electric: Option<RefCell<ElectricSearch>>,
 }
 
 /// The contact of a run as its solvers see it, and what its states derive from it.
@@ -204,52 +208,84 @@ impl<'a> ContactTerms<'a> {
     }
 
     /// The surfaces placed at time `t`, and the interactions whose schedule is due at
-    /// `step` searched anew (once per step). True when the couplings changed.
+    /// `step` searched anew (once per step), the electrical contacts' with them. True
+    /// when the couplings changed.
     fn place(&self, e: &Embedded, u: &[f64], t: f64, step: u64) -> Result<bool, InterfaceFailure> {
         if self.motion.is_none() && self.death.is_none() {
             return Ok(false);
         }
         let mut moving = self.moving.borrow_mut();
+        let coords = match self.motion {
+            Some(motion) => Some(motion.coords_at(t).map_err(InterfaceFailure::Failed)?),
+            None => None,
+        };
+        // A step taken again (a cutback, a new pattern) is placed again, not searched
+        // or counted again.
+        let again = moving.searched_step == Some(step);
+        let due = |schedule: SearchSchedule| {
+            !again && self.motion.is_some() && schedule.full_search(step)
+        };
+        // Element death makes the surfaces again (by each definition's rules), and
+        // they are searched.
+        let mut sets = None;
+        if let Some(death) = self.death {
+            let dead = death.dead_at(t);
+            if dead.len() != moving.dead {
+                let mesh = self.physics.mesh;
+                sets = Some(crate::scene::ContactScene::surfaces(
+                    mesh,
+                    &self.contact.loaded,
+                    &dead,
+                ));
+                moving.dead = dead.len();
+                moving.counts.surface_updates += 1;
+            }
+        }
+        let mut searched = false;
         {
             let mut embedding = e.embedding.borrow_mut();
-            if let Some(motion) = self.motion {
-                let coords = motion.coords_at(t).map_err(InterfaceFailure::Failed)?;
-                embedding.move_nodes(&coords).map_err(failure)?;
+            if let Some(coords) = &coords {
+                embedding.move_nodes(coords).map_err(failure)?;
             }
-            // A step taken again (a cutback, a new pattern) is placed again, not
-            // searched or counted again.
-            let again = moving.searched_step == Some(step);
             // Every interaction of the embedding: the Energy ones, then the species
             // interfaces and voltage ties.
-            let mut due: Vec<usize> = (0..self.term_choice.len())
-                .filter(|&k| !again && self.motion.is_some() && self.schedule(k).full_search(step))
+            let mut search: Vec<usize> = (0..self.term_choice.len())
+                .filter(|&k| due(self.schedule(k)))
                 .collect();
-            // Element death makes the surfaces again, and they are searched.
-            if let Some(death) = self.death {
-                let dead = death.dead_at(t);
-                if dead.len() != moving.dead {
-                    let remade = self.remake_surfaces(&mut embedding, &dead, &mut moving.gone)?;
-                    due.extend(remade);
-                    due.sort_unstable();
-                    due.dedup();
-                    moving.dead = dead.len();
-                    moving.counts.surface_updates += 1;
-                }
+            if let Some(sets) = &sets {
+                let remade =
+                    remake_surfaces(&mut embedding, sets, self.interactions(), &mut moving.gone)?;
+                search.extend(remade);
+                search.sort_unstable();
+                search.dedup();
             }
-            due.retain(|&k| !moving.gone.get(k).copied().unwrap_or(false));
-            moving.searched_step = Some(step);
-            if !due.is_empty() {
-                embedding.search_some(&due).map_err(failure)?;
-                moving.counts.searches += 1;
+            search.retain(|&k| !moving.gone.get(k).copied().unwrap_or(false));
+            if !search.is_empty() {
+                embedding.search_some(&search).map_err(failure)?;
+                searched = true;
                 log::debug!(
                     "step {step}, t = {t}: {} interaction(s) searched anew",
-                    due.len()
+                    search.len()
                 );
-            } else if !again && self.motion.is_some() {
-                moving.counts.refits += 1;
             }
-            moving.current = None;
         }
+        if let Some(electric) = &e.electric {
+            let every = &self.contact.electrical_every;
+            let due = |k: usize| due(SearchSchedule::new(every[k]));
+            searched |= electric.borrow_mut().place(
+                self.contact,
+                coords.as_deref(),
+                sets.as_deref(),
+                &due,
+            )?;
+        }
+        moving.searched_step = Some(step);
+        if searched {
+            moving.counts.searches += 1;
+        } else if !again && self.motion.is_some() {
+            moving.counts.refits += 1;
+        }
+        moving.current = None;
         if step == 0 {
             // The solver asks for the couplings as it starts.
             return Ok(false);
@@ -264,46 +300,13 @@ impl<'a> ContactTerms<'a> {
         Ok(changed)
     }
 
-    /// Every interaction's surfaces made again without the `dead` elements (by its
-    /// definition's rules); an interaction left without faces on a side is gone. The
-    /// interactions to search.
-    fn remake_surfaces(
-        &self,
-        embedding: &mut Embedding,
-        dead: &std::collections::HashSet<crate::mesh::ElemId>,
-        gone: &mut [bool],
-    ) -> Result<Vec<usize>, InterfaceFailure> {
-        let mesh = self.physics.mesh;
-        let sets = crate::scene::ContactScene::surfaces(mesh, &self.contact.loaded, dead);
-        let mut out = Vec::new();
-        // The embedding's interactions in its order: the Energy ones, then the species
-        // interfaces and voltage ties, each with its definition.
+    /// The embedding's interactions in its order, each with its definition: the Energy
+    /// ones, then the species interfaces and voltage ties.
+    fn interactions(&self) -> impl Iterator<Item = (&Pairing, usize)> {
         let fields = (self.contact.species.iter()).chain(&self.contact.voltage_ties);
-        let every = (self.contact.pairings.iter())
+        (self.contact.pairings.iter())
             .zip(self.contact.definition.iter().copied())
-            .chain(fields.map(|f| (&f.pairing, f.definition)));
-        for (k, (p, definition)) in every.enumerate() {
-            if gone[k] {
-                continue;
-            }
-            let set = &sets[definition].1;
-            let side_a = &set.surfaces[p.side_a_surface];
-            let side_b = &set.surfaces[p.side_b_surface];
-            if side_a.faces.is_empty() && side_a.nodes.is_empty() || side_b.faces.is_empty() {
-                log::info!(
-                    "interaction {} / {}: element death left a side without faces; it is off from now on",
-                    p.side_a,
-                    p.side_b
-                );
-                gone[k] = true;
-                continue;
-            }
-            embedding
-                .replace_surfaces(k, side_a.clone(), side_b.clone())
-                .map_err(failure)?;
-            out.push(k);
-        }
-        Ok(out)
+            .chain(fields.map(|f| (&f.pairing, f.definition)))
     }
 
     /// The search schedule of interaction `k`'s definition.
@@ -351,12 +354,14 @@ impl<'a> ContactTerms<'a> {
             .iter()
             .map(|&(n, _)| n)
             .collect();
+        // A search anew integrates as the scene's first search did.
+        let integration = (self.contact.integration).unwrap_or(Integration::Segments { order: 5 });
         let mut embedding = Embedding::over_dofs(
             physics.mesh.clone(),
             dofs.clone(),
             self.conductivity.clone(),
             fixed,
-            Integration::Segments { order: 5 },
+            integration,
         );
         // A conductivity that is not one number (of T, or of x by Lua): the Nitsche forms
         // take it at each point's temperature and position.
@@ -451,11 +456,23 @@ impl<'a> ContactTerms<'a> {
                 embedding.set_temperature_of(k, temperature?, law);
             }
         }
+        let moves = self.motion.is_some() || self.death.is_some();
+        let electric = match moves {
+            true => ElectricSearch::new(
+                self.contact,
+                physics.mesh,
+                dofs,
+                field(0)?.into(),
+                integration,
+            ),
+            false => None,
+        };
         Ok(Embedded {
             embedding: RefCell::new(embedding),
             slots: RefCell::new((0, Vec::new())),
             ties: OnceCell::new(),
             dofs: dofs.len(),
+            electric: electric.map(RefCell::new),
         })
     }
 
@@ -716,7 +733,7 @@ impl<'a> ContactTerms<'a> {
 
 /// A failure of the embedding as the solvers take it: a cutback request retries the
 /// step; a model that failed at a point names it, and how to go past such points.
-fn failure(e: EmbedError) -> InterfaceFailure {
+pub(super) fn failure(e: EmbedError) -> InterfaceFailure {
     match e {
         EmbedError::Cutback { .. } => InterfaceFailure::Cutback(e.to_string()),
         EmbedError::Plugin { .. } => InterfaceFailure::Failed(format!(
@@ -850,6 +867,48 @@ impl Interfaces for ContactTerms<'_> {
         self.at_time(e, t)?;
         self.place(e, u, t, step)
     }
+
+    fn electric_contacts(&self) -> Result<Option<Vec<ElectricContact>>, InterfaceFailure> {
+        match &self.embedded()?.electric {
+            Some(electric) => electric.borrow().contacts(self.contact).map(Some),
+            None => Ok(None),
+        }
+    }
+}
+
+/// The surfaces of `interactions` (the embedding's, in its order, each with its
+/// definition) made again from `sets` (each definition's surfaces without the dead
+/// elements); an interaction left without faces on a side is gone. The interactions to
+/// search.
+pub(super) fn remake_surfaces<'p>(
+    embedding: &mut Embedding,
+    sets: &[(Option<String>, crate::surface::SurfaceSet)],
+    interactions: impl Iterator<Item = (&'p Pairing, usize)>,
+    gone: &mut [bool],
+) -> Result<Vec<usize>, InterfaceFailure> {
+    let mut out = Vec::new();
+    for (k, (p, definition)) in interactions.enumerate() {
+        if gone[k] {
+            continue;
+        }
+        let set = &sets[definition].1;
+        let side_a = &set.surfaces[p.side_a_surface];
+        let side_b = &set.surfaces[p.side_b_surface];
+        if side_a.faces.is_empty() && side_a.nodes.is_empty() || side_b.faces.is_empty() {
+            log::info!(
+                "interaction {} / {}: element death left a side without faces; it is off from now on",
+                p.side_a,
+                p.side_b
+            );
+            gone[k] = true;
+            continue;
+        }
+        embedding
+            .replace_surfaces(k, side_a.clone(), side_b.clone())
+            .map_err(failure)?;
+        out.push(k);
+    }
+    Ok(out)
 }
 
 /// A per-block coefficient law (D S or σ; 1 where a block has none) as the embedding takes

@@ -43,6 +43,10 @@ pub struct ElectricalEnforced {
     pub definition: usize,
     /// The voltage block, for messages.
     pub at: crate::diag::Loc,
+    /// The pairing it was made from.
+    pub pairing: Pairing,
+    /// What searching it again takes (surfaces that move only).
+    pub again: Option<super::SearchAgain>,
 }
 
 /// The voltage block of `def`, if it has one; two, or one that claims another equation
@@ -76,7 +80,7 @@ pub(super) fn voltage_block(def: &ContactDefinition) -> Result<Option<&Enforceme
 /// What a voltage block makes of a pairing.
 pub enum Electrical {
     /// A contact conductance, with its Joule heat.
-    Contact(ElectricalEnforced),
+    Contact(Box<ElectricalEnforced>),
     /// A tie of the voltage field (through the embedding, as a species interface).
     Tie(Box<FieldEnforced>),
 }
@@ -171,7 +175,7 @@ pub(super) fn electrical(
             return None;
         }
     };
-    Some(Electrical::Contact(ElectricalEnforced {
+    Some(Electrical::Contact(Box::new(ElectricalEnforced {
         side_a: pairing.side_a.clone(),
         side_b: pairing.side_b.clone(),
         contact,
@@ -179,7 +183,9 @@ pub(super) fn electrical(
         pressure,
         definition: d,
         at: enf.at.clone(),
-    }))
+        pairing: pairing.clone(),
+        again: None,
+    })))
 }
 
 /// The electrical contact conductance of the voltage block `enf` and its contact

@@ -296,8 +296,9 @@ impl ContactScene {
                 let interaction = list
                     .iter()
                     .find(|i| i.side_a_name == pairing.side_a && i.side_b_name == pairing.side_b);
-                // What searching a species interface or voltage tie again takes (surfaces
-                // that move; a periodic pair's map stays with its Energy entry).
+                // What searching a species interface, voltage tie or electrical contact
+                // again takes (surfaces that move; a periodic pair's map stays with its
+                // Energy entry).
                 let field_again = || {
                     (keep && !pairing.periodic)
                         .then(|| search_again((&set, def, mesh), &pairing, interaction, None))
@@ -306,7 +307,12 @@ impl ContactScene {
                     let scale = interaction.map_or(1.0, |i| i.penalty_scale);
                     let sources = &loaded.sources;
                     match electric::electrical(v, (d, scale), &pairing, deck_dir, sources, diags) {
-                        Some(electric::Electrical::Contact(e)) => scene.electrical.push(e),
+                        Some(electric::Electrical::Contact(e)) => {
+                            scene.electrical.push(electric::ElectricalEnforced {
+                                again: field_again(),
+                                ..*e
+                            })
+                        }
                         Some(electric::Electrical::Tie(t)) => {
                             scene.voltage_ties.push(FieldEnforced {
                                 again: field_again(),

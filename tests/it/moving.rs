@@ -558,3 +558,68 @@ fn species_interfaces_and_voltage_ties_follow_element_death() {
     let m = r.summary.motion.expect("a run with death reports it");
     assert_eq!(m.surface_updates, 1, "{m:?}");
 }
+
+/// Electrical contacts (a contact conductance with its Joule heat) on moving and dying
+/// surfaces. σ = 1, V = 1 at z = 0 and 0 on block 2's top, the contact conductance the
+/// gap law `0.05 / gap` (S/m²): the current through the contact at every step is the
+/// series law of that step's gap, 1/(1 + g/0.05 + 1) A. Block 2 coming down (searched
+/// every step, then every 3 steps), and block 1's upper layer dying at t = 5 under the
+/// lid at rest (1/(0.5 + (g + 0.5)/0.05 + 1) after).
+#[test]
+fn electrical_contacts_move_and_follow_element_death() {
+    let tmp = scratch("moving-electric");
+    let dir = tmp.path();
+    let voltage = "[[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_1\"]\nvalue = 1.0\n\
+                   [[bc]]\nkind = \"voltage\"\nsurfaces = [\"surface_4\"]\nvalue = 0.0\n";
+    let edit = |file: &Path, change: &dyn Fn(String) -> String| {
+        let text = std::fs::read_to_string(file).unwrap();
+        std::fs::write(file, change(text)).unwrap();
+    };
+    let sigma = |text: String| {
+        text.replace(
+            "conductivity = 1.0\nrho_c = 1e-12\n",
+            "conductivity = 1.0\nrho_c = 1e-12\nelectrical_conductivity = 1.0\n",
+        )
+    };
+    let electrical = "  end\n\
+         begin enforcement electrical\n    enforcement for voltage = gap_conductance\n    gap conductance coefficient = lua \"0.05 / gap\"\n  end\nend\n";
+    let worst = |r: &RunResult, law: &dyn Fn(f64) -> f64| {
+        assert_eq!(r.history.len(), 10, "ten steps");
+        let mut worst = 0.0f64;
+        for s in &r.history {
+            let (current, exact) = (s.electric[0].current, law(s.time));
+            println!("t = {}: current {current}, law {exact}", s.time);
+            worst = worst.max((current - exact).abs() / exact);
+        }
+        worst
+    };
+    // Closing: every step, then every 3 steps.
+    for (every, searches) in [(None, 11), (Some(3), 4)] {
+        let problem = closing(dir, &format!("{LUA_DOWN}{voltage}"), every);
+        edit(&problem, &sigma);
+        edit(&dir.join("contact.i"), &|d| {
+            d.replace("  end\nend\n", electrical)
+        });
+        let r = run(&problem);
+        let e = worst(&r, &|t| series_heat(G0 - SPEED * t));
+        println!("closing, schedule {every:?}: worst current {e:.1e}");
+        assert!(e <= 1e-9, "current against the gap law: {e:e}");
+        let m = r.summary.motion.expect("a moving run reports its searches");
+        assert_eq!(m.searches, searches, "{m:?}");
+    }
+    // Element death.
+    let (problem, _) = dying(dir, "block_1");
+    edit(&problem, &|p| {
+        sigma(p).replace("[contact]", &format!("{voltage}[contact]"))
+    });
+    edit(&dir.join("contact.i"), &|d| {
+        d.replace("  end\nend\n", electrical)
+    });
+    let r = run(&problem);
+    let e = worst(&r, &|t| match t >= 5.0 {
+        true => 1.0 / (0.5 + (G0 + 0.5) / K_GAS + 1.0),
+        false => series_heat(G0),
+    });
+    println!("death: worst current {e:.1e}");
+    assert!(e <= 1e-9, "current against the series law: {e:e}");
+}

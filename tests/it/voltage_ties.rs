@@ -116,6 +116,15 @@ fn mean_at(mesh: &Mesh, f: &[f64], z: f64) -> f64 {
     at.iter().sum::<f64>() / at.len() as f64
 }
 
+/// The electrical power fed at z = 0 by the current density `j` (over the unit
+/// section), less a jump `dv`'s share, and the heat leaving by convection at the two
+/// ends, from the nodal voltages and temperatures `(v, t)`.
+fn power_in_and_out(r: &RunResult, (v, t): (&[f64], &[f64]), j: f64, dv: f64) -> (f64, f64) {
+    let power = j * (mean_at(&r.mesh, v, 0.0) - mean_at(&r.mesh, v, L)) - j * dv;
+    let out = H_C * (mean_at(&r.mesh, t, 0.0) - T_INF) + H_C * (mean_at(&r.mesh, t, L) - T_INF);
+    (power, out)
+}
+
 #[test]
 fn every_voltage_tie_reproduces_the_series_bars_at_the_nodes() {
     let mortar = "  enforcement for voltage = tied\n  side b variable voltage to voltage";
@@ -175,9 +184,7 @@ fn every_voltage_tie_reproduces_the_series_bars_at_the_nodes() {
         );
         // The electrical power fed at z = 0 (j V0 over the unit section) leaves as heat
         // by convection at the two ends, less the jump's share for an offset.
-        let power = j * (mean_at(&r.mesh, &v, 0.0) - mean_at(&r.mesh, &v, L)) - j * dv;
-        let out =
-            H_C * (mean_at(&r.mesh, &t, 0.0) - T_INF) + H_C * (mean_at(&r.mesh, &t, L) - T_INF);
+        let (power, out) = power_in_and_out(&r, (&v, &t), j, dv);
         let tol_p = if name == "dash" { 1e-7 } else { 1e-10 };
         assert!(
             (power - out).abs() <= tol_p * power,
@@ -374,13 +381,9 @@ fn only_an_electrical_contact_sees_voltages() {
     );
 }
 
-/// σ(T) = σ0 / (1 + 0.001 (T − 300)) across a voltage tie, 750 A/m² fed at z = 0: the
-/// Nitsche forms weigh the jump with σ at each point's temperature, so the Nitsche tie
-/// approaches the mortar tie's answer (whose multiplier needs no weights) at about second
-/// order; with σ at a probe temperature it is first order and 26–40× farther.
-#[test]
-fn a_nitsche_voltage_tie_follows_sigma_of_t() {
-    let problem = PROBLEM
+/// `problem` with σ(T) = σ0 / (1 + 0.001 (T − 300)) in both bars.
+fn sigma_of_t(problem: &str) -> String {
+    problem
         .replace(
             "electrical_conductivity = 2e3\n",
             "electrical_conductivity = \"2e3 / (1 + 0.001 * (T - 300))\"\n",
@@ -389,10 +392,18 @@ fn a_nitsche_voltage_tie_follows_sigma_of_t() {
             "electrical_conductivity = 1e3\n",
             "electrical_conductivity = \"1e3 / (1 + 0.001 * (T - 300))\"\n",
         )
-        .replace(
-            "kind = \"voltage\"\nsurfaces = [\"surface_1\"]\nvalue = 0.9",
-            "kind = \"current\"\nsurfaces = [\"surface_1\"]\nvalue = 750.0",
-        );
+}
+
+/// σ(T) = σ0 / (1 + 0.001 (T − 300)) across a voltage tie, 750 A/m² fed at z = 0: the
+/// Nitsche forms weigh the jump with σ at each point's temperature, so the Nitsche tie
+/// approaches the mortar tie's answer (whose multiplier needs no weights) at about second
+/// order; with σ at a probe temperature it is first order and 26–40× farther.
+#[test]
+fn a_nitsche_voltage_tie_follows_sigma_of_t() {
+    let problem = sigma_of_t(PROBLEM).replace(
+        "kind = \"voltage\"\nsurfaces = [\"surface_1\"]\nvalue = 0.9",
+        "kind = \"current\"\nsurfaces = [\"surface_1\"]\nvalue = 750.0",
+    );
     let mortar = "  enforcement for voltage = tied\n  side b variable voltage to voltage";
     let nitsche = "  enforcement for voltage = tied_voltage";
     let mut gaps = Vec::new();
@@ -442,15 +453,7 @@ fn a_nitsche_voltage_tie_follows_sigma_of_t() {
 /// σ), and the electrical power fed equals the heat leaving by convection.
 #[test]
 fn sigma_of_t_with_the_voltage_held_at_both_ends_converges() {
-    let problem = PROBLEM
-        .replace(
-            "electrical_conductivity = 2e3\n",
-            "electrical_conductivity = \"2e3 / (1 + 0.001 * (T - 300))\"\n",
-        )
-        .replace(
-            "electrical_conductivity = 1e3\n",
-            "electrical_conductivity = \"1e3 / (1 + 0.001 * (T - 300))\"\n",
-        );
+    let problem = sigma_of_t(PROBLEM);
     let mesh = bars([3, 4], [4, 5]);
     let cases = [
         (
@@ -476,13 +479,10 @@ fn sigma_of_t_with_the_voltage_held_at_both_ends_converges() {
         let dofs = &r.solution.dofs;
         let v = dofs.nodal_values(dofs.field("voltage").unwrap(), &r.solution.u);
         let t = dofs.nodal_values(dofs.field("temperature").unwrap(), &r.solution.u);
-        // The current through the interface over the unit section; what it is fed with
-        // (V(0) − V(L)) less what the contact keeps as its own Joule heat leaves by
-        // convection at the two ends.
+        // The power the current through the interface is fed with (the contact's
+        // Joule heat included, released into its sides) leaves by convection.
         let c = &r.summary.electrical_contacts[0];
-        let power = c.current * (mean_at(&r.mesh, &v, 0.0) - mean_at(&r.mesh, &v, L));
-        let out =
-            H_C * (mean_at(&r.mesh, &t, 0.0) - T_INF) + H_C * (mean_at(&r.mesh, &t, L) - T_INF);
+        let (power, out) = power_in_and_out(&r, (&v, &t), c.current, 0.0);
         // A Nitsche tie leaves a jump of the discretisation's size where V is not
         // linear (σ varies along the bar), and the power its current carries across the
         // jump is not released as heat: measured 2.4e-5 of the power.

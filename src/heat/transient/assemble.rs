@@ -287,12 +287,9 @@ impl Context<'_, '_> {
         };
         // Electrical contacts: the voltage interface and its Joule heat.
         if let Some(el) = &p.electric {
-            let mut power = Vec::with_capacity(setup.electric.len());
-            for ((c, (_, h)), &first) in setup
-                .electric
-                .iter()
-                .zip(&el.contacts)
-                .zip(self.electric_first)
+            let contacts = setup.electric();
+            let mut power = Vec::with_capacity(contacts.len());
+            for ((c, (_, h)), &first) in contacts.iter().zip(&el.contacts).zip(self.electric_first)
             {
                 let at_t = |i: &crate::enforce::interface::HInput| h(i, t);
                 let pw = c

@@ -53,7 +53,7 @@ use crate::mesh::{Mesh, NodeId};
 
 use super::TEMPERATURE;
 use super::electric::{ContactPower, ElectricContact};
-use super::interfaces::Interfaces;
+use super::interfaces::{InterfaceFailure, Interfaces};
 use super::law::Law;
 use super::{FaceBc, HeatError, SourceFn};
 use crate::enforce::interface::{HInput, HValue};
@@ -380,8 +380,8 @@ pub fn solve(
                 .collect();
             tie_first.push(pattern.add_couplings(&pairs)?.start);
         }
-        let mut electric_first = Vec::with_capacity(setup.electric.len());
-        for c in &setup.electric {
+        let mut electric_first = Vec::with_capacity(setup.electric().len());
+        for c in setup.electric().iter() {
             electric_first.push(pattern.add_couplings(&c.couplings())?.start);
         }
         pattern.build()?;
@@ -443,11 +443,19 @@ pub fn solve(
                         let t_new = state.time + dt;
                         // Moving interfaces are placed at t_new; new couplings need a new
                         // pattern, and the step is taken again over it.
-                        if let Some(i) = p.interfaces
-                            && i.advance(&state.u, t_new, state.step as u64 + 1)
-                                .map_err(|e| HeatError::Contact(e.to_string()))?
-                        {
-                            continue 'pattern;
+                        if let Some(i) = p.interfaces {
+                            let contact = |e: InterfaceFailure| HeatError::Contact(e.to_string());
+                            let moved = i
+                                .advance(&state.u, t_new, state.step as u64 + 1)
+                                .map_err(contact)?;
+                            // Electrical contacts on the moved surfaces, with new gaps.
+                            let rewired = match i.electric_contacts().map_err(contact)? {
+                                Some(made) => setup.rebind_electric(mesh, made)?,
+                                None => false,
+                            };
+                            if moved || rewired {
+                                continue 'pattern;
+                            }
                         }
                         let dt_prev = state.past.first().map(|(t, _)| state.time - t);
                         let alpha = weights(scheme, dt, dt_prev);

@@ -29,8 +29,9 @@ pub(super) struct Setup {
     pub(super) rules: Vec<Option<Basis>>,
     /// The voltage field of a thermal–electrical problem.
     pub(super) voltage: Option<FieldId>,
-    /// Its electrical contacts, bound to the dofs.
-    pub(super) electric: Vec<ElectricContact>,
+    /// Its electrical contacts, bound to the dofs (made again when their surfaces
+    /// move: [`Self::rebind_electric`]).
+    pub(super) electric: std::sync::RwLock<Vec<ElectricContact>>,
     /// The species field, numbered last.
     pub(super) species: Option<FieldId>,
 }
@@ -87,15 +88,13 @@ impl Setup {
         if let Some(c) = species {
             dirichlet_dofs.extend(species_dofs(mesh, &dofs, c, &loads.species)?.map(|(d, _)| d));
         }
-        let mut electric = Vec::new();
-        if let (Some(e), Some(v)) = (&p.electric, voltage) {
-            let t = fields[0];
-            for (c, _) in &e.contacts {
-                let mut c = c.clone();
-                c.bind(mesh, &dofs, t, v).map_err(HeatError::Contact)?;
-                electric.push(c);
+        let electric = match (&p.electric, voltage) {
+            (Some(e), Some(v)) => {
+                let contacts = e.contacts.iter().map(|(c, _)| c.clone()).collect();
+                bind_electric(mesh, &dofs, (fields[0], v), contacts)?
             }
-        }
+            _ => Vec::new(),
+        };
         let ties = match p.interfaces {
             Some(i) => i.ties().map_err(HeatError::Contact)?,
             None => Vec::new(),
@@ -128,7 +127,7 @@ impl Setup {
             blocks,
             rules,
             voltage,
-            electric,
+            electric: std::sync::RwLock::new(electric),
             species,
         })
     }
@@ -154,6 +153,42 @@ impl Setup {
         (0..self.n).filter(|&d| !free[d]).collect()
     }
 
+    /// The electrical contacts made again on moved surfaces (in the problem's order):
+    /// bound to the dofs and kept. True when their couplings changed, so the solver
+    /// makes its pattern again.
+    pub(super) fn rebind_electric(
+        &self,
+        mesh: &Mesh,
+        contacts: Vec<ElectricContact>,
+    ) -> Result<bool, HeatError> {
+        let (Some(v), Some(&t)) = (self.voltage, self.fields.first()) else {
+            return Ok(false);
+        };
+        let bound = bind_electric(mesh, &self.dofs, (t, v), contacts)?;
+        let mut kept = self.electric_mut();
+        let changed = bound.len() != kept.len()
+            || bound
+                .iter()
+                .zip(kept.iter())
+                .any(|(a, b)| a.couplings() != b.couplings());
+        *kept = bound;
+        Ok(changed)
+    }
+
+    /// The electrical contacts (a poisoned lock cannot happen: nothing panics while
+    /// holding it, and the data would be whole if it did).
+    pub(super) fn electric(&self) -> std::sync::RwLockReadGuard<'_, Vec<ElectricContact>> {
+        self.electric
+            .read()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    fn electric_mut(&self) -> std::sync::RwLockWriteGuard<'_, Vec<ElectricContact>> {
+        self.electric
+            .write()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
     /// Where the species dofs start (the end of the fields without one).
     pub(super) fn species_start(&self) -> usize {
         self.species
@@ -176,6 +211,22 @@ impl Setup {
         }
         Ok(out)
     }
+}
+
+/// `contacts` bound to the temperature and voltage dofs `(t, v)`.
+fn bind_electric(
+    mesh: &Mesh,
+    dofs: &DofMap,
+    (t, v): (FieldId, FieldId),
+    contacts: Vec<ElectricContact>,
+) -> Result<Vec<ElectricContact>, HeatError> {
+    contacts
+        .into_iter()
+        .map(|mut c| {
+            c.bind(mesh, dofs, t, v).map_err(HeatError::Contact)?;
+            Ok(c)
+        })
+        .collect()
 }
 
 /// `(dof, value)` of nodal voltages; a node without a voltage is an error that names it.
