@@ -310,6 +310,18 @@ impl Bvh {
         &self,
         hint: &mut QueryHint,
         query: &Aabb,
+        visit: impl FnMut(usize, &Aabb),
+    ) {
+        self.query_by_with_hint(hint, |b| b.intersects(query), visit);
+    }
+
+    /// [`Bvh::query_by`] started at the hint's leaf as [`Bvh::query_with_hint`] does:
+    /// the same set of items for the same monotone `accept`, in an order that depends on
+    /// the hint.
+    pub fn query_by_with_hint(
+        &self,
+        hint: &mut QueryHint,
+        accept: impl Fn(&Aabb) -> bool,
         mut visit: impl FnMut(usize, &Aabb),
     ) {
         let start = hint.node as usize;
@@ -317,13 +329,13 @@ impl Bvh {
         let mut first_hit: Option<usize> = None;
         let mut leaf = |k: usize, boxes: &[Aabb], items: &[u32]| {
             for (b, &i) in boxes.iter().zip(items) {
-                if b.intersects(query) {
+                if accept(b) {
                     first_hit.get_or_insert(k);
                     visit(i as usize, b);
                 }
             }
         };
-        self.traverse_from(start, |b| b.intersects(query), &mut leaf);
+        self.traverse_from(start, &accept, &mut leaf);
         let mut c = start;
         while c != 0 {
             let p = self.parent[c] as usize;
@@ -333,8 +345,8 @@ impl Bvh {
                 p + 1
             };
             // Test here first: most siblings miss, and a miss then costs one box test.
-            if self.nodes[sibling].bounds.intersects(query) {
-                self.traverse_from(sibling, |b| b.intersects(query), &mut leaf);
+            if accept(&self.nodes[sibling].bounds) {
+                self.traverse_from(sibling, &accept, &mut leaf);
             }
             c = p;
         }
@@ -573,6 +585,17 @@ mod tests {
         let want: Vec<usize> = (0..items.len()).filter(|&i| accept(&items[i])).collect();
         assert!(!want.is_empty() && want.len() < items.len());
         assert_eq!(got, want);
+        // The same from a hint left by each of a stream of other queries.
+        let mut hint = QueryHint::default();
+        for k in 0..40 {
+            let q = [(k as f64) * 0.7, (k % 13) as f64, 0.5];
+            bvh.query_by_with_hint(&mut hint, |b| b.distance2_to_point(q) <= 1.0, |_, _| {});
+            let mut from_hint = Vec::new();
+            let mut h = hint;
+            bvh.query_by_with_hint(&mut h, accept, |i, _| from_hint.push(i));
+            from_hint.sort_unstable();
+            assert_eq!(from_hint, want, "from the hint of query {k}");
+        }
     }
 
     #[test]

@@ -110,6 +110,23 @@ pub struct ContactPoint {
 }
 
 impl ContactPoint {
+    /// A point of no face and no node, unmatched: what a result is filled with before
+    /// the search writes its points in place.
+    const UNPAIRED: ContactPoint = ContactPoint {
+        a_face: None,
+        a_node: None,
+        xi_a: [0.0; 2],
+        x: [0.0; 3],
+        weight: 0.0,
+        status: PointStatus::Unmatched,
+        b_face: None,
+        xi_b: [0.0; 2],
+        gap: 0.0,
+        offset: 0.0,
+        normal_a: [0.0; 3],
+        normal_b: [0.0; 3],
+    };
+
     /// The side-B face of a matched point.
     pub fn matched_b_face(&self) -> Option<usize> {
         match (self.status, self.b_face) {
@@ -271,57 +288,93 @@ impl Searcher {
         let mut result = SearchResult::default();
         let rules = Rules::new(integration, a.axisymmetric);
         // Faces, in fixed chunks, in parallel; each chunk gives its points and, per face,
-        // the matched weight, total weight and overlap area.
-        let chunks: Vec<ChunkOut> = (0..a.faces.len())
-            .step_by(CHUNK)
-            .collect::<Vec<_>>()
-            .into_par_iter()
-            .map(|start| {
-                let end = (start + CHUNK).min(a.faces.len());
-                let per_point = rules.quadrature(4).len().max(1);
-                let mut points = Vec::with_capacity((end - start) * per_point);
-                let mut per_face = Vec::with_capacity(end - start);
-                let mut scratch = Scratch::default();
-                for fa in start..end {
-                    let before = points.len();
-                    let area = match &rules {
-                        Rules::Quadrature(_) => {
+        // the matched weight, total weight and overlap area. Quadrature faces have a
+        // known number of points each, so they are written straight into the result
+        // (one allocation, no copy); mortar segments come in per chunk.
+        let per_face = match &rules {
+            Rules::Quadrature(_) => {
+                let counts: Vec<usize> = (a.faces.iter())
+                    .map(|f| rules.quadrature(f.len).len())
+                    .collect();
+                let total: usize = counts.iter().sum();
+                result.points = vec![ContactPoint::UNPAIRED; total];
+                result.points.reserve_exact(a.nodes.len());
+                // The result cut into each chunk's points.
+                let mut rest = result.points.as_mut_slice();
+                let mut slices = Vec::with_capacity(a.faces.len().div_ceil(CHUNK));
+                for start in (0..a.faces.len()).step_by(CHUNK) {
+                    let end = (start + CHUNK).min(a.faces.len());
+                    let (head, tail) = rest.split_at_mut(counts[start..end].iter().sum());
+                    slices.push((start, end, head));
+                    rest = tail;
+                }
+                let chunks: Vec<Vec<(f64, f64, f64)>> = slices
+                    .into_par_iter()
+                    .map(|(start, end, slice)| {
+                        let mut scratch = Scratch::default();
+                        let mut points = Vec::new();
+                        let mut at = 0;
+                        let mut per_face = Vec::with_capacity(end - start);
+                        for fa in start..end {
+                            points.clear();
                             let rule = rules.quadrature(a.faces[fa].len);
-                            ctx.quadrature_face(a, fa, rule, overlap, &mut points, &mut scratch)
+                            let area = ctx.quadrature_face(
+                                a,
+                                fa,
+                                rule,
+                                overlap,
+                                &mut points,
+                                &mut scratch,
+                            );
+                            slice[at..at + points.len()].copy_from_slice(&points);
+                            at += points.len();
+                            per_face.push(face_weights(&points, area));
                         }
-                        Rules::Segments { line, triangle } => {
+                        per_face
+                    })
+                    .collect();
+                chunks.into_iter().flatten().collect::<Vec<_>>()
+            }
+            Rules::Segments { line, triangle } => {
+                let chunks: Vec<ChunkOut> = (0..a.faces.len())
+                    .step_by(CHUNK)
+                    .collect::<Vec<_>>()
+                    .into_par_iter()
+                    .map(|start| {
+                        let end = (start + CHUNK).min(a.faces.len());
+                        let mut points = Vec::new();
+                        let mut per_face = Vec::with_capacity(end - start);
+                        let mut scratch = Scratch::default();
+                        for fa in start..end {
+                            let before = points.len();
                             ctx.segment_points(a, fa, (line, triangle), &mut points, &mut scratch);
                             // The matched points' weights sum to the overlap exactly.
-                            points[before..]
+                            let area = points[before..]
                                 .iter()
                                 .filter(|p| p.status == PointStatus::Matched)
                                 .map(|p| p.weight)
-                                .sum()
+                                .sum();
+                            per_face.push(face_weights(&points[before..], area));
                         }
-                    };
-                    let (mut hit, mut total) = (0.0, 0.0);
-                    for p in &points[before..] {
-                        total += p.weight;
-                        if p.status == PointStatus::Matched {
-                            hit += p.weight;
-                        }
-                    }
-                    per_face.push((hit, total, area));
+                        (points, per_face)
+                    })
+                    .collect();
+                let total: usize = chunks.iter().map(|(points, _)| points.len()).sum();
+                result.points.reserve_exact(total + a.nodes.len());
+                let mut per_face = Vec::with_capacity(a.faces.len());
+                for (points, faces) in chunks {
+                    result.points.extend(points);
+                    per_face.extend(faces);
                 }
-                (points, per_face)
-            })
-            .collect();
-        let total: usize = chunks.iter().map(|(points, _)| points.len()).sum();
-        result.points.reserve_exact(total + a.nodes.len());
-        result.contact_fraction.reserve_exact(a.faces.len());
-        for (points, per_face) in chunks {
-            result.points.extend(points);
-            for (hit, total, overlap) in per_face {
-                result
-                    .contact_fraction
-                    .push(if total > 0.0 { hit / total } else { 0.0 });
-                result.stats.overlap_area += overlap;
+                per_face
             }
+        };
+        result.contact_fraction.reserve_exact(a.faces.len());
+        for (hit, total, overlap) in per_face {
+            result
+                .contact_fraction
+                .push(if total > 0.0 { hit / total } else { 0.0 });
+            result.stats.overlap_area += overlap;
         }
         for k in 0..a.nodes.len() {
             let p = ctx.pair_node(a, k);
@@ -335,6 +388,18 @@ impl Searcher {
         tally(&mut result);
         result
     }
+}
+
+/// A face's matched weight, total weight and overlap `area`, from its `points`.
+fn face_weights(points: &[ContactPoint], area: f64) -> (f64, f64, f64) {
+    let (mut hit, mut total) = (0.0, 0.0);
+    for p in points {
+        total += p.weight;
+        if p.status == PointStatus::Matched {
+            hit += p.weight;
+        }
+    }
+    (hit, total, area)
 }
 
 /// The search margin: the larger of the distance acceptance and the buffer (mean face

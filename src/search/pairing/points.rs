@@ -9,7 +9,7 @@
 //! within the reach instead of the many within the margin. The exact tests on each
 //! candidate are those of a query per point, so the pairing does not change.
 
-use crate::search::bvh::{Aabb, Bvh};
+use crate::search::bvh::{Aabb, Bvh, QueryHint};
 use crate::search::mortar::{
     FaceOverlap, MortarPoint, TriangleRule, overlap_length_line_line, rule_line, rule_triangle,
     segments_face_face_into, segments_line_line_into,
@@ -116,6 +116,8 @@ pub(super) struct Scratch {
     overlap: Vec<usize>,
     clip: Option<FaceOverlap>,
     pub(super) mortar: Vec<MortarPoint>,
+    /// Where the last face's tree query found its first face.
+    hint: QueryHint,
 }
 
 impl Ctx<'_> {
@@ -129,7 +131,17 @@ impl Ctx<'_> {
     /// widened by a slack far above the rounding of those sums (ε times the coordinates
     /// near `q`), and the reach by a relative and an absolute slack above the rounding of
     /// the squared distance it is compared as.
-    fn near(&self, q: &Aabb, mut visit: impl FnMut(usize, &Aabb)) {
+    fn near(&self, q: &Aabb, visit: impl FnMut(usize, &Aabb)) {
+        self.near_from(None, q, visit);
+    }
+
+    /// [`Self::near`], the tree walked from `hint`'s leaf when given (the same faces).
+    fn near_from(
+        &self,
+        hint: Option<&mut QueryHint>,
+        q: &Aabb,
+        mut visit: impl FnMut(usize, &Aabb),
+    ) {
         let reach = self.reach2.sqrt() * (1.0 + 1e-9) + 1e-150;
         let size = q
             .min
@@ -140,8 +152,13 @@ impl Ctx<'_> {
         // Infinite margin and reach (no pruning possible) give NaN: then take all.
         let grow = reach - self.margin + slack;
         let grown = q.inflate(if grow.is_nan() { f64::INFINITY } else { grow });
-        self.bvh
-            .query_by(|tree| tree.intersects(&grown), |j, tree| visit(j, tree));
+        let accept = |tree: &Aabb| tree.intersects(&grown);
+        match hint {
+            Some(hint) => self
+                .bvh
+                .query_by_with_hint(hint, accept, |j, tree| visit(j, tree)),
+            None => self.bvh.query_by(accept, |j, tree| visit(j, tree)),
+        }
     }
 
     /// Side-B faces whose tree box meets `face`'s box and whose own box comes within
@@ -333,7 +350,9 @@ impl Ctx<'_> {
         }
         s.near.clear();
         if !query.is_empty() {
-            self.near(&query, |j, tree| s.near.push((j, *tree)));
+            // Side-A faces come in mesh order, mostly next to the one before: the walk
+            // starts where the last face's query found its first face.
+            self.near_from(Some(&mut s.hint), &query, |j, tree| s.near.push((j, *tree)));
         }
         let a_face = Some(fa as u32);
         for &(xi, x, w, outside) in &s.points {
