@@ -93,8 +93,9 @@ pub(super) struct Context<'c, 'a> {
     pub(super) unconverged: RefCell<Option<StepReport>>,
     /// The live part of the problem once elements have died.
     pub(super) alive: RefCell<Option<super::death::Alive>>,
-    /// The voltage has not been solved yet (a fresh start): the next Newton iteration
-    /// solves for the voltages alone, the temperatures held (see [`Context::newton`]).
+    /// The voltage has not been solved yet (a fresh start, until a Newton solve
+    /// converges): a Newton solve's first iteration solves for the voltages alone, the
+    /// temperatures held (see [`Context::newton`]).
     pub(super) settle_voltage: &'c std::cell::Cell<bool>,
 }
 
@@ -166,7 +167,7 @@ impl Context<'_, '_> {
         // σ(T) negative). So the first iteration solves the current's equations alone
         // at the starting temperatures, which is linear for a conductivity that does
         // not depend on V; Newton goes on from that voltage.
-        let mut settle = self.settle_voltage.take().then(|| {
+        let mut settle = self.settle_voltage.get().then(|| {
             let mut held = zero.clone();
             held.extend(setup.outside_voltage().into_iter().map(|d| (d, 0.0)));
             held
@@ -213,6 +214,8 @@ impl Context<'_, '_> {
                     *self.unconverged.borrow_mut() = Some(report);
                     return Ok(Err(message));
                 }
+                // Solved: later steps start from a voltage that is one.
+                self.settle_voltage.set(false);
                 return Ok(Ok(report));
             }
             let clock = std::time::Instant::now();
