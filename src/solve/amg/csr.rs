@@ -64,10 +64,12 @@ impl Csr {
         let (ptr, ri) = (sym.col_ptr(), sym.row_idx());
         // Each stored (i, j) below the diagonal meets its (j, i) in column i: the rows
         // asked of column i come in increasing j, so one cursor per column suffices.
-        let walk = |val: Option<&mut [f64]>| -> bool {
+        // The values are swapped as the pairs are found, the first `limit` pairs only;
+        // returns the pairs swapped, the entries above the diagonal seen, and whether
+        // every pair was found. Swapping the same pairs again undoes it.
+        let walk = |val: &mut [f64], limit: usize| -> (usize, usize, bool) {
             let mut cursor: Vec<usize> = ptr[..n].to_vec();
             let (mut lower, mut upper) = (0usize, 0usize);
-            let mut val = val;
             for j in 0..n {
                 for p in ptr[j]..ptr[j + 1] {
                     let i = ri[p];
@@ -78,26 +80,33 @@ impl Csr {
                     if i == j {
                         continue;
                     }
-                    lower += 1;
+                    if lower == limit {
+                        return (lower, upper, true);
+                    }
                     let end = ptr[i + 1];
                     while cursor[i] < end && ri[cursor[i]] < j {
                         cursor[i] += 1;
                     }
                     if cursor[i] == end || ri[cursor[i]] != j {
-                        return false;
+                        return (lower, upper, false);
                     }
-                    if let Some(v) = val.as_deref_mut() {
-                        v.swap(p, cursor[i]);
-                    }
+                    val.swap(p, cursor[i]);
+                    lower += 1;
                 }
             }
-            lower == upper
+            (lower, upper, true)
         };
         let square = sym.nrows() == n && sym.col_nnz().is_none();
-        if !(square && walk(None)) {
+        if !square {
             return Csr::from_csc(SparseColMatRef::new(sym, &val));
         }
-        walk(Some(&mut val));
+        // One pass for a symmetric structure (the usual case); another to undo the
+        // swaps of any other before copying it.
+        let (lower, upper, paired) = walk(&mut val, usize::MAX);
+        if !paired || lower != upper {
+            walk(&mut val, lower);
+            return Csr::from_csc(SparseColMatRef::new(sym, &val));
+        }
         Csr {
             nrows: n,
             ncols: n,
