@@ -65,6 +65,26 @@ pub(super) fn gauss_seidel(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64], 
     }
 }
 
+/// A forward Gauss–Seidel sweep from `x = 0` (which `x` must hold): row i reads only
+/// its entries left of the diagonal, since every `x_j`, j ≥ i, is still 0 there — half
+/// the matrix read, the values of [`gauss_seidel`] (the skipped terms are products
+/// with zero). Needs ascending columns in each row, as every [`Csr`] of the hierarchy
+/// has.
+pub(super) fn gauss_seidel_from_zero(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64]) {
+    for i in 0..a.nrows {
+        let (start, end) = (a.ptr[i], a.ptr[i + 1]);
+        debug_assert!(a.idx[start..end].is_sorted(), "row {i} is not sorted");
+        let mut s = b[i];
+        for (&j, &v) in a.idx[start..end].iter().zip(&a.val[start..end]) {
+            if j as usize >= i {
+                break;
+            }
+            s -= v * x[j as usize];
+        }
+        x[i] += s * inv_diag[i];
+    }
+}
+
 /// A symmetric Gauss–Seidel sweep over `rows` only: forward through them, then
 /// backward. Its error propagator is self-adjoint in the energy inner product, so it
 /// may sit on either side of the coarse correction and keep the V-cycle symmetric.
