@@ -413,32 +413,45 @@ impl Pattern {
             partners[next[i as usize]] = j;
             next[i as usize] += 1;
         }
+        // Each column's rows gathered once (a marker per dof holds the last column
+        // that took it: no sort of the repeats) and then sorted, as 32-bit indices.
         const CHUNK: usize = 4096;
         let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(CHUNK))
             .into_par_iter()
-            .map(|c| {
-                let (mut lens, mut rows) = (Vec::new(), Vec::new());
-                let mut col = Vec::new();
-                for j in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                    col.clear();
-                    col.push(j);
-                    for &e in &d2e[d2e_ptr[j]..d2e_ptr[j + 1]] {
-                        let (o, ne) = elems[e as usize];
-                        col.extend(
-                            self.elem_dofs[o..o + ne]
-                                .iter()
-                                .filter(|&&d| d != NONE)
-                                .map(|&d| d as usize),
-                        );
+            .map_init(
+                || vec![0u32; n],
+                |seen, c| {
+                    let (mut lens, mut rows) = (Vec::new(), Vec::new());
+                    let mut col: Vec<u32> = Vec::new();
+                    for j in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                        // `seen[d] == j + 1`: d is already in column j.
+                        let mark = j as u32 + 1;
+                        col.clear();
+                        let mut take = |d: u32| {
+                            if seen[d as usize] != mark {
+                                seen[d as usize] = mark;
+                                col.push(d);
+                            }
+                        };
+                        take(j as u32);
+                        for &e in &d2e[d2e_ptr[j]..d2e_ptr[j + 1]] {
+                            let (o, ne) = elems[e as usize];
+                            for &d in &self.elem_dofs[o..o + ne] {
+                                if d != NONE {
+                                    take(d);
+                                }
+                            }
+                        }
+                        for &i in &partners[c_ptr[j]..c_ptr[j + 1]] {
+                            take(i);
+                        }
+                        col.sort_unstable();
+                        lens.push(col.len());
+                        rows.extend(col.iter().map(|&d| d as usize));
                     }
-                    col.extend(partners[c_ptr[j]..c_ptr[j + 1]].iter().map(|&i| i as usize));
-                    col.sort_unstable();
-                    col.dedup();
-                    lens.push(col.len());
-                    rows.extend_from_slice(&col);
-                }
-                (lens, rows)
-            })
+                    (lens, rows)
+                },
+            )
             .collect();
         drop((d2e, d2e_ptr, partners, c_ptr, elems));
         let mut col_ptr = Vec::with_capacity(n + 1);
