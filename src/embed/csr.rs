@@ -107,7 +107,19 @@ impl Embedding {
     /// [`Self::search`] or [`Self::move_nodes`] and only its values change afterwards.
     pub fn evaluate(&mut self, u: &[f64]) -> Result<&Evaluation, EmbedError> {
         let local = self.local_field(u)?;
-        let n = u.len();
+        self.pattern(u.len())?;
+        // Each block is added into the CSR values as it is made (no block is kept).
+        let mut e = self.evaluation.take().expect("made above");
+        let refreshed = self.refresh(&mut e, &local);
+        self.evaluation = Some(e);
+        refreshed?;
+        Ok(self.evaluation.as_ref().expect("just put back"))
+    }
+
+    /// The pattern of [`Self::evaluate`] for `n` host dofs (the Jacobian's structure and
+    /// its pattern number), built when a search or a move has outdated it, without
+    /// evaluating any term: the values are those of the last evaluation, or zeros.
+    pub fn pattern(&mut self, n: usize) -> Result<&Evaluation, EmbedError> {
         let reuse = self
             .evaluation
             .as_ref()
@@ -115,12 +127,7 @@ impl Embedding {
         if !reuse {
             self.build_pattern(n)?;
         }
-        // Each block is added into the CSR values as it is made (no block is kept).
-        let mut e = self.evaluation.take().expect("made above");
-        let refreshed = self.refresh(&mut e, &local);
-        self.evaluation = Some(e);
-        refreshed?;
-        Ok(self.evaluation.as_ref().expect("just put back"))
+        Ok(self.evaluation.as_ref().expect("built above"))
     }
 
     /// The values of `e` at seam's field `local`, in place.
@@ -190,22 +197,43 @@ impl Embedding {
             blocks.push(groups.unwrap_or_default());
         }
         let previous = self.evaluation.as_ref().map_or(0, |e| e.pattern);
-        let mut entries: Vec<(usize, usize)> = Vec::new();
+        // Every block entry bucketed by its row (counting sort), then each row's
+        // columns sorted and made unique in place: no global sort of all entries.
+        let mut row_offsets = vec![0; n + 1];
         for dofs in blocks.iter().flatten() {
             for &i in dofs {
-                entries.extend(dofs.iter().map(|&j| (host(i), host(j))));
+                row_offsets[host(i) + 1] += dofs.len();
             }
-        }
-        entries.sort_unstable();
-        entries.dedup();
-        let mut row_offsets = vec![0; n + 1];
-        for &(i, _) in &entries {
-            row_offsets[i + 1] += 1;
         }
         for i in 0..n {
             row_offsets[i + 1] += row_offsets[i];
         }
-        let columns: Vec<usize> = entries.iter().map(|e| e.1).collect();
+        let mut columns = vec![0usize; row_offsets[n]];
+        let mut next = row_offsets.clone();
+        for dofs in blocks.iter().flatten() {
+            for &i in dofs {
+                let at = &mut next[host(i)];
+                for (c, &j) in columns[*at..*at + dofs.len()].iter_mut().zip(dofs) {
+                    *c = host(j);
+                }
+                *at += dofs.len();
+            }
+        }
+        let mut kept = 0;
+        for i in 0..n {
+            let (a, b) = (row_offsets[i], row_offsets[i + 1]);
+            columns[a..b].sort_unstable();
+            row_offsets[i] = kept;
+            for k in a..b {
+                if k == a || columns[k] != columns[k - 1] {
+                    columns[kept] = columns[k];
+                    kept += 1;
+                }
+            }
+        }
+        row_offsets[n] = kept;
+        columns.truncate(kept);
+        columns.shrink_to_fit();
         let slot = |i: usize, j: usize| {
             let (a, b) = (row_offsets[i], row_offsets[i + 1]);
             a + columns[a..b]

@@ -790,7 +790,8 @@ impl Interfaces for ContactTerms<'_> {
         let e = self.embedded()?;
         self.at_time(e, t)?;
         let mut embedding = e.embedding.borrow_mut();
-        let ev = embedding.evaluate(u).map_err(failure)?;
+        // The structure only: `assemble` evaluates the terms into it.
+        let ev = embedding.pattern(u.len()).map_err(failure)?;
         let (pattern, j) = (ev.pattern, &ev.jacobian);
         let mut slots: Vec<Option<Slot>> = vec![None; j.columns.len()];
         let mut pairs = Vec::new();
