@@ -187,26 +187,40 @@ impl std::fmt::Display for Sci {
 
 const BASE64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
-/// Standard base64 (RFC 4648, with `=` padding) of `bytes`, appended to `out`.
+/// Standard base64 (RFC 4648, with `=` padding) of `bytes`, appended to `out`. The
+/// characters are made as bytes into a small buffer and appended a buffer at a time
+/// (the alphabet is ASCII), not pushed one `char` at a time.
 fn base64_into(bytes: &[u8], out: &mut String) {
-    let sextet = |n: u32, k: u32| BASE64[(n >> (18 - 6 * k) & 63) as usize] as char;
+    let sextet = |n: u32, k: u32| BASE64[(n >> (18 - 6 * k) & 63) as usize];
     out.reserve(bytes.len().div_ceil(3) * 4);
+    let mut buf = [0u8; 4096];
+    let mut k = 0;
     let mut chunks = bytes.chunks_exact(3);
     for c in &mut chunks {
         let n = (u32::from(c[0]) << 16) | (u32::from(c[1]) << 8) | u32::from(c[2]);
-        out.extend([sextet(n, 0), sextet(n, 1), sextet(n, 2), sextet(n, 3)]);
+        buf[k..k + 4].copy_from_slice(&[sextet(n, 0), sextet(n, 1), sextet(n, 2), sextet(n, 3)]);
+        k += 4;
+        if k == buf.len() {
+            out.push_str(ascii(&buf));
+            k = 0;
+        }
     }
+    out.push_str(ascii(&buf[..k]));
     match *chunks.remainder() {
         [a] => {
             let n = u32::from(a) << 16;
-            out.extend([sextet(n, 0), sextet(n, 1), '=', '=']);
+            out.push_str(ascii(&[sextet(n, 0), sextet(n, 1), b'=', b'=']));
         }
         [a, b] => {
             let n = (u32::from(a) << 16) | (u32::from(b) << 8);
-            out.extend([sextet(n, 0), sextet(n, 1), sextet(n, 2), '=']);
+            out.push_str(ascii(&[sextet(n, 0), sextet(n, 1), sextet(n, 2), b'=']));
         }
         _ => {}
     }
+}
+
+fn ascii(b: &[u8]) -> &str {
+    std::str::from_utf8(b).expect("the base64 alphabet is ASCII")
 }
 
 /// Write `mesh` with point and cell data in the given encoding. Lengths are checked:
@@ -546,5 +560,14 @@ mod tests {
             base64_into(plain.as_bytes(), &mut s);
             assert_eq!(s, coded, "{plain}");
         }
+        // Longer than the encoder's buffer: base64 of a concatenation cut at a
+        // multiple of 3 bytes is the concatenation of the two encodings.
+        let long: Vec<u8> = (0..10_001u32).map(|i| (i * 7919 % 251) as u8).collect();
+        let (mut whole, mut parts) = (String::new(), String::new());
+        base64_into(&long, &mut whole);
+        base64_into(&long[..3000], &mut parts);
+        base64_into(&long[3000..], &mut parts);
+        assert_eq!(whole.len(), 10_001usize.div_ceil(3) * 4);
+        assert_eq!(whole, parts);
     }
 }
