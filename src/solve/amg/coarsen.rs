@@ -56,12 +56,17 @@ pub(super) fn filtered_diagonal(a: &Csr) -> Vec<f64> {
         .collect()
 }
 
-/// ρ(D_F⁻¹A_F) of the filtered matrix, as [`spectral_radius_dinv_a`] makes ρ(D⁻¹A),
-/// the scaling inside the product (no scaled copy of the vector).
+/// ρ(D_F⁻¹A_F) of the filtered matrix, as [`spectral_radius_dinv_a`] makes ρ(D⁻¹A).
 pub(super) fn spectral_radius_filtered(a: &Csr, filtered_diag: &[f64]) -> f64 {
     use rayon::prelude::*;
     let scale: Vec<f64> = filtered_diag.iter().map(|d| 1.0 / d.sqrt()).collect();
+    let mut scaled = vec![0.0; a.nrows];
     largest_eigenvalue(a.nrows, |v, beta, w| {
+        scaled
+            .iter_mut()
+            .zip(v)
+            .zip(&scale)
+            .for_each(|((s, v), c)| *s = v * c);
         w.par_iter_mut()
             .with_min_len(1024)
             .enumerate()
@@ -70,9 +75,9 @@ pub(super) fn spectral_radius_filtered(a: &Csr, filtered_diag: &[f64]) -> f64 {
                 for p in a.ptr[i]..a.ptr[i + 1] {
                     let (j, value) = (a.idx[p] as usize, a.val[p]);
                     if j == i {
-                        s += filtered_diag[i] * scale[i] * v[i];
+                        s += filtered_diag[i] * scaled[i];
                     } else if value <= 0.0 {
-                        s += value * scale[j] * v[j];
+                        s += value * scaled[j];
                     }
                 }
                 *wi = scale[i] * s - beta * *wi;
@@ -91,7 +96,7 @@ const LANCZOS_STEPS: usize = 10;
 /// The largest eigenvalue of a symmetric operator `M` of size `n` (`D^{-1/2} B D^{-1/2}`,
 /// whose eigenvalues are those of `D⁻¹B`, for symmetric B and a positive diagonal D),
 /// given as `apply(v, β, w)`: `w ← M v − β w`. By [`LANCZOS_STEPS`] Lanczos steps from a
-/// fixed start (Golub & Van Loan, *Matrix Computations*, § 10.1), in three vectors of
+/// fixed start (Golub & Van Loan, *Matrix Computations*, § 10.1), in two vectors of
 /// `n`: the largest Ritz value, found by bisection on the Sturm sequence of the
 /// tridiagonal matrix. It approaches ρ from below, close enough to be used as it is (as
 /// PyAMG's `approximate_spectral_radius` is). The dot products sum fixed chunks in
@@ -293,26 +298,19 @@ pub(super) fn smoothed_prolongator(
 
 /// The Galerkin product `R (A P)`, a block of coarse rows at a time: each block makes
 /// only the rows of `A P` its rows of `R` reach, so the whole of `A P` (about as large
-/// as A) is never held. Consecutive blocks reach overlapping fine rows (the aggregates
-/// of a block lie together, and P reaches one layer beyond them): the rows of `A P`
-/// the previous block made are taken from it, not made again. Each row of `A P` and of
-/// the product is made as [`Csr::matmul`] makes it, and the block's rows of `R` keep
-/// their order, so the bits are those of `R.matmul(&A.matmul(&P))`.
+/// as A) is never held. Each row of `A P` and of the product is made as
+/// [`Csr::matmul`] makes it, and the block's rows of `R` keep their order, so the bits
+/// are those of `R.matmul(&A.matmul(&P))`.
 pub(super) fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
-    // 1024 coarse rows: with the rows taken over, the work does not depend on the
-    // block, and the two blocks' rows of `A P` held together stay about as large as
-    // one block of 2048 rows was without them (the peak of the set-up).
-    const BLOCK: usize = 1024;
+    const BLOCK: usize = 2048;
     let mut out = Csr {
         nrows: r.nrows,
         ncols: p.ncols,
         ptr: vec![0],
         ..Csr::default()
     };
-    // Fine row → its row in the block's `A P`, and in the previous block's.
+    // Fine row → its row in the block's `A P`.
     let mut local = vec![u32::MAX; a.nrows];
-    let mut before = vec![u32::MAX; a.nrows];
-    let mut previous: Option<(Vec<u32>, Csr)> = None;
     for start in (0..r.nrows).step_by(BLOCK) {
         let end = (start + BLOCK).min(r.nrows);
         let span = r.ptr[start]..r.ptr[end];
@@ -322,25 +320,7 @@ pub(super) fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
         for (k, &i) in fine.iter().enumerate() {
             local[i as usize] = k as u32;
         }
-        let ap = match &previous {
-            None => a.matmul_rows(Some(&fine), p),
-            Some((old_fine, old_ap)) => {
-                for (k, &i) in old_fine.iter().enumerate() {
-                    before[i as usize] = k as u32;
-                }
-                let missing: Vec<u32> = fine
-                    .iter()
-                    .copied()
-                    .filter(|&i| before[i as usize] == u32::MAX)
-                    .collect();
-                let made = a.matmul_rows(Some(&missing), p);
-                let ap = merge_rows(&fine, &before, old_ap, &made);
-                for &i in old_fine {
-                    before[i as usize] = u32::MAX;
-                }
-                ap
-            }
-        };
+        let ap = a.matmul_rows(Some(&fine), p);
         let block = Csr {
             nrows: end - start,
             ncols: fine.len(),
@@ -359,34 +339,6 @@ pub(super) fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
         out.ptr.extend(c.ptr[1..].iter().map(|&q| base + q));
         out.idx.extend(c.idx);
         out.val.extend(c.val);
-        previous = Some((fine, ap));
-    }
-    out
-}
-
-/// The rows `fine` (ascending) of a product, each taken from `old` where `before` gives
-/// it a row there, else from `made` (the others, in order).
-fn merge_rows(fine: &[u32], before: &[u32], old: &Csr, made: &Csr) -> Csr {
-    let mut out = Csr {
-        nrows: fine.len(),
-        ncols: made.ncols,
-        ptr: Vec::with_capacity(fine.len() + 1),
-        ..Csr::default()
-    };
-    out.ptr.push(0);
-    let mut next = 0;
-    for &i in fine {
-        let (src, row) = match before[i as usize] {
-            u32::MAX => {
-                next += 1;
-                (made, next - 1)
-            }
-            k => (old, k as usize),
-        };
-        let span = src.ptr[row]..src.ptr[row + 1];
-        out.idx.extend_from_slice(&src.idx[span.clone()]);
-        out.val.extend_from_slice(&src.val[span]);
-        out.ptr.push(out.idx.len());
     }
     out
 }
