@@ -13,17 +13,22 @@ pub(super) fn spectral_radius_dinv_a(a: &Csr, inv_diag: &[f64]) -> f64 {
     let scale: Vec<f64> = inv_diag.iter().map(|d| d.sqrt()).collect();
     let (mut scaled, mut product) = (vec![0.0; a.nrows], vec![0.0; a.nrows]);
     largest_eigenvalue(a.nrows, |v, beta, w| {
-        scaled
-            .iter_mut()
-            .zip(v)
-            .zip(&scale)
-            .for_each(|((s, v), c)| *s = v * c);
+        scale_into(&mut scaled, v, &scale);
         a.spmv(&scaled, &mut product);
         w.iter_mut()
             .zip(&product)
             .zip(&scale)
             .for_each(|((w, p), c)| *w = c * p - beta * *w);
     })
+}
+
+/// `scaled = D^{-1/2} v`, `scale` holding the diagonal of `D^{-1/2}`.
+fn scale_into(scaled: &mut [f64], v: &[f64], scale: &[f64]) {
+    scaled
+        .iter_mut()
+        .zip(v)
+        .zip(scale)
+        .for_each(|((s, v), c)| *s = v * c);
 }
 
 /// The diagonal of the filtered matrix `A_F` that smooths the prolongator: `A` with
@@ -62,11 +67,7 @@ pub(super) fn spectral_radius_filtered(a: &Csr, filtered_diag: &[f64]) -> f64 {
     let scale: Vec<f64> = filtered_diag.iter().map(|d| 1.0 / d.sqrt()).collect();
     let mut scaled = vec![0.0; a.nrows];
     largest_eigenvalue(a.nrows, |v, beta, w| {
-        scaled
-            .iter_mut()
-            .zip(v)
-            .zip(&scale)
-            .for_each(|((s, v), c)| *s = v * c);
+        scale_into(&mut scaled, v, &scale);
         w.par_iter_mut()
             .with_min_len(1024)
             .enumerate()
