@@ -50,7 +50,15 @@ fn main() -> ExitCode {
             segments,
             order,
             axisymmetric,
-        } => cli::search::search(&deck, &mesh, json, segments, order as usize, axisymmetric),
+            points,
+        } => cli::search::search(
+            &deck,
+            &mesh,
+            json,
+            (segments, order as usize),
+            axisymmetric,
+            points.as_deref(),
+        ),
         Command::Run {
             problem,
             json,

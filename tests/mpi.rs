@@ -4,7 +4,9 @@
 //! distributed solve covers and on generated cases whose interface the partition cuts
 //! (rank 0's log must say that interface couplings join dofs of different ranks).
 //! A run the distributed solve does not cover must be refused (E0901, E0902), writing
-//! nothing.
+//! nothing. The distributed contact search is compared with the serial one directly:
+//! `seam search --points` under `mpirun -n 1..4` must list the serial search's points,
+//! each with the same side-B face, status and projection.
 //!
 //! Built only with `--features mpi` (OpenMPI's `mpirun` and Debian's PETSc); run by
 //! `.ci/run`: `cargo test --features mpi --test mpi`.
@@ -42,8 +44,9 @@ fn scratch(name: &str) -> tempfile::TempDir {
         .unwrap_or_else(|e| panic!("cannot make a scratch folder for {name}: {e}"))
 }
 
-/// `seam -v run --json problem` serially (`ranks` None) or under `mpirun -n ranks`.
-fn launch(problem: &Path, ranks: Option<usize>) -> Output {
+/// `seam -v` serially (`ranks` None) or under `mpirun -n ranks`, one thread per rank (the
+/// ranks share the machine's cores); the command's arguments follow.
+fn seam(ranks: Option<usize>) -> Command {
     let seam = env!("CARGO_BIN_EXE_seam");
     let mut cmd = match ranks {
         None => Command::new(seam),
@@ -53,13 +56,18 @@ fn launch(problem: &Path, ranks: Option<usize>) -> Output {
             c
         }
     };
-    cmd.args(["-v", "run", "--json"])
-        .arg(problem)
-        // One thread per rank: the ranks share the machine's cores.
+    cmd.arg("-v")
         .env("RAYON_NUM_THREADS", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
         .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    cmd
+}
+
+/// `seam -v run --json problem` serially (`ranks` None) or under `mpirun -n ranks`.
+fn launch(problem: &Path, ranks: Option<usize>) -> Output {
+    let mut cmd = seam(ranks);
+    cmd.args(["run", "--json"]).arg(problem);
     cmd.output()
         .unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"))
 }
@@ -390,4 +398,153 @@ fn transient_is_refused_under_mpi() {
         + "[initial]\ntemperature = 300.0\n";
     std::fs::write(&problem, text).unwrap();
     refused(&problem, 2, "E0901", "transient run is not yet distributed");
+}
+
+/// `seam -v search deck --mesh mesh --points FILE args…`, serially or under `mpirun -n`.
+fn search_points(
+    deck: &Path,
+    mesh: &Path,
+    args: &[&str],
+    ranks: Option<usize>,
+) -> (String, String) {
+    let label = ranks.map_or("serial".to_string(), |n| format!("n{n}"));
+    let file = deck.with_file_name(format!("points_{label}.csv"));
+    let mut cmd = seam(ranks);
+    cmd.arg("search")
+        .arg(deck)
+        .arg("--mesh")
+        .arg(mesh)
+        .arg("--points")
+        .arg(&file)
+        .args(args);
+    let out = cmd
+        .output()
+        .unwrap_or_else(|e| panic!("cannot start {cmd:?}: {e}"));
+    let log = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        out.status.success(),
+        "{cmd:?} failed ({}):\n{log}",
+        out.status
+    );
+    let points = std::fs::read_to_string(&file)
+        .unwrap_or_else(|e| panic!("{cmd:?} wrote no {}: {e}\n{log}", file.display()));
+    (points, log)
+}
+
+/// Side-B faces received as candidates from other ranks, summed over the ranks, from
+/// rank 0's log ("(K candidate faces)").
+fn candidate_faces(log: &str) -> usize {
+    log.lines()
+        .filter(|l| l.contains("distributed search"))
+        .flat_map(|l| l.split(" candidate faces)"))
+        .filter_map(|part| part.rsplit('(').next()?.trim().parse::<usize>().ok())
+        .sum()
+}
+
+/// The serial search and the distributed one on 1–4 ranks list the same points in the
+/// same order: equal ids (side-A face or node, status, side-B face), and parametric
+/// coordinates, gap, weight and position equal to round-off (1e-12 of their scale; the
+/// kernels are the serial ones on the same numbers, so they come out bit for bit). From
+/// 2 ranks on some side-A points must have needed side-B faces of another rank.
+fn compare_search(deck: &Path, mesh: &Path, args: &[&str]) {
+    let (serial, _) = search_points(deck, mesh, args, None);
+    let rows = |text: &str| -> Vec<Vec<String>> {
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(str::to_string).collect())
+            .collect()
+    };
+    let expected = rows(&serial);
+    assert!(expected.len() > 10, "too few points to compare:\n{serial}");
+    let matched = expected.iter().filter(|r| r[4] == "Matched").count();
+    assert!(matched > 0, "nothing paired serially");
+    let scale = |c: usize| {
+        expected
+            .iter()
+            .fold(1.0f64, |m, r| m.max(r[c].parse::<f64>().unwrap().abs()))
+    };
+    let scales: Vec<f64> = (6..15).map(scale).collect();
+    for n in RANKS {
+        let (text, log) = search_points(deck, mesh, args, Some(n));
+        let got = rows(&text);
+        assert_eq!(got.len(), expected.len(), "points on {n} rank(s)");
+        let mut worst = 0.0f64;
+        for (k, (g, e)) in got.iter().zip(&expected).enumerate() {
+            assert_eq!(g[..6], e[..6], "point {k} on {n} rank(s)");
+            for c in 6..15 {
+                let d = (g[c].parse::<f64>().unwrap() - e[c].parse::<f64>().unwrap()).abs();
+                assert!(
+                    d <= 1e-12 * scales[c - 6],
+                    "point {k}, column {c}, on {n} rank(s): {g:?} against {e:?}"
+                );
+                worst = worst.max(d / scales[c - 6]);
+            }
+        }
+        let remote = candidate_faces(&log);
+        let volume: Vec<&str> = log
+            .lines()
+            .filter(|l| l.contains("distributed search"))
+            .collect();
+        eprintln!(
+            "{} on {n} rank(s): {} points ({matched} matched) as serial, largest relative difference {worst:.1e}, {remote} side-B faces received; {volume:?}",
+            deck.display(),
+            got.len()
+        );
+        if n > 1 {
+            assert!(
+                remote > 0,
+                "no side-B face crossed ranks on {n} ranks:\n{log}"
+            );
+        }
+    }
+}
+
+/// The search of an example's deck on its mesh.
+fn compare_example_search(name: &str, deck: &str, mesh: &str, args: &[&str]) {
+    let (tmp, _) = example(name);
+    compare_search(&tmp.path().join(deck), &tmp.path().join(mesh), args);
+}
+
+/// Two blocks' gap conductance: an interface cut by the partition.
+#[test]
+fn distributed_search_two_blocks_equals_serial() {
+    compare_example_search("two_blocks", "contact_run.i", "two_blocks.exo", &[]);
+}
+
+/// A cylindrical periodic image (side A mapped) paired with faces at the sector's other end.
+#[test]
+fn distributed_search_periodic_cylindrical_equals_serial() {
+    compare_example_search("turbine_sector", "contact.i", "sector.exo", &[]);
+}
+
+/// A periodic image made by a Lua map.
+#[test]
+fn distributed_search_periodic_lua_equals_serial() {
+    compare_example_search("twisted_channel", "contact.i", "twisted_channel.exo", &[]);
+}
+
+/// 2-D, axisymmetric (edges, weights per revolution).
+#[test]
+fn distributed_search_axisymmetric_equals_serial() {
+    compare_example_search(
+        "shrink_fit",
+        "contact.i",
+        "shrink_fit.exo",
+        &["--axisymmetric"],
+    );
+}
+
+/// The cut bar's non-matching interface, by quadrature and by mortar segments (the
+/// overlap polygons of faces on different ranks).
+#[test]
+fn distributed_search_cut_interface_equals_serial() {
+    let tmp = scratch("search-cut");
+    write_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
+        "",
+    );
+    let (deck, mesh) = (tmp.path().join("contact.i"), tmp.path().join("bar.exo"));
+    compare_search(&deck, &mesh, &[]);
+    compare_search(&deck, &mesh, &["--segments", "--order", "3"]);
 }

@@ -108,6 +108,11 @@ pub enum Command {
         /// Read the (2-D) mesh as axisymmetric: x the radius, areas per full revolution.
         #[arg(long)]
         axisymmetric: bool,
+        /// Also write every searched point to FILE (csv: interaction, point, side-A face
+        /// or node, status, side-B face, ξ_A, ξ_B, gap, weight, x, y, z), in the order
+        /// of the search; under `mpirun`, the distributed search's points, gathered.
+        #[arg(long, value_name = "FILE")]
+        points: Option<std::path::PathBuf>,
     },
     /// Solve a heat-transfer problem with contact (a TOML problem file) and write the
     /// results (VTK XML, Exodus II, csv histories, plots).

@@ -22,6 +22,17 @@ pub const EXIT_BAD_INPUT: u8 = 2;
 pub static QUIET: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 pub const EXIT_PLUGIN_FAULT: u8 = 3;
 
+/// MPI and PETSc for a command started by an MPI launcher (`--features mpi`; nothing
+/// otherwise), up while the returned value lives; exit 1 with E0903 when they cannot
+/// start.
+#[cfg(feature = "mpi")]
+pub fn start_mpi() -> Result<Option<seam::parallel::Session>, ExitCode> {
+    seam::parallel::start().map_err(|e| {
+        eprintln!("error[E0903]: cannot start MPI and PETSc: {e}");
+        ExitCode::from(1)
+    })
+}
+
 /// Load the deck, then the mesh; stop with exit code 2 on the first stage that fails.
 pub fn load(
     deck_path: &Path,

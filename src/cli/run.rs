@@ -14,12 +14,9 @@ pub fn run(path: Option<PathBuf>, json: bool, restart: Option<PathBuf>) -> ExitC
     // Under an MPI launcher (`--features mpi`): MPI and PETSc up for the run, rank 0
     // alone printing (docs/parallel.md).
     #[cfg(feature = "mpi")]
-    let _session = match seam::parallel::start() {
+    let _session = match super::start_mpi() {
         Ok(s) => s,
-        Err(e) => {
-            eprintln!("error[E0903]: cannot start MPI and PETSc: {e}");
-            return ExitCode::from(1);
-        }
+        Err(code) => return code,
     };
     if !seam::parallel::is_root() {
         return run_quietly(path, restart);

@@ -21,12 +21,23 @@ pub fn search(
     deck_path: &Path,
     mesh_path: &Path,
     json: bool,
-    segments: bool,
-    order: usize,
+    (segments, order): (bool, usize),
     axisymmetric: bool,
+    points: Option<&Path>,
 ) -> ExitCode {
     use seam::scene::OutputRule;
     use seam::search::pairing::Integration;
+    // Under an MPI launcher (`--features mpi`): the distributed search, rank 0 alone
+    // printing and writing (docs/parallel.md).
+    #[cfg(feature = "mpi")]
+    let _session = match super::start_mpi() {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let root = seam::parallel::is_root();
+    if !root {
+        log::set_max_level(log::LevelFilter::Error);
+    }
     let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric, json) {
         Ok(x) => x,
         Err(code) => return code,
@@ -67,8 +78,19 @@ pub fn search(
         }
     }
     if diags.has_errors() {
-        eprint_diagnostics(&diags, &loaded.sources);
+        if root {
+            eprint_diagnostics(&diags, &loaded.sources);
+        }
         return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    if !root {
+        return ExitCode::SUCCESS;
+    }
+    if let Some(path) = points
+        && let Err(e) = write_points(path, searched.iter().flat_map(|s| &s.pairings))
+    {
+        eprintln!("error: cannot write {}: {e}", path.display());
+        return ExitCode::from(1);
     }
     if json {
         print_json(&SearchReport {
@@ -176,4 +198,40 @@ fn point_details(p: &seam::search::scene::Pairing, all: bool) -> String {
         );
     }
     out
+}
+
+/// Every searched point of `pairings` as csv, in the search's order, to `path` (`--points`).
+fn write_points<'a>(
+    path: &Path,
+    pairings: impl Iterator<Item = &'a seam::search::scene::Pairing>,
+) -> std::io::Result<()> {
+    use std::io::Write as _;
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(
+        out,
+        "interaction,point,a_face,a_node,status,b_face,xi_a0,xi_a1,xi_b0,xi_b1,gap,weight,x,y,z"
+    )?;
+    let id = |i: Option<u32>| i.map_or(String::new(), |i| i.to_string());
+    for (k, p) in pairings.enumerate() {
+        for (i, q) in p.result.points.iter().enumerate() {
+            writeln!(
+                out,
+                "{k},{i},{},{},{:?},{},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+                id(q.a_face),
+                id(q.a_node),
+                q.status,
+                id(q.b_face),
+                q.xi_a[0],
+                q.xi_a[1],
+                q.xi_b[0],
+                q.xi_b[1],
+                q.gap,
+                q.weight,
+                q.x[0],
+                q.x[1],
+                q.x[2]
+            )?;
+        }
+    }
+    out.flush()
 }

@@ -3,6 +3,8 @@
 //! parts, each dof by its node's owner, and the PETSc numbering — the serial dofs in
 //! order, rank after rank, so that each rank's rows are one contiguous range.
 
+use std::cell::RefCell;
+
 use mpi::traits::{Communicator, Root};
 
 use crate::assembly::{DofMap, FieldId};
@@ -38,24 +40,8 @@ impl Layout {
     ) -> Result<Self, String> {
         let world = session::comm();
         let (rank, size) = (world.rank() as usize, world.size() as usize);
-        let mut part = vec![NO_PART; mesh.num_elems()];
-        if rank == 0 {
-            part = partition(mesh, blocks, size)?;
-        }
-        world.process_at_rank(0).broadcast_into(&mut part[..]);
-        // A node's owner: the lowest part among its elements.
-        let mut node_owner = vec![NO_PART; mesh.num_nodes()];
-        for &b in blocks {
-            let block = &mesh.blocks[b];
-            let nn = block.topology.node_count();
-            for (k, e) in block.elems().enumerate() {
-                let p = part[e.index()];
-                for n in &block.connectivity[k * nn..(k + 1) * nn] {
-                    let o = &mut node_owner[n.index()];
-                    *o = (*o).min(p);
-                }
-            }
-        }
+        let part = element_parts(mesh, blocks)?;
+        let node_owner = node_owners(mesh, blocks, &part);
         let n = dofs.len();
         let mut owner = vec![0u32; n];
         for (i, &o) in node_owner.iter().enumerate() {
@@ -146,6 +132,69 @@ impl Layout {
         };
         (m, local)
     }
+}
+
+thread_local! {
+    /// The last partition made: (element count, node count, blocks) and the parts, so
+    /// the search and the solve of a run partition once and alike.
+    static PARTS: RefCell<Option<(PartsKey, Vec<u32>)>> = const { RefCell::new(None) };
+}
+
+type PartsKey = (usize, usize, Vec<usize>);
+
+/// Per element of `mesh`, its rank: METIS's partition of the elements of `blocks`
+/// (made on rank 0 and broadcast, so every rank holds the same), [`NO_PART`] for
+/// elements of other blocks. Made once per mesh and blocks.
+pub(super) fn element_parts(mesh: &Mesh, blocks: &[usize]) -> Result<Vec<u32>, String> {
+    let key = (mesh.num_elems(), mesh.num_nodes(), blocks.to_vec());
+    if let Some(part) = PARTS.with(|p| {
+        p.borrow()
+            .as_ref()
+            .and_then(|(k, part)| (*k == key).then(|| part.clone()))
+    }) {
+        return Ok(part);
+    }
+    let world = session::comm();
+    let mut part = vec![NO_PART; mesh.num_elems()];
+    // Rank 0's METIS failure reaches every rank (as an empty broadcast flag) so that no
+    // rank waits for a broadcast that never comes.
+    let mut failed = 0u8;
+    let mut error = String::new();
+    if world.rank() == 0 {
+        match partition(mesh, blocks, world.size() as usize) {
+            Ok(p) => part = p,
+            Err(e) => (failed, error) = (1, e),
+        }
+    }
+    world.process_at_rank(0).broadcast_into(&mut failed);
+    if failed != 0 {
+        return Err(if error.is_empty() {
+            "the partition failed on rank 0".into()
+        } else {
+            error
+        });
+    }
+    world.process_at_rank(0).broadcast_into(&mut part[..]);
+    PARTS.with(|p| *p.borrow_mut() = Some((key, part.clone())));
+    Ok(part)
+}
+
+/// Per node, its owner: the lowest part among its elements of `blocks` ([`NO_PART`] for
+/// a node on none).
+pub(super) fn node_owners(mesh: &Mesh, blocks: &[usize], part: &[u32]) -> Vec<u32> {
+    let mut node_owner = vec![NO_PART; mesh.num_nodes()];
+    for &b in blocks {
+        let block = &mesh.blocks[b];
+        let nn = block.topology.node_count();
+        for (k, e) in block.elems().enumerate() {
+            let p = part[e.index()];
+            for n in &block.connectivity[k * nn..(k + 1) * nn] {
+                let o = &mut node_owner[n.index()];
+                *o = (*o).min(p);
+            }
+        }
+    }
+    node_owner
 }
 
 /// METIS's k-way partition of the dual graph (elements sharing a face: 3 common nodes in

@@ -5,7 +5,8 @@
 //! run writes. What is and is not distributed is listed in `docs/parallel.md`.
 //!
 //! Entry points: [`start`] (the binary, before a run), then the hooks the run calls —
-//! [`is_root`] (who writes files and prints), [`steady`] (the linear or
+//! [`is_root`] (who writes files and prints), [`search_pair`] (the contact search of
+//! one pair of surfaces, distributed), [`steady`] (the linear or
 //! Newton-nonlinear steady solve), [`not_distributed`] (what a run under MPI refuses)
 //! and [`linear_solver`] (the summary's linear solver).
 //!
@@ -20,6 +21,8 @@ use crate::heat::steady::{SteadyProblem, SteadySolution};
 mod layout;
 #[cfg(feature = "mpi")]
 pub mod petsc;
+#[cfg(feature = "mpi")]
+pub mod search;
 #[cfg(feature = "mpi")]
 mod session;
 #[cfg(feature = "mpi")]
@@ -56,6 +59,28 @@ pub fn steady(p: &SteadyProblem<'_>) -> Option<Result<SteadySolution, HeatError>
     #[cfg(not(feature = "mpi"))]
     {
         let _ = p;
+        None
+    }
+}
+
+/// `a`'s points paired with `b`'s faces by the distributed search when the run is
+/// distributed (the serial pairing, whole on every rank; see [`search`]), else `None`
+/// (the caller searches serially).
+pub fn search_pair(
+    mesh: &crate::mesh::Mesh,
+    a: &crate::search::pairing::SurfaceGeometry,
+    b: &crate::search::pairing::SurfaceGeometry,
+    settings: &crate::search::SearchSettings,
+    integration: crate::search::pairing::Integration,
+    subdomain: Option<crate::search::pairing::Sphere>,
+) -> Option<Result<crate::search::pairing::SearchResult, String>> {
+    #[cfg(feature = "mpi")]
+    {
+        world().map(|_| search::search_pair(mesh, a, b, settings, integration, subdomain))
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        let _ = (mesh, a, b, settings, integration, subdomain);
         None
     }
 }

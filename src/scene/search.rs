@@ -94,13 +94,12 @@ pub fn search_definition_with_maps(
         if b.faces.is_empty() {
             continue;
         }
-        let t = Instant::now();
-        let searcher = Searcher::new(b, &i.settings);
-        out.timing.build_s += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let mut result = searcher.search(a, b, &i.settings, integration, subdomain);
+        let Some(mut result) =
+            search_pair(mesh, a, b, &i.settings, integration, subdomain, &mut out)
+        else {
+            continue;
+        };
         result.treat_overclosure(i.overclosure);
-        out.timing.search_s += t.elapsed().as_secs_f64();
         out.pairings.push(Pairing {
             side_a: i.side_a_name.clone(),
             side_b: i.side_b_name.clone(),
@@ -131,6 +130,43 @@ pub fn search_definition_with_maps(
         }
     }
     out
+}
+
+/// Pair `a`'s points with `b`'s faces: serially, or under MPI by the distributed search
+/// (the same pairing; `crate::parallel::search`), timed into `out`. `None` (and an
+/// E0904 error) when the distributed search fails.
+fn search_pair(
+    mesh: &Mesh,
+    a: &SurfaceGeometry,
+    b: &SurfaceGeometry,
+    settings: &SearchSettings,
+    integration: Integration,
+    subdomain: Option<Sphere>,
+    out: &mut SceneSearch,
+) -> Option<SearchResult> {
+    let t = Instant::now();
+    match crate::parallel::search_pair(mesh, a, b, settings, integration, subdomain) {
+        Some(Ok(r)) => {
+            out.timing.search_s += t.elapsed().as_secs_f64();
+            Some(r)
+        }
+        Some(Err(e)) => {
+            out.diagnostics.push(
+                Diagnostic::error("E0904", format!("{} / {}: {e}", a.name, b.name)).help(
+                    "run without mpirun (serially); docs/parallel.md lists what is distributed",
+                ),
+            );
+            None
+        }
+        None => {
+            let searcher = Searcher::new(b, settings);
+            out.timing.build_s += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let r = searcher.search(a, b, settings, integration, subdomain);
+            out.timing.search_s += t.elapsed().as_secs_f64();
+            Some(r)
+        }
+    }
 }
 
 /// `Restrict Contact To Subdomain` of a definition: the sphere outside which nothing is
@@ -401,12 +437,9 @@ pub fn search_periodicity(
     let mut best: Option<(usize, SearchResult)> = None;
     for d in candidates {
         let Some(dg) = &geometry[d] else { continue };
-        let t = Instant::now();
-        let searcher = Searcher::new(dg, &settings);
-        out.timing.build_s += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        let r = searcher.search(&image, dg, &settings, integration, subdomain);
-        out.timing.search_s += t.elapsed().as_secs_f64();
+        let Some(r) = search_pair(mesh, &image, dg, &settings, integration, subdomain, out) else {
+            continue;
+        };
         if best
             .as_ref()
             .is_none_or(|(_, b)| r.stats.matched > b.stats.matched)

@@ -99,6 +99,7 @@ const FLAGS: &[(&str, &[&str])] = &[
             "--segments",
             "--order",
             "--axisymmetric",
+            "--points",
         ],
     ),
     ("run", &["--json", "--restart"]),

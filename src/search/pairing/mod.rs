@@ -202,18 +202,20 @@ const CHUNK: usize = 512;
 impl Searcher {
     /// Build the tree over `b`'s faces for `settings`.
     pub fn new(b: &SurfaceGeometry, settings: &SearchSettings) -> Searcher {
-        let margin = margin_for(b, settings);
+        let extent = Extent::of(b.mean_face_size(), max_face_size(b), settings);
+        Searcher::with_extent(b, extent)
+    }
+
+    /// Build the tree over `b`'s faces with a given extent: that of a larger surface of
+    /// which `b` holds the faces near the points to be searched (a distributed search,
+    /// whose ranks hold parts of side B), so that the pairing is the larger one's.
+    pub fn with_extent(b: &SurfaceGeometry, extent: Extent) -> Searcher {
+        let margin = extent.margin;
         let boxes: Vec<Aabb> = b.faces.iter().map(|f| f.aabb().inflate(margin)).collect();
-        let largest = max_face_size(b);
-        let reach = settings
-            .normal_tolerance
-            .unwrap_or(0.0)
-            .max(settings.field_factor * largest)
-            + settings.tangential_tolerance * largest;
         Searcher {
             bvh: Bvh::build(&boxes),
             margin,
-            reach: reach.min(margin),
+            reach: extent.reach,
         }
     }
 
@@ -402,18 +404,36 @@ fn face_weights(points: &[ContactPoint], area: f64) -> (f64, f64, f64) {
     (hit, total, area)
 }
 
-/// The search margin: the larger of the distance acceptance and the buffer (mean face
-/// size × buffer factor), so the box query never misses an acceptable face.
-fn margin_for(b: &SurfaceGeometry, s: &SearchSettings) -> f64 {
-    let size = b.mean_face_size();
-    let distance = s
-        .normal_tolerance
-        .unwrap_or(0.0)
-        .max(s.field_factor * max_face_size(b));
-    (size * s.buffer_factor).max(distance)
+/// How far a search looks from each side-B face, fixed by side B's face sizes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Extent {
+    /// Box inflation: the larger of the distance acceptance and the buffer (mean face
+    /// size × buffer factor), so the box query never misses an acceptable face.
+    pub margin: f64,
+    /// The farthest a point may be from a face's own box and still pair with it (the
+    /// largest distance acceptance plus the tangential tolerance), at most the margin.
+    pub reach: f64,
 }
 
-fn max_face_size(b: &SurfaceGeometry) -> f64 {
+impl Extent {
+    /// The extent of a side B whose faces have mean size `mean` and largest size
+    /// `largest` ([`FaceGeom::size`]).
+    pub fn of(mean: f64, largest: f64, s: &SearchSettings) -> Extent {
+        let distance = s
+            .normal_tolerance
+            .unwrap_or(0.0)
+            .max(s.field_factor * largest);
+        let margin = (mean * s.buffer_factor).max(distance);
+        let reach = distance + s.tangential_tolerance * largest;
+        Extent {
+            margin,
+            reach: reach.min(margin),
+        }
+    }
+}
+
+/// The largest face size of `b` ([`FaceGeom::size`]), 0 without faces.
+pub fn max_face_size(b: &SurfaceGeometry) -> f64 {
     b.faces.iter().map(FaceGeom::size).fold(0.0, f64::max)
 }
 
@@ -501,7 +521,9 @@ impl SearchResult {
     }
 }
 
-fn tally(r: &mut SearchResult) {
+/// Count the points of `r` by status and their gap range into its statistics (which
+/// must start at their defaults, but for the areas).
+pub(crate) fn tally(r: &mut SearchResult) {
     let s = &mut r.stats;
     s.points = r.points.len();
     for p in &r.points {
