@@ -548,3 +548,74 @@ fn distributed_search_cut_interface_equals_serial() {
     compare_search(&deck, &mesh, &[]);
     compare_search(&deck, &mesh, &["--segments", "--order", "3"]);
 }
+
+/// Two interfaces meeting along a line, cut by the partition: boxes A (x < 1) and B
+/// (x > 1) of a long bar (along y) are tied by Nitsche at x = 1, and a lid C (z > 0.5)
+/// lies on both, joined by a gap conductance to their top faces. The two interfaces
+/// share the edge x = 1, z = 0.5 over the bar's whole length, so its nodes — crosspoints
+/// of two interfaces, with side-B faces of three bodies around them — lie wherever the
+/// partition cuts the bar (from 2 ranks on; the meshes of A, B and C do not match).
+fn write_crosspoint_case(dir: &Path) -> PathBuf {
+    let m: Mesh = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
+                .with_side_sets([1, 3, 0, 0, 0, 6]),
+            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
+                .with_side_sets([4, 2, 0, 0, 0, 6]),
+            BoxSpec::hex([0.0, 0.0, 0.5], [2.0, 3.0, 0.8], [7, 13, 2], 3)
+                .with_side_sets([0, 0, 0, 0, 7, 0]),
+        ],
+        false,
+    );
+    ExodusWriter::create(&dir.join("bar.exo"), &m, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    std::fs::write(
+        dir.join("contact.i"),
+        "begin contact definition crosspoint\n\
+         contact surface a contains surface_3\n\
+         contact surface b contains surface_4\n\
+         contact surface top contains surface_6\n\
+         contact surface lid contains surface_7\n\
+         begin enforcement tie\n enforcement for energy = tied_temperature\n end\n\
+         begin enforcement gap\n enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 3000\n end\n\
+         begin interaction ab\n side a a\n side b b\n enforcement = tie\n end\n\
+         begin interaction lid\n side a top\n side b lid\n enforcement = gap\n end\n\
+         end\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("problem.toml"),
+        "[mesh]\nfile = \"bar.exo\"\n\
+         [[material]]\nblocks = [\"block_1\"]\nconductivity = 5.0\n\
+         [[material]]\nblocks = [\"block_2\"]\nconductivity = 40.0\n\
+         [[material]]\nblocks = [\"block_3\"]\nconductivity = 15.0\n\
+         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = \"300 + 10*y\"\n\
+         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = 500.0\n\
+         [[source]]\nblocks = [\"block_1\", \"block_2\", \"block_3\"]\nvalue = \"2e3*y\"\n\
+         [contact]\nfile = \"contact.i\"\n\
+         [solve]\nkind = \"steady\"\n\
+         [output]\ndir = \"out\"\n",
+    )
+    .unwrap();
+    dir.join("problem.toml")
+}
+
+/// The crosspoint case: the search (both interfaces) and the run equal serial.
+#[test]
+fn crosspoint_of_two_interfaces_on_rank_boundaries_equals_serial() {
+    let tmp = scratch("crosspoint");
+    let problem = write_crosspoint_case(tmp.path());
+    compare_search(
+        &tmp.path().join("contact.i"),
+        &tmp.path().join("bar.exo"),
+        &[],
+    );
+    let points = std::fs::read_to_string(tmp.path().join("points_serial.csv")).unwrap();
+    assert!(
+        points.lines().any(|l| l.starts_with("1,")),
+        "both interactions searched"
+    );
+    compare(&problem, true);
+}
