@@ -284,19 +284,6 @@ fn shrink_fit_block_source_is_refused() {
 /// `enforcement`: the lines of its enforcement block; `solve`: more of `[solve]`.
 /// Side set 5 (side A's box bottom, z = 0) is left for a test to use.
 fn write_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
-    let m: Mesh = generate::boxes(
-        &[
-            BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
-                .with_side_sets([1, 3, 0, 0, 5, 0]),
-            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
-                .with_side_sets([4, 2, 0, 0, 0, 0]),
-        ],
-        false,
-    );
-    ExodusWriter::create(&dir.join("bar.exo"), &m, &[], &[])
-        .unwrap()
-        .finish()
-        .unwrap();
     std::fs::write(
         dir.join("contact.i"),
         format!(
@@ -309,18 +296,52 @@ fn write_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
         ),
     )
     .unwrap();
+    write_bar(
+        dir,
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
+                .with_side_sets([1, 3, 0, 0, 5, 0]),
+            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
+                .with_side_sets([4, 2, 0, 0, 0, 0]),
+        ],
+        &[5.0, 40.0],
+        solve,
+    )
+}
+
+/// `bar.exo` of `boxes` (blocks 1, 2, … with `conductivity` each) and its steady
+/// `problem.toml` with `contact.i`: surface_1 held at 300 + 10 y, surface_2 at 500, a
+/// source 2e3 y in every block; `solve`: more of `[solve]`.
+fn write_bar(dir: &Path, boxes: &[BoxSpec], conductivity: &[f64], solve: &str) -> PathBuf {
+    let m: Mesh = generate::boxes(boxes, false);
+    ExodusWriter::create(&dir.join("bar.exo"), &m, &[], &[])
+        .unwrap()
+        .finish()
+        .unwrap();
+    let blocks: Vec<String> = (1..=conductivity.len())
+        .map(|b| format!("\"block_{b}\""))
+        .collect();
+    let materials: String = conductivity
+        .iter()
+        .enumerate()
+        .map(|(b, k)| {
+            format!(
+                "[[material]]\nblocks = [\"block_{}\"]\nconductivity = {k:?}\n",
+                b + 1
+            )
+        })
+        .collect();
     std::fs::write(
         dir.join("problem.toml"),
         format!(
-            "[mesh]\nfile = \"bar.exo\"\n\
-             [[material]]\nblocks = [\"block_1\"]\nconductivity = 5.0\n\
-             [[material]]\nblocks = [\"block_2\"]\nconductivity = 40.0\n\
+            "[mesh]\nfile = \"bar.exo\"\n{materials}\
              [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = \"300 + 10*y\"\n\
              [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = 500.0\n\
-             [[source]]\nblocks = [\"block_1\", \"block_2\"]\nvalue = \"2e3*y\"\n\
+             [[source]]\nblocks = [{}]\nvalue = \"2e3*y\"\n\
              [contact]\nfile = \"contact.i\"\n\
              [solve]\nkind = \"steady\"\n{solve}\n\
-             [output]\ndir = \"out\"\n"
+             [output]\ndir = \"out\"\n",
+            blocks.join(", ")
         ),
     )
     .unwrap();
@@ -556,21 +577,6 @@ fn distributed_search_cut_interface_equals_serial() {
 /// of two interfaces, with side-B faces of three bodies around them — lie wherever the
 /// partition cuts the bar (from 2 ranks on; the meshes of A, B and C do not match).
 fn write_crosspoint_case(dir: &Path) -> PathBuf {
-    let m: Mesh = generate::boxes(
-        &[
-            BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
-                .with_side_sets([1, 3, 0, 0, 0, 6]),
-            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
-                .with_side_sets([4, 2, 0, 0, 0, 6]),
-            BoxSpec::hex([0.0, 0.0, 0.5], [2.0, 3.0, 0.8], [7, 13, 2], 3)
-                .with_side_sets([0, 0, 0, 0, 7, 0]),
-        ],
-        false,
-    );
-    ExodusWriter::create(&dir.join("bar.exo"), &m, &[], &[])
-        .unwrap()
-        .finish()
-        .unwrap();
     std::fs::write(
         dir.join("contact.i"),
         "begin contact definition crosspoint\n\
@@ -585,21 +591,19 @@ fn write_crosspoint_case(dir: &Path) -> PathBuf {
          end\n",
     )
     .unwrap();
-    std::fs::write(
-        dir.join("problem.toml"),
-        "[mesh]\nfile = \"bar.exo\"\n\
-         [[material]]\nblocks = [\"block_1\"]\nconductivity = 5.0\n\
-         [[material]]\nblocks = [\"block_2\"]\nconductivity = 40.0\n\
-         [[material]]\nblocks = [\"block_3\"]\nconductivity = 15.0\n\
-         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_1\"]\nvalue = \"300 + 10*y\"\n\
-         [[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_2\"]\nvalue = 500.0\n\
-         [[source]]\nblocks = [\"block_1\", \"block_2\", \"block_3\"]\nvalue = \"2e3*y\"\n\
-         [contact]\nfile = \"contact.i\"\n\
-         [solve]\nkind = \"steady\"\n\
-         [output]\ndir = \"out\"\n",
+    write_bar(
+        dir,
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 3.0, 0.5], [5, 15, 3], 1)
+                .with_side_sets([1, 3, 0, 0, 0, 6]),
+            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 3.0, 0.5], [4, 11, 2], 2)
+                .with_side_sets([4, 2, 0, 0, 0, 6]),
+            BoxSpec::hex([0.0, 0.0, 0.5], [2.0, 3.0, 0.8], [7, 13, 2], 3)
+                .with_side_sets([0, 0, 0, 0, 7, 0]),
+        ],
+        &[5.0, 40.0, 15.0],
+        "",
     )
-    .unwrap();
-    dir.join("problem.toml")
 }
 
 /// The crosspoint case: the search (both interfaces) and the run equal serial.

@@ -443,6 +443,9 @@ struct Pair {
     /// The interface geometry at the points of `result`, made at the first
     /// `contributions` after a search or a move and reused until the next.
     points: OnceLock<InterfacePoints>,
+    /// The points of `result` this process evaluates, when not all
+    /// ([`Embedding::own_points`]: a rank of a distributed run); cleared by a search.
+    kept: Option<Vec<usize>>,
     /// A flux interaction whose search pairs nothing is an error unless this is set.
     allow_unpaired: bool,
     /// The host's fields on side A and on side B (one field unless the embedding was
@@ -506,6 +509,7 @@ impl Pair {
             searcher: None,
             result: None,
             points: OnceLock::new(),
+            kept: None,
             allow_unpaired: false,
             fields,
             pressures: None,

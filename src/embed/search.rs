@@ -78,6 +78,8 @@ impl Embedding {
             p.result = Some(result);
             p.pressures = None;
             p.points = OnceLock::new();
+            p.kept = None;
+            p.kept = None;
         }
         if let Some(e) = &mut self.evaluation {
             e.outdate();
@@ -150,6 +152,8 @@ impl Embedding {
                 r.update_geometry(&p.a, &p.b);
             }
             p.points = OnceLock::new();
+            p.kept = None;
+            p.kept = None;
             if let Some(e) = &mut self.evaluation {
                 e.outdate();
             }
@@ -202,6 +206,7 @@ impl Embedding {
         p.result = None;
         p.searcher = None;
         p.points = OnceLock::new();
+        p.kept = None;
         if let Some(e) = &mut self.evaluation {
             e.outdate();
         }

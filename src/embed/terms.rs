@@ -9,6 +9,8 @@ use super::{
 };
 use std::cell::Cell;
 
+use crate::mesh::{ElemId, NodeId};
+
 use crate::enforce::conductance::{ConductanceError, ConductanceModel, PointState};
 use crate::enforce::interface::{
     ConductivityLaw, HInput, HValue, InterfaceError, InterfaceForm, InterfacePoints,
@@ -74,7 +76,9 @@ impl Embedding {
             };
             let state = PointState {
                 gap: x.gap,
-                pressure: p.pressures.as_ref().map_or(pressure, |v| v[x.point]),
+                pressure: p.pressures.as_ref().map_or(pressure, |v| {
+                    v[p.kept.as_ref().map_or(x.point, |kept| kept[x.point])]
+                }),
                 temp_a: x.temp_a,
                 temp_b: x.temp_b,
                 x: x.x,
@@ -131,14 +135,16 @@ impl Embedding {
         let points = match p.points.get() {
             Some(points) => points,
             None => {
+                let kept: Vec<_>;
+                let searched = match &p.kept {
+                    Some(k) => {
+                        kept = k.iter().map(|&k| result.points[k]).collect();
+                        &kept
+                    }
+                    None => &result.points,
+                };
                 let made = InterfacePoints::new(
-                    &self.mesh,
-                    &self.dofs,
-                    p.fields,
-                    &p.a,
-                    &p.b,
-                    &result.points,
-                    &form,
+                    &self.mesh, &self.dofs, p.fields, &p.a, &p.b, searched, &form,
                 )
                 .map_err(named)?;
                 p.points.get_or_init(|| made)
@@ -162,6 +168,36 @@ impl Embedding {
                 _ => named(source),
             }
         })
+    }
+
+    /// Evaluate only the points `owns` accepts — by their side-A face's element, or
+    /// their side-A node — from now until the next search or `own_points(None)`: a
+    /// rank of a distributed run assembling the points it owns, so that every point
+    /// enters once over the ranks. Residual, Jacobian and heat are then this process's
+    /// share.
+    pub fn own_points(&mut self, owns: Option<&dyn Fn(Option<ElemId>, Option<NodeId>) -> bool>) {
+        for p in &mut self.pairs {
+            p.kept = match (owns, &p.result) {
+                (Some(owns), Some(r)) => Some(
+                    (0..r.points.len())
+                        .filter(|&k| {
+                            let q = &r.points[k];
+                            let elem = q.a_face.map(|f| p.a.faces[f as usize].side.elem);
+                            let node = q
+                                .a_node
+                                .and_then(|n| p.a.nodes.get(n as usize))
+                                .map(|n| n.0);
+                            owns(elem, node)
+                        })
+                        .collect(),
+                ),
+                _ => None,
+            };
+            p.points = std::sync::OnceLock::new();
+        }
+        if let Some(e) = &mut self.evaluation {
+            e.outdate();
+        }
     }
 
     /// The interface system of flux interaction `p` at seam's field `local`.

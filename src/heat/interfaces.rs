@@ -111,6 +111,18 @@ pub trait Interfaces {
         let _ = (u, t, step);
         Ok(false)
     }
+    /// From now on evaluate only the points `owns` accepts (by side-A element or
+    /// node; `None`: all again): a rank of a distributed solve assembling the points it
+    /// owns, so that each enters once over the ranks. Interfaces that cannot say so.
+    fn own_points(
+        &self,
+        owns: Option<&dyn Fn(Option<crate::mesh::ElemId>, Option<NodeId>) -> bool>,
+    ) -> Result<(), InterfaceFailure> {
+        let _ = owns;
+        Err(InterfaceFailure::Failed(
+            "these interfaces cannot be evaluated point by point per rank".into(),
+        ))
+    }
     /// The problem's electrical contacts as the last [`Self::advance`] left their
     /// surfaces (moved, searched anew or made again by element death), in the problem's
     /// order; `None` while they are as the problem gave them.

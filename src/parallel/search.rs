@@ -27,6 +27,7 @@ use std::cell::Cell;
 
 use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
+use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use crate::mesh::{ElemId, Mesh, NodeId, Side};
@@ -303,29 +304,19 @@ fn top_boxes(tree: &Bvh, boxes: &[Aabb]) -> Vec<f64> {
 
 /// Send `out[r]` to rank `r` and return what each rank sent here (`MPI_Alltoall` of the
 /// counts, then `MPI_Alltoallv`), counting the bytes.
-fn exchange(
-    world: &mpi::topology::SimpleCommunicator,
-    out: &[Vec<f64>],
-    volume: &mut Volume,
-) -> Vec<Vec<f64>> {
+fn exchange(world: &SimpleCommunicator, out: &[Vec<f64>], volume: &mut Volume) -> Vec<Vec<f64>> {
     let size = out.len();
     let send_counts: Vec<i32> = out.iter().map(|v| v.len() as i32).collect();
     let mut recv_counts = vec![0i32; size];
     world.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
-    let displs = |c: &[i32]| -> Vec<i32> {
-        c.iter()
-            .scan(0, |s, &n| {
-                let d = *s;
-                *s += n;
-                Some(d)
-            })
-            .collect()
-    };
     let send: Vec<f64> = out.concat();
     let total: i32 = recv_counts.iter().sum();
     let mut recv = vec![0.0; total as usize];
     {
-        let (sd, rd) = (displs(&send_counts), displs(&recv_counts));
+        let (sd, rd) = (
+            session::displacements(&send_counts),
+            session::displacements(&recv_counts),
+        );
         let sent = Partition::new(&send[..], &send_counts[..], &sd[..]);
         let mut got = PartitionMut::new(&mut recv[..], &recv_counts[..], &rd[..]);
         world.all_to_all_varcount_into(&sent, &mut got);
@@ -344,29 +335,11 @@ fn exchange(
         .collect()
 }
 
-/// Every rank's `mine`, concatenated in rank order on every rank (`MPI_Allgatherv`).
-fn gather(
-    world: &mpi::topology::SimpleCommunicator,
-    mine: &[f64],
-    volume: &mut Volume,
-) -> Vec<f64> {
-    let size = world.size() as usize;
-    let mut counts = vec![0i32; size];
-    world.all_gather_into(&(mine.len() as i32), &mut counts[..]);
-    let displs: Vec<i32> = counts
-        .iter()
-        .scan(0, |s, &n| {
-            let d = *s;
-            *s += n;
-            Some(d)
-        })
-        .collect();
-    let mut all = vec![0.0; counts.iter().sum::<i32>() as usize];
-    {
-        let mut got = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
-        world.all_gather_varcount_into(mine, &mut got);
-    }
-    volume.gather_sent += (mine.len() * 8 * (size - 1)) as u64;
+/// Every rank's `mine`, concatenated in rank order on every rank, counted.
+fn gather(world: &SimpleCommunicator, mine: &[f64], volume: &mut Volume) -> Vec<f64> {
+    let all = session::gather_all(world, mine);
+    let others = world.size() as usize - 1;
+    volume.gather_sent += (mine.len() * 8 * others) as u64;
     volume.gather_received += ((all.len() - mine.len()) * 8) as u64;
     all
 }
@@ -470,7 +443,7 @@ fn point_key(c: &[f64], faces: usize) -> usize {
 }
 
 /// Rank 0 logs every rank's bytes of this search.
-fn log_volume(world: &mpi::topology::SimpleCommunicator, v: &Volume, a: &str, b: &str) {
+fn log_volume(world: &SimpleCommunicator, v: &Volume, a: &str, b: &str) {
     let mine = [
         v.search_sent,
         v.search_received,

@@ -4,8 +4,10 @@
 
 use std::sync::OnceLock;
 
+use mpi::datatype::PartitionMut;
 use mpi::environment::Universe;
 use mpi::topology::{Communicator, SimpleCommunicator};
+use mpi::traits::CommunicatorCollectives;
 
 use super::petsc;
 
@@ -59,4 +61,33 @@ pub(super) fn world() -> Option<(usize, usize)> {
 /// The world communicator (a session is running).
 pub(super) fn comm() -> SimpleCommunicator {
     SimpleCommunicator::world()
+}
+
+/// The displacements of consecutive blocks of `counts` items.
+pub(super) fn displacements(counts: &[i32]) -> Vec<i32> {
+    counts
+        .iter()
+        .scan(0, |s, &n| {
+            let d = *s;
+            *s += n;
+            Some(d)
+        })
+        .collect()
+}
+
+/// Every rank's `mine`, concatenated in rank order, on every rank (`MPI_Allgather` of
+/// the counts, then `MPI_Allgatherv`).
+pub(super) fn gather_all<T>(world: &SimpleCommunicator, mine: &[T]) -> Vec<T>
+where
+    T: mpi::datatype::Equivalence + Copy + Default,
+{
+    let mut counts = vec![0i32; world.size() as usize];
+    world.all_gather_into(&(mine.len() as i32), &mut counts[..]);
+    let displs = displacements(&counts);
+    let mut all = vec![T::default(); counts.iter().sum::<i32>() as usize];
+    {
+        let mut got = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
+        world.all_gather_varcount_into(mine, &mut got);
+    }
+    all
 }

@@ -4,15 +4,18 @@
 //!
 //! Each rank assembles the conduction of its own elements (a mesh of only those,
 //! [`Layout::local_mesh`]) with the serial kernels and adds every entry it made — rows of
-//! any rank: PETSc sends those to their owners at assembly. The interface terms come from
-//! the run's embedding, evaluated on every rank over the whole interface; each rank adds
-//! only the rows of the dofs it owns, so every term enters once. The increment is solved by
-//! PETSc and gathered whole on every rank (each rank's interface evaluation needs the
-//! field at its side-B nodes). Mortar ties with multipliers are refused.
+//! any rank: PETSc sends those to their owners at assembly. The interface terms likewise:
+//! each rank evaluates the points it owns (the side-A points of its elements' faces, or
+//! its side-A nodes; [`crate::heat::interfaces::Interfaces::own_points`]) and adds their
+//! entries, in global (PETSc) dof numbers, to the rows of any rank; the heats are summed
+//! over the ranks. The increment is solved by PETSc and gathered whole on every rank
+//! (each rank's points need the field at their side-B nodes, wherever those are owned).
+//! Mortar ties with multipliers are refused.
 
 use std::cell::Cell;
 use std::time::Instant;
 
+use mpi::collective::SystemOperation;
 use mpi::datatype::PartitionMut;
 use mpi::traits::{AsRaw, CommunicatorCollectives};
 
@@ -23,11 +26,11 @@ use crate::heat::steady::{
     SteadySolution,
 };
 use crate::heat::{FaceBc, HeatError, TEMPERATURE, assemble_conduction, dirichlet_dofs};
-use crate::mesh::{ElemId, Mesh, Side};
+use crate::mesh::{ElemId, Mesh, NodeId, Side};
 use crate::solve::spmv_ref;
 use faer::sparse::SparseColMatRef;
 
-use super::layout::Layout;
+use super::layout::{Layout, node_owners};
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::session;
 
@@ -112,14 +115,31 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     touched.dedup();
     let touched_petsc: Vec<PetscInt> = touched.iter().map(|&d| layout.petsc[d]).collect();
 
-    // The interface terms: a pattern of their couplings alone (no elements).
+    // The interface terms of the points this rank owns (by their side-A face's element
+    // or side-A node), all points again when the solve ends however it ends.
+    let node_owner = node_owners(mesh, dofs.field_blocks(field), &layout.part);
+    let owns = |elem: Option<ElemId>, node: Option<NodeId>| match (elem, node) {
+        (Some(e), _) => layout.part.get(e.index()).copied() == Some(layout.rank as u32),
+        (None, Some(n)) => node_owner.get(n.index()).copied() == Some(layout.rank as u32),
+        (None, None) => false,
+    };
+    let _all_again = match iface {
+        Some(i) => {
+            i.own_points(Some(&owns)).map_err(failed)?;
+            Some(AllPoints(i))
+        }
+        None => None,
+    };
+    // Their pattern: this rank's couplings alone (no elements).
     let empty = empty_mesh(mesh);
     let mut ipattern = Pattern::new(&empty, &dofs);
-    let pairs = match iface {
+    let own_pairs = match iface {
         Some(i) => i.couplings(&u, 0.0).map_err(failed)?,
         None => Vec::new(),
     };
-    let first = ipattern.add_couplings(&pairs)?.start;
+    let first = ipattern.add_couplings(&own_pairs)?.start;
+    // Every rank's couplings, for the preallocation of the rows they reach.
+    let pairs = all_couplings(&world, &own_pairs);
     ipattern.build_direct()?;
     let i_sym = ipattern.symbolic().expect("built").clone();
     let mut iasm = Assembler::direct(&ipattern)?;
@@ -204,18 +224,22 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             *ri -= fi;
         }
         iasm.reset_couplings();
-        if let Some(i) = iface {
-            let mut r_iface = vec![0.0; n];
-            heat = i
-                .assemble(&u, 0.0, &mut r_iface, &mut iasm, first)
-                .map_err(failed)?;
-            for &d in &layout.owned {
-                r[d] += r_iface[d];
-            }
-        }
         let values: Vec<f64> = touched.iter().map(|&d| r[d]).collect();
         r_vec.zero().map_err(petsc_err)?;
         r_vec.add(&touched_petsc, &values).map_err(petsc_err)?;
+        if let Some(i) = iface {
+            // This rank's points' terms, into the rows of any rank.
+            let mut r_iface = vec![0.0; n];
+            let mine = i
+                .assemble(&u, 0.0, &mut r_iface, &mut iasm, first)
+                .map_err(failed)?;
+            let (rows, values): (Vec<PetscInt>, Vec<f64>) = (0..n)
+                .filter(|&d| r_iface[d] != 0.0)
+                .map(|d| (layout.petsc[d], r_iface[d]))
+                .unzip();
+            r_vec.add(&rows, &values).map_err(petsc_err)?;
+            heat = summed_heat(&world, &mine);
+        }
         r_vec.assemble().map_err(petsc_err)?;
         r_vec
             .with_local(local_rows, |v| bc_local.iter().for_each(|&i| v[i] = 0.0))
@@ -240,7 +264,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         add_columns(&mut a, &k_sym, &k_local, &layout, |_| true)?;
         let mut i_values = Vec::new();
         iasm.values_into(&mut i_values)?;
-        add_columns(&mut a, &i_sym, &i_values, &layout, |d| layout.owns(d))?;
+        add_columns(&mut a, &i_sym, &i_values, &layout, |_| true)?;
         a.assemble().map_err(petsc_err)?;
         a.zero_rows_columns(&bc_rows).map_err(petsc_err)?;
         timing.assembly_s += t.elapsed().as_secs_f64();
@@ -291,6 +315,40 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing,
         linear,
     })
+}
+
+/// Evaluates every point again when dropped (the run's output after the solve sees the
+/// whole interface).
+struct AllPoints<'a>(&'a dyn crate::heat::interfaces::Interfaces);
+
+impl Drop for AllPoints<'_> {
+    fn drop(&mut self) {
+        // The run's interfaces accepted the restriction, so they accept its end.
+        let _ = self.0.own_points(None);
+    }
+}
+
+/// Every rank's interface couplings, on every rank (`MPI_Allgatherv`).
+fn all_couplings(
+    world: &mpi::topology::SimpleCommunicator,
+    mine: &[(usize, usize)],
+) -> Vec<(usize, usize)> {
+    let flat: Vec<u64> = mine
+        .iter()
+        .flat_map(|&(i, j)| [i as u64, j as u64])
+        .collect();
+    let all = session::gather_all(world, &flat);
+    all.chunks_exact(2)
+        .map(|c| (c[0] as usize, c[1] as usize))
+        .collect()
+}
+
+/// Each interaction's heat (side A, side B) summed over the ranks' points.
+fn summed_heat(world: &mpi::topology::SimpleCommunicator, mine: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let flat: Vec<f64> = mine.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let mut sum = vec![0.0; flat.len()];
+    world.all_reduce_into(&flat[..], &mut sum[..], SystemOperation::sum());
+    sum.chunks_exact(2).map(|c| (c[0], c[1])).collect()
 }
 
 /// The set-up's phases, as seconds from its start, for the log.

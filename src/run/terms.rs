@@ -869,6 +869,14 @@ impl Interfaces for ContactTerms<'_> {
         self.place(e, u, t, step)
     }
 
+    fn own_points(
+        &self,
+        owns: Option<&dyn Fn(Option<crate::mesh::ElemId>, Option<NodeId>) -> bool>,
+    ) -> Result<(), InterfaceFailure> {
+        self.embedded()?.embedding.borrow_mut().own_points(owns);
+        Ok(())
+    }
+
     fn electric_contacts(&self) -> Result<Option<Vec<ElectricContact>>, InterfaceFailure> {
         match &self.embedded()?.electric {
             Some(electric) => electric.borrow().contacts(self.contact).map(Some),
