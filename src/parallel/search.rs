@@ -26,7 +26,6 @@
 use std::cell::Cell;
 
 use mpi::collective::SystemOperation;
-use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
@@ -305,34 +304,12 @@ fn top_boxes(tree: &Bvh, boxes: &[Aabb]) -> Vec<f64> {
 /// Send `out[r]` to rank `r` and return what each rank sent here (`MPI_Alltoall` of the
 /// counts, then `MPI_Alltoallv`), counting the bytes.
 fn exchange(world: &SimpleCommunicator, out: &[Vec<f64>], volume: &mut Volume) -> Vec<Vec<f64>> {
-    let size = out.len();
-    let send_counts: Vec<i32> = out.iter().map(|v| v.len() as i32).collect();
-    let mut recv_counts = vec![0i32; size];
-    world.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
-    let send: Vec<f64> = out.concat();
-    let total: i32 = recv_counts.iter().sum();
-    let mut recv = vec![0.0; total as usize];
-    {
-        let (sd, rd) = (
-            session::displacements(&send_counts),
-            session::displacements(&recv_counts),
-        );
-        let sent = Partition::new(&send[..], &send_counts[..], &sd[..]);
-        let mut got = PartitionMut::new(&mut recv[..], &recv_counts[..], &rd[..]);
-        world.all_to_all_varcount_into(&sent, &mut got);
-    }
+    let got = session::exchange(world, out);
     // The counts to and from the other ranks, and the numbers (none to itself).
-    volume.search_sent += (send.len() * 8 + (size - 1) * 4) as u64;
-    volume.search_received += (recv.len() * 8 + (size - 1) * 4) as u64;
-    let mut start = 0;
-    recv_counts
-        .iter()
-        .map(|&n| {
-            let v = recv[start..start + n as usize].to_vec();
-            start += n as usize;
-            v
-        })
-        .collect()
+    let others = (out.len() - 1) * 4;
+    volume.search_sent += (out.iter().map(Vec::len).sum::<usize>() * 8 + others) as u64;
+    volume.search_received += (got.iter().map(Vec::len).sum::<usize>() * 8 + others) as u64;
+    got
 }
 
 /// Every rank's `mine`, concatenated in rank order on every rank, counted.

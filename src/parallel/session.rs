@@ -4,7 +4,7 @@
 
 use std::sync::OnceLock;
 
-use mpi::datatype::PartitionMut;
+use mpi::datatype::{Partition, PartitionMut};
 use mpi::environment::Universe;
 use mpi::topology::{Communicator, SimpleCommunicator};
 use mpi::traits::CommunicatorCollectives;
@@ -90,4 +90,33 @@ where
         world.all_gather_varcount_into(mine, &mut got);
     }
     all
+}
+
+/// Send `out[r]` to rank `r`; returns what each rank sent here (`MPI_Alltoall` of the
+/// counts, then `MPI_Alltoallv`).
+pub(super) fn exchange<T>(world: &SimpleCommunicator, out: &[Vec<T>]) -> Vec<Vec<T>>
+where
+    T: mpi::datatype::Equivalence + Copy + Default,
+{
+    let size = out.len();
+    let send_counts: Vec<i32> = out.iter().map(|v| v.len() as i32).collect();
+    let mut recv_counts = vec![0i32; size];
+    world.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
+    let send: Vec<T> = out.concat();
+    let mut recv = vec![T::default(); recv_counts.iter().sum::<i32>() as usize];
+    {
+        let (sd, rd) = (displacements(&send_counts), displacements(&recv_counts));
+        let sent = Partition::new(&send[..], &send_counts[..], &sd[..]);
+        let mut got = PartitionMut::new(&mut recv[..], &recv_counts[..], &rd[..]);
+        world.all_to_all_varcount_into(&sent, &mut got);
+    }
+    let mut start = 0;
+    recv_counts
+        .iter()
+        .map(|&n| {
+            let v = recv[start..start + n as usize].to_vec();
+            start += n as usize;
+            v
+        })
+        .collect()
 }

@@ -8,15 +8,16 @@
 //! each rank evaluates the points it owns (the side-A points of its elements' faces, or
 //! its side-A nodes; [`crate::heat::interfaces::Interfaces::own_points`]) and adds their
 //! entries, in global (PETSc) dof numbers, to the rows of any rank; the heats are summed
-//! over the ranks. The increment is solved by PETSc and gathered whole on every rank
-//! (each rank's points need the field at their side-B nodes, wherever those are owned).
+//! over the ranks. The increment is solved by PETSc; each rank then gets from their
+//! owners only the values it reads (its elements' dofs, and its points' on both sides:
+//! [`Scatter`]), and the whole solution is gathered once, at the end, for the output.
 //! Mortar ties with multipliers are refused.
 
 use std::cell::Cell;
 use std::time::Instant;
 
 use mpi::collective::SystemOperation;
-use mpi::datatype::PartitionMut;
+use mpi::topology::SimpleCommunicator;
 use mpi::traits::{AsRaw, CommunicatorCollectives};
 
 use crate::assembly::{Assembler, DofMap, Pattern};
@@ -133,13 +134,13 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     // Their pattern: this rank's couplings alone (no elements).
     let empty = empty_mesh(mesh);
     let mut ipattern = Pattern::new(&empty, &dofs);
-    let own_pairs = match iface {
+    let pairs_of_mine = match iface {
         Some(i) => i.couplings(&u, 0.0).map_err(failed)?,
         None => Vec::new(),
     };
-    let first = ipattern.add_couplings(&own_pairs)?.start;
+    let first = ipattern.add_couplings(&pairs_of_mine)?.start;
     // Every rank's couplings, for the preallocation of the rows they reach.
-    let pairs = all_couplings(&world, &own_pairs);
+    let pairs = all_couplings(&world, &pairs_of_mine);
     ipattern.build_direct()?;
     let i_sym = ipattern.symbolic().expect("built").clone();
     let mut iasm = Assembler::direct(&ipattern)?;
@@ -208,13 +209,8 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let (mut history, mut heat) = (Vec::new(), Vec::new());
     let (mut converged, mut iterations, mut target) = (false, 0, None);
     let mut last_step = f64::INFINITY;
-    let counts: Vec<i32> = (0..layout.starts.len() - 1)
-        .map(|r| (layout.starts[r + 1] - layout.starts[r]) as i32)
-        .collect();
-    let displs: Vec<i32> = layout.starts[..counts.len()]
-        .iter()
-        .map(|&s| s as i32)
-        .collect();
+    // The dofs this rank reads: its elements' and its points' (side A and side B).
+    let scatter = Scatter::new(&world, &layout, &touched, &pairs_of_mine);
     for it in 0..=p.max_iterations {
         let t = Instant::now();
         // R = K u − F + Σ R_Γ: this rank's elements, and its own rows of the interfaces.
@@ -233,6 +229,13 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             let mine = i
                 .assemble(&u, 0.0, &mut r_iface, &mut iasm, first)
                 .map_err(failed)?;
+            // A point reads the field where it has terms: there it must be kept.
+            if let Some(d) = (0..n).find(|&d| r_iface[d] != 0.0 && !scatter.kept[d]) {
+                return Err(HeatError::Contact(format!(
+                    "distributed solve: an interface point of rank {} reads dof {d}, which it was not sent",
+                    layout.rank
+                )));
+            }
             let (rows, values): (Vec<PetscInt>, Vec<f64>) = (0..n)
                 .filter(|&d| r_iface[d] != 0.0)
                 .map(|d| (layout.petsc[d], r_iface[d]))
@@ -250,7 +253,15 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         let goal = *target.get_or_insert(p.tolerance * scale);
         timing.assembly_s += t.elapsed().as_secs_f64();
         // The serial solve's stopping tests.
-        if crate::heat::steady::newton_converged(it, (rn, goal, scale), last_step, &u, symmetric) {
+        // The stopping test sees |u| at its largest over the ranks (it takes only that).
+        let u_max = [scatter.u_max(&world, &layout, &u)];
+        if crate::heat::steady::newton_converged(
+            it,
+            (rn, goal, scale),
+            last_step,
+            &u_max,
+            symmetric,
+        ) {
             converged = true;
             break;
         }
@@ -280,17 +291,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         let mine = du_vec
             .with_local(local_rows, |v| v.to_vec())
             .map_err(petsc_err)?;
-        let mut whole = vec![0.0; n];
-        {
-            let mut gathered = PartitionMut::new(&mut whole[..], &counts[..], &displs[..]);
-            world.all_gather_varcount_into(&mine[..], &mut gathered);
-        }
-        last_step = 0.0;
-        for (d, ui) in u.iter_mut().enumerate() {
-            let du = whole[layout.petsc[d] as usize];
-            *ui += du;
-            last_step = last_step.max(du.abs());
-        }
+        last_step = scatter.update(&world, &layout, &mine, &mut u);
         timing.solve_s += t.elapsed().as_secs_f64();
         linear.method = Some(match method {
             Method::CgGamg => LinearMethod::AmgCg,
@@ -299,6 +300,13 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         if method == Method::CgGamg {
             linear.cg_iterations.push(its);
         }
+    }
+    // The whole solution on every rank, once: rank 0 writes it, every rank's output
+    // evaluates the interfaces at it.
+    let mine: Vec<f64> = layout.owned.iter().map(|&d| u[d]).collect();
+    let whole = session::gather_all(&world, &mine);
+    for (d, ui) in u.iter_mut().enumerate() {
+        *ui = whole[layout.petsc[d] as usize];
     }
     LAST.with(|l| l.set(Some((method, symmetric))));
     let temperature = dofs.nodal_values(field, &u);
@@ -317,6 +325,96 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     })
 }
 
+/// The increment's values a rank needs, brought from their owners each Newton step
+/// (`MPI_Alltoallv` of the requested dofs' values) instead of gathering it whole.
+struct Scatter {
+    /// Per rank, the serial dofs this rank asks of it, in the order its answers come.
+    asks: Vec<Vec<usize>>,
+    /// Per rank, the local rows (PETSc index − this rank's first row) it asks of us.
+    asked: Vec<Vec<usize>>,
+    /// Per serial dof, whether this rank keeps it up to date (owned or asked).
+    kept: Vec<bool>,
+}
+
+impl Scatter {
+    /// Ask the owners of the `elements`' dofs and the `couplings`' dofs not owned here.
+    fn new(
+        world: &SimpleCommunicator,
+        layout: &Layout,
+        elements: &[usize],
+        couplings: &[(usize, usize)],
+    ) -> Scatter {
+        let size = layout.starts.len() - 1;
+        let mut need: Vec<usize> = elements
+            .iter()
+            .copied()
+            .chain(couplings.iter().flat_map(|&(i, j)| [i, j]))
+            .filter(|&d| !layout.owns(d))
+            .collect();
+        need.sort_unstable();
+        need.dedup();
+        let mut asks = vec![Vec::new(); size];
+        let mut kept = vec![false; layout.petsc.len()];
+        for &d in &layout.owned {
+            kept[d] = true;
+        }
+        for d in need {
+            asks[layout.owner(d)].push(d);
+            kept[d] = true;
+        }
+        let requests: Vec<Vec<i32>> = asks
+            .iter()
+            .map(|a| a.iter().map(|&d| layout.petsc[d]).collect())
+            .collect();
+        let first = layout.rows().start;
+        let asked = session::exchange(world, &requests)
+            .into_iter()
+            .map(|r| r.into_iter().map(|i| i as usize - first).collect())
+            .collect();
+        Scatter { asks, asked, kept }
+    }
+
+    /// Add the increment (`mine`: this rank's rows) to `u` at the dofs owned or asked;
+    /// returns its largest magnitude over every rank.
+    fn update(
+        &self,
+        world: &SimpleCommunicator,
+        layout: &Layout,
+        mine: &[f64],
+        u: &mut [f64],
+    ) -> f64 {
+        let first = layout.rows().start;
+        let answers: Vec<Vec<f64>> = self
+            .asked
+            .iter()
+            .map(|rows| rows.iter().map(|&i| mine[i]).collect())
+            .collect();
+        let got = session::exchange(world, &answers);
+        let mut step = 0.0f64;
+        for &d in &layout.owned {
+            let du = mine[layout.petsc[d] as usize - first];
+            u[d] += du;
+            step = step.max(du.abs());
+        }
+        for (dofs, values) in self.asks.iter().zip(&got) {
+            for (&d, &du) in dofs.iter().zip(values) {
+                u[d] += du;
+            }
+        }
+        let mut largest = 0.0;
+        world.all_reduce_into(&step, &mut largest, SystemOperation::max());
+        largest
+    }
+
+    /// The largest |u| over the owned dofs of every rank.
+    fn u_max(&self, world: &SimpleCommunicator, layout: &Layout, u: &[f64]) -> f64 {
+        let mine = layout.owned.iter().fold(0.0f64, |m, &d| m.max(u[d].abs()));
+        let mut largest = 0.0;
+        world.all_reduce_into(&mine, &mut largest, SystemOperation::max());
+        largest
+    }
+}
+
 /// Evaluates every point again when dropped (the run's output after the solve sees the
 /// whole interface).
 struct AllPoints<'a>(&'a dyn crate::heat::interfaces::Interfaces);
@@ -329,10 +427,7 @@ impl Drop for AllPoints<'_> {
 }
 
 /// Every rank's interface couplings, on every rank (`MPI_Allgatherv`).
-fn all_couplings(
-    world: &mpi::topology::SimpleCommunicator,
-    mine: &[(usize, usize)],
-) -> Vec<(usize, usize)> {
+fn all_couplings(world: &SimpleCommunicator, mine: &[(usize, usize)]) -> Vec<(usize, usize)> {
     let flat: Vec<u64> = mine
         .iter()
         .flat_map(|&(i, j)| [i as u64, j as u64])
@@ -344,7 +439,7 @@ fn all_couplings(
 }
 
 /// Each interaction's heat (side A, side B) summed over the ranks' points.
-fn summed_heat(world: &mpi::topology::SimpleCommunicator, mine: &[(f64, f64)]) -> Vec<(f64, f64)> {
+fn summed_heat(world: &SimpleCommunicator, mine: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let flat: Vec<f64> = mine.iter().flat_map(|&(a, b)| [a, b]).collect();
     let mut sum = vec![0.0; flat.len()];
     world.all_reduce_into(&flat[..], &mut sum[..], SystemOperation::sum());
