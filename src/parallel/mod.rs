@@ -1,8 +1,10 @@
 //! `seam run` on MPI (`--features mpi`, started by `mpirun`): the mesh's elements
-//! partitioned by METIS, each rank assembling its own elements' conduction and the
-//! interface rows of the dofs it owns into a PETSc distributed matrix, the solve by PETSc
-//! (CG + GAMG, or MUMPS LU), the solution gathered so that rank 0 writes what a serial
-//! run writes. What is and is not distributed is listed in `docs/parallel.md`.
+//! partitioned by METIS, the contact search distributed ([`search`]: each rank pairs the
+//! side-A points of its own faces), each rank assembling its own elements' conduction and
+//! its own side-A points' interface terms into a PETSc distributed matrix, the solve by
+//! PETSc (CG + GAMG, or MUMPS LU), the solution gathered at the end so that rank 0 writes
+//! what a serial run writes. What is and is not distributed is listed in
+//! `docs/parallel.md`.
 //!
 //! Entry points: [`start`] (the binary, before a run), then the hooks the run calls —
 //! [`is_root`] (who writes files and prints), [`search_pair`] (the contact search of

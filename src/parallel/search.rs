@@ -84,7 +84,9 @@ pub fn search_pair(
     let blocks: Vec<usize> = (0..mesh.blocks.len())
         .filter(|&k| mesh.blocks[k].topology.is_solid())
         .collect();
+    let started = std::time::Instant::now();
     let part = element_parts(mesh, &blocks)?;
+    let partitioned = started.elapsed().as_secs_f64();
     let face_owner = |f: &FaceGeom| match part.get(f.side.elem.index()) {
         Some(&p) if p != NO_PART => p as usize,
         _ => 0,
@@ -225,6 +227,7 @@ pub fn search_pair(
         subdomain,
     );
 
+    let searched = started.elapsed().as_secs_f64();
     // 5. Every rank's points in serial numbering, gathered whole.
     let mut record = Vec::with_capacity(local.points.len() * POINT_LEN + a_faces.len() * 3);
     for p in &local.points {
@@ -265,6 +268,17 @@ pub fn search_pair(
     );
     result.stats.side_a_area = a.area();
     tally(&mut result);
+    if rank == 0 {
+        // Rank 0's wall time: the partition (made at the run's first search, kept for
+        // the solve), the search proper, the gather.
+        log::info!(
+            "distributed search {} / {} on rank 0: partition {partitioned:.3} s, search {:.3} s, gather {:.3} s",
+            a.name,
+            b.name,
+            searched - partitioned,
+            started.elapsed().as_secs_f64() - searched
+        );
+    }
     log_volume(&world, &volume, &a.name, &b.name);
     LAST.with(|l| l.set(Some(volume)));
     Ok(result)
