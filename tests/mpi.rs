@@ -623,3 +623,31 @@ fn crosspoint_of_two_interfaces_on_rank_boundaries_equals_serial() {
     );
     compare(&problem, true);
 }
+
+/// Side A as a node surface (`Contact Type = node`): its points are nodes, owned by the
+/// lowest rank among their elements; the search and the run equal serial.
+#[test]
+fn node_surface_side_a_equals_serial() {
+    let tmp = scratch("cut-node");
+    let problem = write_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
+        "",
+    );
+    let deck = tmp.path().join("contact.i");
+    let faces = "contact surface a contains surface_3\n";
+    let text = std::fs::read_to_string(&deck).unwrap();
+    assert!(text.contains(faces), "{text}");
+    let nodes = "begin contact surface a\n surface = surface_3\n contact type = node\n end\n";
+    std::fs::write(&deck, text.replace(faces, nodes)).unwrap();
+    compare_search(&deck, &tmp.path().join("bar.exo"), &[]);
+    let points = std::fs::read_to_string(tmp.path().join("points_serial.csv")).unwrap();
+    assert!(
+        points
+            .lines()
+            .skip(1)
+            .all(|l| l.split(',').nth(2) == Some("")),
+        "side A's points are nodes"
+    );
+    compare(&problem, true);
+}
