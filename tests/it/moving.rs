@@ -623,3 +623,58 @@ fn electrical_contacts_move_and_follow_element_death() {
     println!("death: worst current {e:.1e}");
     assert!(e <= 1e-9, "current against the series law: {e:e}");
 }
+
+/// A periodic electrical contact does not move (its map stays with the Energy entry):
+/// the turbine sector's cut faces joined by a voltage contact conductance under a
+/// `[displacement]` is refused with E0731, and the same without the displacement
+/// passes the check.
+#[test]
+fn a_periodic_electrical_contact_that_would_move_is_refused() {
+    let scene = crate::examples::copy_scene_as("turbine_sector", "moving-periodic-electric");
+    let dir = scene.path();
+    let problem = std::fs::read_to_string(dir.join("problem.toml"))
+        .unwrap()
+        .replace(
+            "conductivity = 20.0\n",
+            "conductivity = 20.0\nrho_c = 1e6\nelectrical_conductivity = 1e6\n",
+        )
+        .replace(
+            "[solve]\nkind = \"steady\"\n",
+            "[[bc]]\nkind = \"voltage\"\nsurfaces = [\"bore\"]\nvalue = 0.0\n\
+             [initial]\ntemperature = 300.0\n\
+             [solve]\nkind = \"transient\"\ndt = 1.0\nend_time = 2.0\n",
+        );
+    assert!(problem.contains("transient"), "the problem was edited");
+    let deck = std::fs::read_to_string(dir.join("contact.i"))
+        .unwrap()
+        .replace(
+            "    enforcement for energy = tied\n    side b variable temperature to temperature\n  end\n",
+            "    enforcement for energy = tied_temperature\n  end\n\
+             begin enforcement electrical\n    enforcement for voltage = gap_conductance\n    gap conductance coefficient = constant h = 1e8\n  end\n",
+        );
+    assert!(deck.contains("for voltage"), "the deck was edited");
+    std::fs::write(dir.join("contact.i"), deck).unwrap();
+    let check = |text: &str| -> Vec<String> {
+        std::fs::write(dir.join("checked.toml"), text).unwrap();
+        match seam::run::check(&dir.join("checked.toml")) {
+            Ok(_) => Vec::new(),
+            Err(RunError::Input(d, _)) => d
+                .errors()
+                .map(|d| format!("{}: {}", d.code, d.message))
+                .collect(),
+            Err(e) => panic!("{e:?}"),
+        }
+    };
+    assert_eq!(check(&problem), Vec::<String>::new());
+    let moving = problem.replace(
+        "[contact]",
+        "[displacement]\nvalue = [0.0, 0.0, 0.0]\n[contact]",
+    );
+    let refused = check(&moving);
+    assert_eq!(refused.len(), 1, "{refused:?}");
+    let why = "electrical contact start / end is a periodic pair";
+    assert!(
+        refused[0].starts_with("E0731") && refused[0].contains(why),
+        "{refused:?}"
+    );
+}
