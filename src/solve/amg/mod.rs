@@ -166,8 +166,17 @@ impl AmgCg {
         sym: SymbolicSparseColMatRef<'_, usize>,
         values: Vec<f64>,
     ) -> Result<(), SolveError> {
+        self.setup(Self::rows_of(sym, values)?)
+    }
+
+    /// A symmetric matrix (structure `sym`, its `values` taken) in the row storage
+    /// [`Self::setup`] takes: a caller can free the column structure before the set-up.
+    pub fn rows_of(
+        sym: SymbolicSparseColMatRef<'_, usize>,
+        values: Vec<f64>,
+    ) -> Result<Csr, SolveError> {
         super::check_finite_ref(SparseColMatRef::new(sym, &values))?;
-        self.setup(Csr::from_csc_values(sym, values))
+        Ok(Csr::from_csc_values(sym, values))
     }
 
     /// Build the hierarchy for a matrix in row storage.
