@@ -44,9 +44,9 @@ pub const STEADY_AMG_TOLERANCE: f64 = 1e-13;
 
 /// The steady Newton's stopping test at iteration `it` (0 before any step), with the
 /// residual norm `rn`, its `goal` and `scale`, the last step's largest change and the
-/// field `u`; `symmetric`: a linear problem (one solve leaves only round-off). Shared by
-/// the serial and the distributed solves, so they stop alike.
-pub(crate) fn newton_converged(
+/// field `u`; `symmetric`: a linear problem (one solve leaves only round-off). Through
+/// [`Record`], the serial and the distributed solves stop alike.
+fn newton_converged(
     it: usize,
     (rn, goal, scale): (f64, f64, f64),
     last_step: f64,
@@ -405,9 +405,10 @@ fn pattern_of(
     Ok((pattern, first, tie_first))
 }
 
-/// The steady Newton's residual norms and its goal (fixed at the first residual).
-struct Record {
-    history: Vec<f64>,
+/// The steady Newton's residual norms and its goal (fixed at the first residual),
+/// kept alike by the serial and the distributed solves.
+pub(crate) struct Record {
+    pub(crate) history: Vec<f64>,
     /// ‖F‖, the scale of the goal.
     f_norm: f64,
     tolerance: f64,
@@ -416,9 +417,14 @@ struct Record {
 
 impl Record {
     fn new(f: &[f64], tolerance: f64) -> Record {
+        Record::with_norm(f.iter().map(|v| v * v).sum::<f64>().sqrt(), tolerance)
+    }
+
+    /// For a load vector of norm `f_norm`.
+    pub(crate) fn with_norm(f_norm: f64, tolerance: f64) -> Record {
         Record {
             history: Vec::new(),
-            f_norm: f.iter().map(|v| v * v).sum::<f64>().sqrt(),
+            f_norm,
             tolerance,
             goal: None,
         }
@@ -442,6 +448,19 @@ impl Record {
             r[d] = 0.0;
         }
         let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        self.converged_at(it, rn, last_step, u, symmetric)
+    }
+
+    /// As [`Self::converged`] for a residual of norm `rn` (its Dirichlet rows already
+    /// zero); `u` may be just its largest magnitude.
+    pub(crate) fn converged_at(
+        &mut self,
+        it: usize,
+        rn: f64,
+        last_step: f64,
+        u: &[f64],
+        symmetric: bool,
+    ) -> bool {
         self.history.push(rn);
         let scale = self.f_norm.max(rn).max(1e-300);
         let goal = *self.goal.get_or_insert(self.tolerance * scale);

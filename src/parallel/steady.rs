@@ -206,8 +206,9 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     };
     let mut ksp = Ksp::new(comm, &a, method, tolerance).map_err(petsc_err)?;
     let mut linear = LinearSolves::default();
-    let (mut history, mut heat) = (Vec::new(), Vec::new());
-    let (mut converged, mut iterations, mut target) = (false, 0, None);
+    let mut heat = Vec::new();
+    let mut record = crate::heat::steady::Record::with_norm(f_norm, p.tolerance);
+    let (mut converged, mut iterations) = (false, 0);
     let mut last_step = f64::INFINITY;
     // The dofs this rank reads: its elements' and its points' (side A and side B).
     let scatter = Scatter::new(&world, &layout, &touched, &pairs_of_mine);
@@ -248,20 +249,11 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             .with_local(local_rows, |v| bc_local.iter().for_each(|&i| v[i] = 0.0))
             .map_err(petsc_err)?;
         let rn = r_vec.norm().map_err(petsc_err)?;
-        history.push(rn);
-        let scale = f_norm.max(rn).max(1e-300);
-        let goal = *target.get_or_insert(p.tolerance * scale);
         timing.assembly_s += t.elapsed().as_secs_f64();
-        // The serial solve's stopping tests.
-        // The stopping test sees |u| at its largest over the ranks (it takes only that).
+        // The serial solve's stopping tests; they see |u| at its largest over the ranks
+        // (they take only that).
         let u_max = [scatter.u_max(&world, &layout, &u)];
-        if crate::heat::steady::newton_converged(
-            it,
-            (rn, goal, scale),
-            last_step,
-            &u_max,
-            symmetric,
-        ) {
+        if record.converged_at(it, rn, last_step, &u_max, symmetric) {
             converged = true;
             break;
         }
@@ -316,7 +308,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         temperature,
         newton_iterations: iterations,
         converged,
-        residual_history: history,
+        residual_history: record.history,
         heat,
         tie_heat: Vec::new(),
         crosspoints: Vec::new(),
