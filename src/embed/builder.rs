@@ -22,13 +22,13 @@ struct BlockInput {
 /// The host's mesh and numbering, checked by [`EmbeddingBuilder::build`].
 #[derive(Clone, Debug)]
 pub struct EmbeddingBuilder {
-    coords: Vec<[f64; 3]>,
+    pub(super) coords: Vec<[f64; 3]>,
     blocks: Vec<BlockInput>,
     surfaces: Vec<(String, Faces)>,
-    dofs: Option<Vec<Option<usize>>>,
+    pub(super) dofs: Option<Vec<Option<usize>>>,
     fixed: Vec<usize>,
-    integration: Integration,
-    axisymmetric: bool,
+    pub(super) integration: Integration,
+    pub(super) axisymmetric: bool,
 }
 
 impl EmbeddingBuilder {

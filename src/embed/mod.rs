@@ -129,6 +129,10 @@ pub enum EmbedError {
         factor: f64,
         message: String,
     },
+    /// On MPI ([`RankEmbedding`]): a collective call failed on another rank, whose own
+    /// error says what and where; every rank returns an error, so none is left waiting.
+    #[error("the call failed on rank {rank}\n  help: rank {rank}'s error says what and where")]
+    OtherRank { rank: usize },
 }
 
 fn mesh_error(what: String, help: &str) -> EmbedError {
@@ -565,6 +569,8 @@ mod builder;
 mod csr;
 mod fields;
 mod from_deck;
+#[cfg(feature = "mpi")]
+mod rank;
 mod search;
 mod state;
 mod terms;
@@ -577,4 +583,6 @@ pub use builder::EmbeddingBuilder;
 pub use csr::{CsrMatrix, Evaluation};
 pub(crate) use fields::face_values;
 pub use fields::{Coverage, FaceValues, HostFace, PointValues, Unpaired, UnpairedReason};
+#[cfg(feature = "mpi")]
+pub use rank::{RankEmbedding, duplicate};
 pub use ties::TieConstraints;

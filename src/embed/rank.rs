@@ -1,0 +1,539 @@
+//! The embedding on MPI, one handle per rank: a host that runs on several ranks hands
+//! each rank's local part of its mesh — nodes with their global ids and the host's
+//! global dof numbers, its elements, the interface faces of the elements it owns — and
+//! gets back, on each rank, the interface terms of that rank's own side-A points in the
+//! host's global dof numbers. Summed over the ranks (PETSc's `ADD_VALUES`), they are the
+//! serial embedding's terms; the heats come summed over the ranks on every rank.
+//!
+//! Entry point: [`EmbeddingBuilder::build_on_ranks`] (the builder holds the rank's local
+//! part, its `dofs` the host's global dof of each local node), then
+//! [`RankEmbedding::add_interaction`], [`RankEmbedding::search`] and
+//! [`RankEmbedding::contributions`] at the host's local field. Every method is collective
+//! over the communicator: each rank calls it, in the same order, with the same
+//! interactions; an error on one rank is an error on every rank
+//! ([`EmbedError::OtherRank`] on the others), so no rank is left waiting.
+//!
+//! What is communicated (docs/parallel.md, "The embedding on MPI"): at the build, the
+//! interface — every rank's interface faces with their elements' nodes, coordinates and
+//! global dofs, not the rest of the volume mesh — gathered on every rank
+//! (`MPI_Allgatherv`); at each evaluation, the field at those nodes (`MPI_Allgatherv`)
+//! and the heats (`MPI_Allreduce`). Every rank then searches the whole interface with
+//! the serial search (the same pairing on every rank, so pairs whose faces sit on
+//! different ranks pair exactly as in serial), and evaluates only the points of the
+//! faces it gave ([`Embedding::own_points`]).
+//!
+//! Ownership: a face belongs to the rank that gives it, and must be given by one rank
+//! only (the owner of its element); a node point of a node surface belongs to the lowest
+//! rank among the elements around it. Node ownership is otherwise the host's business:
+//! entries come at any global dof and the host adds them where they belong.
+
+use std::collections::HashMap;
+
+use mpi::collective::SystemOperation;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::{Communicator, CommunicatorCollectives};
+
+use super::{
+    Contributions, EmbedError, Embedding, EmbeddingBuilder, Enforcement, Heat, Interaction, Model,
+    argument, mesh_error,
+};
+use crate::mesh::{ElemId, NodeId};
+use crate::parallel::session::gather_all;
+
+/// One rank's embedding in a host that runs on MPI (see the module docs).
+pub struct RankEmbedding {
+    comm: SimpleCommunicator,
+    rank: usize,
+    /// The whole interface (every rank's interface faces and their elements), with
+    /// seam's node `k` at inner dof `k`.
+    inner: Embedding,
+    /// The host's global dof of each inner node.
+    global_dof: Vec<usize>,
+    /// This rank's local nodes whose values it sends at each evaluation, in order.
+    sent: Vec<usize>,
+    /// Each inner node's value: its position in the gathered values.
+    value_at: Vec<usize>,
+    /// The local nodes the host gave.
+    local_nodes: usize,
+    /// The rank that gave each inner element.
+    origin: Vec<usize>,
+    /// The rank owning each inner node's point (node surfaces): the lowest around it.
+    node_owner: Vec<usize>,
+    /// Over all ranks, the side-A points whose side-B face another rank gave.
+    across: usize,
+}
+
+/// `MPI_Comm_dup` of the host's communicator: seam's messages never meet the host's.
+///
+/// # Safety
+/// `comm` must be a valid communicator of an initialised MPI.
+pub unsafe fn duplicate(comm: mpi::ffi::MPI_Comm) -> SimpleCommunicator {
+    let mut dup = std::mem::MaybeUninit::uninit();
+    // SAFETY: the caller passes a valid communicator; MPI_Comm_dup writes `dup`.
+    unsafe {
+        mpi::ffi::MPI_Comm_dup(comm, dup.as_mut_ptr());
+        <SimpleCommunicator as mpi::raw::FromRaw>::from_raw(dup.assume_init())
+    }
+}
+
+/// An error on some rank becomes an error on every rank: the lowest failing rank's own
+/// error there, [`EmbedError::OtherRank`] naming it elsewhere.
+fn agree<T>(comm: &SimpleCommunicator, r: Result<T, EmbedError>) -> Result<T, EmbedError> {
+    let (rank, size) = (comm.rank(), comm.size());
+    let mine = if r.is_err() { rank } else { size };
+    let mut first = size;
+    comm.all_reduce_into(&mine, &mut first, SystemOperation::min());
+    match r {
+        Err(e) => Err(e),
+        Ok(_) if first < size => Err(EmbedError::OtherRank {
+            rank: first as usize,
+        }),
+        ok => ok,
+    }
+}
+
+/// Every rank's `mine`, one vector per rank.
+fn gather_parts<T>(comm: &SimpleCommunicator, mine: &[T]) -> Vec<Vec<T>>
+where
+    T: mpi::datatype::Equivalence + Copy + Default,
+{
+    let mut counts = vec![0u64; comm.size() as usize];
+    comm.all_gather_into(&(mine.len() as u64), &mut counts[..]);
+    let all = gather_all(comm, mine);
+    let mut start = 0;
+    counts
+        .iter()
+        .map(|&n| {
+            let part = all[start..start + n as usize].to_vec();
+            start += n as usize;
+            part
+        })
+        .collect()
+}
+
+/// What every rank must give alike — blocks (name, topology, conductivity), surface
+/// names, integration, axisymmetry — as one number (FNV-1a of its text).
+fn signature(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// One rank's share of the interface: its faces' elements, their nodes, the faces.
+struct Share {
+    /// `[n_nodes, n_elems, n_faces]`, then per node `[global id, global dof]`, per
+    /// element `[block, its nodes as positions in this share's node list …]`, per face
+    /// `[surface, element (position in this share), side]`.
+    ids: Vec<u64>,
+    /// The coordinates of the nodes, xyz each.
+    coords: Vec<f64>,
+    /// The local nodes, in the share's order.
+    nodes: Vec<usize>,
+}
+
+impl EmbeddingBuilder {
+    /// The embedding of this rank's part of a host on MPI (collective over `comm`): the
+    /// builder holds the rank's local nodes (owned and ghost), its elements and the
+    /// interface faces of the elements it owns (each face on one rank only), with
+    /// [`Self::dofs`] the host's global dof of each local node; `global_ids` gives each
+    /// local node's global id. Every rank gives the same blocks (names, topologies,
+    /// conductivities; a block may have no elements here) and surfaces (names; a surface
+    /// may have no faces here), in the same order.
+    pub fn build_on_ranks(
+        self,
+        comm: SimpleCommunicator,
+        global_ids: &[u64],
+    ) -> Result<RankEmbedding, EmbedError> {
+        let (integration, axisymmetric) = (self.integration, self.axisymmetric);
+        let local = agree(&comm, self.local_share(global_ids));
+        let (local, share) = local?;
+        let rank = comm.rank() as usize;
+
+        // Every rank's blocks and surfaces alike.
+        let mut text = format!("{integration:?} {axisymmetric}");
+        for (b, block) in local.mesh.blocks.iter().enumerate() {
+            text += &format!(
+                "|{} {:?} {:e}",
+                block.name, block.topology, local.conductivity[b]
+            );
+        }
+        for s in &local.mesh.side_sets {
+            text += &format!("|{}", s.name);
+        }
+        let mut signatures = vec![0u64; comm.size() as usize];
+        comm.all_gather_into(&signature(&text), &mut signatures[..]);
+        if let Some(r) = signatures.iter().position(|&s| s != signatures[0]) {
+            return Err(mesh_error(
+                format!(
+                    "rank {r} gives other blocks or surfaces than rank 0 (names, topologies, conductivities or order), or another integration"
+                ),
+                "give every rank the same blocks and surfaces in the same order, empty where the rank has none",
+            ));
+        }
+
+        let ids = gather_parts(&comm, &share.ids);
+        let coords = gather_parts(&comm, &share.coords);
+        let whole = Interface::assemble(&local, &ids, &coords)?;
+
+        let mut builder = Embedding::builder(&whole.coords)
+            .integration(integration)
+            .axisymmetric(axisymmetric)
+            .dofs(&(0..whole.coords.len()).collect::<Vec<_>>());
+        for (b, block) in local.mesh.blocks.iter().enumerate() {
+            builder = builder.block(
+                &block.name,
+                block.topology,
+                &whole.connectivity[b],
+                local.conductivity[b],
+            );
+        }
+        for (s, set) in local.mesh.side_sets.iter().enumerate() {
+            builder = builder.side_set(&set.name, &whole.faces[s]);
+        }
+        let mut inner = builder.build()?;
+        inner.mesh.node_numbers = whole.global_id.iter().map(|&g| g as i64).collect();
+        let mut node_owner = vec![usize::MAX; whole.coords.len()];
+        for (e, &r) in whole.origin.iter().enumerate() {
+            for n in inner.mesh.elem_nodes(ElemId(e as u32)) {
+                node_owner[n.index()] = node_owner[n.index()].min(r);
+            }
+        }
+        Ok(RankEmbedding {
+            comm,
+            rank,
+            inner,
+            global_dof: whole.global_dof,
+            sent: share.nodes,
+            value_at: whole.value_at,
+            local_nodes: local.mesh.coords.len(),
+            origin: whole.origin,
+            node_owner,
+            across: 0,
+        })
+    }
+
+    /// This rank's part checked as a serial embedding, and its share of the interface.
+    fn local_share(self, global_ids: &[u64]) -> Result<(Embedding, Share), EmbedError> {
+        let n = self.coords.len();
+        if global_ids.len() != n {
+            return Err(mesh_error(
+                format!("{} global ids for {n} local nodes", global_ids.len()),
+                "pass one global id per local node, in node order",
+            ));
+        }
+        let host_dofs = self.dofs.clone().unwrap_or_default();
+        let local = self.build()?;
+        let mesh = &local.mesh;
+        // The elements of this rank's faces, and their nodes, in first-seen order.
+        let mut elem_at: HashMap<ElemId, usize> = HashMap::new();
+        let mut node_at: HashMap<usize, usize> = HashMap::new();
+        let (mut elems, mut nodes, mut faces) = (Vec::new(), Vec::new(), Vec::new());
+        for (s, set) in mesh.side_sets.iter().enumerate() {
+            for side in &set.sides {
+                let e = *elem_at.entry(side.elem).or_insert_with(|| {
+                    elems.push(side.elem);
+                    elems.len() - 1
+                });
+                faces.extend_from_slice(&[s as u64, e as u64, u64::from(side.side)]);
+            }
+        }
+        let mut elem_ids = Vec::new();
+        for &e in &elems {
+            elem_ids.push(mesh.block_of(e) as u64);
+            for node in mesh.elem_nodes(e) {
+                let k = *node_at.entry(node.index()).or_insert_with(|| {
+                    nodes.push(node.index());
+                    nodes.len() - 1
+                });
+                elem_ids.push(k as u64);
+            }
+        }
+        let mut ids = vec![
+            nodes.len() as u64,
+            elems.len() as u64,
+            faces.len() as u64 / 3,
+        ];
+        let mut coords = Vec::with_capacity(nodes.len() * 3);
+        for &k in &nodes {
+            // Every node of a block has a dof (the local build checked it).
+            let dof = host_dofs.get(k).copied().flatten().unwrap_or(0);
+            ids.extend_from_slice(&[global_ids[k], dof as u64]);
+            coords.extend_from_slice(&mesh.coords[k]);
+        }
+        ids.extend(elem_ids);
+        ids.extend(faces);
+        Ok((local, Share { ids, coords, nodes }))
+    }
+}
+
+/// The whole interface, made alike on every rank from every rank's share.
+struct Interface {
+    coords: Vec<[f64; 3]>,
+    global_id: Vec<u64>,
+    global_dof: Vec<usize>,
+    /// Per block, the connectivity by inner node.
+    connectivity: Vec<Vec<usize>>,
+    /// Per surface, (inner element, side).
+    faces: Vec<Vec<(usize, u8)>>,
+    /// The rank that gave each inner element.
+    origin: Vec<usize>,
+    value_at: Vec<usize>,
+}
+
+impl Interface {
+    fn assemble(
+        local: &Embedding,
+        ids: &[Vec<u64>],
+        coords: &[Vec<f64>],
+    ) -> Result<Self, EmbedError> {
+        let mesh = &local.mesh;
+        let corrupt = |r: usize| {
+            mesh_error(
+                format!("the interface received from rank {r} is cut short"),
+                "every rank must call seam with the same library and arguments of the same kind",
+            )
+        };
+        let mut whole = Interface {
+            coords: Vec::new(),
+            global_id: Vec::new(),
+            global_dof: Vec::new(),
+            connectivity: vec![Vec::new(); mesh.blocks.len()],
+            faces: vec![Vec::new(); mesh.side_sets.len()],
+            origin: Vec::new(),
+            value_at: Vec::new(),
+        };
+        let mut inner_of: HashMap<u64, usize> = HashMap::new();
+        // Per block, the elements in (rank, order): (rank, inner nodes).
+        let mut per_block: Vec<Vec<(usize, Vec<usize>)>> = vec![Vec::new(); mesh.blocks.len()];
+        // Per rank, each of its elements' (block, position in the block).
+        let mut placed: Vec<Vec<(usize, usize)>> = Vec::with_capacity(ids.len());
+        let mut by_nodes: HashMap<Vec<u64>, usize> = HashMap::new();
+        // Per surface, (block, position in the block, side).
+        let mut raw_faces: Vec<Vec<(usize, usize, u8)>> = vec![Vec::new(); mesh.side_sets.len()];
+        let mut sent = 0;
+        for (r, (ids, xyz)) in ids.iter().zip(coords).enumerate() {
+            let [n_nodes, n_elems, n_faces] = match ids.get(..3) {
+                Some(&[a, b, c]) => [a as usize, b as usize, c as usize],
+                _ => return Err(corrupt(r)),
+            };
+            if xyz.len() != 3 * n_nodes || ids.len() < 3 + 2 * n_nodes + 3 * n_faces {
+                return Err(corrupt(r));
+            }
+            let mut mine = Vec::with_capacity(n_nodes);
+            for k in 0..n_nodes {
+                let (gid, dof) = (ids[3 + 2 * k], ids[4 + 2 * k] as usize);
+                let x = [xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]];
+                let i = *inner_of.entry(gid).or_insert_with(|| {
+                    whole.coords.push(x);
+                    whole.global_id.push(gid);
+                    whole.global_dof.push(dof);
+                    whole.value_at.push(sent + k);
+                    whole.coords.len() - 1
+                });
+                if whole.global_dof[i] != dof {
+                    return Err(mesh_error(
+                        format!(
+                            "global node {gid} has dof {} on one rank and {dof} on rank {r}",
+                            whole.global_dof[i]
+                        ),
+                        "give a node the same global dof on every rank that holds it",
+                    ));
+                }
+                mine.push(i);
+            }
+            sent += n_nodes;
+            let mut at = 3 + 2 * n_nodes;
+            let mut elems = Vec::with_capacity(n_elems);
+            for e in 0..n_elems {
+                let block = *ids.get(at).ok_or_else(|| corrupt(r))? as usize;
+                let Some(b) = mesh.blocks.get(block) else {
+                    return Err(corrupt(r));
+                };
+                let nn = b.topology.node_count();
+                let conn = ids.get(at + 1..at + 1 + nn).ok_or_else(|| corrupt(r))?;
+                let inner: Vec<usize> = conn
+                    .iter()
+                    .map(|&k| mine.get(k as usize).copied().ok_or_else(|| corrupt(r)))
+                    .collect::<Result<_, _>>()?;
+                let mut key: Vec<u64> = inner.iter().map(|&i| whole.global_id[i]).collect();
+                key.sort_unstable();
+                if let Some(&other) = by_nodes.get(&key) {
+                    return Err(mesh_error(
+                        format!(
+                            "the element of global nodes {key:?} carries interface faces on rank {other} and on rank {r} (its element {e} there)"
+                        ),
+                        "give each interface face on one rank only: the rank that owns its element",
+                    ));
+                }
+                by_nodes.insert(key, r);
+                elems.push((block, per_block[block].len()));
+                per_block[block].push((r, inner));
+                at += 1 + nn;
+            }
+            placed.push(elems);
+            let faces = ids.get(at..at + 3 * n_faces).ok_or_else(|| corrupt(r))?;
+            for f in faces.chunks_exact(3) {
+                let (s, e, side) = (f[0] as usize, f[1] as usize, f[2] as u8);
+                let (Some(list), Some(&(b, k))) = (raw_faces.get_mut(s), placed[r].get(e)) else {
+                    return Err(corrupt(r));
+                };
+                list.push((b, k, side));
+            }
+        }
+        // Inner elements block after block; a face's (block, position) becomes its number.
+        let mut first = Vec::with_capacity(per_block.len());
+        for (b, elems) in per_block.into_iter().enumerate() {
+            first.push(whole.origin.len());
+            for (r, nodes) in elems {
+                whole.origin.push(r);
+                whole.connectivity[b].extend(nodes);
+            }
+        }
+        for (list, raw) in whole.faces.iter_mut().zip(raw_faces) {
+            list.extend(raw.into_iter().map(|(b, k, side)| (first[b] + k, side)));
+        }
+        Ok(whole)
+    }
+}
+
+impl RankEmbedding {
+    /// The serial embedding of the whole interface this rank holds (for inspection).
+    pub fn interface(&self) -> &Embedding {
+        &self.inner
+    }
+
+    /// Add an interaction (collective: every rank adds the same ones in the same order).
+    /// Mortar ties with multipliers are refused: multipliers across ranks are not built.
+    pub fn add_interaction(&mut self, i: Interaction) -> Result<usize, EmbedError> {
+        let r = if matches!(i.model, Model::TiedMortar { .. }) {
+            Err(Self::no_multipliers(&i.side_a, &i.side_b))
+        } else {
+            self.inner.add_interaction(i)
+        };
+        agree(&self.comm, r)
+    }
+
+    /// The interactions of a contact deck file (collective), as
+    /// [`Embedding::add_deck_file`]; a deck with mortar ties is refused whole.
+    pub fn add_deck_file(&mut self, path: &std::path::Path) -> Result<Vec<usize>, EmbedError> {
+        let before = self.inner.pairs.len();
+        let mut r = self.inner.add_deck_file(path);
+        if let Some(p) = self.inner.pairs[before..]
+            .iter()
+            .find(|p| matches!(p.enforcement, Enforcement::Tie { .. }))
+        {
+            r = Err(Self::no_multipliers(&p.side_a.name, &p.side_b.name));
+        }
+        if r.is_err() {
+            self.inner.pairs.truncate(before);
+        }
+        agree(&self.comm, r)
+    }
+
+    fn no_multipliers(a: &str, b: &str) -> EmbedError {
+        argument(
+            format!(
+                "interaction {a} / {b}: a mortar tie with multipliers is not distributed (multipliers across ranks are not built)"
+            ),
+            "tie the surfaces by Nitsche (Model::TiedNitsche, SEAM_TIED_NITSCHE), or embed serially",
+        )
+    }
+
+    /// Number of interactions.
+    pub fn len(&self) -> usize {
+        self.inner.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.inner.is_empty()
+    }
+
+    /// Pair every interaction anew (collective): every rank searches the whole interface
+    /// as the serial embedding does and keeps its own side-A points.
+    pub fn search(&mut self) -> Result<(), EmbedError> {
+        let r = self.inner.search();
+        agree(&self.comm, r)?;
+        let (rank, origin, owner) = (self.rank, &self.origin, &self.node_owner);
+        let owns = |e: Option<ElemId>, n: Option<NodeId>| match (e, n) {
+            (Some(e), _) => origin.get(e.index()) == Some(&rank),
+            (None, Some(n)) => owner.get(n.index()) == Some(&rank),
+            (None, None) => false,
+        };
+        self.inner.own_points(Some(&owns));
+        let mut mine = 0u64;
+        for p in &self.inner.pairs {
+            let (Some(result), Some(kept)) = (&p.result, &p.kept) else {
+                continue;
+            };
+            for &k in kept {
+                let b = result.points[k]
+                    .b_face
+                    .map(|f| p.b.faces[f as usize].side.elem);
+                if b.is_some_and(|e| self.origin[e.index()] != rank) {
+                    mine += 1;
+                }
+            }
+        }
+        let mut all = 0u64;
+        self.comm
+            .all_reduce_into(&mine, &mut all, SystemOperation::sum());
+        self.across = all as usize;
+        Ok(())
+    }
+
+    /// Over all ranks, the side-A points (of the last search) paired with a side-B face
+    /// that another rank gave: the pairs that straddle ranks.
+    pub fn points_across(&self) -> usize {
+        self.across
+    }
+
+    /// The interface terms of this rank's own side-A points at the host's field
+    /// (collective): `u_local` holds the value at each local node (owned and ghost, in
+    /// the builder's node order), current at least at the nodes of this rank's
+    /// interface faces' elements. Residual, Jacobian and load come in the host's global
+    /// dof numbers, for this rank to add (with `ADD_VALUES`: they may fall in other
+    /// ranks' rows); `heat` is summed over the ranks, the same on every rank.
+    pub fn contributions(&self, u_local: &[f64]) -> Result<Contributions, EmbedError> {
+        let check = if u_local.len() != self.local_nodes {
+            Err(argument(
+                format!(
+                    "the local field has {} entries for {} local nodes",
+                    u_local.len(),
+                    self.local_nodes
+                ),
+                "pass the value at every local node (owned and ghost), in the builder's node order",
+            ))
+        } else {
+            Ok(())
+        };
+        agree(&self.comm, check)?;
+        let mine: Vec<f64> = self.sent.iter().map(|&k| u_local[k]).collect();
+        let all = gather_all(&self.comm, &mine);
+        let u: Vec<f64> = self.value_at.iter().map(|&k| all[k]).collect();
+        let mut c = agree(&self.comm, self.inner.contributions(&u))?;
+        let dof = |k: usize| self.global_dof[k];
+        for (d, _) in c.residual.iter_mut().chain(c.load.iter_mut()) {
+            *d = dof(*d);
+        }
+        for (i, j, _) in &mut c.jacobian {
+            (*i, *j) = (dof(*i), dof(*j));
+        }
+        let local: Vec<f64> = c
+            .heat
+            .iter()
+            .flat_map(|h| h.map_or([0.0; 2], |h| [h.side_a, h.side_b]))
+            .collect();
+        let mut summed = vec![0.0; local.len()];
+        self.comm
+            .all_reduce_into(&local[..], &mut summed[..], SystemOperation::sum());
+        for (h, s) in c.heat.iter_mut().zip(summed.chunks_exact(2)) {
+            if let Some(h) = h {
+                *h = Heat {
+                    side_a: s[0],
+                    side_b: s[1],
+                };
+            }
+        }
+        Ok(c)
+    }
+}
