@@ -88,6 +88,7 @@ extern "C" {
 #define SEAM_ERR_PLUGIN 8        /* a plugin could not be loaded, or failed at a contact point */
 #define SEAM_CUTBACK 9           /* a conductance model or plugin asks for a smaller step (seam_cutback_factor) */
 #define SEAM_ERR_NOTHING_PAIRED 10 /* a flux interaction's search paired no point (seam_allow_unpaired) */
+#define SEAM_ERR_OTHER_RANK 11   /* MPI: a collective call failed on another rank (its error says why) */
 
 /* Element topologies: 3-D solids, or 2-D ones (a mesh in the xy plane, z = 0). */
 #define SEAM_HEX8 1
@@ -358,6 +359,85 @@ int seam_dual_multipliers(seam_embedding *embedding, size_t tie, const double *r
  * multiplier are lambda_h = sum psi_k lambda_k. Array valid until the next point-field call. */
 int seam_tie_point_fields(seam_embedding *embedding, size_t tie, const double *lambda, size_t n,
                           size_t *out_n, const seam_point_values **out_values);
+
+/* --- on MPI: one embedding per rank (libseam built with --features mpi) ----------------
+ * Declared when mpi.h (or petsc.h) is included before seam.h. A host on MPI gives each
+ * rank's local part and gets, on each rank, the interface terms of that rank's own
+ * side-A points in its global dof numbers; added over the ranks (MatSetValues /
+ * VecSetValues with ADD_VALUES) they are the serial embedding's terms. See
+ * docs/parallel.md ("The embedding on MPI") and examples/c_host/mpi_petsc.c.
+ *
+ *   seam_builder_new(local_coords, n_local, &b);      the rank's nodes, owned and ghost
+ *   seam_builder_add_block(b, "a", SEAM_HEX8, conn, n_elems, k);  every block, on every rank
+ *   seam_builder_add_side_set(b, "right", elems, sides, n);  the faces of the elements
+ *                                                      this rank owns (each face on one rank)
+ *   seam_builder_set_dofs(b, global_dof, n_local);     the host's global dof of each node
+ *   seam_rank_new(b, PETSC_COMM_WORLD, global_ids, n_local, &e); seam_builder_free(b);
+ *   seam_rank_add_interaction(e, "right", "left", SEAM_GAP_CONDUCTANCE, h, 0.0, NULL);
+ *   seam_rank_search(e);
+ *   seam_rank_evaluate(e, u_local, n_local);          the field at the local nodes
+ *   seam_rank_jacobian(e, &n, &rows, &cols, &vals);    MatSetValues(..., ADD_VALUES)
+ *   seam_rank_heat(e, 0, &q_a, &q_b);                 summed over the ranks
+ *   seam_rank_free(e);                                before MPI_Finalize / PetscFinalize
+ *
+ * Collective: seam_rank_new, _add_interaction, _search, _evaluate and _free must be
+ * called by every rank of the communicator, in the same order, with the same
+ * interactions; the getters are local. An error on one rank is an error on every rank:
+ * that rank's own status and message there, SEAM_ERR_OTHER_RANK naming it elsewhere, so
+ * no rank is left waiting in a collective.
+ *
+ * What each rank holds: the whole interface (every rank's interface faces with their
+ * elements' nodes, coordinates and global dofs), gathered at seam_rank_new; not the rest
+ * of the volume mesh. Every rank searches it whole (the serial search) and evaluates only
+ * the points of its own faces. Mortar ties with multipliers are refused (SEAM_ERR_ARGUMENT).
+ */
+#if defined(MPI_VERSION)
+typedef struct SeamRankEmbedding seam_rank_embedding;
+
+/* This rank's embedding. builder: the rank's local part, as for seam_embedding_new, with
+ * seam_builder_set_dofs giving the host's global dof of each local node; every rank
+ * gives the same blocks and surfaces (names, topologies, conductivities; empty where it
+ * has none) in the same order, and each interface face on one rank only (the owner of
+ * its element). global_ids: the global id of each of the n_nodes local nodes (>= 0; a
+ * node held by several ranks has one id and one dof). comm is duplicated (MPI_Comm_dup):
+ * the caller keeps its own. The builder is unchanged and still owned by the caller.
+ * On failure *out_embedding is NULL. */
+int seam_rank_new(const seam_builder *builder, MPI_Comm comm, const int64_t *global_ids,
+                  size_t n_nodes, seam_rank_embedding **out_embedding);
+/* Free the handle and its communicator (collective: MPI_Comm_free); before MPI_Finalize.
+ * Accepts NULL. */
+void seam_rank_free(seam_rank_embedding *embedding);
+/* As seam_add_interaction; SEAM_TIED_MORTAR and SEAM_TIED_DUAL_MORTAR are refused. */
+int seam_rank_add_interaction(seam_rank_embedding *embedding, const char *side_a,
+                              const char *side_b, int model, double h, double offset,
+                              size_t *out_index);
+/* Pair every interaction anew: the serial search of the whole interface, on every rank;
+ * each rank keeps the points of its own side-A faces. */
+int seam_rank_search(seam_rank_embedding *embedding);
+/* Over all ranks, the side-A points of the last search paired with a side-B face that
+ * another rank gave (the pairs that straddle ranks). Local. */
+int seam_rank_points_across(const seam_rank_embedding *embedding, size_t *out_count);
+/* Evaluate this rank's own points at the field u_local: one value per local node (owned
+ * and ghost, in the builder's node order), current at least at the nodes of the
+ * elements of this rank's interface faces. seam gathers what the other ranks' points
+ * need. */
+int seam_rank_evaluate(seam_rank_embedding *embedding, const double *u_local, size_t n_nodes);
+/* The last evaluation's terms of this rank's points, in the host's global dof numbers
+ * (rows and dofs may belong to other ranks: add them with ADD_VALUES); as
+ * seam_residual, seam_jacobian and seam_load. The arrays belong to the handle and stay
+ * valid until the next seam_rank_evaluate, _search, _add_interaction or _free. */
+int seam_rank_residual(const seam_rank_embedding *embedding, size_t *out_n,
+                       const int64_t **out_dofs, const double **out_values);
+int seam_rank_jacobian(const seam_rank_embedding *embedding, size_t *out_n,
+                       const int64_t **out_rows, const int64_t **out_cols,
+                       const double **out_values);
+int seam_rank_load(const seam_rank_embedding *embedding, size_t *out_n,
+                   const int64_t **out_dofs, const double **out_values);
+/* Heat (W) leaving side A and side B of interaction `index` at the last evaluation,
+ * summed over the ranks (the same on every rank). */
+int seam_rank_heat(const seam_rank_embedding *embedding, size_t index, double *out_side_a,
+                   double *out_side_b);
+#endif /* MPI_VERSION */
 
 #ifdef __cplusplus
 }

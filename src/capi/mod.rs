@@ -56,6 +56,8 @@ pub enum SeamStatus {
     Cutback = 9,
     /// A flux interaction's search paired no point (`seam_allow_unpaired` lets it stand).
     NothingPaired = 10,
+    /// On MPI: a collective call failed on another rank (its own error says why).
+    OtherRank = 11,
 }
 
 thread_local! {
@@ -79,6 +81,7 @@ impl From<EmbedError> for Failure {
             EmbedError::Plugin { .. } => SeamStatus::Plugin,
             EmbedError::Cutback { .. } => SeamStatus::Cutback,
             EmbedError::NothingPaired { .. } => SeamStatus::NothingPaired,
+            EmbedError::OtherRank { .. } => SeamStatus::OtherRank,
 
             _ => SeamStatus::Argument,
         };
@@ -291,6 +294,8 @@ pub extern "C" fn seam_last_error() -> *const c_char {
 mod builder;
 mod fields;
 mod interactions;
+#[cfg(feature = "mpi")]
+mod rank;
 mod state;
 mod terms;
 mod ties;
@@ -300,6 +305,8 @@ pub use fields::{
     SeamConductanceFn, SeamCoverage, SeamFaceValues, SeamPointState, SeamPointValues, *,
 };
 pub use interactions::*;
+#[cfg(feature = "mpi")]
+pub use rank::*;
 pub use terms::*;
 pub use ties::*;
 

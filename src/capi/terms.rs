@@ -56,7 +56,7 @@ fn evaluated(e: &SeamEmbedding) -> Result<&Evaluated, Failure> {
     })
 }
 
-unsafe fn pairs(
+pub(super) unsafe fn pairs(
     n: *mut usize,
     dofs: *mut *const i64,
     values: *mut *const f64,
