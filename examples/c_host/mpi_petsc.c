@@ -1,0 +1,345 @@
+/*
+ * A host on MPI and PETSc that embeds seam rank by rank (seam_rank_* in seam.h).
+ *
+ * The problem: two bricks side by side, a = [0,1]^3 (3 x 4 x 4 hexahedra, k = 2 W/m/K)
+ * and b = [1,2] x [0,1]^2 (2 x 5 x 3 hexahedra, k = 5 W/m/K), their faces at x = 1
+ * non-matching, joined by a gap conductance h = 50 W/m^2/K; T = 400 K at x = 0 and
+ * T = 300 K at x = 2, every other face insulated. The answer is 1-D: a heat of
+ * 100 / (1/2 + 1/50 + 1/5) W through the interface, T linear in each brick.
+ *
+ * Every rank makes the whole (small) mesh and keeps its part: rank r owns a contiguous
+ * slab of the element list (a's elements, then b's, x slowest), so from 2 ranks on the
+ * interface is cut and pairs straddle ranks. A node belongs to the lowest rank among its
+ * elements; PETSc's global dofs number the nodes rank after rank. Each rank gives seam
+ * its elements' nodes (owned and ghost) with their global ids and dofs and the interface
+ * faces of its elements, assembles its elements' conduction into an MPIAIJ matrix, adds
+ * seam's terms of its own side-A points (ADD_VALUES), fixes the Dirichlet rows and solves
+ * with KSP (MUMPS LU by default; PETSc options override). Rank 0 prints the interface
+ * heat and the temperature at every node (by global id).
+ *
+ * `mpi_petsc serial` (on one rank) solves the same problem through the serial embedding
+ * (seam_embedding_*) with a dense solve instead, for comparison.
+ *
+ * Build: make -C examples/c_host mpi_petsc (needs petsc-dev and libseam built with
+ * --features mpi); run: mpirun -n 4 examples/c_host/mpi_petsc.
+ */
+#include <petsc.h>
+
+#include "host_fem.h"
+
+enum { NXA = 3, NYA = 4, NZA = 4, NXB = 2, NYB = 5, NZB = 3 };
+#define KA 2.0
+#define KB 5.0
+#define H 50.0
+#define T_LEFT 400.0
+#define T_RIGHT 300.0
+#define NODES_A ((NXA + 1) * (NYA + 1) * (NZA + 1))
+#define NODES ((NODES_A) + (NXB + 1) * (NYB + 1) * (NZB + 1))
+#define ELEMS_A (NXA * NYA * NZA)
+#define ELEMS ((ELEMS_A) + NXB * NYB * NZB)
+
+/* The whole mesh, the same on every rank. */
+typedef struct {
+    double xyz[NODES][3];
+    int conn[ELEMS][8]; /* global node ids, Exodus order */
+    int interface_side[ELEMS]; /* 2: a's face at x = 1 (side A), 4: b's (side B), 0 none */
+    double fixed[NODES]; /* Dirichlet value, or NAN */
+} Mesh;
+
+static void make_mesh(Mesh *m) {
+    const int nx[2] = {NXA, NXB}, ny[2] = {NYA, NYB}, nz[2] = {NZA, NZB};
+    const double x0[2] = {0.0, 1.0};
+    int node0 = 0, elem = 0;
+    for (int blk = 0; blk < 2; blk++) {
+        int sx = nx[blk] + 1, sy = ny[blk] + 1;
+        for (int k = 0; k <= nz[blk]; k++)
+            for (int j = 0; j <= ny[blk]; j++)
+                for (int i = 0; i <= nx[blk]; i++) {
+                    int n = node0 + i + sx * (j + sy * k);
+                    m->xyz[n][0] = x0[blk] + (double)i / nx[blk];
+                    m->xyz[n][1] = (double)j / ny[blk];
+                    m->xyz[n][2] = (double)k / nz[blk];
+                    m->fixed[n] = NAN;
+                    if (blk == 0 && i == 0) m->fixed[n] = T_LEFT;
+                    if (blk == 1 && i == nx[blk]) m->fixed[n] = T_RIGHT;
+                }
+        for (int i = 0; i < nx[blk]; i++)
+            for (int k = 0; k < nz[blk]; k++)
+                for (int j = 0; j < ny[blk]; j++, elem++) {
+                    int c[8][3] = {{i, j, k},         {i + 1, j, k},     {i + 1, j + 1, k},
+                                   {i, j + 1, k},     {i, j, k + 1},     {i + 1, j, k + 1},
+                                   {i + 1, j + 1, k + 1}, {i, j + 1, k + 1}};
+                    for (int a = 0; a < 8; a++)
+                        m->conn[elem][a] = node0 + c[a][0] + sx * (c[a][1] + sy * c[a][2]);
+                    m->interface_side[elem] = 0;
+                    if (blk == 0 && i == nx[blk] - 1) m->interface_side[elem] = 2;
+                    if (blk == 1 && i == 0) m->interface_side[elem] = 4;
+                }
+        node0 += sx * sy * (nz[blk] + 1);
+    }
+}
+
+static void element_matrix(const Mesh *m, int e, double ke[8][8]) {
+    double x[8][3];
+    for (int a = 0; a < 8; a++)
+        for (int d = 0; d < 3; d++) x[a][d] = m->xyz[m->conn[e][a]][d];
+    hex8_conduction(x, e < ELEMS_A ? KA : KB, ke);
+}
+
+static void print_results(const Mesh *m, const double *t_by_node, double qa, double qb,
+                          int ranks, size_t across) {
+    printf("ranks: %d\npoints across ranks: %zu\nheat: %.17g %.17g\n", ranks, across, qa, qb);
+    printf("x:");
+    for (int n = 0; n < NODES; n++) printf(" %.17g", m->xyz[n][0]);
+    printf("\ntemperature:");
+    for (int n = 0; n < NODES; n++) printf(" %.17g", t_by_node[n]);
+    printf("\n");
+}
+
+/* The same problem through the serial embedding and a dense solve. */
+static int serial(const Mesh *m) {
+    static double k[NODES * NODES], t[NODES];
+    int64_t conn[ELEMS * 8], dofs[NODES];
+    size_t n_right = 0, n_left = 0;
+    int64_t right_elem[ELEMS], left_elem[ELEMS];
+    int right_side[ELEMS], left_side[ELEMS];
+    for (int e = 0; e < ELEMS; e++) {
+        for (int a = 0; a < 8; a++) conn[8 * e + a] = m->conn[e][a];
+        if (m->interface_side[e] == 2) {
+            right_elem[n_right] = e;
+            right_side[n_right++] = 2;
+        } else if (m->interface_side[e] == 4) {
+            left_elem[n_left] = e;
+            left_side[n_left++] = 4;
+        }
+    }
+    for (int n = 0; n < NODES; n++) dofs[n] = n;
+    seam_builder *b;
+    seam_embedding *s;
+    CHECK(seam_builder_new(&m->xyz[0][0], NODES, &b));
+    CHECK(seam_builder_add_block(b, "a", SEAM_HEX8, conn, ELEMS_A, KA));
+    CHECK(seam_builder_add_block(b, "b", SEAM_HEX8, conn + 8 * ELEMS_A, ELEMS - ELEMS_A, KB));
+    CHECK(seam_builder_add_side_set(b, "right", right_elem, right_side, n_right));
+    CHECK(seam_builder_add_side_set(b, "left", left_elem, left_side, n_left));
+    CHECK(seam_builder_set_dofs(b, dofs, NODES));
+    CHECK(seam_embedding_new(b, &s));
+    seam_builder_free(b);
+    CHECK(seam_add_interaction(s, "right", "left", SEAM_GAP_CONDUCTANCE, H, 0.0, NULL));
+    CHECK(seam_search(s));
+    for (int e = 0; e < ELEMS; e++) {
+        double ke[8][8];
+        element_matrix(m, e, ke);
+        for (int a = 0; a < 8; a++)
+            for (int c = 0; c < 8; c++) k[m->conn[e][a] * NODES + m->conn[e][c]] += ke[a][c];
+    }
+    CHECK(seam_evaluate(s, t, NODES)); /* t = 0: the Jacobian of a linear model */
+    size_t n;
+    const int64_t *rows, *cols;
+    const double *vals;
+    CHECK(seam_jacobian(s, &n, &rows, &cols, &vals));
+    for (size_t q = 0; q < n; q++) k[rows[q] * NODES + cols[q]] += vals[q];
+    /* Dirichlet rows and columns: the identity's, their values moved to the right. */
+    for (int r = 0; r < NODES; r++) {
+        if (isnan(m->fixed[r])) continue;
+        for (int i = 0; i < NODES; i++) {
+            t[i] -= k[i * NODES + r] * m->fixed[r];
+            k[i * NODES + r] = 0.0;
+            k[r * NODES + i] = 0.0;
+        }
+    }
+    for (int r = 0; r < NODES; r++)
+        if (!isnan(m->fixed[r])) {
+            k[r * NODES + r] = 1.0;
+            t[r] = m->fixed[r];
+        }
+    if (solve_dense(k, t, NODES) != 0) {
+        fprintf(stderr, "the serial system is singular\n");
+        return 1;
+    }
+    double qa, qb;
+    CHECK(seam_heat_at(s, 0, t, NODES, &qa, &qb));
+    print_results(m, t, qa, qb, 1, 0);
+    seam_embedding_free(s);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    static Mesh m;
+    PetscMPIInt rank, size;
+    PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+    PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+    PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+    make_mesh(&m);
+    if (argc > 1 && strcmp(argv[1], "serial") == 0) {
+        int status = size == 1 ? serial(&m) : 2;
+        if (size != 1) fprintf(stderr, "`serial` runs on one rank\n");
+        PetscCall(PetscFinalize());
+        return status;
+    }
+
+    /* Partition: slabs of the element list; a node to the lowest rank among its elements. */
+    static int elem_rank[ELEMS], node_rank[NODES], dof[NODES], local_of[NODES];
+    for (int e = 0; e < ELEMS; e++) elem_rank[e] = (int)((long)e * size / ELEMS);
+    for (int n = 0; n < NODES; n++) node_rank[n] = size;
+    for (int e = 0; e < ELEMS; e++)
+        for (int a = 0; a < 8; a++) {
+            int n = m.conn[e][a];
+            if (elem_rank[e] < node_rank[n]) node_rank[n] = elem_rank[e];
+        }
+    /* PETSc's numbering: the nodes rank after rank, by global id inside a rank. */
+    int next = 0, owned = 0;
+    for (int r = 0; r < size; r++)
+        for (int n = 0; n < NODES; n++)
+            if (node_rank[n] == r) {
+                if (r == rank) owned++;
+                dof[n] = next++;
+            }
+
+    /* This rank's part: its elements, their nodes (owned and ghost) in first-seen order. */
+    static double xyz[NODES][3];
+    static int64_t gid[NODES], gdof[NODES], conn[ELEMS * 8], right[ELEMS], left[ELEMS];
+    static int right_side[ELEMS], left_side[ELEMS];
+    int n_local = 0, n_a = 0, n_b = 0;
+    size_t n_right = 0, n_left = 0;
+    for (int n = 0; n < NODES; n++) local_of[n] = -1;
+    for (int pass = 0; pass < 2; pass++) /* block a's elements, then b's */
+        for (int e = 0; e < ELEMS; e++) {
+            if (elem_rank[e] != rank || (e < ELEMS_A) != (pass == 0)) continue;
+            int local_elem = n_a + n_b;
+            for (int a = 0; a < 8; a++) {
+                int n = m.conn[e][a];
+                if (local_of[n] < 0) {
+                    local_of[n] = n_local;
+                    memcpy(xyz[n_local], m.xyz[n], sizeof xyz[0]);
+                    gid[n_local] = n;
+                    gdof[n_local] = dof[n];
+                    n_local++;
+                }
+                conn[8 * local_elem + a] = local_of[n];
+            }
+            if (m.interface_side[e] == 2) {
+                right[n_right] = local_elem;
+                right_side[n_right++] = 2;
+            } else if (m.interface_side[e] == 4) {
+                left[n_left] = local_elem;
+                left_side[n_left++] = 4;
+            }
+            if (pass == 0) n_a++;
+            else n_b++;
+        }
+
+    seam_builder *b;
+    seam_rank_embedding *s;
+    CHECK(seam_builder_new(&xyz[0][0], (size_t)n_local, &b));
+    CHECK(seam_builder_add_block(b, "a", SEAM_HEX8, conn, (size_t)n_a, KA));
+    CHECK(seam_builder_add_block(b, "b", SEAM_HEX8, conn + 8 * n_a, (size_t)n_b, KB));
+    CHECK(seam_builder_add_side_set(b, "right", right, right_side, n_right));
+    CHECK(seam_builder_add_side_set(b, "left", left, left_side, n_left));
+    CHECK(seam_builder_set_dofs(b, gdof, (size_t)n_local));
+    CHECK(seam_rank_new(b, PETSC_COMM_WORLD, gid, (size_t)n_local, &s));
+    seam_builder_free(b);
+    CHECK(seam_rank_add_interaction(s, "right", "left", SEAM_GAP_CONDUCTANCE, H, 0.0, NULL));
+    CHECK(seam_rank_search(s));
+    size_t across;
+    CHECK(seam_rank_points_across(s, &across));
+
+    /* Conduction of this rank's elements, then seam's terms of its own side-A points. */
+    Mat A;
+    Vec rhs, t;
+    PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, owned, owned, PETSC_DETERMINE, PETSC_DETERMINE,
+                           64, NULL, 64, NULL, &A));
+    PetscCall(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+    PetscCall(MatCreateVecs(A, &t, &rhs));
+    for (int e = 0; e < ELEMS; e++) {
+        if (elem_rank[e] != rank) continue;
+        double ke[8][8];
+        PetscInt rows[8];
+        element_matrix(&m, e, ke);
+        for (int a = 0; a < 8; a++) rows[a] = dof[m.conn[e][a]];
+        PetscCall(MatSetValues(A, 8, rows, 8, rows, &ke[0][0], ADD_VALUES));
+    }
+    static double zero[NODES];
+    CHECK(seam_rank_evaluate(s, zero, (size_t)n_local)); /* a linear model: J at any u */
+    size_t n;
+    const int64_t *rows, *cols, *dofs;
+    const double *vals;
+    CHECK(seam_rank_jacobian(s, &n, &rows, &cols, &vals));
+    for (size_t q = 0; q < n; q++)
+        PetscCall(MatSetValue(A, (PetscInt)rows[q], (PetscInt)cols[q], vals[q], ADD_VALUES));
+    CHECK(seam_rank_load(s, &n, &dofs, &vals));
+    for (size_t q = 0; q < n; q++)
+        PetscCall(VecSetValue(rhs, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
+    PetscCall(VecAssemblyBegin(rhs));
+    PetscCall(VecAssemblyEnd(rhs));
+
+    /* Dirichlet: this rank's fixed rows and columns become the identity's. */
+    static PetscInt fixed_rows[NODES];
+    PetscInt n_fixed = 0;
+    for (int g = 0; g < NODES; g++)
+        if (node_rank[g] == rank && !isnan(m.fixed[g])) {
+            fixed_rows[n_fixed++] = dof[g];
+            PetscCall(VecSetValue(t, dof[g], m.fixed[g], INSERT_VALUES));
+        }
+    PetscCall(VecAssemblyBegin(t));
+    PetscCall(VecAssemblyEnd(t));
+    PetscCall(MatZeroRowsColumns(A, n_fixed, fixed_rows, 1.0, t, rhs));
+
+    KSP ksp;
+    PC pc;
+    PetscCall(KSPCreate(PETSC_COMM_WORLD, &ksp));
+    PetscCall(KSPSetOperators(ksp, A, A));
+    PetscCall(KSPSetType(ksp, KSPPREONLY));
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCSetType(pc, PCLU));
+    PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    PetscCall(KSPSetFromOptions(ksp));
+    PetscCall(KSPSolve(ksp, rhs, t));
+
+    /* The solution at this rank's nodes (owned and ghost), for seam's heat. */
+    IS from;
+    Vec t_local;
+    VecScatter to_local;
+    static PetscInt local_dofs[NODES];
+    for (int k = 0; k < n_local; k++) local_dofs[k] = (PetscInt)gdof[k];
+    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, n_local, local_dofs, PETSC_COPY_VALUES, &from));
+    PetscCall(VecCreateSeq(PETSC_COMM_SELF, n_local, &t_local));
+    PetscCall(VecScatterCreate(t, from, t_local, NULL, &to_local));
+    PetscCall(VecScatterBegin(to_local, t, t_local, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecScatterEnd(to_local, t, t_local, INSERT_VALUES, SCATTER_FORWARD));
+    const PetscScalar *tl;
+    PetscCall(VecGetArrayRead(t_local, &tl));
+    CHECK(seam_rank_evaluate(s, tl, (size_t)n_local));
+    PetscCall(VecRestoreArrayRead(t_local, &tl));
+    double qa, qb;
+    CHECK(seam_rank_heat(s, 0, &qa, &qb));
+
+    /* Rank 0 prints every node's temperature, by global id. */
+    Vec t0;
+    VecScatter to_zero;
+    PetscCall(VecScatterCreateToZero(t, &to_zero, &t0));
+    PetscCall(VecScatterBegin(to_zero, t, t0, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecScatterEnd(to_zero, t, t0, INSERT_VALUES, SCATTER_FORWARD));
+    if (rank == 0) {
+        static double by_node[NODES];
+        const PetscScalar *all;
+        PetscCall(VecGetArrayRead(t0, &all));
+        for (int g = 0; g < NODES; g++) by_node[g] = all[dof[g]];
+        PetscCall(VecRestoreArrayRead(t0, &all));
+        print_results(&m, by_node, qa, qb, size, across);
+    }
+
+    seam_rank_free(s);
+    PetscCall(VecScatterDestroy(&to_zero));
+    PetscCall(VecDestroy(&t0));
+    PetscCall(VecScatterDestroy(&to_local));
+    PetscCall(VecDestroy(&t_local));
+    PetscCall(ISDestroy(&from));
+    PetscCall(KSPDestroy(&ksp));
+    PetscCall(VecDestroy(&t));
+    PetscCall(VecDestroy(&rhs));
+    PetscCall(MatDestroy(&A));
+    PetscCall(PetscFinalize());
+    return 0;
+}
