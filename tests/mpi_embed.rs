@@ -199,3 +199,296 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
         }
     }
 }
+
+/// Set in the processes `mpirun` starts for [`rank_terms_sum_to_the_serial_terms`].
+const CHILD: &str = "SEAM_MPI_EMBED_CHILD";
+
+/// The two bricks of mpi_petsc.c (a: 3 × 4 × 4 hexahedra on [0,1]³, b: 2 × 5 × 3 on
+/// [1,2] × [0,1]²), element by element (a's, then b's, x slowest), with the faces of the
+/// interfaces: a's x = 1 (`right`, side 2), b's x = 1 (`left`, side 4), a's y = 0
+/// (`front`, side 1) and y = 1 (`back`, side 3).
+struct Bricks {
+    xyz: Vec<[f64; 3]>,
+    conn: Vec<[usize; 8]>,
+    /// Per element: its block (0 a, 1 b) and its interface faces (surface, side).
+    block: Vec<usize>,
+    faces: Vec<Vec<(usize, u8)>>,
+}
+
+const SURFACES: [&str; 4] = ["right", "left", "front", "back"];
+
+fn bricks() -> Bricks {
+    let mut m = Bricks {
+        xyz: Vec::new(),
+        conn: Vec::new(),
+        block: Vec::new(),
+        faces: Vec::new(),
+    };
+    for (blk, (n, x0)) in [([3, 4, 4], 0.0), ([2, 5, 3], 1.0)].into_iter().enumerate() {
+        let first = m.xyz.len();
+        let (sx, sy) = (n[0] + 1, n[1] + 1);
+        for k in 0..=n[2] {
+            for j in 0..=n[1] {
+                for i in 0..=n[0] {
+                    let f = |a: usize, b: usize| a as f64 / b as f64;
+                    m.xyz.push([x0 + f(i, n[0]), f(j, n[1]), f(k, n[2])]);
+                }
+            }
+        }
+        let node = |i: usize, j: usize, k: usize| first + i + sx * (j + sy * k);
+        for i in 0..n[0] {
+            for k in 0..n[2] {
+                for j in 0..n[1] {
+                    m.conn.push([
+                        node(i, j, k),
+                        node(i + 1, j, k),
+                        node(i + 1, j + 1, k),
+                        node(i, j + 1, k),
+                        node(i, j, k + 1),
+                        node(i + 1, j, k + 1),
+                        node(i + 1, j + 1, k + 1),
+                        node(i, j + 1, k + 1),
+                    ]);
+                    m.block.push(blk);
+                    let mut faces = Vec::new();
+                    if blk == 0 && i == n[0] - 1 {
+                        faces.push((0, 2));
+                    }
+                    if blk == 1 && i == 0 {
+                        faces.push((1, 4));
+                    }
+                    if blk == 0 && j == 0 {
+                        faces.push((2, 1));
+                    }
+                    if blk == 0 && j == n[1] - 1 {
+                        faces.push((3, 3));
+                    }
+                    m.faces.push(faces);
+                }
+            }
+        }
+    }
+    m
+}
+
+/// A field that is not linear, so the residuals are not those of a linear field.
+fn field(x: [f64; 3]) -> f64 {
+    300.0 + 40.0 * x[0] + 7.0 * (3.0 * x[1]).sin() + 5.0 * x[2] * x[2]
+}
+
+/// The host's global dof of global node `g`: a permutation of the nodes (172 and 7 are
+/// coprime), so that dof and node numbers differ.
+fn dof_of(g: usize, nodes: usize) -> usize {
+    (g * 7) % nodes
+}
+
+fn interactions() -> Vec<seam::embed::Interaction> {
+    use seam::embed::{Interaction, Model, Periodic};
+    vec![
+        Interaction::new("right", "left", Model::GapConductance { h: H }).offset(3.0),
+        Interaction::new("front", "back", Model::TiedNitsche).periodic(Periodic::Rectangular {
+            offset: [0.0, 1.0, 0.0],
+        }),
+    ]
+}
+
+/// An embedding builder of elements `elems` of the bricks (a's and b's blocks, the four
+/// surfaces), with nodes numbered by `local` (global → local, in first-seen order).
+fn builder_of(m: &Bricks, elems: &[usize]) -> (seam::embed::EmbeddingBuilder, Vec<usize>) {
+    use seam::embed::{Embedding, Topology};
+    let mut local_of = vec![usize::MAX; m.xyz.len()];
+    let mut nodes = Vec::new();
+    let mut conn = [Vec::new(), Vec::new()];
+    let mut order = Vec::new();
+    for blk in 0..2 {
+        for &e in elems.iter().filter(|&&e| m.block[e] == blk) {
+            for &g in &m.conn[e] {
+                if local_of[g] == usize::MAX {
+                    local_of[g] = nodes.len();
+                    nodes.push(g);
+                }
+                conn[blk].push(local_of[g]);
+            }
+            order.push(e);
+        }
+    }
+    let coords: Vec<[f64; 3]> = nodes.iter().map(|&g| m.xyz[g]).collect();
+    let dofs: Vec<usize> = nodes.iter().map(|&g| dof_of(g, m.xyz.len())).collect();
+    let mut b = Embedding::builder(&coords)
+        .block("a", Topology::Hex8, &conn[0], KA)
+        .block("b", Topology::Hex8, &conn[1], KB)
+        .dofs(&dofs);
+    for (s, name) in SURFACES.iter().enumerate() {
+        let sides: Vec<(usize, u8)> = order
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &e)| {
+                m.faces[e]
+                    .iter()
+                    .filter(move |f| f.0 == s)
+                    .map(move |f| (k, f.1))
+            })
+            .collect();
+        b = b.side_set(name, &sides);
+    }
+    (b, nodes)
+}
+
+/// Dense `n × n` Jacobian and residual and load vectors of `c`.
+fn dense(c: &seam::embed::Contributions, n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n * n + 2 * n];
+    for &(i, j, v) in &c.jacobian {
+        out[i * n + j] += v;
+    }
+    for &(d, v) in &c.residual {
+        out[n * n + d] += v;
+    }
+    for &(d, v) in &c.load {
+        out[n * n + n + d] += v;
+    }
+    out
+}
+
+/// Under `mpirun -n 1..4`: each rank builds the embedding of its slab of elements
+/// (`RankEmbedding`), a gap conductance with an offset across the non-matching x = 1 and
+/// a periodic Nitsche tie of a's y = 0 and y = 1 faces, evaluates at a curved field; the
+/// ranks' Jacobians, residuals and loads summed equal the serial embedding's, and the
+/// heats too. Then a rank that gives a wrong count of global ids fails with its own
+/// error, and every other rank with `OtherRank` naming it (none hangs).
+#[test]
+fn rank_terms_sum_to_the_serial_terms() {
+    if std::env::var_os(CHILD).is_some() {
+        return rank_terms_child();
+    }
+    for n in 1..=4 {
+        let mut cmd = Command::new("mpirun");
+        cmd.args(["--oversubscribe", "-n", &n.to_string()])
+            .arg(std::env::current_exe().unwrap())
+            .args([
+                "--exact",
+                "rank_terms_sum_to_the_serial_terms",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env(CHILD, "1")
+            .env("RAYON_NUM_THREADS", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+            .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+        let out = cmd.output().expect("mpirun");
+        let text = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(out.status.success(), "{n} ranks:\n{text}");
+        // libtest prints the test's name first, on the same line.
+        let line = text
+            .lines()
+            .find_map(|l| l.find("rank terms:").map(|k| &l[k..]))
+            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
+        eprintln!("mpirun -n {n}: {line}");
+        assert_eq!(
+            text.matches("refused on every rank").count(),
+            n,
+            "every rank saw the bad input refused:\n{text}"
+        );
+    }
+}
+
+fn rank_terms_child() {
+    use mpi::traits::{Communicator, CommunicatorCollectives};
+    use seam::embed::{EmbedError, Embedding};
+    let universe = mpi::initialize().expect("MPI");
+    let world = universe.world();
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let m = bricks();
+    let (n_nodes, n_elems) = (m.xyz.len(), m.conn.len());
+    let u: Vec<f64> = (0..n_nodes)
+        .map(|d| {
+            // u by dof: the node whose dof is d.
+            let g = (0..n_nodes).find(|&g| dof_of(g, n_nodes) == d).unwrap();
+            field(m.xyz[g])
+        })
+        .collect();
+
+    // The serial embedding of the whole mesh.
+    let all: Vec<usize> = (0..n_elems).collect();
+    let mut serial = builder_of(&m, &all).0.build().expect("serial build");
+    for i in interactions() {
+        serial.add_interaction(i).expect("serial interaction");
+    }
+    serial.search().expect("serial search");
+    let want = serial.contributions(&u).expect("serial terms");
+
+    // This rank's slab of elements.
+    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
+    let (b, nodes) = builder_of(&m, &mine);
+    let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
+    let mut e = b
+        .clone()
+        .build_on_ranks(world.duplicate(), &gids)
+        .expect("rank build");
+    for i in interactions() {
+        e.add_interaction(i).expect("rank interaction");
+    }
+    e.search().expect("rank search");
+    let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.xyz[g])).collect();
+    let got = e.contributions(&u_local).expect("rank terms");
+    let mine_dense = dense(&got, n_nodes);
+    let mut summed = vec![0.0; mine_dense.len()];
+    world.all_reduce_into(
+        &mine_dense[..],
+        &mut summed[..],
+        mpi::collective::SystemOperation::sum(),
+    );
+    let serial_dense = dense(&want, n_nodes);
+    let scale = serial_dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let diff = serial_dense
+        .iter()
+        .zip(&summed)
+        .fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+    let mut heat_diff = 0.0f64;
+    for (w, g) in want.heat.iter().zip(&got.heat) {
+        let (w, g) = (w.unwrap(), g.unwrap());
+        heat_diff = heat_diff
+            .max((w.side_a - g.side_a).abs())
+            .max((w.side_b - g.side_b).abs());
+    }
+    let heat_scale = want.heat[0].unwrap().side_a.abs();
+    if rank == 0 {
+        println!(
+            "rank terms: max |Δ| of the summed Jacobian, residual and load {diff:.2e} (of {scale:.3e}), max |Δheat| {heat_diff:.2e} W (of {heat_scale:.3e}), points paired across ranks {}",
+            e.points_across()
+        );
+    }
+    assert!(diff <= 1e-12 * scale, "terms differ by {diff:e}");
+    assert!(
+        heat_diff <= 1e-12 * heat_scale,
+        "heat differs by {heat_diff:e}"
+    );
+    if size > 1 {
+        assert!(e.points_across() > 0, "pairs straddle ranks");
+    }
+
+    // The last rank gives one global id too few: it fails, the others hear of it.
+    let last = size - 1;
+    let short = if rank == last {
+        &gids[..gids.len() - 1]
+    } else {
+        &gids[..]
+    };
+    match b.build_on_ranks(world.duplicate(), short) {
+        Err(EmbedError::Mesh { what, .. }) if rank == last => {
+            assert!(what.contains("global ids for"), "{what}");
+            println!("rank {rank}: refused on every rank ({what})");
+        }
+        Err(EmbedError::OtherRank { rank: r }) if rank != last => {
+            assert_eq!(r, last);
+            println!("rank {rank}: refused on every rank (rank {r} failed)");
+        }
+        Err(other) => panic!("rank {rank}: unexpected error {other}"),
+        Ok(_) => panic!("rank {rank}: a short global id list was taken"),
+    }
+    world.barrier();
+}
