@@ -300,14 +300,14 @@ fn builder_of(m: &Bricks, elems: &[usize]) -> (seam::embed::EmbeddingBuilder, Ve
     let mut nodes = Vec::new();
     let mut conn = [Vec::new(), Vec::new()];
     let mut order = Vec::new();
-    for blk in 0..2 {
+    for (blk, conn) in conn.iter_mut().enumerate() {
         for &e in elems.iter().filter(|&&e| m.block[e] == blk) {
             for &g in &m.conn[e] {
                 if local_of[g] == usize::MAX {
                     local_of[g] = nodes.len();
                     nodes.push(g);
                 }
-                conn[blk].push(local_of[g]);
+                conn.push(local_of[g]);
             }
             order.push(e);
         }
@@ -398,7 +398,7 @@ fn rank_terms_sum_to_the_serial_terms() {
 
 fn rank_terms_child() {
     use mpi::traits::{Communicator, CommunicatorCollectives};
-    use seam::embed::{EmbedError, Embedding};
+    use seam::embed::EmbedError;
     let universe = mpi::initialize().expect("MPI");
     let world = universe.world();
     let (rank, size) = (world.rank() as usize, world.size() as usize);

@@ -30,6 +30,7 @@
 use std::collections::HashMap;
 
 use mpi::collective::SystemOperation;
+use mpi::datatype::PartitionMut;
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
@@ -38,7 +39,6 @@ use super::{
     argument, mesh_error,
 };
 use crate::mesh::{ElemId, NodeId};
-use crate::parallel::session::gather_all;
 
 /// One rank's embedding in a host that runs on MPI (see the module docs).
 pub struct RankEmbedding {
@@ -92,22 +92,30 @@ fn agree<T>(comm: &SimpleCommunicator, r: Result<T, EmbedError>) -> Result<T, Em
     }
 }
 
-/// Every rank's `mine`, one vector per rank.
+/// Every rank's `mine`, one vector per rank, on every rank (`MPI_Allgather` of the
+/// counts, then `MPI_Allgatherv`).
 fn gather_parts<T>(comm: &SimpleCommunicator, mine: &[T]) -> Vec<Vec<T>>
 where
     T: mpi::datatype::Equivalence + Copy + Default,
 {
-    let mut counts = vec![0u64; comm.size() as usize];
-    comm.all_gather_into(&(mine.len() as u64), &mut counts[..]);
-    let all = gather_all(comm, mine);
-    let mut start = 0;
+    let mut counts = vec![0i32; comm.size() as usize];
+    comm.all_gather_into(&(mine.len() as i32), &mut counts[..]);
+    let starts: Vec<i32> = counts
+        .iter()
+        .scan(0, |s, &n| {
+            *s += n;
+            Some(*s - n)
+        })
+        .collect();
+    let mut all = vec![T::default(); counts.iter().sum::<i32>() as usize];
+    {
+        let mut got = PartitionMut::new(&mut all[..], &counts[..], &starts[..]);
+        comm.all_gather_varcount_into(mine, &mut got);
+    }
     counts
         .iter()
-        .map(|&n| {
-            let part = all[start..start + n as usize].to_vec();
-            start += n as usize;
-            part
-        })
+        .zip(&starts)
+        .map(|(&n, &s)| all[s as usize..(s + n) as usize].to_vec())
         .collect()
 }
 
@@ -508,7 +516,7 @@ impl RankEmbedding {
         };
         agree(&self.comm, check)?;
         let mine: Vec<f64> = self.sent.iter().map(|&k| u_local[k]).collect();
-        let all = gather_all(&self.comm, &mine);
+        let all = gather_parts(&self.comm, &mine).concat();
         let u: Vec<f64> = self.value_at.iter().map(|&k| all[k]).collect();
         let mut c = agree(&self.comm, self.inner.contributions(&u))?;
         let dof = |k: usize| self.global_dof[k];

@@ -26,7 +26,7 @@ pub mod petsc;
 #[cfg(feature = "mpi")]
 pub mod search;
 #[cfg(feature = "mpi")]
-pub(crate) mod session;
+mod session;
 #[cfg(feature = "mpi")]
 mod steady;
 

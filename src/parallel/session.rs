@@ -77,7 +77,7 @@ pub(super) fn displacements(counts: &[i32]) -> Vec<i32> {
 
 /// Every rank's `mine`, concatenated in rank order, on every rank (`MPI_Allgather` of
 /// the counts, then `MPI_Allgatherv`).
-pub(crate) fn gather_all<T>(world: &SimpleCommunicator, mine: &[T]) -> Vec<T>
+pub(super) fn gather_all<T>(world: &SimpleCommunicator, mine: &[T]) -> Vec<T>
 where
     T: mpi::datatype::Equivalence + Copy + Default,
 {
