@@ -380,7 +380,7 @@ int seam_tie_point_fields(seam_embedding *embedding, size_t tie, const double *l
  *   seam_rank_heat(e, 0, &q_a, &q_b);                 summed over the ranks
  *   seam_rank_free(e);                                before MPI_Finalize / PetscFinalize
  *
- * Collective: seam_rank_new, _add_interaction, _search, _evaluate and _free must be
+ * Collective: seam_rank_new, _add_interaction, _add_deck, _search, _evaluate and _free must be
  * called by every rank of the communicator, in the same order, with the same
  * interactions; the getters are local. An error on one rank is an error on every rank:
  * that rank's own status and message there, SEAM_ERR_OTHER_RANK naming it elsewhere, so
@@ -411,6 +411,10 @@ void seam_rank_free(seam_rank_embedding *embedding);
 int seam_rank_add_interaction(seam_rank_embedding *embedding, const char *side_a,
                               const char *side_b, int model, double h, double offset,
                               size_t *out_index);
+/* As seam_add_deck: the same deck on every rank (name may be NULL); a deck with a mortar
+ * tie is refused whole (SEAM_ERR_ARGUMENT). */
+int seam_rank_add_deck(seam_rank_embedding *embedding, const char *deck_text, const char *name,
+                       size_t *out_count);
 /* Pair every interaction anew: the serial search of the whole interface, on every rank;
  * each rank keeps the points of its own side-A faces. */
 int seam_rank_search(seam_rank_embedding *embedding);

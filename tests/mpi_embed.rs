@@ -471,6 +471,38 @@ fn rank_terms_child() {
         assert!(e.points_across() > 0, "pairs straddle ranks");
     }
 
+    // The same interface from a deck: the same heat as the serial embedding's deck; a
+    // deck with a mortar tie is refused on every rank, and leaves nothing behind.
+    let deck = |enforcement: &str| {
+        format!(
+            "begin contact definition bricks\n  contact surface ra contains right\n  contact surface lb contains left\n  begin interaction\n    side a ra\n    side b lb\n  end\n  begin enforcement\n{enforcement}  end\nend\n"
+        )
+    };
+    let gap = deck(
+        "    enforcement for energy = gap_conductance\n    gap conductance coefficient = constant h = 50\n",
+    );
+    let mut serial = builder_of(&m, &all).0.build().unwrap();
+    serial.add_deck("bricks.i", &gap).expect("serial deck");
+    serial.search().unwrap();
+    let want = serial.heat(&u).unwrap()[0].unwrap();
+    let mut e = b.clone().build_on_ranks(world.duplicate(), &gids).unwrap();
+    let tie =
+        deck("    enforcement for energy = tied\n    side b variable temperature to temperature\n");
+    match e.add_deck("tied.i", &tie) {
+        Err(EmbedError::Argument { what, .. }) => assert!(what.contains("multipliers"), "{what}"),
+        other => panic!("rank {rank}: a mortar tie deck gave {other:?}"),
+    }
+    assert!(e.is_empty(), "the refused deck left no interaction");
+    assert_eq!(e.add_deck("bricks.i", &gap).expect("rank deck"), vec![0]);
+    e.search().unwrap();
+    let got = e.contributions(&u_local).unwrap().heat[0].unwrap();
+    assert!(
+        (want.side_a - got.side_a).abs() <= 1e-12 * want.side_a.abs(),
+        "deck heat {} against serial {}",
+        got.side_a,
+        want.side_a
+    );
+
     // The last rank gives one global id too few: it fails, the others hear of it.
     let last = size - 1;
     let short = if rank == last {

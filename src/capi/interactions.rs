@@ -141,19 +141,33 @@ pub unsafe extern "C" fn seam_add_deck(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let deck = unsafe { text(deck_text, "deck_text") }?;
-        let name = if name.is_null() {
-            "deck"
-        } else {
-            unsafe { text(name, "name") }?
-        };
+        let (deck, name) = unsafe { deck_args(deck_text, name) }?;
         let added = e.inner.add_deck(name, deck)?;
         e.forget_results();
-        if !out_count.is_null() {
-            unsafe { out(out_count, added.len(), "out_count") }?;
-        }
-        Ok(())
+        unsafe { optional_out(out_count, added.len()) }
     })
+}
+
+/// A deck's text and its label (`"deck"` for a null name).
+pub(super) unsafe fn deck_args<'a>(
+    deck_text: *const c_char,
+    name: *const c_char,
+) -> Result<(&'a str, &'a str), Failure> {
+    let deck = unsafe { text(deck_text, "deck_text") }?;
+    let name = if name.is_null() {
+        "deck"
+    } else {
+        unsafe { text(name, "name") }?
+    };
+    Ok((deck, name))
+}
+
+/// Write `n` to `out_count` (a count or an index) unless it is null.
+pub(super) unsafe fn optional_out(out_count: *mut usize, n: usize) -> Result<(), Failure> {
+    if out_count.is_null() {
+        return Ok(());
+    }
+    unsafe { out(out_count, n, "out_count") }
 }
 
 /// Add the interactions of a deck file (Sierra syntax or `.toml`); relative paths in

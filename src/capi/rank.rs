@@ -84,10 +84,25 @@ pub unsafe extern "C" fn seam_rank_add_interaction(
             .inner
             .add_interaction(Interaction::new(a, b, model).offset(offset))?;
         e.evaluated = None;
-        if !out_index.is_null() {
-            unsafe { out(out_index, i, "out_index") }?;
-        }
-        Ok(())
+        unsafe { interactions::optional_out(out_index, i) }
+    })
+}
+
+/// As `seam_add_deck`, the same deck on every rank; a deck with a mortar tie is
+/// refused whole. Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_add_deck(
+    embedding: *mut SeamRankEmbedding,
+    deck_text: *const c_char,
+    name: *const c_char,
+    out_count: *mut usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let (deck, name) = unsafe { interactions::deck_args(deck_text, name) }?;
+        let added = e.inner.add_deck(name, deck)?;
+        e.evaluated = None;
+        unsafe { interactions::optional_out(out_count, added.len()) }
     })
 }
 

@@ -421,11 +421,11 @@ impl RankEmbedding {
         agree(&self.comm, r)
     }
 
-    /// The interactions of a contact deck file (collective), as
-    /// [`Embedding::add_deck_file`]; a deck with mortar ties is refused whole.
-    pub fn add_deck_file(&mut self, path: &std::path::Path) -> Result<Vec<usize>, EmbedError> {
+    /// The interactions of a contact deck (collective), as [`Embedding::add_deck`]: the
+    /// same deck on every rank; one with a mortar tie is refused whole.
+    pub fn add_deck(&mut self, name: &str, text: &str) -> Result<Vec<usize>, EmbedError> {
         let before = self.inner.pairs.len();
-        let mut r = self.inner.add_deck_file(path);
+        let mut r = self.inner.add_deck(name, text);
         if let Some(p) = self.inner.pairs[before..]
             .iter()
             .find(|p| matches!(p.enforcement, Enforcement::Tie { .. }))
