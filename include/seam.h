@@ -401,7 +401,8 @@ typedef struct SeamRankEmbedding seam_rank_embedding;
  * its element). global_ids: the global id of each of the n_nodes local nodes (>= 0; a
  * node held by several ranks has one id and one dof). comm is duplicated (MPI_Comm_dup):
  * the caller keeps its own. The builder is unchanged and still owned by the caller.
- * On failure *out_embedding is NULL. */
+ * On failure *out_embedding is NULL. MPI not running or comm MPI_COMM_NULL is
+ * SEAM_ERR_ARGUMENT on that rank alone (there is no communicator to tell the others). */
 int seam_rank_new(const seam_builder *builder, MPI_Comm comm, const int64_t *global_ids,
                   size_t n_nodes, seam_rank_embedding **out_embedding);
 /* Free the handle and its communicator (collective: MPI_Comm_free); before MPI_Finalize.

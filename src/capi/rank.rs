@@ -42,8 +42,8 @@ pub unsafe extern "C" fn seam_rank_new(
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        // SAFETY: the host passes a valid communicator of an initialised MPI (seam.h).
-        let comm = unsafe { crate::embed::duplicate(comm) };
+        // SAFETY: the host passes MPI_COMM_NULL or a communicator of its MPI (seam.h).
+        let comm = unsafe { crate::embed::duplicate(comm) }?;
         let inner = b.build_on_ranks(comm, &ids)?;
         let e = Box::new(SeamRankEmbedding {
             inner,

@@ -64,16 +64,44 @@ pub struct RankEmbedding {
 }
 
 /// `MPI_Comm_dup` of the host's communicator: seam's messages never meet the host's.
+/// An MPI not (or no longer) running, `MPI_COMM_NULL` or a communicator MPI refuses to
+/// duplicate is an error, not an abort.
 ///
 /// # Safety
-/// `comm` must be a valid communicator of an initialised MPI.
-pub unsafe fn duplicate(comm: mpi::ffi::MPI_Comm) -> SimpleCommunicator {
-    let mut dup = std::mem::MaybeUninit::uninit();
-    // SAFETY: the caller passes a valid communicator; MPI_Comm_dup writes `dup`.
+/// `comm` must be `MPI_COMM_NULL` or a communicator of this process's MPI.
+pub unsafe fn duplicate(comm: mpi::ffi::MPI_Comm) -> Result<SimpleCommunicator, EmbedError> {
+    use mpi::ffi;
+    let (mut up, mut down) = (0, 0);
+    // SAFETY: both may be called at any time, before MPI_Init and after MPI_Finalize.
     unsafe {
-        mpi::ffi::MPI_Comm_dup(comm, dup.as_mut_ptr());
-        <SimpleCommunicator as mpi::raw::FromRaw>::from_raw(dup.assume_init())
+        ffi::MPI_Initialized(&mut up);
+        ffi::MPI_Finalized(&mut down);
     }
+    if up == 0 || down != 0 {
+        return Err(argument(
+            "MPI is not running".into(),
+            "call MPI_Init (or PetscInitialize) before seam and MPI_Finalize after freeing seam's handles",
+        ));
+    }
+    // SAFETY: a constant of the MPI library.
+    if comm == unsafe { ffi::RSMPI_COMM_NULL } {
+        return Err(argument(
+            "the communicator is MPI_COMM_NULL".into(),
+            "pass the communicator the host's ranks share (e.g. PETSC_COMM_WORLD)",
+        ));
+    }
+    let mut dup = std::mem::MaybeUninit::uninit();
+    // SAFETY: the caller passes a communicator of this MPI; MPI_Comm_dup writes `dup`
+    // when it succeeds. MPI's own error handler on `comm` may still abort on a bad one.
+    let status = unsafe { ffi::MPI_Comm_dup(comm, dup.as_mut_ptr()) };
+    if status != 0 {
+        return Err(argument(
+            format!("MPI_Comm_dup failed on the host's communicator (MPI error {status})"),
+            "pass a valid communicator of the host's ranks",
+        ));
+    }
+    // SAFETY: written by the successful MPI_Comm_dup; seam owns (and frees) the copy.
+    Ok(unsafe { <SimpleCommunicator as mpi::raw::FromRaw>::from_raw(dup.assume_init()) })
 }
 
 /// An error on some rank becomes an error on every rank: the lowest failing rank's own
