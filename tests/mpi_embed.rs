@@ -9,6 +9,9 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use seam::mesh::generate::{self, BoxSpec};
+use seam::mesh::{ElemId, Mesh};
+
 /// Largest difference allowed, relative to the largest |value|: the serial path solves
 /// by dense Gaussian elimination, the distributed one by MUMPS LU over an MPIAIJ matrix
 /// whose entries were summed in another order, which on 172 unknowns leaves round-off of
@@ -204,72 +207,21 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
 const CHILD: &str = "SEAM_MPI_EMBED_CHILD";
 
 /// The two bricks of mpi_petsc.c (a: 3 × 4 × 4 hexahedra on [0,1]³, b: 2 × 5 × 3 on
-/// [1,2] × [0,1]²), element by element (a's, then b's, x slowest), with the faces of the
-/// interfaces: a's x = 1 (`right`, side 2), b's x = 1 (`left`, side 4), a's y = 0
-/// (`front`, side 1) and y = 1 (`back`, side 3).
-struct Bricks {
-    xyz: Vec<[f64; 3]>,
-    conn: Vec<[usize; 8]>,
-    /// Per element: its block (0 a, 1 b) and its interface faces (surface, side).
-    block: Vec<usize>,
-    faces: Vec<Vec<(usize, u8)>>,
+/// [1,2] × [0,1]², meshed apart), by seam's generator, with the side sets of the
+/// interfaces: 1 a's x = 1, 2 b's x = 1, 3 a's y = 0, 4 a's y = 1.
+fn bricks() -> Mesh {
+    generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0; 3], [3, 4, 4], 1).with_side_sets([0, 1, 3, 4, 0, 0]),
+            BoxSpec::hex([1.0, 0.0, 0.0], [2.0, 1.0, 1.0], [2, 5, 3], 2)
+                .with_side_sets([2, 0, 0, 0, 0, 0]),
+        ],
+        false,
+    )
 }
 
+/// The host's names of side sets 1 to 4.
 const SURFACES: [&str; 4] = ["right", "left", "front", "back"];
-
-fn bricks() -> Bricks {
-    let mut m = Bricks {
-        xyz: Vec::new(),
-        conn: Vec::new(),
-        block: Vec::new(),
-        faces: Vec::new(),
-    };
-    for (blk, (n, x0)) in [([3, 4, 4], 0.0), ([2, 5, 3], 1.0)].into_iter().enumerate() {
-        let first = m.xyz.len();
-        let (sx, sy) = (n[0] + 1, n[1] + 1);
-        for k in 0..=n[2] {
-            for j in 0..=n[1] {
-                for i in 0..=n[0] {
-                    let f = |a: usize, b: usize| a as f64 / b as f64;
-                    m.xyz.push([x0 + f(i, n[0]), f(j, n[1]), f(k, n[2])]);
-                }
-            }
-        }
-        let node = |i: usize, j: usize, k: usize| first + i + sx * (j + sy * k);
-        for i in 0..n[0] {
-            for k in 0..n[2] {
-                for j in 0..n[1] {
-                    m.conn.push([
-                        node(i, j, k),
-                        node(i + 1, j, k),
-                        node(i + 1, j + 1, k),
-                        node(i, j + 1, k),
-                        node(i, j, k + 1),
-                        node(i + 1, j, k + 1),
-                        node(i + 1, j + 1, k + 1),
-                        node(i, j + 1, k + 1),
-                    ]);
-                    m.block.push(blk);
-                    let mut faces = Vec::new();
-                    if blk == 0 && i == n[0] - 1 {
-                        faces.push((0, 2));
-                    }
-                    if blk == 1 && i == 0 {
-                        faces.push((1, 4));
-                    }
-                    if blk == 0 && j == 0 {
-                        faces.push((2, 1));
-                    }
-                    if blk == 0 && j == n[1] - 1 {
-                        faces.push((3, 3));
-                    }
-                    m.faces.push(faces);
-                }
-            }
-        }
-    }
-    m
-}
 
 /// A field that is not linear, so the residuals are not those of a linear field.
 fn field(x: [f64; 3]) -> f64 {
@@ -292,42 +244,44 @@ fn interactions() -> Vec<seam::embed::Interaction> {
     ]
 }
 
-/// An embedding builder of elements `elems` of the bricks (a's and b's blocks, the four
-/// surfaces), with nodes numbered by `local` (global → local, in first-seen order).
-fn builder_of(m: &Bricks, elems: &[usize]) -> (seam::embed::EmbeddingBuilder, Vec<usize>) {
+/// An embedding builder of elements `elems` of the bricks (their two blocks, the four
+/// surfaces), with the local nodes in first-seen order (returned by global number).
+fn builder_of(m: &Mesh, elems: &[usize]) -> (seam::embed::EmbeddingBuilder, Vec<usize>) {
     use seam::embed::{Embedding, Topology};
-    let mut local_of = vec![usize::MAX; m.xyz.len()];
+    let mut local_of = vec![usize::MAX; m.coords.len()];
     let mut nodes = Vec::new();
     let mut conn = [Vec::new(), Vec::new()];
-    let mut order = Vec::new();
+    // Local elements are numbered block after block.
+    let (mut local_elem, mut next) = (vec![usize::MAX; m.num_elems()], 0);
     for (blk, conn) in conn.iter_mut().enumerate() {
-        for &e in elems.iter().filter(|&&e| m.block[e] == blk) {
-            for &g in &m.conn[e] {
+        for &e in elems
+            .iter()
+            .filter(|&&e| m.block_of(ElemId(e as u32)) == blk)
+        {
+            for g in m.elem_nodes(ElemId(e as u32)).iter().map(|n| n.index()) {
                 if local_of[g] == usize::MAX {
                     local_of[g] = nodes.len();
                     nodes.push(g);
                 }
                 conn.push(local_of[g]);
             }
-            order.push(e);
+            local_elem[e] = next;
+            next += 1;
         }
     }
-    let coords: Vec<[f64; 3]> = nodes.iter().map(|&g| m.xyz[g]).collect();
-    let dofs: Vec<usize> = nodes.iter().map(|&g| dof_of(g, m.xyz.len())).collect();
+    let coords: Vec<[f64; 3]> = nodes.iter().map(|&g| m.coords[g]).collect();
+    let dofs: Vec<usize> = nodes.iter().map(|&g| dof_of(g, m.coords.len())).collect();
     let mut b = Embedding::builder(&coords)
         .block("a", Topology::Hex8, &conn[0], KA)
         .block("b", Topology::Hex8, &conn[1], KB)
         .dofs(&dofs);
-    for (s, name) in SURFACES.iter().enumerate() {
-        let sides: Vec<(usize, u8)> = order
+    for (k, name) in SURFACES.iter().enumerate() {
+        let set = m.side_sets.iter().find(|s| s.id == k as i64 + 1).unwrap();
+        let sides: Vec<(usize, u8)> = set
+            .sides
             .iter()
-            .enumerate()
-            .flat_map(|(k, &e)| {
-                m.faces[e]
-                    .iter()
-                    .filter(move |f| f.0 == s)
-                    .map(move |f| (k, f.1))
-            })
+            .filter(|s| local_elem[s.elem.index()] != usize::MAX)
+            .map(|s| (local_elem[s.elem.index()], s.side))
             .collect();
         b = b.side_set(name, &sides);
     }
@@ -403,12 +357,12 @@ fn rank_terms_child() {
     let world = universe.world();
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let m = bricks();
-    let (n_nodes, n_elems) = (m.xyz.len(), m.conn.len());
+    let (n_nodes, n_elems) = (m.coords.len(), m.num_elems());
     let u: Vec<f64> = (0..n_nodes)
         .map(|d| {
             // u by dof: the node whose dof is d.
             let g = (0..n_nodes).find(|&g| dof_of(g, n_nodes) == d).unwrap();
-            field(m.xyz[g])
+            field(m.coords[g])
         })
         .collect();
 
@@ -433,7 +387,7 @@ fn rank_terms_child() {
         e.add_interaction(i).expect("rank interaction");
     }
     e.search().expect("rank search");
-    let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.xyz[g])).collect();
+    let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.coords[g])).collect();
     let got = e.contributions(&u_local).expect("rank terms");
     let mine_dense = dense(&got, n_nodes);
     let mut summed = vec![0.0; mine_dense.len()];

@@ -167,18 +167,7 @@ pub unsafe extern "C" fn seam_rank_residual(
     out_dofs: *mut *const i64,
     out_values: *mut *const f64,
 ) -> c_int {
-    guard(|| {
-        let v = unsafe { rank_evaluated(embedding) }?;
-        unsafe {
-            terms::pairs(
-                out_n,
-                out_dofs,
-                out_values,
-                &v.residual_dofs,
-                &v.residual_values,
-            )
-        }
-    })
+    guard(|| unsafe { rank_evaluated(embedding)?.write_residual(out_n, out_dofs, out_values) })
 }
 
 /// This rank's Jacobian triplets, by global dof.
@@ -190,14 +179,8 @@ pub unsafe extern "C" fn seam_rank_jacobian(
     out_cols: *mut *const i64,
     out_values: *mut *const f64,
 ) -> c_int {
-    guard(|| {
-        let v = unsafe { rank_evaluated(embedding) }?;
-        unsafe {
-            out(out_n, v.rows.len(), "out_n")?;
-            out(out_rows, v.rows.as_ptr(), "out_rows")?;
-            out(out_cols, v.cols.as_ptr(), "out_cols")?;
-            out(out_values, v.values.as_ptr(), "out_values")
-        }
+    guard(|| unsafe {
+        rank_evaluated(embedding)?.write_jacobian(out_n, out_rows, out_cols, out_values)
     })
 }
 
@@ -209,10 +192,7 @@ pub unsafe extern "C" fn seam_rank_load(
     out_dofs: *mut *const i64,
     out_values: *mut *const f64,
 ) -> c_int {
-    guard(|| {
-        let v = unsafe { rank_evaluated(embedding) }?;
-        unsafe { terms::pairs(out_n, out_dofs, out_values, &v.load_dofs, &v.load_values) }
-    })
+    guard(|| unsafe { rank_evaluated(embedding)?.write_load(out_n, out_dofs, out_values) })
 }
 
 /// The heat of interaction `index`, summed over the ranks.
@@ -234,9 +214,6 @@ pub unsafe extern "C" fn seam_rank_heat(
                 "interaction indices are 0-based, in the order they were added",
             )
         })?;
-        unsafe {
-            out(out_side_a, a, "out_side_a")?;
-            out(out_side_b, b, "out_side_b")
-        }
+        unsafe { terms::write_heat((a, b), out_side_a, out_side_b) }
     })
 }

@@ -56,7 +56,7 @@ fn evaluated(e: &SeamEmbedding) -> Result<&Evaluated, Failure> {
     })
 }
 
-pub(super) unsafe fn pairs(
+unsafe fn pairs(
     n: *mut usize,
     dofs: *mut *const i64,
     values: *mut *const f64,
@@ -81,16 +81,7 @@ pub unsafe extern "C" fn seam_residual(
     guard(|| {
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let ev = evaluated(e)?;
-        unsafe {
-            pairs(
-                out_n,
-                out_dofs,
-                out_values,
-                &ev.residual_dofs,
-                &ev.residual_values,
-            )
-        }
+        unsafe { evaluated(e)?.write_residual(out_n, out_dofs, out_values) }
     })
 }
 
@@ -105,8 +96,7 @@ pub unsafe extern "C" fn seam_load(
     guard(|| {
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let ev = evaluated(e)?;
-        unsafe { pairs(out_n, out_dofs, out_values, &ev.load_dofs, &ev.load_values) }
+        unsafe { evaluated(e)?.write_load(out_n, out_dofs, out_values) }
     })
 }
 
@@ -122,13 +112,7 @@ pub unsafe extern "C" fn seam_jacobian(
     guard(|| {
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let ev = evaluated(e)?;
-        unsafe {
-            out(out_n, ev.rows.len(), "out_n")?;
-            out(out_rows, ev.rows.as_ptr(), "out_rows")?;
-            out(out_cols, ev.cols.as_ptr(), "out_cols")?;
-            out(out_values, ev.values.as_ptr(), "out_values")
-        }
+        unsafe { evaluated(e)?.write_jacobian(out_n, out_rows, out_cols, out_values) }
     })
 }
 
@@ -169,9 +153,56 @@ pub unsafe extern "C" fn seam_heat(
                 ));
             }
         };
-        unsafe {
-            out(out_side_a, a, "out_side_a")?;
-            out(out_side_b, b, "out_side_b")
-        }
+        unsafe { write_heat((a, b), out_side_a, out_side_b) }
     })
+}
+
+impl Evaluated {
+    /// The residual entries into a getter's out-parameters.
+    pub(super) unsafe fn write_residual(
+        &self,
+        n: *mut usize,
+        dofs: *mut *const i64,
+        values: *mut *const f64,
+    ) -> Result<(), Failure> {
+        unsafe { pairs(n, dofs, values, &self.residual_dofs, &self.residual_values) }
+    }
+
+    /// The load entries into a getter's out-parameters.
+    pub(super) unsafe fn write_load(
+        &self,
+        n: *mut usize,
+        dofs: *mut *const i64,
+        values: *mut *const f64,
+    ) -> Result<(), Failure> {
+        unsafe { pairs(n, dofs, values, &self.load_dofs, &self.load_values) }
+    }
+
+    /// The Jacobian triplets into a getter's out-parameters.
+    pub(super) unsafe fn write_jacobian(
+        &self,
+        n: *mut usize,
+        rows: *mut *const i64,
+        cols: *mut *const i64,
+        values: *mut *const f64,
+    ) -> Result<(), Failure> {
+        unsafe {
+            out(n, self.rows.len(), "out_n")?;
+            out(rows, self.rows.as_ptr(), "out_rows")?;
+            out(cols, self.cols.as_ptr(), "out_cols")?;
+            out(values, self.values.as_ptr(), "out_values")
+        }
+    }
+}
+
+/// A heat (side A, side B) into a getter's out-parameters.
+pub(super) unsafe fn write_heat(
+    (a, b): (f64, f64),
+    side_a: *mut f64,
+    side_b: *mut f64,
+) -> Result<(), Failure> {
+    unsafe {
+        out(side_a, a, "out_side_a")?;
+        out(side_b, b, "out_side_b")
+    }
 }
