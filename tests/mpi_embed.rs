@@ -344,7 +344,7 @@ fn rank_terms_sum_to_the_serial_terms() {
         eprintln!("mpirun -n {n}: {line}");
         assert_eq!(
             text.matches("refused on every rank").count(),
-            n,
+            2 * n,
             "every rank saw the bad input refused:\n{text}"
         );
     }
@@ -457,24 +457,45 @@ fn rank_terms_child() {
         want.side_a
     );
 
-    // The last rank gives one global id too few: it fails, the others hear of it.
+    // The last rank gives a non-finite field at one of its interface nodes, then one
+    // global id too few: it fails each time, the others hear of it.
     let last = size - 1;
+    let mut bad_u = u_local.clone();
+    if rank == last {
+        let k = (0..nodes.len())
+            .find(|&k| m.coords[nodes[k]][0] == 1.0)
+            .expect("an interface node");
+        bad_u[k] = f64::NAN;
+    }
+    refused_everywhere(
+        rank,
+        last,
+        e.contributions(&bad_u).map(|_| ()),
+        "not finite",
+    );
     let short = if rank == last {
         &gids[..gids.len() - 1]
     } else {
         &gids[..]
     };
-    match b.build_on_ranks(world.duplicate(), short) {
-        Err(EmbedError::Mesh { what, .. }) if rank == last => {
-            assert!(what.contains("global ids for"), "{what}");
-            println!("rank {rank}: refused on every rank ({what})");
-        }
-        Err(EmbedError::OtherRank { rank: r }) if rank != last => {
-            assert_eq!(r, last);
-            println!("rank {rank}: refused on every rank (rank {r} failed)");
-        }
-        Err(other) => panic!("rank {rank}: unexpected error {other}"),
-        Ok(_) => panic!("rank {rank}: a short global id list was taken"),
-    }
+    let built = b.build_on_ranks(world.duplicate(), short);
+    refused_everywhere(rank, last, built.map(|_| ()), "global ids for");
     world.barrier();
+}
+
+/// `r` failed on rank `last` with a message holding `what`, and on every other rank
+/// with `OtherRank` naming `last`; each rank says so once.
+fn refused_everywhere(
+    rank: usize,
+    last: usize,
+    r: Result<(), seam::embed::EmbedError>,
+    what: &str,
+) {
+    use seam::embed::EmbedError;
+    match r {
+        Err(EmbedError::OtherRank { rank: r }) if rank != last => assert_eq!(r, last),
+        Err(e) if rank == last => assert!(e.to_string().contains(what), "{e}"),
+        other => panic!("rank {rank}: expected a refusal ({what}), got {other:?}"),
+    }
+    println!("rank {rank}: refused on every rank ({what})");
 }

@@ -539,6 +539,14 @@ impl RankEmbedding {
                 ),
                 "pass the value at every local node (owned and ghost), in the builder's node order",
             ))
+        } else if let Some(&k) = self.sent.iter().find(|&&k| !u_local[k].is_finite()) {
+            Err(argument(
+                format!(
+                    "the local field is not finite at local node {k} ({})",
+                    u_local[k]
+                ),
+                "check the host's solve and its update of ghost values",
+            ))
         } else {
             Ok(())
         };
