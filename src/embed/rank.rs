@@ -13,6 +13,28 @@
 //! interactions; an error on one rank is an error on every rank
 //! ([`EmbedError::OtherRank`] on the others), so no rank is left waiting.
 //!
+//! ```no_run
+//! use seam::embed::{Embedding, Interaction, Model, Topology};
+//! # fn host(world: mpi::topology::SimpleCommunicator) -> Result<(), seam::embed::EmbedError> {
+//! # let (coords, conn_a, conn_b, right, left, global_id, global_dof, u_local):
+//! #   (Vec<[f64; 3]>, Vec<usize>, Vec<usize>, Vec<(usize, u8)>, Vec<(usize, u8)>,
+//! #    Vec<u64>, Vec<usize>, Vec<f64>) = Default::default();
+//! // This rank's part: its nodes (owned and ghost), its elements, its interface faces.
+//! let mut seam = Embedding::builder(&coords)
+//!     .block("a", Topology::Hex8, &conn_a, 2.0) // every rank: the same blocks …
+//!     .block("b", Topology::Hex8, &conn_b, 5.0)
+//!     .side_set("right", &right) // … and surfaces, empty where it has none
+//!     .side_set("left", &left)
+//!     .dofs(&global_dof) // the host's global dof of each local node
+//!     .build_on_ranks(world, &global_id)?;
+//! seam.add_interaction(Interaction::new("right", "left", Model::GapConductance { h: 50.0 }))?;
+//! seam.search()?;
+//! let c = seam.contributions(&u_local)?; // this rank's points, global dofs
+//! for &(row, col, v) in &c.jacobian { /* MatSetValue(A, row, col, v, ADD_VALUES) */ }
+//! let total = c.heat[0].unwrap().side_a; // summed over the ranks
+//! # Ok(()) }
+//! ```
+//!
 //! What is communicated (docs/parallel.md, "The embedding on MPI"): at the build, the
 //! interface — every rank's interface faces with their elements' nodes, coordinates and
 //! global dofs, not the rest of the volume mesh — gathered on every rank
