@@ -13,7 +13,7 @@
 //! `u_A = g + Σ c_j u_j`, for hosts that carry no multipliers.
 //!
 //! A host on MPI makes one embedding per rank from its local part
-//! ([`EmbeddingBuilder::build_on_ranks`] → `RankEmbedding`, `--features mpi`): each rank
+//! (`EmbeddingBuilder::build_on_ranks` → `RankEmbedding`, `--features mpi`): each rank
 //! gets its own side-A points' terms in the host's global dof numbers.
 //!
 //! Periodic conditions pair the image of a surface under a map with its partner, from a
