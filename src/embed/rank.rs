@@ -8,9 +8,9 @@
 //! Entry point: [`EmbeddingBuilder::build_on_ranks`] (the builder holds the rank's local
 //! part, its `dofs` the host's global dof of each local node), then
 //! [`RankEmbedding::add_interaction`], [`RankEmbedding::search`] and
-//! [`RankEmbedding::contributions`] at the host's local field. Every method is collective
-//! over the communicator: each rank calls it, in the same order, with the same
-//! interactions; an error on one rank is an error on every rank
+//! [`RankEmbedding::contributions`] at the host's local field. These (and the build) are
+//! collective over the communicator: each rank calls them, in the same order, with the
+//! same interactions (the accessors are local); an error on one rank is an error on every rank
 //! ([`EmbedError::OtherRank`] on the others), so no rank is left waiting.
 //!
 //! ```no_run
