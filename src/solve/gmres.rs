@@ -46,7 +46,11 @@ pub struct BlockGmres {
 
 impl BlockGmres {
     pub fn new(split: usize, tolerance: f64) -> Self {
-        let options = AmgOptions::default();
+        // The temperature block of a k(T) Jacobian is unsymmetric.
+        let options = AmgOptions {
+            symmetric: false,
+            ..AmgOptions::default()
+        };
         BlockGmres {
             split,
             restart: 60,

@@ -184,14 +184,21 @@ fn tridiagonal_largest_eigenvalue(alpha: &[f64], beta: &[f64]) -> f64 {
 /// or `usize::MAX` for a node left out (no strong neighbour).
 pub(super) fn aggregate(a: &Csr, theta: f64) -> (Vec<usize>, usize) {
     let n = a.nrows;
-    let diag_values = a.diagonal();
-    let diag = diag_values.as_slice();
+    // m_i: row i's largest negative coupling; only negative couplings can be strong.
+    let largest: Vec<f64> = (0..n)
+        .map(|i| {
+            (a.ptr[i]..a.ptr[i + 1])
+                .filter(|&p| a.idx[p] as usize != i)
+                .map(|p| -a.val[p])
+                .fold(0.0, f64::max)
+        })
+        .collect();
     let strong = |i: usize| {
-        let di = diag[i].abs();
+        let (largest, mi) = (&largest, largest[i]);
         (a.ptr[i]..a.ptr[i + 1]).filter_map(move |p| {
             let j = a.idx[p] as usize;
-            (j != i && a.val[p] != 0.0 && a.val[p].abs() >= theta * (di * diag[j].abs()).sqrt())
-                .then_some(j)
+            let c = -a.val[p];
+            (j != i && c > 0.0 && c >= theta * (mi * largest[j]).sqrt()).then_some(j)
         })
     };
     const FREE: usize = usize::MAX;

@@ -3,10 +3,19 @@
 //!
 //! Set-up, level by level until at most [`AmgOptions::coarse_size`] unknowns remain:
 //! 1. strength of connection: `j` is a strong neighbour of `i` when
-//!    `|a_ij| ≥ θ_l √(|a_ii a_jj|)`, `θ_l = θ₀ · 2^{−l}` (Vaněk et al.'s ε·(½)^l, with
-//!    θ₀ = 0.02 rather than their 0.08: the Q1 hex stiffness couples a node to its
-//!    edge and corner neighbours with 1/16 and 1/32 of its diagonal and to its face
-//!    neighbours with 0, so 0.08 would leave no strong connection at all);
+//!    `−a_ij ≥ θ √(m_i m_j)`, `m_i` the largest `−a_ik` of row `i` (`k ≠ i`), θ = 0.25 on
+//!    every level — the classical measure of Ruge & Stüben (relative to the row's
+//!    largest coupling), made symmetric. Measured against the diagonal instead (Vaněk
+//!    et al.'s `|a_ij| ≥ ε √(a_ii a_jj)`), no ε serves both kinds of cell a scene has.
+//!    A cube's Q1 stiffness couples a node to its edge and corner neighbours with 1/16
+//!    and 1/32 of its diagonal and to its face neighbours with 0, so ε must be small;
+//!    a thin part's cells (aspect 5) couple it to the through-thickness neighbour with
+//!    −0.44 of its diagonal, to the edge neighbours across the thickness with −0.12,
+//!    to its corner neighbours with −0.03 and to the in-plane face neighbours with
+//!    +0.22. A small ε makes isotropic aggregates there, which cannot represent the
+//!    error a point smoother leaves (smooth through the thickness, oscillating in the
+//!    plane); against the row's largest coupling the thin cells aggregate across their
+//!    thickness only. Positive couplings are never strong;
 //! 2. aggregation (the paper's three passes): seed aggregates from nodes whose strong
 //!    neighbourhood is still free, attach leftovers to a neighbouring aggregate, group
 //!    the rest; nodes with no strong neighbour (e.g. rows eliminated by Dirichlet
@@ -43,7 +52,10 @@ use coarsen::{
     spectral_radius_filtered,
 };
 pub use csr::Csr;
-use smooth::{gauss_seidel, gauss_seidel_from_zero, penalty_rows, symmetric_gauss_seidel_rows};
+use smooth::{
+    gauss_seidel, gauss_seidel_from_zero, gauss_seidel_from_zero_with_residual, penalty_rows,
+    symmetric_gauss_seidel_rows, symmetric_gauss_seidel_rows_with_residual,
+};
 
 /// The smoother of the V-cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,7 +69,8 @@ pub enum Smoother {
 /// Tuning of [`AmgCg`].
 #[derive(Clone, Copy, Debug)]
 pub struct AmgOptions {
-    /// Strength threshold θ₀ on the finest level (halved on each coarser level).
+    /// Strength threshold θ: `j` is a strong neighbour of `i` when `−a_ij` is at least
+    /// θ times the geometric mean of the two rows' largest negative couplings.
     pub strength: f64,
     /// Stop coarsening at or below this many unknowns and solve densely.
     pub coarse_size: usize,
@@ -71,6 +84,11 @@ pub struct AmgOptions {
     /// large positive couplings and their neighbours; none in a plain conduction
     /// matrix). See `smooth::penalty_rows`.
     pub penalty_sweeps: usize,
+    /// The matrices are symmetric (as CG needs): the V-cycle then makes the residual
+    /// after the pre-smoothing within the sweeps' own pass over the matrix. `false` for
+    /// the diagonal block of an unsymmetric Jacobian (a GMRES preconditioner), where the
+    /// residual is a product with the matrix.
+    pub symmetric: bool,
     /// CG stops when ‖r‖/‖b‖ ≤ this.
     pub tolerance: f64,
     pub max_iterations: usize,
@@ -79,12 +97,13 @@ pub struct AmgOptions {
 impl Default for AmgOptions {
     fn default() -> Self {
         AmgOptions {
-            strength: 0.02,
+            strength: 0.25,
             coarse_size: 500,
             max_levels: 12,
             smoother: Smoother::SymmetricGaussSeidel,
             sweeps: 1,
             penalty_sweeps: 1,
+            symmetric: true,
             // 1e-8: well below the discretisation error of any mesh this solver is
             // meant for; the direct solvers are there when round-off accuracy matters.
             tolerance: 1e-8,
@@ -109,6 +128,8 @@ struct Level {
     x: Vec<f64>,
     b: Vec<f64>,
     res: Vec<f64>,
+    /// Scratch: the values of `penalty_rows` before their sweeps.
+    saved: Vec<f64>,
 }
 
 /// PCG with a smoothed-aggregation AMG V-cycle as preconditioner.
@@ -183,7 +204,7 @@ impl AmgCg {
     pub fn setup(&mut self, a: Csr) -> Result<(), SolveError> {
         self.levels.clear();
         let mut a = a;
-        let mut theta = self.options.strength;
+        let theta = self.options.strength;
         let mut inherited: Option<Vec<u32>> = None;
         loop {
             let diag = a.diagonal();
@@ -248,14 +269,27 @@ impl AmgCg {
                 x: vec![0.0; n],
                 b: vec![0.0; n],
                 res: vec![0.0; n],
+                saved: Vec::new(),
             });
             match next {
-                Some(ac) => {
-                    a = ac;
-                    theta *= 0.5;
-                }
+                Some(ac) => a = ac,
                 None => break,
             }
+        }
+        if log::log_enabled!(log::Level::Debug) {
+            let fine = self.levels[0].a.nnz().max(1) as f64;
+            let all: usize = self.levels.iter().map(|l| l.a.nnz()).sum();
+            let sizes: Vec<String> = self
+                .levels
+                .iter()
+                .map(|l| format!("{} ({} nnz)", l.a.nrows, l.a.nnz()))
+                .collect();
+            log::debug!(
+                "AMG hierarchy: {} levels, {}; operator complexity {:.2}",
+                self.levels.len(),
+                sizes.join(", "),
+                all as f64 / fine
+            );
         }
         let last = self.levels.last().unwrap();
         self.coarse_n = last.a.nrows;
@@ -307,7 +341,29 @@ impl AmgCg {
             }
             return;
         }
-        {
+        if self.options.symmetric && sweeps == 1 && smoother == Smoother::SymmetricGaussSeidel {
+            // The residual made in the sweeps' own passes (the matrix is symmetric).
+            let lev = &mut self.levels[l];
+            lev.x.fill(0.0);
+            gauss_seidel_from_zero_with_residual(
+                &lev.a,
+                &lev.inv_diag,
+                &mut lev.x,
+                &lev.b,
+                &mut lev.res,
+            );
+            for _ in 0..self.options.penalty_sweeps {
+                symmetric_gauss_seidel_rows_with_residual(
+                    &lev.a,
+                    &lev.inv_diag,
+                    &mut lev.x,
+                    &lev.b,
+                    &lev.penalty_rows,
+                    &mut lev.res,
+                    &mut lev.saved,
+                );
+            }
+        } else {
             let lev = &mut self.levels[l];
             lev.x.fill(0.0);
             for k in 0..sweeps {

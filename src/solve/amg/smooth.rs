@@ -85,6 +85,63 @@ pub(super) fn gauss_seidel_from_zero(a: &Csr, inv_diag: &[f64], x: &mut [f64], b
     }
 }
 
+/// [`gauss_seidel_from_zero`] that also leaves the residual `r = b − A x` after it, in
+/// the same pass over the matrix, for a symmetric `a`. Row i's sweep leaves its own
+/// residual at `b_i − Σ_{j≤i} a_ij x_j`, which is zero; every later row k
+/// then takes `a_ki x_k` off it, which is `a_ik x_k` read from row k's entries left of
+/// its diagonal as it is swept (those entries are in cache). This replaces a product
+/// with the whole matrix after the sweep.
+pub(super) fn gauss_seidel_from_zero_with_residual(
+    a: &Csr,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    r: &mut [f64],
+) {
+    for i in 0..a.nrows {
+        let (start, end) = (a.ptr[i], a.ptr[i + 1]);
+        let lower = a.idx[start..end].partition_point(|&j| (j as usize) < i);
+        let (idx, val) = (&a.idx[start..start + lower], &a.val[start..start + lower]);
+        let mut s = b[i];
+        for (&j, &v) in idx.iter().zip(val) {
+            s -= v * x[j as usize];
+        }
+        let xi = s * inv_diag[i];
+        x[i] = xi;
+        // b_i − Σ_{j≤i} a_ij x_j = s − a_ii x_i: zero, but for rounding.
+        r[i] = 0.0;
+        for (&j, &v) in idx.iter().zip(val) {
+            r[j as usize] -= v * xi;
+        }
+    }
+}
+
+/// [`symmetric_gauss_seidel_rows`] keeping the residual `r = b − A x` of a symmetric
+/// `a` up to date: each row's change `δ_k` takes `a_jk δ_k` off `r_j` for the rows j
+/// it couples to. `saved` is scratch of at least `rows.len()` values.
+pub(super) fn symmetric_gauss_seidel_rows_with_residual(
+    a: &Csr,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    rows: &[u32],
+    r: &mut [f64],
+    saved: &mut Vec<f64>,
+) {
+    saved.clear();
+    saved.extend(rows.iter().map(|&k| x[k as usize]));
+    symmetric_gauss_seidel_rows(a, inv_diag, x, b, rows);
+    for (&k, &old) in rows.iter().zip(saved.iter()) {
+        let k = k as usize;
+        let delta = x[k] - old;
+        if delta != 0.0 {
+            for p in a.ptr[k]..a.ptr[k + 1] {
+                r[a.idx[p] as usize] -= a.val[p] * delta;
+            }
+        }
+    }
+}
+
 /// A symmetric Gauss–Seidel sweep over `rows` only: forward through them, then
 /// backward. Its error propagator is self-adjoint in the energy inner product, so it
 /// may sit on either side of the coarse correction and keep the V-cycle symmetric.
