@@ -27,6 +27,12 @@ const INSERT_VALUES: c_int = 1;
 const ADD_VALUES: c_int = 2;
 const MAT_FINAL_ASSEMBLY: c_int = 0;
 const NORM_2: c_int = 1;
+/// `KSPNormType` `KSP_NORM_UNPRECONDITIONED`: stop on the true residual ‖b − Ax‖.
+const KSP_NORM_UNPRECONDITIONED: c_int = 2;
+/// `PCSide` `PC_RIGHT`: GMRES then minimises the true residual.
+const PC_RIGHT: c_int = 1;
+/// `PCCompositeType` `PC_COMPOSITE_ADDITIVE`: the blocks' preconditioners side by side.
+const PC_COMPOSITE_ADDITIVE: c_int = 0;
 /// `PetscDataType` `PETSC_INT`.
 const PETSC_INT: c_int = 16;
 /// `PETSC_DEFAULT`: keep PETSc's value of a tolerance.
@@ -139,6 +145,24 @@ unsafe extern "C" {
         maxits: PetscInt,
     ) -> PetscErrorCode;
     fn KSPSetFromOptions(ksp: Object) -> PetscErrorCode;
+    fn KSPSetInitialGuessNonzero(ksp: Object, flag: c_int) -> PetscErrorCode;
+    fn KSPSetNormType(ksp: Object, t: c_int) -> PetscErrorCode;
+    fn KSPSetPCSide(ksp: Object, side: c_int) -> PetscErrorCode;
+    fn PCFieldSplitSetType(pc: Object, t: c_int) -> PetscErrorCode;
+    fn PCFieldSplitSetIS(pc: Object, name: *const c_char, is: Object) -> PetscErrorCode;
+    fn ISCreateStride(
+        comm: MPI_Comm,
+        n: PetscInt,
+        first: PetscInt,
+        step: PetscInt,
+        is: *mut Object,
+    ) -> PetscErrorCode;
+    fn ISDestroy(is: *mut Object) -> PetscErrorCode;
+    fn PetscOptionsSetValue(
+        options: Object,
+        name: *const c_char,
+        value: *const c_char,
+    ) -> PetscErrorCode;
     fn KSPSetUp(ksp: Object) -> PetscErrorCode;
     fn KSPSolve(ksp: Object, b: Object, x: Object) -> PetscErrorCode;
     fn KSPGetIterationNumber(ksp: Object, its: *mut PetscInt) -> PetscErrorCode;
@@ -277,6 +301,28 @@ impl Mat {
                 &col,
                 values.as_ptr(),
                 ADD_VALUES,
+            )
+        })
+    }
+
+    /// Set row `row`'s entries at columns `cols` (global indices; the row owned here).
+    pub fn set_row(
+        &mut self,
+        row: PetscInt,
+        cols: &[PetscInt],
+        values: &[f64],
+    ) -> Result<(), PetscError> {
+        debug_assert_eq!(cols.len(), values.len());
+        // SAFETY: `cols` and `values` have the length passed; one row.
+        check("MatSetValues", unsafe {
+            MatSetValues(
+                self.0,
+                1,
+                &row,
+                cols.len() as PetscInt,
+                cols.as_ptr(),
+                values.as_ptr(),
+                INSERT_VALUES,
             )
         })
     }
@@ -429,6 +475,9 @@ pub enum Method {
     CgGamg,
     /// A direct LU factorisation by MUMPS (small, unsymmetric or indefinite systems).
     MumpsLu,
+    /// GMRES, right-preconditioned, by GAMG on two diagonal blocks side by side (PETSc's
+    /// additive field split): the coupled thermal–electrical Jacobian.
+    GmresBlocks,
 }
 
 impl Method {
@@ -436,6 +485,7 @@ impl Method {
         match self {
             Method::CgGamg => "PETSc CG + GAMG",
             Method::MumpsLu => "PETSc MUMPS LU",
+            Method::GmresBlocks => "PETSc GMRES + field-split GAMG",
         }
     }
 }
@@ -444,8 +494,28 @@ impl Method {
 /// `PETSC_OPTIONS` override the choice).
 pub struct Ksp(Object);
 
+/// Where a [`Method::GmresBlocks`] splits the unknowns: this rank's rows and the first
+/// global row of the second block (rows below it are the first block).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Split {
+    pub rows: std::ops::Range<usize>,
+    pub at: usize,
+}
+
 impl Ksp {
+    /// A solver of `a` by `method` (relative tolerance `rtol` for the Krylov methods);
+    /// `split` is needed by [`Method::GmresBlocks`] alone.
     pub fn new(comm: MPI_Comm, a: &Mat, method: Method, rtol: f64) -> Result<Ksp, PetscError> {
+        Self::with_split(comm, a, method, rtol, None)
+    }
+
+    pub fn with_split(
+        comm: MPI_Comm,
+        a: &Mat,
+        method: Method,
+        rtol: f64,
+        split: Option<&Split>,
+    ) -> Result<Ksp, PetscError> {
         let mut k: Object = std::ptr::null_mut();
         let mut pc: Object = std::ptr::null_mut();
         // SAFETY: plain calls on handles PETSc made; the names are NUL-terminated.
@@ -463,6 +533,48 @@ impl Ksp {
                         KSPSetTolerances(k, rtol, 1e-300, PETSC_DEFAULT, 10_000),
                     )?;
                 }
+                Method::GmresBlocks => {
+                    let split = split.ok_or(PetscError {
+                        call: "PCFieldSplitSetIS",
+                        code: 0,
+                        message: "GMRES by blocks needs where the blocks split".into(),
+                    })?;
+                    check("KSPSetType", KSPSetType(k, c_name("gmres").as_ptr()))?;
+                    check("KSPSetPCSide", KSPSetPCSide(k, PC_RIGHT))?;
+                    check(
+                        "KSPSetTolerances",
+                        KSPSetTolerances(k, rtol, 1e-300, PETSC_DEFAULT, 10_000),
+                    )?;
+                    check("PCSetType", PCSetType(pc, c_name("fieldsplit").as_ptr()))?;
+                    check(
+                        "PCFieldSplitSetType",
+                        PCFieldSplitSetType(pc, PC_COMPOSITE_ADDITIVE),
+                    )?;
+                    let (rows, at) = (&split.rows, split.at);
+                    let blocks = [rows.start..rows.end.min(at), rows.start.max(at)..rows.end];
+                    for (name, block) in ["0", "1"].into_iter().zip(blocks) {
+                        let mut is: Object = std::ptr::null_mut();
+                        let count = block.end.saturating_sub(block.start);
+                        check(
+                            "ISCreateStride",
+                            ISCreateStride(comm, count as _, block.start as _, 1, &mut is),
+                        )?;
+                        let set = PCFieldSplitSetIS(pc, c_name(name).as_ptr(), is);
+                        ISDestroy(&mut is);
+                        check("PCFieldSplitSetIS", set)?;
+                        // Each block: one V-cycle of GAMG (the split's own Krylov
+                        // method is `preonly` by default).
+                        let key = c_name(&format!("-fieldsplit_{name}_pc_type"));
+                        check(
+                            "PetscOptionsSetValue",
+                            PetscOptionsSetValue(
+                                std::ptr::null_mut(),
+                                key.as_ptr(),
+                                c_name("gamg").as_ptr(),
+                            ),
+                        )?;
+                    }
+                }
                 Method::MumpsLu => {
                     check("KSPSetType", KSPSetType(k, c_name("preonly").as_ptr()))?;
                     check("PCSetType", PCSetType(pc, c_name("lu").as_ptr()))?;
@@ -474,6 +586,22 @@ impl Ksp {
             }
             check("KSPSetFromOptions", KSPSetFromOptions(k))?;
             Ok(ksp)
+        }
+    }
+
+    /// Krylov methods: start from the `x` given to [`Ksp::solve`] (else from 0), and
+    /// stop on the true residual relative to ‖b‖ — the serial AMG-CG's rule.
+    pub fn start_from_x(&mut self, nonzero: bool) -> Result<(), PetscError> {
+        // SAFETY: a valid KSP; PetscBool is an int.
+        unsafe {
+            check(
+                "KSPSetInitialGuessNonzero",
+                KSPSetInitialGuessNonzero(self.0, nonzero as c_int),
+            )?;
+            check(
+                "KSPSetNormType",
+                KSPSetNormType(self.0, KSP_NORM_UNPRECONDITIONED),
+            )
         }
     }
 
