@@ -9,16 +9,18 @@
 //! Entry points: [`start`] (the binary, before a run), then the hooks the run calls —
 //! [`is_root`] (who writes files and prints), [`search_pair`] (the contact search of
 //! one pair of surfaces, distributed), [`steady`] (the linear or
-//! Newton-nonlinear steady solve), [`not_distributed`] (what a run under MPI refuses)
-//! and [`linear_solver`] (the summary's linear solver).
+//! Newton-nonlinear steady solve), [`general_solve`] (the linear solves of the general,
+//! stepped, solver: its assembly replicated on every rank, each step's system solved by
+//! PETSc over all ranks) and [`linear_solver`] (the summary's linear solver).
 //!
 //! Without the feature, or without a launcher, every hook is the serial path: one
 //! process, rank 0, nothing refused.
 
-use crate::diag::Diagnostic;
 use crate::heat::HeatError;
 use crate::heat::steady::{SteadyProblem, SteadySolution};
 
+#[cfg(feature = "mpi")]
+mod general;
 #[cfg(feature = "mpi")]
 mod layout;
 #[cfg(feature = "mpi")]
@@ -31,7 +33,89 @@ mod session;
 mod steady;
 
 #[cfg(feature = "mpi")]
+pub use general::GeneralSolve;
+#[cfg(feature = "mpi")]
 pub use session::{Session, start};
+
+/// Without the feature there is no distributed solve: [`general_solve`] never makes one.
+#[cfg(not(feature = "mpi"))]
+pub enum GeneralSolve {}
+
+#[cfg(not(feature = "mpi"))]
+impl GeneralSolve {
+    pub fn solve(
+        &mut self,
+        _: &faer::sparse::SparseColMat<usize, f64>,
+        _: &[f64],
+        _: Option<&[f64]>,
+        _: System,
+    ) -> Result<Solution, HeatError> {
+        match *self {}
+    }
+}
+
+/// The kind of a step system, as the general solver's serial choice of method sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum System {
+    /// Symmetric positive definite, at or above the AMG threshold.
+    Spd,
+    /// The coupled thermal–electrical Jacobian at or above the threshold; the voltages
+    /// (and what follows them) from dof `at` on.
+    Coupled { at: usize },
+    /// Below the threshold, unsymmetric, or indefinite (multiplier ties).
+    Direct,
+}
+
+impl System {
+    /// Why its method, for the run's summary.
+    pub fn why(self) -> &'static str {
+        match self {
+            System::Spd => "symmetric positive definite, at or above the AMG threshold → CG + GAMG",
+            System::Coupled { .. } => {
+                "unsymmetric coupled thermal–electrical Newton steps at or above the AMG threshold → GMRES, GAMG on the temperature and voltage blocks"
+            }
+            System::Direct => {
+                "below the AMG threshold, unsymmetric, or with multipliers (indefinite) → MUMPS LU"
+            }
+        }
+    }
+}
+
+/// A distributed solve's answer: the whole solution on every rank.
+#[derive(Clone, Debug, Default)]
+pub struct Solution {
+    pub x: Vec<f64>,
+    /// Krylov iterations (0 for a direct solve).
+    pub iterations: usize,
+    /// Seconds setting up (matrix values, factorisation or AMG hierarchy) and solving.
+    pub setup_s: f64,
+    pub solve_s: f64,
+}
+
+/// The distributed linear solves of the general (stepped) solver when the run is
+/// distributed, else `None` (the caller solves serially).
+pub fn general_solve() -> Option<GeneralSolve> {
+    #[cfg(feature = "mpi")]
+    {
+        world().map(|_| GeneralSolve::new())
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        None
+    }
+}
+
+#[cfg(feature = "mpi")]
+thread_local! {
+    /// The method of the last distributed solve and why, for the run's summary.
+    static LAST: std::cell::Cell<Option<(petsc::Method, &'static str)>> =
+        const { std::cell::Cell::new(None) };
+}
+
+#[cfg(feature = "mpi")]
+fn record(method: petsc::Method, why: &'static str) {
+    LAST.with(|l| l.set(Some((method, why))));
+}
 
 /// This process's rank and the number of ranks, when a run is distributed.
 pub fn world() -> Option<(usize, usize)> {
@@ -87,44 +171,13 @@ pub fn search_pair(
     }
 }
 
-/// Under MPI, the diagnostic refusing a run the distributed solve does not cover: one
-/// that the general (stepped) solver would solve — a transient run, or a steady one with
-/// temperature-dependent materials, several fields, a voltage or a species, radiation,
-/// toggles. `None` when the run is not distributed.
-pub fn not_distributed(transient: bool) -> Option<Diagnostic> {
-    let (_, size) = world()?;
-    let what = if transient {
-        "a transient run"
-    } else {
-        "a steady run the general solver takes (temperature-dependent materials, several fields, a voltage or a species, radiation, toggles)"
-    };
-    Some(
-        Diagnostic::error(
-            "E0901",
-            format!("{what} is not yet distributed: under MPI ({size} rank(s)) seam solves steady single-field conduction with constant materials"),
-        )
-        .help("run it without mpirun (serially); docs/parallel.md lists what is distributed today"),
-    )
-}
-
 /// The name and the reason of the linear solver the last distributed solve ran (PETSc's
 /// method and the ranks), for the run's summary; `None` when the run is not distributed.
 pub fn linear_solver() -> Option<(String, String)> {
     #[cfg(feature = "mpi")]
     {
         let (_, size) = world()?;
-        let (method, symmetric) = steady::last_method()?;
-        let why = match (method, symmetric) {
-            (petsc::Method::CgGamg, _) => {
-                "symmetric positive definite, at or above the AMG threshold → CG + GAMG"
-            }
-            (petsc::Method::MumpsLu, true) => {
-                "below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
-            }
-            (petsc::Method::MumpsLu, false) => {
-                "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
-            }
-        };
+        let (method, why) = LAST.with(std::cell::Cell::get)?;
         Some((method.name().into(), format!("MPI, {size} rank(s): {why}")))
     }
     #[cfg(not(feature = "mpi"))]

@@ -13,7 +13,6 @@
 //! [`Scatter`]), and the whole solution is gathered once, at the end, for the output.
 //! Mortar ties with multipliers are refused.
 
-use std::cell::Cell;
 use std::time::Instant;
 
 use mpi::collective::SystemOperation;
@@ -34,16 +33,6 @@ use faer::sparse::SparseColMatRef;
 use super::layout::{Layout, node_owners};
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::session;
-
-thread_local! {
-    /// The method of the last distributed solve and whether its system was symmetric,
-    /// for the run's summary.
-    static LAST: Cell<Option<(Method, bool)>> = const { Cell::new(None) };
-}
-
-pub(super) fn last_method() -> Option<(Method, bool)> {
-    LAST.with(Cell::get)
-}
 
 fn petsc_err(e: PetscError) -> HeatError {
     HeatError::Contact(format!("distributed solve: {e}"))
@@ -287,7 +276,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing.solve_s += t.elapsed().as_secs_f64();
         linear.method = Some(match method {
             Method::CgGamg => LinearMethod::AmgCg,
-            Method::MumpsLu => LinearMethod::Lu,
+            _ => LinearMethod::Lu,
         });
         if method == Method::CgGamg {
             linear.cg_iterations.push(its);
@@ -300,7 +289,16 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     for (d, ui) in u.iter_mut().enumerate() {
         *ui = whole[layout.petsc[d] as usize];
     }
-    LAST.with(|l| l.set(Some((method, symmetric))));
+    let why = match (method, symmetric) {
+        (Method::MumpsLu, true) => {
+            "below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
+        }
+        (Method::MumpsLu, false) => {
+            "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
+        }
+        _ => "symmetric positive definite, at or above the AMG threshold → CG + GAMG",
+    };
+    super::record(method, why);
     let temperature = dofs.nodal_values(field, &u);
     Ok(SteadySolution {
         dofs,

@@ -81,20 +81,21 @@ impl<'a> TimeLoop<'a> {
     ) -> Result<Solved, RunError> {
         if self.is_linear_steady() {
             self.linear_steady()
-        } else if let Some(d) = crate::parallel::not_distributed(self.file.transient) {
-            let mut diags = crate::diag::Diagnostics::default();
-            diags.push(d);
-            Err(RunError::Input(diags, Default::default()))
         } else {
             self.steps(initial, output)
         }
     }
 
     /// Whether one linear steady solve answers the problem: steady, one field, constant
-    /// materials, a source of x alone, no toggles, no radiation.
+    /// materials, a source of x alone, no toggles, no radiation. Under MPI, not with
+    /// multiplier ties: the distributed steady solve does not hold multipliers, the
+    /// general solver (its solves by PETSc) does.
     fn is_linear_steady(&self) -> bool {
         let physics = self.physics;
+        let multipliers_under_mpi =
+            crate::parallel::world().is_some() && self.terms.multiplier_ties();
         !self.file.transient
+            && !multipliers_under_mpi
             && physics.uniform
             && physics.materials.constant().is_some()
             && physics.field_names.len() == 1
@@ -334,7 +335,10 @@ impl<'a> TimeLoop<'a> {
             ..
         } = recorder;
         output.finish_steps(&outcome, &history)?;
-        let linear_solver = self.stepped_solver_summary(&history, outcome.dofs.len());
+        let mut linear_solver = self.stepped_solver_summary(&history, outcome.dofs.len());
+        if let Some((name, reason)) = crate::parallel::linear_solver() {
+            (linear_solver.name, linear_solver.reason) = (name, reason);
+        }
         let solution = steps::final_solution(
             outcome,
             &history,

@@ -72,6 +72,9 @@ pub enum SolveError {
     NotFactored,
     #[error("{0}")]
     Faer(String),
+    /// The distributed solve of a run under MPI (PETSc) failed.
+    #[error("distributed solve: {0}")]
+    Distributed(String),
 }
 
 /// What one solve did.

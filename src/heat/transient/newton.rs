@@ -5,6 +5,7 @@ use std::cell::RefCell;
 
 use crate::assembly::Assembler;
 use crate::heat::{FaceBc, HeatError};
+use crate::parallel::{GeneralSolve, System};
 use crate::solve::{
     AmgCg, AmgOptions, BlockGmres, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, SolveError,
     apply_dirichlet, spmv,
@@ -38,6 +39,8 @@ pub(super) struct Solvers {
     /// The step matrix of the last assembly: later ones refresh its values in place
     /// (the pattern does not change over a run).
     pub(super) matrix: Option<SparseColMat<usize, f64>>,
+    /// Under MPI, the solves by PETSc over every rank in place of the solvers above.
+    pub(super) distributed: Option<GeneralSolve>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -71,6 +74,7 @@ impl Solvers {
             }),
             factored: None,
             matrix: None,
+            distributed: crate::parallel::general_solve(),
         }
     }
 }
@@ -116,6 +120,43 @@ pub(super) fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String 
         "Newton did not converge in {iterations} iterations at t = {t}: ‖R‖ = {}; {cause}",
         shown.join(" → ")
     )
+}
+
+/// The right-hand side `J u + Δb` of a linear step's own system `J x = b`, from its
+/// increment's system `J Δu = Δb` at `u`.
+fn step_system(jac: &SparseColMat<usize, f64>, rhs: &[f64], u: &[f64]) -> Vec<f64> {
+    let mut b = vec![0.0; rhs.len()];
+    spmv(jac, u, &mut b);
+    b.iter_mut().zip(rhs).for_each(|(b, r)| *b += r);
+    b
+}
+
+/// Under MPI: the increment's system `jac Δu = rhs` solved by PETSc over every rank
+/// (`rhs` becomes Δu) — or, from `predictor` `u`, the step's own system `jac x = jac u +
+/// rhs` from `x = u`, as the serial AMG-CG does. The set-up and solve seconds and the
+/// Krylov iterations.
+fn solve_distributed(
+    d: &mut GeneralSolve,
+    jac: &SparseColMat<usize, f64>,
+    rhs: &mut [f64],
+    predictor: Option<&[f64]>,
+    system: System,
+) -> Result<(f64, f64, usize), HeatError> {
+    let solved = match predictor {
+        Some(u) => {
+            let s = d.solve(jac, &step_system(jac, rhs, u), Some(u), system)?;
+            for ((d, x), u) in rhs.iter_mut().zip(&s.x).zip(u) {
+                *d = x - u;
+            }
+            s
+        }
+        None => {
+            let s = d.solve(jac, rhs, None, system)?;
+            rhs.copy_from_slice(&s.x);
+            s
+        }
+    };
+    Ok((solved.setup_s, solved.solve_s, solved.iterations))
 }
 
 impl Context<'_, '_> {
@@ -236,7 +277,21 @@ impl Context<'_, '_> {
             let amg = large && symmetric;
             // A coupled thermal–electrical Jacobian (unsymmetric): block-AMG GMRES.
             let gmres = large && solvers.gmres.is_some();
+            // A linear time step by AMG-CG solves the step's own system from the
+            // predictor (below).
+            let from_predictor = linear && history.is_some();
             let solved = (|| -> Result<(f64, f64, usize), HeatError> {
+                if let Some(d) = solvers.distributed.as_mut() {
+                    let system = match setup.voltage {
+                        _ if amg => System::Spd,
+                        Some(v) if gmres => System::Coupled {
+                            at: setup.dofs.field_range(v).start,
+                        },
+                        _ => System::Direct,
+                    };
+                    let predictor = from_predictor && system == System::Spd;
+                    return solve_distributed(d, &jac, &mut rhs, predictor.then_some(&*u), system);
+                }
                 let t0 = std::time::Instant::now();
                 let same = solvers
                     .factored
@@ -288,10 +343,8 @@ impl Context<'_, '_> {
                     // ‖b‖, as a direct solve's backward error is, rather than relative
                     // to the predictor's residual, which a good predictor has already
                     // made small (the default stopping rule of PETSc's KSP).
-                    Which::Amg if linear && history.is_some() => {
-                        let mut b = vec![0.0; rhs.len()];
-                        spmv(&jac, u, &mut b);
-                        b.iter_mut().zip(&rhs).for_each(|(b, r)| *b += r);
+                    Which::Amg if from_predictor => {
+                        let b = step_system(&jac, &rhs, u);
                         let mut x = u.to_vec();
                         let report = solvers.amg.pcg(&b, &mut x)?;
                         for ((d, x), u) in rhs.iter_mut().zip(&x).zip(u.iter()) {
