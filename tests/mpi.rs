@@ -228,7 +228,8 @@ fn compare(problem: &Path, cut: bool) -> Ran {
             );
         }
         eprintln!(
-            "{} on {n} rank(s): {}; interface couplings across ranks {across:?}",
+            "{} ({}) on {n} rank(s): {}; interface couplings across ranks {across:?}",
+            std::thread::current().name().unwrap_or("?"),
             problem.display(),
             line.join(", ")
         );
