@@ -110,23 +110,6 @@ pub struct ContactPoint {
 }
 
 impl ContactPoint {
-    /// A point of no face and no node, unmatched: what a result is filled with before
-    /// the search writes its points in place.
-    const UNPAIRED: ContactPoint = ContactPoint {
-        a_face: None,
-        a_node: None,
-        xi_a: [0.0; 2],
-        x: [0.0; 3],
-        weight: 0.0,
-        status: PointStatus::Unmatched,
-        b_face: None,
-        xi_b: [0.0; 2],
-        gap: 0.0,
-        offset: 0.0,
-        normal_a: [0.0; 3],
-        normal_b: [0.0; 3],
-    };
-
     /// The side-B face of a matched point.
     pub fn matched_b_face(&self) -> Option<usize> {
         match (self.status, self.b_face) {
@@ -299,10 +282,10 @@ impl Searcher {
                     .map(|f| rules.quadrature(f.len).len())
                     .collect();
                 let total: usize = counts.iter().sum();
-                result.points = vec![ContactPoint::UNPAIRED; total];
-                result.points.reserve_exact(a.nodes.len());
-                // The result cut into each chunk's points.
-                let mut rest = result.points.as_mut_slice();
+                // Room for the points, left unwritten here: each chunk's thread writes its
+                // own (once, and the first touch of fresh memory happens in parallel).
+                result.points = Vec::with_capacity(total + a.nodes.len());
+                let mut rest = &mut result.points.spare_capacity_mut()[..total];
                 let mut slices = Vec::with_capacity(a.faces.len().div_ceil(CHUNK));
                 for start in (0..a.faces.len()).step_by(CHUNK) {
                     let end = (start + CHUNK).min(a.faces.len());
@@ -310,7 +293,7 @@ impl Searcher {
                     slices.push((start, end, head));
                     rest = tail;
                 }
-                let chunks: Vec<Vec<(f64, f64, f64)>> = slices
+                let chunks: Vec<_> = slices
                     .into_par_iter()
                     .map(|(start, end, slice)| {
                         let mut scratch = Scratch::default();
@@ -328,14 +311,21 @@ impl Searcher {
                                 &mut points,
                                 &mut scratch,
                             );
-                            slice[at..at + points.len()].copy_from_slice(&points);
+                            for (slot, p) in slice[at..at + points.len()].iter_mut().zip(&points) {
+                                slot.write(*p);
+                            }
                             at += points.len();
                             per_face.push(face_weights(&points, area));
                         }
-                        per_face
+                        (slice.len() - at, per_face)
                     })
                     .collect();
-                chunks.into_iter().flatten().collect::<Vec<_>>()
+                // Every chunk wrote as many points as its faces' rules have (`counts`).
+                assert!(chunks.iter().all(|(short, _)| *short == 0));
+                // SAFETY: the first `total` slots were cut into the chunks' slices, in
+                // order and without gaps, and each chunk wrote every slot of its slice.
+                unsafe { result.points.set_len(total) };
+                chunks.into_iter().flat_map(|(_, f)| f).collect::<Vec<_>>()
             }
             Rules::Segments { line, triangle } => {
                 let chunks: Vec<ChunkOut> = (0..a.faces.len())

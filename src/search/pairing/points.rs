@@ -456,7 +456,8 @@ impl Ctx<'_> {
         let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
         let mut scratch = Vec::new();
-        let midpoint = rule_line(1);
+        // An axisymmetric edge's rule, made only for such a face.
+        let mut midpoint = None;
         for &j in candidates {
             let fb = &self.b.faces[j];
             let data = match self.b_faces.get(j) {
@@ -473,8 +474,9 @@ impl Ctx<'_> {
                 None if !a.axisymmetric => overlap_length_line_line(face.coords(), fb.coords()),
                 // ∫ 2πr over the interval: its midpoint rule is exact (r is linear).
                 None => {
+                    let midpoint = midpoint.get_or_insert_with(|| rule_line(1));
                     scratch.clear();
-                    segments_line_line_into(face.coords(), fb.coords(), &midpoint, &mut scratch);
+                    segments_line_line_into(face.coords(), fb.coords(), midpoint, &mut scratch);
                     scratch
                         .iter()
                         .map(|m| m.weight * revolution(true, m.x_a))
