@@ -779,6 +779,21 @@ fn hydrogen_wall_species_equals_serial() {
     compare(&problem, false);
 }
 
+/// Resistance spot welding: three electrical contacts (electrode–sheet, sheet–sheet,
+/// sheet–electrode) with their Joule heat, temperature-dependent gap conductances.
+#[test]
+fn spot_weld_equals_serial() {
+    let (_tmp, problem) = example("spot_weld");
+    compare(&problem, false);
+}
+
+/// The electronics scene's steady state (die, CMY thermal interface, finned sink).
+#[test]
+fn electronics_steady_equals_serial() {
+    let (_tmp, problem) = example("electronics");
+    compare(&problem, false);
+}
+
 /// Moving surfaces: the lid lifts from t = 120 s, the contact searched again each step
 /// (cut to 20 steps, every other one written).
 #[test]
