@@ -232,6 +232,7 @@ fn partition(mesh: &Mesh, blocks: &[usize], parts: usize) -> Result<Vec<u32>, St
     let mut options = [0i32; metis_sys::METIS_NOPTIONS as usize];
     // SAFETY: the arrays have the sizes METIS_PartMeshDual documents (eptr ne+1, eind
     // eptr[ne], epart ne, npart nn, options METIS_NOPTIONS); weights may be null.
+    let _one_at_a_time = crate::solve::metis_lock();
     let status = unsafe {
         metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
         metis_sys::METIS_PartMeshDual(

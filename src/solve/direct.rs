@@ -30,6 +30,20 @@ pub enum Ordering {
     Amd,
 }
 
+/// Held around every METIS call. METIS draws its random numbers from one generator in
+/// process-global state (GKlib's `static uint64_t mt[]`, seeded at each call), so two
+/// calls on two threads at once (a host factoring on several threads, or tests in one
+/// process) interleave their draws and may get another ordering than the same call
+/// alone — and race on that state. One call at a time keeps each ordering the one its
+/// graph gives, so runs stay bit-for-bit repeatable.
+pub(crate) fn metis_lock() -> std::sync::MutexGuard<'static, ()> {
+    static METIS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    // A panic while held cannot leave METIS's state inconsistent for the next seeded call.
+    METIS
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
 /// Nested-dissection permutation `(perm, iperm)` of the graph of `a` (off-diagonal
 /// pattern, symmetrised): position `i` of the reordered matrix holds row `perm[i]`.
 /// `None` if METIS reports an error or the size does not fit METIS's 32-bit indices.
@@ -87,6 +101,7 @@ pub fn metis_ordering(a: &SymbolicSparseColMat<usize>) -> Option<(Vec<usize>, Ve
     let mut iperm = vec![0i32; n];
     // SAFETY: all arrays have the sizes METIS_NodeND documents (xadj n+1, adjncy
     // xadj[n], perm and iperm n, options METIS_NOPTIONS); vwgt may be null.
+    let _one_at_a_time = metis_lock();
     let status = unsafe {
         metis_sys::METIS_SetDefaultOptions(options.as_mut_ptr());
         metis_sys::METIS_NodeND(
@@ -522,5 +537,42 @@ impl LinearSolver for Lu {
             iterations: 0,
             residual: f64::NAN,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// METIS orderings made on several threads at once equal the one made alone: its
+    /// random numbers come from process-global state, which [`metis_lock`] keeps to one
+    /// call at a time.
+    #[test]
+    fn metis_orderings_on_several_threads_equal_the_one_made_alone() {
+        let matrix = crate::solve::laplacian_7pt(14);
+        let a = matrix.symbolic().to_owned().unwrap();
+        let alone = metis_ordering(&a).expect("METIS orders a Laplacian");
+        let orderings: Vec<_> = std::thread::scope(|s| {
+            let workers: Vec<_> = (0..4)
+                .map(|_| {
+                    s.spawn(|| {
+                        (0..10)
+                            .map(|_| metis_ordering(&a).unwrap())
+                            .collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            workers
+                .into_iter()
+                .flat_map(|w| w.join().unwrap())
+                .collect()
+        });
+        let differ = orderings.iter().filter(|o| **o != alone).count();
+        assert_eq!(
+            differ,
+            0,
+            "{differ} of {} orderings differ",
+            orderings.len()
+        );
     }
 }

@@ -28,6 +28,8 @@ mod direct;
 mod gmres;
 
 pub use amg::{AmgCg, AmgOptions, Smoother};
+#[cfg(feature = "mpi")]
+pub(crate) use direct::metis_lock;
 pub use direct::{Cholesky, Lu, Ordering, SaddleLdlt, metis_ordering};
 pub use gmres::BlockGmres;
 
