@@ -35,6 +35,7 @@ class CutbackError(SeamError):  # code 9
     factor: float
 
 class NothingPairedError(SeamError): ...  # code 10
+class OtherRankError(SeamError): ...  # code 11
 
 class PointState:
     """A contact point as a conductance function sees it (SI units)."""

@@ -66,9 +66,15 @@ create_exception!(
     SeamError,
     "A flux interaction's search paired no point."
 );
+create_exception!(
+    seam,
+    OtherRankError,
+    SeamError,
+    "On MPI: a collective call failed on another rank, whose own error says what and where."
+);
 
 /// The exception classes and their codes, as in include/seam.h.
-fn classes(py: Python<'_>) -> [(Bound<'_, pyo3::types::PyType>, i32); 9] {
+fn classes(py: Python<'_>) -> [(Bound<'_, pyo3::types::PyType>, i32); 10] {
     [
         (py.get_type::<MeshError>(), 2),
         (py.get_type::<DeckError>(), 3),
@@ -79,6 +85,7 @@ fn classes(py: Python<'_>) -> [(Bound<'_, pyo3::types::PyType>, i32); 9] {
         (py.get_type::<PluginError>(), 8),
         (py.get_type::<CutbackError>(), 9),
         (py.get_type::<NothingPairedError>(), 10),
+        (py.get_type::<OtherRankError>(), 11),
     ]
 }
 
@@ -138,6 +145,7 @@ pub fn to_py(e: EmbedError) -> PyErr {
                 err
             }
             EmbedError::NothingPaired { .. } => raise::<NothingPairedError>(py, &text),
+            EmbedError::OtherRank { .. } => raise::<OtherRankError>(py, &text),
             _ => raise::<ArgumentError>(py, &text),
         }
     })

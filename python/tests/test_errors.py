@@ -35,6 +35,7 @@ def test_codes_are_the_c_api_status_codes():
         "SEAM_ERR_PLUGIN": seam.PluginError,
         "SEAM_CUTBACK": seam.CutbackError,
         "SEAM_ERR_NOTHING_PAIRED": seam.NothingPairedError,
+        "SEAM_ERR_OTHER_RANK": seam.OtherRankError,
     }
     assert set(defined) - {"SEAM_ERR_NULL_ARGUMENT"} == set(classes)
     for name, cls in classes.items():
