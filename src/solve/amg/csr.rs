@@ -154,11 +154,8 @@ impl Csr {
             .with_min_len(1024)
             .enumerate()
             .for_each(|(i, yi)| {
-                let mut s = 0.0;
-                for p in self.ptr[i]..self.ptr[i + 1] {
-                    s += self.val[p] * x[self.idx[p] as usize];
-                }
-                *yi = s;
+                let row = self.ptr[i]..self.ptr[i + 1];
+                *yi = dot_row(&self.idx[row.clone()], &self.val[row], x);
             });
     }
 
@@ -229,4 +226,28 @@ impl Csr {
             })
             .collect()
     }
+}
+
+/// `Σ_k val_k x[idx_k]`, a row of a sparse matrix times `x`, in four interleaved partial
+/// sums added pairwise at the end. One running sum makes each product wait for the
+/// last addition: a hex mesh's row has 27 entries, and that chain, not the memory,
+/// bounded the sweeps. Four chains took a forward Gauss–Seidel sweep of a 1.09 M-row,
+/// 28.9 M-entry Q1 matrix from 20.8 to 17.7 ms and a product from 21.7 to 18 ms. The
+/// order of the sums is fixed, so the bits do not depend on the thread count.
+#[inline(always)]
+pub(super) fn dot_row(idx: &[u32], val: &[f64], x: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let (mut ci, mut cv) = (idx.chunks_exact(4), val.chunks_exact(4));
+    for (j, v) in (&mut ci).zip(&mut cv) {
+        for k in 0..4 {
+            acc[k] += v[k] * x[j[k] as usize];
+        }
+    }
+    // The last entries into the sums they would have gone to in a longer row: a
+    // row's leading part (a sweep from zero reads the entries left of the diagonal)
+    // then sums as the whole row does where the rest multiplies zeros.
+    for (k, (&j, &v)) in ci.remainder().iter().zip(cv.remainder()).enumerate() {
+        acc[k] += v * x[j as usize];
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3])
 }

@@ -1,7 +1,7 @@
 //! Point smoothers of the V-cycle: Gauss–Seidel sweeps over all rows or over a chosen
 //! set of them, and the choice of the rows that get extra sweeps (a penalty interface).
 
-use super::csr::Csr;
+use super::csr::{Csr, dot_row};
 
 /// Share of its diagonal that a row's positive off-diagonal couplings must reach for
 /// the row to get extra sweeps ([`penalty_rows`]). A Q1 or P1 conduction matrix on
@@ -74,13 +74,8 @@ pub(super) fn gauss_seidel_from_zero(a: &Csr, inv_diag: &[f64], x: &mut [f64], b
     for i in 0..a.nrows {
         let (start, end) = (a.ptr[i], a.ptr[i + 1]);
         debug_assert!(a.idx[start..end].is_sorted(), "row {i} is not sorted");
-        let mut s = b[i];
-        for (&j, &v) in a.idx[start..end].iter().zip(&a.val[start..end]) {
-            if j as usize >= i {
-                break;
-            }
-            s -= v * x[j as usize];
-        }
+        let lower = start + a.idx[start..end].partition_point(|&j| (j as usize) < i);
+        let s = b[i] - dot_row(&a.idx[start..lower], &a.val[start..lower], x);
         x[i] += s * inv_diag[i];
     }
 }
@@ -102,13 +97,9 @@ pub(super) fn gauss_seidel_from_zero_with_residual(
         let (start, end) = (a.ptr[i], a.ptr[i + 1]);
         let lower = a.idx[start..end].partition_point(|&j| (j as usize) < i);
         let (idx, val) = (&a.idx[start..start + lower], &a.val[start..start + lower]);
-        let mut s = b[i];
-        for (&j, &v) in idx.iter().zip(val) {
-            s -= v * x[j as usize];
-        }
-        let xi = s * inv_diag[i];
+        let xi = (b[i] - dot_row(idx, val, x)) * inv_diag[i];
         x[i] = xi;
-        // b_i − Σ_{j≤i} a_ij x_j = s − a_ii x_i: zero, but for rounding.
+        // b_i − Σ_{j≤i} a_ij x_j: zero, but for rounding.
         r[i] = 0.0;
         for (&j, &v) in idx.iter().zip(val) {
             r[j as usize] -= v * xi;
@@ -165,9 +156,6 @@ pub(super) fn symmetric_gauss_seidel_rows(
 #[inline(always)]
 fn gauss_seidel_row(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64], i: usize) {
     let (start, end) = (a.ptr[i], a.ptr[i + 1]);
-    let mut s = b[i];
-    for (&j, &v) in a.idx[start..end].iter().zip(&a.val[start..end]) {
-        s -= v * x[j as usize];
-    }
+    let s = b[i] - dot_row(&a.idx[start..end], &a.val[start..end], x);
     x[i] += s * inv_diag[i];
 }
