@@ -430,6 +430,7 @@ impl InterfacePoints {
         points: &[ContactPoint],
         form: &InterfaceForm<'_>,
     ) -> Result<InterfacePoints, InterfaceError> {
+        let clock = std::time::Instant::now();
         let fields = fields.into();
         // The element behind each face, made when a point first meets the face (so a
         // failure is reported at the same point as if every point made its own).
@@ -562,6 +563,14 @@ impl InterfacePoints {
             }
         }
         out.position = out.dofs.iter().map(|&d| position[d as usize]).collect();
+        log::debug!(
+            "interface points {} / {}: {} points in {} element pairs, made in {:.3} s",
+            a.name,
+            b.name,
+            out.len(),
+            out.groups(),
+            clock.elapsed().as_secs_f64()
+        );
         Ok(out)
     }
 
@@ -743,12 +752,16 @@ impl InterfacePoints {
         let mut rhs = vec![0.0; self.touched.len()];
         let mut dh = [0.0; 2 * MAX_NODES];
         let mut m = [0.0; 4 * MAX_NODES * MAX_NODES];
+        // The symmetric points' sum, its upper triangle only (row-major like `m`).
+        let mut sym = [0.0; 4 * MAX_NODES * MAX_NODES];
         for g in 0..self.groups() {
             let dofs = self.group(g);
             let position = &self.position[self.group_dofs[g]..self.group_dofs[g + 1]];
             let nl = dofs.len();
             let m = &mut m[..nl * nl];
             m.fill(0.0);
+            let sym = &mut sym[..nl * nl];
+            sym.fill(0.0);
             for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
                 let PointEval {
                     jump,
@@ -813,8 +826,17 @@ impl InterfacePoints {
                     residual[k] += w * (cp * r_p + ct * r_t + cs * r_s);
                     // Right-hand side of the linear form (the offset terms).
                     rhs[k] += w * form.offset * (cp * ji - ct * fi);
-                    let row = &mut m[i * nl..(i + 1) * nl];
                     let (wj, wf) = (w * ji, w * fi);
+                    if !nonlinear && !scale.varies {
+                        // A symmetric entry (h and k fixed at this point): its upper
+                        // triangle, mirrored once the group is summed.
+                        let row = &mut sym[i * nl..(i + 1) * nl];
+                        for j in i..nl {
+                            row[j] += wj * a[j] - wf * b[j];
+                        }
+                        continue;
+                    }
+                    let row = &mut m[i * nl..(i + 1) * nl];
                     if nonlinear {
                         let wd = w * (dp * r_p + dt * r_t + ds * r_s);
                         for j in 0..nl {
@@ -846,6 +868,17 @@ impl InterfacePoints {
                         for j in 0..nl {
                             row[j] += ga * dscale[0][j] + gb * dscale[1][j] + gal * dscale[2][j];
                         }
+                    }
+                }
+            }
+            // The symmetric part into both triangles: a block of symmetric points alone
+            // is symmetric bit for bit, so is the matrix it is added into.
+            for i in 0..nl {
+                for j in i..nl {
+                    let v = sym[i * nl + j];
+                    m[i * nl + j] += v;
+                    if j != i {
+                        m[j * nl + i] += v;
                     }
                 }
             }
