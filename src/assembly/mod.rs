@@ -266,11 +266,15 @@ pub struct Pattern {
     built: Option<Built>,
 }
 
-/// A built pattern: the CSC structure and, for every slot, its position in the value
-/// array — element slots first unless built for direct assembly.
+/// A built pattern: the CSC structure (32-bit row indices: a dof is 32 bits) and, for
+/// every slot, its position in the value array — element slots first unless built for
+/// direct assembly. faer's symbolic matrix (with `usize` row indices, twice the bytes)
+/// is made from it when first asked for: a solve by AMG-CG never needs it.
 #[derive(Clone, Debug)]
 struct Built {
-    sym: SymbolicSparseColMat<usize>,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<u32>,
+    sym: std::sync::OnceLock<SymbolicSparseColMat<usize>>,
     positions: Vec<u32>,
     element_slots: bool,
 }
@@ -416,7 +420,7 @@ impl Pattern {
         // Each column's rows gathered once (a marker per dof holds the last column
         // that took it: no sort of the repeats) and then sorted, as 32-bit indices.
         const CHUNK: usize = 4096;
-        let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..n.div_ceil(CHUNK))
+        let chunks: Vec<(Vec<usize>, Vec<u32>)> = (0..n.div_ceil(CHUNK))
             .into_par_iter()
             .map_init(
                 || vec![0u32; n],
@@ -447,7 +451,7 @@ impl Pattern {
                         }
                         col.sort_unstable();
                         lens.push(col.len());
-                        rows.extend(col.iter().map(|&d| d as usize));
+                        rows.extend_from_slice(&col);
                     }
                     (lens, rows)
                 },
@@ -471,7 +475,7 @@ impl Pattern {
         }
         let pos = |row: usize, col: usize| -> u32 {
             let rows = &row_idx[col_ptr[col]..col_ptr[col + 1]];
-            (col_ptr[col] + rows.partition_point(|&r| r < row)) as u32
+            (col_ptr[col] + direct::lower_bound(rows, row as u32)) as u32
         };
         let elem_len = if element_slots { self.elem_values } else { 0 };
         let mut positions = vec![0u32; self.value_count() - self.elem_values + elem_len];
@@ -503,23 +507,44 @@ impl Pattern {
         for (i, p) in diag_part.iter_mut().enumerate() {
             *p = pos(i, i);
         }
-        let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         self.built = Some(Built {
-            sym,
+            col_ptr,
+            row_idx,
+            sym: std::sync::OnceLock::new(),
             positions,
             element_slots,
         });
         Ok(())
     }
 
-    /// The symbolic CSC structure (after [`Pattern::build`]).
+    /// The symbolic CSC structure (after [`Pattern::build`]) as faer's matrix, made on
+    /// the first call (a copy of the structure with `usize` row indices).
     pub fn symbolic(&self) -> Option<&SymbolicSparseColMat<usize>> {
-        self.built.as_ref().map(|b| &b.sym)
+        self.built.as_ref().map(|b| {
+            b.sym.get_or_init(|| {
+                let rows = b.row_idx.iter().map(|&r| r as usize).collect();
+                SymbolicSparseColMat::new_checked(self.n, self.n, b.col_ptr.clone(), None, rows)
+            })
+        })
+    }
+
+    /// The CSC structure (after [`Pattern::build`]): column pointers and the rows of
+    /// each column, ascending.
+    pub fn structure(&self) -> Option<(&[usize], &[u32])> {
+        self.built
+            .as_ref()
+            .map(|b| (b.col_ptr.as_slice(), b.row_idx.as_slice()))
+    }
+
+    /// The CSC structure, the pattern given up: for a caller that keeps the matrix
+    /// (e.g. in row storage, the structure being symmetric) after the pattern is gone.
+    pub fn into_structure(self) -> Option<(Vec<usize>, Vec<u32>)> {
+        self.built.map(|b| (b.col_ptr, b.row_idx))
     }
 
     /// Stored entries of the matrix (after [`Pattern::build`]).
     pub fn nnz(&self) -> usize {
-        self.symbolic().map_or(0, |s| s.row_idx().len())
+        self.structure().map_or(0, |(_, rows)| rows.len())
     }
 }
 
@@ -707,7 +732,8 @@ impl<'p> Assembler<'p> {
     /// The assembled matrix (values only: the pattern's symbolic structure is cloned
     /// and the slots are added into their positions in slot order).
     pub fn matrix(&self) -> Result<SparseColMat<usize, f64>, AssemblyError> {
-        let sym = self.built()?.0;
+        self.built()?;
+        let sym = self.pattern.symbolic().expect("built");
         let mut vals = Vec::new();
         self.values_into(&mut vals)?;
         Ok(SparseColMat::new(sym.clone(), vals))
@@ -717,7 +743,8 @@ impl<'p> Assembler<'p> {
     /// [`Self::matrix`]) written into `vals`, resized to the entry count: a matrix
     /// without a copy of the structure.
     pub fn values_into(&self, vals: &mut Vec<f64>) -> Result<(), AssemblyError> {
-        let nnz = self.built()?.0.row_idx().len();
+        self.built()?;
+        let nnz = self.pattern.nnz();
         vals.clear();
         match &self.direct {
             Some(d) if d.values.len() != nnz => {
@@ -737,20 +764,19 @@ impl<'p> Assembler<'p> {
         &self,
         matrix: &mut SparseColMat<usize, f64>,
     ) -> Result<(), AssemblyError> {
-        let sym = self.built()?.0;
+        self.built()?;
+        let (col_ptr, _) = self.pattern.structure().expect("built");
+        let n = self.pattern.n;
         let (have, vals) = matrix.parts_mut();
-        if have.nrows() != sym.nrows()
-            || have.ncols() != sym.ncols()
-            || have.col_ptr() != sym.col_ptr()
-        {
+        if have.nrows() != n || have.ncols() != n || have.col_ptr() != col_ptr {
             return Err(AssemblyError::Faer(format!(
                 "the matrix to refresh ({}×{}, {} entries) is not this pattern's ({}×{}, {} entries)",
                 have.nrows(),
                 have.ncols(),
                 vals.len(),
-                sym.nrows(),
-                sym.ncols(),
-                sym.row_idx().len()
+                n,
+                n,
+                self.pattern.nnz()
             )));
         }
         match &self.direct {
@@ -763,7 +789,8 @@ impl<'p> Assembler<'p> {
         self.sum_slots(vals)
     }
 
-    fn built(&self) -> Result<(&SymbolicSparseColMat<usize>, &[u32]), AssemblyError> {
+    /// The slots' positions in the value array.
+    fn built(&self) -> Result<&[u32], AssemblyError> {
         match &self.pattern.built {
             // A direct assembler skips the element slots of a pattern that has them.
             Some(b) if self.direct.is_some() => {
@@ -772,9 +799,9 @@ impl<'p> Assembler<'p> {
                 } else {
                     0
                 };
-                Ok((&b.sym, &b.positions[skip..]))
+                Ok(&b.positions[skip..])
             }
-            Some(b) if b.element_slots => Ok((&b.sym, &b.positions)),
+            Some(b) if b.element_slots => Ok(&b.positions),
             Some(_) => Err(AssemblyError::Faer(
                 "the pattern was built for direct assembly (Pattern::build_direct)".into(),
             )),
@@ -785,7 +812,7 @@ impl<'p> Assembler<'p> {
     /// Adds every slot into its position of the CSC value array `vals`, slot after slot
     /// (after the element sums of a direct assembler).
     fn sum_slots(&self, vals: &mut [f64]) -> Result<(), AssemblyError> {
-        let positions = self.built()?.1;
+        let positions = self.built()?;
         for (&p, &v) in positions.iter().zip(&self.values) {
             vals[p as usize] += v;
         }

@@ -150,6 +150,17 @@ pub fn spmv_ref(a: SparseColMatRef<'_, usize, f64>, x: &[f64], y: &mut [f64]) {
     }
 }
 
+/// [`spmv`] of a square CSC matrix given as its parts (column pointers, 32-bit rows,
+/// values): the same sums in the same order, so the same bits.
+pub fn spmv_parts(col_ptr: &[usize], rows: &[u32], vals: &[f64], x: &[f64], y: &mut [f64]) {
+    y.fill(0.0);
+    for (j, &xj) in x.iter().enumerate().take(col_ptr.len() - 1) {
+        for p in col_ptr[j]..col_ptr[j + 1] {
+            y[rows[p] as usize] += vals[p] * xj;
+        }
+    }
+}
+
 /// ‖b − A x‖₂ / ‖b‖₂ (or ‖b − A x‖₂ when b = 0).
 pub fn relative_residual(a: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> f64 {
     let mut r = vec![0.0; b.len()];
@@ -205,6 +216,42 @@ pub fn apply_dirichlet_mut(
     bcs: &[(usize, f64)],
 ) -> Result<(), SolveError> {
     let n = a.nrows();
+    let (sym, vals) = a.parts_mut();
+    let ri = sym.row_idx();
+    dirichlet_by(n, sym.col_ptr(), |p| ri[p], vals, b, bcs)
+}
+
+/// [`apply_dirichlet`] on a square CSC matrix given as its parts (column pointers,
+/// 32-bit rows, values).
+pub fn apply_dirichlet_parts(
+    col_ptr: &[usize],
+    rows: &[u32],
+    vals: &mut [f64],
+    b: &mut [f64],
+    bcs: &[(usize, f64)],
+) -> Result<(), SolveError> {
+    dirichlet_by(
+        col_ptr.len() - 1,
+        col_ptr,
+        |p| rows[p] as usize,
+        vals,
+        b,
+        bcs,
+    )
+}
+
+/// The elimination of [`apply_dirichlet`] over `n` columns, `row(p)` the row of stored
+/// entry `p`.
+// Entry positions index the values and name the rows alike.
+#[allow(clippy::needless_range_loop)]
+fn dirichlet_by(
+    n: usize,
+    col_ptr: &[usize],
+    row: impl Fn(usize) -> usize,
+    vals: &mut [f64],
+    b: &mut [f64],
+    bcs: &[(usize, f64)],
+) -> Result<(), SolveError> {
     if b.len() != n {
         return Err(SolveError::Dimension {
             matrix: n,
@@ -221,13 +268,11 @@ pub fn apply_dirichlet_mut(
         }
         fixed[dof] = Some(value);
     }
-    let (sym, vals) = a.parts_mut();
-    let ri = sym.row_idx();
     // Move known values to the right-hand side (reads A before any entry is zeroed).
     for j in 0..n {
         if let Some(g) = fixed[j] {
-            for p in sym.col_range(j) {
-                let i = ri[p];
+            for p in col_ptr[j]..col_ptr[j + 1] {
+                let i = row(p);
                 if fixed[i].is_none() {
                     b[i] -= vals[p] * g;
                 }
@@ -236,8 +281,8 @@ pub fn apply_dirichlet_mut(
     }
     for j in 0..n {
         let mut has_diag = false;
-        for p in sym.col_range(j) {
-            let i = ri[p];
+        for p in col_ptr[j]..col_ptr[j + 1] {
+            let i = row(p);
             if i == j && fixed[j].is_some() {
                 vals[p] = 1.0;
                 has_diag = true;
