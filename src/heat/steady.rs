@@ -15,7 +15,7 @@ use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{
     AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet,
-    apply_dirichlet_mut, spmv, spmv_ref,
+    apply_dirichlet_mut, apply_dirichlet_parts, spmv, spmv_parts, spmv_ref,
 };
 use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
 use std::collections::HashSet;
@@ -497,17 +497,14 @@ fn solve_amg(
     let t = Instant::now();
     let mut fine_s = 0.0;
     let (mut record, mut r, mut heat, fine) = {
-        let sym = pattern.symbolic().expect("built").as_ref();
+        let (col_ptr, rows) = pattern.structure().expect("built");
         let mut asm = Assembler::direct(&pattern)?;
         assemble_conduction(&mut asm, p.mesh, dofs, p.materials, p.source, p.face_bcs)?;
         let f_vol = asm.rhs();
         // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
         let mut r = vec![0.0; n];
-        spmv_ref(
-            SparseColMatRef::new(sym, asm.element_values().expect("K")),
-            u,
-            &mut r,
-        );
+        let k = asm.element_values().expect("K");
+        spmv_parts(col_ptr, rows, k, u, &mut r);
         for (ri, fi) in r.iter_mut().zip(&f_vol) {
             *ri -= fi;
         }
@@ -523,14 +520,23 @@ fn solve_amg(
             let mut values = asm.take_values()?;
             let zero: Vec<(usize, f64)> = bcs.iter().map(|&(d, _)| (d, 0.0)).collect();
             let mut rhs = vec![0.0; n];
-            apply_dirichlet_mut(SparseColMatMut::new(sym, &mut values), &mut rhs, &zero)?;
-            let fine = AmgCg::rows_of(sym, values)?;
+            apply_dirichlet_parts(col_ptr, rows, &mut values, &mut rhs, &zero)?;
             fine_s = t.elapsed().as_secs_f64();
-            Some(fine)
+            Some((values, asm.exactly_symmetric()))
         };
         (record, r, heat, fine)
     };
-    drop(pattern);
+    // The pattern given up: its structure becomes the hierarchy's rows (a symmetric
+    // structure is its own transpose), with no copy.
+    let (col_ptr, rows) = pattern.into_structure().expect("built");
+    let t_rows = Instant::now();
+    let fine = fine
+        .map(|(values, symmetric)| match symmetric {
+            true => AmgCg::rows_of_symmetric_parts(n, col_ptr, rows, values),
+            false => AmgCg::rows_of_parts(n, col_ptr, rows, values),
+        })
+        .transpose()?;
+    fine_s += t_rows.elapsed().as_secs_f64();
     timing.assembly_s += t.elapsed().as_secs_f64() - fine_s;
     timing.factor_s += fine_s;
     let Some(fine) = fine else {

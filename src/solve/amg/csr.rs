@@ -58,10 +58,26 @@ impl Csr {
     /// as assembled patterns do) has its columns' structure as rows: its values are
     /// transposed in place, pair by pair, and nothing else is copied but the indices.
     /// Any other matrix goes through [`Self::from_csc`]. The same result either way.
-    pub fn from_csc_values(sym: SymbolicSparseColMatRef<'_, usize>, mut val: Vec<f64>) -> Csr {
+    pub fn from_csc_values(sym: SymbolicSparseColMatRef<'_, usize>, val: Vec<f64>) -> Csr {
         assert_eq!(sym.row_idx().len(), val.len(), "one value per stored entry");
-        let n = sym.ncols();
-        let (ptr, ri) = (sym.col_ptr(), sym.row_idx());
+        if sym.nrows() != sym.ncols() || sym.col_nnz().is_some() {
+            return Csr::from_csc(SparseColMatRef::new(sym, &val));
+        }
+        let rows = sym.row_idx().iter().map(|&i| i as u32).collect();
+        Csr::from_csc_parts(sym.ncols(), sym.col_ptr().to_vec(), rows, val)
+    }
+
+    /// [`Self::from_csc_values`] of a square CSC matrix given as its parts (column
+    /// pointers, 32-bit rows ascending in each column, values), all taken: for a
+    /// structurally symmetric matrix they become the rows as they are, its values
+    /// transposed in place, with no copy at all.
+    pub fn from_csc_parts(n: usize, ptr: Vec<usize>, ri: Vec<u32>, mut val: Vec<f64>) -> Csr {
+        assert_eq!(
+            ptr.len(),
+            n + 1,
+            "one column pointer per column, and the end"
+        );
+        assert_eq!(ri.len(), val.len(), "one value per stored entry");
         // Each stored (i, j) below the diagonal meets its (j, i) in column i: the rows
         // asked of column i come in increasing j, so one cursor per column suffices.
         // The values are swapped as the pairs are found, the first `limit` pairs only;
@@ -72,7 +88,7 @@ impl Csr {
             let (mut lower, mut upper) = (0usize, 0usize);
             for j in 0..n {
                 for p in ptr[j]..ptr[j + 1] {
-                    let i = ri[p];
+                    let i = ri[p] as usize;
                     if i < j {
                         upper += 1;
                         continue;
@@ -84,10 +100,10 @@ impl Csr {
                         return (lower, upper, true);
                     }
                     let end = ptr[i + 1];
-                    while cursor[i] < end && ri[cursor[i]] < j {
+                    while cursor[i] < end && (ri[cursor[i]] as usize) < j {
                         cursor[i] += 1;
                     }
-                    if cursor[i] == end || ri[cursor[i]] != j {
+                    if cursor[i] == end || ri[cursor[i]] as usize != j {
                         return (lower, upper, false);
                     }
                     val.swap(p, cursor[i]);
@@ -96,22 +112,20 @@ impl Csr {
             }
             (lower, upper, true)
         };
-        let square = sym.nrows() == n && sym.col_nnz().is_none();
-        if !square {
-            return Csr::from_csc(SparseColMatRef::new(sym, &val));
-        }
         // One pass for a symmetric structure (the usual case); another to undo the
-        // swaps of any other before copying it.
+        // swaps of any other before transposing it.
         let (lower, upper, paired) = walk(&mut val, usize::MAX);
         if !paired || lower != upper {
             walk(&mut val, lower);
+            let rows: Vec<usize> = ri.iter().map(|&i| i as usize).collect();
+            let sym = SymbolicSparseColMatRef::new_checked(n, n, &ptr, None, &rows);
             return Csr::from_csc(SparseColMatRef::new(sym, &val));
         }
         Csr {
             nrows: n,
             ncols: n,
-            ptr: ptr.to_vec(),
-            idx: ri.iter().map(|&i| i as u32).collect(),
+            ptr,
+            idx: ri,
             val,
         }
     }
@@ -162,42 +176,52 @@ impl Csr {
     /// `self · b` by Gustavson's row-by-row product; rows in parallel chunks,
     /// concatenated in order (deterministic).
     pub fn matmul(&self, b: &Csr) -> Csr {
-        self.matmul_rows(None, b)
+        self.matmul_rows(None, b, true)
     }
 
     /// Rows `rows` (all when `None`) of `self · b`, each made as [`Self::matmul`]
-    /// makes it.
-    pub(super) fn matmul_rows(&self, rows: Option<&[u32]>, b: &Csr) -> Csr {
+    /// makes it; with `sorted` false each row keeps its columns in the order they were
+    /// first reached (the same values: only the final sort is left out), for a product
+    /// that reads the rows through a scatter and never needs them in order.
+    pub(super) fn matmul_rows(&self, rows: Option<&[u32]>, b: &Csr, sorted: bool) -> Csr {
         const CHUNK: usize = 2048;
         let m = rows.map_or(self.nrows, <[u32]>::len);
         let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..m.div_ceil(CHUNK))
             .into_par_iter()
-            .map(|c| {
-                let rows = (c * CHUNK..((c + 1) * CHUNK).min(m))
-                    .map(|k| rows.map_or(k, |r| r[k] as usize));
-                let mut marker = vec![usize::MAX; b.ncols];
-                let mut acc = vec![0.0; b.ncols];
-                let (mut lens, mut idx, mut val) = (Vec::new(), Vec::new(), Vec::new());
-                for i in rows {
-                    let start = idx.len();
-                    for p in self.ptr[i]..self.ptr[i + 1] {
-                        let (k, aik) = (self.idx[p] as usize, self.val[p]);
-                        for q in b.ptr[k]..b.ptr[k + 1] {
-                            let j = b.idx[q] as usize;
-                            if marker[j] != i {
-                                marker[j] = i;
-                                acc[j] = 0.0;
-                                idx.push(j as u32);
+            // The scatter's marker and sums, made once per worker: a row's marker is
+            // its own index, so a row never sees another's marks.
+            .map_init(
+                || (vec![usize::MAX; b.ncols], vec![0.0; b.ncols]),
+                |(marker, acc), c| {
+                    let rows = (c * CHUNK..((c + 1) * CHUNK).min(m))
+                        .map(|k| rows.map_or(k, |r| r[k] as usize));
+                    let (mut lens, mut idx, mut val) = (Vec::new(), Vec::new(), Vec::new());
+                    for (k, i) in rows.enumerate() {
+                        // The mark of output row `c·CHUNK + k`: distinct for every row
+                        // of this product, even where `rows` repeats a row.
+                        let mark = c * CHUNK + k;
+                        let start = idx.len();
+                        for p in self.ptr[i]..self.ptr[i + 1] {
+                            let (k, aik) = (self.idx[p] as usize, self.val[p]);
+                            for q in b.ptr[k]..b.ptr[k + 1] {
+                                let j = b.idx[q] as usize;
+                                if marker[j] != mark {
+                                    marker[j] = mark;
+                                    acc[j] = 0.0;
+                                    idx.push(j as u32);
+                                }
+                                acc[j] += aik * b.val[q];
                             }
-                            acc[j] += aik * b.val[q];
                         }
+                        if sorted {
+                            idx[start..].sort_unstable();
+                        }
+                        val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
+                        lens.push(idx.len() - start);
                     }
-                    idx[start..].sort_unstable();
-                    val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
-                    lens.push(idx.len() - start);
-                }
-                (lens, idx, val)
-            })
+                    (lens, idx, val)
+                },
+            )
             .collect();
         let mut out = Csr {
             nrows: m,
@@ -236,18 +260,24 @@ impl Csr {
 /// order of the sums is fixed, so the bits do not depend on the thread count.
 #[inline(always)]
 pub(super) fn dot_row(idx: &[u32], val: &[f64], x: &[f64]) -> f64 {
+    dot_row_of(idx, val, x, |v| v)
+}
+
+/// [`dot_row`] of the values `f(val_k)`.
+#[inline(always)]
+pub(super) fn dot_row_of(idx: &[u32], val: &[f64], x: &[f64], f: impl Fn(f64) -> f64) -> f64 {
     let mut acc = [0.0f64; 4];
     let (mut ci, mut cv) = (idx.chunks_exact(4), val.chunks_exact(4));
     for (j, v) in (&mut ci).zip(&mut cv) {
         for k in 0..4 {
-            acc[k] += v[k] * x[j[k] as usize];
+            acc[k] += f(v[k]) * x[j[k] as usize];
         }
     }
     // The last entries into the sums they would have gone to in a longer row: a
     // row's leading part (a sweep from zero reads the entries left of the diagonal)
     // then sums as the whole row does where the rest multiplies zeros.
     for (k, (&j, &v)) in ci.remainder().iter().zip(cv.remainder()).enumerate() {
-        acc[k] += v * x[j as usize];
+        acc[k] += f(v) * x[j as usize];
     }
     (acc[0] + acc[1]) + (acc[2] + acc[3])
 }
