@@ -5,7 +5,7 @@
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
-use super::csr::{Csr, dot_row_of};
+use super::csr::{Csr, Rows, dot_row_of};
 use crate::solve::norm;
 
 /// ρ(D⁻¹A) by [`largest_eigenvalue`] of the similar symmetric `D^{-1/2} A D^{-1/2}`.
@@ -62,7 +62,10 @@ pub(super) fn filtered_diagonal(a: &Csr) -> Vec<f64> {
 }
 
 /// ρ(D_F⁻¹A_F) of the filtered matrix, as [`spectral_radius_dinv_a`] makes ρ(D⁻¹A).
-pub(super) fn spectral_radius_filtered(a: &Csr, filtered_diag: &[f64]) -> f64 {
+pub(super) fn spectral_radius_filtered<V: Copy + Into<f64> + Sync>(
+    a: Rows<'_, V>,
+    filtered_diag: &[f64],
+) -> f64 {
     use rayon::prelude::*;
     let scale: Vec<f64> = filtered_diag.iter().map(|d| 1.0 / d.sqrt()).collect();
     let mut scaled = vec![0.0; a.nrows];
@@ -75,7 +78,9 @@ pub(super) fn spectral_radius_filtered(a: &Csr, filtered_diag: &[f64]) -> f64 {
                 // A_F's row: the negative couplings (min(a_ij, 0) drops the positive
                 // ones and the positive diagonal), then its own diagonal.
                 let row = a.ptr[i]..a.ptr[i + 1];
-                let off = dot_row_of(&a.idx[row.clone()], &a.val[row], &scaled, |v| v.min(0.0));
+                let off = dot_row_of(&a.idx[row.clone()], &a.val[row], &scaled, |v| {
+                    v.into().min(0.0)
+                });
                 let s = off + filtered_diag[i] * scaled[i];
                 *wi = scale[i] * s - beta * *wi;
             });
@@ -444,7 +449,7 @@ mod tests {
                 (got - exact).abs() <= 1e-12 * exact,
                 "n = {n}: {got} vs {exact}"
             );
-            let filtered = spectral_radius_filtered(&a, &filtered_diagonal(&a));
+            let filtered = spectral_radius_filtered(a.with_values(&a.val), &filtered_diagonal(&a));
             assert!(
                 (filtered - exact).abs() <= 1e-12 * exact,
                 "n = {n}: {filtered}"

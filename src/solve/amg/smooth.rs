@@ -1,7 +1,7 @@
 //! Point smoothers of the V-cycle: Gauss–Seidel sweeps over all rows or over a chosen
 //! set of them, and the choice of the rows that get extra sweeps (a penalty interface).
 
-use super::csr::{Csr, dot_row};
+use super::csr::{Csr, Rows, dot_row};
 
 /// Share of its diagonal that a row's positive off-diagonal couplings must reach for
 /// the row to get extra sweeps ([`penalty_rows`]). A Q1 or P1 conduction matrix on
@@ -56,7 +56,13 @@ fn with_neighbours(a: &Csr, rows: &[u32]) -> Vec<u32> {
 
 /// One Gauss–Seidel sweep, `x_i ← x_i + (b_i − (Ax)_i)/a_ii`, rows ascending or
 /// descending.
-pub(super) fn gauss_seidel(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64], forward: bool) {
+pub(super) fn gauss_seidel<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    forward: bool,
+) {
     let mut row = |i: usize| gauss_seidel_row(a, inv_diag, x, b, i);
     if forward {
         (0..a.nrows).for_each(&mut row);
@@ -70,7 +76,12 @@ pub(super) fn gauss_seidel(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64], 
 /// the matrix read, the values of [`gauss_seidel`] (the skipped terms are products
 /// with zero). Needs ascending columns in each row, as every [`Csr`] of the hierarchy
 /// has.
-pub(super) fn gauss_seidel_from_zero(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64]) {
+pub(super) fn gauss_seidel_from_zero<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+) {
     for i in 0..a.nrows {
         let (start, end) = (a.ptr[i], a.ptr[i + 1]);
         debug_assert!(a.idx[start..end].is_sorted(), "row {i} is not sorted");
@@ -86,8 +97,8 @@ pub(super) fn gauss_seidel_from_zero(a: &Csr, inv_diag: &[f64], x: &mut [f64], b
 /// then takes `a_ki x_k` off it, which is `a_ik x_k` read from row k's entries left of
 /// its diagonal as it is swept (those entries are in cache). This replaces a product
 /// with the whole matrix after the sweep.
-pub(super) fn gauss_seidel_from_zero_with_residual(
-    a: &Csr,
+pub(super) fn gauss_seidel_from_zero_with_residual<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
     inv_diag: &[f64],
     x: &mut [f64],
     b: &[f64],
@@ -102,7 +113,7 @@ pub(super) fn gauss_seidel_from_zero_with_residual(
         // b_i − Σ_{j≤i} a_ij x_j: zero, but for rounding.
         r[i] = 0.0;
         for (&j, &v) in idx.iter().zip(val) {
-            r[j as usize] -= v * xi;
+            r[j as usize] -= v.into() * xi;
         }
     }
 }
@@ -110,8 +121,8 @@ pub(super) fn gauss_seidel_from_zero_with_residual(
 /// [`symmetric_gauss_seidel_rows`] keeping the residual `r = b − A x` of a symmetric
 /// `a` up to date: each row's change `δ_k` takes `a_jk δ_k` off `r_j` for the rows j
 /// it couples to. `saved` is scratch of at least `rows.len()` values.
-pub(super) fn symmetric_gauss_seidel_rows_with_residual(
-    a: &Csr,
+pub(super) fn symmetric_gauss_seidel_rows_with_residual<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
     inv_diag: &[f64],
     x: &mut [f64],
     b: &[f64],
@@ -127,7 +138,7 @@ pub(super) fn symmetric_gauss_seidel_rows_with_residual(
         let delta = x[k] - old;
         if delta != 0.0 {
             for p in a.ptr[k]..a.ptr[k + 1] {
-                r[a.idx[p] as usize] -= a.val[p] * delta;
+                r[a.idx[p] as usize] -= a.val[p].into() * delta;
             }
         }
     }
@@ -136,8 +147,8 @@ pub(super) fn symmetric_gauss_seidel_rows_with_residual(
 /// A symmetric Gauss–Seidel sweep over `rows` only: forward through them, then
 /// backward. Its error propagator is self-adjoint in the energy inner product, so it
 /// may sit on either side of the coarse correction and keep the V-cycle symmetric.
-pub(super) fn symmetric_gauss_seidel_rows(
-    a: &Csr,
+pub(super) fn symmetric_gauss_seidel_rows<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
     inv_diag: &[f64],
     x: &mut [f64],
     b: &[f64],
@@ -154,7 +165,13 @@ pub(super) fn symmetric_gauss_seidel_rows(
 /// `x_i ← x_i + (b_i − (Ax)_i)/a_ii`: the body of every sweep, inlined into each (a
 /// call per row costs a tenth of a sweep).
 #[inline(always)]
-fn gauss_seidel_row(a: &Csr, inv_diag: &[f64], x: &mut [f64], b: &[f64], i: usize) {
+fn gauss_seidel_row<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    i: usize,
+) {
     let (start, end) = (a.ptr[i], a.ptr[i + 1]);
     let s = b[i] - dot_row(&a.idx[start..end], &a.val[start..end], x);
     x[i] += s * inv_diag[i];
