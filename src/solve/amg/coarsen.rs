@@ -302,6 +302,10 @@ pub(super) fn smoothed_prolongator(
         }
         p.ptr.push(p.idx.len());
     }
+    // Single-precision values: the V-cycle applies P in single precision (module docs
+    // of the parent), and the coarse operator is then the Galerkin product of the
+    // very P it is used with.
+    p.val.iter_mut().for_each(|v| *v = f64::from(*v as f32));
     p
 }
 
@@ -330,16 +334,32 @@ pub(super) fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
     let (mut up_ptr, mut up_idx, mut up_val) = (vec![0usize], Vec::new(), Vec::new());
     // Fine row → its row in the block's `A P`.
     let mut local = vec![u32::MAX; a.nrows];
+    // P's entries as (column, value) pairs: a row of `A P` reads 27 rows of P, and
+    // each packed row is one or two cache lines instead of one in each of two arrays.
+    // Its values are single-precision numbers already (`smoothed_prolongator`), so
+    // nothing is lost.
+    let packed: Vec<(u32, f32)> = p
+        .idx
+        .iter()
+        .zip(&p.val)
+        .map(|(&j, &v)| (j, v as f32))
+        .collect();
     for start in (0..nc).step_by(block) {
         let end = (start + block).min(nc);
+        // The fine rows the block's rows of R reach, ascending: the rows of A and P
+        // that make them are then read in order, not aggregate by aggregate.
         let mut fine: Vec<u32> = Vec::new();
         for &i in &r.idx[r.ptr[start]..r.ptr[end]] {
             if local[i as usize] == u32::MAX {
-                local[i as usize] = fine.len() as u32;
+                local[i as usize] = 0;
                 fine.push(i);
             }
         }
-        let ap = a.matmul_rows(Some(&fine), p, false);
+        fine.sort_unstable();
+        for (k, &i) in fine.iter().enumerate() {
+            local[i as usize] = k as u32;
+        }
+        let ap = product_rows(a, &fine, p, &packed);
         let rows: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (start..end)
             .step_by(CHUNK)
             .collect::<Vec<_>>()
@@ -347,7 +367,12 @@ pub(super) fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
             .map_init(
                 || (vec![usize::MAX; nc], vec![0.0; nc]),
                 |(marker, acc), first| {
-                    let (mut lens, mut idx, mut val) = (Vec::new(), Vec::new(), Vec::new());
+                    // A Q1 level's coarse rows hold about 80 entries, half of them upper.
+                    let (mut lens, mut idx, mut val) = (
+                        Vec::with_capacity(CHUNK),
+                        Vec::with_capacity(64 * CHUNK),
+                        Vec::with_capacity(64 * CHUNK),
+                    );
                     for g in first..(first + CHUNK).min(end) {
                         let at = idx.len();
                         for q in r.ptr[g]..r.ptr[g + 1] {
@@ -385,6 +410,64 @@ pub(super) fn galerkin(r: &Csr, a: &Csr, p: &Csr) -> Csr {
         }
     }
     mirror_upper(nc, &up_ptr, &up_idx, &up_val)
+}
+
+/// Rows `rows` of `A P`, P's entries read from `packed` (its (column, value) pairs),
+/// each row's columns in the order first reached (as [`Csr::matmul_rows`] unsorted
+/// makes them, the same values).
+fn product_rows(a: &Csr, rows: &[u32], p: &Csr, packed: &[(u32, f32)]) -> Csr {
+    use rayon::prelude::*;
+    const CHUNK: usize = 2048;
+    let (p_ptr, ncols) = (&p.ptr, p.ncols);
+    let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = rows
+        .par_chunks(CHUNK)
+        .map_init(
+            || (vec![u32::MAX; ncols], vec![0.0; ncols]),
+            |(marker, acc), chunk| {
+                let (mut lens, mut idx, mut val) = (
+                    Vec::with_capacity(chunk.len()),
+                    Vec::with_capacity(32 * chunk.len()),
+                    Vec::with_capacity(32 * chunk.len()),
+                );
+                for &i in chunk {
+                    let (i, start) = (i as usize, idx.len());
+                    let row = a.ptr[i]..a.ptr[i + 1];
+                    for (&k, &aik) in a.idx[row.clone()].iter().zip(&a.val[row]) {
+                        let k = k as usize;
+                        for &(j, pkj) in &packed[p_ptr[k]..p_ptr[k + 1]] {
+                            let ju = j as usize;
+                            if marker[ju] != i as u32 {
+                                marker[ju] = i as u32;
+                                acc[ju] = 0.0;
+                                idx.push(j);
+                            }
+                            acc[ju] += aik * f64::from(pkj);
+                        }
+                    }
+                    val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
+                    lens.push(idx.len() - start);
+                }
+                (lens, idx, val)
+            },
+        )
+        .collect();
+    let nnz = chunks.iter().map(|c| c.1.len()).sum();
+    let mut out = Csr {
+        nrows: rows.len(),
+        ncols,
+        ptr: Vec::with_capacity(rows.len() + 1),
+        idx: Vec::with_capacity(nnz),
+        val: Vec::with_capacity(nnz),
+    };
+    out.ptr.push(0);
+    for (lens, idx, val) in chunks {
+        for l in lens {
+            out.ptr.push(out.ptr.last().unwrap() + l);
+        }
+        out.idx.extend(idx);
+        out.val.extend(val);
+    }
+    out
 }
 
 /// The symmetric matrix whose upper triangle (diagonal included, each row sorted) is
