@@ -50,7 +50,7 @@ use interaction::Interaction;
 use species::FieldEnforced;
 
 /// The equation every supported enforcement applies to.
-const ENERGY: &str = "energy";
+pub(crate) const ENERGY: &str = "energy";
 
 /// One pairing with the enforcement that applies to it.
 pub struct Enforced {
@@ -494,13 +494,21 @@ impl ContactScene {
         };
         phase("building the contact surfaces");
         let t = Instant::now();
-        let set = surfaces::build(mesh, def, &loaded.sources);
+        // On a distributed mesh (`seam run` under mpirun) rank 0 builds them on the whole
+        // mesh and each other rank gets its share.
+        let set =
+            crate::parallel::share_surfaces(mesh, || surfaces::build(mesh, def, &loaded.sources));
         self.timing.surfaces_s += t.elapsed().as_secs_f64();
         self.surfaces += set.surfaces.len();
         diags.extend(set.diagnostics.clone());
         let (list, found) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
         diags.extend(found);
-        if diags.has_errors() {
+        // Every rank of a distributed mesh follows rank 0, which checks the whole.
+        if crate::parallel::mesh_is_distributed() {
+            if crate::parallel::root_verdict(diags.has_errors()) {
+                return None;
+            }
+        } else if diags.has_errors() {
             return None;
         }
         phase("contact search");
