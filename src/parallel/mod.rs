@@ -41,6 +41,8 @@ mod session;
 mod share;
 #[cfg(feature = "mpi")]
 mod steady;
+#[cfg(feature = "mpi")]
+mod wire;
 
 #[cfg(feature = "mpi")]
 pub use general::GeneralSolve;
@@ -475,7 +477,7 @@ pub(crate) fn report_holdings(mesh: &crate::mesh::Mesh) {
             nodes: mesh.num_nodes(),
             ..Default::default()
         });
-        let peak = crate::run::peak_memory_mib().unwrap_or(f64::NAN);
+        let peak = peak_resident_mib().unwrap_or(f64::NAN);
         let distributed = mesh_is_distributed();
         let mine = [
             h.owned as f64,
@@ -530,4 +532,13 @@ pub(crate) fn global_unknowns(local: usize) -> usize {
         }
     }
     local
+}
+
+/// This process's peak resident memory (`VmHWM` of `/proc/self/status`), MiB.
+#[cfg(feature = "mpi")]
+fn peak_resident_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
 }

@@ -16,7 +16,7 @@ use crate::mesh::{Mesh, NodeId, Side};
 use crate::surface::{ContactSurface, SurfaceFace, SurfaceKind, SurfaceSet};
 
 use super::part::{self, Part};
-use super::session;
+use super::{session, wire};
 
 /// The surfaces of one contact definition on a distributed mesh: rank 0 builds them
 /// (`build`, on the whole mesh) and sends each other rank its share, which it returns
@@ -29,7 +29,7 @@ pub(super) fn surfaces(mesh: &Mesh, build: impl FnOnce() -> SurfaceSet) -> Surfa
         let size = world.size() as usize;
         for r in 1..size {
             let bytes = part::with(|p| encode_share(p, mesh, &set, r)).unwrap_or_default();
-            part::send_bytes(&world, r, &bytes);
+            wire::send_bytes(&world, r, &bytes);
         }
         if let Err(r) = all_ok(&world, true) {
             set.diagnostics.push(
@@ -42,7 +42,7 @@ pub(super) fn surfaces(mesh: &Mesh, build: impl FnOnce() -> SurfaceSet) -> Surfa
         }
         return set;
     }
-    let bytes = part::receive_bytes(&world);
+    let bytes = wire::receive_bytes(&world);
     let share = part::with(|p| decode_share(p, &bytes)).unwrap_or_else(|| Err("no part".into()));
     let _ = all_ok(&world, share.is_ok());
     share.unwrap_or_default()

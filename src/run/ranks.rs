@@ -12,7 +12,6 @@
 //! each check of the run ([`stop`]) and print nothing, as every rank other than 0 does.
 
 use crate::diag::{Diagnostics, SourceMap};
-use crate::enforce::model::ModelChoice;
 use crate::mesh::Mesh;
 use crate::parallel::{self, MeshPlan, MeshShare};
 
@@ -137,49 +136,8 @@ pub(super) fn distributable(
         return refuse("the contact deck has errors");
     }
     let fields: Vec<&str> = physics.field_names.iter().map(String::as_str).collect();
-    for def in &loaded.deck.contact_definitions {
-        let auto = def.surfaces.iter().any(
-            |s| matches!(s, crate::deck::spec::SurfaceDef::Block(b) if b.auto_subset.is_some()),
-        );
-        if auto {
-            return refuse("an `Auto Subset` (its groups follow the whole surface)");
-        }
-        let align = def.periodicity.iter().any(|q| {
-            matches!(
-                q.transform,
-                crate::deck::spec::PeriodicTransform::AlignSurface { .. }
-            )
-        });
-        if align {
-            return refuse("an `Align_Surface` periodicity (its map follows the whole surfaces)");
-        }
-        for enf in &def.enforcements {
-            let other = enf
-                .models
-                .iter()
-                .any(|m| m.equation != crate::scene::ENERGY);
-            if other {
-                return refuse("a voltage or species enforcement");
-            }
-            let Ok(choice) = crate::scene::enforcement::resolve_for(enf, Some(&fields)) else {
-                return refuse("an enforcement with errors");
-            };
-            whole_needed(&choice)?;
-        }
+    match crate::scene::needs_whole_mesh(&loaded, &fields) {
+        Some(why) => refuse(why),
+        None => Ok(()),
     }
-    Ok(())
-}
-
-/// Why an enforcement needs every rank to hold the whole problem, if it does.
-fn whole_needed(c: &ModelChoice) -> Result<(), String> {
-    if c.mortar {
-        return Err("a mortar tie with multipliers (the general solver)".into());
-    }
-    if c.toggle.is_some() {
-        return Err("a toggled enforcement (the general solver)".into());
-    }
-    if c.pressure_variable.is_some() {
-        return Err("a `Contact Pressure Variable`".into());
-    }
-    Ok(())
 }

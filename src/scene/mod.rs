@@ -50,7 +50,7 @@ use interaction::Interaction;
 use species::FieldEnforced;
 
 /// The equation every supported enforcement applies to.
-pub(crate) const ENERGY: &str = "energy";
+const ENERGY: &str = "energy";
 
 /// One pairing with the enforcement that applies to it.
 pub struct Enforced {
@@ -732,6 +732,48 @@ pub fn conductance_model(
             }
         }
     }
+}
+
+/// Why the contact of `loaded` needs every rank of a distributed `seam run` to hold the
+/// whole mesh (docs/parallel.md), or `None` when each rank can hold its part: surfaces
+/// or maps made from whole surfaces (`Auto Subset`, an `Align_Surface` periodicity), a
+/// voltage or species enforcement, an Energy enforcement that is a mortar tie with
+/// multipliers, switched by a toggle or fed a contact pressure field (the general solver
+/// or whole-mesh data), or one that does not resolve with the problem's `fields`.
+pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static str> {
+    use crate::deck::spec::{PeriodicTransform, SurfaceDef};
+    for def in &loaded.deck.contact_definitions {
+        let auto = def
+            .surfaces
+            .iter()
+            .any(|s| matches!(s, SurfaceDef::Block(b) if b.auto_subset.is_some()));
+        if auto {
+            return Some("an `Auto Subset` (its groups follow the whole surface)");
+        }
+        let align = (def.periodicity.iter())
+            .any(|q| matches!(q.transform, PeriodicTransform::AlignSurface { .. }));
+        if align {
+            return Some("an `Align_Surface` periodicity (its map follows the whole surfaces)");
+        }
+        for enf in &def.enforcements {
+            if enf.models.iter().any(|m| m.equation != ENERGY) {
+                return Some("a voltage or species enforcement");
+            }
+            let Ok(c) = resolve_for(enf, Some(fields)) else {
+                return Some("an enforcement with errors");
+            };
+            if c.mortar {
+                return Some("a mortar tie with multipliers (the general solver)");
+            }
+            if c.toggle.is_some() {
+                return Some("a toggled enforcement (the general solver)");
+            }
+            if c.pressure_variable.is_some() {
+                return Some("a `Contact Pressure Variable`");
+            }
+        }
+    }
+    None
 }
 
 /// Without a mesh: resolve every enforcement block of the deck and make its conductance
