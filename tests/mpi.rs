@@ -877,3 +877,114 @@ fn element_death_equals_serial() {
         "the death changed the surface: {updates}"
     );
 }
+
+/// What rank `r` says it holds, from rank 0's log: (elements, own, ghosts, contact
+/// partners, nodes, PETSc rows).
+fn holdings(log: &str, r: usize) -> Option<[usize; 6]> {
+    let head = format!("rank {r} holds its part: ");
+    let line = log
+        .lines()
+        .find_map(|l| l.split_once(&head).map(|(_, t)| t))?;
+    // "E elements (O own, G ghosts, P contact partners), N nodes (and Q of contact
+    // partners), R PETSc rows; …"
+    let numbers: Vec<usize> = line
+        .split(|c: char| !c.is_ascii_digit() && c != '.')
+        .filter(|w| !w.is_empty() && !w.contains('.'))
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    Some([
+        numbers[0], numbers[1], numbers[2], numbers[3], numbers[4], numbers[6],
+    ])
+}
+
+/// On a distributed mesh, each rank other than 0 holds exactly its part: the elements
+/// the partition gives it, the elements sharing a node with those (one ghost layer) and
+/// their nodes — counted against the partition rank 0 made (`SEAM_PARTITION_FILE`) and
+/// the mesh — and fewer elements and nodes than the whole mesh; the temperatures and
+/// heats equal serial.
+#[test]
+fn ranks_other_than_0_hold_their_own_elements_and_one_ghost_layer() {
+    let tmp = scratch("holdings");
+    let problem = write_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
+        "",
+    );
+    let mesh = seam::mesh::read(&tmp.path().join("bar.exo")).unwrap();
+    let serial = run(&problem, None);
+    let expected: Vec<_> = (serial.fields.iter().cloned())
+        .chain(balances(&serial.summary))
+        .collect();
+    for n in [2, 3, 4] {
+        let partition = tmp.path().join(format!("partition_{n}.txt"));
+        let mut cmd = seam(Some(n));
+        cmd.env("SEAM_PARTITION_FILE", &partition)
+            .args(["run", "--json"])
+            .arg(&problem);
+        let out = cmd.output().unwrap();
+        let log = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{n} ranks:\n{log}");
+        let part: Vec<usize> = std::fs::read_to_string(&partition)
+            .unwrap_or_else(|e| panic!("no partition written on {n} ranks ({e}):\n{log}"))
+            .lines()
+            .map(|l| l.trim().parse().unwrap())
+            .collect();
+        assert_eq!(part.len(), mesh.num_elems(), "one rank per element");
+        // The elements and nodes rank r should hold: its own, and every element with a
+        // node of its own elements.
+        let elems: Vec<Vec<usize>> = mesh
+            .blocks
+            .iter()
+            .flat_map(|b| {
+                (0..b.len()).map(move |k| b.elem_nodes(k).iter().map(|n| n.index()).collect())
+            })
+            .collect();
+        for r in 1..n {
+            let mut near = vec![false; mesh.num_nodes()];
+            for (e, nodes) in elems.iter().enumerate() {
+                if part[e] == r {
+                    nodes.iter().for_each(|&k| near[k] = true);
+                }
+            }
+            let own = part.iter().filter(|&&p| p == r).count();
+            let local: Vec<usize> = (0..elems.len())
+                .filter(|&e| elems[e].iter().any(|&k| near[k]))
+                .collect();
+            let mut nodes = vec![false; mesh.num_nodes()];
+            for &e in &local {
+                elems[e].iter().for_each(|&k| nodes[k] = true);
+            }
+            let node_count = nodes.iter().filter(|&&x| x).count();
+            let [total, o, ghosts, partners, held_nodes, _rows] = holdings(&log, r)
+                .unwrap_or_else(|| panic!("rank {r} of {n} says nothing of what it holds:\n{log}"));
+            eprintln!(
+                "{n} ranks, rank {r}: holds {total} of {} elements ({o} own, {ghosts} ghosts, {partners} contact partners), {held_nodes} of {} nodes; the partition gives {own} own, {} ghosts, {node_count} nodes",
+                mesh.num_elems(),
+                mesh.num_nodes(),
+                local.len() - own
+            );
+            assert_eq!(o, own, "rank {r} of {n}: own elements");
+            assert_eq!(ghosts, local.len() - own, "rank {r} of {n}: ghost layer");
+            assert_eq!(total, local.len() + partners, "rank {r} of {n}: elements");
+            assert_eq!(held_nodes, node_count, "rank {r} of {n}: nodes");
+            assert!(
+                local.len() < mesh.num_elems() && node_count < mesh.num_nodes(),
+                "rank {r} of {n} holds the whole mesh"
+            );
+        }
+        // The results as serial.
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let line = stdout.lines().find(|l| l.starts_with('{')).unwrap();
+        let summary: serde_json::Value = serde_json::from_str(line).unwrap();
+        let fields = nodal_fields(&tmp.path().join("out/results.exo"));
+        let got: Vec<_> = fields.into_iter().chain(balances(&summary)).collect();
+        for ((name, e), (_, g)) in expected.iter().zip(&got) {
+            if e.is_empty() {
+                continue;
+            }
+            let (d, scale) = difference(e, g);
+            eprintln!("{n} ranks: max |Δ{name}| {d:.2e} (of {scale:.3e})");
+            assert!(d <= REL * scale, "{name} differs by {d:e} on {n} ranks");
+        }
+    }
+}

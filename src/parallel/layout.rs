@@ -1,138 +1,19 @@
-//! Who owns what: the elements partitioned by METIS (on rank 0, broadcast, so every rank
-//! holds the same partition), each node owned by the lowest rank among its elements'
-//! parts, each dof by its node's owner, and the PETSc numbering — the serial dofs in
-//! order, rank after rank, so that each rank's rows are one contiguous range.
+//! The partition: the elements of the solid blocks split by METIS into one part per
+//! rank ([`partition`]; for a run whose every rank holds the whole mesh, made on rank 0
+//! and broadcast by [`element_parts`], so every rank holds the same), and each node's
+//! owner, the lowest rank among its elements' parts ([`node_owners`]). What each rank
+//! then holds and how PETSc numbers the dofs is [`super::part`]'s.
 
 use std::cell::RefCell;
 
 use mpi::traits::{Communicator, Root};
 
-use crate::assembly::{DofMap, FieldId};
-use crate::mesh::{Block, ElemId, Mesh, NodeId};
+use crate::mesh::{ElemId, Mesh};
 
-use super::petsc::PetscInt;
 use super::session;
 
 /// Part of an element outside the partitioned blocks (no temperature).
 pub(super) const NO_PART: u32 = u32::MAX;
-
-/// The partition of one solve.
-pub(super) struct Layout {
-    pub rank: usize,
-    /// Per element, its rank (NO_PART outside the partitioned blocks).
-    pub part: Vec<u32>,
-    /// Per serial dof, its PETSc index.
-    pub petsc: Vec<PetscInt>,
-    /// Rank `r`'s PETSc rows are `starts[r]..starts[r + 1]`.
-    pub starts: Vec<usize>,
-    /// The serial dofs this rank owns, ascending (their PETSc indices are consecutive).
-    pub owned: Vec<usize>,
-}
-
-impl Layout {
-    /// Partition the elements of `blocks` into the world's ranks and number the dofs of
-    /// `field` for PETSc.
-    pub fn new(
-        mesh: &Mesh,
-        dofs: &DofMap,
-        field: FieldId,
-        blocks: &[usize],
-    ) -> Result<Self, String> {
-        let world = session::comm();
-        let (rank, size) = (world.rank() as usize, world.size() as usize);
-        let part = element_parts(mesh, blocks)?;
-        let node_owner = node_owners(mesh, blocks, &part);
-        let n = dofs.len();
-        let mut owner = vec![0u32; n];
-        for (i, &o) in node_owner.iter().enumerate() {
-            if let Some(d) = dofs.dof(field, NodeId(i as u32)) {
-                owner[d.index()] = if o == NO_PART { 0 } else { o };
-            }
-        }
-        let mut count = vec![0usize; size];
-        for &o in &owner {
-            count[o as usize] += 1;
-        }
-        let mut starts = vec![0usize; size + 1];
-        for r in 0..size {
-            starts[r + 1] = starts[r] + count[r];
-        }
-        let mut next = starts[..size].to_vec();
-        let mut petsc = vec![0 as PetscInt; n];
-        for (d, &o) in owner.iter().enumerate() {
-            petsc[d] = next[o as usize] as PetscInt;
-            next[o as usize] += 1;
-        }
-        let owned = (0..n).filter(|&d| owner[d] as usize == rank).collect();
-        Ok(Layout {
-            rank,
-            part,
-            petsc,
-            starts,
-            owned,
-        })
-    }
-
-    /// This rank's PETSc rows.
-    pub fn rows(&self) -> std::ops::Range<usize> {
-        self.starts[self.rank]..self.starts[self.rank + 1]
-    }
-
-    /// The rank owning serial dof `d`.
-    pub fn owner(&self, d: usize) -> usize {
-        let i = self.petsc[d] as usize;
-        self.starts.partition_point(|&s| s <= i) - 1
-    }
-
-    /// Whether serial dof `d` is owned here.
-    pub fn owns(&self, d: usize) -> bool {
-        self.rows().contains(&(self.petsc[d] as usize))
-    }
-
-    /// The mesh of this rank's elements: the same nodes and blocks (the blocks holding
-    /// only this rank's elements, in their serial order), and per serial element its
-    /// local element.
-    pub fn local_mesh(&self, mesh: &Mesh) -> (Mesh, Vec<Option<ElemId>>) {
-        let mut local = vec![None; mesh.num_elems()];
-        let mut blocks = Vec::with_capacity(mesh.blocks.len());
-        let mut elem_numbers = Vec::new();
-        let mut next = 0u32;
-        for block in &mesh.blocks {
-            let nn = block.topology.node_count();
-            let first_elem = ElemId(next);
-            let mut connectivity = Vec::new();
-            for (k, e) in block.elems().enumerate() {
-                if self.part[e.index()] as usize == self.rank {
-                    connectivity.extend_from_slice(&block.connectivity[k * nn..(k + 1) * nn]);
-                    elem_numbers.push(mesh.elem_numbers[e.index()]);
-                    local[e.index()] = Some(ElemId(next));
-                    next += 1;
-                }
-            }
-            blocks.push(Block {
-                id: block.id,
-                name: block.name.clone(),
-                topology: block.topology,
-                connectivity,
-                first_elem,
-                thickness: block.thickness,
-            });
-        }
-        let m = Mesh {
-            dim: mesh.dim,
-            coords: mesh.coords.clone(),
-            node_numbers: mesh.node_numbers.clone(),
-            elem_numbers,
-            blocks,
-            side_sets: Vec::new(),
-            node_sets: Vec::new(),
-            assemblies: Vec::new(),
-            source: mesh.source.clone(),
-            axisymmetric: mesh.axisymmetric,
-        };
-        (m, local)
-    }
-}
 
 thread_local! {
     /// The last partition made: (element count, node count, blocks) and the parts, so
@@ -200,7 +81,7 @@ pub(super) fn node_owners(mesh: &Mesh, blocks: &[usize], part: &[u32]) -> Vec<u3
 /// METIS's k-way partition of the dual graph (elements sharing a face: 3 common nodes in
 /// 3-D, 2 in 2-D) of the elements of `blocks` into `parts` parts; other elements get
 /// [`NO_PART`]. Fewer elements than parts: one element per part.
-fn partition(mesh: &Mesh, blocks: &[usize], parts: usize) -> Result<Vec<u32>, String> {
+pub(super) fn partition(mesh: &Mesh, blocks: &[usize], parts: usize) -> Result<Vec<u32>, String> {
     let mut part = vec![NO_PART; mesh.num_elems()];
     let elems: Vec<ElemId> = blocks
         .iter()

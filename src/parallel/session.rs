@@ -7,7 +7,7 @@ use std::sync::OnceLock;
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::environment::Universe;
 use mpi::topology::{Communicator, SimpleCommunicator};
-use mpi::traits::CommunicatorCollectives;
+use mpi::traits::{CommunicatorCollectives, Root};
 
 use super::petsc;
 
@@ -88,6 +88,30 @@ where
     {
         let mut got = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
         world.all_gather_varcount_into(mine, &mut got);
+    }
+    all
+}
+
+/// Every rank's `mine`, concatenated in rank order, on rank 0 (`MPI_Gather` of the
+/// counts, then `MPI_Gatherv`); empty on the other ranks.
+pub(super) fn gather_root<T>(world: &SimpleCommunicator, mine: &[T]) -> Vec<T>
+where
+    T: mpi::datatype::Equivalence + Copy + Default,
+{
+    let root = world.process_at_rank(0);
+    let count = mine.len() as i32;
+    if world.rank() != 0 {
+        root.gather_into(&count);
+        root.gather_varcount_into(mine);
+        return Vec::new();
+    }
+    let mut counts = vec![0i32; world.size() as usize];
+    root.gather_into_root(&count, &mut counts[..]);
+    let displs = displacements(&counts);
+    let mut all = vec![T::default(); counts.iter().sum::<i32>() as usize];
+    {
+        let mut got = PartitionMut::new(&mut all[..], &counts[..], &displs[..]);
+        root.gather_varcount_into_root(mine, &mut got);
     }
     all
 }

@@ -30,7 +30,7 @@ use crate::mesh::{ElemId, Mesh, NodeId, Side};
 use crate::solve::spmv_ref;
 use faer::sparse::SparseColMatRef;
 
-use super::layout::{Layout, node_owners};
+use super::part;
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::session;
 
@@ -38,14 +38,15 @@ fn petsc_err(e: PetscError) -> HeatError {
     HeatError::Contact(format!("distributed solve: {e}"))
 }
 
-/// Solve `p` over the MPI world; every rank returns the whole solution.
+/// Solve `p` over the MPI world: on a run whose mesh is distributed (`p.mesh` this
+/// rank's local mesh with its contact partners), rank 0 returns the whole solution and
+/// every other rank its own part (its owned dofs and those it reads; the rest as they
+/// started); else every rank the whole solution.
 pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> {
     let mesh = p.mesh;
     let world = session::comm();
     let comm = world.as_raw();
-    let blocks: Vec<usize> = (0..mesh.blocks.len())
-        .filter(|&b| mesh.blocks[b].topology.is_solid())
-        .collect();
+    let blocks = part::solid_blocks(mesh);
     let dofs = DofMap::new(mesh, &[(TEMPERATURE, &blocks)])?;
     let field = dofs
         .field(TEMPERATURE)
@@ -71,8 +72,10 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
     let mut timing = SolveTiming::default();
     let t = Instant::now();
-    let layout =
-        Layout::new(mesh, &dofs, field, dofs.field_blocks(field)).map_err(HeatError::Contact)?;
+    part::ensure(mesh).map_err(HeatError::Contact)?;
+    let layout = part::with(|part| Layout::new(part, mesh, &dofs, field))
+        .ok_or_else(|| HeatError::Contact("distributed solve: no partition".into()))?
+        .map_err(HeatError::Contact)?;
     let mut phases = Phases::default();
     phases.mark("partition", t);
     let rows = layout.rows();
@@ -92,6 +95,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let f_local = asm.rhs();
     let k_local = asm.take_values()?;
     drop(asm);
+    drop(pattern);
     phases.mark("own elements", t);
     // The dofs whose residual this rank adds to: its elements' and its own.
     let mut touched: Vec<usize> = local
@@ -101,16 +105,16 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         .filter_map(|&node| dofs.dof(field, node).map(|d| d.index()))
         .chain(layout.owned.iter().copied())
         .collect();
+    drop(local);
     touched.sort_unstable();
     touched.dedup();
     let touched_petsc: Vec<PetscInt> = touched.iter().map(|&d| layout.petsc[d]).collect();
 
     // The interface terms of the points this rank owns (by their side-A face's element
     // or side-A node), all points again when the solve ends however it ends.
-    let node_owner = node_owners(mesh, dofs.field_blocks(field), &layout.part);
     let owns = |elem: Option<ElemId>, node: Option<NodeId>| match (elem, node) {
-        (Some(e), _) => layout.part.get(e.index()).copied() == Some(layout.rank as u32),
-        (None, Some(n)) => node_owner.get(n.index()).copied() == Some(layout.rank as u32),
+        (Some(e), _) => layout.elem_owner.get(e.index()).copied() == Some(layout.rank as u32),
+        (None, Some(n)) => layout.node_owner.get(n.index()).copied() == Some(layout.rank as u32),
         (None, None) => false,
     };
     let _all_again = match iface {
@@ -128,38 +132,43 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         None => Vec::new(),
     };
     let first = ipattern.add_couplings(&pairs_of_mine)?.start;
-    // Every rank's couplings, for the preallocation of the rows they reach.
-    let pairs = all_couplings(&world, &pairs_of_mine);
     ipattern.build_direct()?;
     let i_sym = ipattern.symbolic().expect("built").clone();
     let mut iasm = Assembler::direct(&ipattern)?;
-
-    if layout.rank == 0 {
+    // The couplings of every rank's points that reach this rank's rows, for their
+    // preallocation.
+    let reaching = couplings_to_owners(&world, &layout, &pairs_of_mine);
+    {
         // How the partition meets the interfaces: couplings whose two dofs sit on
         // different ranks are those a per-rank solve would get wrong.
-        let across = pairs
+        let across = pairs_of_mine
             .iter()
             .filter(|&&(i, j)| layout.owner(i) != layout.owner(j))
-            .count();
-        let mut elems = vec![0usize; layout.starts.len() - 1];
-        layout
-            .part
-            .iter()
-            .filter(|&&p| p != super::layout::NO_PART)
-            .for_each(|&p| elems[p as usize] += 1);
-        let dofs_per: Vec<usize> = layout.starts.windows(2).map(|w| w[1] - w[0]).collect();
-        log::info!(
-            "distributed over {} rank(s): elements per rank {elems:?}, dofs per rank {dofs_per:?}; {across} of {} interface couplings join dofs of different ranks",
-            elems.len(),
-            pairs.len()
-        );
+            .count() as u64;
+        let mine = [across, pairs_of_mine.len() as u64];
+        let mut sum = [0u64; 2];
+        world.all_reduce_into(&mine[..], &mut sum[..], SystemOperation::sum());
+        let held = part::with(part::Part::counts).unwrap_or_default();
+        let mut elems = vec![0u64; layout.size];
+        world.all_gather_into(&(held.owned as u64), &mut elems[..]);
+        if layout.rank == 0 {
+            let dofs_per: Vec<usize> = layout.starts.windows(2).map(|w| w[1] - w[0]).collect();
+            log::info!(
+                "distributed over {} rank(s): elements per rank {elems:?}, dofs per rank {dofs_per:?}; {} of {} interface couplings join dofs of different ranks",
+                elems.len(),
+                sum[0],
+                sum[1]
+            );
+        }
     }
     phases.mark("interface pattern", t);
-    let (diagonal, off) = preallocation(mesh, &dofs, field, &layout, &pairs);
+    let (diagonal, off) = preallocation(mesh, &dofs, field, &layout, &reaching);
+    drop(reaching);
     phases.mark("preallocation", t);
     let local_rows = rows.len();
-    let mut a = Mat::aij(comm, local_rows, n, &diagonal, &off).map_err(petsc_err)?;
-    let mut r_vec = Vector::new(comm, local_rows, n).map_err(petsc_err)?;
+    let global = layout.starts[layout.size];
+    let mut a = Mat::aij(comm, local_rows, global, &diagonal, &off).map_err(petsc_err)?;
+    let mut r_vec = Vector::new(comm, local_rows, global).map_err(petsc_err)?;
     let mut du_vec = r_vec.duplicate().map_err(petsc_err)?;
     let bc_rows: Vec<PetscInt> = bcs
         .iter()
@@ -199,8 +208,10 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let mut record = crate::heat::steady::Record::with_norm(f_norm, p.tolerance);
     let (mut converged, mut iterations) = (false, 0);
     let mut last_step = f64::INFINITY;
-    // The dofs this rank reads: its elements' and its points' (side A and side B).
+    // The dofs this rank reads: its elements' and its points' (side A and side B), their
+    // starting values (a prescribed temperature held by another rank) from their owners.
     let scatter = Scatter::new(&world, &layout, &touched, &pairs_of_mine);
+    scatter.start(&world, &layout, &mut u);
     for it in 0..=p.max_iterations {
         let t = Instant::now();
         // R = K u − F + Σ R_Γ: this rank's elements, and its own rows of the interfaces.
@@ -215,9 +226,10 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         r_vec.add(&touched_petsc, &values).map_err(petsc_err)?;
         if let Some(i) = iface {
             // This rank's points' terms, into the rows of any rank.
-            let mut r_iface = vec![0.0; n];
+            r.iter_mut().for_each(|x| *x = 0.0);
+            let r_iface = &mut r;
             let mine = i
-                .assemble(&u, 0.0, &mut r_iface, &mut iasm, first)
+                .assemble(&u, 0.0, r_iface, &mut iasm, first)
                 .map_err(failed)?;
             // A point reads the field where it has terms: there it must be kept.
             if let Some(d) = (0..n).find(|&d| r_iface[d] != 0.0 && !scatter.kept[d]) {
@@ -233,6 +245,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             r_vec.add(&rows, &values).map_err(petsc_err)?;
             heat = summed_heat(&world, &mine);
         }
+        drop(r);
         r_vec.assemble().map_err(petsc_err)?;
         r_vec
             .with_local(local_rows, |v| bc_local.iter().for_each(|&i| v[i] = 0.0))
@@ -282,12 +295,19 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
             linear.cg_iterations.push(its);
         }
     }
-    // The whole solution on every rank, once: rank 0 writes it, every rank's output
-    // evaluates the interfaces at it.
+    // The whole solution, once: on rank 0 (which writes it) when the mesh is
+    // distributed, else on every rank (every rank's output evaluates the interfaces at
+    // it).
     let mine: Vec<f64> = layout.owned.iter().map(|&d| u[d]).collect();
-    let whole = session::gather_all(&world, &mine);
-    for (d, ui) in u.iter_mut().enumerate() {
-        *ui = whole[layout.petsc[d] as usize];
+    let whole = if layout.distributed {
+        session::gather_root(&world, &mine)
+    } else {
+        session::gather_all(&world, &mine)
+    };
+    if whole.len() == global {
+        for (d, ui) in u.iter_mut().enumerate() {
+            *ui = whole[layout.petsc[d] as usize];
+        }
     }
     let why = match (method, symmetric) {
         (Method::MumpsLu, true) => {
@@ -315,14 +335,149 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     })
 }
 
+/// The dofs of one solve as PETSc sees them, on this rank: per local dof its PETSc
+/// index, the rows of every rank, the dofs this rank owns, per local element and node
+/// its owner (from the run's [`part::Part`]).
+struct Layout {
+    rank: usize,
+    size: usize,
+    /// Ranks other than 0 hold their part only (the solution is gathered on rank 0).
+    distributed: bool,
+    /// Per local dof, its PETSc index.
+    petsc: Vec<PetscInt>,
+    /// Rank `r`'s PETSc rows are `starts[r]..starts[r + 1]`.
+    starts: Vec<usize>,
+    /// The local dofs this rank owns, by PETSc index (consecutive).
+    owned: Vec<usize>,
+    elem_owner: Vec<u32>,
+    node_owner: Vec<u32>,
+}
+
+impl Layout {
+    fn new(
+        part: &part::Part,
+        mesh: &Mesh,
+        dofs: &DofMap,
+        field: crate::assembly::FieldId,
+    ) -> Result<Layout, String> {
+        if part.node_petsc.len() < mesh.num_nodes() || part.elem_owner.len() < mesh.num_elems() {
+            return Err(format!(
+                "distributed solve: the mesh has {} nodes and {} elements, this rank's part {} and {}",
+                mesh.num_nodes(),
+                mesh.num_elems(),
+                part.node_petsc.len(),
+                part.elem_owner.len()
+            ));
+        }
+        let mut petsc = vec![-1 as PetscInt; dofs.len()];
+        for k in 0..mesh.num_nodes() {
+            if let Some(d) = dofs.dof(field, NodeId(k as u32)) {
+                petsc[d.index()] = part.node_petsc[k];
+            }
+        }
+        if let Some(d) = petsc.iter().position(|&i| i < 0) {
+            return Err(format!(
+                "distributed solve: dof {d} has no PETSc row (its node is on no partitioned block)"
+            ));
+        }
+        let rows = part.rows();
+        let mut owned: Vec<usize> = (0..dofs.len())
+            .filter(|&d| rows.contains(&(petsc[d] as usize)))
+            .collect();
+        owned.sort_unstable_by_key(|&d| petsc[d]);
+        if owned.len() != rows.len() {
+            return Err(format!(
+                "distributed solve: rank {} holds {} of its {} rows",
+                part.rank,
+                owned.len(),
+                rows.len()
+            ));
+        }
+        Ok(Layout {
+            rank: part.rank,
+            size: part.size,
+            distributed: part.distributed,
+            petsc,
+            starts: part.starts.clone(),
+            owned,
+            elem_owner: (0..mesh.num_elems())
+                .map(|e| part.elem_rank(ElemId(e as u32)) as u32)
+                .collect(),
+            node_owner: (0..mesh.num_nodes())
+                .map(|n| part.node_rank(NodeId(n as u32)) as u32)
+                .collect(),
+        })
+    }
+
+    /// This rank's PETSc rows.
+    fn rows(&self) -> std::ops::Range<usize> {
+        self.starts[self.rank]..self.starts[self.rank + 1]
+    }
+
+    /// The rank owning local dof `d`.
+    fn owner(&self, d: usize) -> usize {
+        let i = self.petsc[d] as usize;
+        self.starts.partition_point(|&s| s <= i) - 1
+    }
+
+    /// Whether local dof `d` is owned here.
+    fn owns(&self, d: usize) -> bool {
+        self.rows().contains(&(self.petsc[d] as usize))
+    }
+
+    /// The mesh of this rank's own elements: the same nodes and blocks (the blocks holding
+    /// only this rank's elements, in their order), and per element of `mesh` its element
+    /// there.
+    fn local_mesh(&self, mesh: &Mesh) -> (Mesh, Vec<Option<ElemId>>) {
+        let mut local = vec![None; mesh.num_elems()];
+        let mut blocks = Vec::with_capacity(mesh.blocks.len());
+        let mut elem_numbers = Vec::new();
+        let mut next = 0u32;
+        for block in &mesh.blocks {
+            let nn = block.topology.node_count();
+            let first_elem = ElemId(next);
+            let mut connectivity = Vec::new();
+            for (k, e) in block.elems().enumerate() {
+                if self.elem_owner[e.index()] as usize == self.rank {
+                    connectivity.extend_from_slice(&block.connectivity[k * nn..(k + 1) * nn]);
+                    elem_numbers.push(mesh.elem_numbers[e.index()]);
+                    local[e.index()] = Some(ElemId(next));
+                    next += 1;
+                }
+            }
+            blocks.push(crate::mesh::Block {
+                id: block.id,
+                name: block.name.clone(),
+                topology: block.topology,
+                connectivity,
+                first_elem,
+                thickness: block.thickness,
+            });
+        }
+        let m = Mesh {
+            dim: mesh.dim,
+            coords: mesh.coords.clone(),
+            node_numbers: mesh.node_numbers.clone(),
+            elem_numbers,
+            blocks,
+            side_sets: Vec::new(),
+            node_sets: Vec::new(),
+            assemblies: Vec::new(),
+            source: mesh.source.clone(),
+            axisymmetric: mesh.axisymmetric,
+        };
+        (m, local)
+    }
+}
+
 /// The increment's values a rank needs, brought from their owners each Newton step
 /// (`MPI_Alltoallv` of the requested dofs' values) instead of gathering it whole.
 struct Scatter {
-    /// Per rank, the serial dofs this rank asks of it, in the order its answers come.
+    /// Per rank, the local dofs this rank asks of it, in the order its answers come.
     asks: Vec<Vec<usize>>,
     /// Per rank, the local rows (PETSc index − this rank's first row) it asks of us.
     asked: Vec<Vec<usize>>,
-    /// Per serial dof, whether this rank keeps it up to date (owned or asked).
+    /// Per local dof, whether this rank keeps it up to date (owned or asked).
     kept: Vec<bool>,
 }
 
@@ -334,7 +489,7 @@ impl Scatter {
         elements: &[usize],
         couplings: &[(usize, usize)],
     ) -> Scatter {
-        let size = layout.starts.len() - 1;
+        let size = layout.size;
         let mut need: Vec<usize> = elements
             .iter()
             .copied()
@@ -364,6 +519,29 @@ impl Scatter {
         Scatter { asks, asked, kept }
     }
 
+    /// The owners' values of `mine` (this rank's rows) at the dofs this rank asked for,
+    /// per rank in the order asked.
+    fn bring(&self, world: &SimpleCommunicator, mine: &[f64]) -> Vec<Vec<f64>> {
+        let answers: Vec<Vec<f64>> = self
+            .asked
+            .iter()
+            .map(|rows| rows.iter().map(|&i| mine[i]).collect())
+            .collect();
+        session::exchange(world, &answers)
+    }
+
+    /// The starting values of the dofs asked for, as their owners hold them (a
+    /// prescribed temperature at a node another rank holds).
+    fn start(&self, world: &SimpleCommunicator, layout: &Layout, u: &mut [f64]) {
+        let mine: Vec<f64> = layout.owned.iter().map(|&d| u[d]).collect();
+        let got = self.bring(world, &mine);
+        for (dofs, values) in self.asks.iter().zip(&got) {
+            for (&d, &v) in dofs.iter().zip(values) {
+                u[d] = v;
+            }
+        }
+    }
+
     /// Add the increment (`mine`: this rank's rows) to `u` at the dofs owned or asked;
     /// returns its largest magnitude over every rank.
     fn update(
@@ -374,12 +552,7 @@ impl Scatter {
         u: &mut [f64],
     ) -> f64 {
         let first = layout.rows().start;
-        let answers: Vec<Vec<f64>> = self
-            .asked
-            .iter()
-            .map(|rows| rows.iter().map(|&i| mine[i]).collect())
-            .collect();
-        let got = session::exchange(world, &answers);
+        let got = self.bring(world, mine);
         let mut step = 0.0f64;
         for &d in &layout.owned {
             let du = mine[layout.petsc[d] as usize - first];
@@ -416,15 +589,27 @@ impl Drop for AllPoints<'_> {
     }
 }
 
-/// Every rank's interface couplings, on every rank (`MPI_Allgatherv`).
-fn all_couplings(world: &SimpleCommunicator, mine: &[(usize, usize)]) -> Vec<(usize, usize)> {
-    let flat: Vec<u64> = mine
-        .iter()
-        .flat_map(|&(i, j)| [i as u64, j as u64])
-        .collect();
-    let all = session::gather_all(world, &flat);
-    all.chunks_exact(2)
-        .map(|c| (c[0] as usize, c[1] as usize))
+/// The couplings (PETSc rows and columns) of every rank's points that fall in this
+/// rank's rows: each rank sends each of its couplings `(i, j)` to the owners of row `i`
+/// and of row `j` (`MPI_Alltoallv`).
+fn couplings_to_owners(
+    world: &SimpleCommunicator,
+    layout: &Layout,
+    mine: &[(usize, usize)],
+) -> Vec<(usize, usize)> {
+    let mut out: Vec<Vec<i32>> = vec![Vec::new(); layout.size];
+    for &(i, j) in mine {
+        let (pi, pj) = (layout.petsc[i], layout.petsc[j]);
+        out[layout.owner(i)].extend_from_slice(&[pi, pj]);
+        out[layout.owner(j)].extend_from_slice(&[pj, pi]);
+    }
+    session::exchange(world, &out)
+        .into_iter()
+        .flat_map(|v| {
+            v.chunks_exact(2)
+                .map(|c| (c[0] as usize, c[1] as usize))
+                .collect::<Vec<_>>()
+        })
         .collect()
 }
 
@@ -535,22 +720,20 @@ fn add_columns(
     Ok(())
 }
 
-/// Exact preallocation of this rank's rows: per row, the columns of every element (of any
-/// rank) at its node, and its interface couplings, counted inside and outside the rank's
-/// column block.
+/// Exact preallocation of this rank's rows: per row, the columns of every element at
+/// its node (all of them held here: a rank holds every element around the nodes it owns),
+/// and the interface couplings `reaching` its rows (PETSc row, PETSc column), counted
+/// inside and outside the rank's column block.
 fn preallocation(
     mesh: &Mesh,
     dofs: &DofMap,
     field: crate::assembly::FieldId,
     layout: &Layout,
-    pairs: &[(usize, usize)],
+    reaching: &[(usize, usize)],
 ) -> (Vec<PetscInt>, Vec<PetscInt>) {
     let rows = layout.rows();
     let mut cols: Vec<Vec<usize>> = vec![Vec::new(); rows.len()];
-    let local_row = |d: usize| -> Option<usize> {
-        let i = layout.petsc[d] as usize;
-        rows.contains(&i).then(|| i - rows.start)
-    };
+    let local_row = |i: usize| -> Option<usize> { rows.contains(&i).then(|| i - rows.start) };
     let mut buf = Vec::new();
     for &b in dofs.field_blocks(field) {
         let nn = mesh.blocks[b].topology.node_count();
@@ -559,30 +742,28 @@ fn preallocation(
             buf.extend(
                 mesh.blocks[b].connectivity[k * nn..(k + 1) * nn]
                     .iter()
-                    .filter_map(|&node| dofs.dof(field, node).map(|d| d.index())),
+                    .filter_map(|&node| dofs.dof(field, node))
+                    .map(|d| layout.petsc[d.index()] as usize),
             );
-            for &d in &buf {
-                if let Some(i) = local_row(d) {
-                    cols[i].extend_from_slice(&buf);
+            for &i in &buf {
+                if let Some(r) = local_row(i) {
+                    cols[r].extend_from_slice(&buf);
                 }
             }
         }
     }
-    for &(i, j) in pairs {
+    for &(i, j) in reaching {
         if let Some(r) = local_row(i) {
             cols[r].push(j);
-        }
-        if let Some(r) = local_row(j) {
-            cols[r].push(i);
         }
     }
     let (mut diagonal, mut off) = (vec![0; rows.len()], vec![0; rows.len()]);
     for (r, c) in cols.iter_mut().enumerate() {
-        c.push(layout.owned[r]);
+        c.push(rows.start + r);
         c.sort_unstable();
         c.dedup();
-        for &d in c.iter() {
-            if rows.contains(&(layout.petsc[d] as usize)) {
+        for &i in c.iter() {
+            if rows.contains(&i) {
                 diagonal[r] += 1;
             } else {
                 off[r] += 1;

@@ -79,7 +79,7 @@ impl RunContact {
             None => RunContact::default(),
         };
         out.loaded.sources.add(&file.text.file, &file.text.text);
-        if diags.has_errors() {
+        if super::ranks::stop(diags) {
             return Err(RunError::Input(
                 std::mem::take(diags),
                 std::mem::take(&mut out.loaded.sources),
@@ -261,6 +261,9 @@ impl RunContact {
                 }
             }
         }
+        // On a distributed mesh, a face of this rank's elements may be in contact through
+        // another rank's points (a side-B face, a tributary face of a node it owns).
+        let in_contact = crate::parallel::faces_in_contact(in_contact);
         let before = face_sites.len();
         face_sites.retain(|f| f.keep || !in_contact.contains(&f.side));
         let masked = before - face_sites.len();
@@ -376,9 +379,12 @@ fn interaction_fields(
         .iter()
         .zip(choices)
         .map(|(p, (c, _, _))| {
+            // A face of this rank's mesh (on a rank holding a part of it, a side-B face
+            // may be another rank's element's, which its mesh does not hold).
             let side_field = |g: &crate::search::pairing::SurfaceGeometry| {
                 g.faces
-                    .first()
+                    .iter()
+                    .find(|f| f.side.elem.index() < mesh.num_elems())
                     .map(|f| materials.fields[mesh.block_of(f.side.elem)].clone())
             };
             let fa = side_field(&p.side_a_geometry).unwrap_or_else(|| TEMPERATURE.into());

@@ -64,6 +64,7 @@ mod output;
 mod physics;
 mod posed;
 mod problem;
+mod ranks;
 mod solve;
 mod species;
 mod steps;
@@ -205,9 +206,12 @@ enum Outcome {
 /// stopped the time loop and the output.
 fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, RunError> {
     let start = Instant::now();
-    // Problem and physics: the file, its mesh, and what the file says on the mesh.
+    crate::parallel::start_run();
+    // Problem and physics: the file, its mesh, and what the file says on the mesh. Under
+    // mpirun, rank 0 reads the mesh and, once the physics is checked on it, sends each
+    // other rank its part or has it read the whole (`ranks`).
     let file = ProblemFile::read(path)?;
-    let (mesh, mesh_s) = file.read_mesh(options)?;
+    let (mesh, mesh_s) = ranks::mesh_for_rank(&file, options)?;
     log::info!(
         "mesh read: {} nodes, {} elements, {} blocks ({mesh_s:.3} s)",
         mesh.num_nodes(),
@@ -216,10 +220,21 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     );
     let mut diags = Diagnostics::default();
     let mut physics = Physics::new(&file, &mesh, &mut diags);
-    if diags.has_errors() {
-        return Err(RunError::Input(diags, file.text.sources()));
+    let ready = if diags.has_errors() {
+        Err(RunError::Input(
+            std::mem::take(&mut diags),
+            file.text.sources(),
+        ))
+    } else {
+        physics.try_start()
+    };
+    ranks::share_mesh(&file, &physics, options, ready.is_ok())?;
+    if ranks::follows_root() {
+        // Rank 0 checked the physics on the whole mesh.
+        diags = Diagnostics::default();
+    } else {
+        ready?;
     }
-    physics.try_start()?;
     // Scene: the contact, the face conditions it masks, what the file joins to it.
     let contact = RunContact::build(&file, &mesh, &physics.field_names, options, &mut diags)?;
     contact.mask_face_conditions(&mut physics.face_sites, &mut diags);
@@ -245,7 +260,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         let field = ("voltage", "E0431", "an electrical_conductivity (S/m)");
         species::check_sides(&mesh, &contact.voltage_ties, &carries, field, &mut diags);
     }
-    if !file.transient {
+    if !file.transient && !ranks::follows_root() {
         posed::check_steady(&physics, &contact.pairings, &mut diags);
     }
     log::info!(
@@ -280,10 +295,17 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
             &mut diags,
         );
     }
-    if diags.has_errors() {
-        return Err(RunError::Input(diags, contact.loaded.sources));
+    if ranks::stop(&mut diags) {
+        return Err(match ranks::follows_root() {
+            true => ranks::quiet(),
+            false => RunError::Input(diags, contact.loaded.sources),
+        });
     }
-    let initial = physics.initial_state()?;
+    let initial = physics.initial_state();
+    if crate::parallel::root_verdict(initial.is_err()) {
+        return Err(initial.err().unwrap_or_else(ranks::quiet));
+    }
+    let initial = initial?;
     if stop == Stop::BeforeSolve {
         return Ok(Outcome::Checked(Checked {
             diagnostics: diags,
@@ -297,8 +319,14 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
         &couplings,
         (motion.as_ref(), death.as_ref()),
     );
-    let mut output = Output::open(&file, &physics, &terms)?;
+    let output = Output::open(&file, &physics, &terms);
+    // Rank 0 alone makes the output folder; every rank stops if it could not.
+    if crate::parallel::root_verdict(output.is_err()) {
+        return Err(output.err().unwrap_or_else(ranks::quiet));
+    }
+    let mut output = output?;
     let solved = TimeLoop::new(&file, &physics, &terms, options).run(initial, &mut output)?;
+    crate::parallel::report_holdings(&mesh);
     terms.report_quarantined(&mut diags);
     // Output: the final files and the summary.
     log::info!(

@@ -108,20 +108,33 @@ impl<'a> TimeLoop<'a> {
     /// One linear steady solve, by a factorisation or AMG-CG as `linear_solver` and the
     /// size say.
     fn linear_steady(&self) -> Result<Solved, RunError> {
-        let (physics, mesh, problem) = (self.physics, self.physics.mesh, &self.file.problem);
+        let (physics, problem) = (self.physics, &self.file.problem);
         let (requested, threshold) = (self.requested, self.threshold);
         let source_failed = std::sync::Mutex::new(None::<String>);
         let source = physics.source_of_x(&source_failed);
         let source_fn = source.as_deref();
+        // On a rank holding a part of the mesh (under mpirun), its part with the side-B
+        // elements of other ranks its contact points paired with, each in a copy of its
+        // block (`origin`: per block, the block it copies).
+        let extended = crate::parallel::extended_mesh(physics.mesh);
+        let (mesh, origin) = match &extended {
+            Some((m, origin)) => (m, Some(origin.as_slice())),
+            None => (physics.mesh, None),
+        };
         let materials = physics.materials.constant().expect("checked constant");
+        let materials = per_block(&materials, origin);
         // The temperature unknowns (multipliers aside) decide the automatic choice.
         let solid: Vec<usize> = (0..mesh.blocks.len())
             .filter(|&b| mesh.blocks[b].topology.is_solid())
             .collect();
         let dofs = DofMap::new(mesh, &[(TEMPERATURE, &solid)])
             .map_err(|e| RunError::Solve(e.to_string()))?;
-        let unknowns = dofs.len();
-        let interfaces = self.terms.prepare(&dofs).map_err(RunError::Solve)?;
+        // Every rank chooses by the whole problem's count.
+        let unknowns = crate::parallel::global_unknowns(dofs.len());
+        let interfaces = self
+            .terms
+            .prepare_on(mesh, origin, &dofs)
+            .map_err(RunError::Solve)?;
         let iterative = match requested {
             Some("amg") => true,
             Some("direct") => false,
@@ -146,7 +159,7 @@ impl<'a> TimeLoop<'a> {
         };
         self.options.phase(&format!(
             "assembling and solving ({} nodes)",
-            mesh.num_nodes()
+            physics.mesh.num_nodes()
         ));
         // Under MPI the distributed solve (crate::parallel), else the serial one.
         let solved = crate::parallel::steady(&steady)
@@ -519,5 +532,14 @@ fn electric_conductance(
             dh_dvolt_a: dva,
             dh_dvolt_b: dvb,
         })
+    }
+}
+
+/// `values` per block of the physics' mesh, for the blocks of a mesh whose block `b`
+/// copies block `origin[b]` (as is without `origin`).
+pub(super) fn per_block<T: Clone>(values: &[T], origin: Option<&[usize]>) -> Vec<T> {
+    match origin {
+        Some(origin) => origin.iter().map(|&b| values[b].clone()).collect(),
+        None => values.to_vec(),
     }
 }

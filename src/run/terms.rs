@@ -331,9 +331,21 @@ impl<'a> ContactTerms<'a> {
     /// Hand the run's interactions to an embedding over the solve's `dofs` (the fields,
     /// before any multiplier), with the Dirichlet nodes at the start fixed; once.
     pub(super) fn prepare(&self, dofs: &DofMap) -> Result<&dyn Interfaces, String> {
+        self.prepare_on(self.physics.mesh, None, dofs)
+    }
+
+    /// As [`Self::prepare`], over `mesh` — the physics' mesh, or on a rank holding a part
+    /// of it that part with the side-B elements of other ranks its points paired with,
+    /// whose block `b` copies block `origin[b]`.
+    pub(super) fn prepare_on(
+        &self,
+        mesh: &crate::mesh::Mesh,
+        origin: Option<&[usize]>,
+        dofs: &DofMap,
+    ) -> Result<&dyn Interfaces, String> {
         match self.embedded.get() {
             None => {
-                let made = self.embed(dofs)?;
+                let made = self.embed(mesh, origin, dofs)?;
                 let e = self.embedded.get_or_init(|| made);
                 // Moving surfaces start where the displacement puts them at the start.
                 self.place(e, &[], self.physics.time.start, 0)
@@ -351,7 +363,12 @@ impl<'a> ContactTerms<'a> {
         Ok(self)
     }
 
-    fn embed(&self, dofs: &DofMap) -> Result<Embedded, String> {
+    fn embed(
+        &self,
+        mesh: &crate::mesh::Mesh,
+        origin: Option<&[usize]>,
+        dofs: &DofMap,
+    ) -> Result<Embedded, String> {
         let physics = self.physics;
         let fixed: Vec<NodeId> = physics
             .loads_at(physics.time.start)?
@@ -362,9 +379,9 @@ impl<'a> ContactTerms<'a> {
         // A search anew integrates as the scene's first search did.
         let integration = (self.contact.integration).unwrap_or(Integration::Segments { order: 5 });
         let mut embedding = Embedding::over_dofs(
-            physics.mesh.clone(),
+            mesh.clone(),
             dofs.clone(),
-            self.conductivity.clone(),
+            super::solve::per_block(&self.conductivity, origin),
             fixed,
             integration,
         );
@@ -373,6 +390,7 @@ impl<'a> ContactTerms<'a> {
         let laws: Vec<crate::heat::law::Law> = (physics.materials.laws.iter())
             .map(|l| l.conductivity.clone())
             .collect();
+        let laws = super::solve::per_block(&laws, origin);
         if laws
             .iter()
             .any(|l| !matches!(l, crate::heat::law::Law::Constant(_)))

@@ -494,13 +494,21 @@ impl ContactScene {
         };
         phase("building the contact surfaces");
         let t = Instant::now();
-        let set = surfaces::build(mesh, def, &loaded.sources);
+        // On a distributed mesh (`seam run` under mpirun) rank 0 builds them on the whole
+        // mesh and each other rank gets its share.
+        let set =
+            crate::parallel::share_surfaces(mesh, || surfaces::build(mesh, def, &loaded.sources));
         self.timing.surfaces_s += t.elapsed().as_secs_f64();
         self.surfaces += set.surfaces.len();
         diags.extend(set.diagnostics.clone());
         let (list, found) = interaction::resolve(def, &set, mesh.dim, &loaded.sources);
         diags.extend(found);
-        if diags.has_errors() {
+        // Every rank of a distributed mesh follows rank 0, which checks the whole.
+        if crate::parallel::mesh_is_distributed() {
+            if crate::parallel::root_verdict(diags.has_errors()) {
+                return None;
+            }
+        } else if diags.has_errors() {
             return None;
         }
         phase("contact search");
@@ -724,6 +732,48 @@ pub fn conductance_model(
             }
         }
     }
+}
+
+/// Why the contact of `loaded` needs every rank of a distributed `seam run` to hold the
+/// whole mesh (docs/parallel.md), or `None` when each rank can hold its part: surfaces
+/// or maps made from whole surfaces (`Auto Subset`, an `Align_Surface` periodicity), a
+/// voltage or species enforcement, an Energy enforcement that is a mortar tie with
+/// multipliers, switched by a toggle or fed a contact pressure field (the general solver
+/// or whole-mesh data), or one that does not resolve with the problem's `fields`.
+pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static str> {
+    use crate::deck::spec::{PeriodicTransform, SurfaceDef};
+    for def in &loaded.deck.contact_definitions {
+        let auto = def
+            .surfaces
+            .iter()
+            .any(|s| matches!(s, SurfaceDef::Block(b) if b.auto_subset.is_some()));
+        if auto {
+            return Some("an `Auto Subset` (its groups follow the whole surface)");
+        }
+        let align = (def.periodicity.iter())
+            .any(|q| matches!(q.transform, PeriodicTransform::AlignSurface { .. }));
+        if align {
+            return Some("an `Align_Surface` periodicity (its map follows the whole surfaces)");
+        }
+        for enf in &def.enforcements {
+            if enf.models.iter().any(|m| m.equation != ENERGY) {
+                return Some("a voltage or species enforcement");
+            }
+            let Ok(c) = resolve_for(enf, Some(fields)) else {
+                return Some("an enforcement with errors");
+            };
+            if c.mortar {
+                return Some("a mortar tie with multipliers (the general solver)");
+            }
+            if c.toggle.is_some() {
+                return Some("a toggled enforcement (the general solver)");
+            }
+            if c.pressure_variable.is_some() {
+                return Some("a `Contact Pressure Variable`");
+            }
+        }
+    }
+    None
 }
 
 /// Without a mesh: resolve every enforcement block of the deck and make its conductance

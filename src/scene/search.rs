@@ -31,7 +31,7 @@ use crate::diag::{Diagnostic, SourceMap};
 use crate::mesh::Mesh;
 use crate::periodic::MapError;
 use crate::search::pairing::{
-    Integration, SearchError, SearchResult, SearchSchedule, Searcher, Sphere, SurfaceGeometry,
+    Integration, SearchError, SearchSchedule, Searcher, Sphere, SurfaceGeometry,
 };
 use crate::search::periodic::{
     Closure, PeriodicError, PeriodicPairing, PeriodicTransform, check_axisymmetric, check_closure,
@@ -91,15 +91,20 @@ pub fn search_definition_with_maps(
         let (Some(a), Some(b)) = (&geometry[i.side_a], &geometry[i.side_b]) else {
             continue;
         };
-        if b.faces.is_empty() {
+        // Under MPI every rank asks (a rank may hold none of side B's faces).
+        if !crate::parallel::any_rank(!b.faces.is_empty()) {
             continue;
         }
-        let Some(mut result) =
-            search_pair(mesh, a, b, &i.settings, integration, subdomain, &mut out)
-        else {
+        let pair = (a, b);
+        let overclosure = Some(i.overclosure);
+        let Some((result, side_b)) = search_pair(
+            mesh,
+            pair,
+            (&i.settings, integration, subdomain, overclosure),
+            &mut out,
+        ) else {
             continue;
         };
-        result.treat_overclosure(i.overclosure);
         out.pairings.push(Pairing {
             side_a: i.side_a_name.clone(),
             side_b: i.side_b_name.clone(),
@@ -107,7 +112,7 @@ pub fn search_definition_with_maps(
             side_b_surface: i.side_b,
             periodic: false,
             side_a_geometry: a.clone(),
-            side_b_geometry: b.clone(),
+            side_b_geometry: side_b.unwrap_or_else(|| b.clone()),
             result,
             worst_image_distance: None,
         });
@@ -132,20 +137,26 @@ pub fn search_definition_with_maps(
     out
 }
 
-/// Pair `a`'s points with `b`'s faces: serially, or under MPI by the distributed search
-/// (the same pairing; `crate::parallel::search`), timed into `out`. `None` (and an
-/// E0904 error) when the distributed search fails.
+/// Pair `a`'s points with `b`'s faces, the matched points' overclosure treated with
+/// `overclosure`: serially, or under MPI by the distributed search (the same pairing;
+/// `crate::parallel::search`; on a rank holding a part of the mesh its own points, with
+/// the side-B faces they paired with), timed into `out`. `None` (and an E0904 error) when
+/// the distributed search fails.
 fn search_pair(
     mesh: &Mesh,
-    a: &SurfaceGeometry,
-    b: &SurfaceGeometry,
-    settings: &SearchSettings,
-    integration: Integration,
-    subdomain: Option<Sphere>,
+    (a, b): (&SurfaceGeometry, &SurfaceGeometry),
+    (settings, integration, subdomain, overclosure): (
+        &SearchSettings,
+        Integration,
+        Option<Sphere>,
+        Option<Overclosure>,
+    ),
     out: &mut SceneSearch,
-) -> Option<SearchResult> {
+) -> Option<crate::parallel::RunPairing> {
     let t = Instant::now();
-    match crate::parallel::search_pair(mesh, a, b, settings, integration, subdomain) {
+    let found =
+        crate::parallel::search_in_run(mesh, (a, b), settings, integration, subdomain, overclosure);
+    match found {
         Some(Ok(r)) => {
             out.timing.search_s += t.elapsed().as_secs_f64();
             Some(r)
@@ -162,9 +173,12 @@ fn search_pair(
             let searcher = Searcher::new(b, settings);
             out.timing.build_s += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            let r = searcher.search(a, b, settings, integration, subdomain);
+            let mut r = searcher.search(a, b, settings, integration, subdomain);
+            if let Some(treatment) = overclosure {
+                r.treat_overclosure(treatment);
+            }
             out.timing.search_s += t.elapsed().as_secs_f64();
-            Some(r)
+            Some((r, None))
         }
     }
 }
@@ -280,6 +294,107 @@ pub fn search_periodicity(
     let settings = base_settings(def, mesh.dim);
     let subdomain = subdomain(def);
     let at = sources.narrow(&p.at, &p.surface);
+    let checked = periodic_image(mesh, p, surfaces, geometry, (deck_dir, sources), &at, out);
+    // Under MPI every rank searches or none does: a rank holding part of the surface
+    // checks that part, rank 0 the whole.
+    let ok = checked.is_some();
+    if let Err(r) = crate::parallel::all_ranks_ok(ok) {
+        if ok {
+            out.diagnostics.push(
+                Diagnostic::error(
+                    "E0904",
+                    format!(
+                        "periodicity for `{}`: its image failed on rank {r}",
+                        p.surface
+                    ),
+                )
+                .at(Some(at.clone()))
+                .help("run without mpirun (serially) to see why"),
+            );
+        }
+        return None;
+    }
+    let (s, image, map, destination) = checked?;
+
+    // The destination: given, or the face surface that takes most image points.
+    let candidates: Vec<usize> = match destination {
+        Some(d) => vec![d],
+        None => (0..surfaces.surfaces.len())
+            .filter(|&d| {
+                // Under MPI every rank asks (a rank may hold none of its faces).
+                let faces = geometry[d].as_ref().is_some_and(|g| !g.faces.is_empty());
+                d != s && crate::parallel::any_rank(faces)
+            })
+            .collect(),
+    };
+    let mut best: Option<(usize, crate::parallel::RunPairing)> = None;
+    for d in candidates {
+        let Some(dg) = &geometry[d] else { continue };
+        let search = (&settings, integration, subdomain, None);
+        let Some(r) = search_pair(mesh, (&image, dg), search, out) else {
+            continue;
+        };
+        if best
+            .as_ref()
+            .is_none_or(|(_, b)| r.0.stats.matched > b.0.stats.matched)
+        {
+            best = Some((d, r));
+        }
+    }
+    let Some((d, (result, side_b))) = best.filter(|(_, r)| r.0.stats.matched > 0) else {
+        out.diagnostics.push(
+            Diagnostic::error(
+                "E0323",
+                format!("periodicity for `{}`: its image lands on no contact surface", p.surface),
+            )
+            .at(Some(at))
+            .help("check the transform (offset, axis, centre, angle or map): the image of the surface must lie on another contact surface"),
+        );
+        return None;
+    };
+    let dg = geometry[d].as_ref().expect("destination geometry exists");
+    let landed = landing(&image, dg);
+    if let Err(e) = landed.check(&surfaces.surfaces[d].name) {
+        out.diagnostics.push(
+            Diagnostic::error("E0324", format!("periodicity for `{}`: {e}", p.surface))
+                .at(Some(at))
+                .help("the transform must carry the surface exactly onto its partner; check the offset, angle or map"),
+        );
+    }
+    Some(PeriodicPairing {
+        pairing: Pairing {
+            side_a: p.surface.to_ascii_lowercase(),
+            side_b: surfaces.surfaces[d].name.clone(),
+            side_a_surface: s,
+            side_b_surface: d,
+            periodic: true,
+            side_a_geometry: image,
+            side_b_geometry: side_b.unwrap_or_else(|| dg.clone()),
+            result,
+            worst_image_distance: Some(landed.worst),
+        },
+        map,
+    })
+}
+
+/// The checks of a periodicity and its image: (source surface, image, map, the
+/// destination `Align_Surface` names), or `None` with the diagnostics in `out`.
+#[allow(clippy::type_complexity)]
+fn periodic_image(
+    mesh: &Mesh,
+    p: &Periodicity,
+    surfaces: &SurfaceSet,
+    geometry: &[Option<SurfaceGeometry>],
+    (deck_dir, sources): (&Path, &SourceMap),
+    at: &crate::diag::Loc,
+    out: &mut SceneSearch,
+) -> Option<(
+    usize,
+    SurfaceGeometry,
+    Box<dyn crate::periodic::PeriodicMap>,
+    Option<usize>,
+)> {
+    let at = at.clone();
     let Some(s) = face_surface(surfaces, &p.surface) else {
         out.diagnostics.push(
             Diagnostic::error(
@@ -293,7 +408,8 @@ pub fn search_periodicity(
     };
     let source = geometry[s].as_ref()?;
     let transform = PeriodicTransform::from(&p.transform);
-    let model_size = mesh.model_size();
+    // The whole mesh's, on a rank that holds a part of it.
+    let model_size = crate::parallel::model_size(mesh);
     let axisymmetric_help = "in an axisymmetric model a periodicity repeats along the axis: `Rectangular Offset = 0 dy`";
     if mesh.axisymmetric && matches!(transform, PeriodicTransform::Cylindrical { .. }) {
         let e = PeriodicError::CylindricalInAxisymmetric;
@@ -427,60 +543,7 @@ pub fn search_periodicity(
         return None;
     }
 
-    // The destination: given, or the face surface that takes most image points.
-    let candidates: Vec<usize> = match destination {
-        Some(d) => vec![d],
-        None => (0..surfaces.surfaces.len())
-            .filter(|&d| d != s && geometry[d].as_ref().is_some_and(|g| !g.faces.is_empty()))
-            .collect(),
-    };
-    let mut best: Option<(usize, SearchResult)> = None;
-    for d in candidates {
-        let Some(dg) = &geometry[d] else { continue };
-        let Some(r) = search_pair(mesh, &image, dg, &settings, integration, subdomain, out) else {
-            continue;
-        };
-        if best
-            .as_ref()
-            .is_none_or(|(_, b)| r.stats.matched > b.stats.matched)
-        {
-            best = Some((d, r));
-        }
-    }
-    let Some((d, result)) = best.filter(|(_, r)| r.stats.matched > 0) else {
-        out.diagnostics.push(
-            Diagnostic::error(
-                "E0323",
-                format!("periodicity for `{}`: its image lands on no contact surface", p.surface),
-            )
-            .at(Some(at))
-            .help("check the transform (offset, axis, centre, angle or map): the image of the surface must lie on another contact surface"),
-        );
-        return None;
-    };
-    let dg = geometry[d].as_ref().expect("destination geometry exists");
-    let landed = landing(&image, dg);
-    if let Err(e) = landed.check(&surfaces.surfaces[d].name) {
-        out.diagnostics.push(
-            Diagnostic::error("E0324", format!("periodicity for `{}`: {e}", p.surface))
-                .at(Some(at))
-                .help("the transform must carry the surface exactly onto its partner; check the offset, angle or map"),
-        );
-    }
-    Some(PeriodicPairing {
-        pairing: Pairing {
-            side_a: p.surface.to_ascii_lowercase(),
-            side_b: surfaces.surfaces[d].name.clone(),
-            side_a_surface: s,
-            side_b_surface: d,
-            periodic: true,
-            side_a_geometry: image,
-            side_b_geometry: dg.clone(),
-            result,
-            worst_image_distance: Some(landed.worst),
-        },
-        map,
-    })
+    Some((s, image, map, destination))
 }
 
 #[cfg(test)]
