@@ -729,14 +729,24 @@ impl<'p> Assembler<'p> {
         Ok(())
     }
 
-    /// The assembled matrix (values only: the pattern's symbolic structure is cloned
-    /// and the slots are added into their positions in slot order).
+    /// The assembled matrix (the slots added into their positions in slot order), with
+    /// a structure of its own: the pattern's faer structure when it has been made (a
+    /// copy), else one made for the matrix alone and not kept by the pattern, so a
+    /// caller that keeps the matrix holds the `usize` structure once, not twice.
     pub fn matrix(&self) -> Result<SparseColMat<usize, f64>, AssemblyError> {
         self.built()?;
-        let sym = self.pattern.symbolic().expect("built");
+        let b = self.pattern.built.as_ref().expect("built");
+        let sym = match b.sym.get() {
+            Some(sym) => sym.clone(),
+            None => {
+                let rows = b.row_idx.iter().map(|&r| r as usize).collect();
+                let n = self.pattern.n;
+                SymbolicSparseColMat::new_checked(n, n, b.col_ptr.clone(), None, rows)
+            }
+        };
         let mut vals = Vec::new();
         self.values_into(&mut vals)?;
-        Ok(SparseColMat::new(sym.clone(), vals))
+        Ok(SparseColMat::new(sym, vals))
     }
 
     /// The assembled values in the CSC order of [`Pattern::symbolic`] (the bits of

@@ -119,11 +119,12 @@ fn run_path(path: &Path, json: bool, restart: Option<PathBuf>) -> ExitCode {
                     }
                 );
                 let ls = &s.linear_solver;
+                let krylov = if ls.name == "GMRES" { "GMRES" } else { "CG" };
                 let cg = match ls.iterations_per_solve.len() {
                     0 => String::new(),
-                    1 => format!(", {} CG iterations", ls.iterations),
+                    1 => format!(", {} {krylov} iterations", ls.iterations),
                     k if k <= 6 => format!(
-                        ", {} CG iterations ({})",
+                        ", {} {krylov} iterations ({})",
                         ls.iterations,
                         ls.iterations_per_solve
                             .iter()
@@ -133,13 +134,19 @@ fn run_path(path: &Path, json: bool, restart: Option<PathBuf>) -> ExitCode {
                     ),
                     // Many solves (time steps): the range per solve, not every count.
                     k => format!(
-                        ", {} CG iterations ({}–{} per solve over {k} solves)",
+                        ", {} {krylov} iterations ({}–{} per solve over {k} solves)",
                         ls.iterations,
                         ls.iterations_per_solve.iter().min().unwrap_or(&0),
                         ls.iterations_per_solve.iter().max().unwrap_or(&0)
                     ),
                 };
-                println!("  linear solver: {} ({}){cg}", ls.name, ls.reason);
+                let kept = match (ls.hierarchy_setups, ls.hierarchy_refreshes) {
+                    (Some(s), Some(r)) if r > 0 => {
+                        format!("; AMG hierarchy set up {s}×, refreshed {r}×")
+                    }
+                    _ => String::new(),
+                };
+                println!("  linear solver: {} ({}){cg}{kept}", ls.name, ls.reason);
                 if s.axisymmetric {
                     println!("  axisymmetric: heats are per full revolution (W)");
                 }

@@ -14,8 +14,8 @@ use std::time::Instant;
 use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{
-    AmgCg, AmgOptions, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, apply_dirichlet,
-    apply_dirichlet_mut, apply_dirichlet_parts, spmv, spmv_parts, spmv_ref,
+    AmgCg, AmgOptions, BlockGmres, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt,
+    apply_dirichlet, apply_dirichlet_mut, apply_dirichlet_parts, spmv, spmv_parts, spmv_ref,
 };
 use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
 use std::collections::HashSet;
@@ -93,6 +93,9 @@ pub enum LinearMethod {
     SaddleLdlt,
     /// CG preconditioned by smoothed-aggregation AMG.
     AmgCg,
+    /// GMRES preconditioned by AMG: an unsymmetric Jacobian beyond the size for
+    /// factorisations.
+    Gmres,
 }
 
 impl LinearMethod {
@@ -103,6 +106,7 @@ impl LinearMethod {
             LinearMethod::Lu => "LU",
             LinearMethod::SaddleLdlt => "LDLᵀ",
             LinearMethod::AmgCg => "AMG-CG",
+            LinearMethod::Gmres => "GMRES",
         }
     }
 }
@@ -113,8 +117,12 @@ pub struct LinearSolves {
     /// The solver of the last solve (`None` when nothing was solved, e.g. the initial
     /// state already met the tolerance, or a transient run).
     pub method: Option<LinearMethod>,
-    /// CG iterations of each AMG-CG solve (empty for factorisations).
+    /// Krylov iterations of each AMG-CG or GMRES solve (empty for factorisations).
     pub cg_iterations: Vec<usize>,
+    /// Iterative solves: AMG hierarchies set up, and kept ones refreshed with a new
+    /// matrix's values (Newton iterations).
+    pub hierarchy_setups: Option<usize>,
+    pub hierarchy_refreshes: usize,
 }
 
 /// A steady problem on a mesh.
@@ -278,6 +286,10 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let mut saddle = SaddleLdlt::with_primal(n_primal, n, Ordering::Metis);
     saddle.sequential = p.reproducible;
     let mut lu = Lu::new();
+    // An unsymmetric Jacobian beyond the size for factorisations: GMRES with an AMG
+    // hierarchy kept across the Newton iterations.
+    let mut gmres =
+        (p.iterative && !symmetric && ties.is_empty()).then(|| BlockGmres::new(n, AMG_TOLERANCE));
     let mut record = Record::new(&f_vol, p.tolerance);
     let mut converged = false;
     let mut iterations = 0;
@@ -334,6 +346,22 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing.assembly_s += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let jac = SparseColMat::new(structure.clone(), jac_values);
+        if let Some(g) = gmres.as_mut() {
+            g.factor(&jac)?;
+            timing.factor_s += t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let report = g.solve(&mut rhs)?;
+            timing.solve_s += t.elapsed().as_secs_f64();
+            linear.method = Some(LinearMethod::Gmres);
+            linear.cg_iterations.push(report.iterations);
+            let (setups, refreshes) = g.reuse_counts();
+            (linear.hierarchy_setups, linear.hierarchy_refreshes) = (Some(setups), refreshes);
+            last_step = rhs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (ui, d) in u.iter_mut().zip(&rhs) {
+                *ui += d;
+            }
+            continue;
+        }
         let saddle_ok = !ties.is_empty() && symmetric && saddle.factor(&jac).is_ok();
         let use_chol = !saddle_ok && ties.is_empty() && symmetric && chol.factor(&jac).is_ok();
         if !saddle_ok && !use_chol {
@@ -555,6 +583,7 @@ fn solve_amg(
     amg.setup(fine)?;
     timing.factor_s += t.elapsed().as_secs_f64();
     linear.method = Some(LinearMethod::AmgCg);
+    linear.hierarchy_setups = Some(1);
     let mut steps = 0;
     for it in 1..=p.max_iterations {
         let t = Instant::now();
@@ -782,7 +811,7 @@ fn solve_dual(
         timing,
         linear: LinearSolves {
             method: Some(LinearMethod::Cholesky),
-            cg_iterations: Vec::new(),
+            ..LinearSolves::default()
         },
     })
 }

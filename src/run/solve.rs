@@ -375,45 +375,63 @@ impl<'a> TimeLoop<'a> {
         let threshold = self.threshold;
         // CG iterations per accepted step, when the steps were solved by AMG-CG.
         let per_step: Vec<usize> = history.iter().map(|r| r.cg_iterations).collect();
+        let setups = history.iter().map(|r| r.hierarchy_setups).sum();
+        let refreshes = history.iter().map(|r| r.hierarchy_refreshes).sum();
+        let iterative = |name: &str, reason: String| LinearSolverSummary {
+            name: name.into(),
+            reason,
+            iterations: per_step.iter().sum(),
+            iterations_per_solve: per_step.clone(),
+            hierarchy_setups: Some(setups),
+            hierarchy_refreshes: Some(refreshes),
+        };
+        let requested = "requested by linear_solver";
         if per_step.iter().any(|&k| k > 0) && self.physics.materials.electric() {
-            LinearSolverSummary {
-                name: "GMRES".into(),
-                reason: if auto {
-                    format!(
-                        "auto: {n:.1e} unknowns, unsymmetric coupled thermal–electrical Newton steps → GMRES preconditioned by AMG on the temperature and voltage blocks"
-                    )
-                } else {
-                    "requested by linear_solver (unsymmetric coupled steps → GMRES with block AMG)"
-                        .into()
+            iterative(
+                "GMRES",
+                match auto {
+                    true => format!(
+                        "auto: {n:.1e} unknowns, unsymmetric coupled thermal–electrical Newton steps → GMRES preconditioned by AMG on the temperature and voltage blocks (hierarchies kept across steps while the matrix changes little)"
+                    ),
+                    false => {
+                        format!("{requested} (unsymmetric coupled steps → GMRES with block AMG)")
+                    }
                 },
-                iterations: per_step.iter().sum(),
-                iterations_per_solve: per_step,
-            }
+            )
+        } else if history.iter().any(|r| r.gmres) {
+            iterative(
+                "GMRES",
+                match auto {
+                    true => format!(
+                        "auto: {n:.1e} unknowns, a nonlinear law makes the Newton Jacobian unsymmetric → GMRES preconditioned by AMG (hierarchy kept across iterations and steps while the matrix changes little)"
+                    ),
+                    false => format!("{requested} (unsymmetric Jacobian → GMRES with AMG)"),
+                },
+            )
         } else if per_step.iter().any(|&k| k > 0) {
-            LinearSolverSummary {
-                name: "AMG-CG".into(),
-                reason: if auto {
-                    format!(
-                        "auto: {n:.1e} unknowns, symmetric positive definite steps → AMG-CG (hierarchy kept while the matrix is unchanged)"
-                    )
-                } else {
-                    "requested by linear_solver".into()
+            iterative(
+                "AMG-CG",
+                match auto {
+                    true => format!(
+                        "auto: {n:.1e} unknowns, symmetric positive definite steps → AMG-CG (hierarchy kept across steps while the matrix changes little)"
+                    ),
+                    false => requested.into(),
                 },
-                iterations: per_step.iter().sum(),
-                iterations_per_solve: per_step,
-            }
+            )
         } else {
             LinearSolverSummary {
                 name: "direct".into(),
                 reason: if auto {
                     format!(
-                        "auto: step systems below {threshold} unknowns or not symmetric positive definite are factored (Cholesky, LDLᵀ or LU by their kind)"
+                        "auto: step systems below {threshold} unknowns or with multipliers are factored (Cholesky, LDLᵀ or LU by their kind)"
                     )
                 } else {
-                    "requested by linear_solver".into()
+                    requested.into()
                 },
                 iterations: 0,
                 iterations_per_solve: Vec::new(),
+                hierarchy_setups: None,
+                hierarchy_refreshes: None,
             }
         }
     }
@@ -482,6 +500,9 @@ fn linear_solver_summary(
             format!("{n:.1e} unknowns, symmetric positive definite → AMG-CG")
         }
         Some(LinearMethod::SaddleLdlt) => "multipliers make the system indefinite → LDLᵀ".into(),
+        Some(LinearMethod::Gmres) => format!(
+            "{n:.1e} unknowns, a temperature-dependent conductance makes the Jacobian unsymmetric → GMRES preconditioned by AMG"
+        ),
         Some(LinearMethod::Lu) => {
             "a temperature-dependent conductance makes the Jacobian unsymmetric → LU".into()
         }
@@ -504,6 +525,8 @@ fn linear_solver_summary(
         reason,
         iterations: linear.cg_iterations.iter().sum(),
         iterations_per_solve: linear.cg_iterations.clone(),
+        hierarchy_setups: linear.hierarchy_setups,
+        hierarchy_refreshes: linear.hierarchy_setups.map(|_| linear.hierarchy_refreshes),
     }
 }
 

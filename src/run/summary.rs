@@ -103,7 +103,7 @@ pub struct Summary {
 /// The linear solver of a run, the reason it was chosen, and its CG iterations.
 #[derive(Clone, Debug, Serialize)]
 pub struct LinearSolverSummary {
-    /// `Cholesky`, `LDLᵀ`, `LU`, `AMG-CG`, or `direct` (transient and nonlinear runs,
+    /// `Cholesky`, `LDLᵀ`, `LU`, `AMG-CG`, `GMRES`, or `direct` (transient and nonlinear runs,
     /// which factor each step's system with the solver its kind needs).
     pub name: String,
     /// Why: `requested by linear_solver`, or `auto: …` with the size and kind.
@@ -112,6 +112,12 @@ pub struct LinearSolverSummary {
     pub iterations: usize,
     /// CG iterations of each solve.
     pub iterations_per_solve: Vec<usize>,
+    /// Iterative runs: AMG hierarchies set up, and kept hierarchies whose finest level
+    /// took a new matrix's values instead (time steps, Newton iterations).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hierarchy_setups: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hierarchy_refreshes: Option<usize>,
 }
 
 /// Peak resident memory of this process in MiB (Linux only; None elsewhere).

@@ -9,6 +9,13 @@
 //! Joule heat's T-derivative), for which the V-cycle is built; the coupling through
 //! `A₁₂` (the Joule heat's V-derivative) is left to the Krylov iteration.
 //!
+//! With `split` equal to the size there is one block: GMRES preconditioned by one
+//! V-cycle of the whole matrix, for the unsymmetric Jacobian of a single field (k(T), a
+//! temperature-dependent conductance, radiation). Each block's hierarchy is kept from
+//! one factorisation to the next while the matrix keeps its structure and the solves do
+//! not degrade ([`AmgCg::setup_or_refresh`]): a Newton iteration or a time step
+//! refreshes the finest level's values instead of setting the hierarchy up again.
+//!
 //! GMRES(m) with right preconditioning, modified Gram–Schmidt and Givens rotations: it
 //! stops when `‖b − A x‖ ≤ tolerance ‖b‖` (the true residual, recomputed at each
 //! restart), or when a restart cycle leaves a true residual within 100 × tolerance no
@@ -68,6 +75,10 @@ impl BlockGmres {
     /// `z = P⁻¹ r`: the block Gauss–Seidel sweep of the module docs.
     fn precondition(&mut self, r: &[f64], z: &mut [f64]) {
         let s = self.split;
+        if s == r.len() {
+            self.first.apply_vcycle(r, z);
+            return;
+        }
         let (z1, z2) = z.split_at_mut(s);
         self.first.apply_vcycle(&r[..s], z1);
         self.t2.resize(r.len() - s, 0.0);
@@ -174,22 +185,58 @@ impl BlockGmres {
     }
 }
 
+impl BlockGmres {
+    /// The hierarchies set up and refreshed since the solver was made, over its blocks.
+    pub fn reuse_counts(&self) -> (usize, usize) {
+        let (a, b) = (self.first.reuse_counts(), self.second.reuse_counts());
+        (a.0 + b.0, a.1 + b.1)
+    }
+
+    fn blocks(&self) -> impl Iterator<Item = &AmgCg> {
+        std::iter::once(&self.first).chain((self.split < self.a.nrows).then_some(&self.second))
+    }
+}
+
 impl LinearSolver for BlockGmres {
     fn factor(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), SolveError> {
         super::check_finite_ref(a.as_ref())?;
         self.a = Csr::from_csc(a.as_ref());
         let (n, s) = (self.a.nrows, self.split);
-        self.first.setup(block(&self.a, 0..s, 0..s))?;
-        self.second.setup(block(&self.a, s..n, s..n))?;
+        if s >= n {
+            self.split = n;
+            self.first.setup_or_refresh(self.a.clone())?;
+            return Ok(());
+        }
+        self.first.setup_or_refresh(block(&self.a, 0..s, 0..s))?;
+        self.second.setup_or_refresh(block(&self.a, s..n, s..n))?;
         self.a21 = block(&self.a, s..n, 0..s);
         Ok(())
     }
 
+    /// GMRES from zero; a solve that fails on a refreshed hierarchy is made again on
+    /// hierarchies set up anew.
     fn solve(&mut self, b: &mut [f64]) -> Result<SolveReport, SolveError> {
         check_rhs(self.a.nrows, b)?;
         let rhs = b.to_vec();
         b.fill(0.0);
-        self.gmres(&rhs, b)
+        let report = match self.gmres(&rhs, b) {
+            Err(SolveError::NotConverged { .. }) if self.blocks().any(AmgCg::is_refreshed) => {
+                let two = self.split < self.a.nrows;
+                self.first.set_up_again()?;
+                if two {
+                    self.second.set_up_again()?;
+                }
+                b.fill(0.0);
+                self.gmres(&rhs, b)?
+            }
+            other => other?,
+        };
+        let two = self.split < self.a.nrows;
+        self.first.note_iterations(report.iterations);
+        if two {
+            self.second.note_iterations(report.iterations);
+        }
+        Ok(report)
     }
 }
 

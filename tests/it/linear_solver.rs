@@ -231,8 +231,9 @@ fn the_json_summary_and_the_text_name_the_solver() {
 #[test]
 fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
     // The electronics warm-up (80 BDF2 steps, linear): every step system is symmetric
-    // positive definite, so above the threshold each step is one AMG-CG solve, the
-    // hierarchy set up again only when the matrix changes (the first two steps).
+    // positive definite, so above the threshold each step is one AMG-CG solve; the
+    // hierarchy is set up once and refreshed with the new values when the matrix
+    // changes (BDF1 → BDF2 after the first step), never factored.
     let file = "transient.toml";
     let (_direct_scene, problem) = scene_file_with(
         "electronics",
@@ -251,6 +252,8 @@ fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
     let steps = amg.summary.transient.as_ref().unwrap().steps;
     assert_eq!(a.iterations_per_solve.len(), steps);
     assert!(a.iterations_per_solve.iter().all(|&k| k > 0), "{a:?}");
+    assert_eq!(a.hierarchy_setups, Some(1), "{a:?}");
+    assert!(a.hierarchy_refreshes >= Some(1), "{a:?}");
     let (ta, td) = (&amg.solution.temperature, &direct.solution.temperature);
     let scale = max_abs(td);
     for (k, (x, y)) in ta.iter().zip(td).enumerate() {
@@ -271,4 +274,63 @@ fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
         assert!((x.heat_side_a - y.heat_side_a).abs() <= AGREE * q);
         assert!((x.heat_side_b - y.heat_side_b).abs() <= AGREE * q);
     }
+}
+
+#[test]
+fn nonlinear_steps_use_gmres_with_a_kept_hierarchy_and_agree_with_lu() {
+    // The two blocks with a conductivity k(T) in the base: the Newton Jacobian is
+    // unsymmetric (dk/dT ∇T). Above the threshold it is solved by GMRES preconditioned by
+    // AMG, the hierarchy kept across Newton iterations (refreshed with each Jacobian's
+    // values), never by LU; the answer is LU's.
+    let k_of_t = |text: String| {
+        text.replace(
+            "conductivity = 16.0",
+            "conductivity = \"16*(1 + 0.004*(T - 300))\"",
+        )
+    };
+    let scene = |tag: &str, extra: &str| {
+        let (dir, path) = two_blocks_with(tag, extra);
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.contains("conductivity = 16.0"),
+            "the base's conductivity"
+        );
+        std::fs::write(&path, k_of_t(text)).unwrap();
+        (dir, path)
+    };
+    let (_d, problem) = scene("kT-direct", "linear_solver = \"direct\"");
+    let direct = run(&problem);
+    assert_eq!(direct.summary.linear_solver.name, "direct");
+    assert!(direct.summary.newton_iterations >= 3, "a nonlinear problem");
+    let (_g, problem) = scene("kT-gmres", "auto_threshold = 1");
+    let gmres = run(&problem);
+    let g = &gmres.summary.linear_solver;
+    assert_eq!(g.name, "GMRES", "{g:?}");
+    assert!(g.reason.starts_with("auto: "), "{}", g.reason);
+    assert!(g.reason.contains("unsymmetric"), "{}", g.reason);
+    assert!(g.iterations_per_solve.iter().all(|&k| k > 0), "{g:?}");
+    let (setups, refreshes) = (g.hierarchy_setups.unwrap(), g.hierarchy_refreshes.unwrap());
+    // Every Jacobian but the first few served by the kept hierarchy.
+    let solves = gmres.summary.newton_iterations;
+    assert_eq!(setups + refreshes, solves, "{g:?}");
+    assert!(refreshes >= 1 && setups < solves, "{g:?}");
+    let (tg, td) = (&gmres.solution.temperature, &direct.solution.temperature);
+    let scale = max_abs(td);
+    for (k, (x, y)) in tg.iter().zip(td).enumerate() {
+        if y.is_finite() {
+            assert!(
+                (x - y).abs() <= AGREE * scale,
+                "node {k}: GMRES {x} vs LU {y}"
+            );
+        }
+    }
+    let (x, y) = (
+        &gmres.summary.interactions[0],
+        &direct.summary.interactions[0],
+    );
+    let q = y.heat_side_a.abs();
+    assert!(
+        (x.heat_side_a - y.heat_side_a).abs() <= AGREE * q,
+        "{x:?} vs {y:?}"
+    );
 }

@@ -228,8 +228,13 @@ pub struct StepReport {
     pub assembly_s: f64,
     pub factor_s: f64,
     pub solve_s: f64,
-    /// CG iterations of the step's AMG-CG solves (0 when it factored).
+    /// Krylov iterations of the step's AMG-CG or GMRES solves (0 when it factored).
     pub cg_iterations: usize,
+    /// The step's Krylov solves were GMRES (an unsymmetric Jacobian), not CG.
+    pub gmres: bool,
+    /// AMG hierarchies set up, and kept ones refreshed with new values, in the step.
+    pub hierarchy_setups: usize,
+    pub hierarchy_refreshes: usize,
     /// Per electrical contact: the current through it and its Joule heat.
     pub electric: Vec<ContactPower>,
     /// `None` when Newton converged; for a steady solve that did not, what happened

@@ -30,7 +30,8 @@ pub(super) struct Solvers {
     pub(super) lu: Lu,
     pub(super) amg: AmgCg,
     /// GMRES preconditioned block by block (temperatures, voltages) for a coupled
-    /// thermal–electrical Jacobian.
+    /// thermal–electrical Jacobian, or by one V-cycle for an unsymmetric one of a
+    /// single field; made at its first use.
     pub(super) gmres: Option<BlockGmres>,
     /// The values of the matrix factored last and which solver holds it: a linear
     /// problem stepping with a fixed step reuses the factorisation (bit for bit the
@@ -66,12 +67,7 @@ impl Solvers {
                 tolerance: crate::heat::steady::AMG_TOLERANCE,
                 ..AmgOptions::default()
             }),
-            gmres: setup.voltage.map(|v| {
-                BlockGmres::new(
-                    setup.dofs.field_range(v).start,
-                    crate::heat::steady::AMG_TOLERANCE,
-                )
-            }),
+            gmres: None,
             factored: None,
             matrix: None,
             distributed: crate::parallel::general_solve(),
@@ -120,6 +116,13 @@ pub(super) fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String 
         "Newton did not converge in {iterations} iterations at t = {t}: ‖R‖ = {}; {cause}",
         shown.join(" → ")
     )
+}
+
+/// AMG hierarchies set up and refreshed by the solvers so far.
+fn solvers_counts(s: &Solvers) -> (usize, usize) {
+    let (a, b) = s.amg.reuse_counts();
+    let (c, d) = s.gmres.as_ref().map_or((0, 0), BlockGmres::reuse_counts);
+    (a + c, b + d)
 }
 
 /// The right-hand side `J u + Δb` of a linear step's own system `J x = b`, from its
@@ -198,6 +201,9 @@ impl Context<'_, '_> {
             factor_s: 0.0,
             solve_s: 0.0,
             cg_iterations: 0,
+            gmres: false,
+            hierarchy_setups: 0,
+            hierarchy_refreshes: 0,
             electric: Vec::new(),
             diagnosis: None,
         };
@@ -275,8 +281,9 @@ impl Context<'_, '_> {
             // AMG-CG for a symmetric positive definite step system from the threshold on.
             let large = setup.ties.is_empty() && p.amg_threshold.is_some_and(|k| setup.n >= k);
             let amg = large && symmetric;
-            // A coupled thermal–electrical Jacobian (unsymmetric): block-AMG GMRES.
-            let gmres = large && solvers.gmres.is_some();
+            // An unsymmetric Jacobian (a nonlinear law; coupled thermal–electrical
+            // fields): GMRES preconditioned by AMG, block by block.
+            let gmres = large && !symmetric;
             // A linear time step by AMG-CG solves the step's own system from the
             // predictor (below).
             let from_predictor = linear && history.is_some();
@@ -303,10 +310,17 @@ impl Context<'_, '_> {
                     None => {
                         solvers.factored = None;
                         let tied = !setup.ties.is_empty();
+                        let before = solvers_counts(solvers);
                         let w = if amg {
-                            solvers.amg.factor(&jac)?;
+                            solvers.amg.factor_or_refresh(&jac)?;
                             Which::Amg
-                        } else if let (true, Some(g)) = (gmres, solvers.gmres.as_mut()) {
+                        } else if gmres {
+                            let split = setup
+                                .voltage
+                                .map_or(setup.n, |v| setup.dofs.field_range(v).start);
+                            let g = solvers.gmres.get_or_insert_with(|| {
+                                BlockGmres::new(split, crate::heat::steady::AMG_TOLERANCE)
+                            });
                             g.factor(&jac)?;
                             Which::Gmres
                         } else if tied && symmetric && solvers.saddle.factor(&jac).is_ok() {
@@ -317,9 +331,13 @@ impl Context<'_, '_> {
                             solvers.lu.factor(&jac)?;
                             Which::Lu
                         };
-                        if linear {
+                        // (A kept AMG hierarchy tells an unchanged matrix itself.)
+                        if linear && w != Which::Amg {
                             solvers.factored = Some((jac.val().to_vec(), w));
                         }
+                        let after = solvers_counts(solvers);
+                        report.hierarchy_setups += after.0 - before.0;
+                        report.hierarchy_refreshes += after.1 - before.1;
                         w
                     }
                 };
@@ -346,14 +364,20 @@ impl Context<'_, '_> {
                     Which::Amg if from_predictor => {
                         let b = step_system(&jac, &rhs, u);
                         let mut x = u.to_vec();
-                        let report = solvers.amg.pcg(&b, &mut x)?;
+                        let solved = solvers.amg.pcg(&b, &mut x)?;
                         for ((d, x), u) in rhs.iter_mut().zip(&x).zip(u.iter()) {
                             *d = x - u;
                         }
-                        report.iterations
+                        solvers.amg.note_iterations(solved.iterations);
+                        solved.iterations
                     }
-                    Which::Amg => solvers.amg.solve(&mut rhs)?.iterations,
+                    Which::Amg => {
+                        let its = solvers.amg.solve(&mut rhs)?.iterations;
+                        solvers.amg.note_iterations(its);
+                        its
+                    }
                     Which::Gmres => {
+                        report.gmres = true;
                         let g = solvers.gmres.as_mut().ok_or(SolveError::NotFactored)?;
                         g.solve(&mut rhs)?.iterations
                     }

@@ -57,6 +57,7 @@ use super::{LinearSolver, SolveError, SolveReport, check_rhs, dot, norm};
 
 mod coarsen;
 mod csr;
+mod reuse;
 mod smooth;
 
 use coarsen::{
@@ -64,6 +65,7 @@ use coarsen::{
     spectral_radius_filtered,
 };
 pub use csr::Csr;
+pub use reuse::Served;
 use smooth::{
     gauss_seidel, gauss_seidel_from_zero, gauss_seidel_from_zero_with_residual, penalty_rows,
     symmetric_gauss_seidel_rows, symmetric_gauss_seidel_rows_with_residual,
@@ -157,6 +159,8 @@ pub struct AmgCg {
     /// Dense Cholesky factor (row-major lower) of the coarsest operator.
     coarse: Vec<f64>,
     coarse_n: usize,
+    /// A kept hierarchy's state (`reuse`).
+    reuse: reuse::Reuse,
 }
 
 /// Description of the hierarchy: unknowns and stored entries per level.
@@ -180,6 +184,7 @@ impl AmgCg {
             levels: Vec::new(),
             coarse: Vec::new(),
             coarse_n: 0,
+            reuse: reuse::Reuse::default(),
         }
     }
 
@@ -280,6 +285,7 @@ impl AmgCg {
     /// Build the hierarchy for a matrix in row storage.
     pub fn setup(&mut self, a: Csr) -> Result<(), SolveError> {
         self.levels.clear();
+        self.reuse.set_up();
         let mut a = a;
         let theta = self.options.strength;
         let mut inherited: Option<Vec<u32>> = None;
@@ -525,6 +531,22 @@ impl AmgCg {
 
     /// PCG on the finest level's matrix; `x` holds the initial guess and the result.
     pub fn pcg(&mut self, b: &[f64], x: &mut [f64]) -> Result<SolveReport, SolveError> {
+        if !self.reuse.refreshed {
+            return self.pcg_once(b, x);
+        }
+        // A refreshed hierarchy that fails is set up anew and the solve made again.
+        let guess = x.to_vec();
+        match self.pcg_once(b, x) {
+            Err(SolveError::NotConverged { .. }) if self.set_up_again()? => {
+                x.copy_from_slice(&guess);
+                self.pcg_once(b, x)
+            }
+            other => other,
+        }
+    }
+
+    /// [`Self::pcg`] on the hierarchy as it is.
+    fn pcg_once(&mut self, b: &[f64], x: &mut [f64]) -> Result<SolveReport, SolveError> {
         let n = b.len();
         let bnorm = norm(b);
         if bnorm == 0.0 {

@@ -1,0 +1,232 @@
+//! A hierarchy kept while the matrix changes little: the finest level's operator (the
+//! one the smoother sweeps and CG multiplies by) takes the new values, the coarser
+//! levels, P and R stay, and the whole hierarchy is set up anew when the solves
+//! degrade.
+//!
+//! Why it is sound: with the fine operator refreshed, the V-cycle is still a symmetric
+//! positive definite preconditioner of the new matrix (forward and backward sweeps of
+//! its own Gauss–Seidel around a coarse correction by any SPD coarse operator), so CG
+//! converges to the new system's solution; only its rate depends on how far the coarse
+//! levels have drifted from the new matrix's Galerkin ones. A time step's matrix
+//! `M/Δt + K(T)` or a Newton Jacobian changes by a small relative amount from one
+//! solve to the next, so the drift costs a few iterations where a set-up costs many.
+//!
+//! The rule: the Krylov iterations of the first solve after a set-up are the base; a
+//! later solve that needs more than `base + base/2 + 3` marks the hierarchy as
+//! degraded, and the next matrix is set up anew. A CG solve that fails to converge on a
+//! refreshed hierarchy is set up anew at once and solved again.
+
+use super::csr::Csr;
+use super::{AmgCg, SolveError};
+
+/// The state of a kept hierarchy.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Reuse {
+    /// The Krylov iterations of the first solve after the last set-up.
+    base: Option<usize>,
+    /// A later solve took too many more: the next matrix gets a new set-up.
+    degraded: bool,
+    /// The finest level was refreshed since the last set-up.
+    pub(super) refreshed: bool,
+    /// Set-ups and refreshes since the solver was made.
+    pub(super) setups: usize,
+    pub(super) refreshes: usize,
+}
+
+impl Reuse {
+    /// A new hierarchy was set up.
+    pub(super) fn set_up(&mut self) {
+        self.base = None;
+        self.degraded = false;
+        self.refreshed = false;
+        self.setups += 1;
+    }
+}
+
+/// How the last [`AmgCg::setup_or_refresh`] served its matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Served {
+    /// A new hierarchy.
+    SetUp,
+    /// The kept hierarchy, its finest level refreshed.
+    Refreshed,
+    /// The kept hierarchy as it is: the matrix is its finest level's, bit for bit.
+    Unchanged,
+}
+
+impl AmgCg {
+    /// Serve `a`: refresh the finest level of the kept hierarchy when `a` has its
+    /// structure and the solves since its set-up have not degraded (module docs),
+    /// else set a new hierarchy up.
+    pub fn setup_or_refresh(&mut self, a: Csr) -> Result<Served, SolveError> {
+        let fits = !self.reuse.degraded
+            && self.levels.first().is_some_and(|l| {
+                l.a.nrows == a.nrows && l.a.ptr == a.ptr && l.a.idx == a.idx && !l.a.val.is_empty()
+            });
+        if !fits {
+            self.setup(a)?;
+            return Ok(Served::SetUp);
+        }
+        let diag = a.diagonal();
+        if let Some(row) = diag.iter().position(|&d| d <= 0.0 || !d.is_finite()) {
+            return Err(SolveError::NotPositiveDefinite { row });
+        }
+        let fine = &mut self.levels[0];
+        fine.inv_diag = diag.iter().map(|d| 1.0 / d).collect();
+        fine.a32 = a.val.iter().map(|&v| v as f32).collect();
+        fine.a = a;
+        self.reuse.refreshed = true;
+        self.reuse.refreshes += 1;
+        Ok(Served::Refreshed)
+    }
+
+    /// [`Self::setup_or_refresh`] of a matrix in column storage (its values checked
+    /// finite, as [`LinearSolver::factor`](crate::solve::LinearSolver::factor) does).
+    pub fn factor_or_refresh(
+        &mut self,
+        a: &faer::sparse::SparseColMat<usize, f64>,
+    ) -> Result<Served, SolveError> {
+        crate::solve::check_finite_ref(a.as_ref())?;
+        if self.levels.first().is_some_and(|l| same_matrix(&l.a, a)) {
+            return Ok(Served::Unchanged);
+        }
+        self.setup_or_refresh(Csr::from_csc(a.as_ref()))
+    }
+
+    /// Record the Krylov iterations of a solve with the current hierarchy (the rule
+    /// of the module docs).
+    pub fn note_iterations(&mut self, iterations: usize) {
+        match self.reuse.base {
+            None => self.reuse.base = Some(iterations),
+            Some(base) if iterations > base + base / 2 + 3 => self.reuse.degraded = true,
+            Some(_) => {}
+        }
+    }
+
+    /// The finest level was refreshed since the last set-up.
+    pub fn is_refreshed(&self) -> bool {
+        self.reuse.refreshed
+    }
+
+    /// Hierarchies set up and finest levels refreshed since the solver was made.
+    pub fn reuse_counts(&self) -> (usize, usize) {
+        (self.reuse.setups, self.reuse.refreshes)
+    }
+
+    /// After a failed solve on a refreshed hierarchy: set it up anew from the finest
+    /// level's own (current) matrix. False when there is nothing to redo.
+    pub(crate) fn set_up_again(&mut self) -> Result<bool, SolveError> {
+        if !self.reuse.refreshed || self.levels.is_empty() || self.levels[0].a.val.is_empty() {
+            return Ok(false);
+        }
+        let a = std::mem::take(&mut self.levels[0].a);
+        self.setup(a)?;
+        Ok(true)
+    }
+}
+
+/// `a` (column storage) is `rows` (row storage), structure and values bit for bit: a
+/// linear problem stepping with a fixed step needs no refresh, and no copy of the
+/// values is kept to tell.
+fn same_matrix(rows: &Csr, a: &faer::sparse::SparseColMat<usize, f64>) -> bool {
+    let s = a.symbolic();
+    if rows.nrows != a.nrows() || rows.ncols != a.ncols() || rows.val.len() != a.val().len() {
+        return false;
+    }
+    // Columns in order meet each row's entries in order: a cursor per row.
+    let mut next: Vec<usize> = rows.ptr[..rows.nrows].to_vec();
+    for j in 0..a.ncols() {
+        for p in s.col_range(j) {
+            let i = s.row_idx()[p];
+            let q = next[i];
+            if q >= rows.ptr[i + 1]
+                || rows.idx[q] as usize != j
+                || rows.val[q].to_bits() != a.val()[p].to_bits()
+            {
+                return false;
+            }
+            next[i] += 1;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::laplace_1d;
+    use super::*;
+    use crate::solve::amg::AmgOptions;
+
+    /// A 1-D Laplacian plus a mass term `c I`: the matrix of a time step.
+    fn step_matrix(n: usize, c: f64) -> Csr {
+        let mut a = laplace_1d(n);
+        for i in 0..n {
+            for p in a.ptr[i]..a.ptr[i + 1] {
+                if a.idx[p] as usize == i {
+                    a.val[p] += c;
+                }
+            }
+        }
+        a
+    }
+
+    /// A matrix that changes a little is served by refreshing the kept hierarchy and
+    /// solved to the tolerance all the same; a different structure, or solves that
+    /// degrade, bring a new set-up.
+    #[test]
+    fn a_kept_hierarchy_serves_a_changed_matrix_and_is_set_up_again_when_it_degrades() {
+        let n = 20_000;
+        let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 100) as f64 / 100.0).collect();
+        let mut s = AmgCg::new(AmgOptions {
+            tolerance: 1e-10,
+            ..AmgOptions::default()
+        });
+        let solve = |s: &mut AmgCg, a: &Csr| {
+            let mut x = vec![0.0; n];
+            let report = s.pcg(&b, &mut x).unwrap();
+            let mut r = vec![0.0; n];
+            a.spmv(&x, &mut r);
+            let res = r
+                .iter()
+                .zip(&b)
+                .map(|(r, b)| (r - b).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let bn = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!(res <= 1.01e-10 * bn, "residual {res:e} of {bn:e}");
+            report.iterations
+        };
+        let a0 = step_matrix(n, 1e-3);
+        assert_eq!(s.setup_or_refresh(a0.clone()).unwrap(), Served::SetUp);
+        let base = solve(&mut s, &a0);
+        s.note_iterations(base);
+        // 1 % more mass: refreshed, converges in about as many iterations.
+        let a1 = step_matrix(n, 1.01e-3);
+        assert_eq!(s.setup_or_refresh(a1.clone()).unwrap(), Served::Refreshed);
+        let its = solve(&mut s, &a1);
+        assert!(its <= base + 2, "{its} iterations against {base}");
+        s.note_iterations(its);
+        assert_eq!(s.reuse_counts(), (1, 1));
+        // A solve that needs many more marks the hierarchy degraded: set up anew.
+        s.note_iterations(base * 3);
+        assert_eq!(s.setup_or_refresh(a1.clone()).unwrap(), Served::SetUp);
+        // The same matrix again, in column storage: served as it is.
+        let csc = |a: &Csr| {
+            let t: Vec<_> = (0..a.nrows)
+                .flat_map(|i| (a.ptr[i]..a.ptr[i + 1]).map(move |p| (i, p)))
+                .map(|(i, p)| faer::sparse::Triplet::new(i, a.idx[p] as usize, a.val[p]))
+                .collect();
+            faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(a.nrows, a.ncols, &t)
+                .unwrap()
+        };
+        assert_eq!(s.factor_or_refresh(&csc(&a1)).unwrap(), Served::Unchanged);
+        let a2 = step_matrix(n, 1.02e-3);
+        assert_eq!(s.factor_or_refresh(&csc(&a2)).unwrap(), Served::Refreshed);
+        // Another structure is always set up anew.
+        assert_eq!(
+            s.setup_or_refresh(step_matrix(n - 1, 1e-3)).unwrap(),
+            Served::SetUp
+        );
+        assert_eq!(s.reuse_counts(), (3, 2));
+    }
+}
