@@ -231,9 +231,8 @@ fn the_json_summary_and_the_text_name_the_solver() {
 #[test]
 fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
     // The electronics warm-up (80 BDF2 steps, linear): every step system is symmetric
-    // positive definite, so above the threshold each step is one AMG-CG solve; the
-    // hierarchy is set up once and refreshed with the new values when the matrix
-    // changes (BDF1 → BDF2 after the first step), never factored.
+    // positive definite, so above the threshold each step is one AMG-CG solve, never a
+    // factorisation; the hierarchy is kept while the matrix is unchanged.
     let file = "transient.toml";
     let (_direct_scene, problem) = scene_file_with(
         "electronics",
@@ -252,8 +251,10 @@ fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
     let steps = amg.summary.transient.as_ref().unwrap().steps;
     assert_eq!(a.iterations_per_solve.len(), steps);
     assert!(a.iterations_per_solve.iter().all(|&k| k > 0), "{a:?}");
-    assert_eq!(a.hierarchy_setups, Some(1), "{a:?}");
-    assert!(a.hierarchy_refreshes >= Some(1), "{a:?}");
+    // Two matrices in the run (BDF1's, then BDF2's): each served once (a set-up, or a
+    // refresh when the diagonal moved little), every other step finds its matrix.
+    let served = a.hierarchy_setups.unwrap() + a.hierarchy_refreshes.unwrap();
+    assert_eq!(served, 2, "{a:?}");
     let (ta, td) = (&amg.solution.temperature, &direct.solution.temperature);
     let scale = max_abs(td);
     for (k, (x, y)) in ta.iter().zip(td).enumerate() {

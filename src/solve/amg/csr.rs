@@ -241,6 +241,29 @@ impl Csr {
         out
     }
 
+    /// Square, with `a_ji` equal to `a_ij` bit for bit wherever either is stored.
+    pub(super) fn is_exactly_symmetric(&self) -> bool {
+        if self.nrows != self.ncols {
+            return false;
+        }
+        // Rows in order meet each column's entries in order: a cursor per row.
+        let mut next: Vec<usize> = self.ptr[..self.nrows].to_vec();
+        for i in 0..self.nrows {
+            for p in self.ptr[i]..self.ptr[i + 1] {
+                let j = self.idx[p] as usize;
+                let q = next[j];
+                if q >= self.ptr[j + 1]
+                    || self.idx[q] as usize != i
+                    || self.val[q].to_bits() != self.val[p].to_bits()
+                {
+                    return false;
+                }
+                next[j] += 1;
+            }
+        }
+        true
+    }
+
     pub(super) fn diagonal(&self) -> Vec<f64> {
         (0..self.nrows)
             .map(|i| {
