@@ -6,8 +6,9 @@
 //!
 //! For each model and integration mode (side-A Gauss points vs mortar segments):
 //! unknowns, L2 and max nodal error, time per phase. `cargo bench --bench enforce`
-//! runs n = 18 and 40 (about 1e4 and 1e5 unknowns, sparse Cholesky); add `-- large` for
-//! n = 88 (about 1e6, solved by AMG-preconditioned CG).
+//! runs n = 18 and 40 (about 1e4 and 1e5 unknowns); add `-- large` for n = 88 (about
+//! 1e6). The linear solver is `seam run`'s default: sparse Cholesky below
+//! `AUTO_AMG_THRESHOLD` nodes, AMG-preconditioned CG from there on.
 
 #[path = "common/mod.rs"]
 mod common;
@@ -17,7 +18,7 @@ use std::time::Instant;
 
 use seam::enforce::interface::{DEFAULT_BETA, Form, HInput, HValue, InterfaceForm};
 use seam::heat::Material;
-use seam::heat::steady::{ContactTerm, SteadyProblem, solve_steady};
+use seam::heat::steady::{AUTO_AMG_THRESHOLD, ContactTerm, SteadyProblem, solve_steady};
 use seam::mesh::generate::{self, BoxSpec};
 use seam::mesh::{Mesh, NodeId};
 use seam::search::SearchSettings;
@@ -124,7 +125,8 @@ fn main() {
             contact: vec![],
             interfaces: None,
             reproducible: true,
-            iterative: n >= 60,
+            // `seam run`'s default: AMG-CG from the auto threshold on.
+            iterative: conforming.num_nodes() >= AUTO_AMG_THRESHOLD,
             tolerance: 1e-10,
             max_iterations: 3,
         })
@@ -197,7 +199,7 @@ fn main() {
                     }],
                     interfaces: None,
                     reproducible: true,
-                    iterative: n >= 60,
+                    iterative: mesh.num_nodes() >= AUTO_AMG_THRESHOLD,
                     tolerance: 1e-10,
                     max_iterations: 3,
                 })

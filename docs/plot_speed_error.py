@@ -20,7 +20,9 @@ def main(src, dst):
         parts = line.split()
         if len(parts) < 9 or not parts[-1].replace(".", "").isdigit() or "n=" not in line:
             continue
-        label = line[:34].strip()
+        # The label is everything before the eight number columns (a long one runs
+        # into the unknowns column, so no fixed width).
+        label = line[: line.rindex(parts[-8])].strip()
         method = label.rsplit(" n=", 1)[0]
         unknowns = int(parts[-8])
         l2 = float(parts[-7])
