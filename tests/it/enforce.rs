@@ -1084,3 +1084,80 @@ fn amg_cg_path_matches_the_direct_solve() {
         .fold(0.0, f64::max);
     assert!(worst < 1e-8, "AMG-CG differs from Cholesky by {worst:e}");
 }
+
+/// A temperature-dependent gap conductance makes the Newton Jacobian unsymmetric: with
+/// `iterative` (the size `seam run` calls large) the steady Newton solves it by
+/// AMG-preconditioned GMRES, its hierarchy kept across the iterations, and reaches LU's
+/// answer.
+#[test]
+fn an_unsymmetric_newton_jacobian_at_scale_is_solved_by_gmres_as_by_lu() {
+    use seam::heat::steady::LinearMethod;
+    let s = setup(12, 8, SolidKind::Hex8);
+    let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
+        .filter_map(|i| {
+            let z = s.mesh.coords[i][2];
+            (z == 0.0 || z == 2.0).then_some((NodeId(i as u32), if z == 0.0 { 0.0 } else { 1.0 }))
+        })
+        .collect();
+    let materials = [Material {
+        conductivity: 1.0,
+        rho_c: 1.0,
+    }; 2];
+    // h = 2 (1 + T_A + T_B²): strongly nonlinear, and unsymmetric in its derivatives.
+    let hf = |p: &HInput| {
+        Ok(HValue {
+            h: 2.0 * (1.0 + p.temp_a + p.temp_b * p.temp_b),
+            dh_dtemp_a: 2.0,
+            dh_dtemp_b: 4.0 * p.temp_b,
+            ..HValue::default()
+        })
+    };
+    let k = [1.0, 1.0];
+    let solve = |iterative: bool| {
+        solve_steady(&SteadyProblem {
+            mesh: &s.mesh,
+            materials: &materials,
+            source: None,
+            dirichlet: &dirichlet,
+            face_bcs: &[],
+            ties: vec![],
+            contact: vec![ContactTerm {
+                side_a: &s.a,
+                side_b: &s.b,
+                points: &s.points,
+                form: InterfaceForm {
+                    form: Form::GapConductance,
+                    h: &hf,
+                    offset: 0.0,
+                    beta: DEFAULT_BETA,
+                    conductivity: &k,
+                    conductivity_of_t: None,
+                    temperature_field: None,
+                },
+                linear: false,
+            }],
+            interfaces: None,
+            reproducible: true,
+            iterative,
+            tolerance: 1e-10,
+            max_iterations: 20,
+        })
+        .unwrap()
+    };
+    let (lu, gmres) = (solve(false), solve(true));
+    assert!(lu.converged && gmres.converged);
+    assert_eq!(lu.linear.method, Some(LinearMethod::Lu));
+    assert_eq!(gmres.linear.method, Some(LinearMethod::Gmres));
+    assert!(gmres.newton_iterations >= 3, "a nonlinear problem");
+    let setups = gmres.linear.hierarchy_setups.unwrap();
+    assert!(setups < gmres.newton_iterations, "{:?}", gmres.linear);
+    assert_eq!(
+        setups + gmres.linear.hierarchy_refreshes,
+        gmres.newton_iterations
+    );
+    for (i, (x, y)) in gmres.temperature.iter().zip(&lu.temperature).enumerate() {
+        assert!((x - y).abs() <= 1e-8, "node {i}: GMRES {x} vs LU {y}");
+    }
+    let (qg, ql) = (gmres.heat[0], lu.heat[0]);
+    assert!((qg.0 - ql.0).abs() <= 1e-8 * ql.0.abs(), "{qg:?} vs {ql:?}");
+}
