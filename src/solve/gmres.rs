@@ -192,8 +192,14 @@ impl BlockGmres {
         (a.0 + b.0, a.1 + b.1)
     }
 
+    /// The blocks' AMG solvers: one when `split` is the size.
     fn blocks(&self) -> impl Iterator<Item = &AmgCg> {
         std::iter::once(&self.first).chain((self.split < self.a.nrows).then_some(&self.second))
+    }
+
+    fn blocks_mut(&mut self) -> impl Iterator<Item = &mut AmgCg> {
+        let two = self.split < self.a.nrows;
+        std::iter::once(&mut self.first).chain(two.then_some(&mut self.second))
     }
 }
 
@@ -221,20 +227,16 @@ impl LinearSolver for BlockGmres {
         b.fill(0.0);
         let report = match self.gmres(&rhs, b) {
             Err(SolveError::NotConverged { .. }) if self.blocks().any(AmgCg::is_refreshed) => {
-                let two = self.split < self.a.nrows;
-                self.first.set_up_again()?;
-                if two {
-                    self.second.set_up_again()?;
+                for block in self.blocks_mut() {
+                    block.set_up_again()?;
                 }
                 b.fill(0.0);
                 self.gmres(&rhs, b)?
             }
             other => other?,
         };
-        let two = self.split < self.a.nrows;
-        self.first.note_iterations(report.iterations);
-        if two {
-            self.second.note_iterations(report.iterations);
+        for block in self.blocks_mut() {
+            block.note_iterations(report.iterations);
         }
         Ok(report)
     }

@@ -3,6 +3,36 @@
 use super::*;
 
 /// The 1-D Laplacian tridiag(−1, 2, −1) of size n.
+/// A square matrix from its rows (column → value, ascending).
+fn csr_of_rows(rows: Vec<std::collections::BTreeMap<usize, f64>>) -> Csr {
+    let n = rows.len();
+    let mut a = Csr {
+        nrows: n,
+        ncols: n,
+        ptr: vec![0],
+        ..Csr::default()
+    };
+    for row in rows {
+        for (j, v) in row {
+            a.idx.push(j as u32);
+            a.val.push(v);
+        }
+        a.ptr.push(a.idx.len());
+    }
+    a
+}
+
+/// ‖b − A x‖₂.
+pub(super) fn residual_norm(a: &Csr, x: &[f64], b: &[f64]) -> f64 {
+    let mut r = vec![0.0; b.len()];
+    a.spmv(x, &mut r);
+    r.iter()
+        .zip(b)
+        .map(|(r, b)| (r - b).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
 pub(super) fn laplace_1d(n: usize) -> Csr {
     let mut c = Csr {
         nrows: n,
@@ -160,14 +190,7 @@ fn amg_cg_solves_1d_laplacian() {
     let b = vec![1.0; n];
     let mut x = vec![0.0; n];
     let rep = s.pcg(&b, &mut x).unwrap();
-    let mut r = vec![0.0; n];
-    a.spmv(&x, &mut r);
-    let res = r
-        .iter()
-        .zip(&b)
-        .map(|(r, b)| (r - b).powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let res = residual_norm(&a, &x, &b);
     assert!(res / (n as f64).sqrt() <= 1e-8, "residual {res}");
     assert!(rep.iterations < 30, "{rep:?}");
 }
@@ -221,20 +244,7 @@ fn penalty_tied_blocks(na: usize, nb: usize) -> Csr {
             }
         }
     }
-    let mut a = Csr {
-        nrows: n,
-        ncols: n,
-        ptr: vec![0],
-        ..Csr::default()
-    };
-    for row in rows {
-        for (j, v) in row {
-            a.idx.push(j as u32);
-            a.val.push(v);
-        }
-        a.ptr.push(a.idx.len());
-    }
-    a
+    csr_of_rows(rows)
 }
 
 /// The Q1 conduction matrix of an `m × m × m` grid of bricks `1 × 1 × 1/aspect`,
@@ -273,20 +283,7 @@ fn stretched_bricks(m: usize, aspect: f64) -> Csr {
             }
         }
     }
-    let mut a = Csr {
-        nrows: n,
-        ncols: n,
-        ptr: vec![0],
-        ..Csr::default()
-    };
-    for row in rows {
-        for (j, v) in row {
-            a.idx.push(j as u32);
-            a.val.push(v);
-        }
-        a.ptr.push(a.idx.len());
-    }
-    a
+    csr_of_rows(rows)
 }
 
 /// Stretched cells couple their in-plane face neighbours positively on every row:
