@@ -237,9 +237,14 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     // The pattern: elements plus every interface coupling (fixed by the pairing).
     let t = Instant::now();
     let couplings = iface.couplings(&u, 0.0).map_err(failed)?;
+    let t_couplings = t.elapsed().as_secs_f64();
     let (pattern, first, tie_coupling_first) =
         pattern_of(mesh, &dofs, &couplings, &ties, &lambda_first)?;
     drop(couplings);
+    log::debug!(
+        "steady: interface couplings {t_couplings:.3} s, pattern {:.3} s",
+        t.elapsed().as_secs_f64() - t_couplings
+    );
     timing.assembly_s += t.elapsed().as_secs_f64();
     let symmetric = iface.is_linear();
     // AMG-CG of a linear problem: its own path, which frees the pattern before the
@@ -529,6 +534,7 @@ fn solve_amg(
         let mut asm = Assembler::direct(&pattern)?;
         assemble_conduction(&mut asm, p.mesh, dofs, p.materials, p.source, p.face_bcs)?;
         let f_vol = asm.rhs();
+        let t_conduction = t.elapsed().as_secs_f64();
         // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
         let mut r = vec![0.0; n];
         let k = asm.element_values().expect("K");
@@ -536,9 +542,15 @@ fn solve_amg(
         for (ri, fi) in r.iter_mut().zip(&f_vol) {
             *ri -= fi;
         }
+        let t_residual = t.elapsed().as_secs_f64();
         let heat = iface
             .assemble(u, 0.0, &mut r, &mut asm, first)
             .map_err(failed)?;
+        log::debug!(
+            "steady: conduction {t_conduction:.3} s, residual {:.3} s, interfaces {:.3} s",
+            t_residual - t_conduction,
+            t.elapsed().as_secs_f64() - t_residual
+        );
         let mut record = Record::new(&f_vol, p.tolerance);
         let fine = if record.converged(0, &mut r, bcs, f64::INFINITY, u, true) {
             None
@@ -557,6 +569,10 @@ fn solve_amg(
     // The pattern given up: its structure becomes the hierarchy's rows (a symmetric
     // structure is its own transpose), with no copy.
     let (col_ptr, rows) = pattern.into_structure().expect("built");
+    log::debug!(
+        "steady: first assembly and residual {:.3} s",
+        t.elapsed().as_secs_f64()
+    );
     let t_rows = Instant::now();
     let fine = fine
         .map(|(values, symmetric)| match symmetric {
