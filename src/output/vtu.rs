@@ -17,7 +17,7 @@
 //! values, as VTK and meshio write it.
 
 use std::fmt::Write as _;
-use std::io;
+use std::io::{self, Write as _};
 use std::path::{Path, PathBuf};
 
 use crate::mesh::{Mesh, Topology};
@@ -81,14 +81,29 @@ fn xml_escape(s: &str) -> String {
     out
 }
 
-/// Appends `DataArray` elements in one encoding.
-struct Arrays {
+/// Appends `DataArray` elements in one encoding, each handed to `out` once made: the
+/// file is never whole in memory (at a million nodes it is about 150 MB), only its
+/// largest array.
+struct Arrays<'w> {
     s: String,
     encoding: VtuEncoding,
     bytes: Vec<u8>,
+    out: &'w mut dyn io::Write,
+    /// The first failure to write (later writes are skipped).
+    failed: Option<io::Error>,
 }
 
-impl Arrays {
+impl Arrays<'_> {
+    /// Hand what is made so far to the writer.
+    fn flush(&mut self) {
+        if self.failed.is_none()
+            && let Err(e) = self.out.write_all(self.s.as_bytes())
+        {
+            self.failed = Some(e);
+        }
+        self.s.clear();
+    }
+
     fn open(&mut self, ty: &str, name: Option<&str>, components: usize) {
         let format = match self.encoding {
             VtuEncoding::Ascii => "ascii",
@@ -138,6 +153,7 @@ impl Arrays {
             }
         }
         self.s.push_str("</DataArray>\n");
+        self.flush();
     }
 
     fn f64s(&mut self, name: Option<&str>, components: usize, values: impl Iterator<Item = f64>) {
@@ -333,7 +349,8 @@ pub fn write_vtu_arrays(
     let block_id: Vec<i64> = blocks()
         .flat_map(|b| std::iter::repeat_n(b.id, b.len()))
         .collect();
-    let s = piece(
+    write_piece(
+        path,
         Piece {
             points: &mesh.coords,
             cells,
@@ -345,8 +362,7 @@ pub fn write_vtu_arrays(
             cell,
         },
         encoding,
-    );
-    std::fs::write(path, s)
+    )
 }
 
 /// Write a grid of its own — `points` and polygon cells, each a list of 3 (triangle,
@@ -397,7 +413,8 @@ pub fn write_vtu_polygons(
         *off += p.len() as i64;
         Some(*off)
     });
-    let s = piece(
+    write_piece(
+        path,
         Piece {
             points,
             cells: polygons.len(),
@@ -409,8 +426,7 @@ pub fn write_vtu_polygons(
             cell,
         },
         encoding,
-    );
-    std::fs::write(path, s)
+    )
 }
 
 /// Everything one `<Piece>` holds.
@@ -425,19 +441,24 @@ struct Piece<'a, C, O, T> {
     cell: &'a [Array<'a>],
 }
 
-/// The whole file of one piece, arrays already checked.
-fn piece<C, O, T>(p: Piece<'_, C, O, T>, encoding: VtuEncoding) -> String
+/// The whole file of one piece, arrays already checked, written to `out` an array at a
+/// time.
+fn piece<C, O, T>(
+    p: Piece<'_, C, O, T>,
+    encoding: VtuEncoding,
+    out: &mut dyn io::Write,
+) -> io::Result<()>
 where
     C: Iterator<Item = i64> + Clone,
     O: Iterator<Item = i64> + Clone,
     T: Iterator<Item = u8>,
 {
-    let values: usize = p.point.iter().map(|a| a.values.len()).sum::<usize>()
-        + p.cell.iter().map(|a| a.values.len()).sum::<usize>();
     let mut a = Arrays {
-        s: String::with_capacity(32 * (3 * p.points.len() + values) + 64 * p.cells),
+        s: String::new(),
         encoding,
         bytes: Vec::new(),
+        out,
+        failed: None,
     };
     a.s.push_str("<?xml version=\"1.0\"?>\n");
     a.s.push_str("<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n");
@@ -466,7 +487,23 @@ where
         a.f64s(Some(x.name), x.components, x.values.iter().copied());
     }
     a.s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    a.s
+    a.flush();
+    match a.failed {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Create `path` and write one piece into it through a buffer.
+fn write_piece<C, O, T>(path: &Path, p: Piece<'_, C, O, T>, encoding: VtuEncoding) -> io::Result<()>
+where
+    C: Iterator<Item = i64> + Clone,
+    O: Iterator<Item = i64> + Clone,
+    T: Iterator<Item = u8>,
+{
+    let mut file = io::BufWriter::new(std::fs::File::create(path)?);
+    piece(p, encoding, &mut file)?;
+    file.flush()
 }
 
 /// A ParaView time series (`.pvd`): a list of `(time, file)` rewritten whole on every
