@@ -588,6 +588,11 @@ pub struct Assembler<'p> {
 }
 
 impl<'p> Assembler<'p> {
+    /// The pattern this assembler fills.
+    pub fn pattern(&self) -> &'p Pattern {
+        self.pattern
+    }
+
     pub fn new(pattern: &'p Pattern) -> Self {
         let vec_elem_len = pattern.block_slots.iter().map(|s| s.1 * s.2).sum();
         Assembler {

@@ -120,6 +120,19 @@ pub fn check_finite_ref(a: SparseColMatRef<'_, usize, f64>) -> Result<(), SolveE
     Ok(())
 }
 
+/// [`check_finite`] of a square CSC matrix given as its parts (column pointers, 32-bit
+/// rows, values).
+pub fn check_finite_parts(col_ptr: &[usize], rows: &[u32], vals: &[f64]) -> Result<(), SolveError> {
+    match vals.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(p) => Err(SolveError::NonFinite {
+            row: rows[p] as usize,
+            col: col_ptr.partition_point(|&start| start <= p) - 1,
+            value: vals[p],
+        }),
+    }
+}
+
 pub(crate) fn check_rhs(n: usize, b: &[f64]) -> Result<(), SolveError> {
     if b.len() != n {
         return Err(SolveError::Dimension {

@@ -8,7 +8,7 @@ use crate::heat::{FaceBc, HeatError};
 use crate::parallel::{GeneralSolve, System};
 use crate::solve::{
     AmgCg, AmgOptions, BlockGmres, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt, SolveError,
-    apply_dirichlet, spmv,
+    apply_dirichlet, apply_dirichlet_parts, spmv,
 };
 use faer::sparse::SparseColMat;
 
@@ -40,6 +40,10 @@ pub(super) struct Solvers {
     /// The step matrix of the last assembly: later ones refresh its values in place
     /// (the pattern does not change over a run).
     pub(super) matrix: Option<SparseColMat<usize, f64>>,
+    /// For AMG-CG on one process, the step matrix's values over the pattern's own
+    /// structure instead (no 64-bit copy of it): the hierarchy's finest level is the
+    /// matrix, so these serve only to hand it over and are reused step after step.
+    pub(super) values: Vec<f64>,
     /// Under MPI, the solves by PETSc over every rank in place of the solvers above.
     pub(super) distributed: Option<GeneralSolve>,
 }
@@ -70,6 +74,7 @@ impl Solvers {
             gmres: None,
             factored: None,
             matrix: None,
+            values: Vec::new(),
             distributed: crate::parallel::general_solve(),
         }
     }
@@ -127,11 +132,21 @@ fn solvers_counts(s: &Solvers) -> (usize, usize) {
 
 /// The right-hand side `J u + Δb` of a linear step's own system `J x = b`, from its
 /// increment's system `J Δu = Δb` at `u`.
-fn step_system(jac: &SparseColMat<usize, f64>, rhs: &[f64], u: &[f64]) -> Vec<f64> {
+/// `product(x, y)` sets `y = J x`.
+fn step_system(product: impl Fn(&[f64], &mut [f64]), rhs: &[f64], u: &[f64]) -> Vec<f64> {
     let mut b = vec![0.0; rhs.len()];
-    spmv(jac, u, &mut b);
+    product(u, &mut b);
     b.iter_mut().zip(rhs).for_each(|(b, r)| *b += r);
     b
+}
+
+/// `y = J x`: by the step matrix, or without one (AMG-CG over the pattern's values) by
+/// the hierarchy's finest level, which is that matrix.
+fn multiply(jac: &Option<SparseColMat<usize, f64>>, amg: &AmgCg, x: &[f64], y: &mut [f64]) {
+    match jac {
+        Some(jac) => spmv(jac, x, y),
+        None => amg.apply(x, y),
+    }
 }
 
 /// Under MPI: the increment's system `jac Δu = rhs` solved by PETSc over every rank
@@ -147,7 +162,8 @@ fn solve_distributed(
 ) -> Result<(f64, f64, usize), HeatError> {
     let solved = match predictor {
         Some(u) => {
-            let s = d.solve(jac, &step_system(jac, rhs, u), Some(u), system)?;
+            let b = step_system(|x, y| spmv(jac, x, y), rhs, u);
+            let s = d.solve(jac, &b, Some(u), system)?;
             for ((d, x), u) in rhs.iter_mut().zip(&s.x).zip(u) {
                 *d = x - u;
             }
@@ -266,17 +282,6 @@ impl Context<'_, '_> {
                 return Ok(Ok(report));
             }
             let clock = std::time::Instant::now();
-            let mut jac = match solvers.matrix.take() {
-                Some(mut kept) => {
-                    asm.refresh_matrix(&mut kept)?;
-                    kept
-                }
-                None => asm.matrix()?,
-            };
-            let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
-            let settling = settle.take();
-            apply_dirichlet(&mut jac, &mut rhs, settling.as_ref().unwrap_or(&zero))?;
-            report.assembly_s += clock.elapsed().as_secs_f64();
             let symmetric = linear;
             // AMG-CG for a symmetric positive definite step system from the threshold on.
             let large = setup.ties.is_empty() && p.amg_threshold.is_some_and(|k| setup.n >= k);
@@ -284,6 +289,30 @@ impl Context<'_, '_> {
             // An unsymmetric Jacobian (a nonlinear law; coupled thermal–electrical
             // fields): GMRES preconditioned by AMG, block by block.
             let gmres = large && !symmetric;
+            let mut rhs: Vec<f64> = r.iter().map(|v| -v).collect();
+            let settling = settle.take();
+            let held = settling.as_ref().unwrap_or(&zero);
+            // AMG-CG on one process takes the values over the pattern's structure; every
+            // other solve a matrix of its own.
+            let jac = if amg && solvers.distributed.is_none() {
+                let mut values = std::mem::take(&mut solvers.values);
+                asm.values_into(&mut values)?;
+                let (col_ptr, rows) = asm.pattern().structure().expect("built");
+                apply_dirichlet_parts(col_ptr, rows, &mut values, &mut rhs, held)?;
+                solvers.values = values;
+                None
+            } else {
+                let mut jac = match solvers.matrix.take() {
+                    Some(mut kept) => {
+                        asm.refresh_matrix(&mut kept)?;
+                        kept
+                    }
+                    None => asm.matrix()?,
+                };
+                apply_dirichlet(&mut jac, &mut rhs, held)?;
+                Some(jac)
+            };
+            report.assembly_s += clock.elapsed().as_secs_f64();
             // A linear time step by AMG-CG solves the step's own system from the
             // predictor (below).
             let from_predictor = linear && history.is_some();
@@ -297,42 +326,56 @@ impl Context<'_, '_> {
                         _ => System::Direct,
                     };
                     let predictor = from_predictor && system == System::Spd;
-                    return solve_distributed(d, &jac, &mut rhs, predictor.then_some(&*u), system);
+                    let jac = jac.as_ref().expect("a matrix of its own under MPI");
+                    return solve_distributed(d, jac, &mut rhs, predictor.then_some(&*u), system);
                 }
                 let t0 = std::time::Instant::now();
-                let same = solvers
-                    .factored
-                    .as_ref()
-                    .filter(|(v, _)| v.as_slice() == jac.val())
-                    .map(|(_, w)| *w);
-                let which = match same {
-                    Some(w) => w,
-                    None => {
+                let same = jac.as_ref().and_then(|jac| {
+                    solvers
+                        .factored
+                        .as_ref()
+                        .filter(|(v, _)| v.as_slice() == jac.val())
+                        .map(|(_, w)| *w)
+                });
+                let which = match (same, jac.as_ref()) {
+                    (Some(w), _) => w,
+                    // AMG-CG over the pattern's values (a kept hierarchy tells an
+                    // unchanged matrix itself).
+                    (None, None) => {
+                        let before = solvers_counts(solvers);
+                        let (col_ptr, rows) = asm.pattern().structure().expect("built");
+                        (solvers.amg).factor_or_refresh_parts(
+                            col_ptr,
+                            rows,
+                            &mut solvers.values,
+                        )?;
+                        let after = solvers_counts(solvers);
+                        report.hierarchy_setups += after.0 - before.0;
+                        report.hierarchy_refreshes += after.1 - before.1;
+                        Which::Amg
+                    }
+                    (None, Some(jac)) => {
                         solvers.factored = None;
                         let tied = !setup.ties.is_empty();
                         let before = solvers_counts(solvers);
-                        let w = if amg {
-                            solvers.amg.factor_or_refresh(&jac)?;
-                            Which::Amg
-                        } else if gmres {
+                        let w = if gmres {
                             let split = setup
                                 .voltage
                                 .map_or(setup.n, |v| setup.dofs.field_range(v).start);
                             let g = solvers.gmres.get_or_insert_with(|| {
                                 BlockGmres::new(split, crate::heat::steady::AMG_TOLERANCE)
                             });
-                            g.factor(&jac)?;
+                            g.factor(jac)?;
                             Which::Gmres
-                        } else if tied && symmetric && solvers.saddle.factor(&jac).is_ok() {
+                        } else if tied && symmetric && solvers.saddle.factor(jac).is_ok() {
                             Which::Saddle
-                        } else if !tied && symmetric && solvers.chol.factor(&jac).is_ok() {
+                        } else if !tied && symmetric && solvers.chol.factor(jac).is_ok() {
                             Which::Cholesky
                         } else {
-                            solvers.lu.factor(&jac)?;
+                            solvers.lu.factor(jac)?;
                             Which::Lu
                         };
-                        // (A kept AMG hierarchy tells an unchanged matrix itself.)
-                        if linear && w != Which::Amg {
+                        if linear {
                             solvers.factored = Some((jac.val().to_vec(), w));
                         }
                         let after = solvers_counts(solvers);
@@ -362,7 +405,7 @@ impl Context<'_, '_> {
                     // to the predictor's residual, which a good predictor has already
                     // made small (the default stopping rule of PETSc's KSP).
                     Which::Amg if from_predictor => {
-                        let b = step_system(&jac, &rhs, u);
+                        let b = step_system(|x, y| multiply(&jac, &solvers.amg, x, y), &rhs, u);
                         let mut x = u.to_vec();
                         let solved = solvers.amg.pcg(&b, &mut x)?;
                         for ((d, x), u) in rhs.iter_mut().zip(&x).zip(u.iter()) {
@@ -414,12 +457,14 @@ impl Context<'_, '_> {
                 // vanishes there).
                 let clock = std::time::Instant::now();
                 let mut jdu = vec![0.0; r.len()];
-                spmv(&jac, &rhs, &mut jdu);
+                multiply(&jac, &solvers.amg, &rhs, &mut jdu);
                 r.iter_mut().zip(&jdu).for_each(|(r, j)| *r += j);
                 carried = Some(r);
                 report.assembly_s += clock.elapsed().as_secs_f64();
             }
-            solvers.matrix = Some(jac);
+            if jac.is_some() {
+                solvers.matrix = jac;
+            }
             let u_max = largest(&u[..species.start]).max(f64::MIN_POSITIVE);
             let c_max = largest(&u[species]).max(f64::MIN_POSITIVE);
             last_update = (step / u_max).max(species_step / c_max);

@@ -116,19 +116,64 @@ impl AmgCg {
         a: &faer::sparse::SparseColMat<usize, f64>,
     ) -> Result<Served, SolveError> {
         crate::solve::check_finite_ref(a.as_ref())?;
-        if let Some(fine) = self.levels.first() {
-            let symmetric = *self
-                .reuse
-                .symmetric
-                .get_or_insert_with(|| fine.a.is_exactly_symmetric());
-            if same_matrix(&fine.a, symmetric, a) {
-                return Ok(Served::Unchanged);
-            }
-            if let Some(served) = self.refresh_in_place(a)? {
-                return Ok(served);
-            }
+        let s = a.symbolic();
+        let view = Csc {
+            n: a.ncols(),
+            col_ptr: s.col_ptr(),
+            rows: s.row_idx(),
+            val: a.val(),
+        };
+        match self.serve_kept(view)? {
+            Some(served) => Ok(served),
+            None => self.setup_or_refresh(Csr::from_csc(a.as_ref())),
         }
-        self.setup_or_refresh(Csr::from_csc(a.as_ref()))
+    }
+
+    /// [`Self::factor_or_refresh`] of a square matrix given as its parts (column
+    /// pointers, 32-bit rows ascending in each column, values): an assembler's pattern
+    /// with its values apart, so no 64-bit copy of the structure is made. A new set-up
+    /// takes the values (`val` is left empty) and copies the structure; a kept
+    /// hierarchy leaves them.
+    pub fn factor_or_refresh_parts(
+        &mut self,
+        col_ptr: &[usize],
+        rows: &[u32],
+        val: &mut Vec<f64>,
+    ) -> Result<Served, SolveError> {
+        let n = col_ptr.len() - 1;
+        crate::solve::check_finite_parts(col_ptr, rows, val)?;
+        let view = Csc {
+            n,
+            col_ptr,
+            rows,
+            val,
+        };
+        match self.serve_kept(view)? {
+            Some(served) => Ok(served),
+            None => self.setup_or_refresh(Csr::from_csc_parts(
+                n,
+                col_ptr.to_vec(),
+                rows.to_vec(),
+                std::mem::take(val),
+            )),
+        }
+    }
+
+    /// Serve `a` with the kept hierarchy as it is (the same matrix) or refreshed in
+    /// its finest level's own arrays; `None` when it does not fit (none kept,
+    /// degraded, another size or entry count).
+    fn serve_kept<I: RowIndex>(&mut self, a: Csc<'_, I>) -> Result<Option<Served>, SolveError> {
+        let Some(fine) = self.levels.first() else {
+            return Ok(None);
+        };
+        let symmetric = *self
+            .reuse
+            .symmetric
+            .get_or_insert_with(|| fine.a.is_exactly_symmetric());
+        if same_matrix(&fine.a, symmetric, a) {
+            return Ok(Some(Served::Unchanged));
+        }
+        self.refresh_in_place(a)
     }
 
     /// [`Self::setup_or_refresh`]'s refresh, written into the finest level's own
@@ -137,33 +182,31 @@ impl AmgCg {
     /// when the kept hierarchy does not fit `a` (degraded, another structure): then
     /// the caller sets up anew. A diagonal that drifted sets up anew here, after the
     /// old hierarchy is let go.
-    fn refresh_in_place(
+    fn refresh_in_place<I: RowIndex>(
         &mut self,
-        a: &faer::sparse::SparseColMat<usize, f64>,
+        a: Csc<'_, I>,
     ) -> Result<Option<Served>, SolveError> {
         let Some(fine) = self.levels.first_mut() else {
             return Ok(None);
         };
-        if self.reuse.degraded || fine.a.nrows != a.nrows() || fine.a.val.len() != a.val().len() {
+        if self.reuse.degraded || fine.a.nrows != a.n || fine.a.val.len() != a.val.len() {
             return Ok(None);
         }
-        let Some(diag) = csc_diagonal(a) else {
+        let Some(diag) = a.diagonal() else {
             return Ok(None);
         };
         if drifted(&fine.inv_diag, &diag) {
             self.levels.clear();
-            self.setup(Csr::from_csc(a.as_ref()))?;
-            return Ok(Some(Served::SetUp));
+            return Ok(None);
         }
         if let Some(row) = diag.iter().position(|&d| d <= 0.0 || !d.is_finite()) {
             return Err(SolveError::NotPositiveDefinite { row });
         }
-        if !transpose_into(&mut fine.a, a) {
+        if !a.transpose_into(&mut fine.a) {
             // Another structure met part-way: the finest level holds a mix, so the
-            // hierarchy is made anew from `a`.
+            // hierarchy is let go and made anew from `a`.
             self.levels.clear();
-            self.setup(Csr::from_csc(a.as_ref()))?;
-            return Ok(Some(Served::SetUp));
+            return Ok(None);
         }
         fine.inv_diag
             .iter_mut()
@@ -211,69 +254,98 @@ impl AmgCg {
     }
 }
 
-/// The diagonal of a square matrix in column storage (`None`: an entry missing).
-fn csc_diagonal(a: &faer::sparse::SparseColMat<usize, f64>) -> Option<Vec<f64>> {
-    let s = a.symbolic();
-    (0..a.ncols())
-        .map(|j| {
-            let rows = &s.row_idx()[s.col_range(j)];
-            let k = rows.binary_search(&j).ok()?;
-            Some(a.val()[s.col_range(j).start + k])
-        })
-        .collect()
+/// A row index of column storage: faer's 64-bit or a pattern's 32-bit.
+pub(super) trait RowIndex: Copy {
+    fn ix(self) -> usize;
 }
 
-/// Write `a` (column storage) into `rows` (row storage) of the same structure, column
-/// by column through a cursor per row. False, with `rows` partly written, when the
-/// structures differ.
-fn transpose_into(rows: &mut Csr, a: &faer::sparse::SparseColMat<usize, f64>) -> bool {
-    let s = a.symbolic();
-    if rows.ncols != a.ncols() || rows.ptr.len() != a.nrows() + 1 {
-        return false;
+impl RowIndex for usize {
+    fn ix(self) -> usize {
+        self
     }
-    let mut next: Vec<usize> = rows.ptr[..rows.nrows].to_vec();
-    for j in 0..a.ncols() {
-        for p in s.col_range(j) {
-            let i = s.row_idx()[p];
-            let q = next[i];
-            if q >= rows.ptr[i + 1] || rows.idx[q] as usize != j {
-                return false;
-            }
-            rows.val[q] = a.val()[p];
-            next[i] += 1;
+}
+
+impl RowIndex for u32 {
+    fn ix(self) -> usize {
+        self as usize
+    }
+}
+
+/// A square matrix in column storage, borrowed as its parts.
+#[derive(Clone, Copy)]
+struct Csc<'a, I> {
+    n: usize,
+    col_ptr: &'a [usize],
+    rows: &'a [I],
+    val: &'a [f64],
+}
+
+impl<I: RowIndex> Csc<'_, I> {
+    fn col(&self, j: usize) -> std::ops::Range<usize> {
+        self.col_ptr[j]..self.col_ptr[j + 1]
+    }
+
+    /// The diagonal (`None`: an entry missing).
+    fn diagonal(&self) -> Option<Vec<f64>> {
+        (0..self.n)
+            .map(|j| {
+                let r = self.col(j);
+                let k = self.rows[r.clone()].partition_point(|&i| i.ix() < j);
+                (r.start + k < r.end && self.rows[r.start + k].ix() == j)
+                    .then(|| self.val[r.start + k])
+            })
+            .collect()
+    }
+
+    /// Write the matrix into `rows` (row storage) of the same structure, column by
+    /// column through a cursor per row. False, with `rows` partly written, when the
+    /// structures differ.
+    fn transpose_into(&self, rows: &mut Csr) -> bool {
+        if rows.ncols != self.n || rows.ptr.len() != self.n + 1 {
+            return false;
         }
+        let mut next: Vec<usize> = rows.ptr[..rows.nrows].to_vec();
+        for j in 0..self.n {
+            for p in self.col(j) {
+                let i = self.rows[p].ix();
+                let q = next[i];
+                if q >= rows.ptr[i + 1] || rows.idx[q] as usize != j {
+                    return false;
+                }
+                rows.val[q] = self.val[p];
+                next[i] += 1;
+            }
+        }
+        // Every row filled to its end: the same number of entries in each.
+        next.iter().zip(&rows.ptr[1..]).all(|(n, end)| n == end)
     }
-    // Every row filled to its end: the same number of entries in each.
-    next.iter().zip(&rows.ptr[1..]).all(|(n, end)| n == end)
 }
 
 /// `a` (column storage) is `rows` (row storage), structure and values bit for bit: a
 /// linear problem stepping with a fixed step needs no refresh, and no copy of the
 /// values is kept to tell. When `rows` is exactly symmetric, `a`'s columns are its rows
 /// and one pass in storage order tells; otherwise each column is walked into the rows.
-fn same_matrix(rows: &Csr, symmetric: bool, a: &faer::sparse::SparseColMat<usize, f64>) -> bool {
-    let s = a.symbolic();
-    if rows.nrows != a.nrows() || rows.ncols != a.ncols() || rows.val.len() != a.val().len() {
+fn same_matrix<I: RowIndex>(rows: &Csr, symmetric: bool, a: Csc<'_, I>) -> bool {
+    if rows.nrows != a.n || rows.ncols != a.n || rows.val.len() != a.val.len() {
         return false;
     }
     let bits = |x: &f64, y: &f64| x.to_bits() == y.to_bits();
     if symmetric {
-        return rows.ptr.as_slice() == s.col_ptr()
+        return rows.ptr.as_slice() == a.col_ptr
             && rows
                 .idx
                 .iter()
-                .zip(s.row_idx())
-                .all(|(&i, &r)| i as usize == r)
-            && rows.val.iter().zip(a.val()).all(|(x, y)| bits(x, y));
+                .zip(a.rows)
+                .all(|(&i, &r)| i as usize == r.ix())
+            && rows.val.iter().zip(a.val).all(|(x, y)| bits(x, y));
     }
     // Columns in order meet each row's entries in order: a cursor per row.
     let mut next: Vec<usize> = rows.ptr[..rows.nrows].to_vec();
-    for j in 0..a.ncols() {
-        for p in s.col_range(j) {
-            let i = s.row_idx()[p];
+    for j in 0..a.n {
+        for p in a.col(j) {
+            let i = a.rows[p].ix();
             let q = next[i];
-            if q >= rows.ptr[i + 1] || rows.idx[q] as usize != j || !bits(&rows.val[q], &a.val()[p])
-            {
+            if q >= rows.ptr[i + 1] || rows.idx[q] as usize != j || !bits(&rows.val[q], &a.val[p]) {
                 return false;
             }
             next[i] += 1;
@@ -375,6 +447,36 @@ mod tests {
         let moved =
             faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &moved).unwrap();
         assert_eq!(s.factor_or_refresh(&moved).unwrap(), Served::SetUp);
+        // The same served from a pattern's parts (32-bit rows, values apart): the
+        // matrix the hierarchy holds is unchanged, a changed one is refreshed and its
+        // values left to the caller, and a new set-up takes them.
+        let parts = |a: &faer::sparse::SparseColMat<usize, f64>| {
+            let s = a.symbolic();
+            let rows: Vec<u32> = s.row_idx().iter().map(|&r| r as u32).collect();
+            (s.col_ptr().to_vec(), rows, a.val().to_vec())
+        };
+        let (ptr, rows, mut val) = parts(&moved);
+        assert_eq!(
+            s.factor_or_refresh_parts(&ptr, &rows, &mut val).unwrap(),
+            Served::Unchanged
+        );
+        let (ptr, rows, mut val) = parts(&csc(&a2));
+        assert_eq!(
+            s.factor_or_refresh_parts(&ptr, &rows, &mut val).unwrap(),
+            Served::SetUp
+        );
+        assert!(val.is_empty(), "a set-up takes the values");
+        let base = solve(&mut s, &a2);
+        s.note_iterations(base);
+        let a3 = step_matrix(n, 1.03);
+        let (ptr, rows, mut val) = parts(&csc(&a3));
+        assert_eq!(
+            s.factor_or_refresh_parts(&ptr, &rows, &mut val).unwrap(),
+            Served::Refreshed
+        );
+        assert_eq!(val.len(), a3.val.len(), "a refresh leaves the values");
+        let its = solve(&mut s, &a3);
+        s.note_iterations(its);
         // A drifted diagonal, and another structure, in column storage: set up anew.
         assert_eq!(
             s.factor_or_refresh(&csc(&step_matrix(n, 1.5))).unwrap(),
@@ -389,6 +491,6 @@ mod tests {
             s.setup_or_refresh(step_matrix(n - 1, 1.0)).unwrap(),
             Served::SetUp
         );
-        assert_eq!(s.reuse_counts(), (8, 2));
+        assert_eq!(s.reuse_counts(), (9, 3));
     }
 }
