@@ -403,11 +403,14 @@ impl Context<'_, '_> {
                     // starts from the predictor and stops at the tolerance relative to
                     // ‖b‖, as a direct solve's backward error is, rather than relative
                     // to the predictor's residual, which a good predictor has already
-                    // made small (the default stopping rule of PETSc's KSP).
+                    // made small (the default stopping rule of PETSc's KSP). The start
+                    // is the predictor moved to its best point in the span of the
+                    // earlier steps' solutions of the same matrix (`rhs` is the
+                    // predictor's residual `b − J u`).
                     Which::Amg if from_predictor => {
                         let b = step_system(|x, y| multiply(&jac, &solvers.amg, x, y), &rhs, u);
                         let mut x = u.to_vec();
-                        let solved = solvers.amg.pcg(&b, &mut x)?;
+                        let solved = solvers.amg.pcg_successive(&b, &mut x, &rhs)?;
                         for ((d, x), u) in rhs.iter_mut().zip(&x).zip(u.iter()) {
                             *d = x - u;
                         }

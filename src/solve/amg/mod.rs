@@ -59,6 +59,7 @@ mod coarsen;
 mod csr;
 mod reuse;
 mod smooth;
+mod successive;
 
 use coarsen::{
     aggregate, filtered_diagonal, galerkin, smoothed_prolongator, spectral_radius_dinv_a,
@@ -70,6 +71,7 @@ use smooth::{
     gauss_seidel, gauss_seidel_from_zero, gauss_seidel_from_zero_with_residual, penalty_rows,
     symmetric_gauss_seidel_rows, symmetric_gauss_seidel_rows_with_residual,
 };
+pub use successive::KEPT_SOLUTIONS;
 
 /// The smoother of the V-cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,6 +163,8 @@ pub struct AmgCg {
     coarse_n: usize,
     /// A kept hierarchy's state (`reuse`).
     reuse: reuse::Reuse,
+    /// Earlier solutions of the finest level's matrix (`successive`).
+    earlier: successive::Earlier,
 }
 
 /// Description of the hierarchy: unknowns and stored entries per level.
@@ -185,6 +189,7 @@ impl AmgCg {
             coarse: Vec::new(),
             coarse_n: 0,
             reuse: reuse::Reuse::default(),
+            earlier: successive::Earlier::default(),
         }
     }
 
@@ -286,6 +291,7 @@ impl AmgCg {
     pub fn setup(&mut self, a: Csr) -> Result<(), SolveError> {
         self.levels.clear();
         self.reuse.set_up();
+        self.earlier.clear();
         let mut a = a;
         let theta = self.options.strength;
         let mut inherited: Option<Vec<u32>> = None;

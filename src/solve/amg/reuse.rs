@@ -104,6 +104,7 @@ impl AmgCg {
         fine.inv_diag = diag.iter().map(|d| 1.0 / d).collect();
         fine.a32 = a.val.iter().map(|&v| v as f32).collect();
         fine.a = a;
+        self.earlier.clear();
         self.reuse.refreshed = true;
         self.reuse.refreshes += 1;
         Ok(Served::Refreshed)
@@ -202,6 +203,7 @@ impl AmgCg {
         if let Some(row) = diag.iter().position(|&d| d <= 0.0 || !d.is_finite()) {
             return Err(SolveError::NotPositiveDefinite { row });
         }
+        self.earlier.clear();
         if !a.transpose_into(&mut fine.a) {
             // Another structure met part-way: the finest level holds a mix, so the
             // hierarchy is let go and made anew from `a`.
