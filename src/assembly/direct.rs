@@ -65,6 +65,8 @@ impl<'p> Assembler<'p> {
             // No element vector slots: element vectors are added into the loads.
             vector: vec![0.0; pattern.n],
             vec_elem_len: 0,
+            elements_touched: true,
+            extras_written: None,
         })
     }
 
@@ -85,6 +87,7 @@ impl<'p> Assembler<'p> {
             ));
         };
         let mut vals = std::mem::take(&mut d.values);
+        self.elements_touched = true;
         if vals.is_empty() {
             return Err(AssemblyError::Faer("the element values were taken".into()));
         }

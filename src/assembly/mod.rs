@@ -585,6 +585,12 @@ pub struct Assembler<'p> {
     /// Element vector slots (`ne` per element), then one per dof for direct loads.
     vector: Vec<f64>,
     vec_elem_len: usize,
+    /// Element matrices were computed (not kept) since the last
+    /// [`Self::values_into_if_changed`] wrote the values.
+    elements_touched: bool,
+    /// The coupling and diagonal slots when [`Self::values_into_if_changed`] last wrote
+    /// the values.
+    extras_written: Option<Vec<f64>>,
 }
 
 impl<'p> Assembler<'p> {
@@ -601,6 +607,8 @@ impl<'p> Assembler<'p> {
             direct: None,
             vector: vec![0.0; vec_elem_len + pattern.n],
             vec_elem_len,
+            elements_touched: true,
+            extras_written: None,
         }
     }
 
@@ -626,7 +634,8 @@ impl<'p> Assembler<'p> {
 
     /// As [`Self::elements`]; with `keep_matrix` the element matrix slots are handed to
     /// the kernel as they are (not zeroed), for kernels that reuse the element matrices
-    /// of the last call and only compute the vectors.
+    /// of the last call and only compute the vectors: such a kernel leaves them as they
+    /// are ([`Self::values_into_if_changed`] counts on it).
     pub fn elements_with<F>(
         &mut self,
         mesh: &Mesh,
@@ -636,6 +645,7 @@ impl<'p> Assembler<'p> {
     ) where
         F: Fn(ElemId, &mut [f64], &mut [f64]) + Sync,
     {
+        self.elements_touched |= !keep_matrix;
         if self.direct.is_some() {
             assert!(!keep_matrix, "a direct assembler keeps no element matrices");
             return self.elements_direct(mesh, blocks, kernel);
@@ -771,6 +781,27 @@ impl<'p> Assembler<'p> {
         self.sum_slots(vals)
     }
 
+    /// [`Self::values_into`], unless the values are the bits this method wrote at its
+    /// last call: no element matrix computed since (kernels that kept them, see
+    /// [`Self::elements_with`]) and the coupling and diagonal slots equal to theirs
+    /// then. In that case `vals` is left as it is and the answer is `false`. A linear
+    /// time step with a fixed step assembles the same matrix every step; this tells so
+    /// by comparing the few slots outside the elements (one per dof and two per
+    /// coupling), not the whole matrix.
+    pub fn values_into_if_changed(&mut self, vals: &mut Vec<f64>) -> Result<bool, AssemblyError> {
+        let base = self.extra_base();
+        let extras = &self.values[base..];
+        if !self.elements_touched && self.extras_written.as_deref() == Some(extras) {
+            return Ok(false);
+        }
+        self.values_into(vals)?;
+        let written = self.extras_written.get_or_insert_with(Vec::new);
+        written.clear();
+        written.extend_from_slice(&self.values[base..]);
+        self.elements_touched = false;
+        Ok(true)
+    }
+
     /// The assembled values written into `matrix`, which holds this pattern's structure
     /// (made by [`Self::matrix`] from the same pattern): the values refreshed in place,
     /// with no allocation and no copy of the structure; the same bits as
@@ -898,5 +929,56 @@ mod tests {
         other_pattern.build().unwrap();
         let mut wrong = Assembler::new(&other_pattern).matrix().unwrap();
         assert!(asm.refresh_matrix(&mut wrong).is_err());
+    }
+
+    /// Values unchanged since the last write are told without writing them: element
+    /// matrices kept and the same coupling and diagonal slots leave `vals` alone; a
+    /// changed diagonal, a changed coupling or recomputed element matrices (even to
+    /// the same values) write them again, the bits of [`Assembler::values_into`].
+    #[test]
+    fn unchanged_values_are_not_written_again() {
+        let mesh = single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [2, 2, 1], 1));
+        let dofs = DofMap::new(&mesh, &[("t", &[0])]).unwrap();
+        let mut pattern = Pattern::new(&mesh, &dofs);
+        pattern.add_couplings(&[(0, 17)]).unwrap();
+        pattern.build().unwrap();
+        let mut asm = Assembler::new(&pattern);
+        let step = |asm: &mut Assembler<'_>, keep: bool, diagonal: f64, coupling: f64| {
+            if keep {
+                asm.elements_with(&mesh, None, true, |_, _, fe| fe.fill(1.0));
+            } else {
+                assemble(asm, &mesh, 1.0);
+            }
+            asm.reset_couplings();
+            asm.add_coupling(0, coupling, coupling);
+            asm.add_diagonal(4, diagonal);
+        };
+        let fresh = |asm: &Assembler<'_>| {
+            let mut v = Vec::new();
+            asm.values_into(&mut v).unwrap();
+            v
+        };
+        let marker = vec![f64::NAN; 3];
+        let mut vals = Vec::new();
+        step(&mut asm, false, 2.0, 0.5);
+        assert!(asm.values_into_if_changed(&mut vals).unwrap());
+        assert_eq!(vals, fresh(&asm));
+        // Kept element matrices, the same extras: not written.
+        step(&mut asm, true, 2.0, 0.5);
+        vals.clone_from(&marker);
+        assert!(!asm.values_into_if_changed(&mut vals).unwrap());
+        assert!(vals.iter().all(|v| v.is_nan()) && vals.len() == 3);
+        // A diagonal term changed; then a coupling.
+        for (diagonal, coupling) in [(2.5, 0.5), (2.5, 0.75)] {
+            step(&mut asm, true, diagonal, coupling);
+            assert!(asm.values_into_if_changed(&mut vals).unwrap());
+            assert_eq!(vals, fresh(&asm));
+        }
+        // Element matrices computed again, to the same values.
+        step(&mut asm, false, 2.5, 0.75);
+        vals.clone_from(&marker);
+        assert!(asm.values_into_if_changed(&mut vals).unwrap());
+        assert_eq!(vals, fresh(&asm));
+        assert!(!asm.values_into_if_changed(&mut vals).unwrap());
     }
 }
