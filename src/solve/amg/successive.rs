@@ -113,7 +113,9 @@ impl AmgCg {
         fine.a.spmv(&part, &mut ap);
         // ‖p − Xc‖²_A = pᵀAp − |c|² for an A-orthonormal X.
         let norm2 = dot(&part, &ap) - subtract(&mut part, &ap);
-        if !(norm2 > NEGLIGIBLE * NEGLIGIBLE * energy) || !energy.is_finite() {
+        // (A NaN anywhere fails the first test too.)
+        let significant = norm2 > NEGLIGIBLE * NEGLIGIBLE * energy;
+        if !significant || !energy.is_finite() {
             return;
         }
         let scale = 1.0 / norm2.sqrt();
