@@ -465,14 +465,14 @@ pub(super) fn read_checkpoint(path: &Path) -> Result<State, RunError> {
     })
 }
 
-/// `steps.csv`: one row per accepted step, with its phase times.
+/// `steps.csv`: one row per accepted step, with its phase times and Krylov iterations.
 pub(super) fn write_steps(dir: &Path, history: &[StepReport]) -> std::io::Result<()> {
     let mut s = String::from(
-        "step,time,dt,newton_iterations,rejected,residual,assembly_s,factor_s,solve_s\n",
+        "step,time,dt,newton_iterations,rejected,residual,assembly_s,factor_s,solve_s,krylov_iterations\n",
     );
     for r in history {
         s.push_str(&format!(
-            "{},{:e},{:e},{},{},{:e},{:.6},{:.6},{:.6}\n",
+            "{},{:e},{:e},{},{},{:e},{:.6},{:.6},{:.6},{}\n",
             r.step,
             r.time,
             r.dt,
@@ -481,7 +481,8 @@ pub(super) fn write_steps(dir: &Path, history: &[StepReport]) -> std::io::Result
             r.residual_history.last().copied().unwrap_or(0.0),
             r.assembly_s,
             r.factor_s,
-            r.solve_s
+            r.solve_s,
+            r.cg_iterations
         ));
     }
     std::fs::write(dir.join("steps.csv"), s)

@@ -250,7 +250,21 @@ fn transient_steps_use_amg_above_the_threshold_and_agree_with_cholesky() {
     assert!(a.reason.starts_with("auto: "), "{}", a.reason);
     let steps = amg.summary.transient.as_ref().unwrap().steps;
     assert_eq!(a.iterations_per_solve.len(), steps);
-    assert!(a.iterations_per_solve.iter().all(|&k| k > 0), "{a:?}");
+    // A step may take no iteration at all: its start, the predictor moved within the
+    // span of the earlier steps' solutions, can meet the stopping test already.
+    assert!(a.iterations_per_solve.iter().sum::<usize>() > 0, "{a:?}");
+    // `steps.csv` carries each step's Krylov iterations (one Newton iteration a step).
+    let csv = std::fs::read_to_string(_amg_scene.path().join("out/steps.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let column = header
+        .iter()
+        .position(|h| *h == "krylov_iterations")
+        .unwrap();
+    let per_step: Vec<usize> = lines
+        .map(|l| l.split(',').nth(column).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(per_step, a.iterations_per_solve);
     // Two matrices in the run (BDF1's, then BDF2's): each served once (a set-up, or a
     // refresh when the diagonal moved little), every other step finds its matrix.
     let served = a.hierarchy_setups.unwrap() + a.hierarchy_refreshes.unwrap();
