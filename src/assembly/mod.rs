@@ -899,15 +899,21 @@ mod tests {
         });
     }
 
-    /// A refresh in place gives the bits a new matrix gives, keeps the structure, and
-    /// refuses a matrix of another pattern.
-    #[test]
-    fn refreshed_matrix_equals_a_new_one() {
+    /// Four hexes with one temperature field and one coupling, (0, 17), built.
+    fn four_hexes_coupled() -> (Mesh, Pattern) {
         let mesh = single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [2, 2, 1], 1));
         let dofs = DofMap::new(&mesh, &[("t", &[0])]).unwrap();
         let mut pattern = Pattern::new(&mesh, &dofs);
         pattern.add_couplings(&[(0, 17)]).unwrap();
         pattern.build().unwrap();
+        (mesh, pattern)
+    }
+
+    /// A refresh in place gives the bits a new matrix gives, keeps the structure, and
+    /// refuses a matrix of another pattern.
+    #[test]
+    fn refreshed_matrix_equals_a_new_one() {
+        let (mesh, pattern) = four_hexes_coupled();
         let mut asm = Assembler::new(&pattern);
         assemble(&mut asm, &mesh, 1.0);
         asm.add_coupling(0, 2.5, -1.5);
@@ -937,11 +943,7 @@ mod tests {
     /// the same values) write them again, the bits of [`Assembler::values_into`].
     #[test]
     fn unchanged_values_are_not_written_again() {
-        let mesh = single_box(BoxSpec::hex([0.0; 3], [1.0; 3], [2, 2, 1], 1));
-        let dofs = DofMap::new(&mesh, &[("t", &[0])]).unwrap();
-        let mut pattern = Pattern::new(&mesh, &dofs);
-        pattern.add_couplings(&[(0, 17)]).unwrap();
-        pattern.build().unwrap();
+        let (mesh, pattern) = four_hexes_coupled();
         let mut asm = Assembler::new(&pattern);
         let step = |asm: &mut Assembler<'_>, keep: bool, diagonal: f64, coupling: f64| {
             if keep {

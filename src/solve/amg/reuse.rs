@@ -358,22 +358,9 @@ fn same_matrix<I: RowIndex>(rows: &Csr, symmetric: bool, a: Csc<'_, I>) -> bool 
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{laplace_1d, residual_norm};
+    use super::super::tests::{residual_norm, step_matrix};
     use super::*;
     use crate::solve::amg::AmgOptions;
-
-    /// A 1-D Laplacian plus a mass term `c I`: the matrix of a time step.
-    fn step_matrix(n: usize, c: f64) -> Csr {
-        let mut a = laplace_1d(n);
-        for i in 0..n {
-            for p in a.ptr[i]..a.ptr[i + 1] {
-                if a.idx[p] as usize == i {
-                    a.val[p] += c;
-                }
-            }
-        }
-        a
-    }
 
     /// A matrix that changes a little is served by refreshing the kept hierarchy and
     /// solved to the tolerance all the same; a different structure, or solves that

@@ -131,22 +131,9 @@ impl AmgCg {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{laplace_1d, residual_norm};
+    use super::super::tests::{residual_norm, step_matrix};
     use super::*;
     use crate::solve::amg::{AmgOptions, Csr, Served};
-
-    /// `L + c I`, `L` the 1-D Laplacian: backward Euler's matrix for `u' = −L u / c`.
-    fn step_matrix(n: usize, c: f64) -> Csr {
-        let mut a = laplace_1d(n);
-        for i in 0..n {
-            for p in a.ptr[i]..a.ptr[i + 1] {
-                if a.idx[p] as usize == i {
-                    a.val[p] += c;
-                }
-            }
-        }
-        a
-    }
 
     fn energy(a: &Csr, x: &[f64], y: &[f64]) -> f64 {
         let mut ay = vec![0.0; y.len()];

@@ -33,6 +33,20 @@ pub(super) fn residual_norm(a: &Csr, x: &[f64], b: &[f64]) -> f64 {
         .sqrt()
 }
 
+/// `L + c I`, `L` the 1-D Laplacian: the matrix of a time step (backward Euler for
+/// `c u' = −L u`).
+pub(super) fn step_matrix(n: usize, c: f64) -> Csr {
+    let mut a = laplace_1d(n);
+    for i in 0..n {
+        for p in a.ptr[i]..a.ptr[i + 1] {
+            if a.idx[p] as usize == i {
+                a.val[p] += c;
+            }
+        }
+    }
+    a
+}
+
 pub(super) fn laplace_1d(n: usize) -> Csr {
     let mut c = Csr {
         nrows: n,
