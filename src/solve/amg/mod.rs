@@ -3,7 +3,7 @@
 //!
 //! Set-up, level by level until at most [`AmgOptions::coarse_size`] unknowns remain:
 //! 1. strength of connection: `j` is a strong neighbour of `i` when
-//!    `−a_ij ≥ θ √(m_i m_j)`, `m_i` the largest `−a_ik` of row `i` (`k ≠ i`), θ = 0.25 on
+//!    `−a_ij ≥ θ √(m_i m_j)`, `m_i` the largest `−a_ik` of row `i` (`k ≠ i`), θ = 0.4 on
 //!    every level — the classical measure of Ruge & Stüben (relative to the row's
 //!    largest coupling), made symmetric. Measured against the diagonal instead (Vaněk
 //!    et al.'s `|a_ij| ≥ ε √(a_ii a_jj)`), no ε serves both kinds of cell a scene has.
@@ -15,7 +15,14 @@
 //!    +0.22. A small ε makes isotropic aggregates there, which cannot represent the
 //!    error a point smoother leaves (smooth through the thickness, oscillating in the
 //!    plane); against the row's largest coupling the thin cells aggregate across their
-//!    thickness only. Positive couplings are never strong;
+//!    thickness only — if θ is above the edge neighbours' 0.12/0.44 = 0.27 of the
+//!    largest, and below a cube's corner neighbours' 1/2 of it (its edge ones are the
+//!    largest), so that a cube still aggregates with all 26 neighbours. θ = 0.4 sits
+//!    between. At θ = 0.25 the thin cells aggregated with their edge neighbours too: the
+//!    electronics warm-up (die cells of aspect 5) took 29–30 CG iterations per early
+//!    step instead of 16–17, at refine 13; the cube meshes of the tied and gap
+//!    benchmarks took 17 and 14 iterations either way (16 and 14 at 0.4).
+//!    Positive couplings are never strong;
 //! 2. aggregation (the paper's three passes): seed aggregates from nodes whose strong
 //!    neighbourhood is still free, attach leftovers to a neighbouring aggregate, group
 //!    the rest; nodes with no strong neighbour (e.g. rows eliminated by Dirichlet
@@ -71,7 +78,7 @@ use smooth::{
     gauss_seidel, gauss_seidel_from_zero, gauss_seidel_from_zero_with_residual, penalty_rows,
     symmetric_gauss_seidel_rows, symmetric_gauss_seidel_rows_with_residual,
 };
-pub use successive::KEPT_SOLUTIONS;
+pub use successive::{KEPT_SOLUTIONS, Successive};
 
 /// The smoother of the V-cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -86,7 +93,8 @@ pub enum Smoother {
 #[derive(Clone, Copy, Debug)]
 pub struct AmgOptions {
     /// Strength threshold θ: `j` is a strong neighbour of `i` when `−a_ij` is at least
-    /// θ times the geometric mean of the two rows' largest negative couplings.
+    /// θ times the geometric mean of the two rows' largest negative couplings (0.4:
+    /// why, in the module docs).
     pub strength: f64,
     /// Stop coarsening at or below this many unknowns and solve densely.
     pub coarse_size: usize,
@@ -113,7 +121,7 @@ pub struct AmgOptions {
 impl Default for AmgOptions {
     fn default() -> Self {
         AmgOptions {
-            strength: 0.25,
+            strength: 0.4,
             coarse_size: 500,
             max_levels: 12,
             smoother: Smoother::SymmetricGaussSeidel,
@@ -537,22 +545,41 @@ impl AmgCg {
 
     /// PCG on the finest level's matrix; `x` holds the initial guess and the result.
     pub fn pcg(&mut self, b: &[f64], x: &mut [f64]) -> Result<SolveReport, SolveError> {
+        let mut r = vec![0.0; b.len()];
+        self.levels[0].a.spmv(x, &mut r);
+        r.par_iter_mut().zip(b).for_each(|(r, b)| *r = b - *r);
+        self.pcg_from(b, x, r)
+    }
+
+    /// [`Self::pcg`] from `x` whose residual `b − A x` the caller has: `r`.
+    fn pcg_from(
+        &mut self,
+        b: &[f64],
+        x: &mut [f64],
+        r: Vec<f64>,
+    ) -> Result<SolveReport, SolveError> {
         if !self.reuse.refreshed {
-            return self.pcg_once(b, x);
+            return self.pcg_once(b, x, r);
         }
-        // A refreshed hierarchy that fails is set up anew and the solve made again.
-        let guess = x.to_vec();
-        match self.pcg_once(b, x) {
+        // A refreshed hierarchy that fails is set up anew (for the same matrix) and the
+        // solve made again from the same start.
+        let (guess, start) = (x.to_vec(), r.clone());
+        match self.pcg_once(b, x, r) {
             Err(SolveError::NotConverged { .. }) if self.set_up_again()? => {
                 x.copy_from_slice(&guess);
-                self.pcg_once(b, x)
+                self.pcg_once(b, x, start)
             }
             other => other,
         }
     }
 
-    /// [`Self::pcg`] on the hierarchy as it is.
-    fn pcg_once(&mut self, b: &[f64], x: &mut [f64]) -> Result<SolveReport, SolveError> {
+    /// [`Self::pcg_from`] on the hierarchy as it is.
+    fn pcg_once(
+        &mut self,
+        b: &[f64],
+        x: &mut [f64],
+        mut r: Vec<f64>,
+    ) -> Result<SolveReport, SolveError> {
         let n = b.len();
         let bnorm = norm(b);
         if bnorm == 0.0 {
@@ -562,9 +589,6 @@ impl AmgCg {
                 residual: 0.0,
             });
         }
-        let mut r = vec![0.0; n];
-        self.levels[0].a.spmv(x, &mut r);
-        r.par_iter_mut().zip(b).for_each(|(r, b)| *r = b - *r);
         let mut z = vec![0.0; n];
         self.precondition(&r, &mut z);
         let mut p = z.clone();

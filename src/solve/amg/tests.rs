@@ -325,6 +325,72 @@ fn stretched_cells_are_not_a_penalty_interface() {
     assert!(rep.iterations <= 30, "{} iterations", rep.iterations);
 }
 
+/// Cells of aspect 5 aggregate across their thickness only at the default strength
+/// threshold: every aggregate is a piece of one column of nodes (module docs). At
+/// θ = 0.25 the edge neighbours across the thickness (0.27 of the largest coupling)
+/// join them, and CG takes more iterations; cubes aggregate with all 26 neighbours
+/// at either.
+#[test]
+fn thin_cells_aggregate_across_their_thickness_only() {
+    let m = 14;
+    let inner = m - 1;
+    let column = |node: usize| node % (inner * inner);
+    let mixed = |a: &Csr, theta: f64| {
+        let (agg, count) = coarsen::aggregate(a, theta);
+        let mut first: Vec<Option<usize>> = vec![None; count];
+        let mut mixed = 0;
+        for (node, &g) in agg.iter().enumerate() {
+            if g == usize::MAX {
+                continue;
+            }
+            match first[g] {
+                None => first[g] = Some(column(node)),
+                Some(c) if c != column(node) => mixed += 1,
+                Some(_) => {}
+            }
+        }
+        (mixed, count)
+    };
+    let thin = stretched_bricks(m, 5.0);
+    let theta = AmgOptions::default().strength;
+    let (off_column, count) = mixed(&thin, theta);
+    assert_eq!(
+        off_column, 0,
+        "{off_column} nodes outside their aggregate's column"
+    );
+    assert!(count > 0);
+    assert!(
+        mixed(&thin, 0.25).0 > 0,
+        "θ = 0.25 aggregates across columns too"
+    );
+    // Cubes: a node's aggregate reaches its corner neighbours (an aggregate of 27
+    // around a seed in the interior).
+    let cube = stretched_bricks(m, 1.0);
+    let (agg, count) = coarsen::aggregate(&cube, theta);
+    let largest = (0..count)
+        .map(|g| agg.iter().filter(|&&a| a == g).count())
+        .max()
+        .unwrap();
+    assert_eq!(largest, 27, "largest cube aggregate {largest}");
+    // The iterations at both thresholds on the thin cells.
+    let iterations = |theta: f64| {
+        let mut s = AmgCg::new(AmgOptions {
+            strength: theta,
+            tolerance: 1e-10,
+            ..AmgOptions::default()
+        });
+        s.setup(thin.clone()).unwrap();
+        let b: Vec<f64> = (0..thin.nrows).map(|i| 1.0 + (i % 5) as f64).collect();
+        let mut x = vec![0.0; thin.nrows];
+        s.pcg(&b, &mut x).unwrap().iterations
+    };
+    let (now, before) = (iterations(theta), iterations(0.25));
+    assert!(
+        now < before,
+        "{now} iterations at θ = {theta}, {before} at 0.25"
+    );
+}
+
 /// The first sweep from zero reads half the matrix and gives the bits of a full
 /// sweep from zero.
 #[test]
