@@ -227,6 +227,20 @@ impl DofMap {
         self.block_fields[block].len() * mesh.blocks[block].topology.node_count()
     }
 
+    /// The dofs of the first field of `elem`'s block at its nodes, in connectivity
+    /// order (the leading part of [`Self::elem_dofs`]), into `out`; their number.
+    pub fn first_field_dofs(&self, mesh: &Mesh, elem: ElemId, out: &mut [u32]) -> usize {
+        let nodes = mesh.elem_nodes(elem);
+        let Some(f) = self.block_fields[mesh.block_of(elem)].first() else {
+            return 0;
+        };
+        let map = &self.fields[f.0 as usize].node_dof;
+        for (o, n) in out.iter_mut().zip(nodes) {
+            *o = map[n.index()];
+        }
+        nodes.len()
+    }
+
     /// Dofs of an element: for each field of its block, its nodes' dofs in
     /// connectivity order. `out` is cleared first.
     pub fn elem_dofs(&self, mesh: &Mesh, elem: ElemId, out: &mut Vec<u32>) {
