@@ -490,18 +490,18 @@ impl Context<'_, '_> {
                 }
                 Err(e) => return Err(e),
             };
+            // R = −(b − J x): at the predictor (the first residual of the history, in
+            // place of u₀'s), and after the step (carried below).
+            let after = residuals.map(|(at_guess, at_solution)| {
+                let rn = at_guess.iter().map(|v| v * v).sum::<f64>().sqrt();
+                *report.residual_history.last_mut().expect("pushed above") = rn;
+                at_solution.into_iter().map(|v| -v).collect::<Vec<f64>>()
+            });
+            let rn = report.residual_history.last().copied().unwrap_or(rn);
             log::debug!(
                 "t = {t}: Newton iteration {} from ‖R‖ = {rn:.3e}: linear set-up {factor_s:.3} s, solve {solve_s:.3} s, {cg} Krylov iterations",
                 it + 1
             );
-            // R = −(b − J x): at the predictor (the first residual of the history),
-            // and after the step (carried below).
-            let after = residuals.map(|(at_guess, at_solution)| {
-                r = at_guess.into_iter().map(|v| -v).collect();
-                let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
-                *report.residual_history.last_mut().expect("pushed above") = rn;
-                at_solution.into_iter().map(|v| -v).collect::<Vec<f64>>()
-            });
             report.factor_s += factor_s;
             report.solve_s += solve_s;
             report.cg_iterations += cg;
