@@ -11,7 +11,7 @@ use crate::heat::electric;
 use crate::heat::interfaces::InterfaceFailure;
 use crate::heat::kernel;
 use crate::heat::law::Law;
-use crate::heat::{FirstError, HeatError, bad_jacobian, elem_coords};
+use crate::heat::{ByElement, FirstError, HeatError, bad_jacobian, elem_coords};
 
 use super::newton::{Context, History};
 use super::{Failure, Loads};
@@ -35,11 +35,11 @@ impl Context<'_, '_> {
         let mesh = p.mesh;
         let dofs = &setup.dofs;
         let (blocks, rules) = (&setup.blocks, &setup.rules);
-        let n_elems = mesh.num_elems();
-        let faces = ByElement::new(loads.faces.iter().map(|f| f.side().elem.0), n_elems);
-        let currents = ByElement::new(loads.currents.iter().map(|(s, _)| s.elem.0), n_elems);
-        let species_fluxes =
-            ByElement::new(loads.species_fluxes.iter().map(|(s, _)| s.elem.0), n_elems);
+        let by_element =
+            |sides: Vec<crate::mesh::Side>| ByElement::new(mesh, &sides).map_err(Failure::Fatal);
+        let faces = by_element(loads.faces.iter().map(|f| f.side()).collect())?;
+        let currents = by_element(loads.currents.iter().map(|(s, _)| *s).collect())?;
+        let species_fluxes = by_element(loads.species_fluxes.iter().map(|(s, _)| *s).collect())?;
         let errors = FirstError::new();
         let (laws, source, block_source) = (p.laws, p.source, p.block_source);
         let sigmas = p.electric.as_ref().map(|el| el.conductivity);
@@ -348,54 +348,6 @@ struct ElementCx<'c> {
     faces: &'c ByElement,
     currents: &'c ByElement,
     species_fluxes: &'c ByElement,
-}
-
-/// The entries of a list of element sides (face conditions, currents, fluxes) by
-/// element: each element's indices into the list, found by two reads. (A binary
-/// search of the list sorted by element took 38 % of the element loop's time on the
-/// 1.17 M-hex electronics warm-up with its element matrices kept: a cache miss at
-/// most of its 18 levels for the 2.6e5 faces of the sink's convection.)
-struct ByElement {
-    /// The list's indices, element by element (in list order within one).
-    indices: Vec<u32>,
-    /// Where element `e`'s run starts in `indices` (`n_elems + 1` of them; none for an
-    /// empty list).
-    start: Vec<u32>,
-}
-
-impl ByElement {
-    /// From the element of each entry of the list, in list order.
-    fn new(elements: impl ExactSizeIterator<Item = u32> + Clone, n_elems: usize) -> Self {
-        if elements.len() == 0 {
-            return ByElement {
-                indices: Vec::new(),
-                start: Vec::new(),
-            };
-        }
-        let mut start = vec![0u32; n_elems + 1];
-        for e in elements.clone() {
-            start[e as usize + 1] += 1;
-        }
-        for i in 0..n_elems {
-            start[i + 1] += start[i];
-        }
-        let mut next = start.clone();
-        let mut indices = vec![0u32; elements.len()];
-        for (k, e) in elements.enumerate() {
-            indices[next[e as usize] as usize] = k as u32;
-            next[e as usize] += 1;
-        }
-        ByElement { indices, start }
-    }
-
-    /// The list's indices of element `e`'s entries, in list order.
-    fn of(&self, e: crate::mesh::ElemId) -> impl Iterator<Item = usize> + '_ {
-        let run = match self.start.get(e.index()..e.index() + 2) {
-            Some(&[a, b]) => a as usize..b as usize,
-            _ => 0..0,
-        };
-        self.indices[run].iter().map(|&k| k as usize)
-    }
 }
 
 impl ElementCx<'_> {
