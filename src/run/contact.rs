@@ -238,7 +238,7 @@ impl RunContact {
                 continue;
             }
             let mut matched_nodes = HashSet::new();
-            for q in &p.result.points {
+            for q in p.result.points.iter() {
                 let Some(face_b) = q.matched_b_face() else {
                     continue;
                 };
@@ -472,7 +472,7 @@ fn point_pressures(
                 Ok(v)
             };
             let mut out = Vec::with_capacity(pairing.result.points.len());
-            for q in &pairing.result.points {
+            for q in pairing.result.points.iter() {
                 let Some(fa) = q.a_face else {
                     let node = q
                         .a_node

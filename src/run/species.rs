@@ -139,7 +139,7 @@ impl Species {
         joins.dedup_by(|x, y| (x.0, x.1) == (y.0, y.1));
         for (k, e) in entries.iter().enumerate() {
             let p = &e.pairing;
-            for q in &p.result.points {
+            for q in p.result.points.iter() {
                 let (Some(fa), Some(fb)) = (q.a_face, q.matched_b_face()) else {
                     continue;
                 };

@@ -171,7 +171,7 @@ fn pair(mesh: &Mesh) -> Pairing {
     Pairing {
         a,
         b,
-        points: r.points,
+        points: std::sync::Arc::unwrap_or_clone(r.points),
     }
 }
 

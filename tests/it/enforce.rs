@@ -53,7 +53,7 @@ fn setup(n1: usize, n2: usize, kind: SolidKind) -> Setup {
         mesh,
         a,
         b,
-        points: r.points,
+        points: std::sync::Arc::unwrap_or_clone(r.points),
     }
 }
 
@@ -338,7 +338,7 @@ fn rings(m: usize) -> Setup {
         mesh,
         a: ga,
         b: gb,
-        points: r.points,
+        points: std::sync::Arc::unwrap_or_clone(r.points),
     }
 }
 
@@ -676,7 +676,7 @@ fn tiny_zero_and_negative_gaps_approach_the_tie() {
             mesh,
             a,
             b,
-            points: r.points,
+            points: std::sync::Arc::unwrap_or_clone(r.points),
         };
         let dirichlet: Vec<(NodeId, f64)> = (0..s.mesh.num_nodes())
             .filter_map(|i| {

@@ -119,7 +119,7 @@ fn setup(n1: usize, n2: usize, kind: SolidKind, side_a: SideA) -> Setup {
         mesh,
         a,
         b,
-        points: r.points,
+        points: std::sync::Arc::unwrap_or_clone(r.points),
     }
 }
 

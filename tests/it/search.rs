@@ -118,7 +118,7 @@ fn points_on_edges_and_vertices_pair_exactly_once() {
     let top = &s.pairings[0];
     let _ = top;
     // Side-B faces in order: 6×6 cells of the top side set, cell (i, j) at index 6j + i.
-    for q in &p.result.points {
+    for q in p.result.points.iter() {
         assert_eq!(q.status, PointStatus::Matched);
         let (x, y) = (q.x[0], q.x[1]);
         // Lowest cell index containing (x, y): smallest j then smallest i with the
@@ -215,7 +215,7 @@ fn concentric_cylinders_overlap_and_gap_statistics() {
         // e_j the radial direction at its mid-angle (j + ½)·10°. Quadrature measures the
         // gap along side B's normal, cos(π/36) − x·e_j; segments along side A's normal
         // n_A, which divides that by n_A·e_j. And the point's angle lies in the facet's.
-        for q in &s.pairings[0].result.points {
+        for q in s.pairings[0].result.points.iter() {
             let j = (q.b_face.expect("matched") as usize % nb) as f64;
             let mid = ((j + 0.5) * 360.0 / nb as f64).to_radians();
             let e = [mid.cos(), mid.sin(), 0.0];
@@ -301,7 +301,7 @@ fn cylindrical_periodicity_and_an_equal_lua_map() {
     assert_eq!(pa.result.stats.matched, pa.result.stats.points);
     assert!(pa.worst_image_distance.unwrap() < 1e-12);
     assert_eq!(pa.result.points.len(), pb.result.points.len());
-    for (x, y) in pa.result.points.iter().zip(&pb.result.points) {
+    for (x, y) in pa.result.points.iter().zip(pb.result.points.iter()) {
         assert_eq!(x.b_face, y.b_face);
         assert!((x.xi_b[0] - y.xi_b[0]).abs() < 1e-12 && (x.xi_b[1] - y.xi_b[1]).abs() < 1e-12);
     }
@@ -466,7 +466,7 @@ fn overclosure_offsets_or_adjustments() {
         &deck("store offsets"),
         Integration::Quadrature { order: 1 },
     );
-    for q in &s.pairings[0].result.points {
+    for q in s.pairings[0].result.points.iter() {
         assert!((q.gap + 0.01).abs() < 1e-14 && (q.offset + 0.01).abs() < 1e-14);
     }
     let s = run(
@@ -474,7 +474,7 @@ fn overclosure_offsets_or_adjustments() {
         &deck("adjust nodes"),
         Integration::Quadrature { order: 1 },
     );
-    for q in &s.pairings[0].result.points {
+    for q in s.pairings[0].result.points.iter() {
         assert_eq!((q.gap, q.offset), (0.0, 0.0));
         assert!((q.x[2] - 1.0).abs() < 1e-14, "moved onto side B: {:?}", q.x);
     }
@@ -537,7 +537,7 @@ fn pairing_is_reused_between_search_updates() {
         .collect();
     let b1 = geo(&lowered, "top");
     r.update_geometry(&a, &b1);
-    for (p, q) in r.points.iter().zip(&before) {
+    for (p, q) in r.points.iter().zip(before.iter()) {
         assert_eq!(p.b_face, q.b_face);
         assert!(
             (p.gap - (q.gap + 0.003)).abs() < 1e-15,

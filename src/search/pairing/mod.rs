@@ -42,6 +42,8 @@ mod points;
 pub(crate) use geometry::face_shapes;
 pub use geometry::{FaceGeom, SearchError, SurfaceGeometry};
 
+use std::sync::Arc;
+
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -150,7 +152,10 @@ pub struct SearchStats {
 /// The pairing of one interaction.
 #[derive(Clone, Debug, Default)]
 pub struct SearchResult {
-    pub points: Vec<ContactPoint>,
+    /// Shared, not copied, by the clones of a result (the run's and its embedding's):
+    /// at 1e6 points they are 150 MB. A change to one clone's points copies them
+    /// ([`Arc::make_mut`]).
+    pub points: Arc<Vec<ContactPoint>>,
     pub stats: SearchStats,
     /// Per side-A face: the fraction (0…1) of its integration weight that is matched
     /// (`Visualize Contact`).
@@ -271,6 +276,7 @@ impl Searcher {
             b_faces: &b_faces,
         };
         let mut result = SearchResult::default();
+        let mut points: Vec<ContactPoint> = Vec::new();
         let rules = Rules::new(integration, a.axisymmetric);
         // Faces, in fixed chunks, in parallel; each chunk gives its points and, per face,
         // the matched weight, total weight and overlap area. Quadrature faces have a
@@ -284,8 +290,8 @@ impl Searcher {
                 let total: usize = counts.iter().sum();
                 // Room for the points, left unwritten here: each chunk's thread writes its
                 // own (once, and the first touch of fresh memory happens in parallel).
-                result.points = Vec::with_capacity(total + a.nodes.len());
-                let mut rest = &mut result.points.spare_capacity_mut()[..total];
+                points = Vec::with_capacity(total + a.nodes.len());
+                let mut rest = &mut points.spare_capacity_mut()[..total];
                 let mut slices = Vec::with_capacity(a.faces.len().div_ceil(CHUNK));
                 for start in (0..a.faces.len()).step_by(CHUNK) {
                     let end = (start + CHUNK).min(a.faces.len());
@@ -324,7 +330,7 @@ impl Searcher {
                 assert!(chunks.iter().all(|(short, _)| *short == 0));
                 // SAFETY: the first `total` slots were cut into the chunks' slices, in
                 // order and without gaps, and each chunk wrote every slot of its slice.
-                unsafe { result.points.set_len(total) };
+                unsafe { points.set_len(total) };
                 chunks.into_iter().flat_map(|(_, f)| f).collect::<Vec<_>>()
             }
             Rules::Segments { line, triangle } => {
@@ -352,10 +358,10 @@ impl Searcher {
                     })
                     .collect();
                 let total: usize = chunks.iter().map(|(points, _)| points.len()).sum();
-                result.points.reserve_exact(total + a.nodes.len());
+                points.reserve_exact(total + a.nodes.len());
                 let mut per_face = Vec::with_capacity(a.faces.len());
-                for (points, faces) in chunks {
-                    result.points.extend(points);
+                for (chunk, faces) in chunks {
+                    points.extend(chunk);
                     per_face.extend(faces);
                 }
                 per_face
@@ -374,8 +380,9 @@ impl Searcher {
                 // A node surface's covered area: its matched nodes' tributary areas.
                 result.stats.overlap_area += p.weight;
             }
-            result.points.push(p);
+            points.push(p);
         }
+        result.points = Arc::new(points);
         result.stats.side_a_area = a.area();
         tally(&mut result);
         result
@@ -455,7 +462,7 @@ impl SearchResult {
     /// surfaces, and its gap and normals are measured anew (quadrature points: along
     /// side B's normal; node points likewise). Statistics follow.
     pub fn update_geometry(&mut self, a: &SurfaceGeometry, b: &SurfaceGeometry) {
-        for p in &mut self.points {
+        for p in Arc::make_mut(&mut self.points) {
             if let Some(f) = p.a_face {
                 let fa = &a.faces[f as usize];
                 p.x = fa.map(p.xi_a);
@@ -489,7 +496,7 @@ impl SearchResult {
     /// `StoreOffsets` keeps the geometry and records the gap as the point's offset.
     /// Statistics are recomputed.
     pub fn treat_overclosure(&mut self, treatment: Overclosure) {
-        for p in &mut self.points {
+        for p in Arc::make_mut(&mut self.points) {
             if p.status != PointStatus::Matched || p.gap >= 0.0 {
                 continue;
             }
@@ -516,7 +523,7 @@ impl SearchResult {
 pub(crate) fn tally(r: &mut SearchResult) {
     let s = &mut r.stats;
     s.points = r.points.len();
-    for p in &r.points {
+    for p in r.points.iter() {
         match p.status {
             PointStatus::Matched => {
                 s.matched += 1;
