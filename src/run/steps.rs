@@ -715,12 +715,19 @@ pub(super) fn write_plots(
 /// of each block within 1.5 times that block's least distance to the line.
 fn line_samples(mesh: &Mesh, t: &[f64], origin: [f64; 3], axis: [f64; 3]) -> Vec<Series> {
     let mut out = Vec::new();
+    // A block's nodes, ascending and each once, by marking them (a sort of the 8
+    // nodes of every hex took 0.2 s at 1.1 M elements).
+    let mut mark = vec![false; mesh.coords.len()];
     for block in &mesh.blocks {
-        let mut nodes: Vec<u32> = (0..block.len())
-            .flat_map(|k| block.elem_nodes(k).iter().map(|n| n.0))
+        mark.fill(false);
+        for k in 0..block.len() {
+            for n in block.elem_nodes(k) {
+                mark[n.0 as usize] = true;
+            }
+        }
+        let nodes: Vec<u32> = (0..mark.len() as u32)
+            .filter(|&n| mark[n as usize])
             .collect();
-        nodes.sort_unstable();
-        nodes.dedup();
         let at = |n: u32| {
             let x = mesh.coords[n as usize];
             let d = [x[0] - origin[0], x[1] - origin[1], x[2] - origin[2]];
