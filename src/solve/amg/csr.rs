@@ -6,6 +6,11 @@
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use rayon::prelude::*;
 
+/// Columns per block of [`Csr::transpose`]'s first pass: a block's entries (a few
+/// hundred thousand at most on a fine level) are scattered to their columns within the
+/// cache.
+const TRANSPOSE_BLOCK_COLUMNS: usize = 1024;
+
 /// A compressed sparse row matrix, the AMG's own storage (row access for smoothing).
 #[derive(Clone, Debug, Default)]
 pub struct Csr {
@@ -135,27 +140,43 @@ impl Csr {
     }
 
     pub fn transpose(&self) -> Csr {
-        let mut ptr = vec![0usize; self.ncols + 1];
+        let (m, n, nnz) = (self.nrows, self.ncols, self.nnz());
+        let mut ptr = vec![0usize; n + 1];
         for &j in &self.idx {
             ptr[j as usize + 1] += 1;
         }
-        for j in 0..self.ncols {
+        for j in 0..n {
             ptr[j + 1] += ptr[j];
         }
-        let mut idx = vec![0; self.nnz()];
-        let mut val = vec![0.0; self.nnz()];
-        let mut next = ptr.clone();
-        for i in 0..self.nrows {
+        // In two passes: the entries first go to their block of columns, in row order,
+        // then each block's to their columns. Written straight to their columns, the
+        // entries of a row of the fine level's P (1.16 M × 46 000, 6.7 M entries) went
+        // to thousands of places at once, each on its own page, and took 0.21 s; a
+        // block's columns fit in the cache and the blocks are few.
+        let block = TRANSPOSE_BLOCK_COLUMNS;
+        let nblocks = n.div_ceil(block).max(1);
+        let mut start: Vec<usize> = (0..=nblocks).map(|b| ptr[(b * block).min(n)]).collect();
+        let mut staged: Vec<(u32, u32, f64)> = vec![(0, 0, 0.0); nnz];
+        for i in 0..m {
             for p in self.ptr[i]..self.ptr[i + 1] {
-                let j = self.idx[p] as usize;
-                idx[next[j]] = i as u32;
-                val[next[j]] = self.val[p];
-                next[j] += 1;
+                let j = self.idx[p];
+                let b = j as usize / block;
+                staged[start[b]] = (j, i as u32, self.val[p]);
+                start[b] += 1;
             }
         }
+        let mut idx = vec![0u32; nnz];
+        let mut val = vec![0.0; nnz];
+        let mut next = ptr.clone();
+        for &(j, i, v) in &staged {
+            let at = &mut next[j as usize];
+            idx[*at] = i;
+            val[*at] = v;
+            *at += 1;
+        }
         Csr {
-            nrows: self.ncols,
-            ncols: self.nrows,
+            nrows: n,
+            ncols: m,
             ptr,
             idx,
             val,
