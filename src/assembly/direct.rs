@@ -58,7 +58,7 @@ impl<'p> Assembler<'p> {
             pattern,
             values: vec![0.0; pattern.value_count() - pattern.elem_values],
             direct: Some(Summed {
-                values: vec![0.0; nnz],
+                values: super::written_zeros(nnz),
                 bad: None,
                 symmetric: true,
             }),
