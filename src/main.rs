@@ -12,32 +12,7 @@ mod cli;
 use cli::args::{Cli, ColorWhen, Command};
 use cli::{EXIT_BAD_INPUT, QUIET};
 
-/// Let the allocator keep the memory a run frees for the run's next arrays instead of
-/// handing it back to the kernel (glibc's default for blocks above 32 MB, and for the
-/// top of the heap). A solve allocates and frees arrays of hundreds of MB in turn — the
-/// pattern, the assembly's values, the hierarchy's products — and each one handed back
-/// is faulted in and zeroed again by the kernel page by page on its next use: at 1.16 M
-/// unknowns 170 000 faults, seconds of system time on a virtual machine. A batch program
-/// gives its memory back when it exits. The library leaves its host's allocator alone;
-/// `MALLOC_MMAP_MAX_`, `MALLOC_TRIM_THRESHOLD_` or `GLIBC_TUNABLES` in the environment
-/// leave it to the user.
-fn keep_freed_memory() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    {
-        let set = |name: &str| std::env::var_os(name).is_some();
-        if !(set("MALLOC_MMAP_MAX_") || set("MALLOC_TRIM_THRESHOLD_") || set("GLIBC_TUNABLES")) {
-            // SAFETY: mallopt only sets the allocator's parameters; it is called before
-            // any other thread exists.
-            unsafe {
-                libc::mallopt(libc::M_MMAP_MAX, 0);
-                libc::mallopt(libc::M_TRIM_THRESHOLD, i32::MAX);
-            }
-        }
-    }
-}
-
 fn main() -> ExitCode {
-    keep_freed_memory();
     let cli = Cli::parse();
     seam::logging::init_stderr(match (cli.quiet, cli.verbose) {
         (true, _) => log::LevelFilter::Error,
