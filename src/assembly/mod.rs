@@ -897,17 +897,6 @@ impl<'p> Assembler<'p> {
     }
 }
 
-/// `n` zeros, written: an array that is read before it is written (sums `+=` into
-/// it) gets each page once, as a write. `vec![0.0; n]` takes zeroed pages from the
-/// system untouched, and the first `+=` on each then faults twice — a read that maps
-/// the shared zero page, then a write that copies it (0.25 GB of matrix values at
-/// 1.16 M unknowns: 62 000 pages).
-pub(crate) fn written_zeros(n: usize) -> Vec<f64> {
-    let mut v = Vec::with_capacity(n);
-    v.resize(n, 0.0);
-    v
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
