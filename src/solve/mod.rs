@@ -191,7 +191,7 @@ pub fn relative_residual(a: &SparseColMat<usize, f64>, x: &[f64], b: &[f64]) -> 
 /// Entries per partial sum of the parallel reductions. Fixed, so a sum is made of the
 /// same partial sums in the same order on any number of threads: results do not depend
 /// on the thread count.
-const REDUCE_CHUNK: usize = 4096;
+pub(crate) const REDUCE_CHUNK: usize = 4096;
 
 /// `a · b`, in fixed chunks summed in order (the same bits on any number of threads).
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -257,12 +257,17 @@ pub(super) fn aggregate(a: &Csr, theta: f64) -> (Vec<usize>, usize) {
 /// aggregate (the positive `a_ij`, j ≠ i, left out and `d_F,i` in place of `a_ii`), in
 /// the order and with the rounding of the product `S · P̂`; then `P = P̂ − S P̂` (P̂'s
 /// entry of row i is among those columns: A stores its diagonal).
+///
+/// With `truncation` τ > 0, a row's entries below τ times its largest (in magnitude)
+/// are dropped and the rest scaled to keep the row's sum, so that P still carries the
+/// constants P̂ carries (the near null space). See [`super::AmgOptions::truncation`].
 pub(super) fn smoothed_prolongator(
     a: &Csr,
     filtered_diag: &[f64],
     agg: &[usize],
     nagg: usize,
     omega: f64,
+    truncation: f64,
 ) -> Csr {
     let n = a.nrows;
     let mut p = Csr {
@@ -300,6 +305,9 @@ pub(super) fn smoothed_prolongator(
         {
             p.val[k] += 1.0;
         }
+        if truncation > 0.0 {
+            truncate_row(&mut p.idx, &mut p.val, start, truncation);
+        }
         p.ptr.push(p.idx.len());
     }
     // Single-precision values: the V-cycle applies P in single precision (module docs
@@ -307,6 +315,34 @@ pub(super) fn smoothed_prolongator(
     // very P it is used with.
     p.val.iter_mut().for_each(|v| *v = f64::from(*v as f32));
     p
+}
+
+/// Drop the entries of the row `idx[start..]`, `val[start..]` below `tau` times its
+/// largest magnitude, in place, and scale the kept ones so the row sums as before.
+/// A row whose kept entries sum to zero is left whole (no scale would restore it).
+fn truncate_row(idx: &mut Vec<u32>, val: &mut Vec<f64>, start: usize, tau: f64) {
+    let row = &val[start..];
+    let largest = row.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let limit = tau * largest;
+    if row.iter().all(|v| v.abs() >= limit) {
+        return;
+    }
+    let sum: f64 = row.iter().sum();
+    let kept: f64 = row.iter().filter(|v| v.abs() >= limit).sum();
+    if kept == 0.0 || !(sum / kept).is_finite() {
+        return;
+    }
+    let scale = sum / kept;
+    let mut w = start;
+    for k in start..idx.len() {
+        if val[k].abs() >= limit {
+            idx[w] = idx[k];
+            val[w] = val[k] * scale;
+            w += 1;
+        }
+    }
+    idx.truncate(w);
+    val.truncate(w);
 }
 
 /// The Galerkin product `R (A P)` of a symmetric `A` with `R = Pᵀ`: its upper

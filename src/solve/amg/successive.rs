@@ -25,7 +25,8 @@
 //! the last solution), and the temperatures at t = 250 s from 1.7e-10 to 5.5e-11 K of
 //! a direct solve's.
 
-use super::{AmgCg, SolveError, SolveReport, dot};
+use super::{AmgCg, SolveError, SolveReport};
+use crate::solve::{REDUCE_CHUNK, dot};
 use rayon::prelude::*;
 
 /// Solutions kept for projection, at most: 8 vectors of the unknowns and their
@@ -92,13 +93,15 @@ impl AmgCg {
             .par_iter_mut()
             .zip(b)
             .for_each(|(r, b)| *r = b - *r);
-        let mut r = at_guess.clone();
+        let mut r = self.spare.pop().unwrap_or_default();
+        r.clear();
+        r.extend_from_slice(&at_guess);
         let earlier = &self.earlier;
-        for (v, av) in earlier.basis.iter().zip(&earlier.products) {
-            let c = dot(v, &at_guess);
-            x.par_iter_mut().zip(v).for_each(|(x, v)| *x += c * v);
-            r.par_iter_mut().zip(av).for_each(|(r, av)| *r -= c * av);
-        }
+        // Each basis vector's coefficient from the guess's residual, then x and r moved
+        // by all of them in one pass each.
+        let c = dots(&earlier.basis, &at_guess);
+        add_combination(x, &earlier.basis, &c, 1.0);
+        add_combination(&mut r, &earlier.products, &c, -1.0);
         let report = self.pcg_from(b, x, r)?;
         let at_solution = self.remember(x, b);
         Ok(Successive {
@@ -135,28 +138,25 @@ impl AmgCg {
         // direction: on the electronics warm-up at refine 6 that took 490 iterations
         // instead of 230, a spike every ninth step.
         let earlier = &mut self.earlier;
-        if earlier.basis.len() >= KEPT_SOLUTIONS {
-            earlier.basis.remove(0);
-            earlier.products.remove(0);
-        }
+        // The oldest vector and its product, when they go, lend their memory to the
+        // new ones (fresh arrays of this size are paged in by the system each step).
+        let (mut part, mut ap) = if earlier.basis.len() >= KEPT_SOLUTIONS {
+            (earlier.basis.remove(0), earlier.products.remove(0))
+        } else {
+            (Vec::new(), Vec::new())
+        };
         let (basis, products) = (&earlier.basis, &earlier.products);
         let energy = dot(x, b);
-        // `y −= Σ c_k w_k` over `ws` (the basis or its products).
-        let take = |y: &mut [f64], ws: &[Vec<f64>], c: &[f64]| {
-            for (w, c) in ws.iter().zip(c) {
-                y.par_iter_mut().zip(w).for_each(|(y, w)| *y -= c * w);
-            }
-        };
-        let coefficients = |y: &[f64]| -> Vec<f64> { basis.iter().map(|v| dot(v, y)).collect() };
-        let first = coefficients(b);
-        let mut part = x.to_vec();
-        take(&mut part, basis, &first);
-        let mut ap = vec![0.0; x.len()];
+        let first = dots(basis, b);
+        part.clear();
+        part.extend_from_slice(x);
+        add_combination(&mut part, basis, &first, -1.0);
+        ap.resize(x.len(), 0.0);
         fine.a.spmv(&part, &mut ap);
         // b − A x = b − A part − Σ c_k A v_k.
         let mut at_solution: Vec<f64> = b.iter().zip(&ap).map(|(b, ap)| b - ap).collect();
-        take(&mut at_solution, products, &first);
-        let second = coefficients(&ap);
+        add_combination(&mut at_solution, products, &first, -1.0);
+        let second = dots(basis, &ap);
         // ‖p − Xc‖²_A = pᵀAp − |c|² for an A-orthonormal X.
         let norm2 = dot(&part, &ap) - second.iter().map(|c| c * c).sum::<f64>();
         // (A NaN anywhere fails the first test too.)
@@ -164,8 +164,8 @@ impl AmgCg {
         if !significant || !energy.is_finite() {
             return at_solution;
         }
-        take(&mut part, basis, &second);
-        take(&mut ap, products, &second);
+        add_combination(&mut part, basis, &second, -1.0);
+        add_combination(&mut ap, products, &second, -1.0);
         let scale = 1.0 / norm2.sqrt();
         part.par_iter_mut().for_each(|p| *p *= scale);
         ap.par_iter_mut().for_each(|p| *p *= scale);
@@ -173,6 +173,54 @@ impl AmgCg {
         earlier.products.push(ap);
         at_solution
     }
+}
+
+/// `[w · y for w in ws]`, in one pass over `y`: each dot product summed as
+/// [`crate::solve::dot`] sums it (in fixed chunks, then the chunks' sums in order), so
+/// with the same bits, whatever the thread count.
+fn dots(ws: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
+    if ws.is_empty() {
+        return Vec::new();
+    }
+    let parts: Vec<Vec<f64>> = y
+        .par_chunks(REDUCE_CHUNK)
+        .enumerate()
+        .map(|(c, y)| {
+            let at = c * REDUCE_CHUNK;
+            ws.iter()
+                .map(|w| {
+                    (w[at..at + y.len()].iter())
+                        .zip(y)
+                        .map(|(w, y)| w * y)
+                        .sum::<f64>()
+                })
+                .collect()
+        })
+        .collect();
+    (0..ws.len())
+        .map(|k| parts.iter().map(|p| p[k]).sum())
+        .collect()
+}
+
+/// `y += sign Σ_k c_k w_k`, in one pass over `y`: each entry takes the terms in the
+/// order of `k`, as one axpy after another would.
+fn add_combination(y: &mut [f64], ws: &[Vec<f64>], c: &[f64], sign: f64) {
+    if ws.is_empty() {
+        return;
+    }
+    y.par_chunks_mut(REDUCE_CHUNK)
+        .enumerate()
+        .for_each(|(chunk, y)| {
+            let at = chunk * REDUCE_CHUNK;
+            for (w, &c) in ws.iter().zip(c) {
+                let w = &w[at..at + y.len()];
+                if sign > 0.0 {
+                    y.iter_mut().zip(w).for_each(|(y, w)| *y += c * w);
+                } else {
+                    y.iter_mut().zip(w).for_each(|(y, w)| *y -= c * w);
+                }
+            }
+        });
 }
 
 #[cfg(test)]

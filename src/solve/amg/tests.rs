@@ -92,7 +92,7 @@ fn transpose_twice_is_identity_and_matmul_matches_dense() {
             }
         })
         .collect();
-    let p = smoothed_prolongator(&big, &big.diagonal(), &agg, nagg, 0.6);
+    let p = smoothed_prolongator(&big, &big.diagonal(), &agg, nagg, 0.6, 0.0);
     let r = p.transpose();
     let want = r.matmul(&big.matmul(&p));
     let got = galerkin(&r, &big, &p);
@@ -438,4 +438,79 @@ fn amg_cg_converges_fast_on_penalty_tied_nonmatching_blocks() {
     assert!(rows > 0 && rows < n / 4, "{rows} penalty rows of {n}");
     assert!(with <= 16, "{with} iterations with the penalty sweeps");
     assert!(with < without, "{with} with the sweeps, {without} without");
+}
+
+/// The Q1 stiffness of an `m × m`-node square grid (8/3 on the diagonal, −1/3 to each
+/// of up to 8 neighbours, the row sums of a pure Neumann problem on interior rows).
+fn q1_grid(m: usize) -> Csr {
+    let rows = (0..m * m)
+        .map(|i| {
+            let (x, y) = ((i % m) as i64, (i / m) as i64);
+            let mut row = std::collections::BTreeMap::new();
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let (u, v) = (x + dx, y + dy);
+                    if (0..m as i64).contains(&u) && (0..m as i64).contains(&v) {
+                        let j = (v * m as i64 + u) as usize;
+                        row.insert(j, if j == i { 8.0 / 3.0 } else { -1.0 / 3.0 });
+                    }
+                }
+            }
+            row
+        })
+        .collect();
+    csr_of_rows(rows)
+}
+
+/// Truncation drops the small entries of each row of P, keeps the large ones in
+/// proportion and the row's sum (so P carries the constants as before).
+#[test]
+fn truncated_prolongator_keeps_row_sums_and_large_entries() {
+    let a = q1_grid(40);
+    let (agg, nagg) = aggregate(&a, 0.4);
+    let diag = filtered_diagonal(&a);
+    let whole = smoothed_prolongator(&a, &diag, &agg, nagg, 0.6, 0.0);
+    // (A 2-D grid's neighbouring aggregates reach 0.1–0.3 of a row's largest entry.)
+    let tau = 0.3;
+    let thin = smoothed_prolongator(&a, &diag, &agg, nagg, 0.6, tau);
+    assert!(
+        thin.nnz() < whole.nnz(),
+        "{} vs {}",
+        thin.nnz(),
+        whole.nnz()
+    );
+    let row = |p: &Csr, i: usize| -> Vec<(u32, f64)> {
+        (p.ptr[i]..p.ptr[i + 1])
+            .map(|q| (p.idx[q], p.val[q]))
+            .collect()
+    };
+    let mut dropped = 0;
+    for i in 0..a.nrows {
+        let (w, t) = (row(&whole, i), row(&thin, i));
+        let sum = |r: &[(u32, f64)]| r.iter().map(|e| e.1).sum::<f64>();
+        // P's values are rounded to single precision after the scaling.
+        assert!(
+            (sum(&w) - sum(&t)).abs() <= 1e-6 * sum(&w).abs().max(1.0),
+            "row {i}"
+        );
+        let largest = w.iter().fold(0.0f64, |m, e| m.max(e.1.abs()));
+        let scale = sum(&w)
+            / w.iter()
+                .filter(|e| e.1.abs() >= tau * largest)
+                .map(|e| e.1)
+                .sum::<f64>();
+        for &(g, v) in &w {
+            match t.iter().find(|e| e.0 == g) {
+                Some(&(_, kept)) => {
+                    assert!(v.abs() >= tau * largest, "row {i}: {v} kept");
+                    assert!((kept - v * scale).abs() <= 1e-6 * v.abs(), "row {i}");
+                }
+                None => {
+                    assert!(v.abs() < tau * largest, "row {i}: {v} dropped");
+                    dropped += 1;
+                }
+            }
+        }
+    }
+    assert!(dropped > 0);
 }
