@@ -30,8 +30,20 @@ impl Embedding {
     /// A mortar tie's rows stay in [`Self::constraints`]: the host drops them (and keeps
     /// its multipliers at 0) while the tie is off.
     pub fn set_active(&mut self, i: usize, on: bool) -> Result<(), EmbedError> {
-        self.pair_mut(i)?.active = on;
+        let p = self.pair_mut(i)?;
+        if p.active != on {
+            p.active = on;
+            self.forget_values();
+        }
         Ok(())
+    }
+
+    /// Something the interface terms depend on besides the field changed: the next
+    /// [`Self::evaluate`] makes them again.
+    fn forget_values(&mut self) {
+        if let Some(e) = &mut self.evaluation {
+            e.forget_values();
+        }
     }
 
     /// Whether interaction `i` is switched on (true unless [`Self::set_active`] said
@@ -70,7 +82,10 @@ impl Embedding {
                 ));
             }
         }
-        p.pressures = pressures;
+        if p.pressures != pressures {
+            p.pressures = pressures;
+            self.forget_values();
+        }
         Ok(())
     }
 
@@ -78,7 +93,11 @@ impl Embedding {
     /// [`super::Interaction::quarantine`]), or stop doing so; the points kept so far stay
     /// listed.
     pub fn set_quarantine(&mut self, i: usize, on: bool) -> Result<(), EmbedError> {
-        self.pair_mut(i)?.quarantine = on;
+        let p = self.pair_mut(i)?;
+        if p.quarantine != on {
+            p.quarantine = on;
+            self.forget_values();
+        }
         Ok(())
     }
 

@@ -499,6 +499,10 @@ impl ConductanceModel for Scaled {
     fn depends_on_temperature(&self) -> bool {
         self.model.depends_on_temperature()
     }
+
+    fn depends_on_time(&self) -> bool {
+        self.model.depends_on_time()
+    }
 }
 
 /// Per species interface: (side A, side B, model), for the CSV and the summary.

@@ -780,3 +780,81 @@ fn embed_jacobian_as_sprs_matches_the_csr_and_the_triplets() {
     assert!(checked > 0);
     assert!(from_triplets.nnz() <= from_csr.nnz());
 }
+
+/// `evaluate` at the field of the last evaluation gives its values again only while
+/// nothing else they depend on changed: each of a point pressure, a switch, a move of
+/// the field and (for a model of the time) the time reaches the values at once, and
+/// going back gives the first values bit for bit. (The CMY model of the deck sees the
+/// pressure and not the time; the Lua one sees the time.)
+#[test]
+fn embed_evaluate_again_follows_every_change_of_its_inputs() {
+    let deck = |h: &str| {
+        format!(
+            "begin contact definition again
+  contact surface a contains base_top
+  contact surface b contains lid_bottom
+  begin interaction
+    side a a
+    side b b
+  end
+  begin enforcement
+    enforcement for energy = gap_conductance
+    gap conductance coefficient = {h}
+    contact pressure = 5e5
+  end
+end
+"
+        )
+    };
+    let mesh = seam::mesh::read(&scene().join("two_blocks.exo")).unwrap();
+    let n = mesh.num_nodes();
+    let dof = example::host_dofs(&mesh);
+    let build = |h: &str| {
+        let mut seam = example::embedding(&mesh, &dof).build().unwrap();
+        seam.add_deck("again.i", &deck(h)).unwrap();
+        seam.search().unwrap();
+        seam
+    };
+    let values = |seam: &mut Embedding, u: &[f64]| -> (Vec<f64>, Vec<f64>) {
+        let e = seam.evaluate(u).unwrap();
+        (e.jacobian.values.clone(), e.residual.clone())
+    };
+    let (u, moved) = (field(n, 0.0), field(n, 5.0));
+    let mut cmy = build("cmy k_a = 150 k_b = 200 slope = 0.1 roughness = 1e-6 hardness = 1e9");
+    let first = values(&mut cmy, &u);
+    assert!(first.1.iter().any(|&r| r != 0.0));
+    assert_eq!(values(&mut cmy, &u), first, "the same inputs");
+    // Another field, then back.
+    assert_ne!(values(&mut cmy, &moved).1, first.1);
+    assert_eq!(values(&mut cmy, &u), first);
+    // Twice the pressure: the values of the CMY model at 1 MPa, as a deck says it.
+    let points = cmy.coverage(0).unwrap().points;
+    cmy.set_point_pressures(0, Some(vec![1e6; points])).unwrap();
+    let pressed = values(&mut cmy, &u);
+    assert_ne!(pressed, first);
+    let mut at_1mpa = build("cmy k_a = 150 k_b = 200 slope = 0.1 roughness = 1e-6 hardness = 1e9");
+    at_1mpa
+        .set_point_pressures(0, Some(vec![1e6; points]))
+        .unwrap();
+    assert_eq!(values(&mut at_1mpa, &u), pressed);
+    cmy.set_point_pressures(0, None).unwrap();
+    assert_eq!(values(&mut cmy, &u), first, "the deck's pressure again");
+    // Switched off: no terms; on again: the first values.
+    cmy.set_active(0, false).unwrap();
+    assert!(values(&mut cmy, &u).0.iter().all(|&v| v == 0.0));
+    cmy.set_active(0, true).unwrap();
+    assert_eq!(values(&mut cmy, &u), first);
+    // A model of the time is evaluated again at another time; CMY need not be.
+    cmy.set_time(7.0).unwrap();
+    assert_eq!(values(&mut cmy, &u), first);
+    let mut clocked = build("lua \"100 * (1 + t)\"");
+    let at_0 = values(&mut clocked, &u);
+    clocked.set_time(2.0).unwrap();
+    let at_2 = values(&mut clocked, &u);
+    assert_ne!(at_2, at_0);
+    // h = 300 at t = 2: the constant model's values, to round-off.
+    let constant = values(&mut build("constant h = 300"), &u);
+    let scale = constant.1.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let off = (at_2.1.iter().zip(&constant.1)).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(off <= 1e-12 * scale, "{off} of {scale}");
+}

@@ -172,6 +172,12 @@ pub trait ConductanceModel {
         true
     }
 
+    /// Whether h may change with the time alone (`PointState::time`). One that says no
+    /// is not evaluated again at the same field (`Embedding::evaluate`): default yes.
+    fn depends_on_time(&self) -> bool {
+        true
+    }
+
     /// The mechanisms this model adds up, when it is a [`Sum`] (for reports that split
     /// the heat by mechanism); empty for a single mechanism.
     fn mechanisms(&self) -> &[Box<dyn ConductanceModel>] {
@@ -274,6 +280,10 @@ impl ConductanceModel for SeeingVoltage {
         self.inner.depends_on_temperature()
     }
 
+    fn depends_on_time(&self) -> bool {
+        self.inner.depends_on_time()
+    }
+
     fn depends_on_voltage(&self) -> bool {
         self.inner.depends_on_voltage()
     }
@@ -334,6 +344,10 @@ impl ConductanceModel for Seeing {
 
     fn depends_on_temperature(&self) -> bool {
         !matches!(self.seen, SeenTemperature::Constant(_)) && self.inner.depends_on_temperature()
+    }
+
+    fn depends_on_time(&self) -> bool {
+        self.inner.depends_on_time()
     }
 
     fn depends_on_voltage(&self) -> bool {
@@ -440,6 +454,9 @@ impl ConductanceModel for Constant {
     fn depends_on_temperature(&self) -> bool {
         false
     }
+    fn depends_on_time(&self) -> bool {
+        false
+    }
     fn evaluate(&self, _state: &PointState) -> Result<Conductance, ConductanceError> {
         // h was checked (finite, ≥ 0) at construction.
         Ok(Conductance {
@@ -540,6 +557,9 @@ impl ConductanceModel for GasGap {
     fn depends_on_temperature(&self) -> bool {
         self.beta != 0.0
     }
+    fn depends_on_time(&self) -> bool {
+        false
+    }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let (a, da) = self.inverse_length(s.gap);
         let k = self.k0 * (1.0 + self.beta * (s.mean_temperature() - self.t0));
@@ -585,6 +605,9 @@ impl Radiation {
 impl ConductanceModel for Radiation {
     fn name(&self) -> String {
         "radiation".into()
+    }
+    fn depends_on_time(&self) -> bool {
+        false
     }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let (a, b, f) = (s.temp_a, s.temp_b, self.factor);
@@ -648,6 +671,9 @@ impl ConductanceModel for Cmy {
         "cmy".into()
     }
     fn depends_on_temperature(&self) -> bool {
+        false
+    }
+    fn depends_on_time(&self) -> bool {
         false
     }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
@@ -754,6 +780,9 @@ impl ConductanceModel for Table {
     fn depends_on_temperature(&self) -> bool {
         self.variable == TableVariable::Temperature
     }
+    fn depends_on_time(&self) -> bool {
+        false
+    }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let mut c = Conductance::default();
         match self.variable {
@@ -791,6 +820,9 @@ impl ConductanceModel for Sum {
     }
     fn depends_on_temperature(&self) -> bool {
         self.parts.iter().any(|p| p.depends_on_temperature())
+    }
+    fn depends_on_time(&self) -> bool {
+        self.parts.iter().any(|p| p.depends_on_time())
     }
     fn evaluate(&self, s: &PointState) -> Result<Conductance, ConductanceError> {
         let mut total = Conductance::default();
