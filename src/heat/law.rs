@@ -66,6 +66,16 @@ impl Law {
         }
     }
 
+    /// May the value change with the time alone? A table in time does, and a Lua
+    /// expression may (it is not read for `t`: the safe answer).
+    pub fn depends_on_time(&self) -> bool {
+        match self {
+            Law::Constant(_) | Law::Table(_) => false,
+            Law::TimeTable(p) => p.len() > 1,
+            Law::Lua { .. } => true,
+        }
+    }
+
     /// Does the value depend on temperature? (A source that does makes the problem
     /// nonlinear.) A Lua expression does when it names the variable `T`.
     pub fn uses_temperature(&self) -> bool {

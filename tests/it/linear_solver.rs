@@ -346,6 +346,45 @@ fn transient_steps_by_amg_with_held_temperatures_agree_with_cholesky() {
     );
 }
 
+/// A face condition that changes in time reaches every AMG step: the die's flux as a
+/// table in time (on, then off from t = 100 s) gives the Cholesky run's temperatures
+/// and heat. (A linear step assembles its right-hand side at the same
+/// field each step, and an unchanged condition lets it keep the element loop's part.)
+#[test]
+fn transient_amg_steps_follow_a_flux_that_changes_in_time() {
+    let file = "transient.toml";
+    let switched = |dir: &TempDir| {
+        let path = dir.path().join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let flux = "kind = \"flux\"\nsurfaces = [\"chip_bottom\"]\nvalue = 1e5\n";
+        assert!(text.contains(flux), "the die's flux");
+        let table = "{ table = [[0.0, 1e5], [99.0, 1e5], [100.0, 0.0]] }";
+        let text = text.replace(
+            flux,
+            &format!("kind = \"flux\"\nsurfaces = [\"chip_bottom\"]\nvalue = {table}\n"),
+        );
+        std::fs::write(&path, text.replace("end_time = 400.0", "end_time = 150.0")).unwrap();
+    };
+    let (direct_scene, problem) = scene_file_with(
+        "electronics",
+        file,
+        "switched-direct",
+        "linear_solver = \"direct\"\nauto_threshold = 1",
+    );
+    switched(&direct_scene);
+    let direct = run(&problem);
+    let (amg_scene, problem) =
+        scene_file_with("electronics", file, "switched-amg", "auto_threshold = 1");
+    switched(&amg_scene);
+    let amg = run(&problem);
+    assert_eq!(amg.summary.linear_solver.name, "AMG-CG");
+    agree_with_cholesky(&amg, &direct);
+    // With its flux off the die has cooled to the sink within milliseconds: nearly no
+    // heat crosses the interface at the end (10 W while it was on).
+    let heat = amg.summary.interactions[0].heat_side_a;
+    assert!(heat.abs() < 0.1, "{heat}");
+}
+
 #[test]
 fn nonlinear_steps_use_gmres_with_a_kept_hierarchy_and_agree_with_lu() {
     // The two blocks with a conductivity k(T) in the base: the Newton Jacobian is

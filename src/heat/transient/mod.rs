@@ -397,6 +397,7 @@ pub fn solve(
             setup: &setup,
             first,
             element_matrices: RefCell::new(None),
+            element_inputs: RefCell::new(None),
             tie_first: &tie_first,
             electric_first: &electric_first,
             power: RefCell::new(Vec::new()),

@@ -88,6 +88,9 @@ pub(super) struct Context<'c, 'a> {
     /// The face-derivative signature under which the element matrix slots were last
     /// computed for a linear problem (None: not kept).
     pub(super) element_matrices: RefCell<Option<Vec<(u32, u8, f64)>>>,
+    /// What the last element loop over kept matrices read (the assembler's element
+    /// vectors are what it made): a loop asked again with the same is not run.
+    pub(super) element_inputs: RefCell<Option<super::assemble::ElementInputs>>,
     pub(super) tie_first: &'c [usize],
     /// Where each electrical contact's couplings start in the assembler.
     pub(super) electric_first: &'c [usize],
