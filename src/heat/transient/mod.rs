@@ -398,6 +398,7 @@ pub fn solve(
             first,
             element_matrices: RefCell::new(None),
             element_inputs: RefCell::new(None),
+            capacity_terms: RefCell::new(Vec::new()),
             tie_first: &tie_first,
             electric_first: &electric_first,
             power: RefCell::new(Vec::new()),

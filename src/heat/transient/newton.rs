@@ -91,6 +91,8 @@ pub(super) struct Context<'c, 'a> {
     /// What the last element loop over kept matrices read (the assembler's element
     /// vectors are what it made): a loop asked again with the same is not run.
     pub(super) element_inputs: RefCell<Option<super::assemble::ElementInputs>>,
+    /// Scratch of the capacity terms, (residual, diagonal) per lumped dof.
+    pub(super) capacity_terms: RefCell<Vec<(f64, f64)>>,
     pub(super) tie_first: &'c [usize],
     /// Where each electrical contact's couplings start in the assembler.
     pub(super) electric_first: &'c [usize],
