@@ -71,7 +71,17 @@ struct Hex8Tables {
     /// `dn_by_point[q][k][a] = ∂N_a/∂ξ_k (ξ_q)`.
     dn_by_point: [[[f64; 8]; 3]; 8],
     weights: [f64; 8],
+    /// The rule's reference stiffness parts, for affine elements: per pair `k ≤ l`
+    /// (in the order of [`HEX8_PAIRS`]) the upper triangle, row by row, of
+    /// `Σ_q w_q (∂_k N_a ∂_l N_b + ∂_l N_a ∂_k N_b)` (halved for `k = l`).
+    stiffness: Hex8Stiffness,
 }
+
+/// The reference stiffness parts of a `Hex8` rule (see [`Hex8Tables`]).
+pub type Hex8Stiffness = [[f64; 36]; 6];
+
+/// The pairs `(k, l)`, `k ≤ l`, of reference directions, in the order of the tables.
+pub const HEX8_PAIRS: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)];
 
 /// A `Hex8` mapped at the eight points of its rule ([`Basis::map_hex8`]).
 #[derive(Clone, Copy, Debug)]
@@ -103,6 +113,7 @@ impl Basis {
                 dn_by_node: [[0.0; 24]; 8],
                 dn_by_point: [[[0.0; 8]; 3]; 8],
                 weights: [0.0; 8],
+                stiffness: [[0.0; 36]; 6],
             };
             for q in 0..8 {
                 t.weights[q] = rule.weights[q];
@@ -111,6 +122,21 @@ impl Basis {
                     for k in 0..3 {
                         t.dn_by_node[a][8 * k + q] = dn[q][a][k];
                         t.dn_by_point[q][k][a] = dn[q][a][k];
+                    }
+                }
+            }
+            for (m, &(k, l)) in t.stiffness.iter_mut().zip(&HEX8_PAIRS) {
+                let mut at = 0;
+                for a in 0..8 {
+                    for b in a..8 {
+                        m[at] = (0..8)
+                            .map(|q| {
+                                let d = &t.dn_by_point[q];
+                                let v = d[k][a] * d[l][b] + d[l][a] * d[k][b];
+                                t.weights[q] * if k == l { 0.5 * v } else { v }
+                            })
+                            .sum();
+                        at += 1;
                     }
                 }
             }
@@ -231,6 +257,41 @@ impl Basis {
             out.jxw[q] = det[q] * t.weights[q];
         }
         Some(Ok(out))
+    }
+
+    /// The Jacobian `J_ik = ∂x_i/∂ξ_k` of a `Hex8` whose map is affine — a
+    /// parallelepiped — to within the round-off of its coordinates, with the reference
+    /// stiffness parts of the rule ([`Hex8Tables`]); `None` for another basis or a map
+    /// that is not affine. Affine: the coefficients of ξη, ξζ, ηζ and ξηζ in the map
+    /// are at most 8ε times the largest coordinate, the size of the rounding of the
+    /// coordinates themselves, so the element is a parallelepiped as far as its
+    /// coordinates can say.
+    pub fn affine_hex8(&self, coords: &[[f64; 3]; 8]) -> Option<([[f64; 3]; 3], &Hex8Stiffness)> {
+        let t = self.hex8.as_deref()?;
+        let nodes = super::shape::reference_nodes(Topology::Hex8)?;
+        let mut j = [[0.0; 3]; 3];
+        let mut bend = [[0.0; 3]; 4];
+        let mut size = 0.0f64;
+        for (c, r) in coords.iter().zip(nodes) {
+            let signs = [r[0] * r[1], r[0] * r[2], r[1] * r[2], r[0] * r[1] * r[2]];
+            for i in 0..3 {
+                size = size.max(c[i].abs());
+                for k in 0..3 {
+                    j[i][k] += r[k] * c[i];
+                }
+                for (b, s) in bend.iter_mut().zip(signs) {
+                    b[i] += s * c[i];
+                }
+            }
+        }
+        let limit = 64.0 * f64::EPSILON * size;
+        // (A NaN coordinate is not affine either.)
+        if !bend.iter().flatten().all(|v| v.abs() <= limit) {
+            return None;
+        }
+        // Σ_a ξ_a x_a = 8 ∂x/∂ξ for the map Σ_a ⅛(1 + ξ_a ξ)(1 + η_a η)(1 + ζ_a ζ) x_a.
+        j.iter_mut().flatten().for_each(|v| *v *= 0.125);
+        Some((j, &t.stiffness))
     }
 
     /// The element's standard rule ([`QuadratureRule::standard`]); `None` for shells

@@ -337,7 +337,7 @@ pub fn assemble_conduction(
         let nn = elem_coords(mesh, e, &mut x);
         let x = &x[..nn];
         let k = materials[b].conductivity;
-        if let Err(bad) = kernel::conductivity(rule, x, |_| k, ke) {
+        if let Err(bad) = kernel::conductivity_uniform(rule, x, k, ke) {
             errors.record(e, bad_jacobian(mesh, e, bad));
             return;
         }
