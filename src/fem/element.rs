@@ -77,7 +77,7 @@ struct Hex8Tables {
     stiffness: Hex8Stiffness,
 }
 
-/// The reference stiffness parts of a `Hex8` rule (see [`Hex8Tables`]).
+/// The reference stiffness parts of a `Hex8` rule (see [`Basis::affine_hex8`]).
 pub type Hex8Stiffness = [[f64; 36]; 6];
 
 /// The pairs `(k, l)`, `k ≤ l`, of reference directions, in the order of the tables.
@@ -261,7 +261,7 @@ impl Basis {
 
     /// The Jacobian `J_ik = ∂x_i/∂ξ_k` of a `Hex8` whose map is affine — a
     /// parallelepiped — to within the round-off of its coordinates, with the reference
-    /// stiffness parts of the rule ([`Hex8Tables`]); `None` for another basis or a map
+    /// stiffness parts of the rule (per pair of [`HEX8_PAIRS`]); `None` for another basis or a map
     /// that is not affine. Affine: the coefficients of ξη, ξζ, ηζ and ξηζ in the map
     /// are at most 8ε times the largest coordinate, the size of the rounding of the
     /// coordinates themselves, so the element is a parallelepiped as far as its
