@@ -275,7 +275,7 @@ pub(crate) fn search(
     // 5. The points: gathered whole in serial order, on every rank or on rank 0; the
     //    other ranks of a distributed mesh keep theirs.
     let mut record = Vec::with_capacity(local.points.len() * POINT_LEN);
-    for p in &local.points {
+    for p in local.points.iter() {
         let a_face = p.a_face.map(|f| face_key(&own.a[f as usize].1));
         let a_node = p.a_node.map(|k| own.nodes[k as usize].1.0.0 as u64);
         let b_face = p.b_face.map(|j| near[j as usize].0);
@@ -420,7 +420,7 @@ fn assemble_whole(
     // Stable: the points of one face come from one rank, in the serial order.
     decoded.sort_by_key(|&(key, _)| key);
     let mut result = SearchResult {
-        points: decoded.into_iter().map(|(_, p)| p).collect(),
+        points: std::sync::Arc::new(decoded.into_iter().map(|(_, p)| p).collect()),
         contact_fraction: vec![0.0; a.faces.len()],
         ..SearchResult::default()
     };
@@ -628,8 +628,7 @@ fn own_result(
     for (k, &(i, _)) in own.a.iter().enumerate() {
         contact_fraction[i] = local.contact_fraction[k];
     }
-    let points = local
-        .points
+    let points: Vec<_> = std::sync::Arc::unwrap_or_clone(local.points)
         .into_iter()
         .map(|mut p| {
             p.a_face = p.a_face.map(|f| own.a[f as usize].0 as u32);
@@ -640,7 +639,7 @@ fn own_result(
         .collect();
     Ok((
         SearchResult {
-            points,
+            points: std::sync::Arc::new(points),
             stats,
             contact_fraction,
         },
