@@ -51,7 +51,7 @@ use super::bvh::{Aabb, Bvh};
 use super::settings::{Overclosure, SearchSettings};
 use crate::vec3::{V3, dot, scale, sub};
 
-use points::{BFace, Ctx, Rules, Scratch};
+use points::{BFace, Ctx, FaceTally, Rules, Scratch};
 
 /// The highest integration order accepted from input. A segment rule of order p on a
 /// triangle has ((p + 2)/2)² points built in O(p³) work, so an order in the thousands
@@ -180,8 +180,8 @@ pub struct Searcher {
     reach: f64,
 }
 
-/// One chunk's points and, per face, (matched weight, total weight, overlap area).
-type ChunkOut = (Vec<ContactPoint>, Vec<(f64, f64, f64)>);
+/// One chunk's points and its faces' tallies.
+type ChunkOut = (Vec<ContactPoint>, Vec<FaceTally>);
 
 /// Side-A faces per parallel chunk: large enough to amortise scheduling, fixed so
 /// results never depend on the thread count.
@@ -303,33 +303,22 @@ impl Searcher {
                     .into_par_iter()
                     .map(|(start, end, slice)| {
                         let mut scratch = Scratch::default();
-                        let mut points = Vec::new();
-                        let mut at = 0;
-                        let mut per_face = Vec::with_capacity(end - start);
-                        for fa in start..end {
-                            points.clear();
-                            let rule = rules.quadrature(a.faces[fa].len);
-                            let area = ctx.quadrature_face(
-                                a,
-                                fa,
-                                rule,
-                                overlap,
-                                &mut points,
-                                &mut scratch,
-                            );
-                            for (slot, p) in slice[at..at + points.len()].iter_mut().zip(&points) {
-                                slot.write(*p);
-                            }
-                            at += points.len();
-                            per_face.push(face_weights(&points, area));
-                        }
-                        (slice.len() - at, per_face)
+                        let (written, per_face) = ctx.quadrature_faces(
+                            a,
+                            start..end,
+                            &rules,
+                            overlap,
+                            slice,
+                            &mut scratch,
+                        );
+                        (slice.len() - written, per_face)
                     })
                     .collect();
                 // Every chunk wrote as many points as its faces' rules have (`counts`).
                 assert!(chunks.iter().all(|(short, _)| *short == 0));
                 // SAFETY: the first `total` slots were cut into the chunks' slices, in
-                // order and without gaps, and each chunk wrote every slot of its slice.
+                // order and without gaps, and each chunk wrote every slot of its slice
+                // (`quadrature_faces` writes one per point of each face's rule, `counts`).
                 unsafe { points.set_len(total) };
                 chunks.into_iter().flat_map(|(_, f)| f).collect::<Vec<_>>()
             }
@@ -352,7 +341,13 @@ impl Searcher {
                                 .filter(|p| p.status == PointStatus::Matched)
                                 .map(|p| p.weight)
                                 .sum();
-                            per_face.push(face_weights(&points[before..], area));
+                            let (hit, total) = face_weights(&points[before..]);
+                            per_face.push(FaceTally {
+                                hit,
+                                total,
+                                area,
+                                measure: a.faces[fa].measure(a.axisymmetric),
+                            });
                         }
                         (points, per_face)
                     })
@@ -368,12 +363,16 @@ impl Searcher {
             }
         };
         result.contact_fraction.reserve_exact(a.faces.len());
-        for (hit, total, overlap) in per_face {
+        for f in &per_face {
             result
                 .contact_fraction
-                .push(if total > 0.0 { hit / total } else { 0.0 });
-            result.stats.overlap_area += overlap;
+                .push(if f.total > 0.0 { f.hit / f.total } else { 0.0 });
+            result.stats.overlap_area += f.area;
         }
+        // `a.area()`, from the measures the faces' tallies hold: the same terms in the
+        // same order.
+        let faces_area: f64 = per_face.iter().map(|f| f.measure).sum();
+        let side_a_area = faces_area + a.node_area.iter().sum::<f64>();
         for k in 0..a.nodes.len() {
             let p = ctx.pair_node(a, k);
             if overlap && p.status == PointStatus::Matched {
@@ -383,14 +382,14 @@ impl Searcher {
             points.push(p);
         }
         result.points = Arc::new(points);
-        result.stats.side_a_area = a.area();
+        result.stats.side_a_area = side_a_area;
         tally(&mut result);
         result
     }
 }
 
-/// A face's matched weight, total weight and overlap `area`, from its `points`.
-fn face_weights(points: &[ContactPoint], area: f64) -> (f64, f64, f64) {
+/// A face's matched weight and total weight, from its `points`.
+fn face_weights(points: &[ContactPoint]) -> (f64, f64) {
     let (mut hit, mut total) = (0.0, 0.0);
     for p in points {
         total += p.weight;
@@ -398,7 +397,7 @@ fn face_weights(points: &[ContactPoint], area: f64) -> (f64, f64, f64) {
             hit += p.weight;
         }
     }
-    (hit, total, area)
+    (hit, total)
 }
 
 /// How far a search looks from each side-B face, fixed by side B's face sizes.
