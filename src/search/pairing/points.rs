@@ -144,6 +144,7 @@ fn extent(b: &Aabb) -> f64 {
 pub(super) struct GroupFace {
     fa: usize,
     n_a: V3,
+    centroid: V3,
     measure: f64,
     area_wanted: bool,
     /// The face's box.
@@ -521,6 +522,7 @@ impl Ctx<'_> {
         GroupFace {
             fa,
             n_a,
+            centroid,
             measure,
             area_wanted,
             bounds,
@@ -567,7 +569,7 @@ impl Ctx<'_> {
             }
         }
         sort_small(&mut s.overlap);
-        tally.area = self.overlap_among(a, fa, &s.overlap, &mut s.clip);
+        tally.area = self.overlap_among(a, fa, (n_a, face.centroid), &s.overlap, &mut s.clip);
         tally
     }
 
@@ -631,13 +633,15 @@ impl Ctx<'_> {
     /// Overlap area of side-A face `fa` (its centroid inside the subdomain) with side B
     /// in quadrature mode: the clipped overlap with every side-B face among
     /// `candidates` (ascending) the pairing would accept for that face: opposed
-    /// normals, and a centroid within the acceptance distance of the face's plane.
+    /// normals, and a centroid within the acceptance distance of the face's plane
+    /// (`n_a`, `c_a`: the face's normal and centroid, as `FaceGeom` makes them).
     /// (In segment mode the matched points' weights sum to it exactly.) `clip` keeps
     /// the clipping buffers from face to face.
     fn overlap_among(
         &self,
         a: &SurfaceGeometry,
         fa: usize,
+        (n_a, c_a): (V3, V3),
         candidates: &[usize],
         clip: &mut Option<FaceOverlap>,
     ) -> f64 {
@@ -652,7 +656,6 @@ impl Ctx<'_> {
                 Some(clip)
             }
         };
-        let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
         let mut scratch = Vec::new();
         // An axisymmetric edge's rule, made only for such a face.
