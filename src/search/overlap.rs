@@ -33,22 +33,21 @@ struct ClipPiece {
 }
 
 impl ClipPiece {
-    fn new(clip: &[P2]) -> ClipPiece {
+    /// Made from `clip`, in place (the piece is too large to be moved for free).
+    fn set(&mut self, clip: &[P2]) {
         let m = clip.len();
         let next = |i: usize| if i + 1 == m { 0 } else { i + 1 };
-        let mut piece = ClipPiece {
-            m,
-            ..ClipPiece::default()
-        };
+        self.m = m;
+        self.scale2 = 0.0;
         for p in clip {
-            piece.scale2 = larger(piece.scale2, p[0] * p[0] + p[1] * p[1]);
+            self.scale2 = larger(self.scale2, p[0] * p[0] + p[1] * p[1]);
         }
         for i in 0..m {
             let e = sub2(clip[next(i)], clip[i]);
-            piece.scale2 = larger(piece.scale2, e[0] * e[0] + e[1] * e[1]);
+            self.scale2 = larger(self.scale2, e[0] * e[0] + e[1] * e[1]);
         }
-        piece.area2 = area2(clip);
-        let ccw = piece.area2 > 0.0;
+        self.area2 = area2(clip);
+        let ccw = self.area2 > 0.0;
         for k in 0..m {
             // Backwards: edge k runs from vertex m − 1 − k to the one before it.
             let (c0, c1) = if ccw {
@@ -57,10 +56,9 @@ impl ClipPiece {
                 let i = m - 1 - k;
                 (clip[i], clip[if i == 0 { m - 1 } else { i - 1 }])
             };
-            piece.c0[k] = c0;
-            piece.e[k] = sub2(c1, c0);
+            self.c0[k] = c0;
+            self.e[k] = sub2(c1, c0);
         }
-        piece
     }
 }
 
@@ -150,7 +148,7 @@ impl FaceOverlap {
         for (idx, &n) in index.iter().zip(&len) {
             if n > 0 {
                 let (p, n) = flat.piece(idx, n);
-                self.pieces[self.count] = ClipPiece::new(&p[..n]);
+                self.pieces[self.count].set(&p[..n]);
                 self.count += 1;
             }
         }
@@ -173,8 +171,11 @@ impl FaceOverlap {
         let (index, len) = fb.pieces();
         if self.count == 1 && len[1] == 0 {
             // Both convex (the common case): one clip.
-            let (pb, n) = fb.piece(&index[0], len[0]);
-            let area = clip_piece_area(&pb[..n], &self.pieces[0], &mut self.buffers);
+            let area = clip_piece_area(
+                fb.piece(&index[0], len[0]),
+                &self.pieces[0],
+                &mut self.buffers,
+            );
             return area.map_or(0.0, |a| 0.0 + a);
         }
         let mut area = 0.0;
@@ -183,8 +184,7 @@ impl FaceOverlap {
                 if n == 0 {
                     continue;
                 }
-                let (pb, n) = fb.piece(idx, n);
-                if let Some(a) = clip_piece_area(&pb[..n], piece, &mut self.buffers) {
+                if let Some(a) = clip_piece_area(fb.piece(idx, n), piece, &mut self.buffers) {
                     area += a;
                 }
             }
@@ -194,18 +194,22 @@ impl FaceOverlap {
 }
 
 /// The signed area of `mortar::clip_into(subject, clip)` for a prepared clip piece and a
-/// subject of at most 4 vertices, clipped in `buffers` (`None` where `clip_into` gives an
+/// subject of at most 4 vertices (the first `n` of `subject`), clipped in `buffers` (`None` where `clip_into` gives an
 /// empty polygon): the same operations in the same order, so the same polygon and, as
 /// `signed_area_polygon` takes it, the same area. The clockwise result (that of an
 /// opposed side-B face, the common case) is measured with its vertices read backwards
 /// instead of being reversed.
 #[inline(always)]
-fn clip_piece_area(subject: &[P2], clip: &ClipPiece, buffers: &mut [[P2; CAP]; 2]) -> Option<f64> {
-    if subject.len() < 3 || clip.m < 3 {
+fn clip_piece_area(
+    (subject, n): ([P2; 4], usize),
+    clip: &ClipPiece,
+    buffers: &mut [[P2; CAP]; 2],
+) -> Option<f64> {
+    if n < 3 || clip.m < 3 {
         return None;
     }
     let mut scale2 = clip.scale2;
-    for p in subject {
+    for p in &subject[..n] {
         scale2 = larger(scale2, p[0] * p[0] + p[1] * p[1]);
     }
     if clip.area2.abs() <= 8.0 * f64::EPSILON * scale2 {
@@ -213,8 +217,10 @@ fn clip_piece_area(subject: &[P2], clip: &ClipPiece, buffers: &mut [[P2; CAP]; 2
     }
     let [a, b] = buffers;
     let (mut from, mut to) = (a, b);
-    from[..subject.len()].copy_from_slice(subject);
-    let mut n = subject.len();
+    // All four slots (fixed size: moves, not a call to copy); the first `n` are the
+    // subject's.
+    from[..4].copy_from_slice(&subject);
+    let mut n = n;
     for k in 0..clip.m {
         let (c0, e) = (clip.c0[k], clip.e[k]);
         let side = |p: P2| cross2(e, sub2(p, c0));

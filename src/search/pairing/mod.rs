@@ -51,7 +51,7 @@ use super::bvh::{Aabb, Bvh};
 use super::settings::{Overclosure, SearchSettings};
 use crate::vec3::{V3, dot, scale, sub};
 
-use points::{BFace, Ctx, FaceTally, Rules, Scratch};
+use points::{Ctx, FaceTally, Rules, Scratch};
 
 /// The highest integration order accepted from input. A segment rule of order p on a
 /// triangle has ((p + 2)/2)² points built in O(p³) work, so an order in the thousands
@@ -251,17 +251,6 @@ impl Searcher {
         subdomain: Option<Sphere>,
         overlap: bool,
     ) -> SearchResult {
-        // The overlap tests each side-B face for several side-A faces: its normal,
-        // centroid and distance limit once.
-        let b_faces: Vec<BFace> =
-            if overlap && matches!(integration, Integration::Quadrature { .. }) {
-                b.faces
-                    .par_iter()
-                    .map(|f| BFace::new(f, settings))
-                    .collect()
-            } else {
-                Vec::new()
-            };
         let ctx = Ctx {
             bvh: &self.bvh,
             margin: self.margin,
@@ -273,7 +262,6 @@ impl Searcher {
             cos_opposed: settings
                 .cull_opposed_normals
                 .then(|| settings.opposed_normal_threshold_angle.to_radians().cos()),
-            b_faces: &b_faces,
         };
         let mut result = SearchResult::default();
         let mut points: Vec<ContactPoint> = Vec::new();
@@ -299,18 +287,13 @@ impl Searcher {
                     slices.push((start, end, head));
                     rest = tail;
                 }
+                // One thread's scratch serves the chunks it takes (`map_init`): its
+                // buffers and side-B faces' data are kept from chunk to chunk.
                 let chunks: Vec<_> = slices
                     .into_par_iter()
-                    .map(|(start, end, slice)| {
-                        let mut scratch = Scratch::default();
-                        let (written, per_face) = ctx.quadrature_faces(
-                            a,
-                            start..end,
-                            &rules,
-                            overlap,
-                            slice,
-                            &mut scratch,
-                        );
+                    .map_init(Scratch::default, |scratch, (start, end, slice)| {
+                        let (written, per_face) =
+                            ctx.quadrature_faces(a, start..end, &rules, overlap, slice, scratch);
                         (slice.len() - written, per_face)
                     })
                     .collect();
@@ -320,7 +303,7 @@ impl Searcher {
                 // order and without gaps, and each chunk wrote every slot of its slice
                 // (`quadrature_faces` writes one per point of each face's rule, `counts`).
                 unsafe { points.set_len(total) };
-                chunks.into_iter().flat_map(|(_, f)| f).collect::<Vec<_>>()
+                chunks.into_iter().map(|(_, f)| f).collect::<Vec<_>>()
             }
             Rules::Segments { line, triangle } => {
                 let chunks: Vec<ChunkOut> = (0..a.faces.len())
@@ -354,16 +337,18 @@ impl Searcher {
                     .collect();
                 let total: usize = chunks.iter().map(|(points, _)| points.len()).sum();
                 points.reserve_exact(total + a.nodes.len());
-                let mut per_face = Vec::with_capacity(a.faces.len());
+                let mut per_face = Vec::with_capacity(chunks.len());
                 for (chunk, faces) in chunks {
                     points.extend(chunk);
-                    per_face.extend(faces);
+                    per_face.push(faces);
                 }
                 per_face
             }
         };
+        // The chunks' tallies, face after face.
+        let per_face = || per_face.iter().flatten();
         result.contact_fraction.reserve_exact(a.faces.len());
-        for f in &per_face {
+        for f in per_face() {
             result
                 .contact_fraction
                 .push(if f.total > 0.0 { f.hit / f.total } else { 0.0 });
@@ -371,7 +356,7 @@ impl Searcher {
         }
         // `a.area()`, from the measures the faces' tallies hold: the same terms in the
         // same order.
-        let faces_area: f64 = per_face.iter().map(|f| f.measure).sum();
+        let faces_area: f64 = per_face().map(|f| f.measure).sum();
         let side_a_area = faces_area + a.node_area.iter().sum::<f64>();
         for k in 0..a.nodes.len() {
             let p = ctx.pair_node(a, k);

@@ -31,14 +31,11 @@ pub(super) struct Ctx<'a> {
     pub(super) subdomain: Option<Sphere>,
     pub(super) cos_check: f64,
     pub(super) cos_opposed: Option<f64>,
-    /// Per side-B face, what the overlap diagnostic tests it by (empty when no overlap
-    /// is computed).
-    pub(super) b_faces: &'a [BFace],
 }
 
-/// What the overlap diagnostic asks of a side-B face, made once per search rather than
-/// once for each side-A face near it: its unit normal, centroid and acceptance distance
-/// ([`Ctx::distance_limit`]).
+/// What the overlap diagnostic asks of a side-B face, made once per thread (see
+/// [`BFaces`]) rather than once for each side-A face near it: its unit normal, centroid
+/// and acceptance distance ([`Ctx::distance_limit`]), as `FaceGeom` makes them.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BFace {
     normal: V3,
@@ -48,11 +45,58 @@ pub(super) struct BFace {
 
 impl BFace {
     pub(super) fn new(face: &FaceGeom, settings: &SearchSettings) -> BFace {
+        // One vector area for the normal and the size (`FaceGeom::normal`, `size`).
+        let va = face.vector_area();
+        let area = norm(va);
+        let size = if face.len == 2 { area } else { area.sqrt() };
         BFace {
-            normal: face.normal(),
+            normal: if area > 0.0 {
+                scale(va, 1.0 / area)
+            } else {
+                [0.0; 3]
+            },
             centroid: face.centroid(),
-            limit: distance_limit(settings, face),
+            limit: settings
+                .normal_tolerance
+                .unwrap_or(settings.field_factor * size),
         }
+    }
+}
+
+/// The [`BFace`]s one thread has made, in a direct-mapped table by face index: side-A
+/// faces come in mesh order, so the side-B faces near one are near the next ones too, and
+/// the table (4096 faces: a few rows of a mesh) holds them while they are wanted. No
+/// table for all of side B: one per search, written before it is read, cost a tenth of
+/// the search in page faults and made the faces no side-A face overlaps.
+#[derive(Default)]
+pub(super) struct BFaces {
+    tags: Vec<u32>,
+    data: Vec<BFace>,
+}
+
+impl BFaces {
+    const SLOTS: usize = 4096;
+
+    fn get(&mut self, j: usize, face: &FaceGeom, settings: &SearchSettings) -> BFace {
+        if self.tags.is_empty() {
+            self.tags = vec![u32::MAX; Self::SLOTS];
+            self.data = vec![
+                BFace {
+                    normal: [0.0; 3],
+                    centroid: [0.0; 3],
+                    limit: 0.0,
+                };
+                Self::SLOTS
+            ];
+        }
+        let slot = j & (Self::SLOTS - 1);
+        // Face indices are below u32::MAX (the tree's bound), so no face matches an
+        // empty slot.
+        if self.tags[slot] != j as u32 {
+            self.data[slot] = BFace::new(face, settings);
+            self.tags[slot] = j as u32;
+        }
+        self.data[slot]
     }
 }
 
@@ -173,6 +217,8 @@ pub(super) struct Scratch {
     /// The overlap's candidates, ascending.
     overlap: Vec<usize>,
     clip: Option<FaceOverlap>,
+    /// The side-B faces' overlap data made so far.
+    b_faces: BFaces,
     pub(super) mortar: Vec<MortarPoint>,
     /// Where the last face's tree query found its first face.
     hint: QueryHint,
@@ -468,11 +514,15 @@ impl Ctx<'_> {
                 let count = face.points.1 - face.points.0;
                 s.near.clear();
                 if let Some(grown) = &face.grown {
+                    // Every gathered face written, the count advanced by whether it is
+                    // kept: no branch to guess per face.
+                    s.near.resize(s.gathered.len(), (0, Aabb::EMPTY));
+                    let mut kept = 0;
                     for &(j, tree) in &s.gathered {
-                        if tree.intersects(grown) {
-                            s.near.push((j, tree));
-                        }
+                        s.near[kept] = (j, tree);
+                        kept += usize::from(tree.intersects(grown));
                     }
+                    s.near.truncate(kept);
                 }
                 let slots = &mut out[at..at + count];
                 at += count;
@@ -569,7 +619,13 @@ impl Ctx<'_> {
             }
         }
         sort_small(&mut s.overlap);
-        tally.area = self.overlap_among(a, fa, (n_a, face.centroid), &s.overlap, &mut s.clip);
+        tally.area = self.overlap_among(
+            a,
+            fa,
+            (n_a, face.centroid),
+            &s.overlap,
+            (&mut s.clip, &mut s.b_faces),
+        );
         tally
     }
 
@@ -643,7 +699,7 @@ impl Ctx<'_> {
         fa: usize,
         (n_a, c_a): (V3, V3),
         candidates: &[usize],
-        clip: &mut Option<FaceOverlap>,
+        (clip, b_faces): (&mut Option<FaceOverlap>, &mut BFaces),
     ) -> f64 {
         let face = &a.faces[fa];
         let mut clip = match face.len {
@@ -662,10 +718,7 @@ impl Ctx<'_> {
         let mut midpoint = None;
         for &j in candidates {
             let fb = &self.b.faces[j];
-            let data = match self.b_faces.get(j) {
-                Some(data) => *data,
-                None => BFace::new(fb, self.settings),
-            };
+            let data = b_faces.get(j, fb, self.settings);
             if !self.normals_ok(n_a, data.normal)
                 || dot(sub(data.centroid, c_a), n_a).abs() > data.limit
             {
