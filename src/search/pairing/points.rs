@@ -151,8 +151,8 @@ impl Rules {
 /// One side-A point of a face: ξ_A, x, weight, outside the subdomain.
 type FacePoint = ([f64; 2], V3, f64, bool);
 
-/// A candidate of one point: its place in the face's candidates and the squared distance
-/// of its own box from the point.
+/// A candidate of one point: its place among the group's gathered faces and the squared
+/// distance of its own box from the point.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Near {
     d2: f64,
@@ -210,8 +210,8 @@ pub(super) struct Scratch {
     group: Vec<GroupFace>,
     /// Side-B faces (index, tree box) the group's walk gathered.
     gathered: Vec<(usize, Aabb)>,
-    /// Side-B faces (index, tree box) from the face's one query.
-    near: Vec<(usize, Aabb)>,
+    /// The face's candidates: those of `gathered` its own query box meets.
+    near: Vec<u32>,
     /// One point's candidates among `near`, nearest first.
     order: Vec<Near>,
     /// The overlap's candidates, ascending.
@@ -338,25 +338,34 @@ impl Ctx<'_> {
     /// bound of [`Self::consider`] ends the rest unprojected. The outcome does not depend
     /// on the order: the best face is the least by its rank key, and a face skipped by the
     /// bound could not have beaten it.
-    fn pair_among(&self, x: V3, n_a: V3, near: &[(usize, Aabb)], order: &mut Vec<Near>) -> Best {
+    ///
+    /// The candidates are `gathered[k]` for `k` in `near`.
+    fn pair_among(
+        &self,
+        (x, n_a): (V3, V3),
+        gathered: &[(usize, Aabb)],
+        near: &[u32],
+        order: &mut Vec<Near>,
+    ) -> Best {
         let mut best = Best {
             found: None,
             rejected: PointStatus::Unmatched,
         };
         let query = Aabb::from_point(x);
         order.clear();
-        for (k, (_, tree)) in near.iter().enumerate() {
+        for &k in near {
+            let (_, tree) = &gathered[k as usize];
             if tree.intersects(&query) {
                 // Farther from the face's own box than the reach: no projection can pass.
                 let d2 = own_box(tree, self.margin).distance2_to_point(x);
                 if d2 <= self.reach2 {
-                    order.push(Near { d2, k: k as u32 });
+                    order.push(Near { d2, k });
                 }
             }
         }
         sort_by_distance(order);
         for c in order.iter() {
-            let (j, _) = near[c.k as usize];
+            let (j, _) = gathered[c.k as usize];
             if !self.consider_within(j, c.d2, x, n_a, &mut best) {
                 break;
             }
@@ -516,10 +525,10 @@ impl Ctx<'_> {
                 if let Some(grown) = &face.grown {
                     // Every gathered face written, the count advanced by whether it is
                     // kept: no branch to guess per face.
-                    s.near.resize(s.gathered.len(), (0, Aabb::EMPTY));
+                    s.near.resize(s.gathered.len(), 0);
                     let mut kept = 0;
-                    for &(j, tree) in &s.gathered {
-                        s.near[kept] = (j, tree);
+                    for (k, (_, tree)) in s.gathered.iter().enumerate() {
+                        s.near[kept] = k as u32;
                         kept += usize::from(tree.intersects(grown));
                     }
                     s.near.truncate(kept);
@@ -595,7 +604,8 @@ impl Ctx<'_> {
         let (mut hit, mut total) = (0.0, 0.0);
         let points = &s.points[face.points.0..face.points.1];
         for (slot, &(xi, x, w, outside)) in out.iter_mut().zip(points) {
-            let best = (!outside).then(|| self.pair_among(x, n_a, &s.near, &mut s.order));
+            let best =
+                (!outside).then(|| self.pair_among((x, n_a), &s.gathered, &s.near, &mut s.order));
             let p = contact_point(a_face, None, xi, x, w, n_a, best);
             total += p.weight;
             if p.status == PointStatus::Matched {
@@ -613,7 +623,8 @@ impl Ctx<'_> {
             return tally;
         }
         s.overlap.clear();
-        for (j, tree) in &s.near {
+        for &k in &s.near {
+            let (j, tree) = &s.gathered[k as usize];
             if self.overlap_candidate(&face.bounds, tree) {
                 s.overlap.push(*j);
             }
