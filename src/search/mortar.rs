@@ -58,18 +58,40 @@ pub struct MortarPoint {
     pub normal: [f64; 3],
 }
 
+#[inline(always)]
 pub(super) fn cross2(a: P2, b: P2) -> f64 {
     a[0] * b[1] - a[1] * b[0]
 }
 
+#[inline(always)]
 pub(super) fn sub2(a: P2, b: P2) -> P2 {
     [a[0] - b[0], a[1] - b[1]]
 }
 
-/// Twice the signed area (shoelace): positive for counter-clockwise polygons.
+/// Twice the signed area (shoelace): positive for counter-clockwise polygons. The terms
+/// `pᵢ × pᵢ₊₁` are summed from `i = 0`, the closing `pₙ₋₁ × p₀` last, onto what
+/// `Iterator::sum` starts from.
+#[inline]
 pub(super) fn area2(poly: &[P2]) -> f64 {
     let n = poly.len();
-    (0..n).map(|i| cross2(poly[i], poly[(i + 1) % n])).sum()
+    let mut sum: f64 = std::iter::empty::<f64>().sum();
+    for i in 0..n {
+        sum += cross2(poly[i], poly[if i + 1 == n { 0 } else { i + 1 }]);
+    }
+    sum
+}
+
+/// [`area2`] of the polygon with its vertices in reverse order, without reversing it: the
+/// same terms summed in the same order as `area2` would on the reversed polygon
+/// (`p_{n−1−i} × p_{n−2−i}`, the closing `p₀ × pₙ₋₁` last).
+#[inline]
+pub(super) fn area2_reversed(poly: &[P2]) -> f64 {
+    let n = poly.len();
+    let mut sum: f64 = std::iter::empty::<f64>().sum();
+    for k in (0..n).rev() {
+        sum += cross2(poly[k], poly[if k == 0 { n - 1 } else { k - 1 }]);
+    }
+    sum
 }
 
 /// Signed area of a polygon by the shoelace formula, positive when counter-clockwise.
@@ -320,17 +342,9 @@ pub(super) struct Flat {
 }
 
 impl Flat {
-    /// The box of the projected nodes: (lowest, highest) per coordinate.
-    pub(super) fn bounds(&self) -> (P2, P2) {
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for p in &self.nodes[..self.len] {
-            for d in 0..2 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
-            }
-        }
-        (lo, hi)
+    /// The projected nodes.
+    pub(super) fn nodes(&self) -> &[P2] {
+        &self.nodes[..self.len]
     }
 
     pub(super) fn new(face: &[V3], plane: &Plane) -> Flat {

@@ -11,7 +11,7 @@
 //! Conventions as in [`super::mortar`]: areas in the plane of A, either winding.
 
 use super::mortar::{
-    Flat, P2, Plane, area2, cross2, intersect, plane_of, signed_area_polygon, sub2, valid_face,
+    Flat, P2, Plane, area2, area2_reversed, cross2, intersect, plane_of, sub2, valid_face,
 };
 
 /// The most vertices a clipped polygon can reach: a piece has at most 4 vertices and is
@@ -33,32 +33,62 @@ struct ClipPiece {
 }
 
 impl ClipPiece {
-    fn new(clip: &[P2]) -> ClipPiece {
+    /// Made from `clip`, in place (the piece is too large to be moved for free).
+    fn set(&mut self, clip: &[P2]) {
         let m = clip.len();
-        let mut piece = ClipPiece {
-            m,
-            ..ClipPiece::default()
-        };
+        let next = |i: usize| if i + 1 == m { 0 } else { i + 1 };
+        self.m = m;
+        self.scale2 = 0.0;
         for p in clip {
-            piece.scale2 = piece.scale2.max(p[0] * p[0] + p[1] * p[1]);
+            self.scale2 = larger(self.scale2, p[0] * p[0] + p[1] * p[1]);
         }
         for i in 0..m {
-            let e = sub2(clip[(i + 1) % m], clip[i]);
-            piece.scale2 = piece.scale2.max(e[0] * e[0] + e[1] * e[1]);
+            let e = sub2(clip[next(i)], clip[i]);
+            self.scale2 = larger(self.scale2, e[0] * e[0] + e[1] * e[1]);
         }
-        piece.area2 = area2(clip);
-        let ccw = piece.area2 > 0.0;
+        self.area2 = area2(clip);
+        let ccw = self.area2 > 0.0;
         for k in 0..m {
+            // Backwards: edge k runs from vertex m − 1 − k to the one before it.
             let (c0, c1) = if ccw {
-                (clip[k], clip[(k + 1) % m])
+                (clip[k], clip[next(k)])
             } else {
-                (clip[m - 1 - k], clip[(2 * m - 2 - k) % m])
+                let i = m - 1 - k;
+                (clip[i], clip[if i == 0 { m - 1 } else { i - 1 }])
             };
-            piece.c0[k] = c0;
-            piece.e[k] = sub2(c1, c0);
+            self.c0[k] = c0;
+            self.e[k] = sub2(c1, c0);
         }
-        piece
     }
+}
+
+/// `a.max(b)` for an `a` that is not NaN, as a comparison (`f64::max` also sorts out
+/// NaNs, at four instructions more): the same value (of ±0 it may keep the other,
+/// which compares equal).
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
+/// `a.min(b)` for an `a` that is not NaN, as [`larger`].
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+/// The box of `points`, as `Flat::bounds` makes it up to the sign of a zero (which
+/// compares equal).
+#[inline(always)]
+fn bounds_of(points: &[P2]) -> (P2, P2) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in points {
+        for d in 0..2 {
+            lo[d] = smaller(lo[d], p[d]);
+            hi[d] = larger(hi[d], p[d]);
+        }
+    }
+    (lo, hi)
 }
 
 /// Side-A face `a` made ready for the overlap areas of many side-B faces
@@ -112,13 +142,13 @@ impl FaceOverlap {
         };
         let flat = Flat::new(a, &plane);
         self.plane = plane;
-        (self.lo, self.hi) = flat.bounds();
+        (self.lo, self.hi) = bounds_of(flat.nodes());
         let (index, len) = flat.pieces();
         self.count = 0;
         for (idx, &n) in index.iter().zip(&len) {
             if n > 0 {
                 let (p, n) = flat.piece(idx, n);
-                self.pieces[self.count] = ClipPiece::new(&p[..n]);
+                self.pieces[self.count].set(&p[..n]);
                 self.count += 1;
             }
         }
@@ -132,22 +162,30 @@ impl FaceOverlap {
             return 0.0;
         }
         let fb = Flat::new(b, &self.plane);
-        let (lo, hi) = fb.bounds();
+        let (lo, hi) = bounds_of(fb.nodes());
         // Boxes apart (strictly): the clip is empty.
-        if (0..2).any(|d| hi[d] < self.lo[d] || lo[d] > self.hi[d]) {
+        if (hi[0] < self.lo[0]) | (lo[0] > self.hi[0]) | (hi[1] < self.lo[1]) | (lo[1] > self.hi[1])
+        {
             return 0.0;
         }
         let (index, len) = fb.pieces();
+        if self.count == 1 && len[1] == 0 {
+            // Both convex (the common case): one clip.
+            let area = clip_piece_area(
+                fb.piece(&index[0], len[0]),
+                &self.pieces[0],
+                &mut self.buffers,
+            );
+            return area.map_or(0.0, |a| 0.0 + a);
+        }
         let mut area = 0.0;
         for piece in &self.pieces[..self.count] {
             for (idx, &n) in index.iter().zip(&len) {
                 if n == 0 {
                     continue;
                 }
-                let (pb, n) = fb.piece(idx, n);
-                let poly = clip_piece(&pb[..n], piece, &mut self.buffers);
-                if !poly.is_empty() {
-                    area += signed_area_polygon(poly);
+                if let Some(a) = clip_piece_area(fb.piece(idx, n), piece, &mut self.buffers) {
+                    area += a;
                 }
             }
         }
@@ -155,23 +193,34 @@ impl FaceOverlap {
     }
 }
 
-/// `mortar::clip_into(subject, clip)` for a prepared clip piece and a subject of at most
-/// 4 vertices, in `buffers`: the same operations in the same order, so the same result.
-fn clip_piece<'b>(subject: &[P2], clip: &ClipPiece, buffers: &'b mut [[P2; CAP]; 2]) -> &'b [P2] {
-    if subject.len() < 3 || clip.m < 3 {
-        return &[];
+/// The signed area of `mortar::clip_into(subject, clip)` for a prepared clip piece and a
+/// subject of at most 4 vertices (the first `n` of `subject`), clipped in `buffers` (`None` where `clip_into` gives an
+/// empty polygon): the same operations in the same order, so the same polygon and, as
+/// `signed_area_polygon` takes it, the same area. The clockwise result (that of an
+/// opposed side-B face, the common case) is measured with its vertices read backwards
+/// instead of being reversed.
+#[inline(always)]
+fn clip_piece_area(
+    (subject, n): ([P2; 4], usize),
+    clip: &ClipPiece,
+    buffers: &mut [[P2; CAP]; 2],
+) -> Option<f64> {
+    if n < 3 || clip.m < 3 {
+        return None;
     }
     let mut scale2 = clip.scale2;
-    for p in subject {
-        scale2 = scale2.max(p[0] * p[0] + p[1] * p[1]);
+    for p in &subject[..n] {
+        scale2 = larger(scale2, p[0] * p[0] + p[1] * p[1]);
     }
     if clip.area2.abs() <= 8.0 * f64::EPSILON * scale2 {
-        return &[];
+        return None;
     }
     let [a, b] = buffers;
     let (mut from, mut to) = (a, b);
-    from[..subject.len()].copy_from_slice(subject);
-    let mut n = subject.len();
+    // All four slots (fixed size: moves, not a call to copy); the first `n` are the
+    // subject's.
+    from[..4].copy_from_slice(&subject);
+    let mut n = n;
     for k in 0..clip.m {
         let (c0, e) = (clip.c0[k], clip.e[k]);
         let side = |p: P2| cross2(e, sub2(p, c0));
@@ -197,7 +246,7 @@ fn clip_piece<'b>(subject: &[P2], clip: &ClipPiece, buffers: &'b mut [[P2; CAP];
         std::mem::swap(&mut from, &mut to);
         n = w;
         if n == 0 {
-            return &[];
+            return None;
         }
     }
     let out = from;
@@ -219,20 +268,17 @@ fn clip_piece<'b>(subject: &[P2], clip: &ClipPiece, buffers: &'b mut [[P2; CAP];
     } {
         w -= 1;
     }
-    let poly = &mut out[..w];
+    let poly = &out[..w];
     let a2 = area2(poly);
     if w < 3 || a2.abs() <= 8.0 * f64::EPSILON * scale2 {
-        return &[];
+        return None;
     }
-    if a2 < 0.0 {
-        poly.reverse();
-    }
-    poly
+    Some(0.5 * if a2 < 0.0 { area2_reversed(poly) } else { a2 })
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::mortar::for_each_overlap;
+    use super::super::mortar::{for_each_overlap, signed_area_polygon};
     use super::*;
     use crate::vec3::V3;
 

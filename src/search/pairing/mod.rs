@@ -51,7 +51,7 @@ use super::bvh::{Aabb, Bvh};
 use super::settings::{Overclosure, SearchSettings};
 use crate::vec3::{V3, dot, scale, sub};
 
-use points::{BFace, Ctx, Rules, Scratch};
+use points::{Ctx, FaceTally, Rules, Scratch};
 
 /// The highest integration order accepted from input. A segment rule of order p on a
 /// triangle has ((p + 2)/2)² points built in O(p³) work, so an order in the thousands
@@ -180,8 +180,8 @@ pub struct Searcher {
     reach: f64,
 }
 
-/// One chunk's points and, per face, (matched weight, total weight, overlap area).
-type ChunkOut = (Vec<ContactPoint>, Vec<(f64, f64, f64)>);
+/// One chunk's points and its faces' tallies.
+type ChunkOut = (Vec<ContactPoint>, Vec<FaceTally>);
 
 /// Side-A faces per parallel chunk: large enough to amortise scheduling, fixed so
 /// results never depend on the thread count.
@@ -251,17 +251,6 @@ impl Searcher {
         subdomain: Option<Sphere>,
         overlap: bool,
     ) -> SearchResult {
-        // The overlap tests each side-B face for several side-A faces: its normal,
-        // centroid and distance limit once.
-        let b_faces: Vec<BFace> =
-            if overlap && matches!(integration, Integration::Quadrature { .. }) {
-                b.faces
-                    .par_iter()
-                    .map(|f| BFace::new(f, settings))
-                    .collect()
-            } else {
-                Vec::new()
-            };
         let ctx = Ctx {
             bvh: &self.bvh,
             margin: self.margin,
@@ -273,7 +262,6 @@ impl Searcher {
             cos_opposed: settings
                 .cull_opposed_normals
                 .then(|| settings.opposed_normal_threshold_angle.to_radians().cos()),
-            b_faces: &b_faces,
         };
         let mut result = SearchResult::default();
         let mut points: Vec<ContactPoint> = Vec::new();
@@ -299,39 +287,23 @@ impl Searcher {
                     slices.push((start, end, head));
                     rest = tail;
                 }
+                // One thread's scratch serves the chunks it takes (`map_init`): its
+                // buffers and side-B faces' data are kept from chunk to chunk.
                 let chunks: Vec<_> = slices
                     .into_par_iter()
-                    .map(|(start, end, slice)| {
-                        let mut scratch = Scratch::default();
-                        let mut points = Vec::new();
-                        let mut at = 0;
-                        let mut per_face = Vec::with_capacity(end - start);
-                        for fa in start..end {
-                            points.clear();
-                            let rule = rules.quadrature(a.faces[fa].len);
-                            let area = ctx.quadrature_face(
-                                a,
-                                fa,
-                                rule,
-                                overlap,
-                                &mut points,
-                                &mut scratch,
-                            );
-                            for (slot, p) in slice[at..at + points.len()].iter_mut().zip(&points) {
-                                slot.write(*p);
-                            }
-                            at += points.len();
-                            per_face.push(face_weights(&points, area));
-                        }
-                        (slice.len() - at, per_face)
+                    .map_init(Scratch::default, |scratch, (start, end, slice)| {
+                        let (written, per_face) =
+                            ctx.quadrature_faces(a, start..end, &rules, overlap, slice, scratch);
+                        (slice.len() - written, per_face)
                     })
                     .collect();
                 // Every chunk wrote as many points as its faces' rules have (`counts`).
                 assert!(chunks.iter().all(|(short, _)| *short == 0));
                 // SAFETY: the first `total` slots were cut into the chunks' slices, in
-                // order and without gaps, and each chunk wrote every slot of its slice.
+                // order and without gaps, and each chunk wrote every slot of its slice
+                // (`quadrature_faces` writes one per point of each face's rule, `counts`).
                 unsafe { points.set_len(total) };
-                chunks.into_iter().flat_map(|(_, f)| f).collect::<Vec<_>>()
+                chunks.into_iter().map(|(_, f)| f).collect::<Vec<_>>()
             }
             Rules::Segments { line, triangle } => {
                 let chunks: Vec<ChunkOut> = (0..a.faces.len())
@@ -352,28 +324,40 @@ impl Searcher {
                                 .filter(|p| p.status == PointStatus::Matched)
                                 .map(|p| p.weight)
                                 .sum();
-                            per_face.push(face_weights(&points[before..], area));
+                            let (hit, total) = face_weights(&points[before..]);
+                            per_face.push(FaceTally {
+                                hit,
+                                total,
+                                area,
+                                measure: a.faces[fa].measure(a.axisymmetric),
+                            });
                         }
                         (points, per_face)
                     })
                     .collect();
                 let total: usize = chunks.iter().map(|(points, _)| points.len()).sum();
                 points.reserve_exact(total + a.nodes.len());
-                let mut per_face = Vec::with_capacity(a.faces.len());
+                let mut per_face = Vec::with_capacity(chunks.len());
                 for (chunk, faces) in chunks {
                     points.extend(chunk);
-                    per_face.extend(faces);
+                    per_face.push(faces);
                 }
                 per_face
             }
         };
+        // The chunks' tallies, face after face.
+        let per_face = || per_face.iter().flatten();
         result.contact_fraction.reserve_exact(a.faces.len());
-        for (hit, total, overlap) in per_face {
+        for f in per_face() {
             result
                 .contact_fraction
-                .push(if total > 0.0 { hit / total } else { 0.0 });
-            result.stats.overlap_area += overlap;
+                .push(if f.total > 0.0 { f.hit / f.total } else { 0.0 });
+            result.stats.overlap_area += f.area;
         }
+        // `a.area()`, from the measures the faces' tallies hold: the same terms in the
+        // same order.
+        let faces_area: f64 = per_face().map(|f| f.measure).sum();
+        let side_a_area = faces_area + a.node_area.iter().sum::<f64>();
         for k in 0..a.nodes.len() {
             let p = ctx.pair_node(a, k);
             if overlap && p.status == PointStatus::Matched {
@@ -383,14 +367,14 @@ impl Searcher {
             points.push(p);
         }
         result.points = Arc::new(points);
-        result.stats.side_a_area = a.area();
+        result.stats.side_a_area = side_a_area;
         tally(&mut result);
         result
     }
 }
 
-/// A face's matched weight, total weight and overlap `area`, from its `points`.
-fn face_weights(points: &[ContactPoint], area: f64) -> (f64, f64, f64) {
+/// A face's matched weight and total weight, from its `points`.
+fn face_weights(points: &[ContactPoint]) -> (f64, f64) {
     let (mut hit, mut total) = (0.0, 0.0);
     for p in points {
         total += p.weight;
@@ -398,7 +382,7 @@ fn face_weights(points: &[ContactPoint], area: f64) -> (f64, f64, f64) {
             hit += p.weight;
         }
     }
-    (hit, total, area)
+    (hit, total)
 }
 
 /// How far a search looks from each side-B face, fixed by side B's face sizes.

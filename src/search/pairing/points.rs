@@ -15,6 +15,8 @@ use crate::search::mortar::{
     segments_face_face_into, segments_line_line_into,
 };
 use crate::search::settings::SearchSettings;
+use std::mem::MaybeUninit;
+
 use crate::vec3::{V3, dot, norm, scale, sub};
 
 use super::geometry::{FaceGeom, SurfaceGeometry, face_jacobian, face_rule, revolution};
@@ -29,14 +31,11 @@ pub(super) struct Ctx<'a> {
     pub(super) subdomain: Option<Sphere>,
     pub(super) cos_check: f64,
     pub(super) cos_opposed: Option<f64>,
-    /// Per side-B face, what the overlap diagnostic tests it by (empty when no overlap
-    /// is computed).
-    pub(super) b_faces: &'a [BFace],
 }
 
-/// What the overlap diagnostic asks of a side-B face, made once per search rather than
-/// once for each side-A face near it: its unit normal, centroid and acceptance distance
-/// ([`Ctx::distance_limit`]).
+/// What the overlap diagnostic asks of a side-B face, made once per thread (see
+/// [`BFaces`]) rather than once for each side-A face near it: its unit normal, centroid
+/// and acceptance distance ([`Ctx::distance_limit`]), as `FaceGeom` makes them.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BFace {
     normal: V3,
@@ -46,11 +45,58 @@ pub(super) struct BFace {
 
 impl BFace {
     pub(super) fn new(face: &FaceGeom, settings: &SearchSettings) -> BFace {
+        // One vector area for the normal and the size (`FaceGeom::normal`, `size`).
+        let va = face.vector_area();
+        let area = norm(va);
+        let size = if face.len == 2 { area } else { area.sqrt() };
         BFace {
-            normal: face.normal(),
+            normal: if area > 0.0 {
+                scale(va, 1.0 / area)
+            } else {
+                [0.0; 3]
+            },
             centroid: face.centroid(),
-            limit: distance_limit(settings, face),
+            limit: settings
+                .normal_tolerance
+                .unwrap_or(settings.field_factor * size),
         }
+    }
+}
+
+/// The [`BFace`]s one thread has made, in a direct-mapped table by face index: side-A
+/// faces come in mesh order, so the side-B faces near one are near the next ones too, and
+/// the table (4096 faces: a few rows of a mesh) holds them while they are wanted. No
+/// table for all of side B: one per search, written before it is read, cost a tenth of
+/// the search in page faults and made the faces no side-A face overlaps.
+#[derive(Default)]
+pub(super) struct BFaces {
+    tags: Vec<u32>,
+    data: Vec<BFace>,
+}
+
+impl BFaces {
+    const SLOTS: usize = 4096;
+
+    fn get(&mut self, j: usize, face: &FaceGeom, settings: &SearchSettings) -> BFace {
+        if self.tags.is_empty() {
+            self.tags = vec![u32::MAX; Self::SLOTS];
+            self.data = vec![
+                BFace {
+                    normal: [0.0; 3],
+                    centroid: [0.0; 3],
+                    limit: 0.0,
+                };
+                Self::SLOTS
+            ];
+        }
+        let slot = j & (Self::SLOTS - 1);
+        // Face indices are below u32::MAX (the tree's bound), so no face matches an
+        // empty slot.
+        if self.tags[slot] != j as u32 {
+            self.data[slot] = BFace::new(face, settings);
+            self.tags[slot] = j as u32;
+        }
+        self.data[slot]
     }
 }
 
@@ -105,16 +151,74 @@ impl Rules {
 /// One side-A point of a face: ξ_A, x, weight, outside the subdomain.
 type FacePoint = ([f64; 2], V3, f64, bool);
 
+/// A candidate of one point: its place among the group's gathered faces and the squared
+/// distance of its own box from the point.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Near {
+    d2: f64,
+    k: u32,
+}
+
+/// What a side-A face adds to the search's sums: its points' matched and total weight,
+/// its overlap area and its measure ([`FaceGeom::measure`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct FaceTally {
+    pub(super) hit: f64,
+    pub(super) total: f64,
+    pub(super) area: f64,
+    pub(super) measure: f64,
+}
+
+/// The most side-A faces whose candidates one walk of the tree gathers
+/// ([`Ctx::quadrature_faces`]).
+const GROUP: usize = 8;
+
+/// How far the faces of a group may spread: the extent of their boxes' union at most this
+/// many times the first face's extent plus the margin (8 faces in a row of a regular
+/// mesh). A mesh's next row starts far away and so starts a new group.
+const GROUP_SPREAD: f64 = 4.0;
+
+/// The largest side of a box (0 when empty).
+fn extent(b: &Aabb) -> f64 {
+    (0..3).fold(0.0, |e: f64, k| e.max(b.max[k] - b.min[k]))
+}
+
+/// A side-A face of a group, its points made ([`Ctx::prepare_face`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct GroupFace {
+    fa: usize,
+    n_a: V3,
+    centroid: V3,
+    measure: f64,
+    area_wanted: bool,
+    /// The face's box.
+    bounds: Aabb,
+    /// Its query box grown for the tree; `None` when it has none (every point outside
+    /// the subdomain, and no overlap).
+    grown: Option<Aabb>,
+    /// Its points in the group's list, from and to.
+    points: (usize, usize),
+}
+
 /// Buffers of one thread's faces, kept from face to face so that the search allocates
 /// only when a face needs more room than any before it.
 #[derive(Default)]
 pub(super) struct Scratch {
+    /// The points of the group's faces.
     points: Vec<FacePoint>,
-    /// Side-B faces (index, tree box) from the face's one query.
-    near: Vec<(usize, Aabb)>,
+    /// The group's faces.
+    group: Vec<GroupFace>,
+    /// Side-B faces (index, tree box) the group's walk gathered.
+    gathered: Vec<(usize, Aabb)>,
+    /// The face's candidates: those of `gathered` its own query box meets.
+    near: Vec<u32>,
+    /// One point's candidates among `near`, nearest first.
+    order: Vec<Near>,
     /// The overlap's candidates, ascending.
     overlap: Vec<usize>,
     clip: Option<FaceOverlap>,
+    /// The side-B faces' overlap data made so far.
+    b_faces: BFaces,
     pub(super) mortar: Vec<MortarPoint>,
     /// Where the last face's tree query found its first face.
     hint: QueryHint,
@@ -142,6 +246,19 @@ impl Ctx<'_> {
         q: &Aabb,
         mut visit: impl FnMut(usize, &Aabb),
     ) {
+        let grown = self.grown(q);
+        let accept = |tree: &Aabb| tree.intersects(&grown);
+        match hint {
+            Some(hint) => self
+                .bvh
+                .query_by_with_hint(hint, accept, |j, tree| visit(j, tree)),
+            None => self.bvh.query_by(accept, |j, tree| visit(j, tree)),
+        }
+    }
+
+    /// The box that [`Self::near`] tests the tree's boxes against for the query `q`:
+    /// `q` grown by `reach − margin` and the slack.
+    fn grown(&self, q: &Aabb) -> Aabb {
         let reach = self.reach2.sqrt() * (1.0 + 1e-9) + 1e-150;
         let size = q
             .min
@@ -151,14 +268,7 @@ impl Ctx<'_> {
         let slack = 1e-12 * (size + self.margin + reach);
         // Infinite margin and reach (no pruning possible) give NaN: then take all.
         let grow = reach - self.margin + slack;
-        let grown = q.inflate(if grow.is_nan() { f64::INFINITY } else { grow });
-        let accept = |tree: &Aabb| tree.intersects(&grown);
-        match hint {
-            Some(hint) => self
-                .bvh
-                .query_by_with_hint(hint, accept, |j, tree| visit(j, tree)),
-            None => self.bvh.query_by(accept, |j, tree| visit(j, tree)),
-        }
+        q.inflate(if grow.is_nan() { f64::INFINITY } else { grow })
     }
 
     /// Side-B faces whose tree box meets `face`'s box and whose own box comes within
@@ -223,16 +333,41 @@ impl Ctx<'_> {
     }
 
     /// Pair `x` among the candidates of a query that covered it: the same tests as
-    /// [`Self::pair`] on the same faces.
-    fn pair_among(&self, x: V3, n_a: V3, near: &[(usize, Aabb)]) -> Best {
+    /// [`Self::pair`] on the same faces, taken nearest first (by the distance of their
+    /// own box), so that a face that has the point inside comes early and the distance
+    /// bound of [`Self::consider`] ends the rest unprojected. The outcome does not depend
+    /// on the order: the best face is the least by its rank key, and a face skipped by the
+    /// bound could not have beaten it.
+    ///
+    /// The candidates are `gathered[k]` for `k` in `near`.
+    fn pair_among(
+        &self,
+        (x, n_a): (V3, V3),
+        gathered: &[(usize, Aabb)],
+        near: &[u32],
+        order: &mut Vec<Near>,
+    ) -> Best {
         let mut best = Best {
             found: None,
             rejected: PointStatus::Unmatched,
         };
         let query = Aabb::from_point(x);
-        for (j, tree) in near {
+        order.clear();
+        for &k in near {
+            let (_, tree) = &gathered[k as usize];
             if tree.intersects(&query) {
-                self.consider(*j, tree, x, n_a, &mut best);
+                // Farther from the face's own box than the reach: no projection can pass.
+                let d2 = own_box(tree, self.margin).distance2_to_point(x);
+                if d2 <= self.reach2 {
+                    order.push(Near { d2, k });
+                }
+            }
+        }
+        sort_by_distance(order);
+        for c in order.iter() {
+            let (j, _) = gathered[c.k as usize];
+            if !self.consider_within(j, c.d2, x, n_a, &mut best) {
+                break;
             }
         }
         best
@@ -247,6 +382,14 @@ impl Ctx<'_> {
         if d2 > self.reach2 {
             return;
         }
+        self.consider_within(j, d2, x, n_a, best);
+    }
+
+    /// [`Self::consider`] of a face within the reach, its own box at squared distance
+    /// `d2` from `x`; `false` when the face was skipped for being farther than the best
+    /// face so far allows (and so is every face farther than it).
+    #[inline]
+    fn consider_within(&self, j: usize, d2: f64, x: V3, n_a: V3, best: &mut Best) -> bool {
         // A face that has the point inside loses only to another that has it inside at
         // a smaller or equal |gap|, which is then the distance to that face, at least
         // the distance to its box. The slack covers the rounding of the own box (ε of
@@ -257,28 +400,29 @@ impl Ctx<'_> {
             let size = x.iter().fold(self.margin, |s, v| s.max(v.abs()));
             let bound = g * (1.0 + 1e-9) + 1e-6 * self.reach2.sqrt() + 1e-12 * size;
             if d2 > bound * bound {
-                return;
+                return false;
             }
         }
         let face = &self.b.faces[j];
         let pr = face.project(x);
         if pr.degenerate || !(pr.inside || self.within_tangential(face, &pr.point, x)) {
-            return;
+            return true;
         }
         if !self.normals_ok(n_a, pr.normal) {
             best.rejected = PointStatus::RejectedAngle;
-            return;
+            return true;
         }
         if pr.gap.abs() > self.distance_limit(face) {
             if best.rejected != PointStatus::RejectedAngle {
                 best.rejected = PointStatus::RejectedDistance;
             }
-            return;
+            return true;
         }
         let key = (!pr.inside, pr.gap.abs(), j as u32);
         if best.found.is_none_or(|(k, ..)| key < k) {
             best.found = Some((key, pr.xi, pr.gap, pr.normal));
         }
+        true
     }
 
     /// A point that did not project inside may still pair if it lies within the
@@ -316,60 +460,184 @@ impl Ctx<'_> {
         self.point(None, Some(k as u32), [0.0; 2], x, w, n)
     }
 
-    /// The points of side-A face `fa` (`rule`: its Gauss rule on the reference face),
-    /// paired and appended to `out`; returns the face's overlap area (see
-    /// [`Self::overlap_among`]) when `overlap`, else 0. One tree query serves the
-    /// points and the overlap: its box holds them all, and each keeps the candidates
-    /// its own query would have found.
-    pub(super) fn quadrature_face(
+    /// The points of side-A faces `faces` (consecutive, each with its Gauss rule of
+    /// `rules`), paired and written to `out` (one slot per point, face after face);
+    /// returns the count written and each face's tally, with its overlap area (see
+    /// [`Self::overlap_among`]) when `overlap`, else 0.
+    ///
+    /// One tree query per face serves its points and its overlap: its box holds them
+    /// all, and each keeps the candidates its own query would have found. And one walk of
+    /// the tree serves a group of up to [`GROUP`] faces that lie close together (as the
+    /// faces of a mesh do, one after the other): it gathers the faces that the union of
+    /// their query boxes meets, among which each face's query keeps those its own box
+    /// meets — the same faces its own walk would have found, since a box that meets a
+    /// face's box meets the union.
+    pub(super) fn quadrature_faces(
         &self,
         a: &SurfaceGeometry,
-        fa: usize,
-        rule: &[([f64; 2], f64)],
+        faces: std::ops::Range<usize>,
+        rules: &Rules,
         overlap: bool,
-        out: &mut Vec<ContactPoint>,
+        out: &mut [MaybeUninit<ContactPoint>],
         s: &mut Scratch,
-    ) -> f64 {
+    ) -> (usize, Vec<FaceTally>) {
+        let mut tallies = Vec::with_capacity(faces.len());
+        let mut at = 0;
+        let mut next = faces.start;
+        while next < faces.end {
+            // The group: faces that stay within `GROUP_SPREAD` times the first one's
+            // extent (plus the margin), their points and grown query boxes.
+            s.group.clear();
+            s.points.clear();
+            let mut spread = Aabb::EMPTY;
+            let mut limit = 0.0;
+            let mut union = Aabb::EMPTY;
+            while next < faces.end && s.group.len() < GROUP {
+                let bounds = a.faces[next].aabb();
+                let wider = spread.union(&bounds);
+                let within = extent(&wider) <= limit;
+                if s.group.is_empty() {
+                    limit = GROUP_SPREAD * (extent(&bounds) + self.margin);
+                } else if !within {
+                    break;
+                }
+                spread = wider;
+                let face = self.prepare_face(a, (next, bounds), rules, overlap, &mut s.points);
+                if let Some(grown) = &face.grown {
+                    union = union.union(grown);
+                }
+                s.group.push(face);
+                next += 1;
+            }
+            s.gathered.clear();
+            // (A grown box may be turned inside out, min above max: `is_empty` says
+            // nothing of whether it meets a box.)
+            if s.group.iter().any(|f| f.grown.is_some()) {
+                let accept = |tree: &Aabb| tree.intersects(&union);
+                let gathered = &mut s.gathered;
+                self.bvh
+                    .query_by_with_hint(&mut s.hint, accept, |j, tree| gathered.push((j, *tree)));
+            }
+            for g in 0..s.group.len() {
+                let face = s.group[g];
+                let count = face.points.1 - face.points.0;
+                s.near.clear();
+                if let Some(grown) = &face.grown {
+                    // Every gathered face written, the count advanced by whether it is
+                    // kept: no branch to guess per face.
+                    s.near.resize(s.gathered.len(), 0);
+                    let mut kept = 0;
+                    for (k, (_, tree)) in s.gathered.iter().enumerate() {
+                        s.near[kept] = k as u32;
+                        kept += usize::from(tree.intersects(grown));
+                    }
+                    s.near.truncate(kept);
+                }
+                let slots = &mut out[at..at + count];
+                at += count;
+                tallies.push(self.quadrature_face(a, &face, slots, s));
+            }
+        }
+        (at, tallies)
+    }
+
+    /// The points of side-A face `fa` (its box `bounds`) and its query box, grown for
+    /// the tree ([`Self::grown`]); the points are appended to `points`.
+    fn prepare_face(
+        &self,
+        a: &SurfaceGeometry,
+        (fa, bounds): (usize, Aabb),
+        rules: &Rules,
+        overlap: bool,
+        points: &mut Vec<FacePoint>,
+    ) -> GroupFace {
         let face = &a.faces[fa];
-        let n_a = face.normal();
+        // The normal and the measure from one vector area (as `FaceGeom::normal` and
+        // `FaceGeom::measure` make them).
+        let va = face.vector_area();
+        let length = norm(va);
+        let n_a = if length > 0.0 {
+            scale(va, 1.0 / length)
+        } else {
+            [0.0; 3]
+        };
+        let centroid = face.centroid();
+        let measure = length * revolution(a.axisymmetric, centroid);
         let mut query = Aabb::EMPTY;
-        s.points.clear();
-        for &(xi, w) in rule {
+        let start = points.len();
+        for &(xi, w) in rules.quadrature(face.len) {
             let x = face.map(xi);
             let w = w * face_jacobian(face, xi) * revolution(a.axisymmetric, x);
             let outside = self.outside(x);
             if !outside {
                 query = query.union(&Aabb::from_point(x));
             }
-            s.points.push((xi, x, w, outside));
+            points.push((xi, x, w, outside));
         }
-        let area_wanted = overlap && !self.outside(face.centroid());
-        let faces = face.aabb();
+        let area_wanted = overlap && !self.outside(centroid);
         if area_wanted {
-            query = query.union(&faces);
+            query = query.union(&bounds);
         }
-        s.near.clear();
-        if !query.is_empty() {
-            // Side-A faces come in mesh order, mostly next to the one before: the walk
-            // starts where the last face's query found its first face.
-            self.near_from(Some(&mut s.hint), &query, |j, tree| s.near.push((j, *tree)));
+        GroupFace {
+            fa,
+            n_a,
+            centroid,
+            measure,
+            area_wanted,
+            bounds,
+            grown: (!query.is_empty()).then(|| self.grown(&query)),
+            points: (start, points.len()),
         }
+    }
+
+    /// One face of a group ([`Self::quadrature_faces`]), its candidates in `s.near`: its
+    /// points paired and written to `out`, and its tally.
+    fn quadrature_face(
+        &self,
+        a: &SurfaceGeometry,
+        face: &GroupFace,
+        out: &mut [MaybeUninit<ContactPoint>],
+        s: &mut Scratch,
+    ) -> FaceTally {
+        let (fa, n_a) = (face.fa, face.n_a);
         let a_face = Some(fa as u32);
-        for &(xi, x, w, outside) in &s.points {
-            let best = (!outside).then(|| self.pair_among(x, n_a, &s.near));
-            out.push(contact_point(a_face, None, xi, x, w, n_a, best));
+        let (mut hit, mut total) = (0.0, 0.0);
+        let points = &s.points[face.points.0..face.points.1];
+        for (slot, &(xi, x, w, outside)) in out.iter_mut().zip(points) {
+            let best =
+                (!outside).then(|| self.pair_among((x, n_a), &s.gathered, &s.near, &mut s.order));
+            let p = contact_point(a_face, None, xi, x, w, n_a, best);
+            total += p.weight;
+            if p.status == PointStatus::Matched {
+                hit += p.weight;
+            }
+            slot.write(p);
         }
-        if !area_wanted {
-            return 0.0;
+        let mut tally = FaceTally {
+            hit,
+            total,
+            area: 0.0,
+            measure: face.measure,
+        };
+        if !face.area_wanted {
+            return tally;
         }
         s.overlap.clear();
-        for (j, tree) in &s.near {
-            if self.overlap_candidate(&faces, tree) {
+        for &k in &s.near {
+            let (j, tree) = &s.gathered[k as usize];
+            if self.overlap_candidate(&face.bounds, tree) {
                 s.overlap.push(*j);
             }
         }
         sort_small(&mut s.overlap);
-        self.overlap_among(a, fa, &s.overlap, &mut s.clip)
+        tally.area = self.overlap_among(
+            a,
+            fa,
+            (n_a, face.centroid),
+            &s.overlap,
+            (&mut s.clip, &mut s.b_faces),
+        );
+        tally
     }
 
     /// The mortar segment points of side-A face `fa` against the side-B faces near it
@@ -432,15 +700,17 @@ impl Ctx<'_> {
     /// Overlap area of side-A face `fa` (its centroid inside the subdomain) with side B
     /// in quadrature mode: the clipped overlap with every side-B face among
     /// `candidates` (ascending) the pairing would accept for that face: opposed
-    /// normals, and a centroid within the acceptance distance of the face's plane.
+    /// normals, and a centroid within the acceptance distance of the face's plane
+    /// (`n_a`, `c_a`: the face's normal and centroid, as `FaceGeom` makes them).
     /// (In segment mode the matched points' weights sum to it exactly.) `clip` keeps
     /// the clipping buffers from face to face.
     fn overlap_among(
         &self,
         a: &SurfaceGeometry,
         fa: usize,
+        (n_a, c_a): (V3, V3),
         candidates: &[usize],
-        clip: &mut Option<FaceOverlap>,
+        (clip, b_faces): (&mut Option<FaceOverlap>, &mut BFaces),
     ) -> f64 {
         let face = &a.faces[fa];
         let mut clip = match face.len {
@@ -453,17 +723,13 @@ impl Ctx<'_> {
                 Some(clip)
             }
         };
-        let (n_a, c_a) = (face.normal(), face.centroid());
         let mut area = 0.0;
         let mut scratch = Vec::new();
         // An axisymmetric edge's rule, made only for such a face.
         let mut midpoint = None;
         for &j in candidates {
             let fb = &self.b.faces[j];
-            let data = match self.b_faces.get(j) {
-                Some(data) => *data,
-                None => BFace::new(fb, self.settings),
-            };
+            let data = b_faces.get(j, fb, self.settings);
             if !self.normals_ok(n_a, data.normal)
                 || dot(sub(data.centroid, c_a), n_a).abs() > data.limit
             {
@@ -502,6 +768,20 @@ fn sort_small(v: &mut [usize]) {
         let x = v[i];
         let mut k = i;
         while k > 0 && v[k - 1] > x {
+            v[k] = v[k - 1];
+            k -= 1;
+        }
+        v[k] = x;
+    }
+}
+
+/// Nearest first, by insertion (a point has a few candidates); equal distances keep
+/// their order.
+fn sort_by_distance(v: &mut [Near]) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut k = i;
+        while k > 0 && v[k - 1].d2 > x.d2 {
             v[k] = v[k - 1];
             k -= 1;
         }
