@@ -40,6 +40,7 @@ pub mod run;
 pub mod scene;
 pub mod script;
 pub mod search;
+pub(crate) mod slices;
 pub mod solve;
 pub mod surface;
 pub(crate) mod vec3;

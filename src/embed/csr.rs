@@ -7,7 +7,10 @@
 //! does not change between evaluations however h changes. Each block entry's place in
 //! `values` is found once (`slots`); a refresh is then one pass over the blocks.
 
+use rayon::prelude::*;
+
 use super::{EmbedError, Embedding, Heat};
+use crate::slices::pieces;
 
 /// A square sparse matrix in compressed sparse row form, in the host's dof numbers:
 /// row `i` holds `columns[row_offsets[i]..row_offsets[i + 1]]` (sorted, no repeats)
@@ -290,10 +293,14 @@ impl Embedding {
                 *at += dofs.len();
             }
         }
+        // Rows sorted in parallel (each its own slice), then made unique in one pass.
+        let lengths = row_offsets.windows(2).map(|w| w[1] - w[0]);
+        let mut rows = pieces(&mut columns, lengths);
+        rows.par_iter_mut().for_each(|row| row.sort_unstable());
+        drop(rows);
         let mut kept = 0;
         for i in 0..n {
             let (a, b) = (row_offsets[i], row_offsets[i + 1]);
-            columns[a..b].sort_unstable();
             row_offsets[i] = kept;
             for k in a..b {
                 if k == a || columns[k] != columns[k - 1] {
@@ -311,15 +318,19 @@ impl Embedding {
                 .binary_search(&j)
                 .expect("the pattern holds every block entry")
         };
+        // Each group's entries written in place, group by group in parallel.
         let slots = blocks
             .iter()
             .map(|pair| {
-                let mut out = Vec::new();
-                for dofs in pair {
-                    for &i in dofs {
-                        out.extend(dofs.iter().map(|&j| slot(host(i), host(j))));
+                let mut out = vec![0; pair.iter().map(|dofs| dofs.len().pow(2)).sum()];
+                let lengths = pair.iter().map(|dofs| dofs.len().pow(2));
+                let groups = pieces(&mut out, lengths);
+                groups.into_par_iter().zip(pair).for_each(|(to, dofs)| {
+                    let row = |&i: &u32| dofs.iter().map(move |&j| slot(host(i), host(j)));
+                    for (t, s) in to.iter_mut().zip(dofs.iter().flat_map(row)) {
+                        *t = s;
                     }
-                }
+                });
                 out
             })
             .collect();

@@ -12,6 +12,9 @@
 //! ([`ContactTerms::term_choice`] maps that order to the interactions').
 
 use std::cell::{OnceCell, Ref, RefCell};
+use std::cmp::Ordering;
+
+use rayon::prelude::*;
 
 use crate::assembly::{Assembler, DofMap};
 use crate::diag::{Diagnostic, Diagnostics};
@@ -21,6 +24,7 @@ use crate::heat::interfaces::{InterfaceFailure, Interfaces, TieRows};
 use crate::mesh::NodeId;
 use crate::search::pairing::{Integration, SearchSchedule};
 use crate::search::scene::Pairing;
+use crate::slices::pieces;
 
 use super::contact::{Couplings, RunContact};
 use super::death::Death;
@@ -816,32 +820,54 @@ impl Interfaces for ContactTerms<'_> {
         // The structure only: `assemble` evaluates the terms into it.
         let ev = embedding.pattern(u.len()).map_err(failure)?;
         let (pattern, j) = (ev.pattern, &ev.jacobian);
-        let mut slots: Vec<Option<Slot>> = vec![None; j.columns.len()];
-        let mut pairs = Vec::new();
-        for i in 0..j.n {
-            for k in j.row_offsets[i]..j.row_offsets[i + 1] {
-                let col = j.columns[k];
-                if col == i {
-                    slots[k] = Some(Slot::Diagonal(i));
-                    continue;
-                }
-                if slots[k].is_some() {
-                    continue; // the transpose of an entry already paired
-                }
-                let c = pairs.len();
-                pairs.push((i, col));
-                slots[k] = Some(Slot::Upper(c));
-                let (a, b) = (j.row_offsets[col], j.row_offsets[col + 1]);
-                if let Ok(at) = j.columns[a..b].binary_search(&i) {
-                    slots[a + at] = Some(Slot::Lower(c));
-                }
-            }
+        // Coupling c is the c-th entry right of the diagonal in row order; (j, i) is
+        // the transpose of (i, j). Rows are sorted, so a row's couplings are its tail.
+        let (offsets, columns) = (&j.row_offsets, &j.columns);
+        let first_upper = |i: usize| {
+            let row = &columns[offsets[i]..offsets[i + 1]];
+            offsets[i] + row.partition_point(|&c| c <= i)
+        };
+        let mut start: Vec<usize> = (0..j.n)
+            .into_par_iter()
+            .map(|i| offsets[i + 1] - first_upper(i))
+            .collect();
+        let mut total = 0;
+        for s in start.iter_mut() {
+            (*s, total) = (total, total + *s);
         }
-        // Every entry got a slot: (i, i) its diagonal, (i, j) a coupling or its transpose.
+        // Pairs and slots written in place, row by row in parallel.
+        let mut pairs = vec![(0, 0); total];
+        let lengths = (0..j.n).map(|i| offsets[i + 1] - first_upper(i));
+        let rows = pieces(&mut pairs, lengths);
+        rows.into_par_iter().enumerate().for_each(|(i, to)| {
+            let upper = &columns[first_upper(i)..offsets[i + 1]];
+            for (p, &c) in to.iter_mut().zip(upper) {
+                *p = (i, c);
+            }
+        });
+        // Every entry gets a slot: (i, i) its diagonal, (i, j) a coupling or its
+        // transpose (the structure is symmetric: each block is dofs × dofs); `None`
+        // for an entry whose transpose is missing.
+        let mut slots = vec![None; columns.len()];
+        let rows = pieces(&mut slots, offsets.windows(2).map(|w| w[1] - w[0]));
+        rows.into_par_iter().enumerate().for_each(|(i, to)| {
+            let (a, upper) = (offsets[i], first_upper(i));
+            for (k, (t, &c)) in to.iter_mut().zip(&columns[a..offsets[i + 1]]).enumerate() {
+                *t = match c.cmp(&i) {
+                    Ordering::Equal => Some(Slot::Diagonal(i)),
+                    Ordering::Greater => Some(Slot::Upper(start[i] + a + k - upper)),
+                    Ordering::Less => {
+                        let transposed = &columns[first_upper(c)..offsets[c + 1]];
+                        (transposed.binary_search(&i).ok()).map(|at| Slot::Lower(start[c] + at))
+                    }
+                };
+            }
+        });
         let slots: Option<Vec<Slot>> = slots.into_iter().collect();
         let slots = slots.ok_or_else(|| {
             InterfaceFailure::Failed("an interface Jacobian entry without a place".into())
         })?;
+        drop(start);
         *e.slots.borrow_mut() = (pattern, slots);
         drop(embedding);
         self.moving.borrow_mut().pairs = pairs.clone();

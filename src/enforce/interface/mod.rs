@@ -418,6 +418,23 @@ struct CachedPoint {
     k0: [f64; 2],
 }
 
+impl CachedPoint {
+    /// A place holder, overwritten before it is read.
+    const EMPTY: CachedPoint = CachedPoint {
+        index: 0,
+        elem: 0,
+        side: 0,
+        na: 0,
+        at: 0,
+        weight: 0.0,
+        gap: 0.0,
+        x: [0.0; 3],
+        alpha: 0.0,
+        blocks: [0; 2],
+        k0: [0.0; 2],
+    };
+}
+
 impl InterfacePoints {
     /// Number of element-pair groups (dense blocks).
     pub fn groups(&self) -> usize {

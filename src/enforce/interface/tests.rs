@@ -168,3 +168,77 @@ fn couplings_and_scatter_place_every_entry() {
     };
     assert_eq!(bits(&into), bits(&fast));
 }
+
+/// Built on one thread and on two, an interface of several runs of groups (36 864
+/// points, more than two runs of `RUN`) gives the same points, values and groups; and
+/// the layout is that of one pass in group order: every matched point once, groups of
+/// increasing elements holding their points in pairing order, each point's jump and
+/// flux entries right after the previous point's.
+#[test]
+fn points_made_in_runs_do_not_depend_on_the_thread_count() {
+    let mesh = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.1], [96, 96, 1], 1)
+                .with_side_sets([0, 0, 0, 0, 0, 1]),
+            BoxSpec::hex([0.0, 0.0, 0.1], [1.0, 1.0, 0.2], [83, 83, 1], 2)
+                .with_side_sets([0, 0, 0, 0, 2, 0]),
+        ],
+        false,
+    );
+    let a = SurfaceGeometry::from_side_set(&mesh, 0).unwrap();
+    let b = SurfaceGeometry::from_side_set(&mesh, 1).unwrap();
+    let settings = SearchSettings::defaults(3);
+    let r = Searcher::new(&b, &settings).search_points(
+        &a,
+        &b,
+        &settings,
+        Integration::Quadrature { order: 2 },
+        None,
+    );
+    let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();
+    let field = dofs.field("temperature").unwrap();
+    let make = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            InterfacePoints::new(&mesh, &dofs, field, &a, &b, &r.points, &form(&H)).unwrap()
+        })
+    };
+    let one = make(1);
+    assert!(one.len() > 2 * points::RUN, "{} points", one.len());
+    assert_eq!(format!("{one:?}"), format!("{:?}", make(2)));
+
+    let matched = r
+        .points
+        .iter()
+        .filter(|p| p.matched_b_face().is_some())
+        .count();
+    assert_eq!(one.points.len(), matched);
+    let mut seen = vec![false; r.points.len()];
+    let mut at = 0;
+    let mut last_pair = None;
+    for g in 0..one.groups() {
+        let group = &one.points[one.group_points[g]..one.group_points[g + 1]];
+        let nl = one.group(g).len();
+        let (ka, _) = r.points[group[0].index as usize].matched_faces().unwrap();
+        let kb = r.points[group[0].index as usize].matched_b_face().unwrap();
+        let pair = (a.faces[ka].side.elem.0, b.faces[kb].side.elem.0);
+        assert!(
+            last_pair < Some(pair),
+            "group {g}: {pair:?} after {last_pair:?}"
+        );
+        last_pair = Some(pair);
+        for (k, p) in group.iter().enumerate() {
+            assert!(
+                k == 0 || group[k - 1].index < p.index,
+                "group {g} out of order"
+            );
+            assert!(!std::mem::replace(&mut seen[p.index as usize], true));
+            assert_eq!(p.at as usize, at, "group {g} point {k}");
+            at += 2 * nl;
+        }
+    }
+    assert_eq!(at, one.values.len());
+}
