@@ -16,6 +16,22 @@ pub(crate) fn pieces<T>(v: &mut [T], lengths: impl IntoIterator<Item = usize>) -
     lengths.into_iter().map(|n| take(&mut rest, n)).collect()
 }
 
+/// The pieces of [`pieces`] that are not empty, each with its place in `lengths`: for
+/// a matrix whose few rows hold anything.
+pub(crate) fn filled_pieces<T>(
+    v: &mut [T],
+    lengths: impl IntoIterator<Item = usize>,
+) -> Vec<(usize, &mut [T])> {
+    let mut rest = v;
+    let mut out = Vec::new();
+    for (i, n) in lengths.into_iter().enumerate() {
+        if n > 0 {
+            out.push((i, take(&mut rest, n)));
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -26,5 +42,9 @@ mod tests {
         assert_eq!(&*p[0], &[0, 1, 2]);
         assert!(p[1].is_empty());
         assert_eq!(&*p[2], &[3, 4, 5, 6]);
+        let f = super::filled_pieces(&mut v, [0, 2, 0, 1]);
+        assert_eq!(f.len(), 2);
+        assert_eq!((f[0].0, &*f[0].1), (1, &[0, 1][..]));
+        assert_eq!((f[1].0, &*f[1].1), (3, &[2][..]));
     }
 }

@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use super::{EmbedError, Embedding, Heat};
-use crate::slices::pieces;
+use crate::slices::{filled_pieces, pieces};
 
 /// A square sparse matrix in compressed sparse row form, in the host's dof numbers:
 /// row `i` holds `columns[row_offsets[i]..row_offsets[i + 1]]` (sorted, no repeats)
@@ -295,8 +295,8 @@ impl Embedding {
         }
         // Rows sorted in parallel (each its own slice), then made unique in one pass.
         let lengths = row_offsets.windows(2).map(|w| w[1] - w[0]);
-        let mut rows = pieces(&mut columns, lengths);
-        rows.par_iter_mut().for_each(|row| row.sort_unstable());
+        let mut rows = filled_pieces(&mut columns, lengths);
+        rows.par_iter_mut().for_each(|(_, row)| row.sort_unstable());
         drop(rows);
         let mut kept = 0;
         for i in 0..n {

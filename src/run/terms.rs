@@ -24,7 +24,7 @@ use crate::heat::interfaces::{InterfaceFailure, Interfaces, TieRows};
 use crate::mesh::NodeId;
 use crate::search::pairing::{Integration, SearchSchedule};
 use crate::search::scene::Pairing;
-use crate::slices::pieces;
+use crate::slices::filled_pieces;
 
 use super::contact::{Couplings, RunContact};
 use super::death::Death;
@@ -838,8 +838,8 @@ impl Interfaces for ContactTerms<'_> {
         // Pairs and slots written in place, row by row in parallel.
         let mut pairs = vec![(0, 0); total];
         let lengths = (0..j.n).map(|i| offsets[i + 1] - first_upper(i));
-        let rows = pieces(&mut pairs, lengths);
-        rows.into_par_iter().enumerate().for_each(|(i, to)| {
+        let rows = filled_pieces(&mut pairs, lengths);
+        rows.into_par_iter().for_each(|(i, to)| {
             let upper = &columns[first_upper(i)..offsets[i + 1]];
             for (p, &c) in to.iter_mut().zip(upper) {
                 *p = (i, c);
@@ -849,8 +849,8 @@ impl Interfaces for ContactTerms<'_> {
         // transpose (the structure is symmetric: each block is dofs × dofs); `None`
         // for an entry whose transpose is missing.
         let mut slots = vec![None; columns.len()];
-        let rows = pieces(&mut slots, offsets.windows(2).map(|w| w[1] - w[0]));
-        rows.into_par_iter().enumerate().for_each(|(i, to)| {
+        let rows = filled_pieces(&mut slots, offsets.windows(2).map(|w| w[1] - w[0]));
+        rows.into_par_iter().for_each(|(i, to)| {
             let (a, upper) = (offsets[i], first_upper(i));
             for (k, (t, &c)) in to.iter_mut().zip(&columns[a..offsets[i + 1]]).enumerate() {
                 *t = match c.cmp(&i) {
