@@ -4,8 +4,9 @@
 # (CalculiX surface-to-surface contact against seam's Gap_Conductance), lower box
 # n1 and upper box n2 cells per unit length, T = 1 at z = 0 and 0 at z = 1. Both run on
 # one thread with their defaults (CalculiX's iterative solver from 1e5 nodes, where its
-# direct one runs out of memory). Prints, per case, each code's wall time, peak memory
-# and largest nodal error against the exact answer, and the ratios.
+# direct one runs out of memory). Prints, per case, each code's wall time (seam's: the
+# median of 3 runs), peak memory and largest nodal error against the exact answer, and
+# the ratios.
 #
 #   benches/peers.sh [quick|full]        (default full: 24x16, 54x36 and 120x80)
 #
