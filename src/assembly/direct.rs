@@ -132,18 +132,24 @@ impl<'p> Assembler<'p> {
                 let dofs = &pattern.elem_dofs[vec_off..vec_off + count * ne];
                 buf.resize(BATCH * ne * ne, 0.0);
                 fbuf.resize(BATCH * ne, 0.0);
-                at.resize(ne * ne, usize::MAX);
+                at.resize(BATCH * ne * ne, usize::MAX);
                 for start in (0..count).step_by(BATCH) {
                     let m = BATCH.min(count - start);
+                    // The element matrices and where their entries go, in parallel; the
+                    // additions below, in element order, so the sums do not depend on
+                    // the thread count.
                     buf[..m * ne * ne]
                         .par_chunks_mut(ne * ne)
                         .zip(fbuf[..m * ne].par_chunks_mut(ne))
+                        .zip(at[..m * ne * ne].par_chunks_mut(ne * ne))
                         .enumerate()
                         .with_min_len(256)
-                        .for_each(|(k, (ke, fe))| {
+                        .for_each(|(k, ((ke, fe), at))| {
                             ke.fill(0.0);
                             fe.fill(0.0);
-                            kernel(ElemId(first + (start + k) as u32), ke, fe);
+                            let e = start + k;
+                            kernel(ElemId(first + e as u32), ke, fe);
+                            positions(col_ptr, row_idx, &dofs[e * ne..(e + 1) * ne], at);
                         });
                     for (k, ke) in buf[..m * ne * ne].chunks_exact(ne * ne).enumerate() {
                         let e = start + k;
@@ -158,7 +164,7 @@ impl<'p> Assembler<'p> {
                                     .all(|b| ke[a * ne + b].to_bits() == ke[b * ne + a].to_bits())
                             });
                         }
-                        positions(col_ptr, row_idx, &dofs[e * ne..(e + 1) * ne], &mut at);
+                        let at = &at[k * ne * ne..(k + 1) * ne * ne];
                         for (&p, &v) in at.iter().zip(ke) {
                             if p != usize::MAX {
                                 summed.values[p] += v;
