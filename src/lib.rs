@@ -20,6 +20,9 @@
 //!   and [`run`] (`seam run`, itself a host of [`embed`]), which [`parallel`] runs on
 //!   MPI and PETSc (`--features mpi`); the binary's CLI on top;
 //! - [`error`]: [`Error`], wrapping every module's own error.
+//!
+//! Below them all, two crate-private helpers: `vec3` (3-vectors as arrays) and `slices`
+//! (an array cut into pieces that threads fill in place).
 
 pub mod assembly;
 pub mod capi;
