@@ -621,9 +621,11 @@ impl InterfacePoints {
             let position = &self.position[self.group_dofs[g]..self.group_dofs[g + 1]];
             let nl = dofs.len();
             let m = &mut m[..nl * nl];
-            m.fill(0.0);
             let sym = &mut sym[..nl * nl];
             sym.fill(0.0);
+            // `m` is zeroed when a point first needs its full rows (a nonlinear or
+            // k(T) point); a group of symmetric points writes it once, from `sym`.
+            let mut full = false;
             for p in &self.points[self.group_points[g]..self.group_points[g + 1]] {
                 let PointEval {
                     jump,
@@ -698,6 +700,10 @@ impl InterfacePoints {
                         }
                         continue;
                     }
+                    if !full {
+                        m.fill(0.0);
+                        full = true;
+                    }
                     let row = &mut m[i * nl..(i + 1) * nl];
                     if nonlinear {
                         let wd = w * (dp * r_p + dt * r_t + ds * r_s);
@@ -734,13 +740,24 @@ impl InterfacePoints {
                 }
             }
             // The symmetric part into both triangles: a block of symmetric points alone
-            // is symmetric bit for bit, so is the matrix it is added into.
-            for i in 0..nl {
-                for j in i..nl {
-                    let v = sym[i * nl + j];
-                    m[i * nl + j] += v;
-                    if j != i {
-                        m[j * nl + i] += v;
+            // is symmetric bit for bit, so is the matrix it is added into. (Written as
+            // `0.0 + v` where `m` was not zeroed: the same bits as adding to zero.)
+            if full {
+                for i in 0..nl {
+                    for j in i..nl {
+                        let v = sym[i * nl + j];
+                        m[i * nl + j] += v;
+                        if j != i {
+                            m[j * nl + i] += v;
+                        }
+                    }
+                }
+            } else {
+                for i in 0..nl {
+                    for j in i..nl {
+                        let v = 0.0 + sym[i * nl + j];
+                        m[i * nl + j] = v;
+                        m[j * nl + i] = v;
                     }
                 }
             }
