@@ -10,10 +10,13 @@
 //! 1e5). Medians of 3 runs. Filters for profiling: a number keeps that size only
 //! (`-- 1000000`), `planar` or `curved` that case, `threads=N` that thread count.
 
+#[path = "common/mod.rs"]
+mod common;
+
 use std::time::Instant;
 
+use seam::mesh::Mesh;
 use seam::mesh::generate::{self, BoxSpec};
-use seam::mesh::{ElemId, Mesh, NodeId, Side};
 use seam::search::SearchSettings;
 use seam::search::pairing::{Integration, Searcher, SurfaceGeometry};
 
@@ -30,52 +33,6 @@ fn planar(n: usize) -> (Mesh, usize, usize) {
         ],
         false,
     );
-    (mesh, 0, 1)
-}
-
-/// Curved: the outer face of a thin ring (side A, n_θ × n_z faces) inside a second ring
-/// with different n_θ and n_z (side B).
-fn curved(faces: usize) -> (Mesh, usize, usize) {
-    let nz = ((faces as f64 / 8.0).sqrt()).round().max(1.0) as usize;
-    let nt = faces / nz;
-    let a = generate::annulus(
-        0.9,
-        1.0,
-        360.0,
-        [0.0, 1.0],
-        [1, nt, nz],
-        1,
-        [0, 1, 0, 0, 0, 0],
-    );
-    let b = generate::annulus(
-        1.0,
-        1.1,
-        360.0,
-        [0.0, 1.0],
-        [1, nt * 9 / 10, nz * 10 / 9 + 1],
-        2,
-        [2, 0, 0, 0, 0, 0],
-    );
-    let mut mesh = a.clone();
-    let shift = mesh.num_nodes() as u32;
-    let eshift = mesh.num_elems() as u32;
-    mesh.coords.extend_from_slice(&b.coords);
-    mesh.node_numbers
-        .extend(b.node_numbers.iter().map(|n| n + shift as i64));
-    let conn = b.blocks[0]
-        .connectivity
-        .iter()
-        .map(|n| NodeId(n.0 + shift))
-        .collect();
-    mesh.push_block(2, "", b.blocks[0].topology, conn, None);
-    let mut ss = b.side_sets[0].clone();
-    for s in &mut ss.sides {
-        *s = Side {
-            elem: ElemId(s.elem.0 + eshift),
-            side: s.side,
-        };
-    }
-    mesh.side_sets.push(ss);
     (mesh, 0, 1)
 }
 
@@ -132,7 +89,7 @@ fn main() {
             let (mesh, ia, ib) = if label == "planar" {
                 planar(n)
             } else {
-                curved(size)
+                (common::rings(size), 0, 1)
             };
             let a = SurfaceGeometry::from_side_set(&mesh, ia).unwrap();
             let b = SurfaceGeometry::from_side_set(&mesh, ib).unwrap();

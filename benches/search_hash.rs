@@ -6,8 +6,11 @@
 //! lines give the same bits. Run: `cargo bench --bench search_hash` (`-- quick` for
 //! 1e4-face cases; `threads=N` for the thread count).
 
+#[path = "common/mod.rs"]
+mod common;
+
+use seam::mesh::Mesh;
 use seam::mesh::generate::{self, BoxSpec, RectSpec};
-use seam::mesh::{ElemId, Mesh, NodeId, Side};
 use seam::search::SearchSettings;
 use seam::search::pairing::{Integration, SearchResult, Searcher, Sphere, SurfaceGeometry};
 
@@ -94,51 +97,6 @@ fn planar(n: usize, tet: bool, lift: f64) -> Mesh {
     )
 }
 
-/// The bench's curved case: the outer face of one ring inside another.
-fn curved(faces: usize) -> Mesh {
-    let nz = ((faces as f64 / 8.0).sqrt()).round().max(1.0) as usize;
-    let nt = faces / nz;
-    let a = generate::annulus(
-        0.9,
-        1.0,
-        360.0,
-        [0.0, 1.0],
-        [1, nt, nz],
-        1,
-        [0, 1, 0, 0, 0, 0],
-    );
-    let b = generate::annulus(
-        1.0,
-        1.1,
-        360.0,
-        [0.0, 1.0],
-        [1, nt * 9 / 10, nz * 10 / 9 + 1],
-        2,
-        [2, 0, 0, 0, 0, 0],
-    );
-    let mut mesh = a.clone();
-    let shift = mesh.num_nodes() as u32;
-    let eshift = mesh.num_elems() as u32;
-    mesh.coords.extend_from_slice(&b.coords);
-    mesh.node_numbers
-        .extend(b.node_numbers.iter().map(|n| n + shift as i64));
-    let conn = b.blocks[0]
-        .connectivity
-        .iter()
-        .map(|n| NodeId(n.0 + shift))
-        .collect();
-    mesh.push_block(2, "", b.blocks[0].topology, conn, None);
-    let mut ss = b.side_sets[0].clone();
-    for s in &mut ss.sides {
-        *s = Side {
-            elem: ElemId(s.elem.0 + eshift),
-            side: s.side,
-        };
-    }
-    mesh.side_sets.push(ss);
-    mesh
-}
-
 /// 2-D: two rectangles, n cells under m along the interface, tied at y = 1.
 fn edges(n: usize) -> Mesh {
     let m = (n as f64 * 0.9).round() as usize;
@@ -171,7 +129,12 @@ fn main() {
             SearchSettings::defaults(3),
             None,
         ),
-        ("curved", curved(faces), SearchSettings::defaults(3), None),
+        (
+            "curved",
+            common::rings(faces),
+            SearchSettings::defaults(3),
+            None,
+        ),
     ];
     // Warped quads: both slabs' faces on z = 0.1 + a wave, side B 0.0003 above.
     let mut warped = planar(n, false, 0.0003);

@@ -235,25 +235,10 @@ impl Ctx<'_> {
     /// widened by a slack far above the rounding of those sums (ε times the coordinates
     /// near `q`), and the reach by a relative and an absolute slack above the rounding of
     /// the squared distance it is compared as.
-    fn near(&self, q: &Aabb, visit: impl FnMut(usize, &Aabb)) {
-        self.near_from(None, q, visit);
-    }
-
-    /// [`Self::near`], the tree walked from `hint`'s leaf when given (the same faces).
-    fn near_from(
-        &self,
-        hint: Option<&mut QueryHint>,
-        q: &Aabb,
-        mut visit: impl FnMut(usize, &Aabb),
-    ) {
+    fn near(&self, q: &Aabb, mut visit: impl FnMut(usize, &Aabb)) {
         let grown = self.grown(q);
-        let accept = |tree: &Aabb| tree.intersects(&grown);
-        match hint {
-            Some(hint) => self
-                .bvh
-                .query_by_with_hint(hint, accept, |j, tree| visit(j, tree)),
-            None => self.bvh.query_by(accept, |j, tree| visit(j, tree)),
-        }
+        self.bvh
+            .query_by(|tree| tree.intersects(&grown), |j, tree| visit(j, tree));
     }
 
     /// The box that [`Self::near`] tests the tree's boxes against for the query `q`:
