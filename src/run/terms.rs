@@ -823,25 +823,24 @@ impl Interfaces for ContactTerms<'_> {
         // Coupling c is the c-th entry right of the diagonal in row order; (j, i) is
         // the transpose of (i, j). Rows are sorted, so a row's couplings are its tail.
         let (offsets, columns) = (&j.row_offsets, &j.columns);
-        let first_upper = |i: usize| {
-            let row = &columns[offsets[i]..offsets[i + 1]];
-            offsets[i] + row.partition_point(|&c| c <= i)
-        };
-        let mut start: Vec<usize> = (0..j.n)
+        // Where each row's couplings start, and how many rows before it hold.
+        let upper: Vec<usize> = (0..j.n)
             .into_par_iter()
-            .map(|i| offsets[i + 1] - first_upper(i))
+            .map(|i| {
+                let row = &columns[offsets[i]..offsets[i + 1]];
+                offsets[i] + row.partition_point(|&c| c <= i)
+            })
             .collect();
+        let mut start: Vec<usize> = (0..j.n).map(|i| offsets[i + 1] - upper[i]).collect();
         let mut total = 0;
         for s in start.iter_mut() {
             (*s, total) = (total, total + *s);
         }
         // Pairs and slots written in place, row by row in parallel.
         let mut pairs = vec![(0, 0); total];
-        let lengths = (0..j.n).map(|i| offsets[i + 1] - first_upper(i));
-        let rows = filled_pieces(&mut pairs, lengths);
+        let rows = filled_pieces(&mut pairs, (0..j.n).map(|i| offsets[i + 1] - upper[i]));
         rows.into_par_iter().for_each(|(i, to)| {
-            let upper = &columns[first_upper(i)..offsets[i + 1]];
-            for (p, &c) in to.iter_mut().zip(upper) {
+            for (p, &c) in to.iter_mut().zip(&columns[upper[i]..offsets[i + 1]]) {
                 *p = (i, c);
             }
         });
@@ -851,13 +850,13 @@ impl Interfaces for ContactTerms<'_> {
         let mut slots = vec![None; columns.len()];
         let rows = filled_pieces(&mut slots, offsets.windows(2).map(|w| w[1] - w[0]));
         rows.into_par_iter().for_each(|(i, to)| {
-            let (a, upper) = (offsets[i], first_upper(i));
+            let a = offsets[i];
             for (k, (t, &c)) in to.iter_mut().zip(&columns[a..offsets[i + 1]]).enumerate() {
                 *t = match c.cmp(&i) {
                     Ordering::Equal => Some(Slot::Diagonal(i)),
-                    Ordering::Greater => Some(Slot::Upper(start[i] + a + k - upper)),
+                    Ordering::Greater => Some(Slot::Upper(start[i] + a + k - upper[i])),
                     Ordering::Less => {
-                        let transposed = &columns[first_upper(c)..offsets[c + 1]];
+                        let transposed = &columns[upper[c]..offsets[c + 1]];
                         (transposed.binary_search(&i).ok()).map(|at| Slot::Lower(start[c] + at))
                     }
                 };
@@ -867,7 +866,6 @@ impl Interfaces for ContactTerms<'_> {
         let slots = slots.ok_or_else(|| {
             InterfaceFailure::Failed("an interface Jacobian entry without a place".into())
         })?;
-        drop(start);
         *e.slots.borrow_mut() = (pattern, slots);
         drop(embedding);
         self.moving.borrow_mut().pairs = pairs.clone();
