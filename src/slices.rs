@@ -1,6 +1,7 @@
 //! Cutting one array into disjoint consecutive pieces, so that threads can fill a
 //! result in place, each its own piece, rather than each building a vector that is
-//! copied into the whole afterwards (a second pass over memory, and its page faults).
+//! copied into the whole afterwards (a second pass over memory, and its page faults);
+//! and comparing arrays bit for bit, as the caches of repeated evaluations do.
 
 /// The first `n` of `*rest`, which keeps the others.
 pub(crate) fn take<'a, T>(rest: &mut &'a mut [T], n: usize) -> &'a mut [T] {
@@ -32,6 +33,12 @@ pub(crate) fn filled_pieces<T>(
     out
 }
 
+/// Whether `a` and `b` hold the same numbers bit for bit (a cache's key: `-0.0` and
+/// `0.0` differ, and a NaN equals itself).
+pub(crate) fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits())
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -46,5 +53,13 @@ mod tests {
         assert_eq!(f.len(), 2);
         assert_eq!((f[0].0, &*f[0].1), (1, &[0, 1][..]));
         assert_eq!((f[1].0, &*f[1].1), (3, &[2][..]));
+    }
+
+    #[test]
+    fn same_bits_tells_signed_zeros_apart_and_lengths_too() {
+        assert!(super::same_bits(&[1.0, f64::NAN], &[1.0, f64::NAN]));
+        assert!(!super::same_bits(&[0.0], &[-0.0]));
+        assert!(!super::same_bits(&[1.0], &[1.0, 2.0]));
+        assert!(!super::same_bits(&[1.0], &[1.0 + f64::EPSILON]));
     }
 }

@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use super::{EmbedError, Embedding, Heat};
-use crate::slices::{filled_pieces, pieces};
+use crate::slices::{filled_pieces, pieces, same_bits};
 
 /// A square sparse matrix in compressed sparse row form, in the host's dof numbers:
 /// row `i` holds `columns[row_offsets[i]..row_offsets[i + 1]]` (sorted, no repeats)
@@ -134,12 +134,7 @@ impl Embedding {
         let mut e = self.evaluation.take().expect("made above");
         let same = repeatable
             && e.made_at.as_ref().is_some_and(|(at, t)| {
-                (*t == time || !self.depends_on_time())
-                    && at.len() == local.len()
-                    && at
-                        .iter()
-                        .zip(&local)
-                        .all(|(a, b)| a.to_bits() == b.to_bits())
+                (*t == time || !self.depends_on_time()) && same_bits(at, &local)
             });
         let refreshed = if same {
             Ok(())

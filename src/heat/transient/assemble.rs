@@ -12,6 +12,7 @@ use crate::heat::interfaces::InterfaceFailure;
 use crate::heat::kernel;
 use crate::heat::law::Law;
 use crate::heat::{ByElement, FirstError, HeatError, bad_jacobian, elem_coords};
+use crate::slices::same_bits;
 
 use super::newton::{Context, History};
 use super::{Failure, Loads};
@@ -215,21 +216,11 @@ impl Context<'_, '_> {
         // field, the face conditions, the sources and the time. Asked again with the same
         // (a linear step with fixed steps assembles at the same u₀ every step), the
         // assembler holds its vectors already.
-        let inputs = keep.then(|| ElementInputs {
-            u: u.to_vec(),
-            t,
-            faces: loads.faces.clone(),
-            currents: loads.currents.clone(),
-            species_fluxes: loads.species_fluxes.clone(),
-        });
         let timeless =
             death.is_none() && block_source.is_none_or(|s| s.iter().all(|q| !q.depends_on_time()));
-        let repeated = inputs.as_ref().is_some_and(|now| {
-            self.element_inputs
-                .borrow()
-                .as_ref()
-                .is_some_and(|last| last.same_as(now, timeless))
-        });
+        let repeated = keep
+            && (self.element_inputs.borrow().as_ref())
+                .is_some_and(|last| last.same_as(u, t, loads, timeless));
         if !repeated {
             asm.elements_with(mesh, Some(blocks), keep, |e, je, re| {
                 if super::death::is_dead(death, e, t) {
@@ -247,7 +238,10 @@ impl Context<'_, '_> {
             });
         }
         let failed = errors.into_result();
-        *self.element_inputs.borrow_mut() = if failed.is_ok() { inputs } else { None };
+        if !repeated {
+            *self.element_inputs.borrow_mut() =
+                (keep && failed.is_ok()).then(|| ElementInputs::of(u, t, loads));
+        }
         failed?;
         if !keep {
             asm.check_finite(mesh).map_err(HeatError::from)?;
@@ -384,20 +378,25 @@ pub(super) struct ElementInputs {
 }
 
 impl ElementInputs {
-    /// Whether a loop reading `now` makes the vectors this one made: the same field
-    /// (bit for bit), conditions and fluxes, and the same time unless nothing read
-    /// depends on it (`timeless`).
-    fn same_as(&self, now: &ElementInputs, timeless: bool) -> bool {
-        (self.t == now.t || timeless)
-            && self.faces == now.faces
-            && self.currents == now.currents
-            && self.species_fluxes == now.species_fluxes
-            && self.u.len() == now.u.len()
-            && self
-                .u
-                .iter()
-                .zip(&now.u)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
+    fn of(u: &[f64], t: f64, loads: &Loads) -> ElementInputs {
+        ElementInputs {
+            u: u.to_vec(),
+            t,
+            faces: loads.faces.clone(),
+            currents: loads.currents.clone(),
+            species_fluxes: loads.species_fluxes.clone(),
+        }
+    }
+
+    /// Whether a loop reading `u`, `t` and `loads` makes the vectors this one made: the
+    /// same field (bit for bit), conditions and fluxes, and the same time unless nothing
+    /// read depends on it (`timeless`).
+    fn same_as(&self, u: &[f64], t: f64, loads: &Loads, timeless: bool) -> bool {
+        (self.t == t || timeless)
+            && self.faces == loads.faces
+            && self.currents == loads.currents
+            && self.species_fluxes == loads.species_fluxes
+            && same_bits(&self.u, u)
     }
 }
 
