@@ -183,6 +183,7 @@ impl InterfacePoints {
                         continue;
                     }
                     let len = l.len;
+                    debug_assert_eq!(len, local_len(key), "the sizes made from the keys");
                     if k == 0 || run.keys[k - 1].0 != key {
                         to.group_dofs[g] = to.at.dofs + d;
                         to.group_points[g] = to.at.points + k;

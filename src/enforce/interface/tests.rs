@@ -6,25 +6,42 @@ use super::*;
 use crate::assembly::Pattern;
 use crate::mesh::generate::{self, BoxSpec};
 use crate::search::SearchSettings;
-use crate::search::pairing::{Integration, Searcher};
+use crate::search::pairing::{Integration, SearchResult, Searcher};
 
 /// A 4 × 4-face slab under a 3 × 3-face one (non-matching, slightly tilted so the
 /// normals and gradients are not axis-aligned), with a temperature-dependent h.
 fn scene() -> (Mesh, DofMap, InterfacePoints, Vec<f64>) {
-    let mut mesh = generate::boxes(
-        &[
-            BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.5], [4, 4, 2], 1)
-                .with_side_sets([0, 0, 0, 0, 0, 1]),
-            BoxSpec::hex([0.0, 0.0, 0.5], [1.0, 1.0, 1.0], [3, 3, 2], 2)
-                .with_side_sets([0, 0, 0, 0, 2, 0]),
-        ],
-        false,
-    );
+    let mut mesh = slabs([4, 2], [3, 2], [0.5, 1.0]);
     for p in &mut mesh.coords {
         p[2] += 0.1 * p[0] - 0.05 * p[1];
     }
-    let a = SurfaceGeometry::from_side_set(&mesh, 0).unwrap();
-    let b = SurfaceGeometry::from_side_set(&mesh, 1).unwrap();
+    let (a, b, r, dofs) = paired(&mesh);
+    let field = dofs.field("temperature").unwrap();
+    let points = InterfacePoints::new(&mesh, &dofs, field, &a, &b, &r.points, &form(&H)).unwrap();
+    let u = (0..dofs.len()).map(|d| 300.0 + (d % 7) as f64).collect();
+    (mesh, dofs, points, u)
+}
+
+/// A slab over the unit square, `lower[0]` cells a side and `lower[1]` through its
+/// height up to `z[0]`, with side set 1 on its top, under another of `upper` cells up to
+/// `z[1]` with side set 2 on its bottom.
+fn slabs(lower: [usize; 2], upper: [usize; 2], z: [f64; 2]) -> Mesh {
+    let ([n, nz], [m, mz]) = (lower, upper);
+    generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, z[0]], [n, n, nz], 1)
+                .with_side_sets([0, 0, 0, 0, 0, 1]),
+            BoxSpec::hex([0.0, 0.0, z[0]], [1.0, 1.0, z[1]], [m, m, mz], 2)
+                .with_side_sets([0, 0, 0, 0, 2, 0]),
+        ],
+        false,
+    )
+}
+
+/// The slabs' faces paired by 2 × 2 Gauss points of side A, and the temperature dofs.
+fn paired(mesh: &Mesh) -> (SurfaceGeometry, SurfaceGeometry, SearchResult, DofMap) {
+    let a = SurfaceGeometry::from_side_set(mesh, 0).unwrap();
+    let b = SurfaceGeometry::from_side_set(mesh, 1).unwrap();
     let settings = SearchSettings::defaults(3);
     let r = Searcher::new(&b, &settings).search_points(
         &a,
@@ -33,11 +50,8 @@ fn scene() -> (Mesh, DofMap, InterfacePoints, Vec<f64>) {
         Integration::Quadrature { order: 2 },
         None,
     );
-    let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();
-    let field = dofs.field("temperature").unwrap();
-    let points = InterfacePoints::new(&mesh, &dofs, field, &a, &b, &r.points, &form(&H)).unwrap();
-    let u = (0..dofs.len()).map(|d| 300.0 + (d % 7) as f64).collect();
-    (mesh, dofs, points, u)
+    let dofs = DofMap::new(mesh, &[("temperature", &[0, 1])]).unwrap();
+    (a, b, r, dofs)
 }
 
 static H: fn(&HInput) -> Result<HValue, String> = |p| {
@@ -176,26 +190,8 @@ fn couplings_and_scatter_place_every_entry() {
 /// flux entries right after the previous point's.
 #[test]
 fn points_made_in_runs_do_not_depend_on_the_thread_count() {
-    let mesh = generate::boxes(
-        &[
-            BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.1], [96, 96, 1], 1)
-                .with_side_sets([0, 0, 0, 0, 0, 1]),
-            BoxSpec::hex([0.0, 0.0, 0.1], [1.0, 1.0, 0.2], [83, 83, 1], 2)
-                .with_side_sets([0, 0, 0, 0, 2, 0]),
-        ],
-        false,
-    );
-    let a = SurfaceGeometry::from_side_set(&mesh, 0).unwrap();
-    let b = SurfaceGeometry::from_side_set(&mesh, 1).unwrap();
-    let settings = SearchSettings::defaults(3);
-    let r = Searcher::new(&b, &settings).search_points(
-        &a,
-        &b,
-        &settings,
-        Integration::Quadrature { order: 2 },
-        None,
-    );
-    let dofs = DofMap::new(&mesh, &[("temperature", &[0, 1])]).unwrap();
+    let mesh = slabs([96, 1], [83, 1], [0.1, 0.2]);
+    let (a, b, r, dofs) = paired(&mesh);
     let field = dofs.field("temperature").unwrap();
     let make = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
