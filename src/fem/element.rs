@@ -327,6 +327,34 @@ impl Basis {
     }
 }
 
+/// `(det J, J⁻¹)` of a 3 × 3 Jacobian by cofactors (not finite for a singular J:
+/// callers test the determinant).
+pub(crate) fn inverse3(j: &[[f64; 3]; 3]) -> (f64, [[f64; 3]; 3]) {
+    let c00 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
+    let c01 = j[1][2] * j[2][0] - j[1][0] * j[2][2];
+    let c02 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
+    let det = j[0][0] * c00 + j[0][1] * c01 + j[0][2] * c02;
+    let r = 1.0 / det;
+    let inv = [
+        [
+            c00 * r,
+            (j[0][2] * j[2][1] - j[0][1] * j[2][2]) * r,
+            (j[0][1] * j[1][2] - j[0][2] * j[1][1]) * r,
+        ],
+        [
+            c01 * r,
+            (j[0][0] * j[2][2] - j[0][2] * j[2][0]) * r,
+            (j[0][2] * j[1][0] - j[0][0] * j[1][2]) * r,
+        ],
+        [
+            c02 * r,
+            (j[0][1] * j[2][0] - j[0][0] * j[2][1]) * r,
+            (j[0][0] * j[1][1] - j[0][1] * j[1][0]) * r,
+        ],
+    ];
+    (det, inv)
+}
+
 /// Evaluate shape functions, physical gradients and det J·w at reference point `xi`
 /// (untabulated; [`Basis::eval`] is the fast path).
 pub fn eval_point(
@@ -371,20 +399,8 @@ fn map_point(
     // inv = J⁻¹ by cofactors.
     let mut inv = [[0.0; 3]; 3];
     let det = if dim == 3 {
-        let c00 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
-        let c01 = j[1][2] * j[2][0] - j[1][0] * j[2][2];
-        let c02 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
-        let det = j[0][0] * c00 + j[0][1] * c01 + j[0][2] * c02;
-        let r = 1.0 / det;
-        inv[0][0] = c00 * r;
-        inv[1][0] = c01 * r;
-        inv[2][0] = c02 * r;
-        inv[0][1] = (j[0][2] * j[2][1] - j[0][1] * j[2][2]) * r;
-        inv[1][1] = (j[0][0] * j[2][2] - j[0][2] * j[2][0]) * r;
-        inv[2][1] = (j[0][1] * j[2][0] - j[0][0] * j[2][1]) * r;
-        inv[0][2] = (j[0][1] * j[1][2] - j[0][2] * j[1][1]) * r;
-        inv[1][2] = (j[0][2] * j[1][0] - j[0][0] * j[1][2]) * r;
-        inv[2][2] = (j[0][0] * j[1][1] - j[0][1] * j[1][0]) * r;
+        let det;
+        (det, inv) = inverse3(&j);
         det
     } else {
         let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];

@@ -101,35 +101,13 @@ pub fn conductivity_uniform(
     let Some((j, parts)) = affine else {
         return conductivity(basis, coords, |_| k, ke);
     };
-    let c00 = j[1][1] * j[2][2] - j[1][2] * j[2][1];
-    let c01 = j[1][2] * j[2][0] - j[1][0] * j[2][2];
-    let c02 = j[1][0] * j[2][1] - j[1][1] * j[2][0];
-    let det = j[0][0] * c00 + j[0][1] * c01 + j[0][2] * c02;
+    let (det, inv) = crate::fem::element::inverse3(&j);
     if det.is_nan() || det <= 0.0 {
         return Err(BadJacobian {
             det,
             point: basis.rule.points[0],
         });
     }
-    let r = 1.0 / det;
-    // J⁻¹ by cofactors (row k of J⁻¹ maps ∂/∂x to ∂/∂ξ_k).
-    let inv = [
-        [
-            c00 * r,
-            (j[0][2] * j[2][1] - j[0][1] * j[2][2]) * r,
-            (j[0][1] * j[1][2] - j[0][2] * j[1][1]) * r,
-        ],
-        [
-            c01 * r,
-            (j[0][0] * j[2][2] - j[0][2] * j[2][0]) * r,
-            (j[0][2] * j[1][0] - j[0][0] * j[1][2]) * r,
-        ],
-        [
-            c02 * r,
-            (j[0][1] * j[2][0] - j[0][0] * j[2][1]) * r,
-            (j[0][0] * j[1][1] - j[0][1] * j[1][0]) * r,
-        ],
-    ];
     let kd = k * det;
     let g = crate::fem::element::HEX8_PAIRS
         .map(|(a, b)| kd * (inv[a][0] * inv[b][0] + inv[a][1] * inv[b][1] + inv[a][2] * inv[b][2]));
@@ -139,7 +117,13 @@ pub fn conductivity_uniform(
             *u += gp * s;
         }
     }
-    let ke = block8(ke);
+    add_mirrored8(block8(ke), &upper);
+    Ok(())
+}
+
+/// `ke += U + Uᵀ − diag U` for the upper triangle `upper` of an 8 × 8 block (row by
+/// row from the diagonal on): exactly symmetric.
+fn add_mirrored8(ke: &mut [f64; 64], upper: &[f64; 36]) {
     let mut at = 0;
     for a in 0..8 {
         for b in a..8 {
@@ -150,7 +134,6 @@ pub fn conductivity_uniform(
             at += 1;
         }
     }
-    Ok(())
 }
 
 /// `K_ab += ∫ k(x) ∇N_a·∇N_b dV`.
@@ -178,16 +161,7 @@ pub fn conductivity(
                 }
             }
         }
-        let mut at = 0;
-        for a in 0..8 {
-            for b in a..8 {
-                ke[a * 8 + b] += upper[at];
-                if b != a {
-                    ke[b * 8 + a] += upper[at];
-                }
-                at += 1;
-            }
-        }
+        add_mirrored8(ke, &upper);
         return Ok(());
     }
     let nn = basis.topology.node_count();
