@@ -13,7 +13,10 @@
 //! *count* keeps the tree balanced whatever the geometry (depth ≤ ⌈log₂ n⌉), so the
 //! build is O(n log n) (a linear-time selection per level) and the query stack has a
 //! fixed size. Ties between equal centroids are broken by item index, so the same input
-//! always gives the same tree.
+//! always gives the same tree. The median split also fixes how many nodes a subtree has
+//! from its item count alone, so the two halves of a large split are built on the
+//! thread pool side by side, each into its own range of the node array: the tree is
+//! the one a single pass in pre-order makes, on any number of threads.
 //!
 //! Layout: one flat node array in depth-first pre-order (the left child of node `i` is
 //! `i + 1`, the right child is stored), plus the item permutation and a copy of the item
@@ -169,18 +172,30 @@ impl Bvh {
     /// # Panics
     /// If there are `u32::MAX` items or more (the node layout stores 32-bit indices).
     pub fn build(items: &[Aabb]) -> Bvh {
+        use rayon::prelude::*;
         let n = items.len();
         assert!(
             n < u32::MAX as usize,
             "Bvh::build: {n} items exceed the 32-bit index range"
         );
-        let centers: Vec<V3> = items.iter().map(Aabb::center).collect();
+        let centers: Vec<V3> = items.par_iter().map(Aabb::center).collect();
         let mut order: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = Vec::with_capacity(if n == 0 { 0 } else { 2 * n.div_ceil(LEAF_SIZE) });
+        let mut nodes = vec![
+            Node {
+                bounds: Aabb::EMPTY,
+                start: 0,
+                count: 0,
+            };
+            if n == 0 { 0 } else { subtree_nodes(n) }
+        ];
         if n > 0 {
-            build_range(&centers, &mut order, 0, &mut nodes);
+            let tree = Tree {
+                centers: &centers,
+                items,
+            };
+            tree.build_split(&mut order, 0, &mut nodes, 0);
         }
-        let boxes = order.iter().map(|&i| items[i as usize]).collect();
+        let boxes = order.par_iter().map(|&i| items[i as usize]).collect();
         let mut parent = vec![0u32; nodes.len()];
         for (k, node) in nodes.iter().enumerate() {
             if node.count == 0 {
@@ -188,14 +203,12 @@ impl Bvh {
                 parent[node.start as usize] = k as u32;
             }
         }
-        let mut bvh = Bvh {
+        Bvh {
             nodes,
             parent,
             order,
             boxes,
-        };
-        bvh.fit_bounds();
-        bvh
+        }
     }
 
     /// Number of items.
@@ -417,55 +430,129 @@ impl Bvh {
     }
 }
 
-/// Builds the subtree over `order[..]` (which starts at leaf slot `offset`), pushing its
-/// nodes in pre-order; returns nothing, the subtree root is the first node pushed.
-fn build_range(centers: &[V3], order: &mut [u32], offset: usize, nodes: &mut Vec<Node>) {
-    let me = nodes.len();
-    let n = order.len();
-    // Bounds are filled in afterwards, bottom-up (`fit_bounds`): one pass in all instead
-    // of one union over the items at every level.
-    if n <= LEAF_SIZE {
-        nodes.push(Node {
-            bounds: Aabb::EMPTY,
-            start: offset as u32,
-            count: n as u32,
+/// Items from which a subtree is built on its own thread's share: below it, the two
+/// halves of a split are built one after the other.
+const PARALLEL_ITEMS: usize = 1 << 14;
+
+/// The number of nodes of the subtree over `n ≥ 1` items: the median split makes it a
+/// function of `n` alone (`⌊n/2⌋` items left, the rest right, leaves of at most
+/// [`LEAF_SIZE`]), which lets the two halves of a split be built side by side into
+/// their own ranges of the node array. The sizes at one depth differ by at most one, so
+/// the recursion on the pair `(f(m), f(m + 1))` visits one `m` per depth.
+fn subtree_nodes(n: usize) -> usize {
+    /// `(f(m), f(m + 1))`.
+    fn pair(m: usize) -> (usize, usize) {
+        if m < LEAF_SIZE {
+            return (1, 1);
+        }
+        if m <= LEAF_SIZE {
+            // f(m) = 1; m + 1 splits into ⌊(m+1)/2⌋ and ⌈(m+1)/2⌉, both leaves.
+            return (1, 3);
+        }
+        // f(k) = 1 + f(⌊k/2⌋) + f(⌈k/2⌉) for k = m and m + 1; the four halves lie in
+        // {h, h + 1} with h = ⌊m/2⌋.
+        let h = m / 2;
+        let (fh, fh1) = pair(h);
+        let f = |k: usize| {
+            let (lo, hi) = (k / 2, k - k / 2);
+            let g = |j: usize| if j == h { fh } else { fh1 };
+            1 + g(lo) + g(hi)
+        };
+        (f(m), f(m + 1))
+    }
+    pair(n).0
+}
+
+/// What every subtree of one build reads: the items' centroids and boxes.
+struct Tree<'a> {
+    centers: &'a [V3],
+    items: &'a [Aabb],
+}
+
+impl Tree<'_> {
+    /// Builds the subtree over `order[..]` (which starts at leaf slot `offset`) into
+    /// `nodes`, which has exactly [`subtree_nodes`] of them and holds node `base` of the
+    /// whole tree first, in pre-order, boxes included; returns the subtree's box. The
+    /// same tree as one pass in pre-order: each half's nodes land where that pass would
+    /// have pushed them.
+    fn build_split(
+        &self,
+        order: &mut [u32],
+        offset: usize,
+        nodes: &mut [Node],
+        base: usize,
+    ) -> Aabb {
+        let n = order.len();
+        debug_assert_eq!(nodes.len(), subtree_nodes(n));
+        if n <= LEAF_SIZE {
+            nodes[0] = Node {
+                bounds: self.leaf_bounds(order),
+                start: offset as u32,
+                count: n as u32,
+            };
+            return nodes[0].bounds;
+        }
+        let mid = self.split(order);
+        let (left, right) = order.split_at_mut(mid);
+        let (root, rest) = nodes.split_first_mut().expect("a subtree has a node");
+        let (left_nodes, right_nodes) = rest.split_at_mut(subtree_nodes(mid));
+        let right_index = base + 1 + left_nodes.len();
+        let (left_bounds, right_bounds) = if n >= PARALLEL_ITEMS {
+            rayon::join(
+                || self.build_split(left, offset, left_nodes, base + 1),
+                || self.build_split(right, offset + mid, right_nodes, right_index),
+            )
+        } else {
+            (
+                self.build_split(left, offset, left_nodes, base + 1),
+                self.build_split(right, offset + mid, right_nodes, right_index),
+            )
+        };
+        *root = Node {
+            bounds: left_bounds.union(&right_bounds),
+            start: right_index as u32,
+            count: 0,
+        };
+        root.bounds
+    }
+
+    /// A leaf's box: the union of its items' boxes in leaf order, as
+    /// [`Bvh::fit_bounds`] makes it.
+    fn leaf_bounds(&self, order: &[u32]) -> Aabb {
+        order
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(&self.items[i as usize]))
+    }
+
+    /// Splits `order` at its median along the longest axis of its centroids' bounds
+    /// (NaN extents never win) and returns the median's place, `n / 2`.
+    fn split(&self, order: &mut [u32]) -> usize {
+        let centers = self.centers;
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for &i in order.iter() {
+            let c = centers[i as usize];
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
+            }
+        }
+        let mut axis = 0;
+        for k in 1..3 {
+            if hi[k] - lo[k] > hi[axis] - lo[axis] {
+                axis = k;
+            }
+        }
+        let mid = order.len() / 2;
+        // Total order (coordinate, then index): the split sets do not depend on the
+        // selection algorithm, so equal inputs give equal trees.
+        order.select_nth_unstable_by(mid, |&a, &b| {
+            centers[a as usize][axis]
+                .total_cmp(&centers[b as usize][axis])
+                .then(a.cmp(&b))
         });
-        return;
+        mid
     }
-    nodes.push(Node {
-        bounds: Aabb::EMPTY,
-        start: 0,
-        count: 0,
-    });
-    // Longest axis of the centroids' bounds; NaN extents never win.
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for &i in order.iter() {
-        let c = centers[i as usize];
-        for k in 0..3 {
-            lo[k] = lo[k].min(c[k]);
-            hi[k] = hi[k].max(c[k]);
-        }
-    }
-    let mut axis = 0;
-    for k in 1..3 {
-        if hi[k] - lo[k] > hi[axis] - lo[axis] {
-            axis = k;
-        }
-    }
-    let mid = n / 2;
-    // Total order (coordinate, then index): the split sets do not depend on the
-    // selection algorithm, so equal inputs give equal trees.
-    order.select_nth_unstable_by(mid, |&a, &b| {
-        centers[a as usize][axis]
-            .total_cmp(&centers[b as usize][axis])
-            .then(a.cmp(&b))
-    });
-    let (left, right) = order.split_at_mut(mid);
-    build_range(centers, left, offset, nodes);
-    let right_index = nodes.len();
-    build_range(centers, right, offset + mid, nodes);
-    nodes[me].start = right_index as u32;
 }
 
 #[cfg(test)]
@@ -495,6 +582,92 @@ mod tests {
         assert!(collect(&bvh, &unit_box(2.0, 0.0, 0.0)).is_empty());
         // Touching boxes intersect (closed boxes).
         assert_eq!(collect(&bvh, &unit_box(1.0, 0.0, 0.0)), vec![0]);
+    }
+
+    /// The node count of a subtree by its definition, for the closed recursion.
+    fn nodes_by_definition(n: usize) -> usize {
+        if n <= LEAF_SIZE {
+            1
+        } else {
+            1 + nodes_by_definition(n / 2) + nodes_by_definition(n - n / 2)
+        }
+    }
+
+    #[test]
+    fn subtree_node_counts_follow_the_median_split() {
+        for n in (1..3000).chain([65_535, 65_536, 65_537, 100_003]) {
+            assert_eq!(subtree_nodes(n), nodes_by_definition(n), "n = {n}");
+        }
+    }
+
+    /// The tree built with its halves on two threads (subtrees of 2¹⁴ items and more)
+    /// against one thread and against one pass in pre-order without the count formula,
+    /// node for node, boxes and permutation included. The items are jittered boxes with
+    /// repeated centroids, so ties between equal coordinates are exercised.
+    #[test]
+    fn parallel_build_is_the_serial_tree() {
+        let n = 70_001;
+        let items: Vec<Aabb> = (0..n)
+            .map(|i| {
+                let (x, y) = ((i % 263) as f64, ((i / 263) % 97) as f64);
+                let z = ((i * 7919) % 5) as f64 * 0.25;
+                let w = 0.5 + ((i * 31) % 7) as f64 * 0.1;
+                Aabb {
+                    min: [x, y, z],
+                    max: [x + w, y + 1.0, z + w],
+                }
+            })
+            .collect();
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| Bvh::build(&items))
+        };
+        let (one, two) = (on(1), on(2));
+        // One pass in pre-order, pushing nodes as they are made, then boxes bottom-up.
+        fn push(tree: &Tree, order: &mut [u32], offset: usize, nodes: &mut Vec<Node>) {
+            let me = nodes.len();
+            nodes.push(Node {
+                bounds: Aabb::EMPTY,
+                start: offset as u32,
+                count: order.len() as u32,
+            });
+            if order.len() > LEAF_SIZE {
+                let mid = tree.split(order);
+                let (left, right) = order.split_at_mut(mid);
+                push(tree, left, offset, nodes);
+                let right_index = nodes.len();
+                push(tree, right, offset + mid, nodes);
+                nodes[me].start = right_index as u32;
+                nodes[me].count = 0;
+            }
+        }
+        let centers: Vec<V3> = items.iter().map(Aabb::center).collect();
+        let tree = Tree {
+            centers: &centers,
+            items: &items,
+        };
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut nodes = Vec::new();
+        push(&tree, &mut order, 0, &mut nodes);
+        let mut serial = Bvh {
+            nodes,
+            parent: two.parent.clone(),
+            boxes: order.iter().map(|&i| items[i as usize]).collect(),
+            order,
+        };
+        serial.fit_bounds();
+        for other in [&one, &serial] {
+            assert_eq!(two.order, other.order);
+            assert_eq!(two.boxes, other.boxes);
+            assert_eq!(two.parent, other.parent);
+            assert_eq!(two.nodes.len(), other.nodes.len());
+            for (a, b) in two.nodes.iter().zip(&other.nodes) {
+                assert_eq!((a.bounds, a.start, a.count), (b.bounds, b.start, b.count));
+            }
+        }
     }
 
     #[test]

@@ -199,7 +199,9 @@ impl Searcher {
     /// whose ranks hold parts of side B), so that the pairing is the larger one's.
     pub fn with_extent(b: &SurfaceGeometry, extent: Extent) -> Searcher {
         let margin = extent.margin;
-        let boxes: Vec<Aabb> = b.faces.iter().map(|f| f.aabb().inflate(margin)).collect();
+        let boxes: Vec<Aabb> = (b.faces.par_iter())
+            .map(|f| f.aabb().inflate(margin))
+            .collect();
         Searcher {
             bvh: Bvh::build(&boxes),
             margin,
