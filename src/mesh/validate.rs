@@ -14,7 +14,7 @@
 //! its Sierra name, the element by its user-visible number, the 1-based local node, and
 //! say how to fix it. Up to [`MAX_REPORTED`] problems are collected into one error.
 
-use super::{Mesh, Topology};
+use super::{Mesh, NodeId, Topology};
 
 /// How many problems one validation error lists before summarising the rest.
 pub const MAX_REPORTED: usize = 10;
@@ -299,35 +299,58 @@ impl Mesh {
     }
 
     fn check_elements(&self, p: &mut Problems) {
-        let num_nodes = self.num_nodes();
+        // Most meshes have no bad element: the blocks are scanned on the thread pool
+        // first, and only a block with a problem is gone through again in order, to
+        // report its first ones.
         for block in &self.blocks {
+            use rayon::prelude::*;
             let npe = block.topology.node_count();
             let corners = corner_table(block.topology, self.dim);
+            let fault = |nodes: &[NodeId]| self.element_fault(nodes, corners);
+            let bad = (block.connectivity.par_chunks_exact(npe))
+                .with_min_len(4096)
+                .any(|nodes| fault(nodes).is_some());
+            if !bad {
+                continue;
+            }
             for (k, nodes) in block.connectivity.chunks_exact(npe).enumerate() {
-                let elem_index = block.first_elem.index() + k;
-                if let Some(local) = nodes.iter().position(|n| n.index() >= num_nodes) {
-                    p.push(ValidationError::DanglingNode {
+                let elem = self.elem_numbers[block.first_elem.index() + k];
+                match fault(nodes) {
+                    None => {}
+                    Some(Fault::Dangling(local)) => p.push(ValidationError::DanglingNode {
                         block: block.sierra_name(),
-                        elem: self.elem_numbers[elem_index],
+                        elem,
                         local: local + 1,
                         index: nodes[local].index(),
-                        num_nodes,
-                    });
-                    continue;
-                }
-                let Some(corners) = corners else { continue };
-                let mut x = [[0.0f64; 3]; 8];
-                for (xi, n) in x.iter_mut().zip(nodes) {
-                    *xi = self.coords[n.index()];
-                }
-                let x = &x[..npe];
-                if let Some(problem) = check_corners(x, corners, self.dim) {
-                    let elem = self.elem_numbers[elem_index];
-                    p.push(problem.into_error(block.sierra_name(), elem));
+                        num_nodes: self.num_nodes(),
+                    }),
+                    Some(Fault::Corner(problem)) => {
+                        p.push(problem.into_error(block.sierra_name(), elem))
+                    }
                 }
             }
         }
     }
+
+    /// What is wrong with the element of `nodes` (its block's `corners`), if anything: a
+    /// node past the mesh's, or a corner whose determinant is not positive.
+    fn element_fault(&self, nodes: &[NodeId], corners: Option<Corners>) -> Option<Fault> {
+        if let Some(local) = nodes.iter().position(|n| n.index() >= self.num_nodes()) {
+            return Some(Fault::Dangling(local));
+        }
+        let mut x = [[0.0f64; 3]; 8];
+        for (xi, n) in x.iter_mut().zip(nodes) {
+            *xi = self.coords[n.index()];
+        }
+        check_corners(&x[..nodes.len()], corners?, self.dim).map(Fault::Corner)
+    }
+}
+
+/// What [`Mesh::element_fault`] finds.
+enum Fault {
+    /// The element's local node (0-based) is not a node of the mesh.
+    Dangling(usize),
+    Corner(CornerProblem),
 }
 
 /// Corners to check: `(corner, [a, b, c])` — the edge vectors from `corner` to `a`, `b`
@@ -486,7 +509,7 @@ fn first_duplicate(v: &[i64]) -> Option<(i64, usize, usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{NodeId, Side, SideSet};
+    use crate::mesh::{Side, SideSet};
 
     const UNIT_HEX: [[f64; 3]; 8] = [
         [0.0, 0.0, 0.0],
