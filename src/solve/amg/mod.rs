@@ -56,6 +56,16 @@
 //! relative, far inside what a smoother's convergence allows (`M + Mᵀ − A` stays
 //! positive definite). The double-precision values of P, R and the coarse operators
 //! are dropped once the hierarchy is made.
+//!
+//! The finest level is the exception: with one symmetric Gauss–Seidel sweep on each
+//! side (the default), it sweeps with its double-precision values, and its backward
+//! sweep also leaves `A z` of the cycle's result `z` in the same pass
+//! (`smooth::gauss_seidel_backward_with_product`). CG then makes its product
+//! `q = A p` as `A z + β q` (p = z + β p) instead of reading the matrix once more:
+//! per iteration the finest matrix is read one and a half times (the forward sweep
+//! from zero reads its lower half) instead of two and a half, and it keeps no
+//! single-precision copy. On the tied 120:80 boxes (31.7 M entries): 17 iterations
+//! before and after, the same error (3.3e-13), the level's 127 MB copy gone.
 
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
@@ -78,8 +88,9 @@ use coarsen::{
 pub use csr::Csr;
 pub use reuse::Served;
 use smooth::{
-    gauss_seidel, gauss_seidel_from_zero, gauss_seidel_from_zero_with_residual, penalty_rows,
-    symmetric_gauss_seidel_rows, symmetric_gauss_seidel_rows_with_residual,
+    gauss_seidel, gauss_seidel_backward_with_product, gauss_seidel_from_zero,
+    gauss_seidel_from_zero_with_residual, penalty_rows, symmetric_gauss_seidel_rows,
+    symmetric_gauss_seidel_rows_with_residual,
 };
 pub use successive::{KEPT_SOLUTIONS, Successive};
 
@@ -165,7 +176,8 @@ struct Level {
     r: Csr,
     /// The values of `a`, `p` and `r` in single precision: what the V-cycle reads
     /// (module docs). The double-precision values of `p` and `r`, and of `a` below the
-    /// finest level, are dropped once the hierarchy is made.
+    /// finest level, are dropped once the hierarchy is made; `a32` of a finest level
+    /// that sweeps in double precision ([`AmgCg::fine_product`]) is empty.
     a32: Vec<f32>,
     p32: Vec<f32>,
     r32: Vec<f32>,
@@ -190,6 +202,9 @@ pub struct AmgCg {
     /// CG's vectors kept between solves: a time step of 1.25 M unknowns otherwise asks
     /// the system for 40 MB of fresh pages each time.
     spare: Vec<Vec<f64>>,
+    /// `A z` of the V-cycle's result `z`, made by its last sweep over the finest level
+    /// when that level sweeps in double precision ([`AmgCg::fine_product`]).
+    product: Vec<f64>,
 }
 
 /// Description of the hierarchy: unknowns and stored entries per level.
@@ -216,7 +231,23 @@ impl AmgCg {
             reuse: reuse::Reuse::default(),
             earlier: successive::Earlier::default(),
             spare: Vec::new(),
+            product: Vec::new(),
         }
+    }
+
+    /// Whether the finest level sweeps with its double-precision values and its last
+    /// sweep leaves `A z` in `product`, which CG then takes for its own product with
+    /// the matrix (module docs): a hierarchy of more than one level, set up for one
+    /// symmetric Gauss–Seidel sweep on each side. Its finest level keeps no
+    /// single-precision values.
+    fn fine_product(&self) -> bool {
+        self.levels.len() > 1 && self.levels[0].a32.is_empty()
+    }
+
+    /// The options under which [`Self::fine_product`] holds once there are two levels.
+    fn sweeps_make_product(&self) -> bool {
+        let o = &self.options;
+        o.symmetric && o.sweeps == 1 && o.smoother == Smoother::SymmetricGaussSeidel
     }
 
     pub fn hierarchy(&self) -> Hierarchy {
@@ -448,6 +479,10 @@ impl AmgCg {
         // The V-cycle's single-precision values of P and R; double precision stays
         // only where the operator itself is applied (the finest level: CG's A p).
         let single = |v: &[f64]| -> Vec<f32> { v.iter().map(|&x| x as f32).collect() };
+        if self.levels.len() > 1 && self.sweeps_make_product() {
+            self.levels[0].a32 = Vec::new();
+            self.product.resize(self.levels[0].a.nrows, 0.0);
+        }
         for (l, lev) in self.levels.iter_mut().enumerate() {
             lev.p32 = single(&lev.p.val);
             lev.r32 = single(&lev.r.val);
@@ -500,26 +535,25 @@ impl AmgCg {
         }
         if self.options.symmetric && sweeps == 1 && smoother == Smoother::SymmetricGaussSeidel {
             // The residual made in the sweeps' own passes (the matrix is symmetric).
+            let penalty_sweeps = self.options.penalty_sweeps;
             let lev = &mut self.levels[l];
             lev.x.fill(0.0);
-            let a = lev.a.with_values(&lev.a32);
-            gauss_seidel_from_zero_with_residual(
+            let Level {
                 a,
-                &lev.inv_diag,
-                &mut lev.x,
-                &lev.b,
-                &mut lev.res,
-            );
-            for _ in 0..self.options.penalty_sweeps {
-                symmetric_gauss_seidel_rows_with_residual(
-                    a,
-                    &lev.inv_diag,
-                    &mut lev.x,
-                    &lev.b,
-                    &lev.penalty_rows,
-                    &mut lev.res,
-                    &mut lev.saved,
-                );
+                a32,
+                inv_diag,
+                penalty_rows,
+                x,
+                b,
+                res,
+                saved,
+                ..
+            } = lev;
+            let parts = (inv_diag.as_slice(), penalty_rows.as_slice(), penalty_sweeps);
+            if a32.is_empty() {
+                presmooth_with_residual(a.with_values(&a.val), parts, x, b, res, saved);
+            } else {
+                presmooth_with_residual(a.with_values(a32), parts, x, b, res, saved);
             }
         } else {
             let lev = &mut self.levels[l];
@@ -559,6 +593,23 @@ impl AmgCg {
             .par_iter_mut()
             .zip(&lev.res)
             .for_each(|(x, c)| *x += c);
+        if lev.a32.is_empty() {
+            // The finest level in double precision: its one backward sweep also makes
+            // `A z` for CG (`fine_product`).
+            let a = lev.a.with_values(&lev.a.val);
+            for _ in 0..self.options.penalty_sweeps {
+                symmetric_gauss_seidel_rows(
+                    a,
+                    &lev.inv_diag,
+                    &mut lev.x,
+                    &lev.b,
+                    &lev.penalty_rows,
+                );
+            }
+            let (x, b, y) = (&mut lev.x, &lev.b, &mut self.product);
+            gauss_seidel_backward_with_product(a, &lev.inv_diag, x, b, y);
+            return;
+        }
         let a = lev.a.with_values(&lev.a32);
         for _ in 0..self.options.penalty_sweeps {
             symmetric_gauss_seidel_rows(a, &lev.inv_diag, &mut lev.x, &lev.b, &lev.penalty_rows);
@@ -637,8 +688,12 @@ impl AmgCg {
         q: &mut [f64],
     ) -> Result<SolveReport, SolveError> {
         let bnorm = norm(b);
+        let fused = self.fine_product();
         self.precondition(r, z);
         p.copy_from_slice(z);
+        if fused {
+            q.copy_from_slice(&self.product);
+        }
         let mut rz = dot(r, z);
         let tol = self.options.tolerance;
         let mut rel = norm(r) / bnorm;
@@ -651,7 +706,9 @@ impl AmgCg {
                     tolerance: tol,
                 });
             }
-            self.levels[0].a.spmv(p, q);
+            if !fused {
+                self.levels[0].a.spmv(p, q);
+            }
             let pq = dot(p, q);
             if pq <= 0.0 || !pq.is_finite() {
                 return Err(SolveError::NotConverged {
@@ -675,6 +732,12 @@ impl AmgCg {
             p.par_iter_mut()
                 .zip(&*z)
                 .for_each(|(p, z)| *p = z + beta * *p);
+            if fused {
+                // A p = A z + β A p_old: the product the last sweep made.
+                q.par_iter_mut()
+                    .zip(&self.product)
+                    .for_each(|(q, az)| *q = az + beta * *q);
+            }
         }
         Ok(SolveReport {
             iterations: it,
@@ -696,6 +759,23 @@ impl LinearSolver for AmgCg {
         let rhs = b.to_vec();
         b.fill(0.0);
         self.pcg(&rhs, b)
+    }
+}
+
+/// The pre-smoothing of the symmetric cycle with one sweep: a forward sweep from zero
+/// that leaves the residual in `res`, then the sweeps over the penalty rows keeping it
+/// up to date. `parts`: the inverse diagonal, the penalty rows and their sweeps.
+fn presmooth_with_residual<V: Copy + Into<f64>>(
+    a: csr::Rows<'_, V>,
+    (inv_diag, penalty_rows, penalty_sweeps): (&[f64], &[u32], usize),
+    x: &mut [f64],
+    b: &[f64],
+    res: &mut [f64],
+    saved: &mut Vec<f64>,
+) {
+    gauss_seidel_from_zero_with_residual(a, inv_diag, x, b, res);
+    for _ in 0..penalty_sweeps {
+        symmetric_gauss_seidel_rows_with_residual(a, inv_diag, x, b, penalty_rows, res, saved);
     }
 }
 

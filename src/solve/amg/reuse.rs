@@ -102,7 +102,10 @@ impl AmgCg {
         self.reuse.symmetric = None;
         let fine = &mut self.levels[0];
         fine.inv_diag = diag.iter().map(|d| 1.0 / d).collect();
-        fine.a32 = a.val.iter().map(|&v| v as f32).collect();
+        // (A finest level that sweeps in double precision keeps no single copy.)
+        if !fine.a32.is_empty() {
+            fine.a32 = a.val.iter().map(|&v| v as f32).collect();
+        }
         fine.a = a;
         self.earlier.clear();
         self.reuse.refreshed = true;

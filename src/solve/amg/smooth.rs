@@ -118,6 +118,39 @@ pub(super) fn gauss_seidel_from_zero_with_residual<V: Copy + Into<f64>>(
     }
 }
 
+/// A backward Gauss–Seidel sweep (as [`gauss_seidel`] backward) that also leaves the
+/// product `y = A x` of the swept `x`, in the same pass over a symmetric `a`: CG's
+/// product with the fine matrix, made where the V-cycle reads the matrix anyway. Row
+/// k, swept after every row above it, finds `x_j`, j > k, final: it sets
+/// `y_k = Σ_{j>k} a_kj x_j + a_kk x_k` and adds `a_kj x_k` to each `y_j`, j > k, which
+/// is `a_jk x_k` (symmetry) — the term of row j that the rows below it complete. Needs
+/// ascending columns and a stored diagonal in each row, as every [`Csr`] of the
+/// hierarchy has.
+pub(super) fn gauss_seidel_backward_with_product<V: Copy + Into<f64>>(
+    a: Rows<'_, V>,
+    inv_diag: &[f64],
+    x: &mut [f64],
+    b: &[f64],
+    y: &mut [f64],
+) {
+    for k in (0..a.nrows).rev() {
+        let (start, end) = (a.ptr[k], a.ptr[k + 1]);
+        let d = start + a.idx[start..end].partition_point(|&j| (j as usize) < k);
+        debug_assert_eq!(a.idx[d] as usize, k, "row {k} stores no diagonal");
+        let (lower, upper) = ((start..d), (d + 1..end));
+        let below = dot_row(&a.idx[lower.clone()], &a.val[lower], x);
+        let (idx, val) = (&a.idx[upper.clone()], &a.val[upper]);
+        let above = dot_row(idx, val, x);
+        let diag: f64 = a.val[d].into();
+        let xk = x[k] + (b[k] - (below + diag * x[k] + above)) * inv_diag[k];
+        x[k] = xk;
+        y[k] = above + diag * xk;
+        for (&j, &v) in idx.iter().zip(val) {
+            y[j as usize] += v.into() * xk;
+        }
+    }
+}
+
 /// [`symmetric_gauss_seidel_rows`] keeping the residual `r = b − A x` of a symmetric
 /// `a` up to date: each row's change `δ_k` takes `a_jk δ_k` off `r_j` for the rows j
 /// it couples to. `saved` is scratch of at least `rows.len()` values.

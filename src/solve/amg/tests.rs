@@ -407,6 +407,39 @@ fn gauss_seidel_from_zero_is_a_full_sweep_from_zero() {
     assert!(full.iter().any(|&v| v != 0.0));
 }
 
+/// The backward sweep that leaves `A x` gives the product of the vector it swept, to
+/// round-off, and the sweep of [`gauss_seidel`] to round-off (its row sums split in
+/// three).
+#[test]
+fn backward_sweep_with_product_is_a_sweep_and_a_product() {
+    let a = penalty_tied_blocks(6, 4);
+    let n = a.nrows;
+    let inv_diag: Vec<f64> = a.diagonal().iter().map(|d| 1.0 / d).collect();
+    let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 23) as f64 - 11.0).collect();
+    let start: Vec<f64> = (0..n).map(|i| ((i * 104_729) % 17) as f64 * 0.1).collect();
+    let (mut plain, mut fused) = (start.clone(), start.clone());
+    gauss_seidel(a.with_values(&a.val), &inv_diag, &mut plain, &b, false);
+    let mut y = vec![f64::NAN; n];
+    gauss_seidel_backward_with_product(a.with_values(&a.val), &inv_diag, &mut fused, &b, &mut y);
+    let mut ax = vec![0.0; n];
+    a.spmv(&fused, &mut ax);
+    let scale = a.val.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+        * fused.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        assert!(
+            (plain[i] - fused[i]).abs() <= 1e-12 * (1.0 + plain[i].abs()),
+            "x[{i}]"
+        );
+        assert!(
+            (y[i] - ax[i]).abs() <= 64.0 * f64::EPSILON * scale,
+            "y[{i}]: {} vs {}",
+            y[i],
+            ax[i]
+        );
+    }
+    assert!(fused != start);
+}
+
 /// The hard case of the interface remedies: on penalty-tied non-matching blocks,
 /// the prolongator smoothed with the filtered matrix and the extra sweeps over the
 /// interface rows keep AMG-CG near its count on one block, and the extra sweeps
