@@ -251,6 +251,16 @@ impl AmgCg {
         o.symmetric && o.sweeps == 1 && o.smoother == Smoother::SymmetricGaussSeidel
     }
 
+    /// The finest level's single-precision values made again where the options were
+    /// changed since the set-up to a cycle that reads them (the options are public);
+    /// called before a cycle is run.
+    fn fit_fine_values(&mut self) {
+        if self.fine_product() && !self.sweeps_make_product() {
+            let fine = &mut self.levels[0];
+            fine.a32 = fine.a.val.iter().map(|&v| v as f32).collect();
+        }
+    }
+
     pub fn hierarchy(&self) -> Hierarchy {
         Hierarchy {
             rows: self.levels.iter().map(|l| l.a.nrows).collect(),
@@ -506,6 +516,7 @@ impl AmgCg {
     /// One V-cycle of the hierarchy set up last: `z ≈ A⁻¹ r` from a zero guess (a
     /// preconditioner for other Krylov methods).
     pub fn apply_vcycle(&mut self, r: &[f64], z: &mut [f64]) {
+        self.fit_fine_values();
         self.precondition(r, z);
     }
 
@@ -689,6 +700,7 @@ impl AmgCg {
         q: &mut [f64],
     ) -> Result<SolveReport, SolveError> {
         let bnorm = norm(b);
+        self.fit_fine_values();
         let fused = self.fine_product();
         self.precondition(r, z);
         p.copy_from_slice(z);
