@@ -31,11 +31,10 @@
 //!    space of a scalar diffusion operator), smoothed `P = (I − ω D_F⁻¹A_F) P̂` with
 //!    `ω = 4/(3 ρ(D_F⁻¹A_F))`, ρ by at most ten Lanczos steps (fewer once the
 //!    estimate settles), where `A_F` is `A` with its positive off-diagonal couplings
-//!    lumped onto the diagonal (Vaněk et al.'s filtered
-//!    matrix; `A_F = A` for an M-matrix — why, at `coarsen::filtered_diagonal`); then
-//!    truncated: in each row the entries below [`AmgOptions::truncation`] of its largest
-//!    are dropped and the rest scaled to keep the row sum (so P still carries the
-//!    constants);
+//!    lumped onto the diagonal (Vaněk et al.'s filtered matrix; `A_F = A` for an
+//!    M-matrix — why, at `coarsen::filtered_diagonal`); then truncated: in each row
+//!    the entries below [`AmgOptions::truncation`] of its largest are dropped and the
+//!    rest scaled to keep the row sum (so P still carries the constants);
 //! 4. Galerkin coarse operator `A_c = Pᵀ A P`.
 //!
 //! The V-cycle smooths with symmetric Gauss–Seidel (forward before, backward after the
