@@ -98,9 +98,10 @@ const LANCZOS_STEPS: usize = 10;
 /// Lanczos stops before [`LANCZOS_STEPS`] once a step raises the largest Ritz value by
 /// less than this fraction of it. On the tied 120:80 boxes of `benches/peers.sh` the
 /// finest level's values run 1.9394, 1.9487, 1.9499, 1.9501, 1.9502 from the fifth
-/// step on, so it stops after seven products (three of its 48 ms products saved);
-/// where the values still climb (the electronics die's aspect-5 cells, 1.9587 →
-/// 1.9719 → 1.9811 at the last steps, and every coarser level measured) all ten run.
+/// step on, so it stops after seven products (three of its 48 ms products saved).
+/// Where the values still climb all ten run: the electronics die's finest level
+/// (aspect-5 cells: 1.9587 → 1.9719 → 1.9811 at the last steps) and the tie's coarser
+/// levels; the die's second level (1.9864 → 1.9871 at its ninth) stops after nine.
 const RITZ_SETTLED: f64 = 1e-3;
 
 /// The largest eigenvalue of a symmetric operator `M` of size `n` (`D^{-1/2} B D^{-1/2}`,
