@@ -188,6 +188,30 @@ struct Level {
     saved: Vec<f64>,
 }
 
+impl Level {
+    /// `times` symmetric Gauss–Seidel sweeps over the penalty rows, with the values the
+    /// level sweeps with (single precision, or double on a finest level that keeps no
+    /// single copy).
+    fn sweep_penalty_rows(&mut self, times: usize) {
+        let Level {
+            a,
+            a32,
+            inv_diag,
+            penalty_rows,
+            x,
+            b,
+            ..
+        } = self;
+        for _ in 0..times {
+            if a32.is_empty() {
+                symmetric_gauss_seidel_rows(a.with_values(&a.val), inv_diag, x, b, penalty_rows);
+            } else {
+                symmetric_gauss_seidel_rows(a.with_values(a32), inv_diag, x, b, penalty_rows);
+            }
+        }
+    }
+}
+
 /// PCG with a smoothed-aggregation AMG V-cycle as preconditioner.
 pub struct AmgCg {
     pub options: AmgOptions,
@@ -577,17 +601,8 @@ impl AmgCg {
                     smooth(lev, smoother, true);
                 }
             }
-            let a = lev.a.with_values(&lev.a32);
-            let times = self.options.penalty_sweeps;
-            sweep_penalty_rows(
-                a,
-                &lev.inv_diag,
-                &mut lev.x,
-                &lev.b,
-                &lev.penalty_rows,
-                times,
-            );
-            a.spmv(&lev.x, &mut lev.res);
+            lev.sweep_penalty_rows(self.options.penalty_sweeps);
+            lev.a.with_values(&lev.a32).spmv(&lev.x, &mut lev.res);
             lev.res
                 .par_iter_mut()
                 .zip(&lev.b)
@@ -604,32 +619,15 @@ impl AmgCg {
             .par_iter_mut()
             .zip(&lev.res)
             .for_each(|(x, c)| *x += c);
-        let times = self.options.penalty_sweeps;
+        lev.sweep_penalty_rows(self.options.penalty_sweeps);
         if lev.a32.is_empty() {
             // The finest level in double precision: its one backward sweep also makes
             // `A z` for CG (`fine_product`).
             let a = lev.a.with_values(&lev.a.val);
-            sweep_penalty_rows(
-                a,
-                &lev.inv_diag,
-                &mut lev.x,
-                &lev.b,
-                &lev.penalty_rows,
-                times,
-            );
             let (x, b, y) = (&mut lev.x, &lev.b, &mut self.product);
             gauss_seidel_backward_with_product(a, &lev.inv_diag, x, b, y);
             return;
         }
-        let a = lev.a.with_values(&lev.a32);
-        sweep_penalty_rows(
-            a,
-            &lev.inv_diag,
-            &mut lev.x,
-            &lev.b,
-            &lev.penalty_rows,
-            times,
-        );
         for _ in 0..sweeps {
             smooth(lev, smoother, false);
         }
@@ -793,20 +791,6 @@ fn presmooth_with_residual<V: Copy + Into<f64>>(
     gauss_seidel_from_zero_with_residual(a, inv_diag, x, b, res);
     for _ in 0..penalty_sweeps {
         symmetric_gauss_seidel_rows_with_residual(a, inv_diag, x, b, penalty_rows, res, saved);
-    }
-}
-
-/// `times` symmetric Gauss–Seidel sweeps over a level's penalty rows `rows`.
-fn sweep_penalty_rows<V: Copy + Into<f64>>(
-    a: csr::Rows<'_, V>,
-    inv_diag: &[f64],
-    x: &mut [f64],
-    b: &[f64],
-    rows: &[u32],
-    times: usize,
-) {
-    for _ in 0..times {
-        symmetric_gauss_seidel_rows(a, inv_diag, x, b, rows);
     }
 }
 
