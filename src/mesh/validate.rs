@@ -338,11 +338,13 @@ impl Mesh {
         if let Some(local) = nodes.iter().position(|n| n.index() >= self.num_nodes()) {
             return Some(Fault::Dangling(local));
         }
+        // No corner table (shells, bars, 2-D elements in a 3-D mesh): nothing to read.
+        let corners = corners?;
         let mut x = [[0.0f64; 3]; 8];
         for (xi, n) in x.iter_mut().zip(nodes) {
             *xi = self.coords[n.index()];
         }
-        check_corners(&x[..nodes.len()], corners?, self.dim).map(Fault::Corner)
+        check_corners(&x[..nodes.len()], corners, self.dim).map(Fault::Corner)
     }
 }
 
