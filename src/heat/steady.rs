@@ -14,7 +14,7 @@ use std::time::Instant;
 use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{
-    AmgCg, AmgOptions, BlockGmres, Cholesky, LinearSolver, Lu, Ordering, SaddleLdlt,
+    AmgCg, AmgOptions, BlockGmres, Cholesky, FineRadius, LinearSolver, Lu, Ordering, SaddleLdlt,
     apply_dirichlet, apply_dirichlet_mut, apply_dirichlet_parts, spmv, spmv_parts, spmv_ref,
 };
 use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
@@ -592,8 +592,12 @@ fn solve_amg(
         });
     };
     let t = Instant::now();
+    // A hierarchy for one linear solve (a further step, if the first falls short,
+    // solves with the same): the finest level's ρ by its bound, one pass instead of up
+    // to ten.
     let mut amg = AmgCg::new(AmgOptions {
         tolerance: STEADY_AMG_TOLERANCE,
+        fine_radius: FineRadius::Bound,
         ..AmgOptions::default()
     });
     amg.setup(fine)?;

@@ -27,7 +27,7 @@ pub mod amg;
 mod direct;
 mod gmres;
 
-pub use amg::{AmgCg, AmgOptions, Smoother};
+pub use amg::{AmgCg, AmgOptions, FineRadius, Smoother};
 #[cfg(feature = "mpi")]
 pub(crate) use direct::metis_lock;
 pub use direct::{Cholesky, Lu, Ordering, SaddleLdlt, metis_ordering};

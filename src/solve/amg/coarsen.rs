@@ -87,21 +87,50 @@ pub(super) fn spectral_radius_filtered<V: Copy + Into<f64> + Sync>(
     })
 }
 
-/// Lanczos steps of [`largest_eigenvalue`]. Each is one product with the fine matrix,
-/// the set-up's costliest pass. Ten give the top of the spectrum of a Q1 operator
-/// within a few per cent: Lanczos converges to the extreme eigenvalues much faster
-/// than the power method, whose twenty products (enlarged by 5 %) still estimated
-/// ρ(D_F⁻¹A_F) of the tied 120:80 boxes of `benches/peers.sh` at 1.88 where ten
-/// Lanczos steps find 1.95.
+/// Gershgorin's bound on ρ(D_F⁻¹A_F) of the filtered matrix: the largest row sum of
+/// `|D_F⁻¹A_F|`, `max_i (d_F,i + Σ_{j≠i} max(−a_ij, 0)) / d_F,i`, in one pass over
+/// the matrix where [`spectral_radius_filtered`] makes up to ten products. It is an
+/// upper bound, so `ω = 4/(3ρ)` from it damps no more than the estimate would. Where
+/// every row sum of `A` is at least 0 (an assembled conduction matrix: zero in the bulk,
+/// positive where a capacity, a convection or an eliminated Dirichlet neighbour adds to
+/// the diagonal; `A_F` keeps them), `d_F,i` is at least the row's negative couplings
+/// and the bound is at most 2 — against 1.95 for the estimate on the tied 120:80 boxes
+/// of `benches/peers.sh` and the electronics die, and 1.49 on their gap-conductance
+/// boxes, whose bulk of Q1 hexes has 1.5. The finest level takes it for a hierarchy
+/// that serves one solve (`FineRadius::Bound`); a Galerkin operator has no such
+/// guarantee, so the coarser levels keep the estimate. The maximum does not depend on
+/// the order, so neither on the threads.
+pub(super) fn gershgorin_filtered(a: &Csr, filtered_diag: &[f64]) -> f64 {
+    use rayon::prelude::*;
+    (0..a.nrows)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|i| {
+            let row = a.ptr[i]..a.ptr[i + 1];
+            let negative: f64 = (a.idx[row.clone()].iter().zip(&a.val[row]))
+                .filter(|&(&j, _)| j as usize != i)
+                .map(|(_, &v)| (-v).max(0.0))
+                .sum();
+            (filtered_diag[i] + negative) / filtered_diag[i]
+        })
+        .reduce(|| 0.0, f64::max)
+}
+
+/// Lanczos steps of [`largest_eigenvalue`], each one product with the level's matrix
+/// (every level's ρ but the finest one's under `FineRadius::Bound`, which takes
+/// [`gershgorin_filtered`]). Ten give the top of the spectrum of a Q1 operator within
+/// a few per cent: Lanczos converges to the extreme eigenvalues much faster than the
+/// power method, whose twenty products (enlarged by 5 %) still estimated ρ(D_F⁻¹A_F)
+/// of the tied 120:80 boxes of `benches/peers.sh` at 1.88 where ten Lanczos steps
+/// find 1.95.
 const LANCZOS_STEPS: usize = 10;
 
 /// Lanczos stops before [`LANCZOS_STEPS`] once a step raises the largest Ritz value by
-/// less than this fraction of it. On the tied 120:80 boxes of `benches/peers.sh` the
-/// finest level's values run 1.9394, 1.9487, 1.9499, 1.9501, 1.9502 from the fifth
-/// step on, so it stops after seven products (three of its 48 ms products saved).
-/// Where the values still climb all ten run: the electronics die's finest level
-/// (aspect-5 cells: 1.9587 → 1.9719 → 1.9811 at the last steps) and the tie's coarser
-/// levels; the die's second level (1.9864 → 1.9871 at its ninth) stops after nine.
+/// less than this fraction of it. The finest level of the tied 120:80 boxes of
+/// `benches/peers.sh` (when it took the estimate) ran 1.9394, 1.9487, 1.9499, 1.9501,
+/// 1.9502 from the fifth step on and stopped after seven products. Where the values
+/// still climb all ten run: the tie's coarser levels; the electronics die's second
+/// level (1.9864 → 1.9871 at its ninth) stops after nine.
 const RITZ_SETTLED: f64 = 1e-3;
 
 /// The largest eigenvalue of a symmetric operator `M` of size `n` (`D^{-1/2} B D^{-1/2}`,
@@ -617,6 +646,36 @@ mod tests {
         });
         assert!((got - 2.0).abs() <= 2e-3, "{got}");
         assert!(products < LANCZOS_STEPS, "{products} products");
+    }
+
+    /// The bound lies above ρ and, for a matrix with zero row sums in its bulk, at 2;
+    /// a positive coupling lumped onto the diagonal and a row made heavier by a
+    /// capacity lower it, to their exact row sums.
+    #[test]
+    fn gershgorin_bound_lies_above_the_spectral_radius() {
+        for n in [1, 5, 8, 1000] {
+            let a = laplace_1d(n);
+            let exact = 1.0 + (std::f64::consts::PI / (n + 1) as f64).cos();
+            let bound = gershgorin_filtered(&a, &filtered_diagonal(&a));
+            assert!(bound >= exact, "n = {n}: {bound} < {exact}");
+            let expected = if n == 1 { 1.0 } else { 2.0 };
+            assert_eq!(bound, expected, "n = {n}");
+        }
+        // [[3, −1, 1], [−1, 3, −1], [1, −1, 3]] plus 1 on the diagonal of row 1:
+        // filtered diagonals 4, 4, 4; negative couplings 1, 2, 1.
+        let mut a = Csr {
+            nrows: 3,
+            ncols: 3,
+            ptr: vec![0, 3, 6, 9],
+            idx: vec![0, 1, 2, 0, 1, 2, 0, 1, 2],
+            val: vec![3.0, -1.0, 1.0, -1.0, 3.0, -1.0, 1.0, -1.0, 3.0],
+        };
+        a.val[4] += 1.0;
+        let filtered = filtered_diagonal(&a);
+        assert_eq!(filtered, vec![4.0, 4.0, 4.0]);
+        assert_eq!(gershgorin_filtered(&a, &filtered), 1.5);
+        let estimate = spectral_radius_filtered(a.with_values(&a.val), &filtered);
+        assert!(estimate <= 1.5 * (1.0 + 1e-12), "{estimate}");
     }
 
     #[test]

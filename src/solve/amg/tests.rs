@@ -501,6 +501,52 @@ fn amg_cg_converges_fast_on_penalty_tied_nonmatching_blocks() {
     assert!(with < without, "{with} with the sweeps, {without} without");
 }
 
+/// The finest level's ρ by its bound instead of the estimate: the same solve to the
+/// tolerance, with the prolongator damped by `4/(3·2)` (the bound on a matrix with
+/// zero row sums in its bulk) and at most two iterations more here; a one-level
+/// hierarchy gets the single-precision values its cycle reads.
+#[test]
+fn fine_radius_bound_solves_as_the_estimate_does() {
+    let a = penalty_tied_blocks(24, 16);
+    let n = a.nrows;
+    let b: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64).collect();
+    let solve = |fine_radius: FineRadius| {
+        let mut s = AmgCg::new(AmgOptions {
+            tolerance: 1e-10,
+            fine_radius,
+            ..AmgOptions::default()
+        });
+        s.setup(a.clone()).unwrap();
+        let mut x = vec![0.0; n];
+        let rep = s.pcg(&b, &mut x).unwrap();
+        let res = residual_norm(&a, &x, &b);
+        assert!(
+            res <= 1e-10 * norm(&b) * 1.01,
+            "{fine_radius:?}: residual {res:.2e}"
+        );
+        assert!(s.fine_product(), "{fine_radius:?}: the fused cycle");
+        rep.iterations
+    };
+    let (estimate, bound) = (solve(FineRadius::Estimate), solve(FineRadius::Bound));
+    assert!(
+        bound <= estimate + 2,
+        "{bound} iterations by the bound, {estimate} by the estimate"
+    );
+    // One level too large for the dense coarse solve: it is swept.
+    let m = 3000;
+    let one_level = laplace_1d(m);
+    let mut s = AmgCg::new(AmgOptions {
+        fine_radius: FineRadius::Bound,
+        max_levels: 1,
+        ..AmgOptions::default()
+    });
+    s.setup(one_level.clone()).unwrap();
+    assert_eq!(s.levels.len(), 1);
+    let (b, mut x) = (vec![1.0; m], vec![0.0; m]);
+    s.pcg(&b, &mut x).unwrap();
+    assert!(residual_norm(&one_level, &x, &b) <= 1e-8 * norm(&b) * 1.01);
+}
+
 /// The Q1 stiffness of an `m × m`-node square grid (8/3 on the diagonal, −1/3 to each
 /// of up to 8 neighbours, the row sums of a pure Neumann problem on interior rows).
 fn q1_grid(m: usize) -> Csr {
