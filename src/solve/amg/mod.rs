@@ -31,12 +31,12 @@
 //!    space of a scalar diffusion operator), smoothed `P = (I − ω D_F⁻¹A_F) P̂` with
 //!    `ω = 4/(3 ρ(D_F⁻¹A_F))`, where `A_F` is `A` with its positive off-diagonal
 //!    couplings lumped onto the diagonal (Vaněk et al.'s filtered matrix; `A_F = A`
-//!    for an M-matrix — why, at `coarsen::filtered_diagonal`), and ρ on the finest
-//!    level the estimate of at most ten Lanczos steps (fewer once it settles), or for a
-//!    hierarchy serving one solve Gershgorin's bound ([`FineRadius`]), on the coarser
-//!    ones the estimate; then truncated: in each row
-//!    the entries below [`AmgOptions::truncation`] of its largest are dropped and the
-//!    rest scaled to keep the row sum (so P still carries the constants);
+//!    for an M-matrix — why, at `coarsen::filtered_diagonal`). ρ is estimated by at
+//!    most ten Lanczos steps (fewer once the estimate settles), except on the finest
+//!    level of a hierarchy that serves one solve, which takes Gershgorin's bound
+//!    ([`FineRadius`]). P is then truncated: in each row the entries below
+//!    [`AmgOptions::truncation`] of its largest are dropped and the rest scaled to keep
+//!    the row sum (so P still carries the constants);
 //! 4. Galerkin coarse operator `A_c = Pᵀ A P`.
 //!
 //! The V-cycle smooths with symmetric Gauss–Seidel (forward before, backward after the
@@ -116,10 +116,10 @@ pub enum FineRadius {
     /// ρ is 1.95 near a penalty interface or in stretched cells and 1.5 in a bulk of Q1
     /// cubes; there the prolongator is damped less than it could be and CG takes more
     /// iterations. For a hierarchy that serves one solve. Measured on one thread at
-    /// about 1e6 unknowns: a conforming box of 100³ cubes 15 → 18 iterations (solve
-    /// +0.3 s) for a set-up 0.55 s shorter; the tied 120:80 boxes of
-    /// `benches/peers.sh` 17 iterations either way, set-up 1.60 → 1.33 s; their
-    /// gap-conductance twin 15 → 16, set-up 1.93 → 1.31 s.
+    /// about 1e6 unknowns (medians of three): a conforming box of 100³ cubes 15 → 18
+    /// iterations (CG +0.31 s) for a set-up 0.55 s shorter; the tied 120:80 boxes of
+    /// `benches/peers.sh` 17 iterations either way, set-up 1.65 → 1.37 s; their
+    /// gap-conductance twin 15 → 16, set-up 1.88 → 1.32 s.
     Bound,
 }
 
