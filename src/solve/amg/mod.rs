@@ -414,13 +414,11 @@ impl AmgCg {
         loop {
             // The values the V-cycle will read, in single precision (module docs); the
             // estimate of ρ below reads them too (its products are the set-up's
-            // costliest passes over the level). A finest level whose ρ is bounded
-            // without them and that will sweep with its double-precision values
-            // (`fine_product`) has none made; should it stay the only level, they are
-            // made at the end.
+            // costliest passes over the level). A finest level that will sweep with its
+            // double-precision values (`fine_product`) has none made, and its estimate
+            // reads those; should it stay the only level, they are made at the end.
             let fine = self.levels.is_empty();
-            let bound = fine && self.options.fine_radius == FineRadius::Bound;
-            let a32: Vec<f32> = if bound && self.sweeps_make_product() {
+            let a32: Vec<f32> = if fine && self.sweeps_make_product() {
                 Vec::new()
             } else {
                 a.val.iter().map(|&v| v as f32).collect()
@@ -464,8 +462,10 @@ impl AmgCg {
                 // Stop when aggregation stalls (nothing to coarsen, or too little).
                 if nagg > 0 && (nagg as f64) < 0.8 * n as f64 {
                     let filtered = filtered_diagonal(&a);
-                    let rho = if bound {
+                    let rho = if fine && self.options.fine_radius == FineRadius::Bound {
                         gershgorin_filtered(&a, &filtered)
+                    } else if a32.is_empty() {
+                        spectral_radius_filtered(a.with_values(&a.val), &filtered)
                     } else {
                         spectral_radius_filtered(a.with_values(&a32), &filtered)
                     };
