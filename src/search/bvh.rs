@@ -652,17 +652,23 @@ mod tests {
         let mut order: Vec<u32> = (0..n as u32).collect();
         let mut nodes = Vec::new();
         push(&tree, &mut order, 0, &mut nodes);
+        // (Parents are checked below against their definition.)
         let mut serial = Bvh {
             nodes,
-            parent: two.parent.clone(),
+            parent: Vec::new(),
             boxes: order.iter().map(|&i| items[i as usize]).collect(),
             order,
         };
         serial.fit_bounds();
+        assert_eq!(two.parent, one.parent);
+        for (k, node) in two.nodes.iter().enumerate().filter(|(_, n)| n.count == 0) {
+            // An internal node is the parent of the node after it and of its right child.
+            assert_eq!(two.parent[k + 1] as usize, k);
+            assert_eq!(two.parent[node.start as usize] as usize, k);
+        }
         for other in [&one, &serial] {
             assert_eq!(two.order, other.order);
             assert_eq!(two.boxes, other.boxes);
-            assert_eq!(two.parent, other.parent);
             assert_eq!(two.nodes.len(), other.nodes.len());
             for (a, b) in two.nodes.iter().zip(&other.nodes) {
                 assert_eq!((a.bounds, a.start, a.count), (b.bounds, b.start, b.count));

@@ -468,6 +468,26 @@ fn backward_sweep_with_product_is_a_sweep_and_a_product() {
     assert!(fused != start);
 }
 
+/// `a x = b` for a fixed `b` (1 to 7 by row) from zero, by AMG-CG with `options` to
+/// the tolerance 1e-10; the residual is checked here. The solver and its iterations.
+fn solve_to_1e10(a: &Csr, options: AmgOptions) -> (AmgCg, usize) {
+    let n = a.nrows;
+    let b: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64).collect();
+    let mut s = AmgCg::new(AmgOptions {
+        tolerance: 1e-10,
+        ..options
+    });
+    s.setup(a.clone()).unwrap();
+    let mut x = vec![0.0; n];
+    let iterations = s.pcg(&b, &mut x).unwrap().iterations;
+    let res = residual_norm(a, &x, &b);
+    assert!(
+        res <= 1e-10 * norm(&b) * 1.01,
+        "{options:?}: residual {res:.2e}"
+    );
+    (s, iterations)
+}
+
 /// The hard case of the interface remedies: on penalty-tied non-matching blocks,
 /// the prolongator smoothed with the filtered matrix and the extra sweeps over the
 /// interface rows keep AMG-CG near its count on one block, and the extra sweeps
@@ -477,21 +497,15 @@ fn backward_sweep_with_product_is_a_sweep_and_a_product() {
 fn amg_cg_converges_fast_on_penalty_tied_nonmatching_blocks() {
     let a = penalty_tied_blocks(24, 16);
     let n = a.nrows;
-    let b: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64).collect();
     let solve = |penalty_sweeps: usize| {
-        let mut s = AmgCg::new(AmgOptions {
-            tolerance: 1e-10,
-            penalty_sweeps,
-            ..AmgOptions::default()
-        });
-        s.setup(a.clone()).unwrap();
-        let mut x = vec![0.0; n];
-        let rep = s.pcg(&b, &mut x).unwrap();
-        let mut r = vec![0.0; n];
-        a.spmv(&x, &mut r);
-        let res = norm(&r.iter().zip(&b).map(|(r, b)| r - b).collect::<Vec<_>>());
-        assert!(res <= 1e-10 * norm(&b) * 1.01, "residual {res:.2e}");
-        (s.levels[0].penalty_rows.len(), rep.iterations)
+        let (s, iterations) = solve_to_1e10(
+            &a,
+            AmgOptions {
+                penalty_sweeps,
+                ..AmgOptions::default()
+            },
+        );
+        (s.levels[0].penalty_rows.len(), iterations)
     };
     let (rows, with) = solve(AmgOptions::default().penalty_sweeps);
     let (_, without) = solve(0);
@@ -508,24 +522,16 @@ fn amg_cg_converges_fast_on_penalty_tied_nonmatching_blocks() {
 #[test]
 fn fine_radius_bound_solves_as_the_estimate_does() {
     let a = penalty_tied_blocks(24, 16);
-    let n = a.nrows;
-    let b: Vec<f64> = (0..n).map(|i| 1.0 + (i % 7) as f64).collect();
     let solve = |fine_radius: FineRadius| {
-        let mut s = AmgCg::new(AmgOptions {
-            tolerance: 1e-10,
-            fine_radius,
-            ..AmgOptions::default()
-        });
-        s.setup(a.clone()).unwrap();
-        let mut x = vec![0.0; n];
-        let rep = s.pcg(&b, &mut x).unwrap();
-        let res = residual_norm(&a, &x, &b);
-        assert!(
-            res <= 1e-10 * norm(&b) * 1.01,
-            "{fine_radius:?}: residual {res:.2e}"
+        let (s, iterations) = solve_to_1e10(
+            &a,
+            AmgOptions {
+                fine_radius,
+                ..AmgOptions::default()
+            },
         );
         assert!(s.fine_product(), "{fine_radius:?}: the fused cycle");
-        rep.iterations
+        iterations
     };
     let (estimate, bound) = (solve(FineRadius::Estimate), solve(FineRadius::Bound));
     assert!(
