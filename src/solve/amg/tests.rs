@@ -627,3 +627,144 @@ fn truncated_prolongator_keeps_row_sums_and_large_entries() {
     }
     assert!(dropped > 0);
 }
+
+/// The sweeps by blocks are Gauss–Seidel inside each block with the other blocks' rows
+/// read as they were before the sweep (written out plainly here), their fused residual
+/// and product are `b − A x` and `A x` of the swept `x`, and one thread and three give
+/// the same bits.
+#[test]
+fn sweeps_by_blocks_are_gauss_seidel_inside_blocks() {
+    let a = q1_grid(50);
+    let n = a.nrows;
+    let blocks = Blocks::new(&a, 600).expect("2 500 rows cut in blocks of 600");
+    assert_eq!(blocks.count(), 4);
+    assert!(blocks.crossing_rows() > 0 && blocks.crossing_rows() < n / 4);
+    let starts: Vec<usize> = (0..=4).map(|k| k * n / 4).collect();
+    let inv_diag: Vec<f64> = a.diagonal().iter().map(|d| 1.0 / d).collect();
+    let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 23) as f64 - 11.0).collect();
+    let start: Vec<f64> = (0..n).map(|i| ((i * 104_729) % 17) as f64 * 0.1).collect();
+    let entries = |i: usize| (a.ptr[i]..a.ptr[i + 1]).map(|p| (a.idx[p] as usize, a.val[p]));
+    // The sweeps written out: block by block, rows outside the block from `before`.
+    let sweep = |x: &mut [f64], forward: bool| {
+        let before = x.to_vec();
+        for k in 0..4 {
+            let (s, e) = (starts[k], starts[k + 1]);
+            let rows: Vec<usize> = if forward {
+                (s..e).collect()
+            } else {
+                (s..e).rev().collect()
+            };
+            for i in rows {
+                let sum: f64 = entries(i)
+                    .map(|(j, v)| v * if (s..e).contains(&j) { x[j] } else { before[j] })
+                    .sum();
+                x[i] += (b[i] - sum) * inv_diag[i];
+            }
+        }
+    };
+    let scale = |x: &[f64]| {
+        a.val.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+            * x.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    };
+    let close = |got: &[f64], want: &[f64], tol: f64, what: &str| {
+        for i in 0..n {
+            assert!(
+                (got[i] - want[i]).abs() <= tol,
+                "{what}[{i}]: {} vs {}",
+                got[i],
+                want[i]
+            );
+        }
+    };
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut blocks = blocks.clone();
+            let rows = a.with_values(&a.val);
+            let (mut x, mut r) = (vec![0.0; n], vec![f64::NAN; n]);
+            blocks.forward_from_zero_with_residual(rows, &inv_diag, &mut x, &b, &mut r);
+            let (mut back, mut y) = (start.clone(), vec![f64::NAN; n]);
+            blocks.backward(rows, &inv_diag, &mut back, &b, Some(&mut y));
+            let mut plain = start.clone();
+            blocks.backward(rows, &inv_diag, &mut plain, &b, None);
+            (x, r, back, y, plain)
+        })
+    };
+    let (x, r, back, y, plain) = run(1);
+    let mut want = vec![0.0; n];
+    sweep(&mut want, true);
+    close(&x, &want, 1e-12 * scale(&want), "forward x");
+    let mut ax = vec![0.0; n];
+    a.spmv(&x, &mut ax);
+    let res: Vec<f64> = b.iter().zip(&ax).map(|(b, ax)| b - ax).collect();
+    close(&r, &res, 64.0 * f64::EPSILON * scale(&x), "residual");
+    let mut want = start.clone();
+    sweep(&mut want, false);
+    close(&back, &want, 1e-12 * scale(&want), "backward x");
+    a.spmv(&back, &mut ax);
+    close(&y, &ax, 64.0 * f64::EPSILON * scale(&back), "product");
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(
+        bits(&plain),
+        bits(&back),
+        "the backward sweep without the product"
+    );
+    // The blocks read across their cuts: not the sweep over all rows at once.
+    let mut whole = start.clone();
+    gauss_seidel(a.with_values(&a.val), &inv_diag, &mut whole, &b, false);
+    assert!(whole.iter().zip(&back).any(|(w, b)| (w - b).abs() > 1e-9));
+    let three = run(3);
+    for (one, three) in [
+        (&x, &three.0),
+        (&r, &three.1),
+        (&back, &three.2),
+        (&y, &three.3),
+    ] {
+        assert_eq!(bits(one), bits(three), "one thread against three");
+    }
+}
+
+/// A hierarchy whose finest level is cut in blocks solves the penalty-tied blocks to
+/// the tolerance within two iterations of the whole sweeps, with the same bits on one
+/// thread and on three.
+#[test]
+fn cycle_with_blocks_solves_as_the_whole_sweeps_do() {
+    let a = penalty_tied_blocks(24, 16);
+    let with = |block_rows: usize| AmgOptions {
+        block_rows,
+        ..AmgOptions::default()
+    };
+    let (whole, whole_its) = solve_to_1e10(&a, with(0));
+    assert!(whole.levels.iter().all(|l| l.blocks.is_none()));
+    let solve = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let (s, iterations) = solve_to_1e10(&a, with(6000));
+            let cut = s.levels[0].blocks.as_ref().map(Blocks::count);
+            let b: Vec<f64> = (0..a.nrows).map(|i| 1.0 + (i % 7) as f64).collect();
+            let mut s = s;
+            let mut x = vec![0.0; a.nrows];
+            s.pcg(&b, &mut x).unwrap();
+            (cut, iterations, x)
+        })
+    };
+    let (cut, its, one) = solve(1);
+    assert_eq!(cut, Some(2), "17 920 rows in two blocks");
+    assert!(
+        its <= whole_its + 2,
+        "{its} iterations by blocks, {whole_its} whole"
+    );
+    let (_, its3, three) = solve(3);
+    assert_eq!(its, its3);
+    assert!(
+        one.iter()
+            .zip(&three)
+            .all(|(a, b)| a.to_bits() == b.to_bits())
+    );
+}
