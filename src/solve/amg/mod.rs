@@ -625,6 +625,9 @@ impl AmgCg {
     fn vcycle(&mut self, l: usize) {
         let sweeps = self.options.sweeps;
         let smoother = self.options.smoother;
+        // The cycle of one symmetric Gauss–Seidel sweep a side, the only one that
+        // sweeps by blocks (the options are public: read them as they are now).
+        let fused = self.sweeps_make_product();
         if l + 1 == self.levels.len() {
             let lev = &mut self.levels[l];
             if self.coarse.is_empty() {
@@ -640,7 +643,7 @@ impl AmgCg {
             }
             return;
         }
-        if self.options.symmetric && sweeps == 1 && smoother == Smoother::SymmetricGaussSeidel {
+        if fused {
             // The residual made in the sweeps' own passes (the matrix is symmetric).
             let penalty_sweeps = self.options.penalty_sweeps;
             let lev = &mut self.levels[l];
@@ -705,7 +708,7 @@ impl AmgCg {
             }
             return;
         }
-        if let Some(blocks) = lev.blocks.as_mut() {
+        if fused && let Some(blocks) = lev.blocks.as_mut() {
             let a = lev.a.with_values(&lev.a32);
             blocks.backward(a, &lev.inv_diag, &mut lev.x, &lev.b, None);
             return;

@@ -222,18 +222,29 @@ fn options_changed_after_the_set_up_still_solve() {
         (|o: &mut AmgOptions| o.sweeps = 2) as fn(&mut AmgOptions),
         |o| o.symmetric = false,
     ] {
+        // Cut in three blocks, which the changed cycle no longer sweeps by: it solves
+        // as one set up with its options from the start.
         let mut s = AmgCg::new(AmgOptions {
             coarse_size: 50,
+            block_rows: 1000,
             ..AmgOptions::default()
         });
         s.setup(a.clone()).unwrap();
         assert!(s.fine_product(), "the default cycle makes CG's product");
+        assert_eq!(s.levels[0].blocks.as_ref().map(Blocks::count), Some(3));
         change(&mut s.options);
         let mut x = vec![0.0; n];
         s.pcg(&b, &mut x).unwrap();
         assert!(!s.fine_product());
         let res = residual_norm(&a, &x, &b);
         assert!(res <= 1e-8 * norm(&b) * 1.01, "residual {res}");
+        // The same bits as a hierarchy set up with the changed options (no blocks).
+        let mut fresh = AmgCg::new(s.options);
+        fresh.setup(a.clone()).unwrap();
+        assert!(fresh.levels[0].blocks.is_none());
+        let mut y = vec![0.0; n];
+        fresh.pcg(&b, &mut y).unwrap();
+        assert!(x.iter().zip(&y).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 }
 
