@@ -20,8 +20,8 @@ use super::csr::{Csr, Rows, dot_row};
 /// cut from twice this on. A cut costs the rows next to it, which read across it (two
 /// planes of nodes in a mesh numbered plane by plane) and are swept again after the
 /// blocks. Measured on the tied 120:80 boxes of `benches/peers.sh` (1.16 M rows, 17 CG
-/// iterations whatever the cut): 2 blocks, 2.5 % of the rows across, CG 2.69 → 2.87 s on
-/// one thread and 2.56 → 1.81 s on two; 4 blocks (2¹⁸ rows), 8.2 % across, 2.92 s on one.
+/// iterations whatever the cut): 2 blocks, 2.5 % of the rows across, CG 2.66 → 2.83 s on
+/// one thread and 2.56 → 1.81 s on two; 4 blocks (2¹⁸ rows), 8.2 % across, 2.93 s on one.
 pub(super) const BLOCK_ROWS: usize = 1 << 19;
 
 /// The largest share of a level's rows that may read across cuts: a level numbered
@@ -285,9 +285,8 @@ impl Blocks {
 }
 
 /// `f(k, part)` for every block's part, side by side; on one thread one after the
-/// other in the sweep's direction (`backward`: last block first), so that a sweep
-/// starts on the rows the last one ended on, still in cache. The blocks are
-/// independent: the order changes no value.
+/// other in the sweep's direction (`backward`: last block first), as the whole sweep
+/// would go. The blocks are independent: the order changes no value.
 fn for_each_block<P: Send>(parts: Vec<P>, backward: bool, f: impl Fn(usize, P) + Sync) {
     if rayon::current_num_threads() > 1 {
         parts.into_par_iter().enumerate().for_each(|(k, p)| f(k, p));

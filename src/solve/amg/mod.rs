@@ -75,7 +75,7 @@
 //! other blocks' rows as they were before the sweep (`blocks`). The cut is a function of
 //! the matrix, not of the threads, so the bits are the same on any number of them. On
 //! the tied 120:80 boxes (two blocks; 17 iterations either way, error 9.7e-14 →
-//! 1.0e-13), CG took 2.56 → 1.81 s on two threads and 2.69 → 2.87 s on one.
+//! 1.0e-13), CG took 2.56 → 1.81 s on two threads and 2.66 → 2.83 s on one.
 
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
