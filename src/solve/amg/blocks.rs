@@ -14,7 +14,7 @@
 
 use rayon::prelude::*;
 
-use super::csr::{Csr, Rows, dot_row};
+use super::csr::{Csr, Rows, dot_row, dot_row_by};
 
 /// The default rows per block, at least ([`super::AmgOptions::block_rows`]): a level is
 /// cut from twice this on. A cut costs the rows next to it, which read across it (two
@@ -37,8 +37,8 @@ pub(super) struct Blocks {
     lower: Vec<Vec<u32>>,
     /// Per block, its rows with an entry left or right of the block, ascending.
     crossing: Vec<Vec<u32>>,
-    /// Every row and column read across a cut, ascending: what a backward sweep keeps
-    /// from before it, in `old`.
+    /// Every column read across a cut, ascending: what a backward sweep keeps from
+    /// before it, in `old`.
     kept: Vec<u32>,
     /// `x` before a backward sweep, at `kept` (other entries unused).
     old: Vec<f64>,
@@ -82,7 +82,6 @@ impl Blocks {
         for (k, rows) in crossing.iter().enumerate() {
             let (s, e) = (starts[k], starts[k + 1]);
             for &i in rows {
-                kept.push(i);
                 let row = &a.idx[a.ptr[i as usize]..a.ptr[i as usize + 1]];
                 kept.extend(
                     row.iter()
@@ -135,7 +134,7 @@ impl Blocks {
     ) {
         let (xs, rs) = (self.split(x), self.split(r));
         let both: Vec<_> = xs.into_iter().zip(rs).collect();
-        for_each_block(both, false, |k, (x, r)| {
+        for_each_block(both, |k, (x, r)| {
             let s = self.starts[k];
             let mut cross = self.lower[k].iter().peekable();
             for il in 0..x.len() {
@@ -197,14 +196,14 @@ impl Blocks {
         let this = &*self;
         let xs = this.split(x);
         let Some(y) = y else {
-            for_each_block(xs, true, |k, x| {
+            for_each_block(xs, |k, x| {
                 this.backward_block::<V, false>(a, inv_diag, b, k, x, &mut []);
             });
             return;
         };
         let ys = this.split(y);
         let both: Vec<_> = xs.into_iter().zip(ys).collect();
-        for_each_block(both, true, |k, (x, y)| {
+        for_each_block(both, |k, (x, y)| {
             this.backward_block::<V, true>(a, inv_diag, b, k, x, y);
         });
         // The product's terms across the cuts: row i's entries right of its block, in
@@ -284,37 +283,15 @@ impl Blocks {
     }
 }
 
-/// `f(k, part)` for every block's part, side by side; on one thread one after the
-/// other in the sweep's direction (`backward`: last block first), as the whole sweep
-/// would go. The blocks are independent: the order changes no value.
-fn for_each_block<P: Send>(parts: Vec<P>, backward: bool, f: impl Fn(usize, P) + Sync) {
-    if rayon::current_num_threads() > 1 {
-        parts.into_par_iter().enumerate().for_each(|(k, p)| f(k, p));
-    } else if backward {
-        parts
-            .into_iter()
-            .enumerate()
-            .rev()
-            .for_each(|(k, p)| f(k, p));
-    } else {
-        parts.into_iter().enumerate().for_each(|(k, p)| f(k, p));
-    }
+/// `f(k, part)` for every block's part, side by side (on one thread, in order). The
+/// blocks are independent: the order changes no value.
+fn for_each_block<P: Send>(parts: Vec<P>, f: impl Fn(usize, P) + Sync) {
+    parts.into_par_iter().enumerate().for_each(|(k, p)| f(k, p));
 }
 
 /// `Σ val_k x[idx_k − s]`: a row's dot product with the values of a block starting at
 /// row `s`, summed as [`super::csr::dot_row`] sums.
 #[inline(always)]
 fn dot_local<V: Copy + Into<f64>>(idx: &[u32], val: &[V], x: &[f64], s: usize) -> f64 {
-    let at = |j: u32| x[j as usize - s];
-    let mut acc = [0.0f64; 4];
-    let (mut ci, mut cv) = (idx.chunks_exact(4), val.chunks_exact(4));
-    for (j, v) in (&mut ci).zip(&mut cv) {
-        for k in 0..4 {
-            acc[k] += v[k].into() * at(j[k]);
-        }
-    }
-    for (k, (&j, &v)) in ci.remainder().iter().zip(cv.remainder()).enumerate() {
-        acc[k] += v.into() * at(j);
-    }
-    (acc[0] + acc[1]) + (acc[2] + acc[3])
+    dot_row_by(idx, val, |v| v.into(), |j| x[j as usize - s])
 }

@@ -310,18 +310,30 @@ pub(super) fn dot_row<V: Copy + Into<f64>>(idx: &[u32], val: &[V], x: &[f64]) ->
 /// [`dot_row`] of the values `f(val_k)`.
 #[inline(always)]
 pub(super) fn dot_row_of<V: Copy>(idx: &[u32], val: &[V], x: &[f64], f: impl Fn(V) -> f64) -> f64 {
+    dot_row_by(idx, val, f, |j| x[j as usize])
+}
+
+/// [`dot_row`] of the values `f(val_k)` and the entries `at(idx_k)` (a vector that
+/// holds only some rows, say).
+#[inline(always)]
+pub(super) fn dot_row_by<V: Copy>(
+    idx: &[u32],
+    val: &[V],
+    f: impl Fn(V) -> f64,
+    at: impl Fn(u32) -> f64,
+) -> f64 {
     let mut acc = [0.0f64; 4];
     let (mut ci, mut cv) = (idx.chunks_exact(4), val.chunks_exact(4));
     for (j, v) in (&mut ci).zip(&mut cv) {
         for k in 0..4 {
-            acc[k] += f(v[k]) * x[j[k] as usize];
+            acc[k] += f(v[k]) * at(j[k]);
         }
     }
     // The last entries into the sums they would have gone to in a longer row: a
     // row's leading part (a sweep from zero reads the entries left of the diagonal)
     // then sums as the whole row does where the rest multiplies zeros.
     for (k, (&j, &v)) in ci.remainder().iter().zip(cv.remainder()).enumerate() {
-        acc[k] += f(v) * x[j as usize];
+        acc[k] += f(v) * at(j);
     }
     (acc[0] + acc[1]) + (acc[2] + acc[3])
 }
