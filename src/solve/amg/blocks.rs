@@ -147,7 +147,7 @@ impl Blocks {
                 } else {
                     0
                 };
-                let diag = row.partition_point(|&j| (j as usize) < i);
+                let diag = a.lower_len(i);
                 let (idx, val) = (&row[first..diag], &a.val[start + first..start + diag]);
                 let xi = (b[i] - dot_local(idx, val, x, s)) * inv_diag[i];
                 x[il] = xi;
@@ -244,7 +244,7 @@ impl Blocks {
             let i = s + il;
             let (start, end) = (a.ptr[i], a.ptr[i + 1]);
             let row = &a.idx[start..end];
-            let d = row.partition_point(|&j| (j as usize) < i);
+            let d = a.lower_len(i);
             debug_assert_eq!(row[d] as usize, i, "row {i} stores no diagonal");
             let diag: f64 = a.val[start + d].into();
             let (lower, vlower) = (&row[..d], &a.val[start..start + d]);

@@ -285,6 +285,17 @@ impl Csr {
         true
     }
 
+    /// Per row, how many of its entries lie left of the diagonal (columns below the
+    /// row's index, the columns ascending): the diagonal's offset in the row.
+    pub(super) fn diagonal_offsets(&self) -> Vec<u32> {
+        (0..self.nrows)
+            .map(|i| {
+                let row = &self.idx[self.ptr[i]..self.ptr[i + 1]];
+                row.partition_point(|&j| (j as usize) < i) as u32
+            })
+            .collect()
+    }
+
     pub(super) fn diagonal(&self) -> Vec<f64> {
         (0..self.nrows)
             .map(|i| {
@@ -346,6 +357,9 @@ pub(super) struct Rows<'a, V> {
     pub(super) ptr: &'a [usize],
     pub(super) idx: &'a [u32],
     pub(super) val: &'a [V],
+    /// Per row, the offset of its diagonal entry in the row ([`Csr::diagonal_offsets`]),
+    /// or empty: the sweeps then search each row for it.
+    pub(super) diag: &'a [u32],
 }
 
 impl<'a> Csr {
@@ -357,6 +371,28 @@ impl<'a> Csr {
             ptr: &self.ptr,
             idx: &self.idx,
             val,
+            diag: &[],
+        }
+    }
+}
+
+impl<'a, V> Rows<'a, V> {
+    /// The same rows, with the offsets of their diagonals as
+    /// [`Csr::diagonal_offsets`] made them: the sweeps read them in place of a binary
+    /// search of every row on every sweep.
+    pub(super) fn with_diagonal(self, diag: &'a [u32]) -> Self {
+        assert_eq!(diag.len(), self.nrows, "one diagonal offset per row");
+        Rows { diag, ..self }
+    }
+
+    /// How many entries of row `i` lie left of its diagonal (columns below `i`): the
+    /// diagonal's offset in the row where it stores one.
+    #[inline(always)]
+    pub(super) fn lower_len(&self, i: usize) -> usize {
+        if self.diag.is_empty() {
+            self.idx[self.ptr[i]..self.ptr[i + 1]].partition_point(|&j| (j as usize) < i)
+        } else {
+            self.diag[i] as usize
         }
     }
 }

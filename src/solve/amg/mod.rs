@@ -208,6 +208,9 @@ impl Default for AmgOptions {
 struct Level {
     a: Csr,
     inv_diag: Vec<f64>,
+    /// Per row of `a`, the offset of its diagonal in the row: the sweeps read it
+    /// (`Rows::with_diagonal`) rather than search every row for it on every sweep.
+    diag_at: Vec<u32>,
     /// ω for Jacobi smoothing (0 when the hierarchy was set up for Gauss–Seidel, which
     /// needs none).
     omega: f64,
@@ -524,6 +527,7 @@ impl AmgCg {
                 None => (Csr::default(), Csr::default(), None),
             };
             self.levels.push(Level {
+                diag_at: a.diagonal_offsets(),
                 a,
                 inv_diag,
                 omega,
@@ -632,7 +636,7 @@ impl AmgCg {
             let lev = &mut self.levels[l];
             if self.coarse.is_empty() {
                 lev.x.fill(0.0);
-                let a = lev.a.with_values(&lev.a32);
+                let a = lev.a.with_values(&lev.a32).with_diagonal(&lev.diag_at);
                 for _ in 0..20 {
                     gauss_seidel(a, &lev.inv_diag, &mut lev.x, &lev.b, true);
                     gauss_seidel(a, &lev.inv_diag, &mut lev.x, &lev.b, false);
@@ -652,6 +656,7 @@ impl AmgCg {
                 a,
                 a32,
                 inv_diag,
+                diag_at,
                 penalty_rows,
                 x,
                 b,
@@ -663,16 +668,18 @@ impl AmgCg {
             let parts = (inv_diag.as_slice(), penalty_rows.as_slice(), penalty_sweeps);
             let blocks = blocks.as_ref();
             if a32.is_empty() {
-                presmooth_with_residual(a.with_values(&a.val), parts, blocks, x, b, res, saved);
+                let a = a.with_values(&a.val).with_diagonal(diag_at);
+                presmooth_with_residual(a, parts, blocks, x, b, res, saved);
             } else {
-                presmooth_with_residual(a.with_values(a32), parts, blocks, x, b, res, saved);
+                let a = a.with_values(a32).with_diagonal(diag_at);
+                presmooth_with_residual(a, parts, blocks, x, b, res, saved);
             }
         } else {
             let lev = &mut self.levels[l];
             lev.x.fill(0.0);
             for k in 0..sweeps {
                 if k == 0 && smoother == Smoother::SymmetricGaussSeidel {
-                    let a = lev.a.with_values(&lev.a32);
+                    let a = lev.a.with_values(&lev.a32).with_diagonal(&lev.diag_at);
                     gauss_seidel_from_zero(a, &lev.inv_diag, &mut lev.x, &lev.b);
                 } else {
                     smooth(lev, smoother, true);
@@ -700,7 +707,7 @@ impl AmgCg {
         if lev.a32.is_empty() {
             // The finest level in double precision: its one backward sweep also makes
             // `A z` for CG (`fine_product`).
-            let a = lev.a.with_values(&lev.a.val);
+            let a = lev.a.with_values(&lev.a.val).with_diagonal(&lev.diag_at);
             let (x, b, y) = (&mut lev.x, &lev.b, &mut self.product);
             match lev.blocks.as_mut() {
                 Some(blocks) => blocks.backward(a, &lev.inv_diag, x, b, Some(y)),
@@ -709,7 +716,7 @@ impl AmgCg {
             return;
         }
         if fused && let Some(blocks) = lev.blocks.as_mut() {
-            let a = lev.a.with_values(&lev.a32);
+            let a = lev.a.with_values(&lev.a32).with_diagonal(&lev.diag_at);
             blocks.backward(a, &lev.inv_diag, &mut lev.x, &lev.b, None);
             return;
         }

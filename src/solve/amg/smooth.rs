@@ -85,7 +85,7 @@ pub(super) fn gauss_seidel_from_zero<V: Copy + Into<f64>>(
     for i in 0..a.nrows {
         let (start, end) = (a.ptr[i], a.ptr[i + 1]);
         debug_assert!(a.idx[start..end].is_sorted(), "row {i} is not sorted");
-        let lower = start + a.idx[start..end].partition_point(|&j| (j as usize) < i);
+        let lower = start + a.lower_len(i);
         let s = b[i] - dot_row(&a.idx[start..lower], &a.val[start..lower], x);
         x[i] += s * inv_diag[i];
     }
@@ -105,8 +105,8 @@ pub(super) fn gauss_seidel_from_zero_with_residual<V: Copy + Into<f64>>(
     r: &mut [f64],
 ) {
     for i in 0..a.nrows {
-        let (start, end) = (a.ptr[i], a.ptr[i + 1]);
-        let lower = a.idx[start..end].partition_point(|&j| (j as usize) < i);
+        let start = a.ptr[i];
+        let lower = a.lower_len(i);
         let (idx, val) = (&a.idx[start..start + lower], &a.val[start..start + lower]);
         let xi = (b[i] - dot_row(idx, val, x)) * inv_diag[i];
         x[i] = xi;
@@ -135,7 +135,7 @@ pub(super) fn gauss_seidel_backward_with_product<V: Copy + Into<f64>>(
 ) {
     for k in (0..a.nrows).rev() {
         let (start, end) = (a.ptr[k], a.ptr[k + 1]);
-        let d = start + a.idx[start..end].partition_point(|&j| (j as usize) < k);
+        let d = start + a.lower_len(k);
         debug_assert_eq!(a.idx[d] as usize, k, "row {k} stores no diagonal");
         let (lower, upper) = ((start..d), (d + 1..end));
         let below = dot_row(&a.idx[lower.clone()], &a.val[lower], x);

@@ -451,6 +451,57 @@ fn gauss_seidel_from_zero_is_a_full_sweep_from_zero() {
     assert!(full.iter().any(|&v| v != 0.0));
 }
 
+/// The sweeps that read each row's diagonal offset (`Rows::with_diagonal`, as the
+/// V-cycle's levels give them) give the bits of the sweeps that search each row for it,
+/// whole and by blocks; and the offsets point at the diagonals.
+#[test]
+fn sweeps_with_diagonal_offsets_are_the_searching_sweeps() {
+    let a = q1_grid(30);
+    let n = a.nrows;
+    let at = a.diagonal_offsets();
+    for i in 0..n {
+        assert_eq!(a.idx[a.ptr[i] + at[i] as usize] as usize, i, "row {i}");
+    }
+    let inv_diag: Vec<f64> = a.diagonal().iter().map(|d| 1.0 / d).collect();
+    let b: Vec<f64> = (0..n).map(|i| ((i * 7919) % 23) as f64 - 11.0).collect();
+    let start: Vec<f64> = (0..n).map(|i| ((i * 104_729) % 17) as f64 * 0.1).collect();
+    let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    let sweeps = |rows: csr::Rows<'_, f64>| {
+        let mut out = Vec::new();
+        let mut x = vec![0.0; n];
+        gauss_seidel_from_zero(rows, &inv_diag, &mut x, &b);
+        out.push(bits(&x));
+        let (mut x, mut r) = (vec![0.0; n], vec![f64::NAN; n]);
+        gauss_seidel_from_zero_with_residual(rows, &inv_diag, &mut x, &b, &mut r);
+        out.extend([bits(&x), bits(&r)]);
+        let (mut x, mut y) = (start.clone(), vec![f64::NAN; n]);
+        gauss_seidel_backward_with_product(rows, &inv_diag, &mut x, &b, &mut y);
+        out.extend([bits(&x), bits(&y)]);
+        let mut blocks = Blocks::new(&a, 300).expect("900 rows cut in blocks of 300");
+        let (mut x, mut r) = (vec![0.0; n], vec![f64::NAN; n]);
+        blocks.forward_from_zero_with_residual(rows, &inv_diag, &mut x, &b, &mut r);
+        out.extend([bits(&x), bits(&r)]);
+        let (mut x, mut y) = (start.clone(), vec![f64::NAN; n]);
+        blocks.backward(rows, &inv_diag, &mut x, &b, Some(&mut y));
+        out.extend([bits(&x), bits(&y)]);
+        out
+    };
+    let searched = sweeps(a.with_values(&a.val));
+    let read = sweeps(a.with_values(&a.val).with_diagonal(&at));
+    assert_eq!(searched, read);
+    // Offsets one off the diagonal change the sweep (the backward sweeps would stop at
+    // their check that the entry is the diagonal): the sweeps read them.
+    let off: Vec<u32> = at.iter().map(|&k| k.saturating_sub(1)).collect();
+    let mut x = vec![0.0; n];
+    gauss_seidel_from_zero(
+        a.with_values(&a.val).with_diagonal(&off),
+        &inv_diag,
+        &mut x,
+        &b,
+    );
+    assert_ne!(searched[0], bits(&x));
+}
+
 /// The backward sweep that leaves `A x` gives the product of the vector it swept, to
 /// round-off, and the sweep of [`gauss_seidel`] to round-off (its row sums split in
 /// three).
