@@ -79,6 +79,7 @@ fn solve(mesh: &Mesh, contact: Vec<ContactTerm<'_>>, iterative: bool) -> SteadyS
         mesh,
         materials: &materials,
         source: Some(&source),
+        block_source: None,
         dirichlet: &boundary(mesh),
         face_bcs: &[],
         ties: vec![],

@@ -63,6 +63,8 @@ pub enum HeatError {
     },
     #[error("{count} materials given for {blocks} blocks")]
     MaterialCount { count: usize, blocks: usize },
+    #[error("{count} block sources given for {blocks} blocks")]
+    SourceCount { count: usize, blocks: usize },
     #[error("Dirichlet node {0} carries no temperature dof")]
     DirichletOffField(i64),
     #[error("side {side} of element {number} is not a side of that element")]
@@ -315,6 +317,37 @@ pub fn assemble_conduction(
     source: Option<SourceFn<'_>>,
     flux_bcs: &[FaceBc],
 ) -> Result<(), HeatError> {
+    conduction_with(asm, mesh, dofs, materials, |_| source, flux_bcs)
+}
+
+/// [`assemble_conduction`] with a source per block: `sources[b]` heats
+/// `mesh.blocks[b]` (`None`: no source there).
+pub fn assemble_conduction_by_block(
+    asm: &mut Assembler<'_>,
+    mesh: &Mesh,
+    dofs: &DofMap,
+    materials: &[Material],
+    sources: &[Option<SourceFn<'_>>],
+    flux_bcs: &[FaceBc],
+) -> Result<(), HeatError> {
+    if sources.len() != mesh.blocks.len() {
+        return Err(HeatError::SourceCount {
+            count: sources.len(),
+            blocks: mesh.blocks.len(),
+        });
+    }
+    conduction_with(asm, mesh, dofs, materials, |b| sources[b], flux_bcs)
+}
+
+/// The conduction terms with block `b`'s source `source_of(b)`.
+fn conduction_with<'s>(
+    asm: &mut Assembler<'_>,
+    mesh: &Mesh,
+    dofs: &DofMap,
+    materials: &[Material],
+    source_of: impl Fn(usize) -> Option<SourceFn<'s>> + Sync,
+    flux_bcs: &[FaceBc],
+) -> Result<(), HeatError> {
     let field = temperature(dofs)?;
     if materials.len() != mesh.blocks.len() {
         return Err(HeatError::MaterialCount {
@@ -341,7 +374,7 @@ pub fn assemble_conduction(
             errors.record(e, bad_jacobian(mesh, e, bad));
             return;
         }
-        if let Some(q) = source
+        if let Some(q) = source_of(b)
             && let Err(bad) = kernel::source(rule, x, q, fe)
         {
             errors.record(e, bad_jacobian(mesh, e, bad));

@@ -23,7 +23,8 @@ use std::collections::HashSet;
 pub use super::interfaces::{ContactTerm, TieTerm};
 use super::interfaces::{InterfaceFailure, Interfaces, Terms, TieRows};
 use super::{
-    FaceBc, HeatError, Material, SourceFn, TEMPERATURE, assemble_conduction, dirichlet_dofs,
+    FaceBc, HeatError, Material, SourceFn, TEMPERATURE, assemble_conduction,
+    assemble_conduction_by_block, dirichlet_dofs,
 };
 
 /// Relative residual at which AMG-preconditioned CG stops, ‖b − Ax‖ ≤ 1e-11 ‖b‖: three
@@ -130,6 +131,9 @@ pub struct SteadyProblem<'a> {
     pub mesh: &'a Mesh,
     pub materials: &'a [Material],
     pub source: Option<SourceFn<'a>>,
+    /// The source per mesh block (`None` on a block without one), used instead of
+    /// `source` when given: heat made in some parts and not in others.
+    pub block_source: Option<&'a [Option<SourceFn<'a>>]>,
     pub dirichlet: &'a [(NodeId, f64)],
     pub face_bcs: &'a [FaceBc],
     pub contact: Vec<ContactTerm<'a>>,
@@ -149,6 +153,35 @@ pub struct SteadyProblem<'a> {
     /// Relative tolerance on the residual norm.
     pub tolerance: f64,
     pub max_iterations: usize,
+}
+
+impl SteadyProblem<'_> {
+    /// The conduction terms of `mesh` (the problem's own, or a rank's part of it, with
+    /// the problem's blocks) into `asm`: its materials, sources and face conditions.
+    pub(crate) fn conduction(
+        &self,
+        asm: &mut Assembler<'_>,
+        mesh: &Mesh,
+        dofs: &DofMap,
+    ) -> Result<(), HeatError> {
+        self.conduction_with_faces(asm, mesh, dofs, self.face_bcs)
+    }
+
+    /// [`Self::conduction`] with the face conditions `faces` (a rank's own).
+    pub(crate) fn conduction_with_faces(
+        &self,
+        asm: &mut Assembler<'_>,
+        mesh: &Mesh,
+        dofs: &DofMap,
+        faces: &[FaceBc],
+    ) -> Result<(), HeatError> {
+        match self.block_source {
+            Some(sources) => {
+                assemble_conduction_by_block(asm, mesh, dofs, self.materials, sources, faces)
+            }
+            None => assemble_conduction(asm, mesh, dofs, self.materials, self.source, faces),
+        }
+    }
 }
 
 /// Wall time of the phases, seconds.
@@ -282,7 +315,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let structure = pattern.symbolic().expect("built");
     let sym = structure.as_ref();
     let mut asm = Assembler::direct(&pattern)?;
-    assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
+    p.conduction(&mut asm, mesh, &dofs)?;
     let f_vol = asm.rhs();
     timing.assembly_s += t.elapsed().as_secs_f64();
 
@@ -532,7 +565,7 @@ fn solve_amg(
     let (mut record, mut r, mut heat, fine) = {
         let (col_ptr, rows) = pattern.structure().expect("built");
         let mut asm = Assembler::direct(&pattern)?;
-        assemble_conduction(&mut asm, p.mesh, dofs, p.materials, p.source, p.face_bcs)?;
+        p.conduction(&mut asm, p.mesh, dofs)?;
         let f_vol = asm.rhs();
         let t_conduction = t.elapsed().as_secs_f64();
         // R = K u − F + Σ R_Γ, the interface Jacobian into the coupling slots.
@@ -667,7 +700,7 @@ fn solve_dual(
         .start;
     pattern.build()?;
     let mut asm = Assembler::new(&pattern);
-    assemble_conduction(&mut asm, mesh, &dofs, p.materials, p.source, p.face_bcs)?;
+    p.conduction(&mut asm, mesh, &dofs)?;
     let mut r_contact = vec![0.0; n];
     iface
         .assemble(&zero, 0.0, &mut r_contact, &mut asm, first)

@@ -25,7 +25,7 @@ use crate::heat::steady::{
     AMG_TOLERANCE, LinearMethod, LinearSolves, STEADY_AMG_TOLERANCE, SolveTiming, SteadyProblem,
     SteadySolution,
 };
-use crate::heat::{FaceBc, HeatError, TEMPERATURE, assemble_conduction, dirichlet_dofs};
+use crate::heat::{FaceBc, HeatError, TEMPERATURE, dirichlet_dofs};
 use crate::mesh::{ElemId, Mesh, NodeId, Side};
 use crate::solve::spmv_ref;
 use faer::sparse::SparseColMatRef;
@@ -91,7 +91,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     pattern.build_direct()?;
     let k_sym = pattern.symbolic().expect("built").clone();
     let mut asm = Assembler::direct(&pattern)?;
-    assemble_conduction(&mut asm, &local, &dofs, p.materials, p.source, &faces)?;
+    p.conduction_with_faces(&mut asm, &local, &dofs, &faces)?;
     let f_local = asm.rhs();
     let k_local = asm.take_values()?;
     drop(asm);

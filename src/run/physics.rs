@@ -40,7 +40,8 @@ pub(super) struct Physics<'a> {
     /// The source per block.
     pub block_source: Vec<Law>,
     /// One source law of x and t everywhere (a plain source function, both solvers);
-    /// else per block (the general solver).
+    /// else per block (per block too in the linear steady solver, when no block's law
+    /// depends on T).
     pub uniform: bool,
     /// The temperature at which laws are tried and Nitsche weights taken.
     pub probe: f64,
@@ -150,13 +151,37 @@ impl<'a> Physics<'a> {
         )
     }
 
+    /// Whether no block's source depends on the temperature: the linear steady solver
+    /// takes the sources as functions of x at the start, one per block.
+    pub(super) fn source_of_x_only(&self) -> bool {
+        !self.block_source.iter().any(Law::uses_temperature)
+    }
+
+    /// The sources per block as functions of x at the start, for the linear steady
+    /// solver when they differ from block to block (`None`: one law everywhere, which
+    /// [`Self::source_of_x`] gives): `None` on a block whose source is a constant 0. A
+    /// point where one fails is kept in `failed` and reported after the solve.
+    pub(super) fn sources_of_x<'s>(
+        &'s self,
+        failed: &'s std::sync::Mutex<Option<String>>,
+    ) -> Option<Vec<Option<SourceOfX<'s>>>> {
+        (!self.uniform).then(|| {
+            (self.block_source.iter())
+                .map(|q| {
+                    (*q != Law::Constant(0.0))
+                        .then(|| Box::new(source_of_x(q, self.time.start, failed)) as Box<_>)
+                })
+                .collect()
+        })
+    }
+
     /// The source as a function of x at the start, for the linear steady solver: when one
     /// law of x and t holds everywhere and it is not zero. A point where it fails is kept
     /// in `failed` and reported after the solve.
     pub(super) fn source_of_x<'s>(
         &'s self,
         failed: &'s std::sync::Mutex<Option<String>>,
-    ) -> Option<Box<dyn Fn([f64; 3]) -> f64 + Sync + 's>> {
+    ) -> Option<SourceOfX<'s>> {
         self.block_source
             .first()
             .filter(|q| self.uniform && **q != Law::Constant(0.0))
@@ -825,6 +850,9 @@ fn block_sources(
 /// A source law that does not depend on T as a function of x at `time`, for the linear
 /// steady solver; the first failure (a Lua error, a non-finite value) is kept in
 /// `failed` and the point contributes nothing.
+/// A source as a function of x at one time (W/m³), for the linear steady solver.
+pub(super) type SourceOfX<'s> = Box<dyn Fn([f64; 3]) -> f64 + Sync + 's>;
+
 fn source_of_x<'a>(
     law: &'a Law,
     time: f64,

@@ -90,7 +90,7 @@ pub(super) fn quiet() -> RunError {
 
 /// Whether the run is one the distributed steady solve takes from start to end, so that
 /// the ranks other than 0 can hold their part of the mesh only: steady, one temperature
-/// field with constant conductivities and one source law of x everywhere, no radiation,
+/// field with constant conductivities and sources of x alone (per block), no radiation,
 /// no moving or dying surfaces, no restart or nodal fields, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
 /// no toggle, no contact pressure field, no voltage or species enforcement, no
@@ -114,14 +114,14 @@ pub(super) fn distributable(
     if !p.nodal_field.is_empty() {
         return refuse("a [[nodal_field]]");
     }
-    if !physics.uniform
+    if !physics.source_of_x_only()
         || physics.materials.constant().is_none()
         || physics.field_names.len() != 1
         || physics.materials.electric()
         || physics.species.any()
     {
         return refuse(
-            "not one temperature field with constant materials and one source law everywhere (the general solver)",
+            "not one temperature field with constant materials and sources of x alone (the general solver)",
         );
     }
     if p.bc.iter().any(|b| b.kind == BcKind::Radiation) {

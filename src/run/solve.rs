@@ -13,7 +13,7 @@ use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
 use crate::heat::transient::{
     self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
 };
-use crate::heat::{HeatError, TEMPERATURE};
+use crate::heat::{HeatError, SourceFn, TEMPERATURE};
 use crate::mesh::NodeId;
 
 use super::output::Output;
@@ -96,7 +96,7 @@ impl<'a> TimeLoop<'a> {
             crate::parallel::world().is_some() && self.terms.multiplier_ties();
         !self.file.transient
             && !multipliers_under_mpi
-            && physics.uniform
+            && physics.source_of_x_only()
             && physics.materials.constant().is_some()
             && physics.field_names.len() == 1
             && !physics.materials.electric()
@@ -113,6 +113,7 @@ impl<'a> TimeLoop<'a> {
         let source_failed = std::sync::Mutex::new(None::<String>);
         let source = physics.source_of_x(&source_failed);
         let source_fn = source.as_deref();
+        let sources = physics.sources_of_x(&source_failed);
         // On a rank holding a part of the mesh (under mpirun), its part with the side-B
         // elements of other ranks its contact points paired with, each in a copy of its
         // block (`origin`: per block, the block it copies).
@@ -123,6 +124,10 @@ impl<'a> TimeLoop<'a> {
         };
         let materials = physics.materials.constant().expect("checked constant");
         let materials = per_block(&materials, origin);
+        let block_source: Option<Vec<Option<SourceFn<'_>>>> = sources.as_ref().map(|q| {
+            let q: Vec<_> = q.iter().map(|f| f.as_deref()).collect();
+            per_block(&q, origin)
+        });
         // The temperature unknowns (multipliers aside) decide the automatic choice.
         let solid: Vec<usize> = (0..mesh.blocks.len())
             .filter(|&b| mesh.blocks[b].topology.is_solid())
@@ -147,6 +152,7 @@ impl<'a> TimeLoop<'a> {
             mesh,
             materials: &materials,
             source: source_fn,
+            block_source: block_source.as_deref(),
             dirichlet: &loads.dirichlet,
             face_bcs: &loads.faces,
             contact: Vec::new(),

@@ -720,6 +720,37 @@ fn shrink_fit_matches_its_closed_form() {
     assert!(worst <= 0.1, "worst nodal error {worst}");
 }
 
+/// A steady run whose source heats some blocks only (the shrink fit heats its shaft, not
+/// its sleeve) takes the linear steady solver, and gives the answer of the general
+/// solver, which takes the same run with the source written as a law of T that adds
+/// nothing (`+ 0*T`): temperatures within 1e-10 of their spread, heats within 1e-10.
+#[test]
+fn a_source_in_some_blocks_takes_the_linear_steady_solver() {
+    let tmp = copy_scene_as("shrink_fit", "shrink_fit-of-t");
+    let dir = tmp.path();
+    let linear = run(&dir.join("problem.toml"));
+    let text = std::fs::read_to_string(dir.join("problem.toml")).unwrap();
+    assert!(text.contains("value = 2e6\n"), "{text}");
+    let of_t = text.replace("value = 2e6\n", "value = \"2e6 + 0*T\"\n");
+    std::fs::write(dir.join("problem.toml"), of_t).unwrap();
+    let general = run(&dir.join("problem.toml"));
+    assert_eq!(linear.summary.linear_solver.name, "Cholesky");
+    assert_eq!(general.summary.linear_solver.name, "direct");
+    let (a, b) = (&linear.solution.temperature, &general.solution.temperature);
+    let worst = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    assert!(
+        worst <= 1e-10 * spread(a),
+        "temperatures differ by {worst:e} K"
+    );
+    let heat = |r: &RunResult| r.summary.interactions[0].heat_side_a;
+    let (h1, h2) = (heat(&linear), heat(&general));
+    assert!((h1 - h2).abs() <= 1e-10 * h1.abs(), "{h1} W against {h2} W");
+}
+
 /// The lid of `opening_gap` is lifted off its base while the base heats it: every step's
 /// heat across the gap and the last step's temperatures against a one-dimensional model
 /// of the same stack solved here (linear elements along z, lumped capacity, backward

@@ -158,6 +158,7 @@ fn solve_form(
         mesh: &s.mesh,
         materials: &materials,
         source: None,
+        block_source: None,
         dirichlet,
         face_bcs: &[],
         ties: vec![],
@@ -198,6 +199,7 @@ fn solve_tie(
         mesh: &s.mesh,
         materials: &materials,
         source: None,
+        block_source: None,
         dirichlet,
         face_bcs: &[],
         ties: vec![TieTerm {
