@@ -847,12 +847,12 @@ fn block_sources(
     out
 }
 
-/// A source law that does not depend on T as a function of x at `time`, for the linear
-/// steady solver; the first failure (a Lua error, a non-finite value) is kept in
-/// `failed` and the point contributes nothing.
 /// A source as a function of x at one time (W/m³), for the linear steady solver.
 pub(super) type SourceOfX<'s> = Box<dyn Fn([f64; 3]) -> f64 + Sync + 's>;
 
+/// A source law that does not depend on T as a function of x at `time`, for the linear
+/// steady solver; the first failure (a Lua error, a non-finite value) is kept in
+/// `failed` and the point contributes nothing.
 fn source_of_x<'a>(
     law: &'a Law,
     time: f64,
