@@ -357,8 +357,9 @@ pub(super) struct Rows<'a, V> {
     pub(super) ptr: &'a [usize],
     pub(super) idx: &'a [u32],
     pub(super) val: &'a [V],
-    /// Per row, the offset of its diagonal entry in the row ([`Csr::diagonal_offsets`]),
-    /// or empty: the sweeps then search each row for it.
+    /// Per row, the offset of its diagonal entry in the row ([`Csr::diagonal_offsets`]):
+    /// the sweeps that split a row at its diagonal read it ([`Rows::with_diagonal`]);
+    /// empty for rows only multiplied.
     pub(super) diag: &'a [u32],
 }
 
@@ -378,22 +379,18 @@ impl<'a> Csr {
 
 impl<'a, V> Rows<'a, V> {
     /// The same rows, with the offsets of their diagonals as
-    /// [`Csr::diagonal_offsets`] made them: the sweeps read them in place of a binary
-    /// search of every row on every sweep.
+    /// [`Csr::diagonal_offsets`] made them, for the sweeps that split each row there
+    /// (made once per level rather than searched for in every row on every sweep).
     pub(super) fn with_diagonal(self, diag: &'a [u32]) -> Self {
         assert_eq!(diag.len(), self.nrows, "one diagonal offset per row");
         Rows { diag, ..self }
     }
 
     /// How many entries of row `i` lie left of its diagonal (columns below `i`): the
-    /// diagonal's offset in the row where it stores one.
+    /// diagonal's offset in the row. Needs [`Self::with_diagonal`].
     #[inline(always)]
     pub(super) fn lower_len(&self, i: usize) -> usize {
-        if self.diag.is_empty() {
-            self.idx[self.ptr[i]..self.ptr[i + 1]].partition_point(|&j| (j as usize) < i)
-        } else {
-            self.diag[i] as usize
-        }
+        self.diag[i] as usize
     }
 }
 
