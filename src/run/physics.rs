@@ -39,10 +39,6 @@ pub(super) struct Physics<'a> {
     pub time: TimeSpec,
     /// The source per block.
     pub block_source: Vec<Law>,
-    /// One source law of x and t everywhere (a plain source function, both solvers);
-    /// else per block (per block too in the linear steady solver, when no block's law
-    /// depends on T).
-    pub uniform: bool,
     /// The temperature at which laws are tried and Nitsche weights taken.
     pub probe: f64,
     /// The sandbox of the run's boundary and initial expressions.
@@ -78,8 +74,6 @@ impl<'a> Physics<'a> {
         let time = time_spec(problem, file.transient, diags);
         let block_source = block_sources(problem, mesh, &file.text, probe, time.start, diags);
         check_nodal_fields(problem, &file.text, diags);
-        let uniform = block_source.windows(2).all(|w| w[0] == w[1])
-            && !block_source.first().is_some_and(Law::uses_temperature);
         let mut field_names: Vec<String> = materials.fields.clone();
         field_names.sort();
         field_names.dedup();
@@ -94,7 +88,6 @@ impl<'a> Physics<'a> {
             face_sites,
             time,
             block_source,
-            uniform,
             probe,
             sandbox: Default::default(),
             species,
@@ -158,34 +151,19 @@ impl<'a> Physics<'a> {
     }
 
     /// The sources per block as functions of x at the start, for the linear steady
-    /// solver when they differ from block to block (`None`: one law everywhere, which
-    /// [`Self::source_of_x`] gives): `None` on a block whose source is a constant 0. A
-    /// point where one fails is kept in `failed` and reported after the solve.
+    /// solver (which takes them when none depends on T: [`Self::source_of_x_only`]):
+    /// `None` on a block whose source is a constant 0. A point where one fails is kept
+    /// in `failed` and reported after the solve.
     pub(super) fn sources_of_x<'s>(
         &'s self,
         failed: &'s std::sync::Mutex<Option<String>>,
-    ) -> Option<Vec<Option<SourceOfX<'s>>>> {
-        (!self.uniform).then(|| {
-            (self.block_source.iter())
-                .map(|q| {
-                    (*q != Law::Constant(0.0))
-                        .then(|| Box::new(source_of_x(q, self.time.start, failed)) as Box<_>)
-                })
-                .collect()
-        })
-    }
-
-    /// The source as a function of x at the start, for the linear steady solver: when one
-    /// law of x and t holds everywhere and it is not zero. A point where it fails is kept
-    /// in `failed` and reported after the solve.
-    pub(super) fn source_of_x<'s>(
-        &'s self,
-        failed: &'s std::sync::Mutex<Option<String>>,
-    ) -> Option<SourceOfX<'s>> {
-        self.block_source
-            .first()
-            .filter(|q| self.uniform && **q != Law::Constant(0.0))
-            .map(|q| Box::new(source_of_x(q, self.time.start, failed)) as Box<_>)
+    ) -> Vec<Option<SourceOfX<'s>>> {
+        (self.block_source.iter())
+            .map(|q| {
+                (*q != Law::Constant(0.0))
+                    .then(|| Box::new(source_of_x(q, self.time.start, failed)) as Box<_>)
+            })
+            .collect()
     }
 
     /// The species interfaces of `contact` on the species blocks: each side carries a

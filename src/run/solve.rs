@@ -111,8 +111,6 @@ impl<'a> TimeLoop<'a> {
         let (physics, problem) = (self.physics, &self.file.problem);
         let (requested, threshold) = (self.requested, self.threshold);
         let source_failed = std::sync::Mutex::new(None::<String>);
-        let source = physics.source_of_x(&source_failed);
-        let source_fn = source.as_deref();
         let sources = physics.sources_of_x(&source_failed);
         // On a rank holding a part of the mesh (under mpirun), its part with the side-B
         // elements of other ranks its contact points paired with, each in a copy of its
@@ -124,10 +122,8 @@ impl<'a> TimeLoop<'a> {
         };
         let materials = physics.materials.constant().expect("checked constant");
         let materials = per_block(&materials, origin);
-        let block_source: Option<Vec<Option<SourceFn<'_>>>> = sources.as_ref().map(|q| {
-            let q: Vec<_> = q.iter().map(|f| f.as_deref()).collect();
-            per_block(&q, origin)
-        });
+        let sources: Vec<Option<SourceFn<'_>>> = sources.iter().map(|f| f.as_deref()).collect();
+        let block_source = per_block(&sources, origin);
         // The temperature unknowns (multipliers aside) decide the automatic choice.
         let solid: Vec<usize> = (0..mesh.blocks.len())
             .filter(|&b| mesh.blocks[b].topology.is_solid())
@@ -151,8 +147,8 @@ impl<'a> TimeLoop<'a> {
         let steady = SteadyProblem {
             mesh,
             materials: &materials,
-            source: source_fn,
-            block_source: block_source.as_deref(),
+            source: None,
+            block_source: Some(&block_source),
             dirichlet: &loads.dirichlet,
             face_bcs: &loads.faces,
             contact: Vec::new(),
