@@ -53,6 +53,7 @@
 //! ```
 
 pub mod bvh;
+mod cover;
 pub mod mortar;
 mod overlap;
 pub mod project;

@@ -558,3 +558,41 @@ fn pairing_is_reused_between_search_updates() {
         r.points.iter().map(|p| p.b_face).collect::<Vec<_>>()
     );
 }
+
+/// The overlap diagnostic where side B covers side A partly, and twice over: a side B
+/// on x ≤ 0.55 under the unit square (its edge crossing side-A faces) covers 0.55;
+/// two sheets of side B, 1e-3 apart, cover it twice (the clipped sums count each
+/// sheet).
+#[test]
+fn overlap_area_counts_a_partial_and_a_double_cover() {
+    let above = BoxSpec::hex([0.0, 0.0, 1.0], [1.0, 1.0, 2.0], [7, 7, 1], 2)
+        .with_side_sets([0, 0, 0, 0, 2, 0]);
+    let partial = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [0.55, 1.0, 1.0], [3, 5, 1], 1)
+                .with_side_sets([0, 0, 0, 0, 0, 1]),
+            above.clone(),
+        ],
+        false,
+    );
+    let double = generate::boxes(
+        &[
+            BoxSpec::hex([0.0; 3], [1.0; 3], [3, 3, 1], 1).with_side_sets([0, 0, 0, 0, 0, 1]),
+            BoxSpec::hex([0.0; 3], [1.0, 1.0, 0.999], [4, 4, 1], 3)
+                .with_side_sets([0, 0, 0, 0, 0, 1]),
+            above,
+        ],
+        false,
+    );
+    for (mesh, covered) in [(&partial, 0.55), (&double, 2.0)] {
+        for order in [1, 2] {
+            let s = run(mesh, PAIR, Integration::Quadrature { order });
+            let st = &s.pairings[0].result.stats;
+            assert!(
+                (st.overlap_area - covered).abs() < 1e-13,
+                "order {order}: {} for {covered}: {st:?}",
+                st.overlap_area
+            );
+        }
+    }
+}

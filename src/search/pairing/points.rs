@@ -10,6 +10,7 @@
 //! candidate are those of a query per point, so the pairing does not change.
 
 use crate::search::bvh::{Aabb, Bvh, QueryHint};
+use crate::search::cover::Cover;
 use crate::search::mortar::{
     FaceOverlap, MortarPoint, TriangleRule, overlap_length_line_line, rule_line, rule_triangle,
     segments_face_face_into, segments_line_line_into,
@@ -217,6 +218,8 @@ pub(super) struct Scratch {
     /// The overlap's candidates, ascending.
     overlap: Vec<usize>,
     clip: Option<FaceOverlap>,
+    /// The test that spares the clipping of a face inside side B.
+    cover: Cover,
     /// The side-B faces' overlap data made so far.
     b_faces: BFaces,
     pub(super) mortar: Vec<MortarPoint>,
@@ -620,7 +623,7 @@ impl Ctx<'_> {
             fa,
             (n_a, face.centroid),
             &s.overlap,
-            (&mut s.clip, &mut s.b_faces),
+            (&mut s.clip, &mut s.cover, &mut s.b_faces),
         );
         tally
     }
@@ -695,9 +698,14 @@ impl Ctx<'_> {
         fa: usize,
         (n_a, c_a): (V3, V3),
         candidates: &[usize],
-        (clip, b_faces): (&mut Option<FaceOverlap>, &mut BFaces),
+        (clip, cover, b_faces): (&mut Option<FaceOverlap>, &mut Cover, &mut BFaces),
     ) -> f64 {
         let face = &a.faces[fa];
+        if face.len != 2
+            && let Some(area) = self.covered(face, (n_a, c_a), candidates, (cover, b_faces))
+        {
+            return area;
+        }
         let mut clip = match face.len {
             2 => None,
             _ => {
@@ -714,10 +722,7 @@ impl Ctx<'_> {
         let mut midpoint = None;
         for &j in candidates {
             let fb = &self.b.faces[j];
-            let data = b_faces.get(j, fb, self.settings);
-            if !self.normals_ok(n_a, data.normal)
-                || dot(sub(data.centroid, c_a), n_a).abs() > data.limit
-            {
+            if !self.overlap_accepts((n_a, c_a), b_faces.get(j, fb, self.settings)) {
                 continue;
             }
             area += match &mut clip {
@@ -736,6 +741,42 @@ impl Ctx<'_> {
             };
         }
         area
+    }
+
+    /// Whether the overlap of a side-A face (normal and centroid `n_a`, `c_a`) counts
+    /// side-B face `b`: opposed normals, and its centroid within the acceptance distance
+    /// of the face's plane.
+    #[inline]
+    fn overlap_accepts(&self, (n_a, c_a): (V3, V3), b: BFace) -> bool {
+        let far = dot(sub(b.centroid, c_a), n_a).abs() > b.limit;
+        self.normals_ok(n_a, b.normal) && !far
+    }
+
+    /// The overlap area of side-A face `face` without clipping, when the side-B faces
+    /// among `candidates` that the overlap accepts cover it exactly once ([`Cover`]): its
+    /// own area. `None` when that is not shown, or when a face near it is not accepted.
+    fn covered(
+        &self,
+        face: &FaceGeom,
+        (n_a, c_a): (V3, V3),
+        candidates: &[usize],
+        (cover, b_faces): (&mut Cover, &mut BFaces),
+    ) -> Option<f64> {
+        if !cover.set_face(face.coords()) {
+            return None;
+        }
+        for &j in candidates {
+            let fb = &self.b.faces[j];
+            let nodes = fb.nodes.map(|n| n.0);
+            let Some(tile) = cover.tile(fb.coords(), &nodes[..fb.len as usize]) else {
+                continue;
+            };
+            if !self.overlap_accepts((n_a, c_a), b_faces.get(j, fb, self.settings)) {
+                return None;
+            }
+            cover.push(tile);
+        }
+        cover.area()
     }
 }
 

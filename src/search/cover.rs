@@ -1,0 +1,432 @@
+//! The overlap diagnostic without clipping, where it can be shown to be the side-A
+//! face's own area: [`Cover`].
+//!
+//! The overlap of side-A face A with side B is `Σ_j |A ∩ B_j|`, each side-B face `B_j`
+//! projected onto the plane of A along A's normal (as [`super::overlap::FaceOverlap`]
+//! clips them). That sum is `∫_A c(p) dp`, where `c(p)` counts the projected faces that
+//! hold `p`. Crossing an edge that two faces share moves `p` out of one face and into
+//! the other, provided the two lie on opposite sides of it, so `c` changes only across
+//! edges no other face takes up. Hence: when every side-B face edge that comes near A is
+//! shared by two of the faces, each projected convex and with the orientation of a
+//! side-B face opposed to A (so that neighbours lie on opposite sides of their common
+//! edge), `c` is one number over A, read off at A's centroid — and when it is 1 the sum
+//! is A's area, to round-off. Everywhere else (an edge of side B's boundary or of a
+//! rejected face crossing A, a fold, two sheets, a corner on the centroid) the test says
+//! nothing and the faces are clipped.
+//!
+//! Within a side B, most side-A faces pass, so the diagnostic costs a projection of the
+//! few faces near each instead of their clipping. The tests are in A's plane
+//! coordinates, with tolerances that err towards clipping.
+
+use crate::vec3::{V3, cross, dot, norm, scale, sub};
+
+use super::mortar::{P2, cross2, sub2};
+
+/// The most side-B faces near one side-A face that the test takes; more, and the faces
+/// are clipped.
+const TILES: usize = 16;
+
+/// A side-B face projected onto A's plane: its corners, and its edges by node numbers
+/// ([`edge_key`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Tile {
+    q: [P2; 4],
+    edges: [u64; 4],
+    len: usize,
+}
+
+/// The edge from node `from` to node `to` as one number.
+#[inline(always)]
+fn edge_key(from: u32, to: u32) -> u64 {
+    (u64::from(from) << 32) | u64::from(to)
+}
+
+/// The corner after `k` of a polygon of `n` corners.
+#[inline(always)]
+fn next(k: usize, n: usize) -> usize {
+    if k + 1 == n { 0 } else { k + 1 }
+}
+
+/// Side-A face A made ready for [`Cover::area`]: its plane, projected corners and box;
+/// then the side-B faces near it, one [`Cover::tile`] and [`Cover::push`] each.
+#[derive(Clone, Debug)]
+pub(crate) struct Cover {
+    origin: V3,
+    t1: V3,
+    t2: V3,
+    /// A's projected box, widened by the tolerance of the projections.
+    lo: P2,
+    hi: P2,
+    /// A's area (its projection onto its own plane).
+    area: f64,
+    tiles: [Tile; TILES],
+    count: usize,
+    /// Whether a face pushed could not be taken: then [`Cover::area`] is `None`.
+    refused: bool,
+}
+
+impl Default for Cover {
+    fn default() -> Self {
+        Cover {
+            origin: [0.0; 3],
+            t1: [0.0; 3],
+            t2: [0.0; 3],
+            lo: [0.0; 2],
+            hi: [0.0; 2],
+            area: 0.0,
+            tiles: [Tile::default(); TILES],
+            count: 0,
+            refused: true,
+        }
+    }
+}
+
+/// Whether the polygon `p` (3 or 4 corners) is strictly convex with the orientation
+/// `sign` (+1 counter-clockwise, −1 clockwise): every corner turns that way by more
+/// than a rounding error.
+#[inline(always)]
+fn convex(p: &[P2], sign: f64) -> bool {
+    let n = p.len();
+    let mut e = [[0.0; 2]; 4];
+    let mut l2 = 0.0;
+    for k in 0..n {
+        e[k] = sub2(p[next(k, n)], p[k]);
+        l2 = larger(l2, e[k][0] * e[k][0] + e[k][1] * e[k][1]);
+    }
+    let tol = 1e-10 * l2;
+    let mut turns = true;
+    for k in 0..n {
+        turns &= sign * cross2(e[k], e[next(k, n)]) > tol;
+    }
+    turns
+}
+
+/// `a.max(b)` as a comparison, for an `a` that is not NaN (a NaN `b` is dropped).
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a { b } else { a }
+}
+
+/// `a.min(b)` as [`larger`].
+#[inline(always)]
+fn smaller(a: f64, b: f64) -> f64 {
+    if b < a { b } else { a }
+}
+
+impl Cover {
+    /// Make ready for side-A face `a` (3 or 4 corners); `false` for a face the test does
+    /// not take (degenerate, or not convex in its plane), whose overlap is then clipped.
+    pub(crate) fn set_face(&mut self, a: &[V3]) -> bool {
+        self.count = 0;
+        self.refused = true;
+        let m = a.len();
+        let va = match m {
+            3 => cross(sub(a[1], a[0]), sub(a[2], a[0])),
+            4 => cross(sub(a[2], a[0]), sub(a[3], a[1])),
+            _ => return false,
+        };
+        let va = scale(va, 0.5);
+        let area = norm(va);
+        let l2 = (0..m).fold(0.0f64, |l, k| {
+            let e = sub(a[next(k, m)], a[k]);
+            l.max(dot(e, e))
+        });
+        // Also false for NaN coordinates.
+        if area.is_nan() || area <= 1e-8 * l2 {
+            return false;
+        }
+        let n = scale(va, 1.0 / area);
+        let mut origin = [0.0; 3];
+        for x in a {
+            origin = [origin[0] + x[0], origin[1] + x[1], origin[2] + x[2]];
+        }
+        self.origin = scale(origin, 1.0 / m as f64);
+        let e = sub(a[1], a[0]);
+        let t1 = sub(e, scale(n, dot(e, n)));
+        let l1 = norm(t1);
+        if l1.is_nan() || l1 <= 0.0 {
+            return false;
+        }
+        self.t1 = scale(t1, 1.0 / l1);
+        self.t2 = cross(n, self.t1);
+        let mut p = [[0.0; 2]; 4];
+        for (k, x) in a.iter().enumerate() {
+            p[k] = self.flat(*x);
+        }
+        if !convex(&p[..m], 1.0) {
+            return false;
+        }
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for q in &p[..m] {
+            for d in 0..2 {
+                lo[d] = lo[d].min(q[d]);
+                hi[d] = hi[d].max(q[d]);
+            }
+        }
+        // Round-off of the projections: ε of the coordinates, far below the pad.
+        let size = self.origin.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        let pad = 1e-9 * l2.sqrt() + 1e-12 * size;
+        self.lo = [lo[0] - pad, lo[1] - pad];
+        self.hi = [hi[0] + pad, hi[1] + pad];
+        self.area = area;
+        self.refused = false;
+        true
+    }
+
+    /// `x` in A's plane coordinates (A's centroid the origin).
+    #[inline(always)]
+    fn flat(&self, x: V3) -> P2 {
+        let d = sub(x, self.origin);
+        [dot(d, self.t1), dot(d, self.t2)]
+    }
+
+    /// Whether the box `(lo, hi)` meets A's.
+    #[inline(always)]
+    fn meets(&self, lo: P2, hi: P2) -> bool {
+        lo[0] <= self.hi[0] && hi[0] >= self.lo[0] && lo[1] <= self.hi[1] && hi[1] >= self.lo[1]
+    }
+
+    /// Side-B face `b` (its corners and node numbers) projected onto A's plane, or
+    /// `None` when its box misses A's (it adds nothing to the overlap).
+    pub(crate) fn tile(&self, b: &[V3], nodes: &[u32]) -> Option<Tile> {
+        let mut t = Tile {
+            len: b.len().min(4),
+            ..Tile::default()
+        };
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for k in 0..t.len {
+            let q = self.flat(b[k]);
+            // A NaN coordinate leaves the box to the other corners; `push` then
+            // refuses the face (its turns are not above the tolerance).
+            for d in 0..2 {
+                lo[d] = smaller(lo[d], q[d]);
+                hi[d] = larger(hi[d], q[d]);
+            }
+            t.q[k] = q;
+            t.edges[k] = edge_key(nodes[k], nodes[next(k, t.len)]);
+        }
+        self.meets(lo, hi).then_some(t)
+    }
+
+    /// Take a side-B face near A that the overlap accepts. It must be convex and
+    /// opposed to A (clockwise in A's plane), and there must be room; otherwise the
+    /// test gives up.
+    pub(crate) fn push(&mut self, t: Tile) {
+        if self.refused || t.len < 3 || self.count == TILES || !convex(&t.q[..t.len], -1.0) {
+            self.refused = true;
+            return;
+        }
+        self.tiles[self.count] = t;
+        self.count += 1;
+    }
+
+    /// A's area when the faces pushed cover it exactly once (see the module
+    /// documentation), else `None`.
+    pub(crate) fn area(&self) -> Option<f64> {
+        if self.refused {
+            return None;
+        }
+        let tiles = &self.tiles[..self.count];
+        // Every edge near A shared, in reverse, by another face.
+        for (i, t) in tiles.iter().enumerate() {
+            for k in 0..t.len {
+                let (u, v) = (t.q[k], t.q[next(k, t.len)]);
+                let lo = [smaller(u[0], v[0]), smaller(u[1], v[1])];
+                let hi = [larger(u[0], v[0]), larger(u[1], v[1])];
+                if self.meets(lo, hi) && !shared(tiles, i, t.edges[k].rotate_left(32)) {
+                    return None;
+                }
+            }
+        }
+        // The count at A's centroid, the origin: inside a clockwise face is right of
+        // every edge. A centroid on an edge (within the tolerance) says nothing.
+        let mut holders = 0;
+        for t in tiles {
+            let (mut out, mut on) = (false, false);
+            for k in 0..t.len {
+                let (u, v) = (t.q[k], t.q[next(k, t.len)]);
+                let e = sub2(v, u);
+                let c = cross2(e, [-u[0], -u[1]]);
+                let tol = 1e-10 * (e[0] * e[0] + e[1] * e[1] + u[0] * u[0] + u[1] * u[1]);
+                out |= c > tol;
+                on |= c.abs() <= tol;
+            }
+            if out {
+                continue;
+            }
+            if on {
+                return None;
+            }
+            holders += 1;
+        }
+        (holders == 1).then_some(self.area)
+    }
+}
+
+/// Whether a face of `tiles` other than the `i`-th has the edge `key` ([`edge_key`]).
+fn shared(tiles: &[Tile], i: usize, key: u64) -> bool {
+    tiles
+        .iter()
+        .enumerate()
+        .any(|(s, t)| s != i && t.edges[..t.len].contains(&key))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::overlap::FaceOverlap;
+    use super::*;
+
+    /// A jittered, slightly warped grid of `n × n` quads on `[0, w] × [0, 1]`, wound
+    /// clockwise seen from above (opposed to a side A facing up), its nodes numbered
+    /// from `first`.
+    fn sheet(
+        n: usize,
+        w: f64,
+        z: f64,
+        first: u32,
+        rand: &mut impl FnMut() -> f64,
+    ) -> Vec<(Vec<V3>, Vec<u32>)> {
+        let mut x = vec![[0.0; 3]; (n + 1) * (n + 1)];
+        for j in 0..=n {
+            for i in 0..=n {
+                let interior = |k: usize| k > 0 && k < n;
+                let (mut u, mut v) = (i as f64 / n as f64, j as f64 / n as f64);
+                if interior(i) {
+                    u += 0.3 * (rand() - 0.5) / n as f64;
+                }
+                if interior(j) {
+                    v += 0.3 * (rand() - 0.5) / n as f64;
+                }
+                x[j * (n + 1) + i] = [w * u, v, z + 0.02 * u * v + 1e-3 * rand()];
+            }
+        }
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let k = j * (n + 1) + i;
+                let ids = [k, k + n + 1, k + n + 2, k + 1];
+                faces.push((
+                    ids.iter().map(|&k| x[k]).collect(),
+                    ids.iter().map(|&k| first + k as u32).collect(),
+                ));
+            }
+        }
+        faces
+    }
+
+    /// The cover test over all of `b` for side-A face `a`.
+    fn cover_area(cover: &mut Cover, a: &[V3], b: &[(Vec<V3>, Vec<u32>)]) -> Option<f64> {
+        assert!(cover.set_face(a));
+        for (x, ids) in b {
+            if let Some(t) = cover.tile(x, ids) {
+                cover.push(t);
+            }
+        }
+        cover.area()
+    }
+
+    /// The clipped sum the cover test stands in for.
+    fn clipped(a: &[V3], b: &[(Vec<V3>, Vec<u32>)]) -> f64 {
+        let mut clip = FaceOverlap::new(a).unwrap();
+        b.iter().map(|(x, _)| clip.area_with(x)).sum()
+    }
+
+    fn rng() -> impl FnMut() -> f64 {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// Side-A quads (some tilted out of plane, some triangles) over a side B that
+    /// covers x ≤ 0.7 only: where the test speaks it gives the clipped sum to
+    /// round-off, it speaks for most faces inside, and never for a face that side B's
+    /// edge crosses.
+    #[test]
+    fn a_face_inside_side_b_has_its_own_area() {
+        let mut rand = rng();
+        let b = sheet(9, 0.7, 0.0, 0, &mut rand);
+        let mut cover = Cover::default();
+        let (mut spoke, mut inside, mut crossing) = (0, 0, 0);
+        for case in 0..3000 {
+            let (c, s) = ([0.9 * rand(), 0.05 + 0.9 * rand()], 0.02 + 0.1 * rand());
+            let tilt = 0.1 * (rand() - 0.5);
+            let mut a: Vec<V3> = [[0.0, 0.0], [1.0, 0.1], [1.1, 1.0], [-0.1, 0.9]]
+                .iter()
+                .map(|q| {
+                    let (x, y) = (c[0] + s * q[0], c[1] + s * q[1]);
+                    [x, y, 1e-3 + tilt * (x - c[0])]
+                })
+                .collect();
+            if case % 4 == 0 {
+                a.pop();
+            }
+            let exact = clipped(&a, &b);
+            let own = 0.5
+                * norm(match a.len() {
+                    3 => cross(sub(a[1], a[0]), sub(a[2], a[0])),
+                    _ => cross(sub(a[2], a[0]), sub(a[3], a[1])),
+                });
+            let got = cover_area(&mut cover, &a, &b);
+            // Side B's edge at x = 0.7, seen from a tilted A up to 1e-3 away.
+            let max_x = a.iter().fold(0.0f64, |m, p| m.max(p[0]));
+            let min_x = a.iter().fold(1.0f64, |m, p| m.min(p[0]));
+            if max_x < 0.69 {
+                inside += 1;
+            } else if min_x < 0.69 && max_x > 0.71 {
+                crossing += 1;
+                assert!(got.is_none(), "case {case}: side B's edge crosses A");
+                assert!(exact < own * (1.0 - 1e-6), "case {case}: {exact} vs {own}");
+            }
+            if let Some(area) = got {
+                spoke += 1;
+                assert!(
+                    (area - exact).abs() <= 1e-13 * own,
+                    "case {case}: {area} vs {exact}"
+                );
+            }
+        }
+        assert!(
+            crossing > 100 && inside > 1000,
+            "{crossing} crossing, {inside} inside"
+        );
+        assert!(spoke > inside * 9 / 10, "{spoke} of {inside} inside");
+    }
+
+    /// Two sheets of side B over A (a double cover, twice A's area when clipped), a
+    /// hole, and a face wound the wrong way: the test says nothing.
+    #[test]
+    fn two_sheets_a_hole_or_a_fold_say_nothing() {
+        let mut rand = rng();
+        let b = sheet(4, 1.0, 0.0, 0, &mut rand);
+        let a: Vec<V3> = vec![
+            [0.4, 0.4, 0.01],
+            [0.6, 0.4, 0.01],
+            [0.6, 0.6, 0.01],
+            [0.4, 0.6, 0.01],
+        ];
+        let mut cover = Cover::default();
+        let own = cover_area(&mut cover, &a, &b).expect("one sheet covers A");
+        assert!((own - 0.04).abs() < 1e-15);
+        let mut two = b.clone();
+        two.extend(sheet(4, 1.0, -0.005, 1000, &mut rand));
+        assert!((clipped(&a, &two) - 0.08).abs() < 1e-14);
+        assert_eq!(cover_area(&mut cover, &a, &two), None);
+        let near = |f: &(Vec<V3>, Vec<u32>)| {
+            let c =
+                f.0.iter()
+                    .fold([0.0; 2], |c, p| [c[0] + p[0] / 4.0, c[1] + p[1] / 4.0]);
+            (c[0] - 0.5).abs() < 0.2 && (c[1] - 0.5).abs() < 0.2
+        };
+        let hole: Vec<_> = b.iter().filter(|f| !near(f)).cloned().collect();
+        assert_eq!(cover_area(&mut cover, &a, &hole), None);
+        let mut fold = b.clone();
+        let k = fold.iter().position(near).unwrap();
+        fold[k].0.reverse();
+        fold[k].1.reverse();
+        assert_eq!(cover_area(&mut cover, &a, &fold), None);
+    }
+}
