@@ -21,6 +21,7 @@
 use crate::vec3::{V3, cross, dot, norm, scale, sub};
 
 use super::mortar::{P2, cross2, sub2};
+use super::overlap::{larger, smaller};
 
 /// The most side-B faces near one side-A face that the test takes; more, and the faces
 /// are clipped.
@@ -99,18 +100,6 @@ fn convex(p: &[P2], sign: f64) -> bool {
         turns &= sign * cross2(e[k], e[next(k, n)]) > tol;
     }
     turns
-}
-
-/// `a.max(b)` as a comparison, for an `a` that is not NaN (a NaN `b` is dropped).
-#[inline(always)]
-fn larger(a: f64, b: f64) -> f64 {
-    if b > a { b } else { a }
-}
-
-/// `a.min(b)` as [`larger`].
-#[inline(always)]
-fn smaller(a: f64, b: f64) -> f64 {
-    if b < a { b } else { a }
 }
 
 impl Cover {

@@ -66,13 +66,13 @@ impl ClipPiece {
 /// NaNs, at four instructions more): the same value (of ±0 it may keep the other,
 /// which compares equal).
 #[inline(always)]
-fn larger(a: f64, b: f64) -> f64 {
+pub(super) fn larger(a: f64, b: f64) -> f64 {
     if b > a { b } else { a }
 }
 
 /// `a.min(b)` for an `a` that is not NaN, as [`larger`].
 #[inline(always)]
-fn smaller(a: f64, b: f64) -> f64 {
+pub(super) fn smaller(a: f64, b: f64) -> f64 {
     if b < a { b } else { a }
 }
 
