@@ -6,13 +6,13 @@
 //! clips them). That sum is `∫_A c(p) dp`, where `c(p)` counts the projected faces that
 //! hold `p`. Crossing an edge that two faces share moves `p` out of one face and into
 //! the other, provided the two lie on opposite sides of it, so `c` changes only across
-//! edges no other face takes up. Hence: when every side-B face edge that comes near A is
-//! shared by two of the faces, each projected convex and with the orientation of a
-//! side-B face opposed to A (so that neighbours lie on opposite sides of their common
-//! edge), `c` is one number over A, read off at A's centroid — and when it is 1 the sum
-//! is A's area, to round-off. Everywhere else (an edge of side B's boundary or of a
-//! rejected face crossing A, a fold, two sheets, a corner on the centroid) the test says
-//! nothing and the faces are clipped.
+//! edges no other face takes up. Hence: when every side-B face edge that comes near A
+//! is shared by exactly two of the faces, each projected convex and with the
+//! orientation of a side-B face opposed to A (so that neighbours lie on opposite sides
+//! of their common edge), `c` is one number over A, read off at A's centroid — and when
+//! it is 1 the sum is A's area, to round-off. Everywhere else (an edge of side B's
+//! boundary or of a rejected face crossing A, an edge of three faces, a fold, two
+//! sheets, a corner on the centroid) the test says nothing and the faces are clipped.
 //!
 //! Within a side B, most side-A faces pass, so the diagnostic costs a projection of the
 //! few faces near each instead of their clipping. The tests are in A's plane
@@ -216,13 +216,15 @@ impl Cover {
             return None;
         }
         let tiles = &self.tiles[..self.count];
-        // Every edge near A shared, in reverse, by another face.
+        // Every edge near A shared, in reverse, by exactly one other face, and by none
+        // the same way round: a third face on an edge (a fin, a slit) would lie over one
+        // of the two.
         for (i, t) in tiles.iter().enumerate() {
             for k in 0..t.len {
                 let (u, v) = (t.q[k], t.q[next(k, t.len)]);
                 let lo = [smaller(u[0], v[0]), smaller(u[1], v[1])];
                 let hi = [larger(u[0], v[0]), larger(u[1], v[1])];
-                if self.meets(lo, hi) && !shared(tiles, i, t.edges[k].rotate_left(32)) {
+                if self.meets(lo, hi) && !shared_once(tiles, i, t.edges[k]) {
                     return None;
                 }
             }
@@ -252,12 +254,20 @@ impl Cover {
     }
 }
 
-/// Whether a face of `tiles` other than the `i`-th has the edge `key` ([`edge_key`]).
-fn shared(tiles: &[Tile], i: usize, key: u64) -> bool {
-    tiles
-        .iter()
-        .enumerate()
-        .any(|(s, t)| s != i && t.edges[..t.len].contains(&key))
+/// Whether, of the faces of `tiles` other than the `i`-th, exactly one has the edge
+/// `key` ([`edge_key`]) in reverse and none has it the same way round.
+fn shared_once(tiles: &[Tile], i: usize, key: u64) -> bool {
+    let reverse = key.rotate_left(32);
+    let (mut opposite, mut same) = (0, 0);
+    for (s, t) in tiles.iter().enumerate() {
+        if s != i {
+            for &e in &t.edges[..t.len] {
+                opposite += usize::from(e == reverse);
+                same += usize::from(e == key);
+            }
+        }
+    }
+    opposite == 1 && same == 0
 }
 
 #[cfg(test)]
@@ -417,5 +427,51 @@ mod tests {
         fold[k].0.reverse();
         fold[k].1.reverse();
         assert_eq!(cover_area(&mut cover, &a, &fold), None);
+        // A slit: a third face on the edge near x = 0.5 of a face left of it, lying over
+        // the face right of it (an edge of three faces), which the clipped sum counts.
+        let (at, ids) = {
+            let f = &b[b
+                .iter()
+                .position(|f| {
+                    let c =
+                        f.0.iter()
+                            .fold([0.0; 2], |c, p| [c[0] + p[0] / 4.0, c[1] + p[1] / 4.0]);
+                    c[0] < 0.5 && c[0] > 0.25 && c[1] > 0.25 && c[1] < 0.5
+                })
+                .unwrap()];
+            (f.0.clone(), f.1.clone())
+        };
+        // Its edge along x = 0.5 (as wound in this face), and the slit face past it,
+        // wound clockwise from above like the rest.
+        let k = (0..4)
+            .find(|&k| at[k][0] > 0.4 && at[(k + 1) % 4][0] > 0.4)
+            .unwrap();
+        let (p, q) = (at[k], at[(k + 1) % 4]);
+        let (ip, iq) = (ids[k], ids[(k + 1) % 4]);
+        let slit = (
+            vec![
+                q,
+                p,
+                [p[0] + 0.2, p[1], p[2] - 0.002],
+                [q[0] + 0.2, q[1], q[2] - 0.002],
+            ],
+            vec![iq, ip, 5000, 5001],
+        );
+        let mut three = b.clone();
+        three.push(slit);
+        // A side-A face across that edge with its centroid left of it, where one face
+        // covers it: only the edge's count of faces tells the double cover right of it.
+        let (x0, x1) = (p[0].min(q[0]) - 0.12, p[0].max(q[0]) + 0.02);
+        let (y0, y1) = (p[1].min(q[1]) + 0.05, p[1].max(q[1]) - 0.05);
+        let a_slit: Vec<V3> = vec![
+            [x0, y0, 0.01],
+            [x1, y0, 0.01],
+            [x1, y1, 0.01],
+            [x0, y1, 0.01],
+        ];
+        let own = (x1 - x0) * (y1 - y0);
+        assert!((clipped(&a_slit, &b) - own).abs() < 1e-14);
+        assert!(clipped(&a_slit, &three) > own + 1e-4);
+        assert_eq!(cover_area(&mut cover, &a_slit, &three), None);
     }
 }
