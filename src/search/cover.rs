@@ -28,12 +28,25 @@ use super::overlap::{larger, smaller};
 const TILES: usize = 16;
 
 /// A side-B face projected onto A's plane: its corners, and its edges by node numbers
-/// ([`edge_key`]).
-#[derive(Clone, Copy, Debug, Default)]
+/// ([`edge_key`]; [`NO_EDGE`] past the last).
+#[derive(Clone, Copy, Debug)]
 pub(crate) struct Tile {
     q: [P2; 4],
     edges: [u64; 4],
     len: usize,
+}
+
+/// The key of no edge: node numbers are below `u32::MAX`.
+const NO_EDGE: u64 = u64::MAX;
+
+impl Default for Tile {
+    fn default() -> Self {
+        Tile {
+            q: [[0.0; 2]; 4],
+            edges: [NO_EDGE; 4],
+            len: 0,
+        }
+    }
 }
 
 /// The edge from node `from` to node `to` as one number.
@@ -61,6 +74,8 @@ pub(crate) struct Cover {
     /// A's area (its projection onto its own plane).
     area: f64,
     tiles: [Tile; TILES],
+    /// The edges of `tiles`, four slots a face, side by side for [`shared_once`].
+    keys: [u64; 4 * TILES],
     count: usize,
     /// Whether a face pushed could not be taken: then [`Cover::area`] is `None`.
     refused: bool,
@@ -76,6 +91,7 @@ impl Default for Cover {
             hi: [0.0; 2],
             area: 0.0,
             tiles: [Tile::default(); TILES],
+            keys: [NO_EDGE; 4 * TILES],
             count: 0,
             refused: true,
         }
@@ -206,6 +222,7 @@ impl Cover {
             return;
         }
         self.tiles[self.count] = t;
+        self.keys[4 * self.count..4 * self.count + 4].copy_from_slice(&t.edges);
         self.count += 1;
     }
 
@@ -219,12 +236,12 @@ impl Cover {
         // Every edge near A shared, in reverse, by exactly one other face, and by none
         // the same way round: a third face on an edge (a fin, a slit) would lie over one
         // of the two.
-        for (i, t) in tiles.iter().enumerate() {
+        for t in tiles {
             for k in 0..t.len {
                 let (u, v) = (t.q[k], t.q[next(k, t.len)]);
                 let lo = [smaller(u[0], v[0]), smaller(u[1], v[1])];
                 let hi = [larger(u[0], v[0]), larger(u[1], v[1])];
-                if self.meets(lo, hi) && !shared_once(tiles, i, t.edges[k]) {
+                if self.meets(lo, hi) && !shared_once(&self.keys[..4 * self.count], t.edges[k]) {
                     return None;
                 }
             }
@@ -254,20 +271,20 @@ impl Cover {
     }
 }
 
-/// Whether, of the faces of `tiles` other than the `i`-th, exactly one has the edge
-/// `key` ([`edge_key`]) in reverse and none has it the same way round.
-fn shared_once(tiles: &[Tile], i: usize, key: u64) -> bool {
+/// Whether, besides the face it came from, exactly one face has the edge `key`
+/// ([`edge_key`]) in reverse and none has it the same way round; `keys` are the faces'
+/// edges, four slots a face.
+fn shared_once(keys: &[u64], key: u64) -> bool {
     let reverse = key.rotate_left(32);
-    let (mut opposite, mut same) = (0, 0);
-    for (s, t) in tiles.iter().enumerate() {
-        if s != i {
-            for &e in &t.edges[..t.len] {
-                opposite += usize::from(e == reverse);
-                same += usize::from(e == key);
-            }
-        }
+    // Every slot, without branches (the unused ones match nothing). The face `key`
+    // came from counts once the same way round and never in reverse: a convex face's
+    // edges are distinct.
+    let (mut opposite, mut same) = (0u32, 0u32);
+    for &e in keys {
+        opposite += u32::from(e == reverse);
+        same += u32::from(e == key);
     }
-    opposite == 1 && same == 0
+    opposite == 1 && same == 1
 }
 
 #[cfg(test)]
