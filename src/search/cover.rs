@@ -18,9 +18,9 @@
 //! few faces near each instead of their clipping. The tests are in A's plane
 //! coordinates, with tolerances that err towards clipping.
 
-use crate::vec3::{V3, cross, dot, norm, scale, sub};
+use crate::vec3::V3;
 
-use super::mortar::{P2, cross2, sub2};
+use super::mortar::{P2, Plane, area2, cross2, plane_of, sub2};
 use super::overlap::{larger, smaller};
 
 /// The most side-B faces near one side-A face that the test takes; more, and the faces
@@ -65,9 +65,8 @@ fn next(k: usize, n: usize) -> usize {
 /// then the side-B faces near it, one [`Cover::tile`] and [`Cover::push`] each.
 #[derive(Clone, Debug)]
 pub(crate) struct Cover {
-    origin: V3,
-    t1: V3,
-    t2: V3,
+    /// A's plane.
+    plane: Plane,
     /// A's projected box, widened by the tolerance of the projections.
     lo: P2,
     hi: P2,
@@ -84,9 +83,7 @@ pub(crate) struct Cover {
 impl Default for Cover {
     fn default() -> Self {
         Cover {
-            origin: [0.0; 3],
-            t1: [0.0; 3],
-            t2: [0.0; 3],
+            plane: Plane::default(),
             lo: [0.0; 2],
             hi: [0.0; 2],
             area: 0.0,
@@ -124,65 +121,39 @@ impl Cover {
     pub(crate) fn set_face(&mut self, a: &[V3]) -> bool {
         self.count = 0;
         self.refused = true;
-        let m = a.len();
-        let va = match m {
-            3 => cross(sub(a[1], a[0]), sub(a[2], a[0])),
-            4 => cross(sub(a[2], a[0]), sub(a[3], a[1])),
-            _ => return false,
+        // The plane the clipping projects onto (`None`: degenerate, or not 3 or 4
+        // corners).
+        let Some(plane) = plane_of(a) else {
+            return false;
         };
-        let va = scale(va, 0.5);
-        let area = norm(va);
-        let l2 = (0..m).fold(0.0f64, |l, k| {
-            let e = sub(a[next(k, m)], a[k]);
-            l.max(dot(e, e))
-        });
-        // Also false for NaN coordinates.
-        if area.is_nan() || area <= 1e-8 * l2 {
-            return false;
-        }
-        let n = scale(va, 1.0 / area);
-        let mut origin = [0.0; 3];
-        for x in a {
-            origin = [origin[0] + x[0], origin[1] + x[1], origin[2] + x[2]];
-        }
-        self.origin = scale(origin, 1.0 / m as f64);
-        let e = sub(a[1], a[0]);
-        let t1 = sub(e, scale(n, dot(e, n)));
-        let l1 = norm(t1);
-        if l1.is_nan() || l1 <= 0.0 {
-            return false;
-        }
-        self.t1 = scale(t1, 1.0 / l1);
-        self.t2 = cross(n, self.t1);
+        self.plane = plane;
+        let m = a.len();
         let mut p = [[0.0; 2]; 4];
         for (k, x) in a.iter().enumerate() {
-            p[k] = self.flat(*x);
+            p[k] = self.plane.to2(*x);
         }
+        // Also false for NaN coordinates.
         if !convex(&p[..m], 1.0) {
             return false;
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for q in &p[..m] {
+        let mut size = 0.0f64;
+        for (q, x) in p[..m].iter().zip(a) {
             for d in 0..2 {
                 lo[d] = lo[d].min(q[d]);
                 hi[d] = hi[d].max(q[d]);
             }
+            size = x.iter().fold(size, |s, v| s.max(v.abs()));
         }
         // Round-off of the projections: ε of the coordinates, far below the pad.
-        let size = self.origin.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-        let pad = 1e-9 * l2.sqrt() + 1e-12 * size;
+        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        let pad = 1e-9 * extent + 1e-12 * size;
         self.lo = [lo[0] - pad, lo[1] - pad];
         self.hi = [hi[0] + pad, hi[1] + pad];
-        self.area = area;
+        // A's projection, as the clipped pieces of a face that covers it sum to.
+        self.area = 0.5 * area2(&p[..m]);
         self.refused = false;
         true
-    }
-
-    /// `x` in A's plane coordinates (A's centroid the origin).
-    #[inline(always)]
-    fn flat(&self, x: V3) -> P2 {
-        let d = sub(x, self.origin);
-        [dot(d, self.t1), dot(d, self.t2)]
     }
 
     /// Whether the box `(lo, hi)` meets A's.
@@ -200,7 +171,7 @@ impl Cover {
         };
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for k in 0..t.len {
-            let q = self.flat(b[k]);
+            let q = self.plane.to2(b[k]);
             // A NaN coordinate leaves the box to the other corners; `push` then
             // refuses the face (its turns are not above the tolerance).
             for d in 0..2 {
@@ -291,6 +262,7 @@ fn shared_once(keys: &[u64], key: u64) -> bool {
 mod tests {
     use super::super::overlap::FaceOverlap;
     use super::*;
+    use crate::vec3::{cross, norm, sub};
 
     /// A jittered, slightly warped grid of `n × n` quads on `[0, w] × [0, 1]`, wound
     /// clockwise seen from above (opposed to a side A facing up), its nodes numbered

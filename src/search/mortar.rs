@@ -284,7 +284,9 @@ pub(super) struct Plane {
 }
 
 impl Plane {
-    fn to2(&self, x: V3) -> P2 {
+    /// `x` in the plane's coordinates (its origin at 0).
+    #[inline(always)]
+    pub(super) fn to2(&self, x: V3) -> P2 {
         let d = sub(x, self.origin);
         [dot(d, self.t1), dot(d, self.t2)]
     }
