@@ -137,15 +137,14 @@ impl Cover {
             return false;
         }
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        let mut size = 0.0f64;
-        for (q, x) in p[..m].iter().zip(a) {
+        for q in &p[..m] {
             for d in 0..2 {
-                lo[d] = lo[d].min(q[d]);
-                hi[d] = hi[d].max(q[d]);
+                lo[d] = smaller(lo[d], q[d]);
+                hi[d] = larger(hi[d], q[d]);
             }
-            size = x.iter().fold(size, |s, v| s.max(v.abs()));
         }
         // Round-off of the projections: ε of the coordinates, far below the pad.
+        let size = (self.plane.origin().iter()).fold(0.0, |s, v| larger(s, v.abs()));
         let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
         let pad = 1e-9 * extent + 1e-12 * size;
         self.lo = [lo[0] - pad, lo[1] - pad];

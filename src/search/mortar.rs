@@ -284,6 +284,11 @@ pub(super) struct Plane {
 }
 
 impl Plane {
+    /// The plane's origin (the face's node average).
+    pub(super) fn origin(&self) -> V3 {
+        self.origin
+    }
+
     /// `x` in the plane's coordinates (its origin at 0).
     #[inline(always)]
     pub(super) fn to2(&self, x: V3) -> P2 {
@@ -306,7 +311,8 @@ pub(super) fn plane_of(a: &[V3]) -> Option<Plane> {
     };
     let l2 = (0..n)
         .map(|i| {
-            let e = sub(a[(i + 1) % n], a[i]);
+            // (Not `(i + 1) % n`: a division, on the overlap's path for every face.)
+            let e = sub(a[if i + 1 == n { 0 } else { i + 1 }], a[i]);
             dot(e, e)
         })
         .fold(0.0, f64::max);
