@@ -39,6 +39,7 @@ pub(super) struct Setup {
 impl Setup {
     pub(super) fn new(p: &TransientProblem<'_>, time: f64) -> Result<Setup, HeatError> {
         let mesh = p.mesh;
+        counts_fit(p)?;
         let specs = p.fields_or_default();
         let mut list: Vec<(&str, &[usize])> = specs
             .iter()
@@ -347,4 +348,83 @@ pub(super) fn lumped_weights(
         .into_iter()
         .map(|((d, b), w)| (d, b, w, coords[d as usize]))
         .collect())
+}
+
+/// The per-block data of `p` has one entry per mesh block: a shorter list would leave
+/// a block without its law (and the assembly reading past its end).
+fn counts_fit(p: &TransientProblem<'_>) -> Result<(), HeatError> {
+    let blocks = p.mesh.blocks.len();
+    if p.laws.len() != blocks {
+        return Err(HeatError::MaterialCount {
+            count: p.laws.len(),
+            blocks,
+        });
+    }
+    if let Some(s) = p.block_source.filter(|s| s.len() != blocks) {
+        return Err(HeatError::SourceCount {
+            count: s.len(),
+            blocks,
+        });
+    }
+    if let Some(s) = p.species.as_ref().filter(|s| s.capacity.len() != blocks) {
+        return Err(HeatError::Step(format!(
+            "{} species capacities given for {blocks} blocks",
+            s.capacity.len()
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::heat::law::Law;
+    use crate::heat::transient::BlockLaws;
+    use crate::mesh::generate::{BoxSpec, boxes};
+
+    /// A law or source list shorter than the mesh's blocks is an error naming both
+    /// counts, not a read past its end.
+    #[test]
+    fn per_block_lists_must_cover_every_block() {
+        let mesh = boxes(
+            &[
+                BoxSpec::hex([0.0; 3], [1.0; 3], [1, 1, 1], 1),
+                BoxSpec::hex([0.0, 0.0, 1.0], [1.0, 1.0, 2.0], [1, 1, 1], 2),
+            ],
+            false,
+        );
+        let law = BlockLaws {
+            conductivity: Law::Constant(1.0),
+            capacity: Law::Constant(1.0),
+        };
+        let (two, one) = ([law.clone(), law.clone()], [law]);
+        let sources = [Law::Constant(1.0)];
+        let loads = |_t: f64| Ok(Loads::default());
+        let problem = |laws, block_source| TransientProblem {
+            mesh: &mesh,
+            fields: Vec::new(),
+            laws,
+            source: None,
+            block_source,
+            loads: &loads,
+            interfaces: None,
+            tolerance: 1e-10,
+            max_iterations: 5,
+            reproducible: true,
+            amg_threshold: None,
+            electric: None,
+            death: None,
+            species: None,
+        };
+        let err = |p: TransientProblem<'_>| Setup::new(&p, 0.0).err().map(|e| e.to_string());
+        assert_eq!(
+            err(problem(&one, None)).as_deref(),
+            Some("1 materials given for 2 blocks")
+        );
+        assert_eq!(
+            err(problem(&two, Some(&sources))).as_deref(),
+            Some("1 block sources given for 2 blocks")
+        );
+        assert_eq!(err(problem(&two, None)), None);
+    }
 }
