@@ -744,14 +744,25 @@ impl AmgCg {
             return self.pcg_once(b, x, r);
         }
         // A refreshed hierarchy that fails is set up anew (for the same matrix) and the
-        // solve made again from the same start.
-        let (guess, start) = (x.to_vec(), r.clone());
+        // solve made again from the same start (kept in spare vectors: a time step
+        // would otherwise page in two fresh ones).
+        let mut copy = |v: &[f64]| {
+            let mut kept = self.spare.pop().unwrap_or_default();
+            kept.clear();
+            kept.extend_from_slice(v);
+            kept
+        };
+        let (guess, start) = (copy(x), copy(&r));
         match self.pcg_once(b, x, r) {
             Err(SolveError::NotConverged { .. }) if self.set_up_again()? => {
                 x.copy_from_slice(&guess);
+                self.spare.push(guess);
                 self.pcg_once(b, x, start)
             }
-            other => other,
+            other => {
+                self.spare.extend([guess, start]);
+                other
+            }
         }
     }
 
@@ -794,6 +805,16 @@ impl AmgCg {
         q: &mut [f64],
     ) -> Result<SolveReport, SolveError> {
         let bnorm = norm(b);
+        let tol = self.options.tolerance;
+        let mut rel = norm(r) / bnorm;
+        // A start that meets the test already (a time step the earlier solutions
+        // predict) needs no cycle.
+        if rel <= tol {
+            return Ok(SolveReport {
+                iterations: 0,
+                residual: rel,
+            });
+        }
         self.fit_fine_values();
         let fused = self.fine_product();
         self.precondition(r, z);
@@ -802,8 +823,6 @@ impl AmgCg {
             q.copy_from_slice(&self.product);
         }
         let mut rz = dot(r, z);
-        let tol = self.options.tolerance;
-        let mut rel = norm(r) / bnorm;
         let mut it = 0;
         while rel > tol {
             if it == self.options.max_iterations {

@@ -153,22 +153,19 @@ impl AmgCg {
         add_combination(&mut part, basis, &first, -1.0);
         ap.resize(x.len(), 0.0);
         fine.a.spmv(&part, &mut ap);
-        // b − A x = b − A part − Σ c_k A v_k.
-        let mut at_solution: Vec<f64> = b.iter().zip(&ap).map(|(b, ap)| b - ap).collect();
-        add_combination(&mut at_solution, products, &first, -1.0);
-        let second = dots(basis, &ap);
+        // b − A x = b − A part − Σ c_k A v_k; with the second pass's coefficients and
+        // the part's energy, in the same pass over A part.
+        let (at_solution, second, energy_of_part) =
+            residual_and_dots(b, &ap, products, &first, basis, &part);
         // ‖p − Xc‖²_A = pᵀAp − |c|² for an A-orthonormal X.
-        let norm2 = dot(&part, &ap) - second.iter().map(|c| c * c).sum::<f64>();
+        let norm2 = energy_of_part - second.iter().map(|c| c * c).sum::<f64>();
         // (A NaN anywhere fails the first test too.)
         let significant = norm2 > NEGLIGIBLE * NEGLIGIBLE * energy;
         if !significant || !energy.is_finite() {
             return at_solution;
         }
-        add_combination(&mut part, basis, &second, -1.0);
-        add_combination(&mut ap, products, &second, -1.0);
         let scale = 1.0 / norm2.sqrt();
-        part.par_iter_mut().for_each(|p| *p *= scale);
-        ap.par_iter_mut().for_each(|p| *p *= scale);
+        remove_and_scale(&mut part, basis, &mut ap, products, &second, scale);
         earlier.basis.push(part);
         earlier.products.push(ap);
         at_solution
@@ -200,6 +197,73 @@ fn dots(ws: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
     (0..ws.len())
         .map(|k| parts.iter().map(|p| p[k]).sum())
         .collect()
+}
+
+/// One pass over `A p` (`ap`) for [`AmgCg::remember`]: the residual
+/// `b − ap − Σ_k c_k P_k` (the products `P` of the basis `X`), each `X_k · ap`, and
+/// `p · ap` — summed as [`dots`] and [`crate::solve::dot`] sum, and the residual's
+/// terms taken in the order of `k`, so the bits of the passes one after another.
+fn residual_and_dots(
+    b: &[f64],
+    ap: &[f64],
+    products: &[Vec<f64>],
+    c: &[f64],
+    basis: &[Vec<f64>],
+    p: &[f64],
+) -> (Vec<f64>, Vec<f64>, f64) {
+    let mut residual = vec![0.0; b.len()];
+    let k = basis.len();
+    let parts: Vec<Vec<f64>> = residual
+        .par_chunks_mut(REDUCE_CHUNK)
+        .enumerate()
+        .map(|(chunk, out)| {
+            let at = chunk * REDUCE_CHUNK;
+            let range = at..at + out.len();
+            let ap = &ap[range.clone()];
+            for ((o, b), ap) in out.iter_mut().zip(&b[range.clone()]).zip(ap) {
+                *o = b - ap;
+            }
+            for (w, &c) in products.iter().zip(c) {
+                let w = &w[range.clone()];
+                out.iter_mut().zip(w).for_each(|(o, w)| *o -= c * w);
+            }
+            let mut sums: Vec<f64> = basis
+                .iter()
+                .map(|w| w[range.clone()].iter().zip(ap).map(|(w, y)| w * y).sum())
+                .collect();
+            sums.push(p[range].iter().zip(ap).map(|(p, y)| p * y).sum());
+            sums
+        })
+        .collect();
+    let mut sums: Vec<f64> = (0..=k).map(|j| parts.iter().map(|s| s[j]).sum()).collect();
+    let energy = sums.pop().expect("k + 1 sums");
+    (residual, sums, energy)
+}
+
+/// `p ← (p − Σ_k c_k X_k)·s` and `y ← (y − Σ_k c_k P_k)·s` in one pass over both,
+/// each entry as [`add_combination`] and a scaling after it would leave it.
+fn remove_and_scale(
+    p: &mut [f64],
+    basis: &[Vec<f64>],
+    y: &mut [f64],
+    products: &[Vec<f64>],
+    c: &[f64],
+    s: f64,
+) {
+    p.par_chunks_mut(REDUCE_CHUNK)
+        .zip(y.par_chunks_mut(REDUCE_CHUNK))
+        .enumerate()
+        .for_each(|(chunk, (p, y))| {
+            let at = chunk * REDUCE_CHUNK;
+            for (out, ws) in [(&mut *p, basis), (&mut *y, products)] {
+                let range = at..at + out.len();
+                for (w, &c) in ws.iter().zip(c) {
+                    let w = &w[range.clone()];
+                    out.iter_mut().zip(w).for_each(|(o, w)| *o -= c * w);
+                }
+                out.iter_mut().for_each(|o| *o *= s);
+            }
+        });
 }
 
 /// `y += sign Σ_k c_k w_k`, in one pass over `y`: each entry takes the terms in the
