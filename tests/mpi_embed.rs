@@ -315,27 +315,7 @@ fn rank_terms_sum_to_the_serial_terms() {
         return rank_terms_child();
     }
     for n in 1..=4 {
-        let mut cmd = Command::new("mpirun");
-        cmd.args(["--oversubscribe", "-n", &n.to_string()])
-            .arg(std::env::current_exe().unwrap())
-            .args([
-                "--exact",
-                "rank_terms_sum_to_the_serial_terms",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env(CHILD, "1")
-            .env("RAYON_NUM_THREADS", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
-            .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
-            .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
-        let out = cmd.output().expect("mpirun");
-        let text = format!(
-            "{}{}",
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        );
-        assert!(out.status.success(), "{n} ranks:\n{text}");
+        let text = child_on(n, "rank_terms_sum_to_the_serial_terms");
         // libtest prints the test's name first, on the same line.
         let line = text
             .lines()
@@ -350,9 +330,31 @@ fn rank_terms_sum_to_the_serial_terms() {
     }
 }
 
+/// This test binary's test `name` under `mpirun -n n` (with [`CHILD`] set), which must
+/// succeed within 5 minutes (a rank that fails while the others wait in a collective
+/// would otherwise hang the suite); its stdout and stderr.
+fn child_on(n: usize, name: &str) -> String {
+    let mut cmd = Command::new("timeout");
+    cmd.args(["300", "mpirun", "--oversubscribe", "-n", &n.to_string()])
+        .arg(std::env::current_exe().unwrap())
+        .args(["--exact", name, "--nocapture", "--test-threads=1"])
+        .env(CHILD, "1")
+        .env("RAYON_NUM_THREADS", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+        .env("OMPI_MCA_rmaps_base_oversubscribe", "1");
+    let out = cmd.output().expect("mpirun");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "{n} ranks:\n{text}");
+    text
+}
+
 fn rank_terms_child() {
     use mpi::traits::{Communicator, CommunicatorCollectives};
-    use seam::embed::EmbedError;
     let universe = mpi::initialize().expect("MPI");
     let world = universe.world();
     let (rank, size) = (world.rank() as usize, world.size() as usize);
@@ -426,7 +428,7 @@ fn rank_terms_child() {
     }
 
     // The same interface from a deck: the same heat as the serial embedding's deck; a
-    // deck with a mortar tie is refused on every rank, and leaves nothing behind.
+    // deck with a mortar tie is taken (its rows: `rank_tie_rows_are_the_serial_rows`).
     let deck = |enforcement: &str| {
         format!(
             "begin contact definition bricks\n  contact surface ra contains right\n  contact surface lb contains left\n  begin interaction\n    side a ra\n    side b lb\n  end\n  begin enforcement\n{enforcement}  end\nend\n"
@@ -442,14 +444,10 @@ fn rank_terms_child() {
     let mut e = b.clone().build_on_ranks(world.duplicate(), &gids).unwrap();
     let tie =
         deck("    enforcement for energy = tied\n    side b variable temperature to temperature\n");
-    match e.add_deck("tied.i", &tie) {
-        Err(EmbedError::Argument { what, .. }) => assert!(what.contains("multipliers"), "{what}"),
-        other => panic!("rank {rank}: a mortar tie deck gave {other:?}"),
-    }
-    assert!(e.is_empty(), "the refused deck left no interaction");
-    assert_eq!(e.add_deck("bricks.i", &gap).expect("rank deck"), vec![0]);
+    assert_eq!(e.add_deck("tied.i", &tie).expect("tie deck"), vec![0]);
+    assert_eq!(e.add_deck("bricks.i", &gap).expect("rank deck"), vec![1]);
     e.search().unwrap();
-    let got = e.contributions(&u_local).unwrap().heat[0].unwrap();
+    let got = e.contributions(&u_local).unwrap().heat[1].unwrap();
     assert!(
         (want.side_a - got.side_a).abs() <= 1e-12 * want.side_a.abs(),
         "deck heat {} against serial {}",
@@ -498,4 +496,153 @@ fn refused_everywhere(
         other => panic!("rank {rank}: expected a refusal ({what}), got {other:?}"),
     }
     println!("rank {rank}: refused on every rank ({what})");
+}
+
+/// Under `mpirun -n 1..4`: a mortar tie of a's x = 1 face (side A, 4 × 4 faces) to b's
+/// (5 × 3), with a's nodes on the edge y = 0 of it fixed (each rank fixing those it
+/// holds, so the crosspoints lie across the slabs' boundaries), standard and dual
+/// multipliers. Each multiplier's row comes from one rank only, and the ranks' rows
+/// together (by the multiplier's side-A dof) are the serial embedding's: `C`, `g`, the
+/// dual tie's condensed rows, the crosspoints, and the heat for the same multipliers.
+#[test]
+fn rank_tie_rows_are_the_serial_rows() {
+    if std::env::var_os(CHILD).is_some() {
+        return rank_ties_child();
+    }
+    for n in 1..=4 {
+        let text = child_on(n, "rank_tie_rows_are_the_serial_rows");
+        let line = text
+            .lines()
+            .find_map(|l| l.find("rank ties:").map(|k| &l[k..]))
+            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
+        eprintln!("mpirun -n {n}: {line}");
+    }
+}
+
+fn rank_ties_child() {
+    use mpi::collective::SystemOperation;
+    use mpi::traits::{Communicator, CommunicatorCollectives};
+    use seam::embed::{Interaction, Model, Multipliers};
+    let universe = mpi::initialize().expect("MPI");
+    let world = universe.world();
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let m = bricks();
+    let (n_nodes, n_elems) = (m.coords.len(), m.num_elems());
+    // Brick a's nodes come first (the generator numbers box by box).
+    let a_nodes = 4 * 5 * 5;
+    let fixed = |g: usize| g < a_nodes && m.coords[g][0] == 1.0 && m.coords[g][1] == 0.0;
+    let all: Vec<usize> = (0..n_elems).collect();
+    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
+    let sum = |v: &[f64]| {
+        let mut out = vec![0.0; v.len()];
+        world.all_reduce_into(v, &mut out[..], SystemOperation::sum());
+        out
+    };
+    let mut report = String::new();
+    for multipliers in [Multipliers::Standard, Multipliers::Dual] {
+        let tie = || Interaction::new("right", "left", Model::TiedMortar { multipliers });
+        let (b, serial_nodes) = builder_of(&m, &all);
+        let local_fixed: Vec<usize> = (0..serial_nodes.len())
+            .filter(|&k| fixed(serial_nodes[k]))
+            .collect();
+        let mut serial = b.fixed_nodes(&local_fixed).build().expect("serial build");
+        serial.add_interaction(tie()).unwrap();
+        serial.search().unwrap();
+        let want = serial.constraints().expect("serial rows").remove(0);
+
+        let (b, nodes) = builder_of(&m, &mine);
+        let local_fixed: Vec<usize> = (0..nodes.len()).filter(|&k| fixed(nodes[k])).collect();
+        let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
+        let mut e = (b.fixed_nodes(&local_fixed))
+            .build_on_ranks(world.duplicate(), &gids)
+            .expect("rank build");
+        assert_eq!(e.add_interaction(tie()).unwrap(), 0);
+        e.search().unwrap();
+        let got = e.constraints().expect("rank rows").remove(0);
+        assert_eq!(
+            got.total,
+            want.multiplier_dofs.len(),
+            "multipliers in the tie"
+        );
+        assert_eq!(got.index.len(), got.rows.multiplier_dofs.len());
+
+        // Rows by the multiplier's side-A dof: [C row (n), g, count, condensed constant,
+        // condensed row (n), condensed count].
+        let width = 2 * n_nodes + 4;
+        let dense = |t: &seam::embed::TieConstraints| {
+            let mut out = vec![0.0; n_nodes * width];
+            for (k, &d) in t.multiplier_dofs.iter().enumerate() {
+                out[d * width + n_nodes] = t.rhs[k];
+                out[d * width + n_nodes + 1] += 1.0;
+            }
+            for &(k, j, c) in &t.entries {
+                out[t.multiplier_dofs[k] * width + j] += c;
+            }
+            for c in &t.condensed {
+                let row = &mut out[c.dof * width..(c.dof + 1) * width];
+                row[n_nodes + 2] = c.constant;
+                row[2 * n_nodes + 3] += 1.0;
+                for &(j, v) in &c.terms {
+                    row[n_nodes + 3 + j] += v;
+                }
+            }
+            out
+        };
+        let summed = sum(&dense(&got.rows));
+        let serial_dense = dense(&want);
+        let scale = serial_dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        let diff =
+            (serial_dense.iter().zip(&summed)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+        assert!(
+            diff <= 1e-12 * scale,
+            "{multipliers:?}: rows differ by {diff:e}"
+        );
+        // (The counts are in the rows: a multiplier or condensed row on two ranks
+        // would count 2.)
+        if multipliers == Multipliers::Dual {
+            assert_eq!(want.condensed.len(), want.multiplier_dofs.len());
+        }
+
+        // The crosspoints, by global node.
+        let mut cross = vec![0.0; n_nodes];
+        for &g in &got.rows.crosspoints {
+            cross[g] += 1.0;
+        }
+        let cross = sum(&cross);
+        let mut want_cross = vec![0.0; n_nodes];
+        for &k in &want.crosspoints {
+            want_cross[serial_nodes[k]] += 1.0;
+        }
+        assert!(
+            !want.crosspoints.is_empty(),
+            "the fixed edge makes crosspoints"
+        );
+        assert_eq!(cross, want_cross, "{multipliers:?}: crosspoints");
+
+        // The heat for multipliers λ(dof) = 1 + dof / 100.
+        let lambda = |dofs: &[usize]| dofs.iter().map(|&d| 1.0 + d as f64 / 100.0).collect();
+        let lambda_serial: Vec<f64> = lambda(&want.multiplier_dofs);
+        let heat_serial = want.heat(&lambda_serial).unwrap();
+        let lambda_rank: Vec<f64> = lambda(&got.rows.multiplier_dofs);
+        let heat = e.tie_heat(&got, &lambda_rank).unwrap();
+        let dq = (heat.side_a - heat_serial.side_a)
+            .abs()
+            .max((heat.side_b - heat_serial.side_b).abs());
+        assert!(
+            dq <= 1e-12 * heat_serial.side_a.abs(),
+            "{multipliers:?}: heat {dq:e}"
+        );
+        report += &format!(
+            " {multipliers:?}: {} multipliers, max |Δ| of the rows {diff:.1e} (of {scale:.2e}), |Δheat| {dq:.1e} W (of {:.3e});",
+            got.total,
+            heat_serial.side_a.abs()
+        );
+        if size > 1 {
+            assert!(e.points_across() > 0, "pairs straddle ranks");
+        }
+    }
+    if rank == 0 {
+        println!("rank ties:{report}");
+    }
+    world.barrier();
 }

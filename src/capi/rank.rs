@@ -80,6 +80,9 @@ pub unsafe extern "C" fn seam_rank_add_interaction(
         let e = unsafe { handle(embedding, "embedding") }?;
         let (a, b) = unsafe { (text(side_a, "side_a")?, text(side_b, "side_b")?) };
         let model = interactions::model_of(model, h)?;
+        if matches!(model, Model::TiedMortar { .. }) {
+            return Err(RankEmbedding::no_multipliers(a, b).into());
+        }
         let i = e
             .inner
             .add_interaction(Interaction::new(a, b, model).offset(offset))?;
@@ -100,7 +103,9 @@ pub unsafe extern "C" fn seam_rank_add_deck(
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
         let (deck, name) = unsafe { interactions::deck_args(deck_text, name) }?;
+        let first = e.inner.len();
         let added = e.inner.add_deck(name, deck)?;
+        e.inner.refuse_ties_from(first)?;
         e.evaluated = None;
         unsafe { interactions::optional_out(out_count, added.len()) }
     })

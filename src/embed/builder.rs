@@ -26,7 +26,7 @@ pub struct EmbeddingBuilder {
     blocks: Vec<BlockInput>,
     surfaces: Vec<(String, Faces)>,
     pub(super) dofs: Option<Vec<Option<usize>>>,
-    fixed: Vec<usize>,
+    pub(super) fixed: Vec<usize>,
     pub(super) integration: Integration,
     pub(super) axisymmetric: bool,
 }

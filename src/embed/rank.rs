@@ -44,6 +44,10 @@
 //! different ranks pair exactly as in serial), and evaluates only the points of the
 //! faces it gave ([`Embedding::own_points`]).
 //!
+//! Mortar ties give their constraint rows by [`RankEmbedding::constraints`]: each rank
+//! the rows (and, for dual multipliers, the condensed rows) of the multipliers whose
+//! side-A node it owns, in the host's global dofs, each with its index in the whole tie.
+//!
 //! Ownership: a face belongs to the rank that gives it, and must be given by one rank
 //! only (the owner of its element); a node point of a node surface belongs to the lowest
 //! rank among the elements around it. Node ownership is otherwise the host's business:
@@ -57,8 +61,8 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::{
-    Contributions, EmbedError, Embedding, EmbeddingBuilder, Enforcement, Heat, Interaction, Model,
-    argument, mesh_error,
+    Contributions, EmbedError, Embedding, EmbeddingBuilder, Enforcement, Heat, Interaction,
+    TieConstraints, argument, mesh_error,
 };
 use crate::mesh::{ElemId, NodeId};
 
@@ -83,6 +87,19 @@ pub struct RankEmbedding {
     node_owner: Vec<usize>,
     /// Over all ranks, the side-A points whose side-B face another rank gave.
     across: usize,
+}
+
+/// One mortar tie's rows on one rank ([`RankEmbedding::constraints`]).
+#[derive(Clone, Debug)]
+pub struct RankTie {
+    /// The rows of this rank's multipliers, numbered 0.. in `index`'s order, in the
+    /// host's global dofs ([`TieConstraints`]; its `heat` is this rank's share, its
+    /// `dual_multipliers` reads the residual at global dofs).
+    pub rows: TieConstraints,
+    /// Each of this rank's multipliers' index in the whole tie (ascending).
+    pub index: Vec<usize>,
+    /// The whole tie's multipliers, over every rank.
+    pub total: usize,
 }
 
 /// `MPI_Comm_dup` of the host's communicator: seam's messages never meet the host's.
@@ -203,6 +220,10 @@ impl EmbeddingBuilder {
         global_ids: &[u64],
     ) -> Result<RankEmbedding, EmbedError> {
         let (integration, axisymmetric) = (self.integration, self.axisymmetric);
+        // The fixed nodes by global id (a node fixed on any rank is fixed).
+        let fixed: Vec<u64> = (self.fixed.iter())
+            .filter_map(|&f| global_ids.get(f).copied())
+            .collect();
         let local = agree(&comm, self.local_share(global_ids));
         let (local, share) = local?;
         let rank = comm.rank() as usize;
@@ -250,6 +271,12 @@ impl EmbeddingBuilder {
         }
         let mut inner = builder.build()?;
         inner.mesh.node_numbers = whole.global_id.iter().map(|&g| g as i64).collect();
+        let fixed: std::collections::HashSet<u64> =
+            gather_parts(&comm, &fixed).into_iter().flatten().collect();
+        inner.fixed = (0..whole.global_id.len())
+            .filter(|&i| fixed.contains(&whole.global_id[i]))
+            .map(|i| NodeId(i as u32))
+            .collect();
         let mut node_owner = vec![usize::MAX; whole.coords.len()];
         for (e, &r) in whole.origin.iter().enumerate() {
             for n in inner.mesh.elem_nodes(ElemId(e as u32)) {
@@ -461,40 +488,83 @@ impl RankEmbedding {
     }
 
     /// Add an interaction (collective: every rank adds the same ones in the same order).
-    /// Mortar ties with multipliers are refused: multipliers across ranks are not built.
+    /// A mortar tie gives its rows by [`Self::constraints`].
     pub fn add_interaction(&mut self, i: Interaction) -> Result<usize, EmbedError> {
-        let r = if matches!(i.model, Model::TiedMortar { .. }) {
-            Err(Self::no_multipliers(&i.side_a, &i.side_b))
-        } else {
-            self.inner.add_interaction(i)
-        };
+        let r = self.inner.add_interaction(i);
         agree(&self.comm, r)
     }
 
     /// The interactions of a contact deck (collective), as [`Embedding::add_deck`]: the
-    /// same deck on every rank; one with a mortar tie is refused whole.
+    /// same deck on every rank.
     pub fn add_deck(&mut self, name: &str, text: &str) -> Result<Vec<usize>, EmbedError> {
-        let before = self.inner.pairs.len();
-        let mut r = self.inner.add_deck(name, text);
-        if let Some(p) = self.inner.pairs[before..]
-            .iter()
-            .find(|p| matches!(p.enforcement, Enforcement::Tie { .. }))
-        {
-            r = Err(Self::no_multipliers(&p.side_a.name, &p.side_b.name));
-        }
-        if r.is_err() {
-            self.inner.pairs.truncate(before);
-        }
+        let r = self.inner.add_deck(name, text);
         agree(&self.comm, r)
     }
 
-    fn no_multipliers(a: &str, b: &str) -> EmbedError {
+    /// Drop the interactions from `first` on when one of them is a mortar tie, with the
+    /// error that says so: for the C interface, which has no accessor of a rank's tie
+    /// rows yet. Every rank holds the same interactions, so every rank refuses alike.
+    pub(crate) fn refuse_ties_from(&mut self, first: usize) -> Result<(), EmbedError> {
+        let Some(p) = (self.inner.pairs[first..].iter())
+            .find(|p| matches!(p.enforcement, Enforcement::Tie { .. }))
+        else {
+            return Ok(());
+        };
+        let e = Self::no_multipliers(&p.side_a.name, &p.side_b.name);
+        self.inner.pairs.truncate(first);
+        Err(e)
+    }
+
+    pub(crate) fn no_multipliers(a: &str, b: &str) -> EmbedError {
         argument(
             format!(
-                "interaction {a} / {b}: a mortar tie with multipliers is not distributed (multipliers across ranks are not built)"
+                "interaction {a} / {b}: a mortar tie's rows per rank are not in the C interface yet"
             ),
-            "tie the surfaces by Nitsche (Model::TiedNitsche, SEAM_TIED_NITSCHE), or embed serially",
+            "tie the surfaces by Nitsche (SEAM_TIED_NITSCHE), or use the Rust RankEmbedding::constraints",
         )
+    }
+
+    /// The rows of every mortar tie that belong to this rank (collective), in
+    /// interaction order: the multipliers whose side-A node this rank owns (the lowest
+    /// rank among the interface elements around it), in the host's global dofs. Each
+    /// multiplier is on one rank only, so the ranks' rows together are the serial
+    /// embedding's [`Embedding::constraints`]; each rank has `index`, every multiplier's
+    /// place in the whole tie, to number the host's multiplier unknowns. A dual tie's
+    /// condensed rows come the same way; `crosspoints` are the owned side-A nodes left
+    /// without a multiplier, by global id. A fixed node ([`EmbeddingBuilder::fixed_nodes`])
+    /// given on any rank is fixed for all.
+    pub fn constraints(&self) -> Result<Vec<RankTie>, EmbedError> {
+        let ties = agree(&self.comm, self.inner.constraints())?;
+        let mine = |n: usize| self.node_owner.get(n) == Some(&self.rank);
+        let dof = |d: usize| self.global_dof[d];
+        let node = |n: usize| self.inner.mesh.node_numbers[n] as usize;
+        Ok(ties
+            .iter()
+            .map(|t| {
+                let (rows, index) = t.restricted(&mine, &dof, &node);
+                RankTie {
+                    rows,
+                    index,
+                    total: t.multiplier_dofs.len(),
+                }
+            })
+            .collect())
+    }
+
+    /// Heat (W) through a tie for this rank's multipliers `lambda` (one per entry of
+    /// `tie.rows.multiplier_dofs`), summed over the ranks (collective).
+    pub fn tie_heat(&self, tie: &RankTie, lambda: &[f64]) -> Result<Heat, EmbedError> {
+        let own = agree(&self.comm, tie.rows.heat(lambda))?;
+        let mut summed = [0.0; 2];
+        self.comm.all_reduce_into(
+            &[own.side_a, own.side_b][..],
+            &mut summed[..],
+            SystemOperation::sum(),
+        );
+        Ok(Heat {
+            side_a: summed[0],
+            side_b: summed[1],
+        })
     }
 
     /// Number of interactions.

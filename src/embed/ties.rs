@@ -106,6 +106,62 @@ impl TieConstraints {
     }
 }
 
+impl TieConstraints {
+    /// The rows of the multipliers whose side-A node `mine` holds, renumbered in their
+    /// order, with every dof mapped by `dof` and every crosspoint node by `node` (only
+    /// those `mine` holds kept); and each kept multiplier's index in `self`. A tie's
+    /// rows on one rank of a host on MPI ([`super::RankEmbedding::constraints`]), its
+    /// dofs being the inner embedding's nodes.
+    #[cfg(feature = "mpi")]
+    pub(crate) fn restricted(
+        &self,
+        mine: &dyn Fn(usize) -> bool,
+        dof: &dyn Fn(usize) -> usize,
+        node: &dyn Fn(usize) -> usize,
+    ) -> (TieConstraints, Vec<usize>) {
+        let index: Vec<usize> = (0..self.multiplier_dofs.len())
+            .filter(|&k| mine(self.multiplier_dofs[k]))
+            .collect();
+        let mut kept = vec![usize::MAX; self.multiplier_dofs.len()];
+        for (i, &k) in index.iter().enumerate() {
+            kept[k] = i;
+        }
+        let rows = TieConstraints {
+            interaction: self.interaction,
+            multiplier_dofs: index
+                .iter()
+                .map(|&k| dof(self.multiplier_dofs[k]))
+                .collect(),
+            entries: (self.entries.iter())
+                .filter(|e| kept[e.0] != usize::MAX)
+                .map(|&(k, d, c)| (kept[k], dof(d), c))
+                .collect(),
+            rhs: index.iter().map(|&k| self.rhs[k]).collect(),
+            crosspoints: (self.crosspoints.iter())
+                .filter(|&&n| mine(n))
+                .map(|&n| node(n))
+                .collect(),
+            multipliers: self.multipliers,
+            condensed: (self.condensed.iter())
+                .filter(|c| mine(c.dof))
+                .map(|c| Condensed {
+                    dof: dof(c.dof),
+                    constant: c.constant,
+                    terms: c.terms.iter().map(|&(j, v)| (dof(j), v)).collect(),
+                })
+                .collect(),
+            diagonal: index.iter().map(|&k| self.diagonal[k]).collect(),
+            side_a_dofs: self.side_a_dofs.iter().map(|&d| dof(d)).collect(),
+            side_b_dofs: self.side_b_dofs.iter().map(|&d| dof(d)).collect(),
+            point_psi: (self.point_psi.iter())
+                .filter(|e| kept[e.1 as usize] != usize::MAX)
+                .map(|&(p, k, psi)| (p, kept[k as usize] as u32, psi))
+                .collect(),
+        };
+        (rows, index)
+    }
+}
+
 impl Embedding {
     /// The constraint rows of every mortar tie, in interaction order. Fixed nodes and
     /// nodes of an earlier tie get no multiplier (crosspoints).
