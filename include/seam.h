@@ -408,12 +408,12 @@ int seam_rank_new(const seam_builder *builder, MPI_Comm comm, const int64_t *glo
 /* Free the handle and its communicator (collective: MPI_Comm_free); before MPI_Finalize.
  * Accepts NULL. */
 void seam_rank_free(seam_rank_embedding *embedding);
-/* As seam_add_interaction; SEAM_TIED_MORTAR and SEAM_TIED_DUAL_MORTAR are refused. */
+/* As seam_add_interaction; a mortar tie (SEAM_TIED_MORTAR, SEAM_TIED_DUAL_MORTAR) gives
+ * its rows by seam_rank_constraints. */
 int seam_rank_add_interaction(seam_rank_embedding *embedding, const char *side_a,
                               const char *side_b, int model, double h, double offset,
                               size_t *out_index);
-/* As seam_add_deck: the same deck on every rank (name may be NULL); a deck with a mortar
- * tie is refused whole (SEAM_ERR_ARGUMENT). */
+/* As seam_add_deck: the same deck on every rank (name may be NULL). */
 int seam_rank_add_deck(seam_rank_embedding *embedding, const char *deck_text, const char *name,
                        size_t *out_count);
 /* Pair every interaction anew: the serial search of the whole interface, on every rank;
@@ -438,6 +438,33 @@ int seam_rank_jacobian(const seam_rank_embedding *embedding, size_t *out_n,
                        const double **out_values);
 int seam_rank_load(const seam_rank_embedding *embedding, size_t *out_n,
                    const int64_t **out_dofs, const double **out_values);
+/* Mortar ties on ranks (after seam_rank_search): each rank gets the rows of the
+ * multipliers whose side-A node it owns (the lowest rank among the interface elements
+ * around it), in global dofs, so every multiplier's row comes from one rank. Computes
+ * them (collective) and returns this rank's condensed rows of the dual ties, as
+ * seam_constraints. The arrays of these calls belong to the handle and stay valid
+ * until the next seam_rank_constraints, _search, _add_interaction, _add_deck or _free. */
+int seam_rank_constraints(seam_rank_embedding *embedding, size_t *out_n_rows,
+                          const int64_t **out_dofs, const double **out_constants,
+                          const size_t **out_offsets, const int64_t **out_cols,
+                          const double **out_coefficients);
+/* Number of ties (0 before seam_rank_constraints). Local. */
+int seam_rank_tie_count(const seam_rank_embedding *embedding, size_t *out_count);
+/* This rank's C u = g of one tie, as seam_tie_rows: its multipliers numbered 0.. in this
+ * rank's order. Local. */
+int seam_rank_tie_rows(const seam_rank_embedding *embedding, size_t tie,
+                       size_t *out_n_multipliers, const int64_t **out_multiplier_dofs,
+                       const double **out_rhs, size_t *out_n_entries,
+                       const int64_t **out_multipliers, const int64_t **out_dofs,
+                       const double **out_values);
+/* Each of this rank's multipliers' place in the whole tie (the same numbering on every
+ * rank: number the host's multiplier unknowns by it) and the tie's count of them. Local. */
+int seam_rank_tie_index(const seam_rank_embedding *embedding, size_t tie,
+                        const int64_t **out_index, size_t *out_total);
+/* Heat (W) through a tie for this rank's multipliers lambda (n, in this rank's order),
+ * summed over the ranks. Collective. */
+int seam_rank_tie_heat(const seam_rank_embedding *embedding, size_t tie, const double *lambda,
+                       size_t n, double *out_side_a, double *out_side_b);
 /* Heat (W) leaving side A and side B of interaction `index` at the last evaluation,
  * summed over the ranks (the same on every rank). */
 int seam_rank_heat(const seam_rank_embedding *embedding, size_t index, double *out_side_a,

@@ -87,12 +87,13 @@ fn build_host(dir: &Path) -> PathBuf {
     host
 }
 
-/// The host under `mpirun -n ranks` (with `serial`: the serial embedding, one rank).
-fn run(host: &Path, ranks: usize, serial: bool) -> Printed {
-    let mut cmd = Command::new("mpirun");
-    cmd.args(["--oversubscribe", "-n", &ranks.to_string()])
+/// The host under `mpirun -n ranks` in `mode` (`serial`: the serial embedding, one
+/// rank; `tie`: a mortar tie with multipliers).
+fn run(host: &Path, ranks: usize, mode: Option<&str>) -> Printed {
+    let mut cmd = Command::new("timeout");
+    cmd.args(["300", "mpirun", "--oversubscribe", "-n", &ranks.to_string()])
         .arg(host)
-        .args(serial.then_some("serial"))
+        .args(mode)
         .env("LD_LIBRARY_PATH", library_dir())
         .env("RAYON_NUM_THREADS", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
@@ -137,7 +138,12 @@ fn difference(a: &[f64], b: &[f64]) -> f64 {
 
 /// The heat through the three resistances in series (unit lengths and cross-section).
 fn heat_exact() -> f64 {
-    (T_LEFT - T_RIGHT) / (1.0 / KA + 1.0 / H + 1.0 / KB)
+    heat_through(1.0 / H)
+}
+
+/// The heat with an interface resistance `r` (0: tied).
+fn heat_through(r: f64) -> f64 {
+    (T_LEFT - T_RIGHT) / (1.0 / KA + r + 1.0 / KB)
 }
 
 /// Brick a's nodes come first: (3 + 1) × (4 + 1) × (4 + 1) of them.
@@ -147,7 +153,12 @@ const NODES_A: usize = 100;
 /// consistent interface form reproduce exactly); a's and b's nodes at x = 1 differ by
 /// the jump q/h.
 fn exact_temperatures(x: &[f64]) -> Vec<f64> {
-    let q = heat_exact();
+    exact_temperatures_through(x, 1.0 / H)
+}
+
+/// [`exact_temperatures`] with an interface resistance `r` (0: tied, T continuous).
+fn exact_temperatures_through(x: &[f64], r: f64) -> Vec<f64> {
+    let q = heat_through(r);
     x.iter()
         .enumerate()
         .map(|(k, &x)| {
@@ -168,7 +179,7 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
         .unwrap();
     let host = build_host(tmp.path());
 
-    let serial = run(&host, 1, true);
+    let serial = run(&host, 1, Some("serial"));
     let t_scale = serial
         .temperature
         .iter()
@@ -184,7 +195,7 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
     assert!((serial.heat[0] + serial.heat[1]).abs() <= REL * q);
 
     for n in 1..=4 {
-        let par = run(&host, n, false);
+        let par = run(&host, n, None);
         assert_eq!(par.ranks, n);
         let dt = difference(&serial.temperature, &par.temperature);
         let dq = difference(&serial.heat, &par.heat);
@@ -200,6 +211,38 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
                 "the partition should cut the interface on {n} ranks"
             );
         }
+    }
+}
+
+/// The PETSc host with a mortar tie (standard multipliers) instead of the gap
+/// conductance, under `mpirun -n 1..4`: each rank adds the rows `C u = g` of the
+/// multipliers it owns, numbered by their place in the whole tie, and the solve of
+/// `[K Cᵀ; C 0]` gives the 1-D answer of a perfect contact — T continuous, linear in each
+/// brick, 100 / (1/2 + 1/5) W — which the mortar tie reproduces exactly.
+#[test]
+fn petsc_host_with_a_mortar_tie_gives_the_1d_answer_on_1_to_4_ranks() {
+    let tmp = tempfile::Builder::new()
+        .prefix("mpi-embed-tie-")
+        .tempdir_in(env!("CARGO_TARGET_TMPDIR"))
+        .unwrap();
+    let host = build_host(tmp.path());
+    let q = heat_through(0.0);
+    for n in 1..=4 {
+        let par = run(&host, n, Some("tie"));
+        assert_eq!(par.ranks, n);
+        let exact = exact_temperatures_through(&par.x, 0.0);
+        let t_scale = exact.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+        let dt = difference(&exact, &par.temperature);
+        let dq = (par.heat[0] - q).abs().max((par.heat[1] + q).abs());
+        eprintln!(
+            "mpirun -n {n} (tie): max |ΔT| {dt:.2e} K (of {t_scale:.0}), max |Δheat| {dq:.2e} W (of {q:.3}), points paired across ranks {}",
+            par.across
+        );
+        assert!(
+            dt <= REL * t_scale,
+            "T off the 1-D answer by {dt:e} on {n} ranks"
+        );
+        assert!(dq <= REL * q, "heat off by {dq:e} on {n} ranks");
     }
 }
 
@@ -624,7 +667,7 @@ fn rank_ties_child() {
         let lambda_serial: Vec<f64> = lambda(&want.multiplier_dofs);
         let heat_serial = want.heat(&lambda_serial).unwrap();
         let lambda_rank: Vec<f64> = lambda(&got.rows.multiplier_dofs);
-        let heat = e.tie_heat(&got, &lambda_rank).unwrap();
+        let heat = e.tie_heat(&got.rows, &lambda_rank).unwrap();
         let dq = (heat.side_a - heat_serial.side_a)
             .abs()
             .max((heat.side_b - heat_serial.side_b).abs());

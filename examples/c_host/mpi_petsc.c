@@ -20,6 +20,14 @@
  * `mpi_petsc serial` (on one rank) solves the same problem through the serial embedding
  * (seam_embedding_*) with a dense solve instead, for comparison.
  *
+ * `mpi_petsc tie` ties the two faces by a mortar tie with standard multipliers instead
+ * (T continuous: a heat of 100 / (1/2 + 1/5) W): each rank gets the rows C u = g of the
+ * multipliers whose side-A node it owns (seam_rank_constraints, seam_rank_tie_rows) and
+ * their places in the whole tie (seam_rank_tie_index); the host numbers the multipliers
+ * after every node, as extra rows of the last rank, adds C and C^T (ADD_VALUES) and
+ * solves [K C^T; C 0] [T; lambda] = [F; g] by MUMPS; the heat comes from its
+ * multipliers (seam_rank_tie_heat).
+ *
  * Build: make -C examples/c_host mpi_petsc (needs petsc-dev and libseam built with
  * --features mpi); run: mpirun -n 4 examples/c_host/mpi_petsc.
  */
@@ -177,6 +185,8 @@ int main(int argc, char **argv) {
         return status;
     }
 
+    const int tie = argc > 1 && strcmp(argv[1], "tie") == 0;
+
     /* Partition: slabs of the element list; a node to the lowest rank among its elements. */
     static int elem_rank[ELEMS], node_rank[NODES], dof[NODES], local_of[NODES];
     for (int e = 0; e < ELEMS; e++) elem_rank[e] = (int)((long)e * size / ELEMS);
@@ -238,16 +248,35 @@ int main(int argc, char **argv) {
     CHECK(seam_builder_set_dofs(b, gdof, (size_t)n_local));
     CHECK(seam_rank_new(b, PETSC_COMM_WORLD, gid, (size_t)n_local, &s));
     seam_builder_free(b);
-    CHECK(seam_rank_add_interaction(s, "right", "left", SEAM_GAP_CONDUCTANCE, H, 0.0, NULL));
+    CHECK(seam_rank_add_interaction(s, "right", "left",
+                                    tie ? SEAM_TIED_MORTAR : SEAM_GAP_CONDUCTANCE, H, 0.0,
+                                    NULL));
     CHECK(seam_rank_search(s));
     size_t across;
     CHECK(seam_rank_points_across(s, &across));
 
+    /* A tie: this rank's multipliers' rows, and where they sit in the whole tie. */
+    size_t n_mult = 0, n_entries = 0, total = 0;
+    const int64_t *mult_dofs = NULL, *mults = NULL, *mult_cols = NULL, *place = NULL;
+    const double *g = NULL, *c_values = NULL;
+    if (tie) {
+        size_t n_rows;
+        const int64_t *rdofs, *rcols;
+        const double *rconst, *rcoef;
+        const size_t *roffsets;
+        CHECK(seam_rank_constraints(s, &n_rows, &rdofs, &rconst, &roffsets, &rcols, &rcoef));
+        CHECK(seam_rank_tie_rows(s, 0, &n_mult, &mult_dofs, &g, &n_entries, &mults, &mult_cols,
+                                 &c_values));
+        CHECK(seam_rank_tie_index(s, 0, &place, &total));
+    }
+    /* The multipliers are numbered after every node, as the last rank's extra rows. */
+    const PetscInt local_rows = owned + (rank == size - 1 ? (PetscInt)total : 0);
+
     /* Conduction of this rank's elements, then seam's terms of its own side-A points. */
     Mat A;
     Vec rhs, t;
-    PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, owned, owned, PETSC_DETERMINE, PETSC_DETERMINE,
-                           64, NULL, 64, NULL, &A));
+    PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, local_rows, local_rows, PETSC_DETERMINE,
+                           PETSC_DETERMINE, 64, NULL, 64, NULL, &A));
     PetscCall(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
     PetscCall(MatCreateVecs(A, &t, &rhs));
     for (int e = 0; e < ELEMS; e++) {
@@ -269,6 +298,13 @@ int main(int argc, char **argv) {
     CHECK(seam_rank_load(s, &n, &dofs, &vals));
     for (size_t q = 0; q < n; q++)
         PetscCall(VecSetValue(rhs, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    for (size_t q = 0; q < n_entries; q++) { /* C and C^T of this rank's multipliers */
+        PetscInt row = NODES + (PetscInt)place[mults[q]], col = (PetscInt)mult_cols[q];
+        PetscCall(MatSetValue(A, row, col, c_values[q], ADD_VALUES));
+        PetscCall(MatSetValue(A, col, row, c_values[q], ADD_VALUES));
+    }
+    for (size_t k = 0; k < n_mult; k++)
+        PetscCall(VecSetValue(rhs, NODES + (PetscInt)place[k], g[k], ADD_VALUES));
     PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
     PetscCall(VecAssemblyBegin(rhs));
@@ -313,7 +349,25 @@ int main(int argc, char **argv) {
     CHECK(seam_rank_evaluate(s, tl, (size_t)n_local));
     PetscCall(VecRestoreArrayRead(t_local, &tl));
     double qa, qb;
-    CHECK(seam_rank_heat(s, 0, &qa, &qb));
+    IS at_mult = NULL;
+    Vec lambda = NULL;
+    VecScatter to_lambda = NULL;
+    if (tie) { /* this rank's multipliers from the solution, for the tie's heat */
+        static PetscInt mult_rows[NODES];
+        for (size_t k = 0; k < n_mult; k++) mult_rows[k] = NODES + (PetscInt)place[k];
+        PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)n_mult, mult_rows,
+                                  PETSC_COPY_VALUES, &at_mult));
+        PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)n_mult, &lambda));
+        PetscCall(VecScatterCreate(t, at_mult, lambda, NULL, &to_lambda));
+        PetscCall(VecScatterBegin(to_lambda, t, lambda, INSERT_VALUES, SCATTER_FORWARD));
+        PetscCall(VecScatterEnd(to_lambda, t, lambda, INSERT_VALUES, SCATTER_FORWARD));
+        const PetscScalar *l;
+        PetscCall(VecGetArrayRead(lambda, &l));
+        CHECK(seam_rank_tie_heat(s, 0, l, n_mult, &qa, &qb));
+        PetscCall(VecRestoreArrayRead(lambda, &l));
+    } else {
+        CHECK(seam_rank_heat(s, 0, &qa, &qb));
+    }
 
     /* Rank 0 prints every node's temperature, by global id. */
     Vec t0;
@@ -331,6 +385,9 @@ int main(int argc, char **argv) {
     }
 
     seam_rank_free(s);
+    PetscCall(VecScatterDestroy(&to_lambda));
+    PetscCall(VecDestroy(&lambda));
+    PetscCall(ISDestroy(&at_mult));
     PetscCall(VecScatterDestroy(&to_zero));
     PetscCall(VecDestroy(&t0));
     PetscCall(VecScatterDestroy(&to_local));

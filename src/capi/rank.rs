@@ -9,7 +9,13 @@ use crate::embed::RankEmbedding;
 pub struct SeamRankEmbedding {
     inner: RankEmbedding,
     evaluated: Option<Evaluated>,
+    /// This rank's rows of the mortar ties (`seam_rank_constraints`), with each tie's
+    /// multipliers' indices in the whole tie and its count of them.
+    rows: Option<(Rows, Vec<Places>)>,
 }
+
+/// A tie's multipliers on this rank: their places in the whole tie, and its count.
+type Places = (Vec<i64>, usize);
 
 /// Make this rank's embedding from `builder` (its local part; its dofs the host's global
 /// dofs) and `global_ids` (one per local node), over a duplicate of `comm`. Collective.
@@ -48,6 +54,7 @@ pub unsafe extern "C" fn seam_rank_new(
         let e = Box::new(SeamRankEmbedding {
             inner,
             evaluated: None,
+            rows: None,
         });
         unsafe { out(out_embedding, Box::into_raw(e), "out_embedding") }
     })
@@ -80,19 +87,15 @@ pub unsafe extern "C" fn seam_rank_add_interaction(
         let e = unsafe { handle(embedding, "embedding") }?;
         let (a, b) = unsafe { (text(side_a, "side_a")?, text(side_b, "side_b")?) };
         let model = interactions::model_of(model, h)?;
-        if matches!(model, Model::TiedMortar { .. }) {
-            return Err(RankEmbedding::no_multipliers(a, b).into());
-        }
         let i = e
             .inner
             .add_interaction(Interaction::new(a, b, model).offset(offset))?;
-        e.evaluated = None;
+        (e.evaluated, e.rows) = (None, None);
         unsafe { interactions::optional_out(out_index, i) }
     })
 }
 
-/// As `seam_add_deck`, the same deck on every rank; a deck with a mortar tie is
-/// refused whole. Collective.
+/// As `seam_add_deck`, the same deck on every rank. Collective.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_rank_add_deck(
     embedding: *mut SeamRankEmbedding,
@@ -103,10 +106,8 @@ pub unsafe extern "C" fn seam_rank_add_deck(
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
         let (deck, name) = unsafe { interactions::deck_args(deck_text, name) }?;
-        let first = e.inner.len();
         let added = e.inner.add_deck(name, deck)?;
-        e.inner.refuse_ties_from(first)?;
-        e.evaluated = None;
+        (e.evaluated, e.rows) = (None, None);
         unsafe { interactions::optional_out(out_count, added.len()) }
     })
 }
@@ -116,7 +117,7 @@ pub unsafe extern "C" fn seam_rank_add_deck(
 pub unsafe extern "C" fn seam_rank_search(embedding: *mut SeamRankEmbedding) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        e.evaluated = None;
+        (e.evaluated, e.rows) = (None, None);
         Ok(e.inner.search()?)
     })
 }
@@ -220,5 +221,143 @@ pub unsafe extern "C" fn seam_rank_heat(
             )
         })?;
         unsafe { terms::write_heat((a, b), out_side_a, out_side_b) }
+    })
+}
+
+/// This rank's rows of every mortar tie (after `seam_rank_search`; collective): the
+/// multipliers whose side-A node it owns, in the host's global dofs. Returns the dual
+/// ties' condensed rows as `seam_constraints` does; `seam_rank_tie_rows` gives each
+/// tie's `C u = g` and `seam_rank_tie_index` its multipliers' places in the whole tie.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_rank_constraints(
+    embedding: *mut SeamRankEmbedding,
+    out_n_rows: *mut usize,
+    out_dofs: *mut *const i64,
+    out_constants: *mut *const f64,
+    out_offsets: *mut *const usize,
+    out_cols: *mut *const i64,
+    out_coefficients: *mut *const f64,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        e.rows = None;
+        let ties = e.inner.constraints()?;
+        let index = (ties.iter())
+            .map(|t| (t.index.iter().map(|&k| as_i64(k)).collect(), t.total))
+            .collect();
+        let rows = Rows::of(ties.into_iter().map(|t| t.rows).collect());
+        let (r, _) = e.rows.insert((rows, index));
+        unsafe {
+            r.write_condensed(
+                out_n_rows,
+                out_dofs,
+                out_constants,
+                out_offsets,
+                out_cols,
+                out_coefficients,
+            )
+        }
+    })
+}
+
+/// The rows of `seam_rank_constraints`, or why not.
+unsafe fn rank_rows<'a>(e: *const SeamRankEmbedding) -> Result<&'a (Rows, Vec<Places>), Failure> {
+    // SAFETY: a non-null handle came from this library (module Safety).
+    let e = unsafe { e.as_ref() }.ok_or_else(|| null("embedding"))?;
+    e.rows.as_ref().ok_or_else(|| {
+        Failure(
+            SeamStatus::Order,
+            "no constraints yet\n  help: call seam_rank_constraints first (after seam_rank_search)"
+                .into(),
+        )
+    })
+}
+
+/// Number of mortar ties (after `seam_rank_constraints`; 0 before).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_tie_count(
+    embedding: *const SeamRankEmbedding,
+    out_count: *mut usize,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let n = e.rows.as_ref().map_or(0, |(r, _)| r.ties.len());
+        unsafe { out(out_count, n, "out_count") }
+    })
+}
+
+/// This rank's rows `C u = g` of tie `index`, as `seam_tie_rows`: its multipliers
+/// numbered 0.. in this rank's order, dofs global.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_rank_tie_rows(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    out_n_multipliers: *mut usize,
+    out_multiplier_dofs: *mut *const i64,
+    out_rhs: *mut *const f64,
+    out_n_entries: *mut usize,
+    out_multipliers: *mut *const i64,
+    out_dofs: *mut *const i64,
+    out_values: *mut *const f64,
+) -> c_int {
+    guard(|| unsafe {
+        ties::write_tie_rows(
+            rank_rows(embedding)?.0.tie(index)?,
+            out_n_multipliers,
+            out_multiplier_dofs,
+            out_rhs,
+            out_n_entries,
+            out_multipliers,
+            out_dofs,
+            out_values,
+        )
+    })
+}
+
+/// Each of this rank's multipliers of tie `index`: its place in the whole tie (the same
+/// numbering on every rank, ascending), and the whole tie's count of multipliers.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_tie_index(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    out_index: *mut *const i64,
+    out_total: *mut usize,
+) -> c_int {
+    guard(|| {
+        let (rows, places) = unsafe { rank_rows(embedding) }?;
+        rows.tie(index)?;
+        let (place, total) = &places[index];
+        unsafe {
+            out(out_index, place.as_ptr(), "out_index")?;
+            out(out_total, *total, "out_total")
+        }
+    })
+}
+
+/// Heat through tie `index` for this rank's multipliers `lambda` (`n` of them, in this
+/// rank's order), summed over the ranks. Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_tie_heat(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    lambda: *const f64,
+    n: usize,
+    out_side_a: *mut f64,
+    out_side_b: *mut f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let (rows, _) = unsafe { rank_rows(embedding) }?;
+        let (t, _) = rows.tie(index)?;
+        let lambda = unsafe { slice(lambda, n, "lambda") }?;
+        let heat = e.inner.tie_heat(t, lambda)?;
+        unsafe {
+            out(out_side_a, heat.side_a, "out_side_a")?;
+            out(out_side_b, heat.side_b, "out_side_b")
+        }
     })
 }

@@ -20,6 +20,23 @@ pub unsafe extern "C" fn seam_constraints(
         let e = unsafe { handle(embedding, "embedding") }?;
         e.rows = None;
         let ties = e.inner.constraints()?;
+        let r = e.rows.insert(Rows::of(ties));
+        unsafe {
+            r.write_condensed(
+                out_n_rows,
+                out_dofs,
+                out_constants,
+                out_offsets,
+                out_cols,
+                out_coefficients,
+            )
+        }
+    })
+}
+
+impl Rows {
+    /// The C arrays of `ties`: the dual ones' condensed rows, and each tie's `C u = g`.
+    pub(super) fn of(ties: Vec<TieConstraints>) -> Rows {
         let mut r = Rows {
             offsets: vec![0],
             ..Rows::default()
@@ -40,20 +57,74 @@ pub unsafe extern "C" fn seam_constraints(
                 (t, arrays)
             })
             .collect();
-        let r = e.rows.insert(r);
+        r
+    }
+
+    /// The condensed rows into the caller's out-pointers (`seam_constraints`).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) unsafe fn write_condensed(
+        &self,
+        out_n_rows: *mut usize,
+        out_dofs: *mut *const i64,
+        out_constants: *mut *const f64,
+        out_offsets: *mut *const usize,
+        out_cols: *mut *const i64,
+        out_coefficients: *mut *const f64,
+    ) -> Result<(), Failure> {
         unsafe {
-            out(out_n_rows, r.dofs.len(), "out_n_rows")?;
-            out(out_dofs, r.dofs.as_ptr(), "out_dofs")?;
-            out(out_constants, r.constants.as_ptr(), "out_constants")?;
-            out(out_offsets, r.offsets.as_ptr(), "out_offsets")?;
-            out(out_cols, r.cols.as_ptr(), "out_cols")?;
+            out(out_n_rows, self.dofs.len(), "out_n_rows")?;
+            out(out_dofs, self.dofs.as_ptr(), "out_dofs")?;
+            out(out_constants, self.constants.as_ptr(), "out_constants")?;
+            out(out_offsets, self.offsets.as_ptr(), "out_offsets")?;
+            out(out_cols, self.cols.as_ptr(), "out_cols")?;
             out(
                 out_coefficients,
-                r.coefficients.as_ptr(),
+                self.coefficients.as_ptr(),
                 "out_coefficients",
             )
         }
-    })
+    }
+
+    /// Tie `index`, or why not.
+    pub(super) fn tie(&self, index: usize) -> Result<&(TieConstraints, TieArrays), Failure> {
+        self.ties.get(index).ok_or_else(|| {
+            bad(
+                format!("tie {index} does not exist ({} in all)", self.ties.len()),
+                "ties are numbered from 0 in interaction order",
+            )
+        })
+    }
+}
+
+/// Tie `t`'s `C u = g` into the caller's out-pointers (`seam_tie_rows`).
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn write_tie_rows(
+    (t, a): &(TieConstraints, TieArrays),
+    out_n_multipliers: *mut usize,
+    out_multiplier_dofs: *mut *const i64,
+    out_rhs: *mut *const f64,
+    out_n_entries: *mut usize,
+    out_multipliers: *mut *const i64,
+    out_dofs: *mut *const i64,
+    out_values: *mut *const f64,
+) -> Result<(), Failure> {
+    unsafe {
+        out(
+            out_n_multipliers,
+            a.multiplier_dofs.len(),
+            "out_n_multipliers",
+        )?;
+        out(
+            out_multiplier_dofs,
+            a.multiplier_dofs.as_ptr(),
+            "out_multiplier_dofs",
+        )?;
+        out(out_rhs, t.rhs.as_ptr(), "out_rhs")?;
+        out(out_n_entries, a.values.len(), "out_n_entries")?;
+        out(out_multipliers, a.multipliers.as_ptr(), "out_multipliers")?;
+        out(out_dofs, a.dofs.as_ptr(), "out_dofs")?;
+        out(out_values, a.values.as_ptr(), "out_values")
+    }
 }
 
 pub(super) fn tie<'a>(
@@ -68,12 +139,7 @@ pub(super) fn tie<'a>(
             "no constraints yet\n  help: call seam_constraints first (after seam_search)".into(),
         )
     })?;
-    rows.ties.get(index).ok_or_else(|| {
-        bad(
-            format!("tie {index} does not exist ({} in all)", rows.ties.len()),
-            "ties are numbered from 0 in interaction order",
-        )
-    })
+    rows.tie(index)
 }
 
 /// Number of mortar ties (after `seam_constraints`).
@@ -106,25 +172,17 @@ pub unsafe extern "C" fn seam_tie_rows(
     out_dofs: *mut *const i64,
     out_values: *mut *const f64,
 ) -> c_int {
-    guard(|| {
-        let (t, a) = tie(embedding, index)?;
-        unsafe {
-            out(
-                out_n_multipliers,
-                a.multiplier_dofs.len(),
-                "out_n_multipliers",
-            )?;
-            out(
-                out_multiplier_dofs,
-                a.multiplier_dofs.as_ptr(),
-                "out_multiplier_dofs",
-            )?;
-            out(out_rhs, t.rhs.as_ptr(), "out_rhs")?;
-            out(out_n_entries, a.values.len(), "out_n_entries")?;
-            out(out_multipliers, a.multipliers.as_ptr(), "out_multipliers")?;
-            out(out_dofs, a.dofs.as_ptr(), "out_dofs")?;
-            out(out_values, a.values.as_ptr(), "out_values")
-        }
+    guard(|| unsafe {
+        write_tie_rows(
+            tie(embedding, index)?,
+            out_n_multipliers,
+            out_multiplier_dofs,
+            out_rhs,
+            out_n_entries,
+            out_multipliers,
+            out_dofs,
+            out_values,
+        )
     })
 }
 

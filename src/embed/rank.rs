@@ -61,8 +61,8 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::{
-    Contributions, EmbedError, Embedding, EmbeddingBuilder, Enforcement, Heat, Interaction,
-    TieConstraints, argument, mesh_error,
+    Contributions, EmbedError, Embedding, EmbeddingBuilder, Heat, Interaction, TieConstraints,
+    argument, mesh_error,
 };
 use crate::mesh::{ElemId, NodeId};
 
@@ -501,29 +501,6 @@ impl RankEmbedding {
         agree(&self.comm, r)
     }
 
-    /// Drop the interactions from `first` on when one of them is a mortar tie, with the
-    /// error that says so: for the C interface, which has no accessor of a rank's tie
-    /// rows yet. Every rank holds the same interactions, so every rank refuses alike.
-    pub(crate) fn refuse_ties_from(&mut self, first: usize) -> Result<(), EmbedError> {
-        let Some(p) = (self.inner.pairs[first..].iter())
-            .find(|p| matches!(p.enforcement, Enforcement::Tie { .. }))
-        else {
-            return Ok(());
-        };
-        let e = Self::no_multipliers(&p.side_a.name, &p.side_b.name);
-        self.inner.pairs.truncate(first);
-        Err(e)
-    }
-
-    pub(crate) fn no_multipliers(a: &str, b: &str) -> EmbedError {
-        argument(
-            format!(
-                "interaction {a} / {b}: a mortar tie's rows per rank are not in the C interface yet"
-            ),
-            "tie the surfaces by Nitsche (SEAM_TIED_NITSCHE), or use the Rust RankEmbedding::constraints",
-        )
-    }
-
     /// The rows of every mortar tie that belong to this rank (collective), in
     /// interaction order: the multipliers whose side-A node this rank owns (the lowest
     /// rank among the interface elements around it), in the host's global dofs. Each
@@ -552,9 +529,10 @@ impl RankEmbedding {
     }
 
     /// Heat (W) through a tie for this rank's multipliers `lambda` (one per entry of
-    /// `tie.rows.multiplier_dofs`), summed over the ranks (collective).
-    pub fn tie_heat(&self, tie: &RankTie, lambda: &[f64]) -> Result<Heat, EmbedError> {
-        let own = agree(&self.comm, tie.rows.heat(lambda))?;
+    /// `rows.multiplier_dofs`, `rows` a [`RankTie`]'s), summed over the ranks
+    /// (collective).
+    pub fn tie_heat(&self, rows: &TieConstraints, lambda: &[f64]) -> Result<Heat, EmbedError> {
+        let own = agree(&self.comm, rows.heat(lambda))?;
         let mut summed = [0.0; 2];
         self.comm.all_reduce_into(
             &[own.side_a, own.side_b][..],
