@@ -355,9 +355,6 @@ pub unsafe extern "C" fn seam_rank_tie_heat(
         let (t, _) = rows.tie(index)?;
         let lambda = unsafe { slice(lambda, n, "lambda") }?;
         let heat = e.inner.tie_heat(t, lambda)?;
-        unsafe {
-            out(out_side_a, heat.side_a, "out_side_a")?;
-            out(out_side_b, heat.side_b, "out_side_b")
-        }
+        unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
     })
 }
