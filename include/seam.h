@@ -461,6 +461,12 @@ int seam_rank_tie_rows(const seam_rank_embedding *embedding, size_t tie,
  * rank: number the host's multiplier unknowns by it) and the tie's count of them. Local. */
 int seam_rank_tie_index(const seam_rank_embedding *embedding, size_t tie,
                         const int64_t **out_index, size_t *out_total);
+/* A condensed dual tie's multipliers on this rank from the host's residual K u - F
+ * without the tie at each of this rank's multipliers' dofs (n values, in this rank's
+ * order): written into out_lambda, which holds `capacity` >= n values. Local. */
+int seam_rank_dual_multipliers(const seam_rank_embedding *embedding, size_t tie,
+                               const double *residual_at, size_t n, double *out_lambda,
+                               size_t capacity);
 /* Heat (W) through a tie for this rank's multipliers lambda (n, in this rank's order),
  * summed over the ranks. Collective. */
 int seam_rank_tie_heat(const seam_rank_embedding *embedding, size_t tie, const double *lambda,

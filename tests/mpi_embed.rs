@@ -29,6 +29,9 @@ const T_RIGHT: f64 = 300.0;
 
 /// What the host prints on rank 0.
 struct Printed {
+    /// `tie dual`: the largest difference between the solved multipliers and those
+    /// recovered from the host's residual.
+    recovered: Option<f64>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -88,8 +91,8 @@ fn build_host(dir: &Path) -> PathBuf {
 }
 
 /// The host under `mpirun -n ranks` in `mode` (`serial`: the serial embedding, one
-/// rank; `tie`: a mortar tie with multipliers).
-fn run(host: &Path, ranks: usize, mode: Option<&str>) -> Printed {
+/// rank; `tie`: a mortar tie with multipliers; `tie dual`: dual ones).
+fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
     let mut cmd = Command::new("timeout");
     cmd.args(["300", "mpirun", "--oversubscribe", "-n", &ranks.to_string()])
         .arg(host)
@@ -119,7 +122,12 @@ fn run(host: &Path, ranks: usize, mode: Option<&str>) -> Printed {
             .collect()
     };
     let heat = numbers("heat:");
+    let recovered = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("dual multipliers from the residual:"))
+        .map(|v| v.trim().parse().unwrap());
     Printed {
+        recovered,
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -179,7 +187,7 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
         .unwrap();
     let host = build_host(tmp.path());
 
-    let serial = run(&host, 1, Some("serial"));
+    let serial = run(&host, 1, &["serial"]);
     let t_scale = serial
         .temperature
         .iter()
@@ -195,7 +203,7 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
     assert!((serial.heat[0] + serial.heat[1]).abs() <= REL * q);
 
     for n in 1..=4 {
-        let par = run(&host, n, None);
+        let par = run(&host, n, &[]);
         assert_eq!(par.ranks, n);
         let dt = difference(&serial.temperature, &par.temperature);
         let dq = difference(&serial.heat, &par.heat);
@@ -214,11 +222,13 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
     }
 }
 
-/// The PETSc host with a mortar tie (standard multipliers) instead of the gap
-/// conductance, under `mpirun -n 1..4`: each rank adds the rows `C u = g` of the
+/// The PETSc host with a mortar tie instead of the gap conductance, standard and dual
+/// multipliers, under `mpirun -n 1..4`: each rank adds the rows `C u = g` of the
 /// multipliers it owns, numbered by their place in the whole tie, and the solve of
 /// `[K Cᵀ; C 0]` gives the 1-D answer of a perfect contact — T continuous, linear in each
-/// brick, 100 / (1/2 + 1/5) W — which the mortar tie reproduces exactly.
+/// brick, 100 / (1/2 + 1/5) W — which the mortar tie reproduces exactly. With dual
+/// multipliers the host also recovers them from its residual without the tie
+/// (`seam_rank_dual_multipliers`), as a host that condensed the tie would.
 #[test]
 fn petsc_host_with_a_mortar_tie_gives_the_1d_answer_on_1_to_4_ranks() {
     let tmp = tempfile::Builder::new()
@@ -227,15 +237,29 @@ fn petsc_host_with_a_mortar_tie_gives_the_1d_answer_on_1_to_4_ranks() {
         .unwrap();
     let host = build_host(tmp.path());
     let q = heat_through(0.0);
-    for n in 1..=4 {
-        let par = run(&host, n, Some("tie"));
+    for (n, mode) in (1..=4).flat_map(|n| [(n, &["tie"][..]), (n, &["tie", "dual"][..])]) {
+        let par = run(&host, n, mode);
         assert_eq!(par.ranks, n);
+        let dual = mode.len() == 2;
+        if dual {
+            // λ = −r/D from the residual without the tie: the solved multipliers (of
+            // the order of the flux, 142.857 W/m²).
+            let dl = par
+                .recovered
+                .expect("the dual host prints its multipliers' check");
+            eprintln!("mpirun -n {n} (dual): multipliers from the residual off by {dl:.2e}");
+            assert!(
+                dl <= REL * q,
+                "dual multipliers from the residual off by {dl:e}"
+            );
+        }
         let exact = exact_temperatures_through(&par.x, 0.0);
         let t_scale = exact.iter().fold(0.0f64, |m, t| m.max(t.abs()));
         let dt = difference(&exact, &par.temperature);
         let dq = (par.heat[0] - q).abs().max((par.heat[1] + q).abs());
         eprintln!(
-            "mpirun -n {n} (tie): max |ΔT| {dt:.2e} K (of {t_scale:.0}), max |Δheat| {dq:.2e} W (of {q:.3}), points paired across ranks {}",
+            "mpirun -n {n} ({}): max |ΔT| {dt:.2e} K (of {t_scale:.0}), max |Δheat| {dq:.2e} W (of {q:.3}), points paired across ranks {}",
+            mode.join(" "),
             par.across
         );
         assert!(
@@ -680,6 +704,33 @@ fn rank_ties_child() {
             got.total,
             heat_serial.side_a.abs()
         );
+        if multipliers == Multipliers::Dual {
+            // A host that condensed the tie: its multipliers from its residual
+            // r(dof) = sin(dof) (any vector), the serial from the whole of it, each rank
+            // from its value at its own multipliers' dofs.
+            let r = |d: usize| (d as f64).sin();
+            let whole: Vec<f64> = (0..n_nodes).map(r).collect();
+            let lambda_serial = want.dual_multipliers(&whole).unwrap();
+            let at: Vec<f64> = got.rows.multiplier_dofs.iter().map(|&d| r(d)).collect();
+            let lambda_rank = got.rows.dual_multipliers_at(&at).unwrap();
+            let mut by_dof = vec![0.0; n_nodes];
+            for (&d, l) in got.rows.multiplier_dofs.iter().zip(&lambda_rank) {
+                by_dof[d] += l;
+            }
+            let by_dof = sum(&by_dof);
+            let dl = (want.multiplier_dofs.iter().zip(&lambda_serial))
+                .fold(0.0f64, |m, (&d, l)| m.max((by_dof[d] - l).abs()));
+            assert!(dl <= 1e-12, "dual multipliers differ by {dl:e}");
+            let (q_serial, q_rank) = (
+                want.heat(&lambda_serial).unwrap().side_a,
+                e.tie_heat(&got.rows, &lambda_rank).unwrap().side_a,
+            );
+            assert!(
+                (q_serial - q_rank).abs() <= 1e-12 * q_serial.abs().max(1.0),
+                "heat from the dual multipliers {q_rank} against {q_serial}"
+            );
+            report += &format!(" dual multipliers from the residual: max |Δλ| {dl:.1e};");
+        }
         if size > 1 {
             assert!(e.points_across() > 0, "pairs straddle ranks");
         }

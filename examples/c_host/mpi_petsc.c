@@ -26,7 +26,10 @@
  * their places in the whole tie (seam_rank_tie_index); the host numbers the multipliers
  * after every node, as extra rows of the last rank, adds C and C^T (ADD_VALUES) and
  * solves [K C^T; C 0] [T; lambda] = [F; g] by MUMPS; the heat comes from its
- * multipliers (seam_rank_tie_heat).
+ * multipliers (seam_rank_tie_heat). `mpi_petsc tie dual` does the same with dual
+ * multipliers, and also recovers them from its own residual K T - F without the tie at
+ * its multipliers' dofs (seam_rank_dual_multipliers), as a host that condensed the tie
+ * would: rank 0 prints the largest difference from the solved ones.
  *
  * Build: make -C examples/c_host mpi_petsc (needs petsc-dev and libseam built with
  * --features mpi); run: mpirun -n 4 examples/c_host/mpi_petsc.
@@ -186,6 +189,7 @@ int main(int argc, char **argv) {
     }
 
     const int tie = argc > 1 && strcmp(argv[1], "tie") == 0;
+    const int dual = tie && argc > 2 && strcmp(argv[2], "dual") == 0;
 
     /* Partition: slabs of the element list; a node to the lowest rank among its elements. */
     static int elem_rank[ELEMS], node_rank[NODES], dof[NODES], local_of[NODES];
@@ -249,7 +253,7 @@ int main(int argc, char **argv) {
     CHECK(seam_rank_new(b, PETSC_COMM_WORLD, gid, (size_t)n_local, &s));
     seam_builder_free(b);
     CHECK(seam_rank_add_interaction(s, "right", "left",
-                                    tie ? SEAM_TIED_MORTAR : SEAM_GAP_CONDUCTANCE, H, 0.0,
+                                    dual ? SEAM_TIED_DUAL_MORTAR : tie ? SEAM_TIED_MORTAR : SEAM_GAP_CONDUCTANCE, H, 0.0,
                                     NULL));
     CHECK(seam_rank_search(s));
     size_t across;
@@ -273,10 +277,12 @@ int main(int argc, char **argv) {
     const PetscInt local_rows = owned + (rank == size - 1 ? (PetscInt)total : 0);
 
     /* Conduction of this rank's elements, then seam's terms of its own side-A points. */
-    Mat A;
+    Mat A, K; /* K: the conduction alone, for the residual without the tie */
     Vec rhs, t;
     PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, local_rows, local_rows, PETSC_DETERMINE,
                            PETSC_DETERMINE, 64, NULL, 64, NULL, &A));
+    PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, local_rows, local_rows, PETSC_DETERMINE,
+                           PETSC_DETERMINE, 27, NULL, 27, NULL, &K));
     PetscCall(MatSetOption(A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
     PetscCall(MatCreateVecs(A, &t, &rhs));
     for (int e = 0; e < ELEMS; e++) {
@@ -286,6 +292,7 @@ int main(int argc, char **argv) {
         element_matrix(&m, e, ke);
         for (int a = 0; a < 8; a++) rows[a] = dof[m.conn[e][a]];
         PetscCall(MatSetValues(A, 8, rows, 8, rows, &ke[0][0], ADD_VALUES));
+        PetscCall(MatSetValues(K, 8, rows, 8, rows, &ke[0][0], ADD_VALUES));
     }
     static double zero[NODES];
     CHECK(seam_rank_evaluate(s, zero, (size_t)n_local)); /* a linear model: J at any u */
@@ -307,6 +314,8 @@ int main(int argc, char **argv) {
         PetscCall(VecSetValue(rhs, NODES + (PetscInt)place[k], g[k], ADD_VALUES));
     PetscCall(MatAssemblyBegin(A, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(A, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
     PetscCall(VecAssemblyBegin(rhs));
     PetscCall(VecAssemblyEnd(rhs));
 
@@ -364,6 +373,39 @@ int main(int argc, char **argv) {
         const PetscScalar *l;
         PetscCall(VecGetArrayRead(lambda, &l));
         CHECK(seam_rank_tie_heat(s, 0, l, n_mult, &qa, &qb));
+        if (dual) { /* the multipliers again, from K T (no source: F = 0) */
+            static PetscInt at_rows[NODES];
+            static double r_at[NODES], recovered[NODES];
+            Vec kt, r_local;
+            IS at_dofs;
+            VecScatter to_r;
+            for (size_t k = 0; k < n_mult; k++) at_rows[k] = (PetscInt)mult_dofs[k];
+            PetscCall(VecDuplicate(t, &kt));
+            PetscCall(MatMult(K, t, kt));
+            PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)n_mult, at_rows,
+                                      PETSC_COPY_VALUES, &at_dofs));
+            PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)n_mult, &r_local));
+            PetscCall(VecScatterCreate(kt, at_dofs, r_local, NULL, &to_r));
+            PetscCall(VecScatterBegin(to_r, kt, r_local, INSERT_VALUES, SCATTER_FORWARD));
+            PetscCall(VecScatterEnd(to_r, kt, r_local, INSERT_VALUES, SCATTER_FORWARD));
+            const PetscScalar *r;
+            PetscCall(VecGetArrayRead(r_local, &r));
+            for (size_t k = 0; k < n_mult; k++) r_at[k] = r[k];
+            PetscCall(VecRestoreArrayRead(r_local, &r));
+            CHECK(seam_rank_dual_multipliers(s, 0, r_at, n_mult, recovered, NODES));
+            double worst = 0.0, all_worst;
+            for (size_t k = 0; k < n_mult; k++) {
+                double d = fabs(recovered[k] - l[k]);
+                if (d > worst) worst = d;
+            }
+            PetscCallMPI(MPI_Reduce(&worst, &all_worst, 1, MPI_DOUBLE, MPI_MAX, 0,
+                                    PETSC_COMM_WORLD));
+            if (rank == 0) printf("dual multipliers from the residual: %.3e\n", all_worst);
+            PetscCall(VecScatterDestroy(&to_r));
+            PetscCall(VecDestroy(&r_local));
+            PetscCall(ISDestroy(&at_dofs));
+            PetscCall(VecDestroy(&kt));
+        }
         PetscCall(VecRestoreArrayRead(lambda, &l));
     } else {
         CHECK(seam_rank_heat(s, 0, &qa, &qb));
@@ -397,6 +439,7 @@ int main(int argc, char **argv) {
     PetscCall(VecDestroy(&t));
     PetscCall(VecDestroy(&rhs));
     PetscCall(MatDestroy(&A));
+    PetscCall(MatDestroy(&K));
     PetscCall(PetscFinalize());
     return 0;
 }

@@ -295,25 +295,34 @@ pub unsafe extern "C" fn seam_dual_multipliers(
         let e = unsafe { handle_ref(embedding) }?;
         let residual = unsafe { slice(residual, n, "residual") }?;
         let lambda = ties::tie(e, tie)?.0.dual_multipliers(residual)?;
-        if capacity < lambda.len() {
-            return Err(bad(
-                format!(
-                    "out_lambda holds {capacity} values, the tie has {} multipliers",
-                    lambda.len()
-                ),
-                "pass an array of n_multipliers entries (seam_tie_rows)",
-            ));
-        }
-        if lambda.is_empty() {
-            return Ok(());
-        }
-        if out_lambda.is_null() {
-            return Err(null("out_lambda"));
-        }
-        // SAFETY: non-null and valid for `capacity` ≥ len entries (checked above).
-        unsafe { std::ptr::copy_nonoverlapping(lambda.as_ptr(), out_lambda, lambda.len()) };
-        Ok(())
+        unsafe { write_lambda(&lambda, out_lambda, capacity) }
     })
+}
+
+/// Copy `lambda` into the caller's `out_lambda` of `capacity` values.
+pub(super) unsafe fn write_lambda(
+    lambda: &[f64],
+    out_lambda: *mut f64,
+    capacity: usize,
+) -> Result<(), Failure> {
+    if capacity < lambda.len() {
+        return Err(bad(
+            format!(
+                "out_lambda holds {capacity} values, the tie has {} multipliers",
+                lambda.len()
+            ),
+            "pass an array of n_multipliers entries (seam_tie_rows)",
+        ));
+    }
+    if lambda.is_empty() {
+        return Ok(());
+    }
+    if out_lambda.is_null() {
+        return Err(null("out_lambda"));
+    }
+    // SAFETY: non-null and valid for `capacity` ≥ len entries (checked above).
+    unsafe { std::ptr::copy_nonoverlapping(lambda.as_ptr(), out_lambda, lambda.len()) };
+    Ok(())
 }
 
 /// Heat (W) leaving side A and side B of flux interaction `index` at the host's field

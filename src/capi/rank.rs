@@ -358,3 +358,25 @@ pub unsafe extern "C" fn seam_rank_tie_heat(
         unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
     })
 }
+
+/// A condensed dual tie's multipliers on this rank, `λ_k = −r_k / D_k`, from the host's
+/// residual `K u − F` without the tie at each of this rank's multipliers' dofs
+/// (`residual_at`, `n` values in this rank's order): written into `out_lambda`, which
+/// holds `capacity` ≥ n values. Local.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_dual_multipliers(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    residual_at: *const f64,
+    n: usize,
+    out_lambda: *mut f64,
+    capacity: usize,
+) -> c_int {
+    guard(|| {
+        let (rows, _) = unsafe { rank_rows(embedding) }?;
+        let (t, _) = rows.tie(index)?;
+        let at = unsafe { slice(residual_at, n, "residual_at") }?;
+        let lambda = t.dual_multipliers_at(at)?;
+        unsafe { fields::write_lambda(&lambda, out_lambda, capacity) }
+    })
+}

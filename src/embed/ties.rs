@@ -68,6 +68,17 @@ impl TieConstraints {
         ))
     }
 
+    /// A tie condensed by its host has dual multipliers.
+    fn dual_only(&self) -> Result<(), EmbedError> {
+        if self.condensed.is_empty() && !self.multiplier_dofs.is_empty() {
+            return Err(argument(
+                "this tie has standard multipliers; they are unknowns of the host's system".into(),
+                "read λ from the host's solution, or build the tie with Multipliers::Dual",
+            ));
+        }
+        Ok(())
+    }
+
     /// Heat leaving each side for multipliers `lambda` (the flux from A to B), one per
     /// multiplier: `Σ_{i ∈ side} (Cᵀλ)_i`.
     pub fn heat(&self, lambda: &[f64]) -> Result<Heat, EmbedError> {
@@ -84,25 +95,38 @@ impl TieConstraints {
     /// Dual multipliers of a host that condensed the tie: `λ_k = −r_k / D_k`, with `r`
     /// the host's own residual `K u − F` (without the tie) at its solution, by host dof.
     pub fn dual_multipliers(&self, residual: &[f64]) -> Result<Vec<f64>, EmbedError> {
-        if self.condensed.is_empty() && !self.multiplier_dofs.is_empty() {
-            return Err(argument(
-                "this tie has standard multipliers; they are unknowns of the host's system".into(),
-                "read λ from the host's solution, or build the tie with Multipliers::Dual",
-            ));
-        }
-        self.multiplier_dofs
-            .iter()
-            .zip(&self.diagonal)
-            .map(|(&d, &diag)| {
-                let r = residual.get(d).ok_or_else(|| {
+        self.dual_only()?;
+        let at = (self.multiplier_dofs.iter())
+            .map(|&d| {
+                residual.get(d).copied().ok_or_else(|| {
                     argument(
                         format!("residual has {} entries, dof {d} is needed", residual.len()),
                         "pass the host's whole residual vector",
                     )
-                })?;
-                Ok(if diag == 0.0 { 0.0 } else { -r / diag })
+                })
             })
-            .collect()
+            .collect::<Result<Vec<f64>, _>>()?;
+        self.dual_multipliers_at(&at)
+    }
+
+    /// [`Self::dual_multipliers`] from the residual at each multiplier's own dof, in
+    /// multiplier order (`at[k]` at `multiplier_dofs[k]`): what a host on MPI has of
+    /// its residual at the multipliers its rank owns.
+    pub fn dual_multipliers_at(&self, at: &[f64]) -> Result<Vec<f64>, EmbedError> {
+        self.dual_only()?;
+        if at.len() != self.multiplier_dofs.len() {
+            return Err(argument(
+                format!(
+                    "{} residual values given, the tie has {} multipliers",
+                    at.len(),
+                    self.multiplier_dofs.len()
+                ),
+                "pass the residual at each entry of `multiplier_dofs`, in order",
+            ));
+        }
+        Ok((at.iter().zip(&self.diagonal))
+            .map(|(r, &diag)| if diag == 0.0 { 0.0 } else { -r / diag })
+            .collect())
     }
 }
 
