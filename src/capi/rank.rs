@@ -351,9 +351,21 @@ pub unsafe extern "C" fn seam_rank_tie_heat(
     guard(|| {
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let (rows, _) = unsafe { rank_rows(embedding) }?;
-        let (t, _) = rows.tie(index)?;
-        let lambda = unsafe { slice(lambda, n, "lambda") }?;
+        let local = (|| {
+            let (t, _) = unsafe { rank_rows(embedding) }?.0.tie(index)?;
+            Ok::<_, Failure>((t, unsafe { slice(lambda, n, "lambda") }?))
+        })();
+        // A bad argument on one rank must not leave the others in the sum: this rank
+        // returns its own failure, the others `SEAM_ERR_OTHER_RANK`.
+        let agreed = e.inner.agree_on(match &local {
+            Ok(_) => Ok(()),
+            Err(f) => Err(crate::embed::EmbedError::Argument {
+                what: f.1.clone(),
+                help: String::new(),
+            }),
+        });
+        let (t, lambda) = local?;
+        agreed?;
         let heat = e.inner.tie_heat(t, lambda)?;
         unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
     })

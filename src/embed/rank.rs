@@ -93,8 +93,8 @@ pub struct RankEmbedding {
 #[derive(Clone, Debug)]
 pub struct RankTie {
     /// The rows of this rank's multipliers, numbered 0.. in `index`'s order, in the
-    /// host's global dofs ([`TieConstraints`]; its `heat` is this rank's share, its
-    /// `dual_multipliers` reads the residual at global dofs).
+    /// host's global dofs ([`TieConstraints`]; its `heat` is this rank's share, and
+    /// its `dual_multipliers_at` takes the residual at this rank's multipliers' dofs).
     pub rows: TieConstraints,
     /// Each of this rank's multipliers' index in the whole tie (ascending).
     pub index: Vec<usize>,
@@ -526,6 +526,12 @@ impl RankEmbedding {
                 }
             })
             .collect())
+    }
+
+    /// `r` on this rank, made an error on every rank when it is one on any (collective):
+    /// for a caller that checks its arguments before a collective call.
+    pub(crate) fn agree_on<T>(&self, r: Result<T, EmbedError>) -> Result<T, EmbedError> {
+        agree(&self.comm, r)
     }
 
     /// Heat (W) through a tie for this rank's multipliers `lambda` (one per entry of
