@@ -583,6 +583,11 @@ fn rank_tie_rows_are_the_serial_rows() {
             .find_map(|l| l.find("rank ties:").map(|k| &l[k..]))
             .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
         eprintln!("mpirun -n {n}: {line}");
+        assert_eq!(
+            text.matches("refused on every rank").count(),
+            2 * n,
+            "every rank saw the short multipliers refused, for both ties:\n{text}"
+        );
     }
 }
 
@@ -692,6 +697,18 @@ fn rank_ties_child() {
         let heat_serial = want.heat(&lambda_serial).unwrap();
         let lambda_rank: Vec<f64> = lambda(&got.rows.multiplier_dofs);
         let heat = e.tie_heat(&got.rows, &lambda_rank).unwrap();
+        // The lowest rank owning multipliers gives one too few: refused there, and on
+        // every other rank, none left waiting in the sum.
+        let mine = if got.index.is_empty() { size } else { rank };
+        let mut bad = size;
+        world.all_reduce_into(&mine, &mut bad, SystemOperation::min());
+        let short = &lambda_rank[..lambda_rank.len() - usize::from(rank == bad)];
+        refused_everywhere(
+            rank,
+            bad,
+            e.tie_heat(&got.rows, short).map(|_| ()),
+            "multipliers given",
+        );
         let dq = (heat.side_a - heat_serial.side_a)
             .abs()
             .max((heat.side_b - heat_serial.side_b).abs());
