@@ -107,6 +107,28 @@ static void print_results(const Mesh *m, const double *t_by_node, double qa, dou
     printf("\n");
 }
 
+/* The entries of the distributed vector `from` at global rows `rows` (n of them), into
+ * `out` on this rank (collective over from's communicator). */
+static PetscErrorCode gather_at(Vec from, PetscInt n, const PetscInt *rows, double *out) {
+    IS at;
+    Vec local;
+    VecScatter scatter;
+    const PetscScalar *v;
+    PetscFunctionBeginUser;
+    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, n, rows, PETSC_COPY_VALUES, &at));
+    PetscCall(VecCreateSeq(PETSC_COMM_SELF, n, &local));
+    PetscCall(VecScatterCreate(from, at, local, NULL, &scatter));
+    PetscCall(VecScatterBegin(scatter, from, local, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecScatterEnd(scatter, from, local, INSERT_VALUES, SCATTER_FORWARD));
+    PetscCall(VecGetArrayRead(local, &v));
+    for (PetscInt k = 0; k < n; k++) out[k] = v[k];
+    PetscCall(VecRestoreArrayRead(local, &v));
+    PetscCall(VecScatterDestroy(&scatter));
+    PetscCall(VecDestroy(&local));
+    PetscCall(ISDestroy(&at));
+    PetscFunctionReturn(0); /* PETSc 3.18 has no PETSC_SUCCESS */
+}
+
 /* The same problem through the serial embedding and a dense solve. */
 static int serial(const Mesh *m) {
     static double k[NODES * NODES], t[NODES];
@@ -343,70 +365,33 @@ int main(int argc, char **argv) {
     PetscCall(KSPSolve(ksp, rhs, t));
 
     /* The solution at this rank's nodes (owned and ghost), for seam's heat. */
-    IS from;
-    Vec t_local;
-    VecScatter to_local;
     static PetscInt local_dofs[NODES];
+    static double t_local[NODES];
     for (int k = 0; k < n_local; k++) local_dofs[k] = (PetscInt)gdof[k];
-    PetscCall(ISCreateGeneral(PETSC_COMM_SELF, n_local, local_dofs, PETSC_COPY_VALUES, &from));
-    PetscCall(VecCreateSeq(PETSC_COMM_SELF, n_local, &t_local));
-    PetscCall(VecScatterCreate(t, from, t_local, NULL, &to_local));
-    PetscCall(VecScatterBegin(to_local, t, t_local, INSERT_VALUES, SCATTER_FORWARD));
-    PetscCall(VecScatterEnd(to_local, t, t_local, INSERT_VALUES, SCATTER_FORWARD));
-    const PetscScalar *tl;
-    PetscCall(VecGetArrayRead(t_local, &tl));
-    CHECK(seam_rank_evaluate(s, tl, (size_t)n_local));
-    PetscCall(VecRestoreArrayRead(t_local, &tl));
+    PetscCall(gather_at(t, n_local, local_dofs, t_local));
+    CHECK(seam_rank_evaluate(s, t_local, (size_t)n_local));
     double qa, qb;
-    IS at_mult = NULL;
-    Vec lambda = NULL;
-    VecScatter to_lambda = NULL;
     if (tie) { /* this rank's multipliers from the solution, for the tie's heat */
-        static PetscInt mult_rows[NODES];
-        for (size_t k = 0; k < n_mult; k++) mult_rows[k] = NODES + (PetscInt)place[k];
-        PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)n_mult, mult_rows,
-                                  PETSC_COPY_VALUES, &at_mult));
-        PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)n_mult, &lambda));
-        PetscCall(VecScatterCreate(t, at_mult, lambda, NULL, &to_lambda));
-        PetscCall(VecScatterBegin(to_lambda, t, lambda, INSERT_VALUES, SCATTER_FORWARD));
-        PetscCall(VecScatterEnd(to_lambda, t, lambda, INSERT_VALUES, SCATTER_FORWARD));
-        const PetscScalar *l;
-        PetscCall(VecGetArrayRead(lambda, &l));
-        CHECK(seam_rank_tie_heat(s, 0, l, n_mult, &qa, &qb));
+        static PetscInt at[NODES];
+        static double lambda[NODES];
+        for (size_t k = 0; k < n_mult; k++) at[k] = NODES + (PetscInt)place[k];
+        PetscCall(gather_at(t, (PetscInt)n_mult, at, lambda));
+        CHECK(seam_rank_tie_heat(s, 0, lambda, n_mult, &qa, &qb));
         if (dual) { /* the multipliers again, from K T (no source: F = 0) */
-            static PetscInt at_rows[NODES];
             static double r_at[NODES], recovered[NODES];
-            Vec kt, r_local;
-            IS at_dofs;
-            VecScatter to_r;
-            for (size_t k = 0; k < n_mult; k++) at_rows[k] = (PetscInt)mult_dofs[k];
+            Vec kt;
             PetscCall(VecDuplicate(t, &kt));
             PetscCall(MatMult(K, t, kt));
-            PetscCall(ISCreateGeneral(PETSC_COMM_SELF, (PetscInt)n_mult, at_rows,
-                                      PETSC_COPY_VALUES, &at_dofs));
-            PetscCall(VecCreateSeq(PETSC_COMM_SELF, (PetscInt)n_mult, &r_local));
-            PetscCall(VecScatterCreate(kt, at_dofs, r_local, NULL, &to_r));
-            PetscCall(VecScatterBegin(to_r, kt, r_local, INSERT_VALUES, SCATTER_FORWARD));
-            PetscCall(VecScatterEnd(to_r, kt, r_local, INSERT_VALUES, SCATTER_FORWARD));
-            const PetscScalar *r;
-            PetscCall(VecGetArrayRead(r_local, &r));
-            for (size_t k = 0; k < n_mult; k++) r_at[k] = r[k];
-            PetscCall(VecRestoreArrayRead(r_local, &r));
+            for (size_t k = 0; k < n_mult; k++) at[k] = (PetscInt)mult_dofs[k];
+            PetscCall(gather_at(kt, (PetscInt)n_mult, at, r_at));
+            PetscCall(VecDestroy(&kt));
             CHECK(seam_rank_dual_multipliers(s, 0, r_at, n_mult, recovered, NODES));
             double worst = 0.0, all_worst;
-            for (size_t k = 0; k < n_mult; k++) {
-                double d = fabs(recovered[k] - l[k]);
-                if (d > worst) worst = d;
-            }
+            for (size_t k = 0; k < n_mult; k++) worst = fmax(worst, fabs(recovered[k] - lambda[k]));
             PetscCallMPI(MPI_Reduce(&worst, &all_worst, 1, MPI_DOUBLE, MPI_MAX, 0,
                                     PETSC_COMM_WORLD));
             if (rank == 0) printf("dual multipliers from the residual: %.3e\n", all_worst);
-            PetscCall(VecScatterDestroy(&to_r));
-            PetscCall(VecDestroy(&r_local));
-            PetscCall(ISDestroy(&at_dofs));
-            PetscCall(VecDestroy(&kt));
         }
-        PetscCall(VecRestoreArrayRead(lambda, &l));
     } else {
         CHECK(seam_rank_heat(s, 0, &qa, &qb));
     }
@@ -427,14 +412,8 @@ int main(int argc, char **argv) {
     }
 
     seam_rank_free(s);
-    PetscCall(VecScatterDestroy(&to_lambda));
-    PetscCall(VecDestroy(&lambda));
-    PetscCall(ISDestroy(&at_mult));
     PetscCall(VecScatterDestroy(&to_zero));
     PetscCall(VecDestroy(&t0));
-    PetscCall(VecScatterDestroy(&to_local));
-    PetscCall(VecDestroy(&t_local));
-    PetscCall(ISDestroy(&from));
     PetscCall(KSPDestroy(&ksp));
     PetscCall(VecDestroy(&t));
     PetscCall(VecDestroy(&rhs));
