@@ -200,10 +200,7 @@ pub unsafe extern "C" fn seam_tie_heat(
         let (t, _) = tie(embedding, index)?;
         let lambda = unsafe { slice(lambda, n, "lambda") }?;
         let heat = t.heat(lambda)?;
-        unsafe {
-            out(out_side_a, heat.side_a, "out_side_a")?;
-            out(out_side_b, heat.side_b, "out_side_b")
-        }
+        unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
     })
 }
 
@@ -222,9 +219,6 @@ pub unsafe extern "C" fn seam_dual_tie_heat(
         let (t, _) = tie(embedding, index)?;
         let r = unsafe { slice(residual, n, "residual") }?;
         let heat = t.heat(&t.dual_multipliers(r)?)?;
-        unsafe {
-            out(out_side_a, heat.side_a, "out_side_a")?;
-            out(out_side_b, heat.side_b, "out_side_b")
-        }
+        unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
     })
 }

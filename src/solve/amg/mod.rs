@@ -788,23 +788,23 @@ impl AmgCg {
             v
         };
         let (mut z, mut p, mut q) = (vector(), vector(), vector());
-        let report = self.cg_loop(b, x, &mut r, &mut z, &mut p, &mut q);
+        let report = self.cg_loop(bnorm, x, &mut r, &mut z, &mut p, &mut q);
         self.spare.extend([r, z, p, q]);
         report
     }
 
     /// The iterations of [`Self::pcg_once`] in its vectors: `r` the residual at `x` on
-    /// entry; `z`, `p`, `q` of length n, their values overwritten.
+    /// entry, `bnorm` the right-hand side's norm (nonzero); `z`, `p`, `q` of length n,
+    /// their values overwritten.
     fn cg_loop(
         &mut self,
-        b: &[f64],
+        bnorm: f64,
         x: &mut [f64],
         r: &mut [f64],
         z: &mut [f64],
         p: &mut [f64],
         q: &mut [f64],
     ) -> Result<SolveReport, SolveError> {
-        let bnorm = norm(b);
         let tol = self.options.tolerance;
         let mut rel = norm(r) / bnorm;
         // A start that meets the test already (a time step the earlier solutions

@@ -223,10 +223,7 @@ fn residual_and_dots(
             for ((o, b), ap) in out.iter_mut().zip(&b[range.clone()]).zip(ap) {
                 *o = b - ap;
             }
-            for (w, &c) in products.iter().zip(c) {
-                let w = &w[range.clone()];
-                out.iter_mut().zip(w).for_each(|(o, w)| *o -= c * w);
-            }
+            subtract_at(out, at, products, c);
             let mut sums: Vec<f64> = basis
                 .iter()
                 .map(|w| w[range.clone()].iter().zip(ap).map(|(w, y)| w * y).sum())
@@ -256,11 +253,7 @@ fn remove_and_scale(
         .for_each(|(chunk, (p, y))| {
             let at = chunk * REDUCE_CHUNK;
             for (out, ws) in [(&mut *p, basis), (&mut *y, products)] {
-                let range = at..at + out.len();
-                for (w, &c) in ws.iter().zip(c) {
-                    let w = &w[range.clone()];
-                    out.iter_mut().zip(w).for_each(|(o, w)| *o -= c * w);
-                }
+                subtract_at(out, at, ws, c);
                 out.iter_mut().for_each(|o| *o *= s);
             }
         });
@@ -276,15 +269,25 @@ fn add_combination(y: &mut [f64], ws: &[Vec<f64>], c: &[f64], sign: f64) {
         .enumerate()
         .for_each(|(chunk, y)| {
             let at = chunk * REDUCE_CHUNK;
-            for (w, &c) in ws.iter().zip(c) {
-                let w = &w[at..at + y.len()];
-                if sign > 0.0 {
+            if sign > 0.0 {
+                for (w, &c) in ws.iter().zip(c) {
+                    let w = &w[at..at + y.len()];
                     y.iter_mut().zip(w).for_each(|(y, w)| *y += c * w);
-                } else {
-                    y.iter_mut().zip(w).for_each(|(y, w)| *y -= c * w);
                 }
+            } else {
+                subtract_at(y, at, ws, c);
             }
         });
+}
+
+/// `y −= Σ_k c_k w_k[at..]` for one chunk `y` starting at entry `at`, the terms in the
+/// order of `k`.
+#[inline(always)]
+fn subtract_at(y: &mut [f64], at: usize, ws: &[Vec<f64>], c: &[f64]) {
+    for (w, &c) in ws.iter().zip(c) {
+        let w = &w[at..at + y.len()];
+        y.iter_mut().zip(w).for_each(|(y, w)| *y -= c * w);
+    }
 }
 
 #[cfg(test)]
