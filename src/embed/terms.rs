@@ -215,7 +215,8 @@ impl Embedding {
         if !p.active {
             return Ok(p.is_flux().then(Heat::default));
         }
-        Ok(self.system(p, local)?.map(|s| {
+        let residual = self.with_form(p, |points, form| points.residual(form, local))?;
+        Ok(residual.map(|s| {
             let (side_a, side_b) = s.heat();
             Heat { side_a, side_b }
         }))

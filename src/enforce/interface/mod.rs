@@ -608,6 +608,27 @@ impl InterfacePoints {
         &self,
         form: &InterfaceForm<'_>,
         u: &[f64],
+        block: impl FnMut(&[u32], &[f64]),
+    ) -> Result<InterfaceSystem, InterfaceError> {
+        self.walk::<true>(form, u, block)
+    }
+
+    /// The residual, right-hand side and heat accounting of the form at `u`, without
+    /// the Jacobian: what a caller that wants only the heat needs. The same bits as
+    /// [`Self::evaluate`]'s residual (the same sums in the same order).
+    pub fn residual(
+        &self,
+        form: &InterfaceForm<'_>,
+        u: &[f64],
+    ) -> Result<InterfaceSystem, InterfaceError> {
+        self.walk::<false>(form, u, |_, _| {})
+    }
+
+    /// [`Self::for_each_block`], the blocks made only when `BLOCKS`.
+    fn walk<const BLOCKS: bool>(
+        &self,
+        form: &InterfaceForm<'_>,
+        u: &[f64],
         mut block: impl FnMut(&[u32], &[f64]),
     ) -> Result<InterfaceSystem, InterfaceError> {
         let mut residual = vec![0.0; self.touched.len()];
@@ -690,6 +711,9 @@ impl InterfacePoints {
                     residual[k] += w * (cp * r_p + ct * r_t + cs * r_s);
                     // Right-hand side of the linear form (the offset terms).
                     rhs[k] += w * form.offset * (cp * ji - ct * fi);
+                    if !BLOCKS {
+                        continue;
+                    }
                     let (wj, wf) = (w * ji, w * fi);
                     if !nonlinear && !scale.varies {
                         // A symmetric entry (h and k fixed at this point): its upper
@@ -738,6 +762,9 @@ impl InterfacePoints {
                         }
                     }
                 }
+            }
+            if !BLOCKS {
+                continue;
             }
             // The symmetric part into both triangles: a block of symmetric points alone
             // is symmetric bit for bit, so is the matrix it is added into. (Written as

@@ -238,3 +238,20 @@ fn points_made_in_runs_do_not_depend_on_the_thread_count() {
     }
     assert_eq!(at, one.values.len());
 }
+
+/// The residual alone (what a heat query reads) is `evaluate`'s residual and
+/// right-hand side bit for bit, and so is the heat; with a nonlinear h and an offset,
+/// so that every term of the residual is in play.
+#[test]
+fn residual_alone_is_the_evaluated_residual() {
+    let (_, _, points, u) = scene();
+    let f = form(&H);
+    let whole = points.evaluate(&f, &u).unwrap();
+    let alone = points.residual(&f, &u).unwrap();
+    assert!(alone.blocks.is_empty());
+    assert!(whole.residual.iter().any(|&(_, v)| v != 0.0));
+    let bits = |v: &[(u32, f64)]| v.iter().map(|&(d, x)| (d, x.to_bits())).collect::<Vec<_>>();
+    assert_eq!(bits(&alone.residual), bits(&whole.residual));
+    assert_eq!(bits(&alone.rhs), bits(&whole.rhs));
+    assert_eq!(alone.heat(), whole.heat());
+}
