@@ -299,7 +299,12 @@ pub(super) fn lumped_weights(
     species: Option<FieldId>,
     live: &dyn Fn(crate::mesh::ElemId) -> bool,
 ) -> Result<Vec<LumpedWeight>, HeatError> {
-    let mut out: std::collections::BTreeMap<(u32, u32), f64> = Default::default();
+    // Summed block by block into a dense array over the dofs (each weight takes its
+    // elements' terms in the order a map keyed by (dof, block) would), then listed by
+    // dof and block.
+    let mut out: Vec<(u32, u32, f64)> = Vec::new();
+    let mut sum = vec![0.0; dofs.len()];
+    let mut touched = vec![false; dofs.len()];
     let mut elem_dofs = Vec::new();
     for (b, block) in mesh.blocks.iter().enumerate() {
         if dofs.block_fields(b).is_empty() {
@@ -314,6 +319,15 @@ pub(super) fn lumped_weights(
         let nn = block.topology.node_count();
         let with_species = species.is_some_and(|c| dofs.block_fields(b).contains(&c));
         let mut me = vec![0.0; nn * nn];
+        let mut listed = Vec::new();
+        let mut add = |d: u32, w: f64| {
+            let k = d as usize;
+            if !touched[k] {
+                touched[k] = true;
+                listed.push(d);
+            }
+            sum[k] += w;
+        };
         for k in 0..block.len() {
             let e = crate::mesh::ElemId(block.first_elem.0 + k as u32);
             if !live(e) {
@@ -326,14 +340,20 @@ pub(super) fn lumped_weights(
                 .map_err(|bad| bad_jacobian(mesh, e, bad))?;
             dofs.elem_dofs(mesh, e, &mut elem_dofs);
             for a in 0..nn {
-                *out.entry((elem_dofs[a], b as u32)).or_default() += me[a * nn + a];
+                add(elem_dofs[a], me[a * nn + a]);
                 if with_species {
-                    let d = elem_dofs[elem_dofs.len() - nn + a];
-                    *out.entry((d, b as u32)).or_default() += me[a * nn + a];
+                    add(elem_dofs[elem_dofs.len() - nn + a], me[a * nn + a]);
                 }
             }
         }
+        for d in listed {
+            let k = d as usize;
+            out.push((d, b as u32, sum[k]));
+            (sum[k], touched[k]) = (0.0, false);
+        }
     }
+    // By dof, then block (each pair once).
+    out.sort_unstable_by_key(|&(d, b, _)| (d, b));
     // Coordinates of each dof's node.
     let mut coords = vec![[0.0; 3]; dofs.len()];
     for f in 0..dofs.field_count() {
@@ -346,7 +366,7 @@ pub(super) fn lumped_weights(
     }
     Ok(out
         .into_iter()
-        .map(|((d, b), w)| (d, b, w, coords[d as usize]))
+        .map(|(d, b, w)| (d, b, w, coords[d as usize]))
         .collect())
 }
 
