@@ -203,7 +203,7 @@ pub(crate) fn written_zeros(n: usize) -> Vec<f64> {
 /// (`usize::MAX` where a dof is missing): in column `d[b]`, the count of its rows below
 /// `d[a]`. Elements of 4 and 8 dofs count all their rows against a column in one pass
 /// ([`positions_of`]); others search each.
-fn positions(col_ptr: &[usize], row_idx: &[u32], d: &[u32], at: &mut [usize]) {
+pub(super) fn positions(col_ptr: &[usize], row_idx: &[u32], d: &[u32], at: &mut [usize]) {
     if let Ok(d) = <&[u32; 8]>::try_from(d) {
         return positions_of(col_ptr, row_idx, d, at);
     }
