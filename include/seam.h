@@ -471,10 +471,26 @@ int seam_rank_dual_multipliers(const seam_rank_embedding *embedding, size_t tie,
  * summed over the ranks. Collective. */
 int seam_rank_tie_heat(const seam_rank_embedding *embedding, size_t tie, const double *lambda,
                        size_t n, double *out_side_a, double *out_side_b);
+/* Heat (W) through a condensed dual tie from the host's residual K u - F without the
+ * tie at each of this rank's multipliers' dofs (n values, in this rank's order), summed
+ * over the ranks: the rank form of seam_dual_tie_heat. Collective. */
+int seam_rank_dual_tie_heat(const seam_rank_embedding *embedding, size_t tie,
+                            const double *residual_at, size_t n, double *out_side_a,
+                            double *out_side_b);
 /* Heat (W) leaving side A and side B of interaction `index` at the last evaluation,
  * summed over the ranks (the same on every rank). */
 int seam_rank_heat(const seam_rank_embedding *embedding, size_t index, double *out_side_a,
                    double *out_side_b);
+/* Values at this rank's own side-A points of flux interaction `index` at the local field
+ * (n_nodes values, as for seam_rank_evaluate); for each, out_points its index in the
+ * interaction's point order (seam_point_fields' order; the ranks' points together are
+ * that list, each point once) and out_side_b_ranks the rank whose element
+ * side_b_element is (-1 where unpaired). Faces are named by the element index of the
+ * rank that gave them: side A's is this rank's own. Arrays valid until the next call.
+ * Collective. */
+int seam_rank_point_fields(seam_rank_embedding *embedding, size_t index, const double *u_local,
+                           size_t n_nodes, size_t *out_n, const seam_point_values **out_values,
+                           const size_t **out_points, const int **out_side_b_ranks);
 #endif /* MPI_VERSION */
 
 #ifdef __cplusplus

@@ -32,6 +32,11 @@ struct Printed {
     /// `tie dual`: the largest difference between the solved multipliers and those
     /// recovered from the host's residual.
     recovered: Option<f64>,
+    /// `tie dual`: the tie's heat from the host's residual (`seam_rank_dual_tie_heat`).
+    dual_heat: Option<[f64; 2]>,
+    /// The gap conductance on ranks: the flux times the weight summed over every rank's
+    /// own contact points (`seam_rank_point_fields`), and the count of points.
+    point_fields: Option<(f64, usize)>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -122,12 +127,16 @@ fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
             .collect()
     };
     let heat = numbers("heat:");
-    let recovered = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("dual multipliers from the residual:"))
-        .map(|v| v.trim().parse().unwrap());
+    let optional = |prefix: &str| -> Option<Vec<f64>> {
+        stdout
+            .lines()
+            .find_map(|l| l.strip_prefix(prefix))
+            .map(|v| v.split_whitespace().map(|w| w.parse().unwrap()).collect())
+    };
     Printed {
-        recovered,
+        recovered: optional("dual multipliers from the residual:").map(|v| v[0]),
+        dual_heat: optional("dual heat from the residual:").map(|v| [v[0], v[1]]),
+        point_fields: optional("point fields:").map(|v| (v[0], v[1] as usize)),
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -202,17 +211,32 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
     assert!((serial.heat[0] - q).abs() <= REL * q);
     assert!((serial.heat[0] + serial.heat[1]).abs() <= REL * q);
 
+    let mut points = None;
     for n in 1..=4 {
         let par = run(&host, n, &[]);
         assert_eq!(par.ranks, n);
         let dt = difference(&serial.temperature, &par.temperature);
         let dq = difference(&serial.heat, &par.heat);
+        // Each rank's own points' flux: together every point once, their heat the
+        // interface's.
+        let (q_points, count) = par.point_fields.expect("the host prints its point fields");
+        let dq_points = (q_points - par.heat[0]).abs();
         eprintln!(
-            "mpirun -n {n}: max |ΔT| {dt:.2e} K (of {t_scale:.0}), max |Δheat| {dq:.2e} W (of {q:.3}), points paired across ranks {}",
+            "mpirun -n {n}: max |ΔT| {dt:.2e} K (of {t_scale:.0}), max |Δheat| {dq:.2e} W (of {q:.3}), points paired across ranks {}; Σ q w over the ranks' {count} points off the heat by {dq_points:.2e} W",
             par.across
         );
         assert!(dt <= REL * t_scale, "T differs by {dt:e} on {n} ranks");
         assert!(dq <= REL * q, "heat differs by {dq:e} on {n} ranks");
+        assert!(
+            dq_points <= REL * q,
+            "point fields' heat off by {dq_points:e} on {n} ranks"
+        );
+        assert!(count > 0);
+        assert_eq!(
+            *points.get_or_insert(count),
+            count,
+            "every point once on {n} ranks"
+        );
         if n > 1 {
             assert!(
                 par.across > 0,
@@ -252,6 +276,10 @@ fn petsc_host_with_a_mortar_tie_gives_the_1d_answer_on_1_to_4_ranks() {
                 dl <= REL * q,
                 "dual multipliers from the residual off by {dl:e}"
             );
+            let [ra, rb] = par.dual_heat.expect("the dual host prints its heat");
+            let dq = (ra - q).abs().max((rb + q).abs());
+            eprintln!("mpirun -n {n} (dual): heat from the residual off by {dq:.2e} W");
+            assert!(dq <= REL * q, "dual heat from the residual off by {dq:e}");
         }
         let exact = exact_temperatures_through(&par.x, 0.0);
         let t_scale = exact.iter().fold(0.0f64, |m, t| m.max(t.abs()));
@@ -389,6 +417,12 @@ fn rank_terms_sum_to_the_serial_terms() {
             .find_map(|l| l.find("rank terms:").map(|k| &l[k..]))
             .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
         eprintln!("mpirun -n {n}: {line}");
+        if let Some(points) = text
+            .lines()
+            .find_map(|l| l.find("rank point fields:").map(|k| &l[k..]))
+        {
+            eprintln!("mpirun -n {n}: {points}");
+        }
         assert_eq!(
             text.matches("refused on every rank").count(),
             2 * n,
@@ -494,6 +528,57 @@ fn rank_terms_child() {
         assert!(e.points_across() > 0, "pairs straddle ranks");
     }
 
+    // Each rank's own points' values, the gap conductance's and the periodic tie's: the
+    // serial embedding's at the same places, and every point on exactly one rank.
+    let mut point_diff = 0.0f64;
+    for i in 0..2 {
+        let whole = serial.point_fields(i, &u).expect("serial point fields");
+        let own = e.point_fields(i, &u_local).expect("rank point fields");
+        let q_scale = whole.iter().fold(0.0f64, |m, p| m.max(p.flux.abs()));
+        let close = |a: f64, b: f64| a.is_nan() && b.is_nan() || (a - b).abs() <= 1e-12 * q_scale;
+        let mut count = vec![0.0; whole.len()];
+        // A rank's builder numbers its slab's elements from 0: the serial (global)
+        // element of rank r's element k is r's first plus k.
+        let global = |r: usize, f: Option<seam::embed::HostFace>| {
+            f.map(|f| (n_elems * r / size + f.element, f.side))
+        };
+        for p in &own {
+            let (k, v) = (p.point, &p.values);
+            let w = &whole[k];
+            count[k] += 1.0;
+            assert_eq!(
+                (v.x, v.weight, v.paired, v.gap),
+                (w.x, w.weight, w.paired, w.gap),
+                "interaction {i}, point {k}"
+            );
+            let b_rank = p.side_b_rank.unwrap_or(usize::MAX);
+            assert_eq!(
+                (global(rank, v.side_a), global(b_rank, v.side_b)),
+                (global(0, w.side_a), global(0, w.side_b)),
+                "interaction {i}, point {k}: the faces"
+            );
+            assert!(
+                close(v.flux, w.flux) && close(v.temp_a, w.temp_a) && close(v.temp_b, w.temp_b),
+                "interaction {i}, point {k}: {v:?} against {w:?}"
+            );
+            point_diff = point_diff.max((v.flux - w.flux).abs() / q_scale);
+        }
+        let mut counted = vec![0.0; count.len()];
+        world.all_reduce_into(
+            &count[..],
+            &mut counted[..],
+            mpi::collective::SystemOperation::sum(),
+        );
+        assert!(
+            counted.iter().all(|&c| c == 1.0),
+            "interaction {i}: every point on one rank"
+        );
+        assert!(whole.iter().any(|p| p.paired));
+    }
+    if rank == 0 {
+        println!("rank point fields: largest flux difference {point_diff:.1e} of the largest flux");
+    }
+
     // The same interface from a deck: the same heat as the serial embedding's deck; a
     // deck with a mortar tie is taken (its rows: `rank_tie_rows_are_the_serial_rows`).
     let deck = |enforcement: &str| {
@@ -585,8 +670,8 @@ fn rank_tie_rows_are_the_serial_rows() {
         eprintln!("mpirun -n {n}: {line}");
         assert_eq!(
             text.matches("refused on every rank").count(),
-            2 * n,
-            "every rank saw the short multipliers refused, for both ties:\n{text}"
+            3 * n,
+            "every rank saw the short multipliers refused, for both ties, and the dual tie's short residual:\n{text}"
         );
     }
 }
@@ -752,7 +837,27 @@ fn rank_ties_child() {
                 (q_serial - q_rank).abs() <= 1e-12 * q_serial.abs().max(1.0),
                 "heat from the dual multipliers {q_rank} against {q_serial}"
             );
-            report += &format!(" dual multipliers from the residual: max |Δλ| {dl:.1e};");
+            // The heat straight from the residual; a residual one value short on the
+            // rank refused above is refused on every rank.
+            let from_residual = e.dual_tie_heat(&got.rows, &at).unwrap();
+            let want_q = want.heat(&lambda_serial).unwrap();
+            let dq = (from_residual.side_a - want_q.side_a)
+                .abs()
+                .max((from_residual.side_b - want_q.side_b).abs());
+            assert!(
+                dq <= 1e-12 * want_q.side_a.abs().max(1.0),
+                "dual heat from the residual off by {dq:e}"
+            );
+            let short = &at[..at.len() - usize::from(rank == bad)];
+            refused_everywhere(
+                rank,
+                bad,
+                e.dual_tie_heat(&got.rows, short).map(|_| ()),
+                "residual values given",
+            );
+            report += &format!(
+                " dual multipliers from the residual: max |Δλ| {dl:.1e}, |Δheat| {dq:.1e} W;"
+            );
         }
         if size > 1 {
             assert!(e.points_across() > 0, "pairs straddle ranks");

@@ -15,7 +15,9 @@
  * faces of its elements, assembles its elements' conduction into an MPIAIJ matrix, adds
  * seam's terms of its own side-A points (ADD_VALUES), fixes the Dirichlet rows and solves
  * with KSP (MUMPS LU by default; PETSc options override). Rank 0 prints the interface
- * heat and the temperature at every node (by global id).
+ * heat and the temperature at every node (by global id), and the flux at every contact
+ * point weighted and summed over the ranks, each rank reading its own points
+ * (seam_rank_point_fields), with the count of points.
  *
  * `mpi_petsc serial` (on one rank) solves the same problem through the serial embedding
  * (seam_embedding_*) with a dense solve instead, for comparison.
@@ -28,7 +30,8 @@
  * solves [K C^T; C 0] [T; lambda] = [F; g] by MUMPS; the heat comes from its
  * multipliers (seam_rank_tie_heat). `mpi_petsc tie dual` does the same with dual
  * multipliers, and also recovers them from its own residual K T - F without the tie at
- * its multipliers' dofs (seam_rank_dual_multipliers), as a host that condensed the tie
+ * its multipliers' dofs (seam_rank_dual_multipliers) and takes the tie's heat from that
+ * residual (seam_rank_dual_tie_heat), as a host that condensed the tie
  * would: rank 0 prints the largest difference from the solved ones.
  *
  * Build: make -C examples/c_host mpi_petsc (needs petsc-dev and libseam built with
@@ -391,9 +394,33 @@ int main(int argc, char **argv) {
             PetscCallMPI(MPI_Reduce(&worst, &all_worst, 1, MPI_DOUBLE, MPI_MAX, 0,
                                     PETSC_COMM_WORLD));
             if (rank == 0) printf("dual multipliers from the residual: %.3e\n", all_worst);
+            /* The heat straight from the residual, as a condensing host would take it. */
+            double ra, rb;
+            CHECK(seam_rank_dual_tie_heat(s, 0, r_at, n_mult, &ra, &rb));
+            if (rank == 0) printf("dual heat from the residual: %.17g %.17g\n", ra, rb);
         }
     } else {
         CHECK(seam_rank_heat(s, 0, &qa, &qb));
+        /* The flux at this rank's own contact points, weighted and summed over the
+         * ranks: each point is one rank's, so the sum is the interface's heat. */
+        size_t n_points;
+        const seam_point_values *values;
+        const size_t *points;
+        const int *side_b_ranks;
+        CHECK(seam_rank_point_fields(s, 0, t_local, (size_t)n_local, &n_points, &values, &points,
+                                     &side_b_ranks));
+        double own[2] = {0.0, (double)n_points}, all[2];
+        for (size_t k = 0; k < n_points; k++) {
+            if (!values[k].paired) continue;
+            own[0] += values[k].flux * values[k].weight;
+            /* Side A is this rank's own element, side B an element of side_b_ranks[k]. */
+            if (values[k].side_a_element < 0 || side_b_ranks[k] < 0 || side_b_ranks[k] >= size) {
+                fprintf(stderr, "rank %d: point %zu names faces it should not\n", rank, points[k]);
+                return 1;
+            }
+        }
+        PetscCallMPI(MPI_Allreduce(own, all, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
+        if (rank == 0) printf("point fields: %.17g %.0f\n", all[0], all[1]);
     }
 
     /* Rank 0 prints every node's temperature, by global id. */

@@ -118,7 +118,7 @@ impl From<&FaceValues> for SeamFaceValues {
 }
 
 /// An array the handle keeps, through the out pointers (count and start).
-unsafe fn array_out<T>(
+pub(super) unsafe fn array_out<T>(
     values: &[T],
     out_n: *mut usize,
     out_values: *mut *const T,

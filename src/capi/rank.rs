@@ -12,6 +12,17 @@ pub struct SeamRankEmbedding {
     /// This rank's rows of the mortar ties (`seam_rank_constraints`), with each tie's
     /// multipliers' indices in the whole tie and its count of them.
     rows: Option<(Rows, Vec<Places>)>,
+    /// The last `seam_rank_point_fields`.
+    points: OwnPoints,
+}
+
+/// This rank's own points of the last `seam_rank_point_fields`: their values, their
+/// indices in the interaction's point order, and their side-B faces' ranks.
+#[derive(Default)]
+struct OwnPoints {
+    values: Vec<fields::SeamPointValues>,
+    index: Vec<usize>,
+    side_b_rank: Vec<c_int>,
 }
 
 /// A tie's multipliers on this rank: their places in the whole tie, and its count.
@@ -55,6 +66,7 @@ pub unsafe extern "C" fn seam_rank_new(
             inner,
             evaluated: None,
             rows: None,
+            points: Default::default(),
         });
         unsafe { out(out_embedding, Box::into_raw(e), "out_embedding") }
     })
@@ -349,23 +361,7 @@ pub unsafe extern "C" fn seam_rank_tie_heat(
     out_side_b: *mut f64,
 ) -> c_int {
     guard(|| {
-        // SAFETY: a non-null handle came from this library (module Safety).
-        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
-        let local = (|| {
-            let (t, _) = unsafe { rank_rows(embedding) }?.0.tie(index)?;
-            Ok::<_, Failure>((t, unsafe { slice(lambda, n, "lambda") }?))
-        })();
-        // A bad argument on one rank must not leave the others in the sum: this rank
-        // returns its own failure, the others `SEAM_ERR_OTHER_RANK`.
-        let agreed = e.inner.agree_on(match &local {
-            Ok(_) => Ok(()),
-            Err(f) => Err(crate::embed::EmbedError::Argument {
-                what: f.1.clone(),
-                help: String::new(),
-            }),
-        });
-        let (t, lambda) = local?;
-        agreed?;
+        let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
         let heat = e.inner.tie_heat(t, lambda)?;
         unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
     })
@@ -390,5 +386,97 @@ pub unsafe extern "C" fn seam_rank_dual_multipliers(
         let at = unsafe { slice(residual_at, n, "residual_at") }?;
         let lambda = t.dual_multipliers_at(at)?;
         unsafe { fields::write_lambda(&lambda, out_lambda, capacity) }
+    })
+}
+
+/// Heat (W) through condensed dual tie `index` from the host's residual `K u − F`
+/// without the tie at each of this rank's multipliers' dofs (`residual_at`, `n` values
+/// in this rank's order), summed over the ranks: the rank form of `seam_dual_tie_heat`.
+/// Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_dual_tie_heat(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    residual_at: *const f64,
+    n: usize,
+    out_side_a: *mut f64,
+    out_side_b: *mut f64,
+) -> c_int {
+    guard(|| {
+        let (e, t, at) =
+            unsafe { tie_on_every_rank(embedding, index, residual_at, n, "residual_at") }?;
+        let heat = e.inner.dual_tie_heat(t, at)?;
+        unsafe { terms::write_heat((heat.side_a, heat.side_b), out_side_a, out_side_b) }
+    })
+}
+
+/// The handle, tie `index`'s rows on this rank and the `n` values at `values`, for a
+/// collective call: a bad argument on one rank must not leave the others waiting in
+/// the sum, so this rank returns its own failure and the others
+/// `SEAM_ERR_OTHER_RANK`.
+unsafe fn tie_on_every_rank<'a>(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    values: *const f64,
+    n: usize,
+    name: &str,
+) -> Result<(&'a SeamRankEmbedding, &'a TieConstraints, &'a [f64]), Failure> {
+    // SAFETY: a non-null handle came from this library (module Safety).
+    let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+    let local = (|| {
+        let (t, _) = unsafe { rank_rows(embedding) }?.0.tie(index)?;
+        Ok::<_, Failure>((t, unsafe { slice(values, n, name) }?))
+    })();
+    let agreed = e.inner.agree_on(match &local {
+        Ok(_) => Ok(()),
+        Err(f) => Err(crate::embed::EmbedError::Argument {
+            what: f.1.clone(),
+            help: String::new(),
+        }),
+    });
+    let (t, values) = local?;
+    agreed?;
+    Ok((e, t, values))
+}
+
+/// The values at this rank's own side-A points of flux interaction `index` at the
+/// local field (`n_nodes` values, one per local node, as for `seam_rank_evaluate`):
+/// `out_values`; for each, `out_points` its index in the interaction's point order (the
+/// serial `seam_point_fields` order; the ranks' points together are that list, each
+/// point once) and `out_side_b_ranks` the rank whose element `side_b_element` is (−1
+/// where unpaired). Faces are named by the element index of the rank that gave them:
+/// side A's is this rank's own. The arrays stay valid until the next call. Collective.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_rank_point_fields(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    u_local: *const f64,
+    n_nodes: usize,
+    out_n: *mut usize,
+    out_values: *mut *const fields::SeamPointValues,
+    out_points: *mut *const usize,
+    out_side_b_ranks: *mut *const c_int,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let u = unsafe { slice(u_local, n_nodes, "u_local") }?;
+        let points = e.inner.point_fields(index, u)?;
+        e.points = OwnPoints {
+            values: points.iter().map(|p| (&p.values).into()).collect(),
+            index: points.iter().map(|p| p.point).collect(),
+            side_b_rank: (points.iter())
+                .map(|p| p.side_b_rank.map_or(-1, |r| r as c_int))
+                .collect(),
+        };
+        unsafe {
+            out(out_points, e.points.index.as_ptr(), "out_points")?;
+            out(
+                out_side_b_ranks,
+                e.points.side_b_rank.as_ptr(),
+                "out_side_b_ranks",
+            )?;
+            fields::array_out(&e.points.values, out_n, out_values)
+        }
     })
 }

@@ -255,10 +255,19 @@ impl Embedding {
         let p = self.pair_at(i)?;
         let local = self.local_field(u)?;
         let count = Self::searched(p)?.points.len();
+        // With points kept (a rank's own), the cache numbers them in `kept`'s order.
+        let cached = p.kept.as_ref().map_or(count, Vec::len);
         let fluxes = self
-            .with_form(p, |cache, form| cache.point_flux(form, &local, count))?
+            .with_form(p, |cache, form| cache.point_flux(form, &local, cached))?
             .ok_or_else(|| tie_refused(p))?;
-        Ok((p, fluxes))
+        let Some(kept) = &p.kept else {
+            return Ok((p, fluxes));
+        };
+        let mut out = vec![None; count];
+        for (&k, f) in kept.iter().zip(fluxes) {
+            out[k] = f;
+        }
+        Ok((p, out))
     }
 
     /// Per face of flux interaction `i` at the host's field `u`: side A's faces, then

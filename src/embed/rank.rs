@@ -61,8 +61,8 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::{
-    Contributions, EmbedError, Embedding, EmbeddingBuilder, Heat, Interaction, TieConstraints,
-    argument, mesh_error,
+    Contributions, EmbedError, Embedding, EmbeddingBuilder, Heat, HostFace, Interaction,
+    PointValues, TieConstraints, argument, mesh_error,
 };
 use crate::mesh::{ElemId, NodeId};
 
@@ -83,10 +83,25 @@ pub struct RankEmbedding {
     local_nodes: usize,
     /// The rank that gave each inner element.
     origin: Vec<usize>,
+    /// Each inner element's index in the builder of the rank that gave it (its
+    /// `HostFace` element there).
+    host_elem: Vec<usize>,
     /// The rank owning each inner node's point (node surfaces): the lowest around it.
     node_owner: Vec<usize>,
     /// Over all ranks, the side-A points whose side-B face another rank gave.
     across: usize,
+}
+
+/// One of this rank's own side-A points ([`RankEmbedding::point_fields`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RankPoint {
+    /// Its index in the interaction's point order (the serial embedding's).
+    pub point: usize,
+    /// Its values; `side_a` is an element of this rank's builder, `side_b` one of
+    /// `side_b_rank`'s.
+    pub values: PointValues,
+    /// The rank whose element `values.side_b` is (`None` where it paired nothing).
+    pub side_b_rank: Option<usize>,
 }
 
 /// One mortar tie's rows on one rank ([`RankEmbedding::constraints`]).
@@ -197,7 +212,8 @@ fn signature(text: &str) -> u64 {
 /// One rank's share of the interface: its faces' elements, their nodes, the faces.
 struct Share {
     /// `[n_nodes, n_elems, n_faces]`, then per node `[global id, global dof]`, per
-    /// element `[block, its nodes as positions in this share's node list …]`, per face
+    /// element `[block, its index in this rank's builder, its nodes as positions in this
+    /// share's node list …]`, per face
     /// `[surface, element (position in this share), side]`.
     ids: Vec<u64>,
     /// The coordinates of the nodes, xyz each.
@@ -292,6 +308,7 @@ impl EmbeddingBuilder {
             value_at: whole.value_at,
             local_nodes: local.mesh.coords.len(),
             origin: whole.origin,
+            host_elem: whole.host_elem,
             node_owner,
             across: 0,
         })
@@ -324,7 +341,7 @@ impl EmbeddingBuilder {
         }
         let mut elem_ids = Vec::new();
         for &e in &elems {
-            elem_ids.push(mesh.block_of(e) as u64);
+            elem_ids.extend_from_slice(&[mesh.block_of(e) as u64, u64::from(e.0)]);
             for node in mesh.elem_nodes(e) {
                 let k = *node_at.entry(node.index()).or_insert_with(|| {
                     nodes.push(node.index());
@@ -362,6 +379,8 @@ struct Interface {
     faces: Vec<Vec<(usize, u8)>>,
     /// The rank that gave each inner element.
     origin: Vec<usize>,
+    /// Each inner element's index in its rank's builder.
+    host_elem: Vec<usize>,
     value_at: Vec<usize>,
 }
 
@@ -385,11 +404,13 @@ impl Interface {
             connectivity: vec![Vec::new(); mesh.blocks.len()],
             faces: vec![Vec::new(); mesh.side_sets.len()],
             origin: Vec::new(),
+            host_elem: Vec::new(),
             value_at: Vec::new(),
         };
         let mut inner_of: HashMap<u64, usize> = HashMap::new();
-        // Per block, the elements in (rank, order): (rank, inner nodes).
-        let mut per_block: Vec<Vec<(usize, Vec<usize>)>> = vec![Vec::new(); mesh.blocks.len()];
+        // Per block, the elements in (rank, order): (rank, index there, inner nodes).
+        let mut per_block: Vec<Vec<(usize, usize, Vec<usize>)>> =
+            vec![Vec::new(); mesh.blocks.len()];
         // Per rank, each of its elements' (block, position in the block).
         let mut placed: Vec<Vec<(usize, usize)>> = Vec::with_capacity(ids.len());
         let mut by_nodes: HashMap<Vec<u64>, usize> = HashMap::new();
@@ -435,7 +456,8 @@ impl Interface {
                     return Err(corrupt(r));
                 };
                 let nn = b.topology.node_count();
-                let conn = ids.get(at + 1..at + 1 + nn).ok_or_else(|| corrupt(r))?;
+                let host = *ids.get(at + 1).ok_or_else(|| corrupt(r))? as usize;
+                let conn = ids.get(at + 2..at + 2 + nn).ok_or_else(|| corrupt(r))?;
                 let inner: Vec<usize> = conn
                     .iter()
                     .map(|&k| mine.get(k as usize).copied().ok_or_else(|| corrupt(r)))
@@ -452,8 +474,8 @@ impl Interface {
                 }
                 by_nodes.insert(key, r);
                 elems.push((block, per_block[block].len()));
-                per_block[block].push((r, inner));
-                at += 1 + nn;
+                per_block[block].push((r, host, inner));
+                at += 2 + nn;
             }
             placed.push(elems);
             let faces = ids.get(at..at + 3 * n_faces).ok_or_else(|| corrupt(r))?;
@@ -469,8 +491,9 @@ impl Interface {
         let mut first = Vec::with_capacity(per_block.len());
         for (b, elems) in per_block.into_iter().enumerate() {
             first.push(whole.origin.len());
-            for (r, nodes) in elems {
+            for (r, host, nodes) in elems {
                 whole.origin.push(r);
+                whole.host_elem.push(host);
                 whole.connectivity[b].extend(nodes);
             }
         }
@@ -551,6 +574,54 @@ impl RankEmbedding {
         })
     }
 
+    /// Heat (W) through a condensed dual tie from the host's residual `K u − F` without
+    /// the tie, at this rank's multipliers' dofs (`residual_at`, in `rows`' order; `rows`
+    /// a [`RankTie`]'s), summed over the ranks (collective): the multipliers of
+    /// [`TieConstraints::dual_multipliers_at`] through [`Self::tie_heat`]. The rank form
+    /// of the serial `dual_multipliers` then `heat`.
+    pub fn dual_tie_heat(
+        &self,
+        rows: &TieConstraints,
+        residual_at: &[f64],
+    ) -> Result<Heat, EmbedError> {
+        let lambda = agree(&self.comm, rows.dual_multipliers_at(residual_at))?;
+        self.tie_heat(rows, &lambda)
+    }
+
+    /// The values at this rank's own side-A points of flux interaction `i` at the host's
+    /// field (collective; `u_local` as for [`Self::contributions`]): each point's index
+    /// in the interaction's point order (the serial [`Embedding::point_fields`] order)
+    /// with its values, its faces named as the ranks that gave them name them (side A's
+    /// is this rank's own element; side B's is `side_b_rank`'s). A point is its side-A
+    /// face's rank's (or, on a node surface, its
+    /// node's owner's), so the ranks' lists together are the serial list, each point
+    /// once.
+    pub fn point_fields(&self, i: usize, u_local: &[f64]) -> Result<Vec<RankPoint>, EmbedError> {
+        let u = self.whole_field(u_local)?;
+        let values = agree(&self.comm, self.inner.point_fields(i, &u))?;
+        let kept = self.inner.pairs[i].kept.as_deref().unwrap_or_default();
+        // Faces by the element index of the rank that gave them.
+        let rename = |f: HostFace| HostFace {
+            element: self.host_elem[f.element],
+            ..f
+        };
+        Ok(kept
+            .iter()
+            .map(|&k| {
+                let v = values[k];
+                RankPoint {
+                    point: k,
+                    side_b_rank: v.side_b.map(|f| self.origin[f.element]),
+                    values: PointValues {
+                        side_a: v.side_a.map(rename),
+                        side_b: v.side_b.map(rename),
+                        ..v
+                    },
+                }
+            })
+            .collect())
+    }
+
     /// Number of interactions.
     pub fn len(&self) -> usize {
         self.inner.len()
@@ -606,30 +677,7 @@ impl RankEmbedding {
     /// dof numbers, for this rank to add (with `ADD_VALUES`: they may fall in other
     /// ranks' rows); `heat` is summed over the ranks, the same on every rank.
     pub fn contributions(&self, u_local: &[f64]) -> Result<Contributions, EmbedError> {
-        let check = if u_local.len() != self.local_nodes {
-            Err(argument(
-                format!(
-                    "the local field has {} entries for {} local nodes",
-                    u_local.len(),
-                    self.local_nodes
-                ),
-                "pass the value at every local node (owned and ghost), in the builder's node order",
-            ))
-        } else if let Some(&k) = self.sent.iter().find(|&&k| !u_local[k].is_finite()) {
-            Err(argument(
-                format!(
-                    "the local field is not finite at local node {k} ({})",
-                    u_local[k]
-                ),
-                "check the host's solve and its update of ghost values",
-            ))
-        } else {
-            Ok(())
-        };
-        agree(&self.comm, check)?;
-        let mine: Vec<f64> = self.sent.iter().map(|&k| u_local[k]).collect();
-        let all = gather_parts(&self.comm, &mine).concat();
-        let u: Vec<f64> = self.value_at.iter().map(|&k| all[k]).collect();
+        let u = self.whole_field(u_local)?;
         let mut c = agree(&self.comm, self.inner.contributions(&u))?;
         let dof = |k: usize| self.global_dof[k];
         for (d, _) in c.residual.iter_mut().chain(c.load.iter_mut()) {
@@ -655,5 +703,35 @@ impl RankEmbedding {
             }
         }
         Ok(c)
+    }
+
+    /// The field at every inner node from each rank's local values (collective): the
+    /// values this rank's interface needs, checked on every rank first (a wrong length
+    /// or a value that is not finite is refused everywhere).
+    fn whole_field(&self, u_local: &[f64]) -> Result<Vec<f64>, EmbedError> {
+        let check = if u_local.len() != self.local_nodes {
+            Err(argument(
+                format!(
+                    "the local field has {} entries for {} local nodes",
+                    u_local.len(),
+                    self.local_nodes
+                ),
+                "pass the value at every local node (owned and ghost), in the builder's node order",
+            ))
+        } else if let Some(&k) = self.sent.iter().find(|&&k| !u_local[k].is_finite()) {
+            Err(argument(
+                format!(
+                    "the local field is not finite at local node {k} ({})",
+                    u_local[k]
+                ),
+                "check the host's solve and its update of ghost values",
+            ))
+        } else {
+            Ok(())
+        };
+        agree(&self.comm, check)?;
+        let mine: Vec<f64> = self.sent.iter().map(|&k| u_local[k]).collect();
+        let all = gather_parts(&self.comm, &mine).concat();
+        Ok(self.value_at.iter().map(|&k| all[k]).collect())
     }
 }
