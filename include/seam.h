@@ -380,9 +380,10 @@ int seam_tie_point_fields(seam_embedding *embedding, size_t tie, const double *l
  *   seam_rank_heat(e, 0, &q_a, &q_b);                 summed over the ranks
  *   seam_rank_free(e);                                before MPI_Finalize / PetscFinalize
  *
- * Collective: seam_rank_new, _add_interaction, _add_deck, _search, _evaluate and _free must be
- * called by every rank of the communicator, in the same order, with the same
- * interactions; the getters are local. An error on one rank is an error on every rank:
+ * Collective: seam_rank_new, _add_interaction, _add_deck, _search, _move_nodes, _evaluate,
+ * _constraints, _tie_heat, _dual_tie_heat, _point_fields and _free must be called by every
+ * rank of the communicator, in the same order, with the same interactions; the getters are
+ * local. An error on one rank is an error on every rank:
  * that rank's own status and message there, SEAM_ERR_OTHER_RANK naming it elsewhere, so
  * no rank is left waiting in a collective.
  *
@@ -419,6 +420,10 @@ int seam_rank_add_deck(seam_rank_embedding *embedding, const char *deck_text, co
 /* Pair every interaction anew: the serial search of the whole interface, on every rank;
  * each rank keeps the points of its own side-A faces. */
 int seam_rank_search(seam_rank_embedding *embedding);
+/* New coordinates of this rank's local nodes (xyz per node, n_nodes as the builder's):
+ * pairings kept, gaps measured anew, as seam_move_nodes; the last evaluation and the tie
+ * rows are dropped. Collective. */
+int seam_rank_move_nodes(seam_rank_embedding *embedding, const double *coords, size_t n_nodes);
 /* Over all ranks, the side-A points of the last search paired with a side-B face that
  * another rank gave (the pairs that straddle ranks). Local. */
 int seam_rank_points_across(const seam_rank_embedding *embedding, size_t *out_count);

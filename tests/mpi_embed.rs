@@ -423,9 +423,15 @@ fn rank_terms_sum_to_the_serial_terms() {
         {
             eprintln!("mpirun -n {n}: {points}");
         }
+        if let Some(moved) = text
+            .lines()
+            .find_map(|l| l.find("rank move:").map(|k| &l[k..]))
+        {
+            eprintln!("mpirun -n {n}: {moved}");
+        }
         assert_eq!(
             text.matches("refused on every rank").count(),
-            2 * n,
+            3 * n,
             "every rank saw the bad input refused:\n{text}"
         );
     }
@@ -579,6 +585,56 @@ fn rank_terms_child() {
         println!("rank point fields: largest flux difference {point_diff:.1e} of the largest flux");
     }
 
+    // Brick a stretched by 2 % in y (its faces' areas change), brick b stretched by
+    // 10 % in x, slid by 0.05 in y and drawn back by 0.01 (its gradients change), on
+    // every rank and in the serial embedding: the pairings kept, the points placed
+    // again, the terms again the serial ones (and not those before the move).
+    let moved = |g: usize| {
+        let x = m.coords[g];
+        if g >= NODES_A {
+            [1.01 + 1.1 * (x[0] - 1.0), x[1] + 0.05, x[2]]
+        } else {
+            [x[0], 1.02 * x[1], x[2]]
+        }
+    };
+    let serial_nodes = builder_of(&m, &all).1;
+    let moved_serial: Vec<[f64; 3]> = serial_nodes.iter().map(|&g| moved(g)).collect();
+    serial.move_nodes(&moved_serial).expect("serial move");
+    let want_moved = serial
+        .contributions(&u)
+        .expect("serial terms after the move");
+    let moved_local: Vec<[f64; 3]> = nodes.iter().map(|&g| moved(g)).collect();
+    e.move_nodes(&moved_local).expect("rank move");
+    let got_moved = e
+        .contributions(&u_local)
+        .expect("rank terms after the move");
+    let mut summed = vec![0.0; mine_dense.len()];
+    world.all_reduce_into(
+        &dense(&got_moved, n_nodes)[..],
+        &mut summed[..],
+        mpi::collective::SystemOperation::sum(),
+    );
+    let serial_moved = dense(&want_moved, n_nodes);
+    let moved_diff =
+        (serial_moved.iter().zip(&summed)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+    let moved_by =
+        (serial_moved.iter().zip(&serial_dense)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+    let dq_moved = (want_moved.heat[0].unwrap().side_a - got_moved.heat[0].unwrap().side_a).abs();
+    if rank == 0 {
+        println!(
+            "rank move: max |Δ| of the summed terms after the move {moved_diff:.2e} (the move changed them by {moved_by:.2e}), |Δheat| {dq_moved:.2e} W"
+        );
+    }
+    assert!(
+        moved_diff <= 1e-12 * scale,
+        "terms after the move differ by {moved_diff:e}"
+    );
+    assert!(moved_by > 1e-3 * scale, "the move changes the terms");
+    assert!(
+        dq_moved <= 1e-12 * heat_scale,
+        "heat after the move differs by {dq_moved:e}"
+    );
+
     // The same interface from a deck: the same heat as the serial embedding's deck; a
     // deck with a mortar tie is taken (its rows: `rank_tie_rows_are_the_serial_rows`).
     let deck = |enforcement: &str| {
@@ -623,6 +679,8 @@ fn rank_terms_child() {
         e.contributions(&bad_u).map(|_| ()),
         "not finite",
     );
+    let short_coords = &moved_local[..moved_local.len() - usize::from(rank == last)];
+    refused_everywhere(rank, last, e.move_nodes(short_coords), "coordinates for");
     let short = if rank == last {
         &gids[..gids.len() - 1]
     } else {

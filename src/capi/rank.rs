@@ -134,6 +134,25 @@ pub unsafe extern "C" fn seam_rank_search(embedding: *mut SeamRankEmbedding) -> 
     })
 }
 
+/// New coordinates of this rank's local nodes (xyz per node, `n_nodes` of them, as the
+/// builder's nodes): pairings kept, points placed again on the moved faces and gaps
+/// measured anew, as `seam_move_nodes`. The last evaluation and tie rows are dropped.
+/// Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_move_nodes(
+    embedding: *mut SeamRankEmbedding,
+    coords: *const f64,
+    n_nodes: usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let xyz = unsafe { slice(coords, n_nodes.saturating_mul(3), "coords") }?;
+        let points: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        (e.evaluated, e.rows) = (None, None);
+        Ok(e.inner.move_nodes(&points)?)
+    })
+}
+
 /// Over all ranks, the side-A points of the last search whose side-B face another rank
 /// gave.
 #[unsafe(no_mangle)]

@@ -636,13 +636,7 @@ impl RankEmbedding {
     pub fn search(&mut self) -> Result<(), EmbedError> {
         let r = self.inner.search();
         agree(&self.comm, r)?;
-        let (rank, origin, owner) = (self.rank, &self.origin, &self.node_owner);
-        let owns = |e: Option<ElemId>, n: Option<NodeId>| match (e, n) {
-            (Some(e), _) => origin.get(e.index()) == Some(&rank),
-            (None, Some(n)) => owner.get(n.index()) == Some(&rank),
-            (None, None) => false,
-        };
-        self.inner.own_points(Some(&owns));
+        self.keep_own_points();
         let mut mine = 0u64;
         for p in &self.inner.pairs {
             let (Some(result), Some(kept)) = (&p.result, &p.kept) else {
@@ -652,7 +646,7 @@ impl RankEmbedding {
                 let b = result.points[k]
                     .b_face
                     .map(|f| p.b.faces[f as usize].side.elem);
-                if b.is_some_and(|e| self.origin[e.index()] != rank) {
+                if b.is_some_and(|e| self.origin[e.index()] != self.rank) {
                     mine += 1;
                 }
             }
@@ -662,6 +656,57 @@ impl RankEmbedding {
             .all_reduce_into(&mine, &mut all, SystemOperation::sum());
         self.across = all as usize;
         Ok(())
+    }
+
+    /// The nodes moved (collective): each rank gives the new coordinates of its local
+    /// nodes (owned and ghost, in the builder's node order; current at least at its
+    /// interface faces' elements' nodes). Every pairing is kept and its points placed
+    /// again on the moved faces, gaps measured anew, as the serial
+    /// [`Embedding::move_nodes`]; [`Self::search`] pairs anew.
+    pub fn move_nodes(&mut self, coords_local: &[[f64; 3]]) -> Result<(), EmbedError> {
+        let check = if coords_local.len() != self.local_nodes {
+            Err(argument(
+                format!(
+                    "{} coordinates for {} local nodes",
+                    coords_local.len(),
+                    self.local_nodes
+                ),
+                "pass every local node's new coordinates (owned and ghost), in the builder's node order",
+            ))
+        } else if let Some(&k) =
+            (self.sent.iter()).find(|&&k| coords_local[k].iter().any(|c| !c.is_finite()))
+        {
+            Err(argument(
+                format!(
+                    "local node {k} moved to a non-finite position {:?}",
+                    coords_local[k]
+                ),
+                "check the host's displacement field",
+            ))
+        } else {
+            Ok(())
+        };
+        agree(&self.comm, check)?;
+        let mine: Vec<f64> = (self.sent.iter()).flat_map(|&k| coords_local[k]).collect();
+        let all = self.whole(&mine, 3);
+        let coords: Vec<[f64; 3]> = all.chunks_exact(3).map(|x| [x[0], x[1], x[2]]).collect();
+        let moved = self.inner.move_nodes(&coords);
+        agree(&self.comm, moved)?;
+        // A move forgets which points are whose.
+        self.keep_own_points();
+        Ok(())
+    }
+
+    /// Evaluate only this rank's own side-A points: those of the faces it gave, and on
+    /// a node surface those of the nodes it owns.
+    fn keep_own_points(&mut self) {
+        let (rank, origin, owner) = (self.rank, &self.origin, &self.node_owner);
+        let owns = |e: Option<ElemId>, n: Option<NodeId>| match (e, n) {
+            (Some(e), _) => origin.get(e.index()) == Some(&rank),
+            (None, Some(n)) => owner.get(n.index()) == Some(&rank),
+            (None, None) => false,
+        };
+        self.inner.own_points(Some(&owns));
     }
 
     /// Over all ranks, the side-A points (of the last search) paired with a side-B face
@@ -731,7 +776,15 @@ impl RankEmbedding {
         };
         agree(&self.comm, check)?;
         let mine: Vec<f64> = self.sent.iter().map(|&k| u_local[k]).collect();
-        let all = gather_parts(&self.comm, &mine).concat();
-        Ok(self.value_at.iter().map(|&k| all[k]).collect())
+        Ok(self.whole(&mine, 1))
+    }
+
+    /// Per inner node, its `width` values from the ranks that hold it, each rank giving
+    /// `width` values per node it sends (collective).
+    fn whole(&self, mine: &[f64], width: usize) -> Vec<f64> {
+        let all = gather_parts(&self.comm, mine).concat();
+        (self.value_at.iter())
+            .flat_map(|&k| all[k * width..(k + 1) * width].iter().copied())
+            .collect()
     }
 }

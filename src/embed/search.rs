@@ -79,7 +79,6 @@ impl Embedding {
             p.pressures = None;
             p.points = OnceLock::new();
             p.kept = None;
-            p.kept = None;
         }
         if let Some(e) = &mut self.evaluation {
             e.outdate();
