@@ -281,6 +281,19 @@ fn petsc_host_with_a_mortar_tie_gives_the_1d_answer_on_1_to_4_ranks() {
             eprintln!("mpirun -n {n} (dual): heat from the residual off by {dq:.2e} W");
             assert!(dq <= REL * q, "dual heat from the residual off by {dq:e}");
         }
+        // The multiplier field at every rank's own points, weighted: the heat.
+        let (q_points, count) = par
+            .point_fields
+            .expect("the tie host prints its point fields");
+        let dq_points = (q_points - q).abs();
+        eprintln!(
+            "mpirun -n {n} ({}): Σ λ_h w over the ranks' {count} points off by {dq_points:.2e} W",
+            mode.join(" ")
+        );
+        assert!(
+            dq_points <= REL * q,
+            "the multiplier field's heat off by {dq_points:e}"
+        );
         let exact = exact_temperatures_through(&par.x, 0.0);
         let t_scale = exact.iter().fold(0.0f64, |m, t| m.max(t.abs()));
         let dt = difference(&exact, &par.temperature);
@@ -540,45 +553,13 @@ fn rank_terms_child() {
     for i in 0..2 {
         let whole = serial.point_fields(i, &u).expect("serial point fields");
         let own = e.point_fields(i, &u_local).expect("rank point fields");
-        let q_scale = whole.iter().fold(0.0f64, |m, p| m.max(p.flux.abs()));
-        let close = |a: f64, b: f64| a.is_nan() && b.is_nan() || (a - b).abs() <= 1e-12 * q_scale;
-        let mut count = vec![0.0; whole.len()];
-        // A rank's builder numbers its slab's elements from 0: the serial (global)
-        // element of rank r's element k is r's first plus k.
-        let global = |r: usize, f: Option<seam::embed::HostFace>| {
-            f.map(|f| (n_elems * r / size + f.element, f.side))
-        };
-        for p in &own {
-            let (k, v) = (p.point, &p.values);
-            let w = &whole[k];
-            count[k] += 1.0;
-            assert_eq!(
-                (v.x, v.weight, v.paired, v.gap),
-                (w.x, w.weight, w.paired, w.gap),
-                "interaction {i}, point {k}"
-            );
-            let b_rank = p.side_b_rank.unwrap_or(usize::MAX);
-            assert_eq!(
-                (global(rank, v.side_a), global(b_rank, v.side_b)),
-                (global(0, w.side_a), global(0, w.side_b)),
-                "interaction {i}, point {k}: the faces"
-            );
-            assert!(
-                close(v.flux, w.flux) && close(v.temp_a, w.temp_a) && close(v.temp_b, w.temp_b),
-                "interaction {i}, point {k}: {v:?} against {w:?}"
-            );
-            point_diff = point_diff.max((v.flux - w.flux).abs() / q_scale);
-        }
-        let mut counted = vec![0.0; count.len()];
-        world.all_reduce_into(
-            &count[..],
-            &mut counted[..],
-            mpi::collective::SystemOperation::sum(),
-        );
-        assert!(
-            counted.iter().all(|&c| c == 1.0),
-            "interaction {i}: every point on one rank"
-        );
+        point_diff = point_diff.max(own_points_are_the_serial_ones(
+            &world,
+            n_elems,
+            &whole,
+            &own,
+            &format!("interaction {i}"),
+        ));
         assert!(whole.iter().any(|p| p.paired));
     }
     if rank == 0 {
@@ -689,6 +670,66 @@ fn rank_terms_child() {
     let built = b.build_on_ranks(world.duplicate(), short);
     refused_everywhere(rank, last, built.map(|_| ()), "global ids for");
     world.barrier();
+}
+
+/// Each of this rank's points `own` (of a slab partition of `n_elems` elements) against
+/// the serial embedding's point `whole[point]`: the same place, weight and faces (a
+/// rank's builder numbers its slab's elements from 0, so rank r's element k is the
+/// serial element r's first + k), the flux, temperatures and multiplier within 1e-12 of
+/// the largest flux; and over the ranks, every point once. Returns the largest flux
+/// difference relative to the largest flux.
+fn own_points_are_the_serial_ones(
+    world: &mpi::topology::SimpleCommunicator,
+    n_elems: usize,
+    whole: &[seam::embed::PointValues],
+    own: &[seam::embed::RankPoint],
+    what: &str,
+) -> f64 {
+    use mpi::traits::{Communicator, CommunicatorCollectives};
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let q_scale = whole.iter().fold(0.0f64, |m, p| m.max(p.flux.abs()));
+    let close = |a: f64, b: f64| a.is_nan() && b.is_nan() || (a - b).abs() <= 1e-12 * q_scale;
+    let global = |r: usize, f: Option<seam::embed::HostFace>| {
+        f.map(|f| (n_elems * r / size + f.element, f.side))
+    };
+    let mut count = vec![0.0; whole.len()];
+    let mut worst = 0.0f64;
+    for p in own {
+        let (k, v) = (p.point, &p.values);
+        let w = &whole[k];
+        count[k] += 1.0;
+        assert_eq!(
+            (v.x, v.weight, v.paired, v.gap),
+            (w.x, w.weight, w.paired, w.gap),
+            "{what}, point {k}"
+        );
+        let b_rank = p.side_b_rank.unwrap_or(usize::MAX);
+        assert_eq!(
+            (global(rank, v.side_a), global(b_rank, v.side_b)),
+            (global(0, w.side_a), global(0, w.side_b)),
+            "{what}, point {k}: the faces"
+        );
+        let multiplier = |m: Option<f64>| m.unwrap_or(f64::NAN);
+        assert!(
+            close(v.flux, w.flux)
+                && close(v.temp_a, w.temp_a)
+                && close(v.temp_b, w.temp_b)
+                && close(multiplier(v.multiplier), multiplier(w.multiplier)),
+            "{what}, point {k}: {v:?} against {w:?}"
+        );
+        worst = worst.max((v.flux - w.flux).abs() / q_scale);
+    }
+    let mut counted = vec![0.0; count.len()];
+    world.all_reduce_into(
+        &count[..],
+        &mut counted[..],
+        mpi::collective::SystemOperation::sum(),
+    );
+    assert!(
+        counted.iter().all(|&c| c == 1.0),
+        "{what}: every point on one rank"
+    );
+    worst
 }
 
 /// `r` failed on rank `last` with a message holding `what`, and on every other rank
@@ -865,8 +906,20 @@ fn rank_ties_child() {
             dq <= 1e-12 * heat_serial.side_a.abs(),
             "{multipliers:?}: heat {dq:e}"
         );
+        // The multiplier field at each rank's own points: its faces' multipliers come
+        // from whichever ranks own them.
+        let whole = serial.tie_point_fields(&want, &lambda_serial).unwrap();
+        let own = e.tie_point_fields(&got, &lambda_rank).unwrap();
+        let field_diff = own_points_are_the_serial_ones(
+            &world,
+            n_elems,
+            &whole,
+            &own,
+            &format!("{multipliers:?}"),
+        );
+        assert!(whole.iter().any(|p| p.multiplier.is_some()));
         report += &format!(
-            " {multipliers:?}: {} multipliers, max |Δ| of the rows {diff:.1e} (of {scale:.2e}), |Δheat| {dq:.1e} W (of {:.3e});",
+            " {multipliers:?}: {} multipliers, max |Δ| of the rows {diff:.1e} (of {scale:.2e}), |Δheat| {dq:.1e} W (of {:.3e}), multiplier field at the points {field_diff:.1e};",
             got.total,
             heat_serial.side_a.abs()
         );

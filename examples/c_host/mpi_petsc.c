@@ -28,7 +28,8 @@
  * their places in the whole tie (seam_rank_tie_index); the host numbers the multipliers
  * after every node, as extra rows of the last rank, adds C and C^T (ADD_VALUES) and
  * solves [K C^T; C 0] [T; lambda] = [F; g] by MUMPS; the heat comes from its
- * multipliers (seam_rank_tie_heat). `mpi_petsc tie dual` does the same with dual
+ * multipliers (seam_rank_tie_heat) and from the multiplier field at the contact points
+ * (seam_rank_tie_point_fields, weighted and summed over the ranks). `mpi_petsc tie dual` does the same with dual
  * multipliers, and also recovers them from its own residual K T - F without the tie at
  * its multipliers' dofs (seam_rank_dual_multipliers) and takes the tie's heat from that
  * residual (seam_rank_dual_tie_heat), as a host that condensed the tie
@@ -380,6 +381,19 @@ int main(int argc, char **argv) {
         for (size_t k = 0; k < n_mult; k++) at[k] = NODES + (PetscInt)place[k];
         PetscCall(gather_at(t, (PetscInt)n_mult, at, lambda));
         CHECK(seam_rank_tie_heat(s, 0, lambda, n_mult, &qa, &qb));
+        /* The multiplier field at this rank's own points, weighted and summed over the
+         * ranks: the flux density integrated over the face, the tie's heat. */
+        size_t n_points;
+        const seam_point_values *values;
+        const size_t *points;
+        const int *side_b_ranks;
+        CHECK(seam_rank_tie_point_fields(s, 0, lambda, n_mult, &n_points, &values, &points,
+                                         &side_b_ranks));
+        double own[2] = {0.0, (double)n_points}, all[2];
+        for (size_t k = 0; k < n_points; k++)
+            if (values[k].has_multiplier) own[0] += values[k].multiplier * values[k].weight;
+        PetscCallMPI(MPI_Allreduce(own, all, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
+        if (rank == 0) printf("point fields: %.17g %.0f\n", all[0], all[1]);
         if (dual) { /* the multipliers again, from K T (no source: F = 0) */
             static double r_at[NODES], recovered[NODES];
             Vec kt;

@@ -25,6 +25,35 @@ struct OwnPoints {
     side_b_rank: Vec<c_int>,
 }
 
+impl OwnPoints {
+    /// Keep `points` as C arrays and hand them out.
+    unsafe fn write(
+        &mut self,
+        points: &[crate::embed::RankPoint],
+        out_n: *mut usize,
+        out_values: *mut *const fields::SeamPointValues,
+        out_points: *mut *const usize,
+        out_side_b_ranks: *mut *const c_int,
+    ) -> Result<(), Failure> {
+        *self = OwnPoints {
+            values: points.iter().map(|p| (&p.values).into()).collect(),
+            index: points.iter().map(|p| p.point).collect(),
+            side_b_rank: (points.iter())
+                .map(|p| p.side_b_rank.map_or(-1, |r| r as c_int))
+                .collect(),
+        };
+        unsafe {
+            out(out_points, self.index.as_ptr(), "out_points")?;
+            out(
+                out_side_b_ranks,
+                self.side_b_rank.as_ptr(),
+                "out_side_b_ranks",
+            )?;
+            fields::array_out(&self.values, out_n, out_values)
+        }
+    }
+}
+
 /// A tie's multipliers on this rank: their places in the whole tie, and its count.
 type Places = (Vec<i64>, usize);
 
@@ -481,21 +510,43 @@ pub unsafe extern "C" fn seam_rank_point_fields(
         let e = unsafe { handle(embedding, "embedding") }?;
         let u = unsafe { slice(u_local, n_nodes, "u_local") }?;
         let points = e.inner.point_fields(index, u)?;
-        e.points = OwnPoints {
-            values: points.iter().map(|p| (&p.values).into()).collect(),
-            index: points.iter().map(|p| p.point).collect(),
-            side_b_rank: (points.iter())
-                .map(|p| p.side_b_rank.map_or(-1, |r| r as c_int))
-                .collect(),
-        };
         unsafe {
-            out(out_points, e.points.index.as_ptr(), "out_points")?;
-            out(
-                out_side_b_ranks,
-                e.points.side_b_rank.as_ptr(),
-                "out_side_b_ranks",
-            )?;
-            fields::array_out(&e.points.values, out_n, out_values)
+            e.points
+                .write(&points, out_n, out_values, out_points, out_side_b_ranks)
+        }
+    })
+}
+
+/// The values at this rank's own side-A points of tie `index` (after
+/// `seam_rank_constraints`) for this rank's multipliers `lambda` (`n`, in this rank's
+/// order: the host's unknowns, or `seam_rank_dual_multipliers`' for a condensed dual
+/// tie), with each point's index and side-B face's rank, as `seam_rank_point_fields`
+/// gives them; `multiplier` is the multiplier field λ_h at the point, gathered from
+/// every rank's multipliers. The arrays stay valid until the next point-field call.
+/// Collective.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_rank_tie_point_fields(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    lambda: *const f64,
+    n: usize,
+    out_n: *mut usize,
+    out_values: *mut *const fields::SeamPointValues,
+    out_points: *mut *const usize,
+    out_side_b_ranks: *mut *const c_int,
+) -> c_int {
+    guard(|| {
+        let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
+        let (place, total) = &unsafe { rank_rows(embedding) }?.1[index];
+        let place: Vec<u64> = place.iter().map(|&k| k as u64).collect();
+        let points = e
+            .inner
+            .tie_point_fields_at(t.interaction, &place, *total, lambda)?;
+        let e = unsafe { handle(embedding, "embedding") }?;
+        unsafe {
+            e.points
+                .write(&points, out_n, out_values, out_points, out_side_b_ranks)
         }
     })
 }

@@ -599,14 +599,80 @@ impl RankEmbedding {
     pub fn point_fields(&self, i: usize, u_local: &[f64]) -> Result<Vec<RankPoint>, EmbedError> {
         let u = self.whole_field(u_local)?;
         let values = agree(&self.comm, self.inner.point_fields(i, &u))?;
+        Ok(self.own_points_of(i, &values))
+    }
+
+    /// The values at this rank's own side-A points of a mortar tie (`tie` one of
+    /// [`Self::constraints`]) for this rank's multipliers `lambda` (one per entry of
+    /// `tie.index`: the host's unknowns, or those of
+    /// [`TieConstraints::dual_multipliers_at`] for a condensed dual tie), as
+    /// [`Self::point_fields`] gives them: the multiplier field at a point takes the
+    /// multipliers of its face's nodes, whichever ranks own them, so every rank's are
+    /// gathered first (collective; 16 B per multiplier).
+    pub fn tie_point_fields(
+        &self,
+        tie: &RankTie,
+        lambda: &[f64],
+    ) -> Result<Vec<RankPoint>, EmbedError> {
+        let place: Vec<u64> = tie.index.iter().map(|&k| k as u64).collect();
+        self.tie_point_fields_at(tie.rows.interaction, &place, tie.total, lambda)
+    }
+
+    /// [`Self::tie_point_fields`] of the tie of interaction `i`, with this rank's
+    /// multipliers' places in the whole tie `place` and the tie's count of them `total`.
+    pub(crate) fn tie_point_fields_at(
+        &self,
+        i: usize,
+        place: &[u64],
+        total: usize,
+        lambda: &[f64],
+    ) -> Result<Vec<RankPoint>, EmbedError> {
+        let check = if lambda.len() != place.len() {
+            Err(argument(
+                format!(
+                    "{} multipliers given, this rank has {} of the tie",
+                    lambda.len(),
+                    place.len()
+                ),
+                "pass one value per entry of the tie's index on this rank, in order",
+            ))
+        } else {
+            Ok(())
+        };
+        agree(&self.comm, check)?;
+        let (place, values) = (
+            gather_parts(&self.comm, place).concat(),
+            gather_parts(&self.comm, lambda).concat(),
+        );
+        let mut whole = vec![0.0; total];
+        for (&k, &l) in place.iter().zip(&values) {
+            if let Some(w) = whole.get_mut(k as usize) {
+                *w = l;
+            }
+        }
+        let ties = agree(&self.comm, self.inner.constraints())?;
+        let rows = ties.iter().find(|t| t.interaction == i).ok_or_else(|| {
+            argument(
+                format!("interaction {i} is not a mortar tie"),
+                "pass a tie of this embedding's constraints()",
+            )
+        });
+        let values = agree(
+            &self.comm,
+            rows.and_then(|t| self.inner.tie_point_fields(t, &whole)),
+        )?;
+        Ok(self.own_points_of(i, &values))
+    }
+
+    /// This rank's own points of interaction `i` among `values` (every point's, in
+    /// point order), their faces named by the ranks that gave them.
+    fn own_points_of(&self, i: usize, values: &[PointValues]) -> Vec<RankPoint> {
         let kept = self.inner.pairs[i].kept.as_deref().unwrap_or_default();
-        // Faces by the element index of the rank that gave them.
         let rename = |f: HostFace| HostFace {
             element: self.host_elem[f.element],
             ..f
         };
-        Ok(kept
-            .iter()
+        kept.iter()
             .map(|&k| {
                 let v = values[k];
                 RankPoint {
@@ -619,7 +685,7 @@ impl RankEmbedding {
                     },
                 }
             })
-            .collect())
+            .collect()
     }
 
     /// Number of interactions.
