@@ -381,9 +381,9 @@ int seam_tie_point_fields(seam_embedding *embedding, size_t tie, const double *l
  *   seam_rank_free(e);                                before MPI_Finalize / PetscFinalize
  *
  * Collective: seam_rank_new, _add_interaction, _add_deck, _search, _move_nodes, _evaluate,
- * _constraints, _tie_heat, _dual_tie_heat, _point_fields and _free must be called by every
- * rank of the communicator, in the same order, with the same interactions; the getters are
- * local. An error on one rank is an error on every rank:
+ * _constraints, _tie_heat, _dual_tie_heat, the point- and face-field calls and _free must be
+ * called by every rank of the communicator, in the same order, with the same interactions;
+ * the getters are local. An error on one rank is an error on every rank:
  * that rank's own status and message there, SEAM_ERR_OTHER_RANK naming it elsewhere, so
  * no rank is left waiting in a collective.
  *
@@ -504,6 +504,20 @@ int seam_rank_point_fields(seam_rank_embedding *embedding, size_t index, const d
 int seam_rank_tie_point_fields(seam_rank_embedding *embedding, size_t tie, const double *lambda,
                                size_t n, size_t *out_n, const seam_point_values **out_values,
                                const size_t **out_points, const int **out_side_b_ranks);
+/* Per face of flux interaction `index` at the local field (n_nodes values): the faces this
+ * rank gave (side A's, then side B's if side_b), named by its own elements, with
+ * seam_face_fields' values (each point's flux from the rank that owns it). The ranks'
+ * faces together are the serial list. Array valid until the next face-field call.
+ * Collective. */
+int seam_rank_face_fields(seam_rank_embedding *embedding, size_t index, const double *u_local,
+                          size_t n_nodes, int side_b, size_t *out_n,
+                          const seam_face_values **out_values);
+/* Per face of tie `tie` for this rank's multipliers lambda (n, as for
+ * seam_rank_tie_point_fields): this rank's faces, flux the mean multiplier field.
+ * Collective. */
+int seam_rank_tie_face_fields(seam_rank_embedding *embedding, size_t tie, const double *lambda,
+                              size_t n, int side_b, size_t *out_n,
+                              const seam_face_values **out_values);
 #endif /* MPI_VERSION */
 
 #ifdef __cplusplus

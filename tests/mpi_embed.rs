@@ -37,6 +37,9 @@ struct Printed {
     /// The gap conductance on ranks: the flux times the weight summed over every rank's
     /// own contact points (`seam_rank_point_fields`), and the count of points.
     point_fields: Option<(f64, usize)>,
+    /// The same from the faces' mean flux (`seam_rank_face_fields`): over side A's
+    /// faces, over side B's, and the count of faces.
+    face_fields: Option<(f64, f64, usize)>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -137,6 +140,7 @@ fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
         recovered: optional("dual multipliers from the residual:").map(|v| v[0]),
         dual_heat: optional("dual heat from the residual:").map(|v| [v[0], v[1]]),
         point_fields: optional("point fields:").map(|v| (v[0], v[1] as usize)),
+        face_fields: optional("face fields:").map(|v| (v[0], v[1], v[2] as usize)),
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -211,7 +215,7 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
     assert!((serial.heat[0] - q).abs() <= REL * q);
     assert!((serial.heat[0] + serial.heat[1]).abs() <= REL * q);
 
-    let mut points = None;
+    let (mut points, mut faces) = (None, None);
     for n in 1..=4 {
         let par = run(&host, n, &[]);
         assert_eq!(par.ranks, n);
@@ -236,6 +240,20 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
             *points.get_or_insert(count),
             count,
             "every point once on {n} ranks"
+        );
+        let (on_a, on_b, n_faces) = par.face_fields.expect("the host prints its face fields");
+        let dq_faces = (on_a - par.heat[0]).abs().max((on_b - par.heat[0]).abs());
+        eprintln!(
+            "mpirun -n {n}: Σ flux × paired area over the ranks' {n_faces} faces off the heat by {dq_faces:.2e} W"
+        );
+        assert!(
+            dq_faces <= REL * q,
+            "face fields' heat off by {dq_faces:e} on {n} ranks"
+        );
+        assert_eq!(
+            *faces.get_or_insert(n_faces),
+            n_faces,
+            "every face once on {n} ranks"
         );
         if n > 1 {
             assert!(
@@ -561,9 +579,20 @@ fn rank_terms_child() {
             &format!("interaction {i}"),
         ));
         assert!(whole.iter().any(|p| p.paired));
+        let whole = serial.face_fields(i, &u, true).expect("serial face fields");
+        let own = e.face_fields(i, &u_local, true).expect("rank face fields");
+        point_diff = point_diff.max(own_faces_are_the_serial_ones(
+            &world,
+            n_elems,
+            &whole,
+            &own,
+            &format!("interaction {i}"),
+        ));
     }
     if rank == 0 {
-        println!("rank point fields: largest flux difference {point_diff:.1e} of the largest flux");
+        println!(
+            "rank point fields: largest flux difference, at points and faces, {point_diff:.1e} of the largest flux"
+        );
     }
 
     // Brick a stretched by 2 % in y (its faces' areas change), brick b stretched by
@@ -729,6 +758,57 @@ fn own_points_are_the_serial_ones(
         counted.iter().all(|&c| c == 1.0),
         "{what}: every point on one rank"
     );
+    worst
+}
+
+/// This rank's faces `own` against the serial embedding's `whole` (matched by the face's
+/// serial element, side and surface side; rank r's element k is the serial element r's
+/// first + k): every value within 1e-12 of the largest flux, and over the ranks, every
+/// serial face once. Returns the largest flux difference relative to the largest flux.
+fn own_faces_are_the_serial_ones(
+    world: &mpi::topology::SimpleCommunicator,
+    n_elems: usize,
+    whole: &[seam::embed::FaceValues],
+    own: &[seam::embed::FaceValues],
+    what: &str,
+) -> f64 {
+    use mpi::traits::{Communicator, CommunicatorCollectives};
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let at: std::collections::HashMap<(usize, u8, u8), usize> = (whole.iter().enumerate())
+        .map(|(j, f)| ((f.face.element, f.face.side, f.side), j))
+        .collect();
+    let q_scale = whole.iter().fold(0.0f64, |m, f| m.max(f.flux.abs()));
+    let mut count = vec![0.0; whole.len()];
+    let mut worst = 0.0f64;
+    for f in own {
+        let key = (n_elems * rank / size + f.face.element, f.face.side, f.side);
+        let j = *at
+            .get(&key)
+            .unwrap_or_else(|| panic!("{what}: face {key:?} is not the serial embedding's"));
+        let w = &whole[j];
+        count[j] += 1.0;
+        let near = |a: f64, b: f64, scale: f64| (a - b).abs() <= 1e-12 * scale;
+        assert!(
+            near(f.area, w.area, w.area)
+                && near(f.paired_area, w.paired_area, w.area)
+                && near(f.fraction, w.fraction, 1.0)
+                && near(f.gap, w.gap, 1.0)
+                && near(f.flux, w.flux, q_scale),
+            "{what}, face {key:?}: {f:?} against {w:?}"
+        );
+        worst = worst.max((f.flux - w.flux).abs() / q_scale);
+    }
+    let mut counted = vec![0.0; count.len()];
+    world.all_reduce_into(
+        &count[..],
+        &mut counted[..],
+        mpi::collective::SystemOperation::sum(),
+    );
+    assert!(
+        counted.iter().all(|&c| c == 1.0),
+        "{what}: every face on one rank"
+    );
+    assert!(whole.iter().any(|f| f.paired_area > 0.0));
     worst
 }
 
@@ -918,6 +998,15 @@ fn rank_ties_child() {
             &format!("{multipliers:?}"),
         );
         assert!(whole.iter().any(|p| p.multiplier.is_some()));
+        let whole = serial.tie_face_fields(&want, &lambda_serial, true).unwrap();
+        let own = e.tie_face_fields(&got, &lambda_rank, true).unwrap();
+        let field_diff = field_diff.max(own_faces_are_the_serial_ones(
+            &world,
+            n_elems,
+            &whole,
+            &own,
+            &format!("{multipliers:?} faces"),
+        ));
         report += &format!(
             " {multipliers:?}: {} multipliers, max |Δ| of the rows {diff:.1e} (of {scale:.2e}), |Δheat| {dq:.1e} W (of {:.3e}), multiplier field at the points {field_diff:.1e};",
             got.total,

@@ -17,7 +17,8 @@
  * with KSP (MUMPS LU by default; PETSc options override). Rank 0 prints the interface
  * heat and the temperature at every node (by global id), and the flux at every contact
  * point weighted and summed over the ranks, each rank reading its own points
- * (seam_rank_point_fields), with the count of points.
+ * (seam_rank_point_fields), with the count of points, and the same from the mean flux
+ * of every face (seam_rank_face_fields: side A's and side B's), with the count of faces.
  *
  * `mpi_petsc serial` (on one rank) solves the same problem through the serial embedding
  * (seam_embedding_*) with a dense solve instead, for comparison.
@@ -435,6 +436,16 @@ int main(int argc, char **argv) {
         }
         PetscCallMPI(MPI_Allreduce(own, all, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
         if (rank == 0) printf("point fields: %.17g %.0f\n", all[0], all[1]);
+        /* Per face, the mean flux over its paired area, on the faces this rank gave:
+         * summed over the ranks, side A's and side B's each carry the heat. */
+        size_t n_faces;
+        const seam_face_values *faces;
+        CHECK(seam_rank_face_fields(s, 0, t_local, (size_t)n_local, 1, &n_faces, &faces));
+        double on[3] = {0.0, 0.0, (double)n_faces}, summed[3];
+        for (size_t k = 0; k < n_faces; k++)
+            on[faces[k].surface_side] += faces[k].flux * faces[k].paired_area;
+        PetscCallMPI(MPI_Allreduce(on, summed, 3, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
+        if (rank == 0) printf("face fields: %.17g %.17g %.0f\n", summed[0], summed[1], summed[2]);
     }
 
     /* Rank 0 prints every node's temperature, by global id. */

@@ -12,8 +12,10 @@ pub struct SeamRankEmbedding {
     /// This rank's rows of the mortar ties (`seam_rank_constraints`), with each tie's
     /// multipliers' indices in the whole tie and its count of them.
     rows: Option<(Rows, Vec<Places>)>,
-    /// The last `seam_rank_point_fields`.
+    /// The last `seam_rank_point_fields` or `seam_rank_tie_point_fields`.
     points: OwnPoints,
+    /// The last `seam_rank_face_fields` or `seam_rank_tie_face_fields`.
+    faces: Vec<fields::SeamFaceValues>,
 }
 
 /// This rank's own points of the last `seam_rank_point_fields`: their values, their
@@ -96,6 +98,7 @@ pub unsafe extern "C" fn seam_rank_new(
             evaluated: None,
             rows: None,
             points: Default::default(),
+            faces: Vec::new(),
         });
         unsafe { out(out_embedding, Box::into_raw(e), "out_embedding") }
     })
@@ -548,5 +551,56 @@ pub unsafe extern "C" fn seam_rank_tie_point_fields(
             e.points
                 .write(&points, out_n, out_values, out_points, out_side_b_ranks)
         }
+    })
+}
+
+/// Per face of flux interaction `index` at the local field (`n_nodes` values, as for
+/// `seam_rank_evaluate`): the faces this rank gave (side A's, then side B's when
+/// `side_b` is nonzero), named by its own elements, with `seam_face_fields`' values
+/// (every point's flux summed from the rank that owns it). The ranks' faces together are
+/// the serial list. Array valid until the next face-field call. Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_face_fields(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    u_local: *const f64,
+    n_nodes: usize,
+    side_b: c_int,
+    out_n: *mut usize,
+    out_values: *mut *const fields::SeamFaceValues,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let u = unsafe { slice(u_local, n_nodes, "u_local") }?;
+        let faces = e.inner.face_fields(index, u, side_b != 0)?;
+        e.faces = faces.iter().map(fields::SeamFaceValues::from).collect();
+        unsafe { fields::array_out(&e.faces, out_n, out_values) }
+    })
+}
+
+/// Per face of tie `index` (after `seam_rank_constraints`) for this rank's multipliers
+/// `lambda` (`n`, as for `seam_rank_tie_point_fields`): the faces this rank gave, as
+/// `seam_rank_face_fields` gives them, `flux` the mean multiplier field. Array valid
+/// until the next face-field call. Collective.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_rank_tie_face_fields(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    lambda: *const f64,
+    n: usize,
+    side_b: c_int,
+    out_n: *mut usize,
+    out_values: *mut *const fields::SeamFaceValues,
+) -> c_int {
+    guard(|| {
+        let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
+        let (place, total) = &unsafe { rank_rows(embedding) }?.1[index];
+        let place: Vec<u64> = place.iter().map(|&k| k as u64).collect();
+        let faces =
+            (e.inner).tie_face_fields_at(t.interaction, &place, *total, lambda, side_b != 0)?;
+        let e = unsafe { handle(embedding, "embedding") }?;
+        e.faces = faces.iter().map(fields::SeamFaceValues::from).collect();
+        unsafe { fields::array_out(&e.faces, out_n, out_values) }
     })
 }

@@ -61,8 +61,8 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::{Communicator, CommunicatorCollectives};
 
 use super::{
-    Contributions, EmbedError, Embedding, EmbeddingBuilder, Heat, HostFace, Interaction,
-    PointValues, TieConstraints, argument, mesh_error,
+    Contributions, EmbedError, Embedding, EmbeddingBuilder, FaceValues, Heat, HostFace,
+    Interaction, PointValues, TieConstraints, argument, mesh_error,
 };
 use crate::mesh::{ElemId, NodeId};
 
@@ -627,6 +627,90 @@ impl RankEmbedding {
         total: usize,
         lambda: &[f64],
     ) -> Result<Vec<RankPoint>, EmbedError> {
+        let (rows, whole) = self.whole_tie(i, place, total, lambda)?;
+        let values = agree(&self.comm, self.inner.tie_point_fields(&rows, &whole))?;
+        Ok(self.own_points_of(i, &values))
+    }
+
+    /// Per face of the mortar tie `tie` for this rank's multipliers `lambda` (as
+    /// [`Self::tie_point_fields`]), the faces this rank gave, as [`Self::face_fields`]
+    /// gives them (collective).
+    pub fn tie_face_fields(
+        &self,
+        tie: &RankTie,
+        lambda: &[f64],
+        side_b: bool,
+    ) -> Result<Vec<FaceValues>, EmbedError> {
+        let place: Vec<u64> = tie.index.iter().map(|&k| k as u64).collect();
+        self.tie_face_fields_at(tie.rows.interaction, &place, tie.total, lambda, side_b)
+    }
+
+    /// [`Self::tie_face_fields`] with the tie given as for [`Self::tie_point_fields_at`].
+    pub(crate) fn tie_face_fields_at(
+        &self,
+        i: usize,
+        place: &[u64],
+        total: usize,
+        lambda: &[f64],
+        side_b: bool,
+    ) -> Result<Vec<FaceValues>, EmbedError> {
+        let (rows, whole) = self.whole_tie(i, place, total, lambda)?;
+        let faces = agree(
+            &self.comm,
+            self.inner.tie_face_fields(&rows, &whole, side_b),
+        )?;
+        Ok(self.own_faces_of(faces))
+    }
+
+    /// Per face of flux interaction `i` at the host's field (collective; `u_local` as
+    /// for [`Self::contributions`]): the faces this rank gave (side A's, then side B's
+    /// with `side_b`), named by this rank's elements, with the serial
+    /// [`Embedding::face_fields`]' values: every point's flux is summed from the rank
+    /// that owns it (8 B per point), so a face whose points sit on several ranks has
+    /// them all. The ranks' faces together are the serial list, each face once.
+    pub fn face_fields(
+        &self,
+        i: usize,
+        u_local: &[f64],
+        side_b: bool,
+    ) -> Result<Vec<FaceValues>, EmbedError> {
+        let u = self.whole_field(u_local)?;
+        let own = agree(&self.comm, self.inner.point_flux(i, &u))?;
+        let mine: Vec<f64> = own.iter().map(|f| f.map_or(0.0, |f| f.q)).collect();
+        let mut every = vec![0.0; mine.len()];
+        self.comm
+            .all_reduce_into(&mine[..], &mut every[..], SystemOperation::sum());
+        let p = &self.inner.pairs[i];
+        let points = &Embedding::searched(p)?.points;
+        let faces = super::face_values(&p.a, &p.b, points, |k| Some(every[k]), side_b);
+        Ok(self.own_faces_of(faces))
+    }
+
+    /// The faces of `faces` this rank gave, named by its elements.
+    fn own_faces_of(&self, faces: Vec<FaceValues>) -> Vec<FaceValues> {
+        (faces.into_iter())
+            .filter(|f| self.origin[f.face.element] == self.rank)
+            .map(|f| FaceValues {
+                face: HostFace {
+                    element: self.host_elem[f.face.element],
+                    ..f.face
+                },
+                ..f
+            })
+            .collect()
+    }
+
+    /// The whole tie of interaction `i` (every rank computes it from the interface it
+    /// holds) and every multiplier of it, gathered from each rank's `lambda` at its
+    /// places `place` in the tie of `total` (collective; a `lambda` of another length
+    /// than `place` is refused on every rank).
+    fn whole_tie(
+        &self,
+        i: usize,
+        place: &[u64],
+        total: usize,
+        lambda: &[f64],
+    ) -> Result<(TieConstraints, Vec<f64>), EmbedError> {
         let check = if lambda.len() != place.len() {
             Err(argument(
                 format!(
@@ -651,17 +735,16 @@ impl RankEmbedding {
             }
         }
         let ties = agree(&self.comm, self.inner.constraints())?;
-        let rows = ties.iter().find(|t| t.interaction == i).ok_or_else(|| {
-            argument(
-                format!("interaction {i} is not a mortar tie"),
-                "pass a tie of this embedding's constraints()",
-            )
-        });
-        let values = agree(
-            &self.comm,
-            rows.and_then(|t| self.inner.tie_point_fields(t, &whole)),
-        )?;
-        Ok(self.own_points_of(i, &values))
+        let rows = ties
+            .into_iter()
+            .find(|t| t.interaction == i)
+            .ok_or_else(|| {
+                argument(
+                    format!("interaction {i} is not a mortar tie"),
+                    "pass a tie of this embedding's constraints()",
+                )
+            });
+        Ok((agree(&self.comm, rows)?, whole))
     }
 
     /// This rank's own points of interaction `i` among `values` (every point's, in
