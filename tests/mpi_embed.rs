@@ -714,7 +714,7 @@ fn own_points_are_the_serial_ones(
     own: &[seam::embed::RankPoint],
     what: &str,
 ) -> f64 {
-    use mpi::traits::{Communicator, CommunicatorCollectives};
+    use mpi::traits::Communicator;
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let q_scale = whole.iter().fold(0.0f64, |m, p| m.max(p.flux.abs()));
     let close = |a: f64, b: f64| a.is_nan() && b.is_nan() || (a - b).abs() <= 1e-12 * q_scale;
@@ -748,16 +748,7 @@ fn own_points_are_the_serial_ones(
         );
         worst = worst.max((v.flux - w.flux).abs() / q_scale);
     }
-    let mut counted = vec![0.0; count.len()];
-    world.all_reduce_into(
-        &count[..],
-        &mut counted[..],
-        mpi::collective::SystemOperation::sum(),
-    );
-    assert!(
-        counted.iter().all(|&c| c == 1.0),
-        "{what}: every point on one rank"
-    );
+    each_once(world, &count, &format!("{what}: every point"));
     worst
 }
 
@@ -772,7 +763,7 @@ fn own_faces_are_the_serial_ones(
     own: &[seam::embed::FaceValues],
     what: &str,
 ) -> f64 {
-    use mpi::traits::{Communicator, CommunicatorCollectives};
+    use mpi::traits::Communicator;
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let at: std::collections::HashMap<(usize, u8, u8), usize> = (whole.iter().enumerate())
         .map(|(j, f)| ((f.face.element, f.face.side, f.side), j))
@@ -798,18 +789,21 @@ fn own_faces_are_the_serial_ones(
         );
         worst = worst.max((f.flux - w.flux).abs() / q_scale);
     }
+    each_once(world, &count, &format!("{what}: every face"));
+    assert!(whole.iter().any(|f| f.paired_area > 0.0));
+    worst
+}
+
+/// `count` (this rank's count of each item) summed over the ranks is 1 for every item.
+fn each_once(world: &mpi::topology::SimpleCommunicator, count: &[f64], what: &str) {
+    use mpi::traits::CommunicatorCollectives;
     let mut counted = vec![0.0; count.len()];
     world.all_reduce_into(
-        &count[..],
+        count,
         &mut counted[..],
         mpi::collective::SystemOperation::sum(),
     );
-    assert!(
-        counted.iter().all(|&c| c == 1.0),
-        "{what}: every face on one rank"
-    );
-    assert!(whole.iter().any(|f| f.paired_area > 0.0));
-    worst
+    assert!(counted.iter().all(|&c| c == 1.0), "{what} on one rank");
 }
 
 /// `r` failed on rank `last` with a message holding `what`, and on every other rank

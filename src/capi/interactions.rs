@@ -225,6 +225,12 @@ pub unsafe extern "C" fn seam_set_time(embedding: *mut SeamEmbedding, time: f64)
     })
 }
 
+/// `n_nodes` points from the C array `coords` (xyz per node).
+pub(super) unsafe fn xyz(coords: *const f64, n_nodes: usize) -> Result<Vec<[f64; 3]>, Failure> {
+    let xyz = unsafe { slice(coords, n_nodes.saturating_mul(3), "coords") }?;
+    Ok(xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+}
+
 /// New coordinates of every node (3 per node): pairings are kept, gaps measured anew.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_move_nodes(
@@ -234,9 +240,7 @@ pub unsafe extern "C" fn seam_move_nodes(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let xyz = unsafe { slice(coords, n_nodes.saturating_mul(3), "coords") }?;
-        let points: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        e.inner.move_nodes(&points)?;
+        e.inner.move_nodes(&unsafe { xyz(coords, n_nodes) }?)?;
         e.forget_results();
         Ok(())
     })

@@ -178,8 +178,7 @@ pub unsafe extern "C" fn seam_rank_move_nodes(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let xyz = unsafe { slice(coords, n_nodes.saturating_mul(3), "coords") }?;
-        let points: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let points = unsafe { interactions::xyz(coords, n_nodes) }?;
         (e.evaluated, e.rows) = (None, None);
         Ok(e.inner.move_nodes(&points)?)
     })
@@ -322,6 +321,18 @@ pub unsafe extern "C" fn seam_rank_constraints(
             )
         }
     })
+}
+
+/// Tie `index`'s multipliers on this rank: their places in the whole tie, and its count.
+unsafe fn places(e: *const SeamRankEmbedding, index: usize) -> Result<(Vec<u64>, usize), Failure> {
+    let (_, places) = unsafe { rank_rows(e) }?;
+    let (place, total) = places.get(index).ok_or_else(|| {
+        bad(
+            format!("tie {index} does not exist ({} in all)", places.len()),
+            "ties are numbered from 0 in interaction order",
+        )
+    })?;
+    Ok((place.iter().map(|&k| k as u64).collect(), *total))
 }
 
 /// The rows of `seam_rank_constraints`, or why not.
@@ -541,11 +552,8 @@ pub unsafe extern "C" fn seam_rank_tie_point_fields(
 ) -> c_int {
     guard(|| {
         let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
-        let (place, total) = &unsafe { rank_rows(embedding) }?.1[index];
-        let place: Vec<u64> = place.iter().map(|&k| k as u64).collect();
-        let points = e
-            .inner
-            .tie_point_fields_at(t.interaction, &place, *total, lambda)?;
+        let (place, total) = unsafe { places(embedding, index) }?;
+        let points = (e.inner).tie_point_fields_at(t.interaction, &place, total, lambda)?;
         let e = unsafe { handle(embedding, "embedding") }?;
         unsafe {
             e.points
@@ -595,10 +603,9 @@ pub unsafe extern "C" fn seam_rank_tie_face_fields(
 ) -> c_int {
     guard(|| {
         let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
-        let (place, total) = &unsafe { rank_rows(embedding) }?.1[index];
-        let place: Vec<u64> = place.iter().map(|&k| k as u64).collect();
+        let (place, total) = unsafe { places(embedding, index) }?;
         let faces =
-            (e.inner).tie_face_fields_at(t.interaction, &place, *total, lambda, side_b != 0)?;
+            (e.inner).tie_face_fields_at(t.interaction, &place, total, lambda, side_b != 0)?;
         let e = unsafe { handle(embedding, "embedding") }?;
         e.faces = faces.iter().map(fields::SeamFaceValues::from).collect();
         unsafe { fields::array_out(&e.faces, out_n, out_values) }
