@@ -427,6 +427,10 @@ int seam_rank_move_nodes(seam_rank_embedding *embedding, const double *coords, s
 /* Over all ranks, the side-A points of the last search paired with a side-B face that
  * another rank gave (the pairs that straddle ranks). Local. */
 int seam_rank_points_across(const seam_rank_embedding *embedding, size_t *out_count);
+/* What the last search of interaction `index` paired, over every rank (seam_coverage's
+ * values; the same on every rank, which holds the whole pairing). Local. */
+int seam_rank_coverage(const seam_rank_embedding *embedding, size_t index,
+                       seam_coverage_info *out_coverage);
 /* Evaluate this rank's own points at the field u_local: one value per local node (owned
  * and ghost, in the builder's node order), current at least at the nodes of the
  * elements of this rank's interface faces. seam gathers what the other ranks' points

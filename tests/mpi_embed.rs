@@ -40,6 +40,9 @@ struct Printed {
     /// The same from the faces' mean flux (`seam_rank_face_fields`): over side A's
     /// faces, over side B's, and the count of faces.
     face_fields: Option<(f64, f64, usize)>,
+    /// The gap conductance's coverage on rank 0 (`seam_rank_coverage`): side-A points,
+    /// paired points, paired area.
+    coverage: Option<(usize, usize, f64)>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -141,6 +144,7 @@ fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
         dual_heat: optional("dual heat from the residual:").map(|v| [v[0], v[1]]),
         point_fields: optional("point fields:").map(|v| (v[0], v[1] as usize)),
         face_fields: optional("face fields:").map(|v| (v[0], v[1], v[2] as usize)),
+        coverage: optional("coverage:").map(|v| (v[0] as usize, v[1] as usize, v[2])),
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -240,6 +244,17 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
             *points.get_or_insert(count),
             count,
             "every point once on {n} ranks"
+        );
+        // Every point paired, over the whole unit face, on every rank count.
+        let (all_points, paired, area) = par.coverage.expect("the host prints its coverage");
+        assert_eq!(
+            (all_points, paired),
+            (count, count),
+            "coverage on {n} ranks"
+        );
+        assert!(
+            (area - 1.0).abs() <= 1e-12,
+            "paired area {area} on {n} ranks"
         );
         let (on_a, on_b, n_faces) = par.face_fields.expect("the host prints its face fields");
         let dq_faces = (on_a - par.heat[0]).abs().max((on_b - par.heat[0]).abs());
@@ -579,6 +594,18 @@ fn rank_terms_child() {
             &format!("interaction {i}"),
         ));
         assert!(whole.iter().any(|p| p.paired));
+        // The pairing's coverage: the whole interaction's, on every rank.
+        let (c, w) = (e.coverage(i).unwrap(), serial.coverage(i).unwrap());
+        assert_eq!(
+            (c.points, c.paired_points, c.unpaired.len()),
+            (w.points, w.paired_points, w.unpaired.len()),
+            "interaction {i}: coverage"
+        );
+        assert!(
+            (c.area - w.area).abs() <= 1e-12 * w.area
+                && (c.paired_area - w.paired_area).abs() <= 1e-12 * w.area,
+            "interaction {i}: {c:?} against {w:?}"
+        );
         let whole = serial.face_fields(i, &u, true).expect("serial face fields");
         let own = e.face_fields(i, &u_local, true).expect("rank face fields");
         point_diff = point_diff.max(own_faces_are_the_serial_ones(

@@ -436,6 +436,12 @@ int main(int argc, char **argv) {
         }
         PetscCallMPI(MPI_Allreduce(own, all, 2, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD));
         if (rank == 0) printf("point fields: %.17g %.0f\n", all[0], all[1]);
+        /* What the search paired: the whole interaction's, on every rank. */
+        seam_coverage_info coverage;
+        CHECK(seam_rank_coverage(s, 0, &coverage));
+        if (rank == 0)
+            printf("coverage: %zu %zu %.17g\n", coverage.points, coverage.paired_points,
+                   coverage.paired_area);
         /* Per face, the mean flux over its paired area, on the faces this rank gave:
          * summed over the ranks, side A's and side B's each carry the heat. */
         size_t n_faces;

@@ -102,6 +102,25 @@ impl From<&PointValues> for SeamPointValues {
     }
 }
 
+impl From<&Coverage> for SeamCoverage {
+    fn from(c: &Coverage) -> Self {
+        let (has_gap, (gap_min, gap_max)) = match c.gap_range {
+            Some(g) => (1, g),
+            None => (0, (0.0, 0.0)),
+        };
+        SeamCoverage {
+            points: c.points,
+            paired_points: c.paired_points,
+            area: c.area,
+            paired_area: c.paired_area,
+            unpaired: c.unpaired.len(),
+            has_gap,
+            gap_min,
+            gap_max,
+        }
+    }
+}
+
 impl From<&FaceValues> for SeamFaceValues {
     fn from(f: &FaceValues) -> Self {
         SeamFaceValues {
@@ -146,21 +165,7 @@ pub unsafe extern "C" fn seam_coverage(
         // SAFETY: a non-null handle came from this library (module Safety).
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
         let c: Coverage = e.inner.coverage(index)?;
-        let (has_gap, (gap_min, gap_max)) = match c.gap_range {
-            Some(g) => (1, g),
-            None => (0, (0.0, 0.0)),
-        };
-        let value = SeamCoverage {
-            points: c.points,
-            paired_points: c.paired_points,
-            area: c.area,
-            paired_area: c.paired_area,
-            unpaired: c.unpaired.len(),
-            has_gap,
-            gap_min,
-            gap_max,
-        };
-        unsafe { out(out_coverage, value, "out_coverage") }
+        unsafe { out(out_coverage, SeamCoverage::from(&c), "out_coverage") }
     })
 }
 

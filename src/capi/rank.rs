@@ -184,6 +184,22 @@ pub unsafe extern "C" fn seam_rank_move_nodes(
     })
 }
 
+/// What the last search of interaction `index` paired, over every rank (the same on
+/// every rank: each holds the whole pairing). Local.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_coverage(
+    embedding: *const SeamRankEmbedding,
+    index: usize,
+    out_coverage: *mut fields::SeamCoverage,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let c = e.inner.coverage(index)?;
+        unsafe { out(out_coverage, fields::SeamCoverage::from(&c), "out_coverage") }
+    })
+}
+
 /// Over all ranks, the side-A points of the last search whose side-B face another rank
 /// gave.
 #[unsafe(no_mangle)]

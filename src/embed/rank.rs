@@ -858,6 +858,13 @@ impl RankEmbedding {
         self.inner.own_points(Some(&owns));
     }
 
+    /// What the last search of interaction `i` paired, over every rank: every rank
+    /// holds the whole pairing, so this is the serial [`Embedding::coverage`] and the
+    /// same on every rank (local).
+    pub fn coverage(&self, i: usize) -> Result<super::Coverage, EmbedError> {
+        self.inner.coverage(i)
+    }
+
     /// Over all ranks, the side-A points (of the last search) paired with a side-B face
     /// that another rank gave: the pairs that straddle ranks.
     pub fn points_across(&self) -> usize {
