@@ -417,6 +417,10 @@ int seam_rank_add_interaction(seam_rank_embedding *embedding, const char *side_a
 /* As seam_add_deck: the same deck on every rank (name may be NULL). */
 int seam_rank_add_deck(seam_rank_embedding *embedding, const char *deck_text, const char *name,
                        size_t *out_count);
+/* As seam_add_deck_file: every rank reads the same file (relative paths in it from its
+ * folder), which must be readable from every rank. */
+int seam_rank_add_deck_file(seam_rank_embedding *embedding, const char *path,
+                            size_t *out_count);
 /* Pair every interaction anew: the serial search of the whole interface, on every rank;
  * each rank keeps the points of its own side-A faces. */
 int seam_rank_search(seam_rank_embedding *embedding);

@@ -477,7 +477,7 @@ fn rank_terms_sum_to_the_serial_terms() {
         }
         assert_eq!(
             text.matches("refused on every rank").count(),
-            3 * n,
+            4 * n,
             "every rank saw the bad input refused:\n{text}"
         );
     }
@@ -698,6 +698,37 @@ fn rank_terms_child() {
         "deck heat {} against serial {}",
         got.side_a,
         want.side_a
+    );
+
+    // The same deck from a file every rank reads: the same heat; a file the last rank
+    // cannot read fails every rank.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("mpi-embed-deck-{size}"));
+    if rank == 0 {
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("bricks.i"), &gap).unwrap();
+    }
+    world.barrier();
+    let mut from_file = b.clone().build_on_ranks(world.duplicate(), &gids).unwrap();
+    let added = from_file.add_deck_file(&dir.join("bricks.i"));
+    assert_eq!(added.expect("deck file"), vec![0]);
+    from_file.search().unwrap();
+    let got = from_file.contributions(&u_local).unwrap().heat[0].unwrap();
+    assert!(
+        (want.side_a - got.side_a).abs() <= 1e-12 * want.side_a.abs(),
+        "deck file heat {} against serial {}",
+        got.side_a,
+        want.side_a
+    );
+    let unreadable = dir.join(if rank == size - 1 {
+        "missing.i"
+    } else {
+        "bricks.i"
+    });
+    refused_everywhere(
+        rank,
+        size - 1,
+        from_file.add_deck_file(&unreadable).map(|_| ()),
+        "missing.i",
     );
 
     // The last rank gives a non-finite field at one of its interface nodes, then one

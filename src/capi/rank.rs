@@ -156,6 +156,23 @@ pub unsafe extern "C" fn seam_rank_add_deck(
     })
 }
 
+/// As `seam_add_deck_file`: every rank reads the same file (relative paths in it from
+/// its folder). Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_add_deck_file(
+    embedding: *mut SeamRankEmbedding,
+    path: *const c_char,
+    out_count: *mut usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let path = unsafe { text(path, "path") }?;
+        let added = e.inner.add_deck_file(std::path::Path::new(path))?;
+        (e.evaluated, e.rows) = (None, None);
+        unsafe { interactions::optional_out(out_count, added.len()) }
+    })
+}
+
 /// Pair every interaction anew. Collective.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn seam_rank_search(embedding: *mut SeamRankEmbedding) -> c_int {

@@ -524,6 +524,14 @@ impl RankEmbedding {
         agree(&self.comm, r)
     }
 
+    /// The interactions of a deck file (collective), as [`Embedding::add_deck_file`]:
+    /// every rank reads the same file (relative paths in it from its folder), so it must
+    /// be readable from every rank; a rank that cannot read it fails every rank.
+    pub fn add_deck_file(&mut self, path: &std::path::Path) -> Result<Vec<usize>, EmbedError> {
+        let r = self.inner.add_deck_file(path);
+        agree(&self.comm, r)
+    }
+
     /// The rows of every mortar tie that belong to this rank (collective), in
     /// interaction order: the multipliers whose side-A node this rank owns (the lowest
     /// rank among the interface elements around it), in the host's global dofs. Each
