@@ -43,6 +43,8 @@ struct Printed {
     /// The gap conductance's coverage on rank 0 (`seam_rank_coverage`): side-A points,
     /// paired points, paired area.
     coverage: Option<(usize, usize, f64)>,
+    /// Every rank saw a null field on the last rank refused (1), none left waiting.
+    refused: Option<f64>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -145,6 +147,7 @@ fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
         point_fields: optional("point fields:").map(|v| (v[0], v[1] as usize)),
         face_fields: optional("face fields:").map(|v| (v[0], v[1], v[2] as usize)),
         coverage: optional("coverage:").map(|v| (v[0] as usize, v[1] as usize, v[2])),
+        refused: optional("bad argument refused on every rank:").map(|v| v[0]),
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -244,6 +247,11 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
             *points.get_or_insert(count),
             count,
             "every point once on {n} ranks"
+        );
+        assert_eq!(
+            par.refused,
+            Some(1.0),
+            "a null field on the last of {n} ranks"
         );
         // Every point paired, over the whole unit face, on every rank count.
         let (all_points, paired, area) = par.coverage.expect("the host prints its coverage");

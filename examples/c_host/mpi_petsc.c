@@ -322,6 +322,14 @@ int main(int argc, char **argv) {
         PetscCall(MatSetValues(K, 8, rows, 8, rows, &ke[0][0], ADD_VALUES));
     }
     static double zero[NODES];
+    /* A bad argument on one rank (no field on the last) fails the call on every rank, that
+     * rank with its own status and the others with SEAM_ERR_OTHER_RANK: none is left
+     * waiting in the collective. */
+    const int last = rank == size - 1;
+    int status = seam_rank_evaluate(s, last ? NULL : zero, (size_t)n_local);
+    int as_expected = status == (last ? SEAM_ERR_NULL_ARGUMENT : SEAM_ERR_OTHER_RANK), all_expected;
+    PetscCallMPI(MPI_Allreduce(&as_expected, &all_expected, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD));
+    if (rank == 0) printf("bad argument refused on every rank: %d\n", all_expected);
     CHECK(seam_rank_evaluate(s, zero, (size_t)n_local)); /* a linear model: J at any u */
     size_t n;
     const int64_t *rows, *cols, *dofs;

@@ -70,28 +70,34 @@ pub unsafe extern "C" fn seam_rank_new(
     out_embedding: *mut *mut SeamRankEmbedding,
 ) -> c_int {
     guard(|| {
-        if out_embedding.is_null() {
-            return Err(null("out_embedding"));
-        }
-        // SAFETY: null or valid for the call (module Safety).
-        unsafe { out_embedding.write(std::ptr::null_mut()) };
-        // SAFETY: a non-null handle came from this library (module Safety).
-        let b = unsafe { builder.as_ref() }.ok_or_else(|| null("builder"))?;
-        let b = b.0.clone().ok_or_else(|| null("builder"))?;
-        let ids = unsafe { slice(global_ids, n_nodes, "global_ids") }?;
-        let ids = ids
-            .iter()
-            .map(|&g| {
-                u64::try_from(g).map_err(|_| {
-                    bad(
-                        format!("global id {g} is negative"),
-                        "global ids are 0-based",
-                    )
-                })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        // The communicator first (collective): every argument is then checked on every
+        // rank before the build, so a bad one on one rank fails them all.
         // SAFETY: the host passes MPI_COMM_NULL or a communicator of its MPI (seam.h).
         let comm = unsafe { crate::embed::duplicate(comm) }?;
+        let args = (|| {
+            if out_embedding.is_null() {
+                return Err(null("out_embedding"));
+            }
+            // SAFETY: null or valid for the call (module Safety).
+            unsafe { out_embedding.write(std::ptr::null_mut()) };
+            // SAFETY: a non-null handle came from this library (module Safety).
+            let b = unsafe { builder.as_ref() }.ok_or_else(|| null("builder"))?;
+            let b = b.0.clone().ok_or_else(|| null("builder"))?;
+            let ids = unsafe { slice(global_ids, n_nodes, "global_ids") }?;
+            let ids = ids
+                .iter()
+                .map(|&g| {
+                    u64::try_from(g).map_err(|_| {
+                        bad(
+                            format!("global id {g} is negative"),
+                            "global ids are 0-based",
+                        )
+                    })
+                })
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok((b, ids))
+        })();
+        let (b, ids) = on_every_rank(&comm, args)?;
         let inner = b.build_on_ranks(comm, &ids)?;
         let e = Box::new(SeamRankEmbedding {
             inner,
@@ -129,8 +135,11 @@ pub unsafe extern "C" fn seam_rank_add_interaction(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let (a, b) = unsafe { (text(side_a, "side_a")?, text(side_b, "side_b")?) };
-        let model = interactions::model_of(model, h)?;
+        let args = (|| {
+            let (a, b) = unsafe { (text(side_a, "side_a")?, text(side_b, "side_b")?) };
+            Ok::<_, Failure>((a, b, interactions::model_of(model, h)?))
+        })();
+        let (a, b, model) = on_every_rank(e.inner.comm(), args)?;
         let i = e
             .inner
             .add_interaction(Interaction::new(a, b, model).offset(offset))?;
@@ -149,7 +158,8 @@ pub unsafe extern "C" fn seam_rank_add_deck(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let (deck, name) = unsafe { interactions::deck_args(deck_text, name) }?;
+        let args = unsafe { interactions::deck_args(deck_text, name) };
+        let (deck, name) = on_every_rank(e.inner.comm(), args)?;
         let added = e.inner.add_deck(name, deck)?;
         (e.evaluated, e.rows) = (None, None);
         unsafe { interactions::optional_out(out_count, added.len()) }
@@ -166,7 +176,7 @@ pub unsafe extern "C" fn seam_rank_add_deck_file(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let path = unsafe { text(path, "path") }?;
+        let path = on_every_rank(e.inner.comm(), unsafe { text(path, "path") })?;
         let added = e.inner.add_deck_file(std::path::Path::new(path))?;
         (e.evaluated, e.rows) = (None, None);
         unsafe { interactions::optional_out(out_count, added.len()) }
@@ -195,7 +205,9 @@ pub unsafe extern "C" fn seam_rank_move_nodes(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let points = unsafe { interactions::xyz(coords, n_nodes) }?;
+        let points = on_every_rank(e.inner.comm(), unsafe {
+            interactions::xyz(coords, n_nodes)
+        })?;
         (e.evaluated, e.rows) = (None, None);
         Ok(e.inner.move_nodes(&points)?)
     })
@@ -241,7 +253,9 @@ pub unsafe extern "C" fn seam_rank_evaluate(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let u = unsafe { slice(u_local, n_nodes, "u_local") }?;
+        let u = on_every_rank(e.inner.comm(), unsafe {
+            slice(u_local, n_nodes, "u_local")
+        })?;
         e.evaluated = None;
         e.evaluated = Some(Evaluated::from(e.inner.contributions(u)?));
         Ok(())
@@ -505,10 +519,8 @@ pub unsafe extern "C" fn seam_rank_dual_tie_heat(
     })
 }
 
-/// The handle, tie `index`'s rows on this rank and the `n` values at `values`, for a
-/// collective call: a bad argument on one rank must not leave the others waiting in
-/// the sum, so this rank returns its own failure and the others
-/// `SEAM_ERR_OTHER_RANK`.
+/// The handle, tie `index`'s rows on this rank and the `n` values at `values`, agreed
+/// on every rank ([`on_every_rank`]) for a collective call.
 unsafe fn tie_on_every_rank<'a>(
     embedding: *const SeamRankEmbedding,
     index: usize,
@@ -522,16 +534,31 @@ unsafe fn tie_on_every_rank<'a>(
         let (t, _) = unsafe { rank_rows(embedding) }?.0.tie(index)?;
         Ok::<_, Failure>((t, unsafe { slice(values, n, name) }?))
     })();
-    let agreed = e.inner.agree_on(match &local {
-        Ok(_) => Ok(()),
-        Err(f) => Err(crate::embed::EmbedError::Argument {
-            what: f.1.clone(),
-            help: String::new(),
-        }),
-    });
-    let (t, values) = local?;
-    agreed?;
+    let (t, values) = on_every_rank(e.inner.comm(), local)?;
     Ok((e, t, values))
+}
+
+/// This rank's reading of its arguments, agreed on before a collective call: a bad
+/// argument (a null or short array, a bad string) on one rank must not leave the others
+/// waiting, so this rank returns its own failure and the others
+/// `SEAM_ERR_OTHER_RANK`.
+fn on_every_rank<T>(
+    comm: &mpi::topology::SimpleCommunicator,
+    local: Result<T, Failure>,
+) -> Result<T, Failure> {
+    let agreed = crate::embed::agree(
+        comm,
+        match &local {
+            Ok(_) => Ok(()),
+            Err(f) => Err(crate::embed::EmbedError::Argument {
+                what: f.1.clone(),
+                help: String::new(),
+            }),
+        },
+    );
+    let value = local?;
+    agreed?;
+    Ok(value)
 }
 
 /// The values at this rank's own side-A points of flux interaction `index` at the
@@ -555,7 +582,9 @@ pub unsafe extern "C" fn seam_rank_point_fields(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let u = unsafe { slice(u_local, n_nodes, "u_local") }?;
+        let u = on_every_rank(e.inner.comm(), unsafe {
+            slice(u_local, n_nodes, "u_local")
+        })?;
         let points = e.inner.point_fields(index, u)?;
         unsafe {
             e.points
@@ -612,7 +641,9 @@ pub unsafe extern "C" fn seam_rank_face_fields(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let u = unsafe { slice(u_local, n_nodes, "u_local") }?;
+        let u = on_every_rank(e.inner.comm(), unsafe {
+            slice(u_local, n_nodes, "u_local")
+        })?;
         let faces = e.inner.face_fields(index, u, side_b != 0)?;
         e.faces = faces.iter().map(fields::SeamFaceValues::from).collect();
         unsafe { fields::array_out(&e.faces, out_n, out_values) }

@@ -588,5 +588,7 @@ pub use csr::{CsrMatrix, Evaluation};
 pub(crate) use fields::face_values;
 pub use fields::{Coverage, FaceValues, HostFace, PointValues, Unpaired, UnpairedReason};
 #[cfg(feature = "mpi")]
+pub(crate) use rank::agree;
+#[cfg(feature = "mpi")]
 pub use rank::{RankEmbedding, RankPoint, RankTie, duplicate};
 pub use ties::TieConstraints;

@@ -160,7 +160,10 @@ pub unsafe fn duplicate(comm: mpi::ffi::MPI_Comm) -> Result<SimpleCommunicator, 
 
 /// An error on some rank becomes an error on every rank: the lowest failing rank's own
 /// error there, [`EmbedError::OtherRank`] naming it elsewhere.
-fn agree<T>(comm: &SimpleCommunicator, r: Result<T, EmbedError>) -> Result<T, EmbedError> {
+pub(crate) fn agree<T>(
+    comm: &SimpleCommunicator,
+    r: Result<T, EmbedError>,
+) -> Result<T, EmbedError> {
     let (rank, size) = (comm.rank(), comm.size());
     let mine = if r.is_err() { rank } else { size };
     let mut first = size;
@@ -559,10 +562,9 @@ impl RankEmbedding {
             .collect())
     }
 
-    /// `r` on this rank, made an error on every rank when it is one on any (collective):
-    /// for a caller that checks its arguments before a collective call.
-    pub(crate) fn agree_on<T>(&self, r: Result<T, EmbedError>) -> Result<T, EmbedError> {
-        agree(&self.comm, r)
+    /// Its communicator (seam's duplicate of the host's).
+    pub(crate) fn comm(&self) -> &SimpleCommunicator {
+        &self.comm
     }
 
     /// Heat (W) through a tie for this rank's multipliers `lambda` (one per entry of
@@ -601,9 +603,8 @@ impl RankEmbedding {
     /// in the interaction's point order (the serial [`Embedding::point_fields`] order)
     /// with its values, its faces named as the ranks that gave them name them (side A's
     /// is this rank's own element; side B's is `side_b_rank`'s). A point is its side-A
-    /// face's rank's (or, on a node surface, its
-    /// node's owner's), so the ranks' lists together are the serial list, each point
-    /// once.
+    /// face's rank's (or, on a node surface, its node's owner's), so the ranks' lists
+    /// together are the serial list, each point once.
     pub fn point_fields(&self, i: usize, u_local: &[f64]) -> Result<Vec<RankPoint>, EmbedError> {
         let u = self.whole_field(u_local)?;
         let values = agree(&self.comm, self.inner.point_fields(i, &u))?;
@@ -848,10 +849,10 @@ impl RankEmbedding {
         let all = self.whole(&mine, 3);
         let coords: Vec<[f64; 3]> = all.chunks_exact(3).map(|x| [x[0], x[1], x[2]]).collect();
         let moved = self.inner.move_nodes(&coords);
-        agree(&self.comm, moved)?;
-        // A move forgets which points are whose.
+        // A move forgets which points are whose, even one that failed part of the way
+        // (a rank must never go on evaluating every point).
         self.keep_own_points();
-        Ok(())
+        agree(&self.comm, moved)
     }
 
     /// Evaluate only this rank's own side-A points: those of the faces it gave, and on
