@@ -199,11 +199,37 @@ pub(crate) fn written_zeros(n: usize) -> Vec<f64> {
     v
 }
 
+/// The slot of every entry of a block's element matrices (`ne` dofs each, `dofs` in
+/// element order) in the CSC structure, into `slots`: each column's rows read once for
+/// all the element's dofs (the counting search of [`positions`]), not one binary search
+/// per entry.
+pub(super) fn element_slots(
+    col_ptr: &[usize],
+    row_idx: &[u32],
+    dofs: &[u32],
+    ne: usize,
+    slots: &mut [u32],
+) {
+    slots
+        .par_chunks_mut((ne * ne).max(1))
+        .zip(dofs.par_chunks(ne.max(1)))
+        .with_min_len(256)
+        .for_each_init(
+            || vec![0usize; ne * ne],
+            |at, (slots, d)| {
+                positions(col_ptr, row_idx, d, at);
+                for (s, &p) in slots.iter_mut().zip(at.iter()) {
+                    *s = p as u32;
+                }
+            },
+        );
+}
+
 /// The CSC position of every entry `(d[a], d[b])` of an element, row-major into `at`
 /// (`usize::MAX` where a dof is missing): in column `d[b]`, the count of its rows below
 /// `d[a]`. Elements of 4 and 8 dofs count all their rows against a column in one pass
 /// ([`positions_of`]); others search each.
-pub(super) fn positions(col_ptr: &[usize], row_idx: &[u32], d: &[u32], at: &mut [usize]) {
+fn positions(col_ptr: &[usize], row_idx: &[u32], d: &[u32], at: &mut [usize]) {
     if let Ok(d) = <&[u32; 8]>::try_from(d) {
         return positions_of(col_ptr, row_idx, d, at);
     }

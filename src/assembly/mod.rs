@@ -500,21 +500,7 @@ impl Pattern {
             let (block_part, tail) = elem_part.split_at_mut(count * ne * ne);
             elem_part = tail;
             let dofs = &self.elem_dofs[dof_off..dof_off + count * ne];
-            // Each column's rows read once for all the element's dofs (the counting
-            // search of the direct assembly), not one binary search per entry.
-            block_part
-                .par_chunks_mut((ne * ne).max(1))
-                .zip(dofs.par_chunks(ne.max(1)))
-                .with_min_len(256)
-                .for_each_init(
-                    || vec![0usize; ne * ne],
-                    |at, (slots, d)| {
-                        direct::positions(&col_ptr, &row_idx, d, at);
-                        for (s, &p) in slots.iter_mut().zip(at.iter()) {
-                            *s = p as u32;
-                        }
-                    },
-                );
+            direct::element_slots(&col_ptr, &row_idx, dofs, ne, block_part);
             dof_off += count * ne;
         }
         let (coupling_part, diag_part) = rest.split_at_mut(2 * self.couplings.len());
