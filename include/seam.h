@@ -443,7 +443,8 @@ int seam_rank_evaluate(seam_rank_embedding *embedding, const double *u_local, si
 /* The last evaluation's terms of this rank's points, in the host's global dof numbers
  * (rows and dofs may belong to other ranks: add them with ADD_VALUES); as
  * seam_residual, seam_jacobian and seam_load. The arrays belong to the handle and stay
- * valid until the next seam_rank_evaluate, _search, _add_interaction or _free. */
+ * valid until the next seam_rank_evaluate, _search, _move_nodes, _add_interaction,
+ * _add_deck, _add_deck_file or _free. */
 int seam_rank_residual(const seam_rank_embedding *embedding, size_t *out_n,
                        const int64_t **out_dofs, const double **out_values);
 int seam_rank_jacobian(const seam_rank_embedding *embedding, size_t *out_n,
@@ -456,7 +457,8 @@ int seam_rank_load(const seam_rank_embedding *embedding, size_t *out_n,
  * around it), in global dofs, so every multiplier's row comes from one rank. Computes
  * them (collective) and returns this rank's condensed rows of the dual ties, as
  * seam_constraints. The arrays of these calls belong to the handle and stay valid
- * until the next seam_rank_constraints, _search, _add_interaction, _add_deck or _free. */
+ * until the next seam_rank_constraints, _search, _move_nodes, _add_interaction, _add_deck,
+ * _add_deck_file or _free. */
 int seam_rank_constraints(seam_rank_embedding *embedding, size_t *out_n_rows,
                           const int64_t **out_dofs, const double **out_constants,
                           const size_t **out_offsets, const int64_t **out_cols,
