@@ -509,7 +509,7 @@ int seam_rank_point_fields(seam_rank_embedding *embedding, size_t index, const d
 /* Values at this rank's own side-A points of tie `tie` (after seam_rank_constraints) for
  * this rank's multipliers lambda (n, in this rank's order; for a condensed dual tie those
  * of seam_rank_dual_multipliers), as seam_rank_point_fields gives them: multiplier is the
- * multiplier field at the point, from every rank's multipliers (gathered). Arrays valid
+ * multiplier field at the point, summed from every rank's multipliers. Arrays valid
  * until the next point-field call. Collective. */
 int seam_rank_tie_point_fields(seam_rank_embedding *embedding, size_t tie, const double *lambda,
                                size_t n, size_t *out_n, const seam_point_values **out_values,

@@ -1049,7 +1049,7 @@ fn rank_ties_child() {
         // The multiplier field at each rank's own points: its faces' multipliers come
         // from whichever ranks own them.
         let whole = serial.tie_point_fields(&want, &lambda_serial).unwrap();
-        let own = e.tie_point_fields(&got, &lambda_rank).unwrap();
+        let own = e.tie_point_fields(&got.rows, &lambda_rank).unwrap();
         let field_diff = own_points_are_the_serial_ones(
             &world,
             n_elems,
@@ -1059,7 +1059,7 @@ fn rank_ties_child() {
         );
         assert!(whole.iter().any(|p| p.multiplier.is_some()));
         let whole = serial.tie_face_fields(&want, &lambda_serial, true).unwrap();
-        let own = e.tie_face_fields(&got, &lambda_rank, true).unwrap();
+        let own = e.tie_face_fields(&got.rows, &lambda_rank, true).unwrap();
         let field_diff = field_diff.max(own_faces_are_the_serial_ones(
             &world,
             n_elems,

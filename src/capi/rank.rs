@@ -370,18 +370,6 @@ pub unsafe extern "C" fn seam_rank_constraints(
     })
 }
 
-/// Tie `index`'s multipliers on this rank: their places in the whole tie, and its count.
-unsafe fn places(e: *const SeamRankEmbedding, index: usize) -> Result<(Vec<u64>, usize), Failure> {
-    let (_, places) = unsafe { rank_rows(e) }?;
-    let (place, total) = places.get(index).ok_or_else(|| {
-        bad(
-            format!("tie {index} does not exist ({} in all)", places.len()),
-            "ties are numbered from 0 in interaction order",
-        )
-    })?;
-    Ok((place.iter().map(|&k| k as u64).collect(), *total))
-}
-
 /// The rows of `seam_rank_constraints`, or why not.
 unsafe fn rank_rows<'a>(e: *const SeamRankEmbedding) -> Result<&'a (Rows, Vec<Places>), Failure> {
     // SAFETY: a non-null handle came from this library (module Safety).
@@ -597,8 +585,8 @@ pub unsafe extern "C" fn seam_rank_point_fields(
 /// `seam_rank_constraints`) for this rank's multipliers `lambda` (`n`, in this rank's
 /// order: the host's unknowns, or `seam_rank_dual_multipliers`' for a condensed dual
 /// tie), with each point's index and side-B face's rank, as `seam_rank_point_fields`
-/// gives them; `multiplier` is the multiplier field λ_h at the point, gathered from
-/// every rank's multipliers. The arrays stay valid until the next point-field call.
+/// gives them; `multiplier` is the multiplier field λ_h at the point, summed from every
+/// rank's multipliers. The arrays stay valid until the next point-field call.
 /// Collective.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
@@ -614,8 +602,7 @@ pub unsafe extern "C" fn seam_rank_tie_point_fields(
 ) -> c_int {
     guard(|| {
         let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
-        let (place, total) = unsafe { places(embedding, index) }?;
-        let points = (e.inner).tie_point_fields_at(t.interaction, &place, total, lambda)?;
+        let points = e.inner.tie_point_fields(t, lambda)?;
         let e = unsafe { handle(embedding, "embedding") }?;
         unsafe {
             e.points
@@ -667,9 +654,7 @@ pub unsafe extern "C" fn seam_rank_tie_face_fields(
 ) -> c_int {
     guard(|| {
         let (e, t, lambda) = unsafe { tie_on_every_rank(embedding, index, lambda, n, "lambda") }?;
-        let (place, total) = unsafe { places(embedding, index) }?;
-        let faces =
-            (e.inner).tie_face_fields_at(t.interaction, &place, total, lambda, side_b != 0)?;
+        let faces = e.inner.tie_face_fields(t, lambda, side_b != 0)?;
         let e = unsafe { handle(embedding, "embedding") }?;
         e.faces = faces.iter().map(fields::SeamFaceValues::from).collect();
         unsafe { fields::array_out(&e.faces, out_n, out_values) }

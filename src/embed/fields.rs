@@ -297,12 +297,43 @@ impl Embedding {
         tie: &TieConstraints,
         lambda: &[f64],
     ) -> Result<Vec<PointValues>, EmbedError> {
+        self.tie_point_values(tie.interaction, &self.tie_field(tie, lambda)?)
+    }
+
+    /// Per face of a mortar tie for its multipliers `lambda` (see
+    /// [`Self::tie_point_fields`]): side A's faces, then side B's with `side_b`.
+    pub fn tie_face_fields(
+        &self,
+        tie: &TieConstraints,
+        lambda: &[f64],
+        side_b: bool,
+    ) -> Result<Vec<FaceValues>, EmbedError> {
+        self.tie_face_values(tie.interaction, &self.tie_field(tie, lambda)?, side_b)
+    }
+
+    /// The multiplier field of `tie` for `lambda` at each point of its pairing (`None`
+    /// where it has no multiplier).
+    pub(crate) fn tie_field(
+        &self,
+        tie: &TieConstraints,
+        lambda: &[f64],
+    ) -> Result<Vec<Option<f64>>, EmbedError> {
         let p = self.pair_at(tie.interaction)?;
+        tie.multiplier_field(lambda, Self::searched(p)?.points.len())
+    }
+
+    /// The point values of the tie of interaction `i` for its multiplier `field` (one
+    /// per point).
+    pub(crate) fn tie_point_values(
+        &self,
+        i: usize,
+        field: &[Option<f64>],
+    ) -> Result<Vec<PointValues>, EmbedError> {
+        let p = self.pair_at(i)?;
         let points = &Self::searched(p)?.points;
-        let field = tie.multiplier_field(lambda, points.len())?;
         Ok(points
             .iter()
-            .zip(&field)
+            .zip(field)
             .map(|(q, m)| {
                 let flux = m.map(|m| PointFlux {
                     q: m,
@@ -314,17 +345,15 @@ impl Embedding {
             .collect())
     }
 
-    /// Per face of a mortar tie for its multipliers `lambda` (see
-    /// [`Self::tie_point_fields`]): side A's faces, then side B's with `side_b`.
-    pub fn tie_face_fields(
+    /// The face values of the tie of interaction `i` for its multiplier `field`.
+    pub(crate) fn tie_face_values(
         &self,
-        tie: &TieConstraints,
-        lambda: &[f64],
+        i: usize,
+        field: &[Option<f64>],
         side_b: bool,
     ) -> Result<Vec<FaceValues>, EmbedError> {
-        let p = self.pair_at(tie.interaction)?;
+        let p = self.pair_at(i)?;
         let points = &Self::searched(p)?.points;
-        let field = tie.multiplier_field(lambda, points.len())?;
         Ok(face_values(&p.a, &p.b, points, |k| field[k], side_b))
     }
 }

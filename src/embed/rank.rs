@@ -611,64 +611,64 @@ impl RankEmbedding {
         Ok(self.own_points_of(i, &values))
     }
 
-    /// The values at this rank's own side-A points of a mortar tie (`tie` one of
-    /// [`Self::constraints`]) for this rank's multipliers `lambda` (one per entry of
-    /// `tie.index`: the host's unknowns, or those of
+    /// The values at this rank's own side-A points of a mortar tie for this rank's
+    /// multipliers `lambda` (`rows` a [`RankTie`]'s; one value per entry of its
+    /// `multiplier_dofs`: the host's unknowns, or those of
     /// [`TieConstraints::dual_multipliers_at`] for a condensed dual tie), as
-    /// [`Self::point_fields`] gives them: the multiplier field at a point takes the
-    /// multipliers of its face's nodes, whichever ranks own them, so every rank's are
-    /// gathered first (collective; 16 B per multiplier).
+    /// [`Self::point_fields`] gives them (collective). The multiplier field at a point
+    /// takes the multipliers of its face's nodes, which other ranks may own: each rank's
+    /// share of the field at every point is summed over the ranks (16 B per point).
     pub fn tie_point_fields(
         &self,
-        tie: &RankTie,
+        rows: &TieConstraints,
         lambda: &[f64],
     ) -> Result<Vec<RankPoint>, EmbedError> {
-        let place: Vec<u64> = tie.index.iter().map(|&k| k as u64).collect();
-        self.tie_point_fields_at(tie.rows.interaction, &place, tie.total, lambda)
+        let field = self.tie_field(rows, lambda)?;
+        let values = agree(
+            &self.comm,
+            self.inner.tie_point_values(rows.interaction, &field),
+        )?;
+        Ok(self.own_points_of(rows.interaction, &values))
     }
 
-    /// [`Self::tie_point_fields`] of the tie of interaction `i`, with this rank's
-    /// multipliers' places in the whole tie `place` and the tie's count of them `total`.
-    pub(crate) fn tie_point_fields_at(
-        &self,
-        i: usize,
-        place: &[u64],
-        total: usize,
-        lambda: &[f64],
-    ) -> Result<Vec<RankPoint>, EmbedError> {
-        let (rows, whole) = self.whole_tie(i, place, total, lambda)?;
-        let values = agree(&self.comm, self.inner.tie_point_fields(&rows, &whole))?;
-        Ok(self.own_points_of(i, &values))
-    }
-
-    /// Per face of the mortar tie `tie` for this rank's multipliers `lambda` (as
+    /// Per face of a mortar tie for this rank's multipliers `lambda` (as
     /// [`Self::tie_point_fields`]), the faces this rank gave, as [`Self::face_fields`]
     /// gives them (collective).
     pub fn tie_face_fields(
         &self,
-        tie: &RankTie,
+        rows: &TieConstraints,
         lambda: &[f64],
         side_b: bool,
     ) -> Result<Vec<FaceValues>, EmbedError> {
-        let place: Vec<u64> = tie.index.iter().map(|&k| k as u64).collect();
-        self.tie_face_fields_at(tie.rows.interaction, &place, tie.total, lambda, side_b)
-    }
-
-    /// [`Self::tie_face_fields`] with the tie given as for [`Self::tie_point_fields_at`].
-    pub(crate) fn tie_face_fields_at(
-        &self,
-        i: usize,
-        place: &[u64],
-        total: usize,
-        lambda: &[f64],
-        side_b: bool,
-    ) -> Result<Vec<FaceValues>, EmbedError> {
-        let (rows, whole) = self.whole_tie(i, place, total, lambda)?;
+        let field = self.tie_field(rows, lambda)?;
         let faces = agree(
             &self.comm,
-            self.inner.tie_face_fields(&rows, &whole, side_b),
+            self.inner.tie_face_values(rows.interaction, &field, side_b),
         )?;
         Ok(self.own_faces_of(faces))
+    }
+
+    /// The multiplier field of a tie at every point of its pairing (`None` where it has
+    /// no multiplier), from each rank's multipliers `lambda` for its `rows` (collective;
+    /// a `lambda` of another length than the rows' multipliers is refused on every
+    /// rank): each rank's part `Σ ψ_k λ_k` over its own multipliers, summed.
+    fn tie_field(
+        &self,
+        rows: &TieConstraints,
+        lambda: &[f64],
+    ) -> Result<Vec<Option<f64>>, EmbedError> {
+        let mine = agree(&self.comm, self.inner.tie_field(rows, lambda))?;
+        // Per point its part of the field and whether this rank has a multiplier there.
+        let parts: Vec<f64> = (mine.iter())
+            .flat_map(|m| [m.unwrap_or(0.0), f64::from(u8::from(m.is_some()))])
+            .collect();
+        let mut summed = vec![0.0; parts.len()];
+        self.comm
+            .all_reduce_into(&parts[..], &mut summed[..], SystemOperation::sum());
+        Ok(summed
+            .chunks_exact(2)
+            .map(|s| (s[1] > 0.0).then_some(s[0]))
+            .collect())
     }
 
     /// Per face of flux interaction `i` at the host's field (collective; `u_local` as
@@ -707,53 +707,6 @@ impl RankEmbedding {
                 ..f
             })
             .collect()
-    }
-
-    /// The whole tie of interaction `i` (every rank computes it from the interface it
-    /// holds) and every multiplier of it, gathered from each rank's `lambda` at its
-    /// places `place` in the tie of `total` (collective; a `lambda` of another length
-    /// than `place` is refused on every rank).
-    fn whole_tie(
-        &self,
-        i: usize,
-        place: &[u64],
-        total: usize,
-        lambda: &[f64],
-    ) -> Result<(TieConstraints, Vec<f64>), EmbedError> {
-        let check = if lambda.len() != place.len() {
-            Err(argument(
-                format!(
-                    "{} multipliers given, this rank has {} of the tie",
-                    lambda.len(),
-                    place.len()
-                ),
-                "pass one value per entry of the tie's index on this rank, in order",
-            ))
-        } else {
-            Ok(())
-        };
-        agree(&self.comm, check)?;
-        let (place, values) = (
-            gather_parts(&self.comm, place).concat(),
-            gather_parts(&self.comm, lambda).concat(),
-        );
-        let mut whole = vec![0.0; total];
-        for (&k, &l) in place.iter().zip(&values) {
-            if let Some(w) = whole.get_mut(k as usize) {
-                *w = l;
-            }
-        }
-        let ties = agree(&self.comm, self.inner.constraints())?;
-        let rows = ties
-            .into_iter()
-            .find(|t| t.interaction == i)
-            .ok_or_else(|| {
-                argument(
-                    format!("interaction {i} is not a mortar tie"),
-                    "pass a tie of this embedding's constraints()",
-                )
-            });
-        Ok((agree(&self.comm, rows)?, whole))
     }
 
     /// This rank's own points of interaction `i` among `values` (every point's, in
