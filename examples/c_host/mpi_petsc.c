@@ -30,11 +30,11 @@
  * after every node, as extra rows of the last rank, adds C and C^T (ADD_VALUES) and
  * solves [K C^T; C 0] [T; lambda] = [F; g] by MUMPS; the heat comes from its
  * multipliers (seam_rank_tie_heat) and from the multiplier field at the contact points
- * (seam_rank_tie_point_fields, weighted and summed over the ranks). `mpi_petsc tie dual` does the same with dual
- * multipliers, and also recovers them from its own residual K T - F without the tie at
- * its multipliers' dofs (seam_rank_dual_multipliers) and takes the tie's heat from that
- * residual (seam_rank_dual_tie_heat), as a host that condensed the tie
- * would: rank 0 prints the largest difference from the solved ones.
+ * (seam_rank_tie_point_fields, weighted and summed over the ranks). `mpi_petsc tie dual`
+ * does the same with dual multipliers, and also recovers them from its own residual
+ * K T - F without the tie at its multipliers' dofs (seam_rank_dual_multipliers) and
+ * takes the tie's heat from that residual (seam_rank_dual_tie_heat), as a host that
+ * condensed the tie would: rank 0 prints the largest difference from the solved ones.
  *
  * Build: make -C examples/c_host mpi_petsc (needs petsc-dev and libseam built with
  * --features mpi); run: mpirun -n 4 examples/c_host/mpi_petsc.
