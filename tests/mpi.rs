@@ -4,9 +4,11 @@
 //! contacts' currents and Joule heats, species fluxes) must agree to round-off — on the
 //! bundled steady scenes the distributed steady solve covers and on generated cases whose
 //! interface the partition cuts (rank 0's log must say that interface couplings join dofs
-//! of different ranks), and on the runs of the general (stepped) solver, whose linear
-//! solves PETSc distributes: transient runs, thermal–electrical and species scenes,
-//! moving surfaces, element death, mortar ties with multipliers. The distributed contact
+//! of different ranks), on linear transient runs with fixed steps (assembled per rank as
+//! the steady solve is: their mesh distributed, each rank stepping its own part), and on
+//! the runs of the general (stepped) solver, whose linear solves PETSc distributes:
+//! adaptive steps, thermal–electrical and species scenes, moving surfaces, element
+//! death, mortar ties with multipliers. The distributed contact
 //! search is compared with the serial one directly: `seam search --points` under
 //! `mpirun -n 1..4` must list the serial search's points, each with the same side-B face,
 //! status and projection.
@@ -189,7 +191,13 @@ fn couplings_across(log: &str) -> Option<usize> {
 /// interface must be cut by the partition from 2 ranks on. The serial run, for more
 /// checks.
 fn compare(problem: &Path, cut: bool) -> Ran {
+    compare_runs(problem, cut).0
+}
+
+/// [`compare`], with the distributed runs (on 1, 2, 3 and 4 ranks) besides.
+fn compare_runs(problem: &Path, cut: bool) -> (Ran, Vec<Ran>) {
     let serial = run(problem, None);
+    let mut runs = Vec::new();
     assert!(serial.summary["converged"].as_bool().unwrap());
     let expected: Vec<_> = (serial.fields.iter().cloned())
         .chain(balances(&serial.summary))
@@ -240,8 +248,34 @@ fn compare(problem: &Path, cut: bool) -> Ran {
                 par.log
             );
         }
+        runs.push(par);
     }
-    serial
+    (serial, runs)
+}
+
+/// Rank 0's log line saying the other ranks hold their part of the mesh only.
+const PART_ONLY: &str = "each rank other than 0 holds its own elements and a ghost layer";
+
+/// The runs of a linear transient problem with fixed steps: from 2 ranks on, each rank
+/// other than 0 held its part of the mesh only and the steps were assembled per rank
+/// (the summary's reason names the path), with the serial run's steps.
+fn assert_steps_distributed(serial: &Ran, runs: &[Ran]) {
+    let steps = |r: &Ran| r.summary["transient"]["steps"].as_u64().unwrap();
+    for (n, par) in (1..).zip(runs) {
+        assert_eq!(steps(par), steps(serial), "steps on {n} ranks");
+        let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(
+            reason.contains("linear transient steps"),
+            "the distributed steps on {n} ranks: {reason}"
+        );
+        if n > 1 {
+            assert!(
+                par.log.contains(PART_ONLY),
+                "{n} ranks: the mesh should be distributed:\n{}",
+                par.log
+            );
+        }
+    }
 }
 
 /// Copy an example folder (files only, no earlier output) into a scratch folder.
@@ -478,7 +512,76 @@ fn cut_interface_transient_equals_serial() {
         )
         + "[initial]\ntemperature = 300.0\n";
     std::fs::write(&problem, text).unwrap();
-    compare(&problem, false);
+    let (serial, runs) = compare_runs(&problem, false);
+    assert_steps_distributed(&serial, &runs);
+}
+
+/// The cut bar stepped by BDF2 under loads that change at every step (a Dirichlet
+/// value and a heat flux growing in time, so each rank assembles its face conditions
+/// again), by CG + GAMG: every step's temperatures and heats equal serial.
+#[test]
+fn cut_interface_transient_loads_in_time_equal_serial() {
+    let tmp = scratch("transient_loads");
+    let problem = write_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
+        "scheme = \"bdf2\"\nlinear_solver = \"amg\"\n",
+    );
+    let text = std::fs::read_to_string(&problem)
+        .unwrap()
+        .replace(
+            "kind = \"steady\"\n",
+            "kind = \"transient\"\ndt = 0.05\nend_time = 0.3\n",
+        )
+        .replace("value = 500.0", "value = \"500 - 400*t\"")
+        .replace(
+            "conductivity = ",
+            "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
+        )
+        + "[initial]\ntemperature = 300.0\n"
+        + "[[bc]]\nkind = \"flux\"\nsurfaces = [\"surface_5\"]\nvalue = \"2e4*t*(1 + y)\"\n";
+    std::fs::write(&problem, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    let cg = &runs[1].summary["linear_solver"];
+    assert!(
+        cg["name"].as_str().unwrap().contains("CG"),
+        "CG + GAMG asked for: {cg}"
+    );
+}
+
+/// Adaptive steps are the general solver's (its assembly on every rank, the whole mesh
+/// on each): the same steps and temperatures as serial.
+#[test]
+fn cut_interface_adaptive_transient_equals_serial() {
+    let tmp = scratch("transient_adaptive");
+    let problem = write_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
+        "adaptive = true\n",
+    );
+    let text = std::fs::read_to_string(&problem)
+        .unwrap()
+        .replace(
+            "kind = \"steady\"\n",
+            "kind = \"transient\"\ndt = 0.02\nend_time = 0.3\n",
+        )
+        .replace(
+            "conductivity = ",
+            "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
+        )
+        + "[initial]\ntemperature = 300.0\n";
+    std::fs::write(&problem, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, false);
+    let steps = |r: &Ran| r.summary["transient"]["steps"].as_u64().unwrap();
+    for par in &runs {
+        assert_eq!(steps(par), steps(&serial));
+        assert!(
+            par.log.contains("every rank reads the whole mesh"),
+            "adaptive steps keep the whole mesh on every rank:\n{}",
+            par.log
+        );
+    }
 }
 
 /// `seam -v search deck --mesh mesh --points FILE args…`, serially or under `mpirun -n`.
@@ -742,19 +845,22 @@ fn electronics_transient(solve: &str) -> (tempfile::TempDir, PathBuf) {
     )
 }
 
-/// The general solver's transient steps, solved by MUMPS.
+/// The electronics warm-up's linear steps, assembled per rank and solved by MUMPS.
 #[test]
 fn electronics_transient_equals_serial() {
     let (_tmp, problem) = electronics_transient("");
-    compare(&problem, false);
+    let (serial, runs) = compare_runs(&problem, false);
+    assert_steps_distributed(&serial, &runs);
 }
 
-/// The same by CG + GAMG (serial: seam's AMG-CG), each linear step's own system solved
-/// from the predictor to 1e-11 of ‖b‖.
+/// The same by CG + GAMG (serial: seam's AMG-CG, each linear step's own system solved
+/// from the predictor to 1e-11 of ‖b‖; distributed: each step's increment to 1e-11 of
+/// its residual).
 #[test]
 fn electronics_transient_by_cg_gamg_equals_serial() {
     let (_tmp, problem) = electronics_transient("linear_solver = \"amg\"\n");
-    compare(&problem, false);
+    let (serial, runs) = compare_runs(&problem, false);
+    assert_steps_distributed(&serial, &runs);
 }
 
 /// Thermal–electrical (temperature and voltage, Joule heat, an electrical contact):

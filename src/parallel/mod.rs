@@ -14,7 +14,8 @@
 //! rank 0 or the other ranks work out for the ranks holding parts), [`search_pair`] (the
 //! contact search of one pair of surfaces, distributed), [`extended_mesh`] (a rank's part
 //! with the side-B elements its points paired with), [`steady`] (the linear or
-//! Newton-nonlinear steady solve), [`general_solve`] (the linear solves of the general,
+//! Newton-nonlinear steady solve), [`transient`] (a linear transient run's steps, its
+//! assembly distributed as the steady solve's), [`general_solve`] (the linear solves of the general,
 //! stepped, solver: its assembly replicated on every rank, each step's system solved by
 //! PETSc over all ranks), [`linear_solver`] (the summary's linear solver) and
 //! [`report_holdings`] (what each rank held, in rank 0's log).
@@ -34,6 +35,8 @@ pub(crate) mod part;
 #[cfg(feature = "mpi")]
 pub mod petsc;
 #[cfg(feature = "mpi")]
+mod rows;
+#[cfg(feature = "mpi")]
 pub mod search;
 #[cfg(feature = "mpi")]
 mod session;
@@ -41,6 +44,8 @@ mod session;
 mod share;
 #[cfg(feature = "mpi")]
 mod steady;
+#[cfg(feature = "mpi")]
+mod stepped;
 #[cfg(feature = "mpi")]
 mod wire;
 
@@ -157,6 +162,52 @@ pub fn steady(p: &SteadyProblem<'_>) -> Option<Result<SteadySolution, HeatError>
     #[cfg(not(feature = "mpi"))]
     {
         let _ = p;
+        None
+    }
+}
+
+/// A linear transient run's time stepping, for [`transient`].
+pub struct Stepping<'s> {
+    /// ρc (J/m³/K) per block of the problem's mesh.
+    pub rho_c: &'s [f64],
+    pub scheme: crate::heat::transient::Scheme,
+    pub start: f64,
+    pub end: f64,
+    /// The step (fixed).
+    pub dt: f64,
+    /// The temperature at each node of the rank's mesh at `start` (the nodes after it,
+    /// a contact partner's, take their owners' values).
+    pub initial: &'s [f64],
+    /// The Dirichlet values and face conditions at a time.
+    #[allow(clippy::type_complexity)]
+    pub loads: &'s dyn Fn(
+        f64,
+    ) -> Result<
+        (Vec<(crate::mesh::NodeId, f64)>, Vec<crate::heat::FaceBc>),
+        HeatError,
+    >,
+}
+
+/// The steps of a linear transient run with its assembly distributed when the run is
+/// distributed, else `None` (the caller steps serially): `p` the problem at the start,
+/// `on_step` each accepted step (on rank 0 the whole state, on any other rank its own
+/// dofs).
+pub fn transient(
+    p: &SteadyProblem<'_>,
+    s: &Stepping<'_>,
+    on_step: &mut dyn FnMut(
+        &crate::heat::transient::StepReport,
+        &crate::heat::transient::State,
+        &crate::assembly::DofMap,
+    ) -> Result<(), HeatError>,
+) -> Option<Result<crate::heat::transient::Outcome, HeatError>> {
+    #[cfg(feature = "mpi")]
+    {
+        world().map(|_| stepped::solve(p, s, on_step))
+    }
+    #[cfg(not(feature = "mpi"))]
+    {
+        let _ = (p, s, on_step);
         None
     }
 }

@@ -81,9 +81,36 @@ impl<'a> TimeLoop<'a> {
     ) -> Result<Solved, RunError> {
         if self.is_linear_steady() {
             self.linear_steady()
+        } else if self.is_linear_transient_on_ranks() {
+            self.linear_steps_on_ranks(initial, output)
         } else {
             self.steps(initial, output)
         }
+    }
+
+    /// Whether a run under MPI steps with its assembly distributed: a transient run
+    /// whose every step is linear and of the given size — one field, constant
+    /// materials, a source of x alone, no toggles, radiation or multiplier ties, fixed
+    /// steps, no restart, nothing moving or dying, no nodal field. (Every run whose mesh
+    /// `ranks::distributable` splits and is transient is one.)
+    fn is_linear_transient_on_ranks(&self) -> bool {
+        let (physics, problem) = (self.physics, &self.file.problem);
+        crate::parallel::world().is_some()
+            && self.file.transient
+            && physics.time.adaptive.is_none()
+            && !self.terms.multiplier_ties()
+            && physics.source_of_x_only()
+            && physics.materials.constant().is_some()
+            && physics.field_names.len() == 1
+            && !physics.materials.electric()
+            && !physics.species.any()
+            && !self.terms.couplings.any_toggle()
+            && problem.bc.iter().all(|b| b.kind != BcKind::Radiation)
+            && problem.restart.is_none()
+            && self.options.restart.is_none()
+            && problem.displacement.is_none()
+            && problem.death.is_empty()
+            && problem.nodal_field.is_empty()
     }
 
     /// Whether one linear steady solve answers the problem: steady, one field, constant
@@ -112,53 +139,10 @@ impl<'a> TimeLoop<'a> {
         let (requested, threshold) = (self.requested, self.threshold);
         let source_failed = std::sync::Mutex::new(None::<String>);
         let sources = physics.sources_of_x(&source_failed);
-        // On a rank holding a part of the mesh (under mpirun), its part with the side-B
-        // elements of other ranks its contact points paired with, each in a copy of its
-        // block (`origin`: per block, the block it copies).
-        let extended = crate::parallel::extended_mesh(physics.mesh);
-        let (mesh, origin) = match &extended {
-            Some((m, origin)) => (m, Some(origin.as_slice())),
-            None => (physics.mesh, None),
-        };
-        let materials = physics.materials.constant().expect("checked constant");
-        let materials = per_block(&materials, origin);
         let sources: Vec<Option<SourceFn<'_>>> = sources.iter().map(|f| f.as_deref()).collect();
-        let block_source = per_block(&sources, origin);
-        // The temperature unknowns (multipliers aside) decide the automatic choice.
-        let solid: Vec<usize> = (0..mesh.blocks.len())
-            .filter(|&b| mesh.blocks[b].topology.is_solid())
-            .collect();
-        let dofs = DofMap::new(mesh, &[(TEMPERATURE, &solid)])
-            .map_err(|e| RunError::Solve(e.to_string()))?;
-        // Every rank chooses by the whole problem's count.
-        let unknowns = crate::parallel::global_unknowns(dofs.len());
-        let interfaces = self
-            .terms
-            .prepare_on(mesh, origin, &dofs)
-            .map_err(RunError::Solve)?;
-        let iterative = match requested {
-            Some("amg") => true,
-            Some("direct") => false,
-            _ => unknowns >= threshold,
-        };
-        let loads = physics
-            .loads_at(physics.time.start)
-            .map_err(RunError::Solve)?;
-        let steady = SteadyProblem {
-            mesh,
-            materials: &materials,
-            source: None,
-            block_source: Some(&block_source),
-            dirichlet: &loads.dirichlet,
-            face_bcs: &loads.faces,
-            contact: Vec::new(),
-            ties: Vec::new(),
-            interfaces: Some(interfaces),
-            iterative,
-            reproducible: problem.solve.reproducible.unwrap_or(true),
-            tolerance: problem.solve.tolerance,
-            max_iterations: problem.solve.max_iterations,
-        };
+        let extended = crate::parallel::extended_mesh(physics.mesh);
+        let linear = self.linear_problem(&extended, &sources)?;
+        let (unknowns, steady) = (linear.unknowns, linear.problem(problem));
         self.options.phase(&format!(
             "assembling and solving ({} nodes)",
             physics.mesh.num_nodes()
@@ -194,6 +178,142 @@ impl<'a> TimeLoop<'a> {
             mechanisms: Vec::new(),
             linear_solver,
             linear_steady: true,
+            species_flux: Vec::new(),
+        })
+    }
+
+    /// What a linear solve (steady, or a linear transient run's steps on ranks) is made
+    /// of, at the start time: on a rank holding a part of the mesh (under mpirun), its
+    /// part `extended` with the side-B elements of other ranks its contact points
+    /// paired with, each in a copy of its block.
+    fn linear_problem<'m>(
+        &'m self,
+        extended: &'m Option<(crate::mesh::Mesh, Vec<usize>)>,
+        sources: &[Option<SourceFn<'m>>],
+    ) -> Result<LinearProblem<'m>, RunError> {
+        let physics = self.physics;
+        // `origin`: per block, the block it copies.
+        let (mesh, origin) = match extended {
+            Some((m, origin)) => (m, Some(origin.as_slice())),
+            None => (physics.mesh, None),
+        };
+        let constant = physics.materials.constant().expect("checked constant");
+        let rho_c: Vec<f64> = constant.iter().map(|m| m.rho_c).collect();
+        // The temperature unknowns (multipliers aside) decide the automatic choice.
+        let solid: Vec<usize> = (0..mesh.blocks.len())
+            .filter(|&b| mesh.blocks[b].topology.is_solid())
+            .collect();
+        let dofs = DofMap::new(mesh, &[(TEMPERATURE, &solid)])
+            .map_err(|e| RunError::Solve(e.to_string()))?;
+        // Every rank chooses by the whole problem's count.
+        let unknowns = crate::parallel::global_unknowns(dofs.len());
+        let interfaces = self
+            .terms
+            .prepare_on(mesh, origin, &dofs)
+            .map_err(RunError::Solve)?;
+        let iterative = match self.requested {
+            Some("amg") => true,
+            Some("direct") => false,
+            _ => unknowns >= self.threshold,
+        };
+        let loads = physics
+            .loads_at(physics.time.start)
+            .map_err(RunError::Solve)?;
+        Ok(LinearProblem {
+            mesh,
+            materials: per_block(&constant, origin),
+            rho_c: per_block(&rho_c, origin),
+            block_source: per_block(sources, origin),
+            loads,
+            interfaces,
+            iterative,
+            unknowns,
+        })
+    }
+
+    /// A linear transient run under MPI: its steps with the assembly distributed
+    /// ([`crate::parallel::transient`]), each accepted one recorded as the general
+    /// solver's are — written by rank 0, which gets the whole state.
+    fn linear_steps_on_ranks(
+        &self,
+        initial: Option<Vec<f64>>,
+        output: &mut Output<'a>,
+    ) -> Result<Solved, RunError> {
+        let (physics, problem, time) = (self.physics, &self.file.problem, &self.physics.time);
+        let source_failed = std::sync::Mutex::new(None::<String>);
+        let sources = physics.sources_of_x(&source_failed);
+        let sources: Vec<Option<SourceFn<'_>>> = sources.iter().map(|f| f.as_deref()).collect();
+        let extended = crate::parallel::extended_mesh(physics.mesh);
+        let linear = self.linear_problem(&extended, &sources)?;
+        let steady = linear.problem(problem);
+        let initial = match initial {
+            Some(v) => v,
+            None => physics.initial_values()?,
+        };
+        let loads = |t: f64| {
+            (physics.loads_at(t))
+                .map(|l| (l.dirichlet, l.faces))
+                .map_err(HeatError::Step)
+        };
+        let stepping = crate::parallel::Stepping {
+            rho_c: &linear.rho_c,
+            scheme: time.scheme,
+            start: time.start,
+            end: time.end,
+            dt: time.dt,
+            initial: &initial,
+            loads: &loads,
+        };
+        let mut recorder = Recorder {
+            output,
+            terms: self.terms,
+            progress: self.options.progress.as_deref(),
+            history: Vec::new(),
+            mechanisms: Vec::new(),
+            species_flux: Vec::new(),
+        };
+        self.options.phase(&format!(
+            "assembling and solving the steps ({} nodes)",
+            physics.mesh.num_nodes()
+        ));
+        // Rank 0 records and writes each step; the other ranks keep its report.
+        let root = crate::parallel::is_root();
+        let mut on_step = |r: &StepReport, st: &State, dofs: &DofMap| match root {
+            true => recorder.record(r, st, dofs),
+            false => {
+                recorder.history.push(r.clone());
+                Ok(())
+            }
+        };
+        let outcome = crate::parallel::transient(&steady, &stepping, &mut on_step)
+            .ok_or_else(|| RunError::Solve("a run on ranks without MPI".into()))?
+            .map_err(|e| RunError::Solve(e.to_string()))?;
+        if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
+            return Err(RunError::Solve(format!("[[source]]: {e}")));
+        }
+        let Recorder {
+            output,
+            history,
+            mechanisms,
+            ..
+        } = recorder;
+        output.finish_steps(&outcome, &history)?;
+        let mut linear_solver = self.stepped_solver_summary(&history, linear.unknowns);
+        if let Some((name, reason)) = crate::parallel::linear_solver() {
+            (linear_solver.name, linear_solver.reason) = (name, reason);
+        }
+        let solution = steps::final_solution(
+            outcome,
+            &history,
+            &physics.field_names,
+            self.terms.energy_flux_count(),
+        );
+        Ok(Solved {
+            solution,
+            history,
+            mechanisms,
+            linear_solver,
+            linear_steady: false,
             species_flux: Vec::new(),
         })
     }
@@ -435,6 +555,41 @@ impl<'a> TimeLoop<'a> {
                 hierarchy_setups: None,
                 hierarchy_refreshes: None,
             }
+        }
+    }
+}
+
+/// A linear problem at the start time, over a rank's mesh (see
+/// [`TimeLoop::linear_problem`]).
+struct LinearProblem<'m> {
+    mesh: &'m crate::mesh::Mesh,
+    materials: Vec<crate::heat::Material>,
+    /// ρc per block.
+    rho_c: Vec<f64>,
+    block_source: Vec<Option<SourceFn<'m>>>,
+    loads: Loads,
+    interfaces: &'m dyn crate::heat::interfaces::Interfaces,
+    iterative: bool,
+    /// The whole problem's unknowns.
+    unknowns: usize,
+}
+
+impl LinearProblem<'_> {
+    fn problem<'s>(&'s self, p: &super::problem::Problem) -> SteadyProblem<'s> {
+        SteadyProblem {
+            mesh: self.mesh,
+            materials: &self.materials,
+            source: None,
+            block_source: Some(&self.block_source),
+            dirichlet: &self.loads.dirichlet,
+            face_bcs: &self.loads.faces,
+            contact: Vec::new(),
+            ties: Vec::new(),
+            interfaces: Some(self.interfaces),
+            iterative: self.iterative,
+            reproducible: p.solve.reproducible.unwrap_or(true),
+            tolerance: p.solve.tolerance,
+            max_iterations: p.solve.max_iterations,
         }
     }
 }

@@ -60,6 +60,8 @@ use crate::enforce::interface::{HInput, HValue};
 
 use newton::{Context, History, Solvers};
 use setup::Setup;
+#[cfg(feature = "mpi")]
+pub(crate) use setup::lumped_weights;
 
 /// Time integration scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -288,7 +290,7 @@ impl TransientProblem<'_> {
 
 /// The time-derivative weights `(α₀, α₁, α₂)` of a step of size `dt` after a step of
 /// size `dt_prev` (None: no history, backward Euler).
-fn weights(scheme: Scheme, dt: f64, dt_prev: Option<f64>) -> [f64; 3] {
+pub(crate) fn weights(scheme: Scheme, dt: f64, dt_prev: Option<f64>) -> [f64; 3] {
     match (scheme, dt_prev) {
         (Scheme::Bdf2, Some(prev)) => {
             let w = dt / prev;

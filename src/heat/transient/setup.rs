@@ -288,12 +288,12 @@ pub(super) fn node_dofs(
 }
 
 /// (dof, block, ∫N_a dV over that block's elements at the node, node coordinates).
-pub(super) type LumpedWeight = (u32, u32, f64, [f64; 3]);
+pub(crate) type LumpedWeight = (u32, u32, f64, [f64; 3]);
 
 /// Lumped capacity weights `∫ N_a dV` per (dof, block) over the `live` elements, with
 /// the node's coordinates: for each block's first field (its temperature) and, where it
 /// lives, the `species` (the last of the block's fields); a voltage has none.
-pub(super) fn lumped_weights(
+pub(crate) fn lumped_weights(
     mesh: &Mesh,
     dofs: &DofMap,
     species: Option<FieldId>,

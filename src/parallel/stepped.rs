@@ -1,0 +1,175 @@
+//! A linear transient run on MPI with its assembly distributed: the steady path's
+//! set-up and Newton iteration ([`super::steady`]: each rank its own elements, the
+//! interface points it owns, PETSc's rows of its nodes) with the lumped capacity of
+//! the serial general solver, stepped by backward Euler or BDF2 with the serial time
+//! loop's fixed steps.
+//!
+//! Every rank keeps its local dofs' last two states (the history of BDF2), up to date
+//! at the dofs it reads. After each accepted step the field is gathered on rank 0,
+//! which holds the whole mesh, evaluates every interface point again and hands the
+//! whole state to the run (outputs, checkpoints); the other ranks hand their own.
+//!
+//! The run takes this path only where every step is linear and of a given size
+//! ([`super::Stepping`]): constant materials, sources of x alone, linear interfaces, no
+//! adaptive steps. A step that does not converge stops the run (the serial solver
+//! would cut it; a linear step converges in one Newton step).
+
+use crate::assembly::DofMap;
+use crate::heat::steady::SteadyProblem;
+use crate::heat::transient::{Outcome, State, StepReport, weights};
+use crate::heat::{HeatError, dirichlet_dofs};
+
+use super::Stepping;
+use super::petsc::Method;
+use super::steady::{Built, Capacity, Newton, agreed};
+
+/// The run's steps over the MPI world from `s.start` to `s.end`; `on_step` gets each
+/// accepted step: on rank 0 the whole state, on every other rank its own dofs. Rank 0's
+/// outcome holds the whole final state, every other rank's its own dofs.
+pub(super) fn solve(
+    p: &SteadyProblem<'_>,
+    s: &Stepping<'_>,
+    on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
+) -> Result<Outcome, HeatError> {
+    let built = Built::new(p, s.start)?;
+    let mut newton = Newton::new(&built, true)?;
+    let (n, field, root) = (built.n, built.field, built.is_root());
+    let m = built.capacity(s.rho_c)?;
+    // The initial field at the rank's nodes; a contact partner's nodes from their owners.
+    let mut u = vec![0.0; n];
+    for (node, &v) in s.initial.iter().enumerate() {
+        if let Some(d) = built.dofs.dof(field, crate::mesh::NodeId(node as u32)) {
+            u[d.index()] = v;
+        }
+    }
+    built.start(&mut u, &[]);
+    // What the run sees: the whole state on rank 0, its own dofs elsewhere.
+    let mut state = State {
+        step: 0,
+        time: s.start,
+        dt: s.dt,
+        u: u.clone(),
+        past: Vec::new(),
+    };
+    built.gather(&mut state.u);
+    // This rank's last accepted states before the current one, newest first.
+    let mut past: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut faces = p.face_bcs.to_vec();
+    let mut steps = 0;
+    let eps = 1e-12 * s.end.abs().max(s.dt);
+    while state.time < s.end - eps {
+        let time = state.time;
+        // The serial loop's step: the given size, the last one to the end without a
+        // sliver before it.
+        let mut dt = s.dt.min(s.end - time);
+        if s.end - time - dt < 1e-6 * dt {
+            dt = s.end - time;
+        }
+        let t_new = time + dt;
+        log::debug!("rank step {} from t = {time} by {dt}", state.step + 1);
+        let dt_prev = past.first().map(|(t, _)| time - t);
+        let alpha = weights(s.scheme, dt, dt_prev);
+        // The step's loads; a rank that cannot make them stops every rank.
+        let loads = (s.loads)(t_new).and_then(|(dirichlet, now)| {
+            let bcs = dirichlet_dofs(p.mesh, &built.dofs, field, &dirichlet)?;
+            let conduction = match now != faces {
+                true => Some(built.conduction(&now)?),
+                false => None,
+            };
+            Ok((bcs, now, conduction))
+        });
+        let (bcs, now, conduction) = agreed(loads)?;
+        if let Some(kf) = conduction {
+            newton.set_conduction(kf);
+            faces = now;
+        }
+        let previous = past.first().map(|(_, v)| v.as_slice());
+        let rest: Vec<f64> = (0..n)
+            .map(|d| match m[d] != 0.0 {
+                true => (alpha[1] * u[d] + previous.map_or(0.0, |v| alpha[2] * v[d])) / dt,
+                false => 0.0,
+            })
+            .collect();
+        let capacity = Capacity {
+            m: &m,
+            c0: alpha[0] / dt,
+            rest: &rest,
+        };
+        let mut next = u.clone();
+        built.start(&mut next, &bcs);
+        let solved = newton.solve(&mut next, t_new, Some(&capacity))?;
+        if !solved.converged {
+            return Err(HeatError::Step(format!(
+                "at t = {t_new}: the distributed step did not converge in {} Newton iterations (‖R‖: {:.3e} → {:.3e}); the distributed transient solve does not cut steps: run without mpirun to let the general solver cut it",
+                solved.iterations,
+                solved.history.first().copied().unwrap_or(f64::NAN),
+                solved.history.last().copied().unwrap_or(f64::NAN),
+            )));
+        }
+        past.insert(0, (time, std::mem::replace(&mut u, next)));
+        past.truncate(1);
+        steps += 1;
+        let mut now_u = u.clone();
+        built.gather(&mut now_u);
+        if root {
+            let old = std::mem::replace(&mut state.u, now_u);
+            state.past.insert(0, (time, old));
+            state.past.truncate(2);
+        } else {
+            state.u = now_u;
+        }
+        state.time = t_new;
+        state.step += 1;
+        let cg = solved.cg_iterations.iter().sum();
+        let report = StepReport {
+            step: state.step,
+            time: t_new,
+            dt,
+            newton_iterations: solved.iterations,
+            residual_history: solved.history,
+            rejected: 0,
+            error_estimate: None,
+            heat: solved.heat,
+            assembly_s: solved.timing.assembly_s,
+            factor_s: solved.timing.factor_s,
+            solve_s: solved.timing.solve_s,
+            cg_iterations: cg,
+            gmres: false,
+            hierarchy_setups: match newton.method {
+                Method::CgGamg => solved.setups,
+                _ => 0,
+            },
+            hierarchy_refreshes: 0,
+            electric: Vec::new(),
+            diagnosis: None,
+        };
+        // Rank 0's outputs see every interface point; a failure there stops every rank.
+        let handed = match root {
+            true => built
+                .all_points()
+                .and_then(|()| on_step(&report, &state, &built.dofs))
+                .and_then(|()| built.own_points_again(&u, t_new)),
+            false => on_step(&report, &state, &built.dofs),
+        };
+        agreed(handed)?;
+    }
+    let why = match newton.method {
+        Method::CgGamg => {
+            "linear transient steps, symmetric positive definite, at or above the AMG threshold → CG + GAMG (hierarchy kept while the step size holds)"
+        }
+        _ => {
+            "linear transient steps below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU (factorisation kept while the step size holds)"
+        }
+    };
+    super::record(newton.method, why);
+    drop(newton);
+    let dofs = built.dofs.clone();
+    Ok(Outcome {
+        dofs,
+        fields: vec![field],
+        state,
+        steps,
+        rejected: 0,
+        crosspoints: Vec::new(),
+    })
+}
