@@ -112,6 +112,7 @@ unsafe extern "C" {
         x: Object,
         b: Object,
     ) -> PetscErrorCode;
+    fn MatMult(mat: Object, x: Object, y: Object) -> PetscErrorCode;
     fn MatDestroy(mat: *mut Object) -> PetscErrorCode;
 
     fn VecCreateMPI(comm: MPI_Comm, n: PetscInt, nn: PetscInt, v: *mut Object) -> PetscErrorCode;
@@ -281,6 +282,12 @@ impl Mat {
             )?;
             Ok(mat)
         }
+    }
+
+    /// `y = A x` (collective; the matrix assembled).
+    pub fn mult(&self, x: &Vector, y: &mut Vector) -> Result<(), PetscError> {
+        // SAFETY: valid handles with the matrix's layout.
+        check("MatMult", unsafe { MatMult(self.0, x.0, y.0) })
     }
 
     /// Add `values[k]` at `(rows[k], col)` (global indices, any rank's rows).
@@ -603,6 +610,15 @@ impl Ksp {
                 KSPSetNormType(self.0, KSP_NORM_UNPRECONDITIONED),
             )
         }
+    }
+
+    /// A Krylov method stops at ‖b − A x‖ ≤ max(`rtol` ‖b‖, `atol`) (with
+    /// [`Ksp::start_from_x`]'s norm: the true residual).
+    pub fn set_tolerances(&mut self, rtol: f64, atol: f64) -> Result<(), PetscError> {
+        // SAFETY: a valid KSP.
+        check("KSPSetTolerances", unsafe {
+            KSPSetTolerances(self.0, rtol, atol, PETSC_DEFAULT, 10_000)
+        })
     }
 
     /// The preconditioner or factorisation made (collective).

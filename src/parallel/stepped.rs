@@ -16,7 +16,7 @@
 
 use crate::assembly::DofMap;
 use crate::heat::steady::SteadyProblem;
-use crate::heat::transient::{Outcome, State, StepReport, weights};
+use crate::heat::transient::{Outcome, State, StepReport, predictor, weights};
 use crate::heat::{HeatError, dirichlet_dofs};
 
 use super::Stepping;
@@ -43,22 +43,23 @@ pub(super) fn solve(
         }
     }
     built.start(&mut u, &[]);
-    // What the run sees: the whole state on rank 0, its own dofs elsewhere.
-    let mut state = State {
+    // This rank's state: its local dofs, up to date at those it reads, and its last two
+    // accepted states before (BDF2 and the predictor read them).
+    let mut mine = State {
         step: 0,
         time: s.start,
         dt: s.dt,
-        u: u.clone(),
+        u,
         past: Vec::new(),
     };
+    // What the run sees: the whole state on rank 0, its own dofs elsewhere.
+    let mut state = mine.clone();
     built.gather(&mut state.u);
-    // This rank's last accepted states before the current one, newest first.
-    let mut past: Vec<(f64, Vec<f64>)> = Vec::new();
     let mut faces = p.face_bcs.to_vec();
     let mut steps = 0;
     let eps = 1e-12 * s.end.abs().max(s.dt);
-    while state.time < s.end - eps {
-        let time = state.time;
+    while mine.time < s.end - eps {
+        let time = mine.time;
         // The serial loop's step: the given size, the last one to the end without a
         // sliver before it.
         let mut dt = s.dt.min(s.end - time);
@@ -66,8 +67,8 @@ pub(super) fn solve(
             dt = s.end - time;
         }
         let t_new = time + dt;
-        log::debug!("rank step {} from t = {time} by {dt}", state.step + 1);
-        let dt_prev = past.first().map(|(t, _)| time - t);
+        log::debug!("rank step {} from t = {time} by {dt}", mine.step + 1);
+        let dt_prev = mine.past.first().map(|(t, _)| time - t);
         let alpha = weights(s.scheme, dt, dt_prev);
         // The step's loads; a rank that cannot make them stops every rank.
         let loads = (s.loads)(t_new).and_then(|(dirichlet, now)| {
@@ -83,7 +84,7 @@ pub(super) fn solve(
             newton.set_conduction(kf);
             faces = now;
         }
-        let previous = past.first().map(|(_, v)| v.as_slice());
+        let (u, previous) = (&mine.u, mine.past.first().map(|(_, v)| v.as_slice()));
         let rest: Vec<f64> = (0..n)
             .map(|d| match m[d] != 0.0 {
                 true => (alpha[1] * u[d] + previous.map_or(0.0, |v| alpha[2] * v[d])) / dt,
@@ -95,7 +96,8 @@ pub(super) fn solve(
             c0: alpha[0] / dt,
             rest: &rest,
         };
-        let mut next = u.clone();
+        // From the serial step's predictor (its extrapolation is local to each dof).
+        let mut next = predictor(&mine, dt, s.scheme.order() as usize);
         built.start(&mut next, &bcs);
         let solved = newton.solve(&mut next, t_new, Some(&capacity))?;
         if !solved.converged {
@@ -106,10 +108,13 @@ pub(super) fn solve(
                 solved.history.last().copied().unwrap_or(f64::NAN),
             )));
         }
-        past.insert(0, (time, std::mem::replace(&mut u, next)));
-        past.truncate(1);
+        let old = std::mem::replace(&mut mine.u, next);
+        mine.past.insert(0, (time, old));
+        mine.past.truncate(2);
+        mine.time = t_new;
+        mine.step += 1;
         steps += 1;
-        let mut now_u = u.clone();
+        let mut now_u = mine.u.clone();
         built.gather(&mut now_u);
         if root {
             let old = std::mem::replace(&mut state.u, now_u);
@@ -148,7 +153,7 @@ pub(super) fn solve(
             true => built
                 .all_points()
                 .and_then(|()| on_step(&report, &state, &built.dofs))
-                .and_then(|()| built.own_points_again(&u, t_new)),
+                .and_then(|()| built.own_points_again(&mine.u, t_new)),
             false => on_step(&report, &state, &built.dofs),
         };
         agreed(handed)?;

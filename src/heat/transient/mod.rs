@@ -562,7 +562,7 @@ fn factor(tol: f64, err: f64, scheme: Scheme) -> f64 {
 /// The starting guess of a step: the last state, extrapolated linearly when `order` ≥ 1
 /// and a history exists, quadratically (through the last three states) when `order` ≥ 2
 /// and two earlier states exist.
-fn predictor(state: &State, dt: f64, order: usize) -> Vec<f64> {
+pub(crate) fn predictor(state: &State, dt: f64, order: usize) -> Vec<f64> {
     if let (2.., [(t1, u1), (t2, u2), ..]) = (order, state.past.as_slice())
         && state.time > *t1
         && *t1 > *t2
