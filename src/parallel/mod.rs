@@ -173,8 +173,10 @@ pub struct Stepping<'s> {
     pub scheme: crate::heat::transient::Scheme,
     pub start: f64,
     pub end: f64,
-    /// The step (fixed).
+    /// The first step (every step, without `adaptive`).
     pub dt: f64,
+    /// Steps chosen by the local error estimate.
+    pub adaptive: Option<crate::heat::transient::Adaptive>,
     /// The temperature at each node of the rank's mesh at `start` (the nodes after it,
     /// a contact partner's, take their owners' values).
     pub initial: &'s [f64],

@@ -364,6 +364,38 @@ impl<'p> Built<'p> {
         Ok(())
     }
 
+    /// The serial general solver's local error estimate of a step of size `dt` from
+    /// `state` (this rank's) to `u_new`, `predicted` the predictor through the last
+    /// states: the largest `|u_new − predicted|` over every rank's own dofs times the
+    /// scheme's error constant relative to the predictor's (backward Euler
+    /// `Δt/(Δt + Δtₙ₋₁)`, BDF2 2/11); `None` while the history is too short (collective).
+    pub(super) fn local_error(
+        &self,
+        scheme: crate::heat::transient::Scheme,
+        state: &crate::heat::transient::State,
+        u_new: &[f64],
+        predicted: &[f64],
+        dt: f64,
+    ) -> Option<f64> {
+        use crate::heat::transient::Scheme;
+        let c = match scheme {
+            Scheme::BackwardEuler => {
+                let (t1, _) = state.past.first()?;
+                dt / (dt + (state.time - t1))
+            }
+            Scheme::Bdf2 => {
+                state.past.get(1)?;
+                2.0 / 11.0
+            }
+        };
+        let mine =
+            (self.layout.owned.iter()).fold(0.0f64, |m, &d| m.max((u_new[d] - predicted[d]).abs()));
+        let mut worst = 0.0;
+        self.world
+            .all_reduce_into(&mine, &mut worst, SystemOperation::max());
+        Some(worst * c)
+    }
+
     /// The lumped capacity `∫ ρc N_a` of this rank's own elements at each local dof,
     /// `rho_c` per block of the problem's mesh.
     pub(super) fn capacity(&self, rho_c: &[f64]) -> Result<Vec<f64>, HeatError> {

@@ -2,21 +2,23 @@
 //! set-up and Newton iteration ([`super::steady`]: each rank its own elements, the
 //! interface points it owns, PETSc's rows of its nodes) with the lumped capacity of
 //! the serial general solver, stepped by backward Euler or BDF2 with the serial time
-//! loop's fixed steps.
+//! loop's steps — fixed, or chosen by its local error estimate (the largest over every
+//! rank's own dofs), attempts above the tolerance taken again with a smaller step.
 //!
-//! Every rank keeps its local dofs' last two states (the history of BDF2), up to date
-//! at the dofs it reads. After each accepted step the field is gathered on rank 0,
-//! which holds the whole mesh, evaluates every interface point again and hands the
-//! whole state to the run (outputs, checkpoints); the other ranks hand their own.
+//! Every rank keeps its local dofs' last two states (the history of BDF2 and the
+//! predictor), up to date at the dofs it reads. After each accepted step the field is
+//! gathered on rank 0, which holds the whole mesh, evaluates every interface point
+//! again and hands the whole state to the run (outputs, checkpoints); the other ranks
+//! hand their own.
 //!
-//! The run takes this path only where every step is linear and of a given size
-//! ([`super::Stepping`]): constant materials, sources of x alone, linear interfaces, no
-//! adaptive steps. A step that does not converge stops the run (the serial solver
-//! would cut it; a linear step converges in one Newton step).
+//! The run takes this path only where every step is linear ([`super::Stepping`]):
+//! constant materials, sources of x alone, linear interfaces. A step that does not
+//! converge stops the run (the serial solver would cut it; a linear step converges in
+//! one Newton step).
 
 use crate::assembly::DofMap;
 use crate::heat::steady::SteadyProblem;
-use crate::heat::transient::{Outcome, State, StepReport, predictor, weights};
+use crate::heat::transient::{Outcome, State, StepReport, factor, predictor, weights};
 use crate::heat::{HeatError, dirichlet_dofs};
 
 use super::Stepping;
@@ -58,56 +60,92 @@ pub(super) fn solve(
     let mut faces = p.face_bcs.to_vec();
     let mut steps = 0;
     let eps = 1e-12 * s.end.abs().max(s.dt);
+    let mut rejected_total = 0;
     while mine.time < s.end - eps {
         let time = mine.time;
-        // The serial loop's step: the given size, the last one to the end without a
-        // sliver before it.
-        let mut dt = s.dt.min(s.end - time);
-        if s.end - time - dt < 1e-6 * dt {
-            dt = s.end - time;
-        }
-        let t_new = time + dt;
-        log::debug!("rank step {} from t = {time} by {dt}", mine.step + 1);
-        let dt_prev = mine.past.first().map(|(t, _)| time - t);
-        let alpha = weights(s.scheme, dt, dt_prev);
-        // The step's loads; a rank that cannot make them stops every rank.
-        let loads = (s.loads)(t_new).and_then(|(dirichlet, now)| {
-            let bcs = dirichlet_dofs(p.mesh, &built.dofs, field, &dirichlet)?;
-            let conduction = match now != faces {
-                true => Some(built.conduction(&now)?),
-                false => None,
+        let mut rejected = 0;
+        // The serial loop's attempts: the step to try (at most `dt_max`), the last one
+        // to the end without a sliver before it; with adaptive steps an attempt whose
+        // local error is above the tolerance is taken again with a smaller step.
+        let (solved, dt, estimate, next) = loop {
+            let mut dt = mine.dt.min(s.end - time);
+            if let Some(a) = s.adaptive {
+                dt = dt.min(a.dt_max);
+            }
+            if s.end - time - dt < 1e-6 * dt {
+                dt = s.end - time;
+            }
+            let t_new = time + dt;
+            log::debug!("rank step {} from t = {time} by {dt}", mine.step + 1);
+            let dt_prev = mine.past.first().map(|(t, _)| time - t);
+            let alpha = weights(s.scheme, dt, dt_prev);
+            // The step's loads; a rank that cannot make them stops every rank.
+            let loads = (s.loads)(t_new).and_then(|(dirichlet, now)| {
+                let bcs = dirichlet_dofs(p.mesh, &built.dofs, field, &dirichlet)?;
+                let conduction = match now != faces {
+                    true => Some(built.conduction(&now)?),
+                    false => None,
+                };
+                Ok((bcs, now, conduction))
+            });
+            let (bcs, now, conduction) = agreed(loads)?;
+            if let Some(kf) = conduction {
+                newton.set_conduction(kf);
+                faces = now;
+            }
+            let (u, previous) = (&mine.u, mine.past.first().map(|(_, v)| v.as_slice()));
+            let rest: Vec<f64> = (0..n)
+                .map(|d| match m[d] != 0.0 {
+                    true => (alpha[1] * u[d] + previous.map_or(0.0, |v| alpha[2] * v[d])) / dt,
+                    false => 0.0,
+                })
+                .collect();
+            let capacity = Capacity {
+                m: &m,
+                c0: alpha[0] / dt,
+                rest: &rest,
             };
-            Ok((bcs, now, conduction))
-        });
-        let (bcs, now, conduction) = agreed(loads)?;
-        if let Some(kf) = conduction {
-            newton.set_conduction(kf);
-            faces = now;
-        }
-        let (u, previous) = (&mine.u, mine.past.first().map(|(_, v)| v.as_slice()));
-        let rest: Vec<f64> = (0..n)
-            .map(|d| match m[d] != 0.0 {
-                true => (alpha[1] * u[d] + previous.map_or(0.0, |v| alpha[2] * v[d])) / dt,
-                false => 0.0,
-            })
-            .collect();
-        let capacity = Capacity {
-            m: &m,
-            c0: alpha[0] / dt,
-            rest: &rest,
+            // From the serial step's predictor (its extrapolation is local to each dof).
+            let predicted = predictor(&mine, dt, s.scheme.order() as usize);
+            let mut next = predicted.clone();
+            built.start(&mut next, &bcs);
+            let solved = newton.solve(&mut next, t_new, Some(&capacity))?;
+            if !solved.converged {
+                return Err(HeatError::Step(format!(
+                    "at t = {t_new}: the distributed step did not converge in {} Newton iterations (‖R‖: {:.3e} → {:.3e}); the distributed transient solve does not cut steps: run without mpirun to let the general solver cut it",
+                    solved.iterations,
+                    solved.history.first().copied().unwrap_or(f64::NAN),
+                    solved.history.last().copied().unwrap_or(f64::NAN),
+                )));
+            }
+            let Some(a) = s.adaptive else {
+                break (solved, dt, None, next);
+            };
+            let estimate = built.local_error(s.scheme, &mine, &next, &predicted, dt);
+            match estimate {
+                Some(e) if e > a.tolerance => {
+                    mine.dt = dt * factor(a.tolerance, e, s.scheme).clamp(0.2, 0.9);
+                    rejected += 1;
+                    rejected_total += 1;
+                    if mine.dt < a.dt_min {
+                        return Err(HeatError::Step(format!(
+                            "at t = {time}: the local error {e:.3e} K stays above the tolerance {:.3e} K down to dt_min = {}",
+                            a.tolerance, a.dt_min
+                        )));
+                    }
+                }
+                _ => {
+                    if let Some(e) = estimate {
+                        mine.dt = (dt * factor(a.tolerance, e, s.scheme).clamp(0.2, 2.0))
+                            .clamp(a.dt_min, a.dt_max);
+                    }
+                    break (solved, dt, estimate, next);
+                }
+            }
+            // (Rejected: `next` is dropped, the state stays.)
         };
-        // From the serial step's predictor (its extrapolation is local to each dof).
-        let mut next = predictor(&mine, dt, s.scheme.order() as usize);
-        built.start(&mut next, &bcs);
-        let solved = newton.solve(&mut next, t_new, Some(&capacity))?;
-        if !solved.converged {
-            return Err(HeatError::Step(format!(
-                "at t = {t_new}: the distributed step did not converge in {} Newton iterations (‖R‖: {:.3e} → {:.3e}); the distributed transient solve does not cut steps: run without mpirun to let the general solver cut it",
-                solved.iterations,
-                solved.history.first().copied().unwrap_or(f64::NAN),
-                solved.history.last().copied().unwrap_or(f64::NAN),
-            )));
-        }
+        let t_new = time + dt;
+        // Accepted: the history shifts.
         let old = std::mem::replace(&mut mine.u, next);
         mine.past.insert(0, (time, old));
         mine.past.truncate(2);
@@ -125,6 +163,7 @@ pub(super) fn solve(
         }
         state.time = t_new;
         state.step += 1;
+        state.dt = mine.dt;
         let cg = solved.cg_iterations.iter().sum();
         let report = StepReport {
             step: state.step,
@@ -132,8 +171,8 @@ pub(super) fn solve(
             dt,
             newton_iterations: solved.iterations,
             residual_history: solved.history,
-            rejected: 0,
-            error_estimate: None,
+            rejected,
+            error_estimate: estimate,
             heat: solved.heat,
             assembly_s: solved.timing.assembly_s,
             factor_s: solved.timing.factor_s,
@@ -174,7 +213,7 @@ pub(super) fn solve(
         fields: vec![field],
         state,
         steps,
-        rejected: 0,
+        rejected: rejected_total,
         crosspoints: Vec::new(),
     })
 }

@@ -90,8 +90,7 @@ pub(super) fn quiet() -> RunError {
 
 /// Whether the run is one the distributed steady solve, or the distributed linear
 /// transient steps, take from start to end, so that the ranks other than 0 can hold
-/// their part of the mesh only: steady or stepped by fixed steps, one temperature
-/// field with constant conductivities and sources of x alone (per block), no radiation,
+/// their part of the mesh only: steady or transient, one temperature field with constant conductivities and sources of x alone (per block), no radiation,
 /// no moving or dying surfaces, no restart or nodal fields, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
 /// no toggle, no contact pressure field, no voltage or species enforcement, no
@@ -103,9 +102,6 @@ pub(super) fn distributable(
 ) -> Result<(), String> {
     let p = &file.problem;
     let refuse = |why: &str| Err(why.to_string());
-    if file.transient && physics.time.adaptive.is_some() {
-        return refuse("a transient run with adaptive steps (the general solver)");
-    }
     if p.restart.is_some() || options.restart.is_some() {
         return refuse("a restart");
     }

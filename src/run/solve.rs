@@ -89,15 +89,14 @@ impl<'a> TimeLoop<'a> {
     }
 
     /// Whether a run under MPI steps with its assembly distributed: a transient run
-    /// whose every step is linear and of the given size — one field, constant
-    /// materials, a source of x alone, no toggles, radiation or multiplier ties, fixed
-    /// steps, no restart, nothing moving or dying, no nodal field. (Every run whose mesh
+    /// whose every step is linear — one field, constant materials, a source of x alone,
+    /// no toggles, radiation or multiplier ties, no restart, nothing moving or dying, no
+    /// nodal field. (Every run whose mesh
     /// `ranks::distributable` splits and is transient is one.)
     fn is_linear_transient_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
         crate::parallel::world().is_some()
             && self.file.transient
-            && physics.time.adaptive.is_none()
             && !self.terms.multiplier_ties()
             && physics.source_of_x_only()
             && physics.materials.constant().is_some()
@@ -261,6 +260,7 @@ impl<'a> TimeLoop<'a> {
             start: time.start,
             end: time.end,
             dt: time.dt,
+            adaptive: time.adaptive,
             initial: &initial,
             loads: &loads,
         };

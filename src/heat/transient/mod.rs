@@ -552,7 +552,7 @@ pub fn solve(
 }
 
 /// Step-size factor `(tol/err)^(1/(p+1))` with a safety factor 0.9.
-fn factor(tol: f64, err: f64, scheme: Scheme) -> f64 {
+pub(crate) fn factor(tol: f64, err: f64, scheme: Scheme) -> f64 {
     if err <= 0.0 {
         return f64::INFINITY;
     }
