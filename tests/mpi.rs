@@ -256,16 +256,17 @@ fn compare_runs(problem: &Path, cut: bool) -> (Ran, Vec<Ran>) {
 /// Rank 0's log line saying the other ranks hold their part of the mesh only.
 const PART_ONLY: &str = "each rank other than 0 holds its own elements and a ghost layer";
 
-/// The runs of a linear transient problem with fixed steps: from 2 ranks on, each rank
-/// other than 0 held its part of the mesh only and the steps were assembled per rank
-/// (the summary's reason names the path), with the serial run's steps.
+/// The runs of a transient problem the steady solver's distribution steps: from 2 ranks
+/// on, each rank other than 0 held its part of the mesh only and the steps were
+/// assembled per rank (the summary's reason names the path), with the serial run's
+/// steps.
 fn assert_steps_distributed(serial: &Ran, runs: &[Ran]) {
     let steps = |r: &Ran| r.summary["transient"]["steps"].as_u64().unwrap();
     for (n, par) in (1..).zip(runs) {
         assert_eq!(steps(par), steps(serial), "steps on {n} ranks");
         let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
         assert!(
-            reason.contains("linear transient steps"),
+            reason.contains("transient steps assembled per rank"),
             "the distributed steps on {n} ranks: {reason}"
         );
         if n > 1 {
@@ -548,6 +549,44 @@ fn cut_interface_transient_loads_in_time_equal_serial() {
         cg["name"].as_str().unwrap().contains("CG"),
         "CG + GAMG asked for: {cg}"
     );
+}
+
+/// Transient steps across a conductance that depends on temperature: Newton at each
+/// step, the unsymmetric Jacobian by MUMPS, assembled per rank.
+#[test]
+fn cut_interface_transient_newton_equals_serial() {
+    let tmp = scratch("transient_newton");
+    let problem = write_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = table of temperature = 300 1e3 600 4e3",
+        "",
+    );
+    let text = std::fs::read_to_string(&problem)
+        .unwrap()
+        .replace(
+            "kind = \"steady\"\n",
+            "kind = \"transient\"\ndt = 0.1\nend_time = 0.3\n",
+        )
+        .replace(
+            "conductivity = ",
+            "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
+        )
+        + "[initial]\ntemperature = 300.0\n";
+    std::fs::write(&problem, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    for par in &runs {
+        let solver = &par.summary["linear_solver"];
+        assert!(
+            solver["reason"].as_str().unwrap().contains("unsymmetric"),
+            "{solver}"
+        );
+        assert!(
+            par.summary["newton_iterations"].as_u64().unwrap() > 3,
+            "{}",
+            par.summary
+        );
+    }
 }
 
 /// Adaptive steps by BDF2, their local error estimate the largest over every rank's own

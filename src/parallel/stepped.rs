@@ -11,10 +11,11 @@
 //! again and hands the whole state to the run (outputs, checkpoints); the other ranks
 //! hand their own.
 //!
-//! The run takes this path only where every step is linear ([`super::Stepping`]):
-//! constant materials, sources of x alone, linear interfaces. A step that does not
-//! converge stops the run (the serial solver would cut it; a linear step converges in
-//! one Newton step).
+//! The run takes this path where the steady solver's conditions hold
+//! ([`super::Stepping`]): constant materials, sources of x alone, interface terms
+//! linear or Newton-nonlinear through a temperature-dependent conductance. A step that
+//! does not converge stops the run (the serial solver would cut it; a linear step
+//! converges in one Newton step).
 
 use crate::assembly::DofMap;
 use crate::heat::steady::SteadyProblem;
@@ -197,12 +198,15 @@ pub(super) fn solve(
         };
         agreed(handed)?;
     }
-    let why = match newton.method {
-        Method::CgGamg => {
-            "linear transient steps, symmetric positive definite, at or above the AMG threshold → CG + GAMG (hierarchy kept while the step size holds)"
+    let why = match (newton.method, newton.symmetric) {
+        (Method::CgGamg, _) => {
+            "transient steps assembled per rank, symmetric positive definite, at or above the AMG threshold → CG + GAMG (hierarchy kept while the step size holds)"
         }
-        _ => {
-            "linear transient steps below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU (factorisation kept while the step size holds)"
+        (_, true) => {
+            "transient steps assembled per rank, below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU (factorisation kept while the step size holds)"
+        }
+        (_, false) => {
+            "transient steps assembled per rank, a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU at each Newton iteration"
         }
     };
     super::record(newton.method, why);

@@ -88,10 +88,11 @@ impl<'a> TimeLoop<'a> {
         }
     }
 
-    /// Whether a run under MPI steps with its assembly distributed: a transient run
-    /// whose every step is linear — one field, constant materials, a source of x alone,
-    /// no toggles, radiation or multiplier ties, no restart, nothing moving or dying, no
-    /// nodal field. (Every run whose mesh
+    /// Whether a run under MPI steps with its assembly distributed: a transient run of
+    /// the kind the linear steady solve takes — one field, constant materials, a source
+    /// of x alone, no toggles, radiation or multiplier ties (its interfaces linear, or
+    /// Newton through a temperature-dependent conductance) — with no restart, nothing
+    /// moving or dying and no nodal field. (Every run whose mesh
     /// `ranks::distributable` splits and is transient is one.)
     fn is_linear_transient_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
@@ -230,7 +231,8 @@ impl<'a> TimeLoop<'a> {
         })
     }
 
-    /// A linear transient run under MPI: its steps with the assembly distributed
+    /// A transient run under MPI of the kind the linear steady solve takes: its steps
+    /// with the assembly distributed
     /// ([`crate::parallel::transient`]), each accepted one recorded as the general
     /// solver's are — written by rank 0, which gets the whole state.
     fn linear_steps_on_ranks(
