@@ -55,8 +55,10 @@ fn scratch(name: &str) -> tempfile::TempDir {
         .unwrap_or_else(|e| panic!("cannot make a scratch folder for {name}: {e}"))
 }
 
-/// `seam -v` serially (`ranks` None) or under `mpirun -n ranks`, one thread per rank (the
-/// ranks share the machine's cores); the command's arguments follow.
+/// `seam -vv` serially (`ranks` None) or under `mpirun -n ranks`, one thread per rank
+/// (the ranks share the machine's cores); the command's arguments follow. Debug records
+/// on: rank 0 logs them and the other ranks do not, so a collective call made only to
+/// log something fails the run here.
 fn seam(ranks: Option<usize>) -> Command {
     let seam = env!("CARGO_BIN_EXE_seam");
     let mut cmd = match ranks {
@@ -76,7 +78,7 @@ fn seam(ranks: Option<usize>) -> Command {
             c
         }
     };
-    cmd.arg("-v")
+    cmd.arg("-vv")
         .env("RAYON_NUM_THREADS", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
         .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
@@ -84,7 +86,7 @@ fn seam(ranks: Option<usize>) -> Command {
     cmd
 }
 
-/// `seam -v run --json problem` serially (`ranks` None) or under `mpirun -n ranks`.
+/// `seam -vv run --json problem` serially (`ranks` None) or under `mpirun -n ranks`.
 fn launch(problem: &Path, ranks: Option<usize>) -> Output {
     let mut cmd = seam(ranks);
     cmd.args(["run", "--json"]).arg(problem);
@@ -491,28 +493,40 @@ fn cut_interface_crosspoints_on_rank_boundaries_equal_serial() {
     compare(&problem, true);
 }
 
-/// A transient run of the cut bar (ρc = 10 J/m³/K: the field moves by tens of kelvin
-/// each step): every step's temperatures equal serial.
-#[test]
-fn cut_interface_transient_equals_serial() {
-    let tmp = scratch("transient");
-    let problem = write_cut_case(
-        tmp.path(),
-        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
-        "",
-    );
+/// The cut bar's gap conductance, constant.
+const GAP_H: &str =
+    "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000";
+
+/// The cut bar as a transient problem (ρc = 10 J/m³/K: the field moves by tens of
+/// kelvin each step) from 300 K, to t = 0.3 by steps of `dt`; `enforcement` and `solve`
+/// as [`write_cut_case`]'s. Its text, for a test to change before it is written again.
+fn write_transient_cut_case(
+    dir: &Path,
+    enforcement: &str,
+    solve: &str,
+    dt: f64,
+) -> (PathBuf, String) {
+    let problem = write_cut_case(dir, enforcement, solve);
     let text = std::fs::read_to_string(&problem)
         .unwrap()
         .replace(
             "kind = \"steady\"\n",
-            "kind = \"transient\"\ndt = 0.1\nend_time = 0.3\n",
+            &format!("kind = \"transient\"\ndt = {dt:?}\nend_time = 0.3\n"),
         )
         .replace(
             "conductivity = ",
             "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
         )
         + "[initial]\ntemperature = 300.0\n";
-    std::fs::write(&problem, text).unwrap();
+    std::fs::write(&problem, &text).unwrap();
+    (problem, text)
+}
+
+/// A transient run of the cut bar: every step's temperatures equal serial.
+#[test]
+fn cut_interface_transient_equals_serial() {
+    let tmp = scratch("transient");
+    let (problem, _) = write_transient_cut_case(tmp.path(), GAP_H, "", 0.1);
     let (serial, runs) = compare_runs(&problem, false);
     assert_steps_distributed(&serial, &runs);
 }
@@ -523,23 +537,9 @@ fn cut_interface_transient_equals_serial() {
 #[test]
 fn cut_interface_transient_loads_in_time_equal_serial() {
     let tmp = scratch("transient_loads");
-    let problem = write_cut_case(
-        tmp.path(),
-        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
-        "scheme = \"bdf2\"\nlinear_solver = \"amg\"\n",
-    );
-    let text = std::fs::read_to_string(&problem)
-        .unwrap()
-        .replace(
-            "kind = \"steady\"\n",
-            "kind = \"transient\"\ndt = 0.05\nend_time = 0.3\n",
-        )
-        .replace("value = 500.0", "value = \"500 - 400*t\"")
-        .replace(
-            "conductivity = ",
-            "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
-        )
-        + "[initial]\ntemperature = 300.0\n"
+    let solve = "scheme = \"bdf2\"\nlinear_solver = \"amg\"\n";
+    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, solve, 0.05);
+    let text = text.replace("value = 500.0", "value = \"500 - 400*t\"")
         + "[[bc]]\nkind = \"flux\"\nsurfaces = [\"surface_5\"]\nvalue = \"2e4*t*(1 + y)\"\n";
     std::fs::write(&problem, text).unwrap();
     let (serial, runs) = compare_runs(&problem, true);
@@ -556,23 +556,8 @@ fn cut_interface_transient_loads_in_time_equal_serial() {
 #[test]
 fn cut_interface_transient_newton_equals_serial() {
     let tmp = scratch("transient_newton");
-    let problem = write_cut_case(
-        tmp.path(),
-        "enforcement for energy = gap_conductance\n gap conductance coefficient = table of temperature = 300 1e3 600 4e3",
-        "",
-    );
-    let text = std::fs::read_to_string(&problem)
-        .unwrap()
-        .replace(
-            "kind = \"steady\"\n",
-            "kind = \"transient\"\ndt = 0.1\nend_time = 0.3\n",
-        )
-        .replace(
-            "conductivity = ",
-            "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
-        )
-        + "[initial]\ntemperature = 300.0\n";
-    std::fs::write(&problem, text).unwrap();
+    let h_of_t = "enforcement for energy = gap_conductance\n gap conductance coefficient = table of temperature = 300 1e3 600 4e3";
+    let (problem, _) = write_transient_cut_case(tmp.path(), h_of_t, "", 0.1);
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
     for par in &runs {
@@ -596,23 +581,8 @@ fn cut_interface_transient_newton_equals_serial() {
 #[test]
 fn cut_interface_adaptive_transient_equals_serial() {
     let tmp = scratch("transient_adaptive");
-    let problem = write_cut_case(
-        tmp.path(),
-        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
-        "scheme = \"bdf2\"\nadaptive = true\ntime_tolerance = 0.5\n",
-    );
-    let text = std::fs::read_to_string(&problem)
-        .unwrap()
-        .replace(
-            "kind = \"steady\"\n",
-            "kind = \"transient\"\ndt = 0.1\nend_time = 0.3\n",
-        )
-        .replace(
-            "conductivity = ",
-            "density = 1.0\nspecific_heat = 10.0\nconductivity = ",
-        )
-        + "[initial]\ntemperature = 300.0\n";
-    std::fs::write(&problem, text).unwrap();
+    let solve = "scheme = \"bdf2\"\nadaptive = true\ntime_tolerance = 0.5\n";
+    let (problem, _) = write_transient_cut_case(tmp.path(), GAP_H, solve, 0.1);
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
     let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();
