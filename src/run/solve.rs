@@ -293,31 +293,7 @@ impl<'a> TimeLoop<'a> {
         if let Some(e) = source_failed.lock().ok().and_then(|mut s| s.take()) {
             return Err(RunError::Solve(format!("[[source]]: {e}")));
         }
-        let Recorder {
-            output,
-            history,
-            mechanisms,
-            ..
-        } = recorder;
-        output.finish_steps(&outcome, &history)?;
-        let mut linear_solver = self.stepped_solver_summary(&history, linear.unknowns);
-        if let Some((name, reason)) = crate::parallel::linear_solver() {
-            (linear_solver.name, linear_solver.reason) = (name, reason);
-        }
-        let solution = steps::final_solution(
-            outcome,
-            &history,
-            &physics.field_names,
-            self.terms.energy_flux_count(),
-        );
-        Ok(Solved {
-            solution,
-            history,
-            mechanisms,
-            linear_solver,
-            linear_steady: false,
-            species_flux: Vec::new(),
-        })
+        self.stepped(recorder, outcome, linear.unknowns)
     }
 
     /// The general solver's steps: a transient run, or a nonlinear steady solve as one
@@ -464,6 +440,18 @@ impl<'a> TimeLoop<'a> {
         let mut on_step = |r: &StepReport, st: &State, dofs: &DofMap| recorder.record(r, st, dofs);
         let outcome = transient::solve(&tp, mode, start, &mut on_step)
             .map_err(|e| RunError::Solve(e.to_string()))?;
+        let n = outcome.dofs.len();
+        self.stepped(recorder, outcome, n)
+    }
+
+    /// A stepped run's end: the last step written if it was not, the linear solver
+    /// summarised (`unknowns`: the whole problem's), the final state as the solution.
+    fn stepped(
+        &self,
+        recorder: Recorder<'_, 'a>,
+        outcome: transient::Outcome,
+        unknowns: usize,
+    ) -> Result<Solved, RunError> {
         let Recorder {
             output,
             history,
@@ -472,15 +460,15 @@ impl<'a> TimeLoop<'a> {
             ..
         } = recorder;
         output.finish_steps(&outcome, &history)?;
-        let mut linear_solver = self.stepped_solver_summary(&history, outcome.dofs.len());
+        let mut linear_solver = self.stepped_solver_summary(&history, unknowns);
         if let Some((name, reason)) = crate::parallel::linear_solver() {
             (linear_solver.name, linear_solver.reason) = (name, reason);
         }
         let solution = steps::final_solution(
             outcome,
             &history,
-            &physics.field_names,
-            terms.energy_flux_count(),
+            &self.physics.field_names,
+            self.terms.energy_flux_count(),
         );
         Ok(Solved {
             solution,
