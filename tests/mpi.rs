@@ -574,6 +574,37 @@ fn cut_interface_transient_newton_equals_serial() {
     }
 }
 
+/// A step whose Newton iteration fails is cut in half and taken again, as serial: the
+/// temperature-dependent conductance of [`cut_interface_transient_newton_equals_serial`]
+/// with Newton held to 3 iterations, which the first steps of 0.1 do not converge in.
+/// Every rank count takes the serial steps, cuts, Newton iterations and temperatures
+/// (the steps' stopping test is the serial step's).
+#[test]
+fn cut_interface_transient_newton_cuts_failed_steps_as_serial() {
+    let tmp = scratch("transient_newton_cut");
+    let h_of_t = "enforcement for energy = gap_conductance\n gap conductance coefficient = table of temperature = 300 1e3 600 4e3";
+    let (problem, _) = write_transient_cut_case(tmp.path(), h_of_t, "max_iterations = 3\n", 0.1);
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();
+    eprintln!("steps cut, serial: {}", serial.summary["transient"]);
+    assert!(
+        rejected(&serial) > 0,
+        "some steps cut: {}",
+        serial.summary["transient"]
+    );
+    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
+    for par in &runs {
+        assert_eq!(
+            rejected(par),
+            rejected(&serial),
+            "{}",
+            par.summary["transient"]
+        );
+        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
+    }
+}
+
 /// Adaptive steps by BDF2, their local error estimate the largest over every rank's own
 /// dofs: the serial steps (sizes, rejected attempts) and temperatures, assembled per
 /// rank. The first step (0.1) is far too long for the tolerance, so attempts are

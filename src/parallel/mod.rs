@@ -177,6 +177,9 @@ pub struct Stepping<'s> {
     pub dt: f64,
     /// Steps chosen by the local error estimate.
     pub adaptive: Option<crate::heat::transient::Adaptive>,
+    /// The least step a failing step may be cut to, without `adaptive` (with it, its
+    /// own `dt_min`).
+    pub dt_min: f64,
     /// The temperature at each node of the rank's mesh at `start` (the nodes after it,
     /// a contact partner's, take their owners' values).
     pub initial: &'s [f64],

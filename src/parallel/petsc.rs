@@ -180,6 +180,14 @@ pub struct PetscError {
     pub message: String,
 }
 
+impl PetscError {
+    /// The Krylov solve ran and diverged (a negative `KSPConvergedReason`), as opposed
+    /// to a call that failed: the same on every rank, and a step may be retried.
+    pub fn is_divergence(&self) -> bool {
+        self.call == "KSPSolve" && self.code < 0
+    }
+}
+
 fn check(call: &'static str, code: PetscErrorCode) -> Result<(), PetscError> {
     if code == 0 {
         return Ok(());

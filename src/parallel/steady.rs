@@ -54,6 +54,9 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     let mut u = vec![0.0; built.n];
     built.start(&mut u, &built.bcs);
     let solved = newton.solve(&mut u, 0.0, None)?;
+    if let Some(why) = solved.failure {
+        return Err(HeatError::Step(why));
+    }
     built.gather(&mut u);
     let (method, symmetric) = (newton.method, newton.symmetric);
     let why = match (method, symmetric) {
@@ -128,6 +131,10 @@ pub(super) struct Capacity<'a> {
 /// What one Newton solve ([`Newton::solve`]) ends with, the same on every rank.
 pub(super) struct Solved {
     pub converged: bool,
+    /// Why the iteration stopped short, where it could not go on (a residual that is
+    /// not finite, a Krylov solve that diverged); the same on every rank. A time step
+    /// that stops so, or does not converge, is cut and taken again.
+    pub failure: Option<String>,
     /// Newton steps taken (linear solves).
     pub iterations: usize,
     /// ‖R‖ at every iterate.
@@ -608,6 +615,7 @@ impl<'b, 'p> Newton<'b, 'p> {
         let mut record = crate::heat::steady::Record::with_norm(f_norm, p.tolerance);
         let mut heat = Vec::new();
         let (mut converged, mut iterations, mut setups) = (false, 0, 0);
+        let mut failure = None;
         let mut cg_iterations = Vec::new();
         let mut last_step = f64::INFINITY;
         let k_sym = &built.k_sym;
@@ -669,10 +677,26 @@ impl<'b, 'p> Newton<'b, 'p> {
                 .map_err(petsc_err)?;
             let rn = self.r_vec.norm().map_err(petsc_err)?;
             timing.assembly_s += start.elapsed().as_secs_f64();
+            if !rn.is_finite() {
+                record.history.push(rn);
+                failure = Some(format!("the residual is not finite at t = {t}"));
+                break;
+            }
             // The serial solve's stopping tests; they see |u| at its largest over the
-            // ranks (they take only that).
-            let u_max = [built.scatter.u_max(&built.world, layout, u)];
-            if record.converged_at(it, rn, last_step, &u_max, self.symmetric) {
+            // ranks (they take only that). A time step's are the serial step's: done
+            // after one solve of a linear step, else once the last update is within the
+            // tolerance of max |u| — so the steps take the serial iterations and fail
+            // (and are cut) where the serial ones do.
+            let u_max = built.scatter.u_max(&built.world, layout, u);
+            let done = match capacity {
+                Some(_) => {
+                    record.history.push(rn);
+                    let u_max = u_max.max(f64::MIN_POSITIVE);
+                    it > 0 && (self.symmetric || last_step <= p.tolerance * u_max)
+                }
+                None => record.converged_at(it, rn, last_step, &[u_max], self.symmetric),
+            };
+            if done {
                 converged = true;
                 break;
             }
@@ -702,10 +726,14 @@ impl<'b, 'p> Newton<'b, 'p> {
             self.r_vec
                 .with_local(local_rows, |v| v.iter_mut().for_each(|x| *x = -*x))
                 .map_err(petsc_err)?;
-            let its = self
-                .ksp
-                .solve(&self.r_vec, &mut self.du_vec)
-                .map_err(petsc_err)?;
+            let its = match self.ksp.solve(&self.r_vec, &mut self.du_vec) {
+                Ok(its) => its,
+                Err(e) if e.is_divergence() => {
+                    failure = Some(format!("the linear solve failed at t = {t}: {e}"));
+                    break;
+                }
+                Err(e) => return Err(petsc_err(e)),
+            };
             let mine = self
                 .du_vec
                 .with_local(local_rows, |v| v.to_vec())
@@ -718,6 +746,7 @@ impl<'b, 'p> Newton<'b, 'p> {
         }
         Ok(Solved {
             converged,
+            failure,
             iterations,
             history: record.history,
             heat,

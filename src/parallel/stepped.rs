@@ -13,13 +13,15 @@
 //!
 //! The run takes this path where the steady solver's conditions hold
 //! ([`super::Stepping`]): constant materials, sources of x alone, interface terms
-//! linear or Newton-nonlinear through a temperature-dependent conductance. A step that
-//! does not converge stops the run (the serial solver would cut it; a linear step
-//! converges in one Newton step).
+//! linear or Newton-nonlinear through a temperature-dependent conductance. A step whose
+//! Newton iteration does not converge (or meets a residual that is not finite, or a
+//! Krylov solve that diverges) is cut in half and taken again, as the serial loop cuts
+//! it, down to the run's `dt_min`; every rank sees the same failure, so they cut
+//! together.
 
 use crate::assembly::DofMap;
 use crate::heat::steady::SteadyProblem;
-use crate::heat::transient::{Outcome, State, StepReport, factor, predictor, weights};
+use crate::heat::transient::{Outcome, State, StepReport, factor, predictor, unconverged, weights};
 use crate::heat::{HeatError, dirichlet_dofs};
 
 use super::Stepping;
@@ -111,13 +113,24 @@ pub(super) fn solve(
             let mut next = predicted.clone();
             built.start(&mut next, &bcs);
             let solved = newton.solve(&mut next, t_new, Some(&capacity))?;
-            if !solved.converged {
-                return Err(HeatError::Step(format!(
-                    "at t = {t_new}: the distributed step did not converge in {} Newton iterations (‖R‖: {:.3e} → {:.3e}); the distributed transient solve does not cut steps: run without mpirun to let the general solver cut it",
-                    solved.iterations,
-                    solved.history.first().copied().unwrap_or(f64::NAN),
-                    solved.history.last().copied().unwrap_or(f64::NAN),
-                )));
+            // A failed attempt: the serial loop's cut, the same on every rank (the
+            // residual norms and the Krylov solve's outcome are global).
+            let failure = (solved.failure.clone()).or_else(|| {
+                (!solved.converged).then(|| unconverged(p.max_iterations, t_new, &solved.history))
+            });
+            if let Some(why) = failure {
+                log::debug!("rank step at t = {t_new} failed, cut: {why}");
+                rejected += 1;
+                rejected_total += 1;
+                mine.dt = dt * 0.5;
+                let floor = s.adaptive.map_or(s.dt_min, |a| a.dt_min);
+                if mine.dt < floor {
+                    return Err(HeatError::Step(format!(
+                        "at t = {time}: {why}; the step was cut to {} and may not go below {floor}",
+                        mine.dt
+                    )));
+                }
+                continue;
             }
             let Some(a) = s.adaptive else {
                 break (solved, dt, None, next);

@@ -263,6 +263,7 @@ impl<'a> TimeLoop<'a> {
             end: time.end,
             dt: time.dt,
             adaptive: time.adaptive,
+            dt_min: time.dt_min,
             initial: &initial,
             loads: &loads,
         };

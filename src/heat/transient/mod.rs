@@ -58,9 +58,10 @@ use super::law::Law;
 use super::{FaceBc, HeatError, SourceFn};
 use crate::enforce::interface::{HInput, HValue};
 
+#[cfg(feature = "mpi")]
+pub(crate) use newton::unconverged;
 use newton::{Context, History, Solvers};
 use setup::Setup;
-#[cfg(feature = "mpi")]
 pub(crate) use setup::lumped_weights;
 
 /// Time integration scheme.

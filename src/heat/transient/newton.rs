@@ -111,7 +111,7 @@ pub(super) struct Context<'c, 'a> {
 
 /// Why Newton ran out of iterations, from its residual history: the history itself and
 /// the likely cause.
-pub(super) fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String {
+pub(crate) fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String {
     let shown: Vec<String> = history.iter().map(|r| format!("{r:.3e}")).collect();
     let (first, last) = (history[0], history[history.len() - 1]);
     let falling = history.len() >= 2 && last < 0.5 * history[history.len() - 2];
