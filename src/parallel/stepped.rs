@@ -202,6 +202,7 @@ pub(super) fn solve(
             diagnosis: None,
         };
         // Rank 0's outputs see every interface point; a failure there stops every rank.
+        let clock = std::time::Instant::now();
         let handed = match root {
             true => built
                 .all_points()
@@ -209,6 +210,11 @@ pub(super) fn solve(
                 .and_then(|()| built.own_points_again(&mine.u, t_new)),
             false => on_step(&report, &state, &built.dofs),
         };
+        log::debug!(
+            "step {}: handed to the run's outputs in {:.3} s",
+            state.step,
+            clock.elapsed().as_secs_f64()
+        );
         agreed(handed)?;
     }
     let why = match (newton.method, newton.symmetric) {
