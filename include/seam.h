@@ -428,6 +428,21 @@ int seam_rank_search(seam_rank_embedding *embedding);
  * pairings kept, gaps measured anew, as seam_move_nodes; the last evaluation and the tie
  * rows are dropped. Collective. */
 int seam_rank_move_nodes(seam_rank_embedding *embedding, const double *coords, size_t n_nodes);
+/* Between evaluations, as seam_set_time, seam_set_active, seam_set_quarantine and
+ * seam_allow_unpaired. Collective: every rank calls them in the same order with the same
+ * arguments (each rank makes its own points' terms with them); arguments that differ
+ * between ranks are SEAM_ERR_ARGUMENT on every rank. The first three drop the last
+ * evaluation. */
+int seam_rank_set_time(seam_rank_embedding *embedding, double time);
+int seam_rank_set_active(seam_rank_embedding *embedding, size_t index, int on);
+int seam_rank_set_quarantine(seam_rank_embedding *embedding, size_t index, int on);
+int seam_rank_allow_unpaired(seam_rank_embedding *embedding, size_t index, int allow);
+/* The points of interaction `index` this rank quarantined (its own side-A points), as
+ * seam_quarantined: xyz (3 per point) and the reasons, one line per point, valid until
+ * the next seam_rank_quarantined on this handle; out_total (NULL on every rank, or on
+ * none) the count over every rank. Collective. */
+int seam_rank_quarantined(seam_rank_embedding *embedding, size_t index, size_t *out_n,
+                          const double **out_xyz, const char **out_reasons, size_t *out_total);
 /* Over all ranks, the side-A points of the last search paired with a side-B face that
  * another rank gave (the pairs that straddle ranks). Local. */
 int seam_rank_points_across(const seam_rank_embedding *embedding, size_t *out_count);

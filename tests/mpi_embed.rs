@@ -45,6 +45,11 @@ struct Printed {
     coverage: Option<(usize, usize, f64)>,
     /// Every rank saw a null field on the last rank refused (1), none left waiting.
     refused: Option<f64>,
+    /// Every rank saw a time that differs on the last rank refused (1; on one rank,
+    /// `seam_rank_set_time` took it).
+    time_refused: Option<f64>,
+    /// Points quarantined over every rank and on rank 0 (`seam_rank_quarantined`).
+    quarantined: Option<f64>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -148,6 +153,8 @@ fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
         face_fields: optional("face fields:").map(|v| (v[0], v[1], v[2] as usize)),
         coverage: optional("coverage:").map(|v| (v[0] as usize, v[1] as usize, v[2])),
         refused: optional("bad argument refused on every rank:").map(|v| v[0]),
+        time_refused: optional("differing times refused on every rank:").map(|v| v[0]),
+        quarantined: optional("quarantined:").map(|v| v[0]),
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -252,6 +259,16 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
             par.refused,
             Some(1.0),
             "a null field on the last of {n} ranks"
+        );
+        assert_eq!(
+            par.time_refused,
+            Some(1.0),
+            "times that differ on {n} ranks"
+        );
+        assert_eq!(
+            par.quarantined,
+            Some(0.0),
+            "a constant model quarantines nothing"
         );
         // Every point paired, over the whole unit face, on every rank count.
         let (all_points, paired, area) = par.coverage.expect("the host prints its coverage");
@@ -552,26 +569,7 @@ fn rank_terms_child() {
     e.search().expect("rank search");
     let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.coords[g])).collect();
     let got = e.contributions(&u_local).expect("rank terms");
-    let mine_dense = dense(&got, n_nodes);
-    let mut summed = vec![0.0; mine_dense.len()];
-    world.all_reduce_into(
-        &mine_dense[..],
-        &mut summed[..],
-        mpi::collective::SystemOperation::sum(),
-    );
-    let serial_dense = dense(&want, n_nodes);
-    let scale = serial_dense.iter().fold(0.0f64, |s, v| s.max(v.abs()));
-    let diff = serial_dense
-        .iter()
-        .zip(&summed)
-        .fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
-    let mut heat_diff = 0.0f64;
-    for (w, g) in want.heat.iter().zip(&got.heat) {
-        let (w, g) = (w.unwrap(), g.unwrap());
-        heat_diff = heat_diff
-            .max((w.side_a - g.side_a).abs())
-            .max((w.side_b - g.side_b).abs());
-    }
+    let (diff, scale, heat_diff) = summed_difference(&world, &want, &got, n_nodes);
     let heat_scale = want.heat[0].unwrap().side_a.abs();
     if rank == 0 {
         println!(
@@ -653,18 +651,10 @@ fn rank_terms_child() {
     let got_moved = e
         .contributions(&u_local)
         .expect("rank terms after the move");
-    let mut summed = vec![0.0; mine_dense.len()];
-    world.all_reduce_into(
-        &dense(&got_moved, n_nodes)[..],
-        &mut summed[..],
-        mpi::collective::SystemOperation::sum(),
-    );
-    let serial_moved = dense(&want_moved, n_nodes);
-    let moved_diff =
-        (serial_moved.iter().zip(&summed)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+    let (moved_diff, _, dq_moved) = summed_difference(&world, &want_moved, &got_moved, n_nodes);
+    let (serial_moved, serial_dense) = (dense(&want_moved, n_nodes), dense(&want, n_nodes));
     let moved_by =
         (serial_moved.iter().zip(&serial_dense)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
-    let dq_moved = (want_moved.heat[0].unwrap().side_a - got_moved.heat[0].unwrap().side_a).abs();
     if rank == 0 {
         println!(
             "rank move: max |Δ| of the summed terms after the move {moved_diff:.2e} (the move changed them by {moved_by:.2e}), |Δheat| {dq_moved:.2e} W"
@@ -858,6 +848,170 @@ fn own_faces_are_the_serial_ones(
     each_once(world, &count, &format!("{what}: every face"));
     assert!(whole.iter().any(|f| f.paired_area > 0.0));
     worst
+}
+
+/// The ranks' terms `got` summed against the serial `want` (`n` dofs): the largest
+/// difference of the dense Jacobian, residual and load, their largest magnitude, and
+/// the largest difference of the heats (which come summed over the ranks already).
+fn summed_difference(
+    world: &mpi::topology::SimpleCommunicator,
+    want: &seam::embed::Contributions,
+    got: &seam::embed::Contributions,
+    n: usize,
+) -> (f64, f64, f64) {
+    use mpi::traits::CommunicatorCollectives;
+    let mine = dense(got, n);
+    let mut summed = vec![0.0; mine.len()];
+    world.all_reduce_into(
+        &mine[..],
+        &mut summed[..],
+        mpi::collective::SystemOperation::sum(),
+    );
+    let serial = dense(want, n);
+    let scale = serial.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+    let diff = (serial.iter().zip(&summed)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+    let mut heat_diff = 0.0f64;
+    assert_eq!(want.heat.len(), got.heat.len());
+    for (w, g) in want.heat.iter().zip(&got.heat) {
+        let (w, g) = (w.unwrap_or_default(), g.unwrap_or_default());
+        heat_diff = heat_diff
+            .max((w.side_a - g.side_a).abs())
+            .max((w.side_b - g.side_b).abs());
+    }
+    (diff, scale, heat_diff)
+}
+
+/// Under `mpirun -n 1..4`: the per-rank setters against the serial embedding's, on the
+/// bricks' gap conductance with a host model whose h grows with the time and fails where
+/// y < 0.3 from t = 1 on. At t = 2 with quarantine on, the ranks' summed terms and heat
+/// are the serial ones (and not those at t = 0); the points the ranks quarantined are
+/// the serial ones, each on one rank; switched off, the interaction adds nothing on any
+/// rank, as serially. A time that differs between ranks is refused on every rank.
+#[test]
+fn rank_setters_equal_the_serial_ones() {
+    if std::env::var_os(CHILD).is_some() {
+        return rank_setters_child();
+    }
+    for n in 1..=4 {
+        let text = child_on(n, "rank_setters_equal_the_serial_ones");
+        let line = text
+            .lines()
+            .find_map(|l| l.find("rank setters:").map(|k| &l[k..]))
+            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
+        eprintln!("mpirun -n {n}: {line}");
+        if n > 1 {
+            assert_eq!(
+                text.matches("refused on every rank (set_time)").count(),
+                n,
+                "every rank refused the times that differ:\n{text}"
+            );
+        }
+    }
+}
+
+fn rank_setters_child() {
+    use mpi::traits::Communicator;
+    use seam::embed::{Conductance, FnConductance, Interaction, Model};
+    use std::sync::Arc;
+    let universe = mpi::initialize().expect("MPI");
+    let world = universe.world();
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let m = bricks();
+    let (n_nodes, n_elems) = (m.coords.len(), m.num_elems());
+    let u: Vec<f64> = (0..n_nodes)
+        .map(|d| field(m.coords[(0..n_nodes).find(|&g| dof_of(g, n_nodes) == d).unwrap()]))
+        .collect();
+    let model = || {
+        let h = FnConductance::new("h of t", false, |s: &seam::embed::PointState| {
+            if s.time >= 1.0 && s.x[1] < 0.3 {
+                return Err(format!("no data below y = 0.3 at t = {}", s.time));
+            }
+            Ok(Conductance {
+                h: H * (1.0 + s.time),
+                ..Conductance::default()
+            })
+        });
+        Interaction::new("right", "left", Model::GapConductance { h: H })
+            .conductance(Arc::new(h))
+            .quarantine()
+    };
+    let all: Vec<usize> = (0..n_elems).collect();
+    let mut serial = builder_of(&m, &all).0.build().expect("serial build");
+    serial.add_interaction(model()).expect("serial interaction");
+    serial.search().expect("serial search");
+    let at_zero = serial.contributions(&u).expect("serial terms at t = 0");
+    serial.set_time(2.0).expect("serial time");
+    let want = serial.contributions(&u).expect("serial terms at t = 2");
+    let kept = serial.quarantined(0);
+
+    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
+    let (b, nodes) = builder_of(&m, &mine);
+    let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
+    let mut e = b
+        .build_on_ranks(world.duplicate(), &gids)
+        .expect("rank build");
+    e.add_interaction(model()).expect("rank interaction");
+    e.search().expect("rank search");
+    let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.coords[g])).collect();
+    e.set_time(2.0).expect("rank time");
+    assert_eq!(e.time(), 2.0);
+    let got = e.contributions(&u_local).expect("rank terms at t = 2");
+    let (diff, scale, heat_diff) = summed_difference(&world, &want, &got, n_nodes);
+    let heat = want.heat[0].unwrap().side_a;
+    let heat_then = at_zero.heat[0].unwrap().side_a;
+    assert!(
+        (heat - heat_then).abs() > 0.2 * heat_then.abs(),
+        "h depends on t: {heat} W at t = 2 against {heat_then} at t = 0"
+    );
+    assert!(diff <= 1e-12 * scale, "terms at t = 2 differ by {diff:e}");
+    assert!(
+        heat_diff <= 1e-12 * heat.abs(),
+        "heat differs by {heat_diff:e}"
+    );
+
+    // The quarantined points: the serial ones, each on one rank.
+    assert!(!kept.is_empty(), "the model failed somewhere");
+    let own = e.quarantined(0);
+    assert_eq!(
+        e.quarantined_count(0),
+        kept.len(),
+        "quarantined over the ranks"
+    );
+    let count: Vec<f64> = (kept.iter())
+        .map(|q| f64::from(u8::from(own.iter().any(|o| o.x == q.x))))
+        .collect();
+    each_once(&world, &count, "a quarantined point");
+    assert!(
+        own.iter().all(|o| o.message.contains("below y = 0.3")),
+        "{own:?}"
+    );
+
+    // Switched off: nothing on any rank, as serially.
+    serial.set_active(0, false).expect("serial off");
+    e.set_active(0, false).expect("rank off");
+    assert!(!e.is_active(0));
+    let (want_off, got_off) = (
+        serial.contributions(&u).expect("serial off terms"),
+        e.contributions(&u_local).expect("rank off terms"),
+    );
+    let (diff_off, _, heat_off) = summed_difference(&world, &want_off, &got_off, n_nodes);
+    assert!(got_off.jacobian.iter().all(|t| t.2 == 0.0) && diff_off == 0.0 && heat_off == 0.0);
+    if rank == 0 {
+        println!(
+            "rank setters: at t = 2 max |Δ| of the summed terms {diff:.2e} (of {scale:.3e}), max |Δheat| {heat_diff:.2e} W of {heat:.4e} (at t = 0: {heat_then:.4e}), {} points quarantined as serially; switched off: 0 W",
+            kept.len()
+        );
+    }
+
+    // Times that differ between ranks: refused on every rank, none left waiting.
+    if size > 1 {
+        let t = if rank + 1 == size { 3.0 } else { 2.0 };
+        match e.set_time(t) {
+            Err(err) => assert!(err.to_string().contains("different arguments"), "{err}"),
+            Ok(()) => panic!("rank {rank}: times that differ accepted"),
+        }
+        println!("rank {rank}: refused on every rank (set_time)");
+    }
 }
 
 /// `count` (this rank's count of each item) summed over the ranks is 1 for every item.

@@ -330,7 +330,23 @@ int main(int argc, char **argv) {
     int as_expected = status == (last ? SEAM_ERR_NULL_ARGUMENT : SEAM_ERR_OTHER_RANK), all_expected;
     PetscCallMPI(MPI_Allreduce(&as_expected, &all_expected, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD));
     if (rank == 0) printf("bad argument refused on every rank: %d\n", all_expected);
+    /* The host's time, which every rank must give alike: a time that differs on the last
+     * rank is refused on every rank (SEAM_ERR_ARGUMENT); then the same time everywhere. */
+    status = seam_rank_set_time(s, size > 1 && last ? 1.0 : 0.0);
+    int time_ok = status == (size > 1 ? SEAM_ERR_ARGUMENT : SEAM_OK), all_time_ok;
+    PetscCallMPI(MPI_Allreduce(&time_ok, &all_time_ok, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD));
+    if (rank == 0) printf("differing times refused on every rank: %d\n", all_time_ok);
+    CHECK(seam_rank_set_time(s, 0.0));
+    CHECK(seam_rank_set_active(s, 0, 1));
     CHECK(seam_rank_evaluate(s, zero, (size_t)n_local)); /* a linear model: J at any u */
+    {
+        /* A constant model fails nowhere: no point quarantined on any rank. */
+        size_t own, total;
+        const double *xyz;
+        const char *reasons;
+        CHECK(seam_rank_quarantined(s, 0, &own, &xyz, &reasons, &total));
+        if (rank == 0) printf("quarantined: %zu\n", total + own);
+    }
     size_t n;
     const int64_t *rows, *cols, *dofs;
     const double *vals;

@@ -16,6 +16,8 @@ pub struct SeamRankEmbedding {
     points: OwnPoints,
     /// The last `seam_rank_face_fields` or `seam_rank_tie_face_fields`.
     faces: Vec<fields::SeamFaceValues>,
+    /// The last `seam_rank_quarantined`: xyz and the reasons.
+    quarantined: (Vec<f64>, CString),
 }
 
 /// This rank's own points of the last `seam_rank_point_fields`: their values, their
@@ -105,6 +107,7 @@ pub unsafe extern "C" fn seam_rank_new(
             rows: None,
             points: Default::default(),
             faces: Vec::new(),
+            quarantined: Default::default(),
         });
         unsafe { out(out_embedding, Box::into_raw(e), "out_embedding") }
     })
@@ -226,6 +229,91 @@ pub unsafe extern "C" fn seam_rank_coverage(
         let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
         let c = e.inner.coverage(index)?;
         unsafe { out(out_coverage, fields::SeamCoverage::from(&c), "out_coverage") }
+    })
+}
+
+/// The host's time for the next `seam_rank_evaluate` (conductance models and plugins
+/// that depend on t see it). Collective: the same time on every rank, else
+/// SEAM_ERR_ARGUMENT on every rank. The last evaluation is dropped.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_set_time(embedding: *mut SeamRankEmbedding, time: f64) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        e.evaluated = None;
+        Ok(e.inner.set_time(time)?)
+    })
+}
+
+/// Switch interaction `index` on (`on` non-zero) or off: while off a flux interaction
+/// adds nothing on any rank and reports 0 W. Collective, with the same arguments on
+/// every rank. The last evaluation is dropped.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_set_active(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    on: c_int,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        e.evaluated = None;
+        Ok(e.inner.set_active(index, on != 0)?)
+    })
+}
+
+/// Quarantine the points where interaction `index`'s conductance fails (`on`
+/// non-zero): they contribute nothing and each rank lists its own by
+/// `seam_rank_quarantined`. Collective, with the same arguments on every rank.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_set_quarantine(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    on: c_int,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        e.evaluated = None;
+        Ok(e.inner.set_quarantine(index, on != 0)?)
+    })
+}
+
+/// Let interaction `index` (every interaction with SIZE_MAX) pair nothing without
+/// SEAM_ERR_NOTHING_PAIRED (`allow` non-zero), or refuse it again (0). Collective, with
+/// the same arguments on every rank.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_allow_unpaired(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    allow: c_int,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let which = (index != usize::MAX).then_some(index);
+        Ok(e.inner.allow_unpaired(which, allow != 0)?)
+    })
+}
+
+/// The points of interaction `index` this rank quarantined so far (its own side-A
+/// points): `out_n` points, their xyz (3 per point) and the reasons, one line per point;
+/// valid until the next `seam_rank_quarantined` on this handle. `out_total` (may be
+/// null only if every rank passes null) the count over every rank. Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_quarantined(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    out_n: *mut usize,
+    out_xyz: *mut *const f64,
+    out_reasons: *mut *const c_char,
+    out_total: *mut usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let total = e.inner.quarantined_count(index);
+        e.quarantined = state::quarantined_arrays(&e.inner.quarantined(index));
+        if !out_total.is_null() {
+            unsafe { out(out_total, total, "out_total") }?;
+        }
+        let (xyz, reasons) = &e.quarantined;
+        unsafe { state::quarantined_out((xyz, reasons), out_n, out_xyz, out_reasons) }
     })
 }
 

@@ -4,7 +4,7 @@
 use std::ffi::{CString, c_char, c_int};
 
 use super::fields::handle_ref;
-use super::{SeamEmbedding, guard, handle, out, slice};
+use super::{Failure, SeamEmbedding, guard, handle, out, slice};
 
 /// Switch interaction `index` on (`on` non-zero) or off: while off a flux interaction
 /// adds nothing and reports 0 W; the CSR pattern is kept.
@@ -74,14 +74,31 @@ pub unsafe extern "C" fn seam_quarantined(
         let e = unsafe { handle_ref(embedding) }?;
         let kept = e.inner.quarantined(index);
         let b = &mut e.buffers;
-        b.quarantined_xyz = kept.iter().flat_map(|q| q.x).collect();
-        let lines: Vec<String> = kept.iter().map(|q| q.message.replace('\n', " ")).collect();
-        b.quarantined_reasons =
-            CString::new(lines.join("\n").replace('\0', " ")).unwrap_or_default();
-        unsafe {
-            out(out_n, kept.len(), "out_n")?;
-            out(out_xyz, b.quarantined_xyz.as_ptr(), "out_xyz")?;
-            out(out_reasons, b.quarantined_reasons.as_ptr(), "out_reasons")
-        }
+        (b.quarantined_xyz, b.quarantined_reasons) = quarantined_arrays(&kept);
+        let arrays = (&b.quarantined_xyz, &b.quarantined_reasons);
+        unsafe { quarantined_out(arrays, out_n, out_xyz, out_reasons) }
     })
+}
+
+/// Quarantined points as C arrays: their xyz (3 per point) and the reasons, one line
+/// per point ('\n'-separated, NUL-terminated).
+pub(super) fn quarantined_arrays(kept: &[crate::embed::Quarantined]) -> (Vec<f64>, CString) {
+    let xyz = kept.iter().flat_map(|q| q.x).collect();
+    let lines: Vec<String> = kept.iter().map(|q| q.message.replace('\n', " ")).collect();
+    let reasons = CString::new(lines.join("\n").replace('\0', " ")).unwrap_or_default();
+    (xyz, reasons)
+}
+
+/// Hand out the arrays of [`quarantined_arrays`] (kept by the handle).
+pub(super) unsafe fn quarantined_out(
+    (xyz, reasons): (&Vec<f64>, &CString),
+    out_n: *mut usize,
+    out_xyz: *mut *const f64,
+    out_reasons: *mut *const c_char,
+) -> Result<(), Failure> {
+    unsafe {
+        out(out_n, xyz.len() / 3, "out_n")?;
+        out(out_xyz, xyz.as_ptr(), "out_xyz")?;
+        out(out_reasons, reasons.as_ptr(), "out_reasons")
+    }
 }

@@ -44,6 +44,13 @@
 //! different ranks pair exactly as in serial), and evaluates only the points of the
 //! faces it gave ([`Embedding::own_points`]).
 //!
+//! Between evaluations the host sets the time, switches interactions on and off,
+//! quarantines failing points and lets interactions stand unpaired as on one process
+//! ([`RankEmbedding::set_time`], [`RankEmbedding::set_active`],
+//! [`RankEmbedding::set_quarantine`], [`RankEmbedding::allow_unpaired`]); these are
+//! collective, and arguments that differ between ranks are refused on every rank. Each
+//! rank lists the points it quarantined ([`RankEmbedding::quarantined`]).
+//!
 //! Mortar ties give their constraint rows by [`RankEmbedding::constraints`]: each rank
 //! the rows (and, for dual multipliers, the condensed rows) of the multipliers whose
 //! side-A node it owns, in the host's global dofs, each with its index in the whole tie.
@@ -52,6 +59,8 @@
 //! only (the owner of its element); a node point of a node surface belongs to the lowest
 //! rank among the elements around it. Node ownership is otherwise the host's business:
 //! entries come at any global dof and the host adds them where they belong.
+
+mod state;
 
 use std::collections::HashMap;
 
