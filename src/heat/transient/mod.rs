@@ -62,6 +62,7 @@ use crate::enforce::interface::{HInput, HValue};
 pub(crate) use newton::unconverged;
 use newton::{Context, History, Solvers};
 use setup::Setup;
+#[cfg(feature = "mpi")]
 pub(crate) use setup::lumped_weights;
 
 /// Time integration scheme.
