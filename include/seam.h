@@ -455,6 +455,24 @@ int seam_rank_coverage(const seam_rank_embedding *embedding, size_t index,
  * elements of this rank's interface faces. seam gathers what the other ranks' points
  * need. */
 int seam_rank_evaluate(seam_rank_embedding *embedding, const double *u_local, size_t n_nodes);
+/* CSR, as seam_evaluate_csr: evaluate this rank's own points at u_local into the rows
+ * they touch, in the host's global dofs, built at the first call after a search or move
+ * and refreshed in place after (collective); seam_rank_heat then gives its heats. */
+int seam_rank_evaluate_csr(seam_rank_embedding *embedding, const double *u_local,
+                           size_t n_nodes);
+/* n_rows rows (their global dofs, ascending, in rows), n_rows + 1 offsets, nnz global
+ * columns (ascending within a row) and values, to add with MatSetValues(..., ADD_VALUES)
+ * row by row. pattern (may be NULL) changes only when a search or move made a new
+ * pattern: while it stays, rows, offsets and columns hold the same contents. Valid until
+ * the next evaluation, search or move. Local. */
+int seam_rank_jacobian_csr(const seam_rank_embedding *embedding, size_t *out_n_rows,
+                           size_t *out_nnz, const size_t **out_rows,
+                           const size_t **out_row_offsets, const size_t **out_columns,
+                           const double **out_values, uint64_t *out_pattern);
+/* This rank's share of the residual (load = 0) or of the load of linear models (load != 0)
+ * at each of the CSR's rows. Local. */
+int seam_rank_vector_csr(const seam_rank_embedding *embedding, int load, size_t *out_n_rows,
+                         const double **out_values);
 /* The last evaluation's terms of this rank's points, in the host's global dof numbers
  * (rows and dofs may belong to other ranks: add them with ADD_VALUES); as
  * seam_residual, seam_jacobian and seam_load. The arrays belong to the handle and stay

@@ -50,6 +50,10 @@ struct Printed {
     time_refused: Option<f64>,
     /// Points quarantined over every rank and on rank 0 (`seam_rank_quarantined`).
     quarantined: Option<f64>,
+    /// The interface terms through `seam_rank_evaluate_csr` against the triplets: the
+    /// largest difference of the matrices and of the loads over the ranks, and the count
+    /// of CSR entries over the ranks.
+    csr: Option<(f64, f64, usize)>,
     ranks: usize,
     across: usize,
     heat: [f64; 2],
@@ -155,6 +159,7 @@ fn run(host: &Path, ranks: usize, mode: &[&str]) -> Printed {
         refused: optional("bad argument refused on every rank:").map(|v| v[0]),
         time_refused: optional("differing times refused on every rank:").map(|v| v[0]),
         quarantined: optional("quarantined:").map(|v| v[0]),
+        csr: optional("csr against triplets:").map(|v| (v[0], v[1], v[2] as usize)),
         ranks: numbers("ranks:")[0] as usize,
         across: numbers("points across ranks:")[0] as usize,
         heat: [heat[0], heat[1]],
@@ -269,6 +274,14 @@ fn petsc_host_equals_the_serial_embedding_and_the_1d_answer_on_1_to_4_ranks() {
             par.quarantined,
             Some(0.0),
             "a constant model quarantines nothing"
+        );
+        let (dm, dv, nnz) = par.csr.expect("the host compares the CSR form");
+        eprintln!(
+            "mpirun -n {n}: CSR against triplets {dm:.1e} (matrix), {dv:.1e} (load), {nnz} entries over the ranks"
+        );
+        assert!(
+            dm <= 1e-10 && dv <= 1e-10 && nnz > 0,
+            "CSR against triplets: {dm:e} {dv:e} {nnz}"
         );
         // Every point paired, over the whole unit face, on every rank count.
         let (all_points, paired, area) = par.coverage.expect("the host prints its coverage");
@@ -879,6 +892,146 @@ fn summed_difference(
             .max((w.side_b - g.side_b).abs());
     }
     (diff, scale, heat_diff)
+}
+
+/// Dense `n × n` Jacobian and residual and load vectors of a rank's CSR evaluation.
+fn dense_csr(e: &seam::embed::RankEvaluation, n: usize) -> Vec<f64> {
+    let mut out = vec![0.0; n * n + 2 * n];
+    for (r, &row) in e.rows.iter().enumerate() {
+        for k in e.row_offsets[r]..e.row_offsets[r + 1] {
+            out[row * n + e.columns[k]] += e.values[k];
+        }
+        out[n * n + row] += e.residual[r];
+        out[n * n + n + row] += e.load[r];
+    }
+    out
+}
+
+/// Under `mpirun -n 1..4`: each rank's CSR evaluation (`RankEmbedding::evaluate`) of the
+/// bricks' gap conductance and periodic tie, summed over the ranks, is the serial
+/// embedding's CSR evaluation, with the heats; its rows are sorted and its columns sorted
+/// within each row; a second evaluation at another field keeps the rows, columns and
+/// pattern number and refreshes the values; a move makes a new pattern.
+#[test]
+fn rank_csr_sums_to_the_serial_csr() {
+    if std::env::var_os(CHILD).is_some() {
+        return rank_csr_child();
+    }
+    for n in 1..=4 {
+        let text = child_on(n, "rank_csr_sums_to_the_serial_csr");
+        let line = text
+            .lines()
+            .find_map(|l| l.find("rank csr:").map(|k| &l[k..]))
+            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
+        eprintln!("mpirun -n {n}: {line}");
+    }
+}
+
+fn rank_csr_child() {
+    use mpi::traits::{Communicator, CommunicatorCollectives};
+    let universe = mpi::initialize().expect("MPI");
+    let world = universe.world();
+    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let m = bricks();
+    let (n, n_elems) = (m.coords.len(), m.num_elems());
+    let by_dof = |f: &dyn Fn([f64; 3]) -> f64| -> Vec<f64> {
+        (0..n)
+            .map(|d| f(m.coords[(0..n).find(|&g| dof_of(g, n) == d).unwrap()]))
+            .collect()
+    };
+    let other = |x: [f64; 3]| field(x) + 30.0 * x[1] * x[2];
+    let all: Vec<usize> = (0..n_elems).collect();
+    let mut serial = builder_of(&m, &all).0.build().expect("serial build");
+    for i in interactions() {
+        serial.add_interaction(i).expect("serial interaction");
+    }
+    serial.search().expect("serial search");
+    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
+    let (b, nodes) = builder_of(&m, &mine);
+    let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
+    let mut e = b
+        .build_on_ranks(world.duplicate(), &gids)
+        .expect("rank build");
+    for i in interactions() {
+        e.add_interaction(i).expect("rank interaction");
+    }
+    e.search().expect("rank search");
+    let summed = |got: &seam::embed::RankEvaluation| {
+        let mine = dense_csr(got, n);
+        let mut all = vec![0.0; mine.len()];
+        world.all_reduce_into(
+            &mine[..],
+            &mut all[..],
+            mpi::collective::SystemOperation::sum(),
+        );
+        all
+    };
+    let serial_dense = |ev: &seam::embed::Evaluation| {
+        let mut out = vec![0.0; n * n + 2 * n];
+        for i in 0..n {
+            for k in ev.jacobian.row_offsets[i]..ev.jacobian.row_offsets[i + 1] {
+                out[i * n + ev.jacobian.columns[k]] += ev.jacobian.values[k];
+            }
+            out[n * n + i] = ev.residual[i];
+            out[n * n + n + i] = ev.load[i];
+        }
+        out
+    };
+    let mut worst = 0.0f64;
+    let mut first = None;
+    for f in [&field as &dyn Fn([f64; 3]) -> f64, &other] {
+        let (u, u_local) = (
+            by_dof(f),
+            nodes.iter().map(|&g| f(m.coords[g])).collect::<Vec<_>>(),
+        );
+        let want = serial.evaluate(&u).expect("serial csr").clone();
+        let got = e.evaluate(&u_local).expect("rank csr").clone();
+        assert!(got.rows.is_sorted() && got.rows.windows(2).all(|w| w[0] < w[1]));
+        for r in 0..got.rows.len() {
+            let cols = &got.columns[got.row_offsets[r]..got.row_offsets[r + 1]];
+            assert!(cols.windows(2).all(|w| w[0] < w[1]), "row {r}'s columns");
+        }
+        let (w, g) = (serial_dense(&want), summed(&got));
+        let scale = w.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+        let diff = (w.iter().zip(&g)).fold(0.0f64, |s, (a, b)| s.max((a - b).abs()));
+        assert!(
+            diff <= 1e-12 * scale,
+            "the CSR terms differ by {diff:e} (of {scale:e})"
+        );
+        worst = worst.max(diff / scale);
+        let (hw, hg) = (want.heat[0].unwrap(), got.heat[0].unwrap());
+        assert!(
+            (hw.side_a - hg.side_a).abs() <= 1e-12 * hw.side_a.abs(),
+            "{hw:?} {hg:?}"
+        );
+        // The second field: the same rows, columns and pattern, other values.
+        match &first {
+            None => first = Some(got),
+            Some(f) => {
+                assert_eq!(
+                    (&f.rows, &f.row_offsets, &f.columns),
+                    (&got.rows, &got.row_offsets, &got.columns)
+                );
+                assert_eq!(f.pattern, got.pattern);
+                assert!(
+                    f.residual != got.residual || got.rows.is_empty(),
+                    "values refreshed"
+                );
+            }
+        }
+    }
+    let before = first.unwrap().pattern;
+    let local: Vec<[f64; 3]> = nodes.iter().map(|&g| m.coords[g]).collect();
+    e.move_nodes(&local).expect("rank move");
+    let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.coords[g])).collect();
+    let after = e.evaluate(&u_local).expect("rank csr after a move").pattern;
+    assert_ne!(after, before, "a move makes a new pattern");
+    if rank == 0 {
+        println!(
+            "rank csr: summed over the ranks, max |Δ| from the serial CSR {worst:.1e} of the largest entry, at two fields; rows on rank 0 {}",
+            e.evaluation().unwrap().rows.len()
+        );
+    }
 }
 
 /// Under `mpirun -n 1..4`: the per-rank setters against the serial embedding's, on the

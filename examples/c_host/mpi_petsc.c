@@ -201,6 +201,64 @@ static int serial(const Mesh *m) {
     return 0;
 }
 
+/* The interface terms through the CSR form (seam_rank_evaluate_csr at u, this rank's
+ * rows added row by row) against the triplets of the last seam_rank_evaluate at the same
+ * u (which it replaces): prints the largest difference of the matrices and of the loads
+ * over the ranks, and the count of CSR entries over the ranks. */
+static PetscErrorCode csr_against_triplets(seam_rank_embedding *s, int rank, PetscInt local_rows,
+                                           const double *u, size_t n_local) {
+    Mat T, C;
+    Vec lt, lc;
+    PetscReal dm, dv;
+    size_t n, n_rows, nnz;
+    const int64_t *rows, *cols, *dofs;
+    const size_t *csr_rows, *offsets, *columns;
+    const double *vals, *csr_vals, *csr_load;
+    uint64_t pattern;
+    PetscFunctionBeginUser;
+    PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, local_rows, local_rows, PETSC_DETERMINE,
+                           PETSC_DETERMINE, 64, NULL, 64, NULL, &T));
+    PetscCall(MatSetOption(T, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+    PetscCall(MatDuplicate(T, MAT_DO_NOT_COPY_VALUES, &C));
+    PetscCall(MatCreateVecs(T, &lt, &lc));
+    CHECK(seam_rank_jacobian(s, &n, &rows, &cols, &vals));
+    for (size_t q = 0; q < n; q++)
+        PetscCall(MatSetValue(T, (PetscInt)rows[q], (PetscInt)cols[q], vals[q], ADD_VALUES));
+    CHECK(seam_rank_load(s, &n, &dofs, &vals));
+    for (size_t q = 0; q < n; q++)
+        PetscCall(VecSetValue(lt, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    CHECK(seam_rank_evaluate_csr(s, u, n_local));
+    CHECK(seam_rank_jacobian_csr(s, &n_rows, &nnz, &csr_rows, &offsets, &columns, &csr_vals,
+                                 &pattern));
+    CHECK(seam_rank_vector_csr(s, 1, &n_rows, &csr_load));
+    for (size_t r = 0; r < n_rows; r++) {
+        for (size_t k = offsets[r]; k < offsets[r + 1]; k++)
+            PetscCall(MatSetValue(C, (PetscInt)csr_rows[r], (PetscInt)columns[k], csr_vals[k],
+                                  ADD_VALUES));
+        PetscCall(VecSetValue(lc, (PetscInt)csr_rows[r], csr_load[r], ADD_VALUES));
+    }
+    PetscCall(MatAssemblyBegin(T, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(T, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyBegin(C, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(C, MAT_FINAL_ASSEMBLY));
+    PetscCall(VecAssemblyBegin(lt));
+    PetscCall(VecAssemblyEnd(lt));
+    PetscCall(VecAssemblyBegin(lc));
+    PetscCall(VecAssemblyEnd(lc));
+    PetscCall(MatAXPY(T, -1.0, C, DIFFERENT_NONZERO_PATTERN));
+    PetscCall(MatNorm(T, NORM_INFINITY, &dm));
+    PetscCall(VecAXPY(lt, -1.0, lc));
+    PetscCall(VecNorm(lt, NORM_INFINITY, &dv));
+    unsigned long long mine = nnz, all;
+    PetscCallMPI(MPI_Allreduce(&mine, &all, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, PETSC_COMM_WORLD));
+    if (rank == 0) printf("csr against triplets: %.3e %.3e %llu\n", (double)dm, (double)dv, all);
+    PetscCall(MatDestroy(&T));
+    PetscCall(MatDestroy(&C));
+    PetscCall(VecDestroy(&lt));
+    PetscCall(VecDestroy(&lc));
+    PetscFunctionReturn(0);
+}
+
 int main(int argc, char **argv) {
     static Mesh m;
     PetscMPIInt rank, size;
@@ -356,6 +414,7 @@ int main(int argc, char **argv) {
     CHECK(seam_rank_load(s, &n, &dofs, &vals));
     for (size_t q = 0; q < n; q++)
         PetscCall(VecSetValue(rhs, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    PetscCall(csr_against_triplets(s, rank, local_rows, zero, (size_t)n_local));
     for (size_t q = 0; q < n_entries; q++) { /* C and C^T of this rank's multipliers */
         PetscInt row = NODES + (PetscInt)place[mults[q]], col = (PetscInt)mult_cols[q];
         PetscCall(MatSetValue(A, row, col, c_values[q], ADD_VALUES));

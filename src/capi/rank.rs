@@ -18,6 +18,8 @@ pub struct SeamRankEmbedding {
     faces: Vec<fields::SeamFaceValues>,
     /// The last `seam_rank_quarantined`: xyz and the reasons.
     quarantined: (Vec<f64>, CString),
+    /// The last evaluation was `seam_rank_evaluate_csr` (its terms are in `inner`).
+    csr_current: bool,
 }
 
 /// This rank's own points of the last `seam_rank_point_fields`: their values, their
@@ -108,6 +110,7 @@ pub unsafe extern "C" fn seam_rank_new(
             points: Default::default(),
             faces: Vec::new(),
             quarantined: Default::default(),
+            csr_current: false,
         });
         unsafe { out(out_embedding, Box::into_raw(e), "out_embedding") }
     })
@@ -146,7 +149,7 @@ pub unsafe extern "C" fn seam_rank_add_interaction(
         let i = e
             .inner
             .add_interaction(Interaction::new(a, b, model).offset(offset))?;
-        (e.evaluated, e.rows) = (None, None);
+        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
         unsafe { interactions::optional_out(out_index, i) }
     })
 }
@@ -164,7 +167,7 @@ pub unsafe extern "C" fn seam_rank_add_deck(
         let args = unsafe { interactions::deck_args(deck_text, name) };
         let (deck, name) = on_every_rank(e.inner.comm(), args)?;
         let added = e.inner.add_deck(name, deck)?;
-        (e.evaluated, e.rows) = (None, None);
+        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
         unsafe { interactions::optional_out(out_count, added.len()) }
     })
 }
@@ -181,7 +184,7 @@ pub unsafe extern "C" fn seam_rank_add_deck_file(
         let e = unsafe { handle(embedding, "embedding") }?;
         let path = on_every_rank(e.inner.comm(), unsafe { text(path, "path") })?;
         let added = e.inner.add_deck_file(std::path::Path::new(path))?;
-        (e.evaluated, e.rows) = (None, None);
+        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
         unsafe { interactions::optional_out(out_count, added.len()) }
     })
 }
@@ -191,7 +194,7 @@ pub unsafe extern "C" fn seam_rank_add_deck_file(
 pub unsafe extern "C" fn seam_rank_search(embedding: *mut SeamRankEmbedding) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        (e.evaluated, e.rows) = (None, None);
+        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
         Ok(e.inner.search()?)
     })
 }
@@ -211,7 +214,7 @@ pub unsafe extern "C" fn seam_rank_move_nodes(
         let points = on_every_rank(e.inner.comm(), unsafe {
             interactions::xyz(coords, n_nodes)
         })?;
-        (e.evaluated, e.rows) = (None, None);
+        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
         Ok(e.inner.move_nodes(&points)?)
     })
 }
@@ -239,7 +242,7 @@ pub unsafe extern "C" fn seam_rank_coverage(
 pub unsafe extern "C" fn seam_rank_set_time(embedding: *mut SeamRankEmbedding, time: f64) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        e.evaluated = None;
+        (e.evaluated, e.csr_current) = (None, false);
         Ok(e.inner.set_time(time)?)
     })
 }
@@ -255,7 +258,7 @@ pub unsafe extern "C" fn seam_rank_set_active(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        e.evaluated = None;
+        (e.evaluated, e.csr_current) = (None, false);
         Ok(e.inner.set_active(index, on != 0)?)
     })
 }
@@ -271,7 +274,7 @@ pub unsafe extern "C" fn seam_rank_set_quarantine(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        e.evaluated = None;
+        (e.evaluated, e.csr_current) = (None, false);
         Ok(e.inner.set_quarantine(index, on != 0)?)
     })
 }
@@ -344,7 +347,7 @@ pub unsafe extern "C" fn seam_rank_evaluate(
         let u = on_every_rank(e.inner.comm(), unsafe {
             slice(u_local, n_nodes, "u_local")
         })?;
-        e.evaluated = None;
+        (e.evaluated, e.csr_current) = (None, false);
         e.evaluated = Some(Evaluated::from(e.inner.contributions(u)?));
         Ok(())
     })
@@ -407,17 +410,109 @@ pub unsafe extern "C" fn seam_rank_heat(
     out_side_b: *mut f64,
 ) -> c_int {
     guard(|| {
-        let v = unsafe { rank_evaluated(embedding) }?;
-        let (a, b) = v.heat.get(index).copied().flatten().ok_or_else(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let heat: Vec<Option<(f64, f64)>> = match rank_csr(e) {
+            Ok(c) => (c.heat.iter())
+                .map(|h| h.map(|h| (h.side_a, h.side_b)))
+                .collect(),
+            Err(_) => unsafe { rank_evaluated(embedding) }?.heat.clone(),
+        };
+        let (a, b) = heat.get(index).copied().flatten().ok_or_else(|| {
             bad(
-                format!(
-                    "no flux interaction {index} ({} interactions)",
-                    v.heat.len()
-                ),
+                format!("no flux interaction {index} ({} interactions)", heat.len()),
                 "interaction indices are 0-based, in the order they were added",
             )
         })?;
         unsafe { terms::write_heat((a, b), out_side_a, out_side_b) }
+    })
+}
+
+/// Evaluate this rank's own side-A points at the local field (`n_nodes` values, one per
+/// local node) into CSR: the rows its points touch, in the host's global dofs, built at
+/// the first call after a search or move and refreshed in place after. Collective.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_evaluate_csr(
+    embedding: *mut SeamRankEmbedding,
+    u_local: *const f64,
+    n_nodes: usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let u = on_every_rank(e.inner.comm(), unsafe {
+            slice(u_local, n_nodes, "u_local")
+        })?;
+        (e.evaluated, e.csr_current) = (None, false);
+        e.inner.evaluate(u)?;
+        e.csr_current = true;
+        Ok(())
+    })
+}
+
+fn rank_csr(e: &SeamRankEmbedding) -> Result<&crate::embed::RankEvaluation, Failure> {
+    (e.inner.evaluation()).filter(|_| e.csr_current).ok_or_else(|| {
+        Failure(
+            SeamStatus::Order,
+            "nothing evaluated into CSR\n  help: call seam_rank_evaluate_csr first (after seam_rank_search)".into(),
+        )
+    })
+}
+
+/// This rank's CSR of the last `seam_rank_evaluate_csr`: `n_rows` rows (their global
+/// dofs ascending in `rows`), `n_rows + 1` offsets, `nnz` global columns (ascending
+/// within a row) and values. `pattern` (may be null) changes only when a search or a
+/// move made a new pattern; while it stays, rows, offsets and columns hold the same
+/// contents. Arrays valid until the next evaluation, search or move. Local.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn seam_rank_jacobian_csr(
+    embedding: *const SeamRankEmbedding,
+    out_n_rows: *mut usize,
+    out_nnz: *mut usize,
+    out_rows: *mut *const usize,
+    out_row_offsets: *mut *const usize,
+    out_columns: *mut *const usize,
+    out_values: *mut *const f64,
+    out_pattern: *mut u64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let c = rank_csr(e)?;
+        unsafe {
+            out(out_n_rows, c.rows.len(), "out_n_rows")?;
+            out(out_nnz, c.columns.len(), "out_nnz")?;
+            out(out_rows, c.rows.as_ptr(), "out_rows")?;
+            out(out_row_offsets, c.row_offsets.as_ptr(), "out_row_offsets")?;
+            out(out_columns, c.columns.as_ptr(), "out_columns")?;
+            out(out_values, c.values.as_ptr(), "out_values")?;
+            if !out_pattern.is_null() {
+                out(out_pattern, c.pattern, "out_pattern")?;
+            }
+            Ok(())
+        }
+    })
+}
+
+/// This rank's share of the residual (`load` zero) or of the load of linear models
+/// (`load` non-zero) at each of the CSR's `n_rows` rows, as `seam_rank_jacobian_csr`
+/// gives them. Local.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_vector_csr(
+    embedding: *const SeamRankEmbedding,
+    load: c_int,
+    out_n_rows: *mut usize,
+    out_values: *mut *const f64,
+) -> c_int {
+    guard(|| {
+        // SAFETY: a non-null handle came from this library (module Safety).
+        let e = unsafe { embedding.as_ref() }.ok_or_else(|| null("embedding"))?;
+        let c = rank_csr(e)?;
+        let v = if load != 0 { &c.load } else { &c.residual };
+        unsafe {
+            out(out_n_rows, v.len(), "out_n_rows")?;
+            out(out_values, v.as_ptr(), "out_values")
+        }
     })
 }
 

@@ -590,5 +590,5 @@ pub use fields::{Coverage, FaceValues, HostFace, PointValues, Unpaired, Unpaired
 #[cfg(feature = "mpi")]
 pub(crate) use rank::agree;
 #[cfg(feature = "mpi")]
-pub use rank::{RankEmbedding, RankPoint, RankTie, duplicate};
+pub use rank::{RankEmbedding, RankEvaluation, RankPoint, RankTie, duplicate};
 pub use ties::TieConstraints;

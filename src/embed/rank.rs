@@ -60,7 +60,10 @@
 //! rank among the elements around it. Node ownership is otherwise the host's business:
 //! entries come at any global dof and the host adds them where they belong.
 
+mod csr;
 mod state;
+
+pub use csr::RankEvaluation;
 
 use std::collections::HashMap;
 
@@ -99,6 +102,8 @@ pub struct RankEmbedding {
     node_owner: Vec<usize>,
     /// Over all ranks, the side-A points whose side-B face another rank gave.
     across: usize,
+    /// The last [`RankEmbedding::evaluate`], with its map from the inner CSR.
+    evaluation: Option<RankEvaluation>,
 }
 
 /// One of this rank's own side-A points ([`RankEmbedding::point_fields`]).
@@ -323,6 +328,7 @@ impl EmbeddingBuilder {
             host_elem: whole.host_elem,
             node_owner,
             across: 0,
+            evaluation: None,
         })
     }
 
@@ -858,15 +864,19 @@ impl RankEmbedding {
         for (i, j, _) in &mut c.jacobian {
             (*i, *j) = (dof(*i), dof(*j));
         }
-        let local: Vec<f64> = c
-            .heat
-            .iter()
+        self.sum_heat(&mut c.heat);
+        Ok(c)
+    }
+
+    /// Each interaction's heat (this rank's share) summed over the ranks (collective).
+    fn sum_heat(&self, heat: &mut [Option<Heat>]) {
+        let local: Vec<f64> = (heat.iter())
             .flat_map(|h| h.map_or([0.0; 2], |h| [h.side_a, h.side_b]))
             .collect();
         let mut summed = vec![0.0; local.len()];
         self.comm
             .all_reduce_into(&local[..], &mut summed[..], SystemOperation::sum());
-        for (h, s) in c.heat.iter_mut().zip(summed.chunks_exact(2)) {
+        for (h, s) in heat.iter_mut().zip(summed.chunks_exact(2)) {
             if let Some(h) = h {
                 *h = Heat {
                     side_a: s[0],
@@ -874,7 +884,6 @@ impl RankEmbedding {
                 };
             }
         }
-        Ok(c)
     }
 
     /// The field at every inner node from each rank's local values (collective): the
