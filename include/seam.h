@@ -431,11 +431,16 @@ int seam_rank_move_nodes(seam_rank_embedding *embedding, const double *coords, s
 /* Between evaluations, as seam_set_time, seam_set_active, seam_set_quarantine and
  * seam_allow_unpaired. Collective: every rank calls them in the same order with the same
  * arguments (each rank makes its own points' terms with them); arguments that differ
- * between ranks are SEAM_ERR_ARGUMENT on every rank. The first three drop the last
- * evaluation. */
+ * between ranks are SEAM_ERR_ARGUMENT on every rank. All but seam_rank_allow_unpaired
+ * drop the last evaluation. */
 int seam_rank_set_time(seam_rank_embedding *embedding, double time);
 int seam_rank_set_active(seam_rank_embedding *embedding, size_t index, int on);
 int seam_rank_set_quarantine(seam_rank_embedding *embedding, size_t index, int on);
+/* As seam_set_point_pressures, for this rank's own n contact points of interaction
+ * `index`, in the order seam_rank_point_fields lists them on this rank (pressures NULL
+ * and n = 0 on every rank go back to the enforcement's Contact Pressure). */
+int seam_rank_set_point_pressures(seam_rank_embedding *embedding, size_t index,
+                                  const double *pressures, size_t n);
 int seam_rank_allow_unpaired(seam_rank_embedding *embedding, size_t index, int allow);
 /* The points of interaction `index` this rank quarantined (its own side-A points), as
  * seam_quarantined: xyz (3 per point) and the reasons, one line per point, valid until

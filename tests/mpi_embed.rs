@@ -399,6 +399,9 @@ fn bricks() -> Mesh {
     )
 }
 
+/// The pressure scale of the setters' test model (Pa): h doubles at P0.
+const P0: f64 = 1e6;
+
 /// The host's names of side sets 1 to 4.
 const SURFACES: [&str; 4] = ["right", "left", "front", "back"];
 
@@ -1063,7 +1066,7 @@ fn rank_setters_equal_the_serial_ones() {
 }
 
 fn rank_setters_child() {
-    use mpi::traits::Communicator;
+    use mpi::traits::{Communicator, CommunicatorCollectives};
     use seam::embed::{Conductance, FnConductance, Interaction, Model};
     use std::sync::Arc;
     let universe = mpi::initialize().expect("MPI");
@@ -1080,7 +1083,7 @@ fn rank_setters_child() {
                 return Err(format!("no data below y = 0.3 at t = {}", s.time));
             }
             Ok(Conductance {
-                h: H * (1.0 + s.time),
+                h: H * (1.0 + s.time) * (1.0 + s.pressure / P0),
                 ..Conductance::default()
             })
         });
@@ -1139,6 +1142,59 @@ fn rank_setters_child() {
         "{own:?}"
     );
 
+    // Pressures at the points, from their positions: each rank gives its own points'.
+    let pressure = |x: [f64; 3]| P0 * (0.5 + x[1] + x[2] * x[2]);
+    let whole: Vec<f64> = (serial.point_fields(0, &u).expect("serial points").iter())
+        .map(|p| pressure(p.x))
+        .collect();
+    serial
+        .set_point_pressures(0, Some(whole))
+        .expect("serial pressures");
+    let own: Vec<f64> = (e.point_fields(0, &u_local).expect("rank points").iter())
+        .map(|p| pressure(p.values.x))
+        .collect();
+    e.set_point_pressures(0, Some(&own))
+        .expect("rank pressures");
+    let (want_p, got_p) = (
+        serial
+            .contributions(&u)
+            .expect("serial terms with pressures"),
+        e.contributions(&u_local)
+            .expect("rank terms with pressures"),
+    );
+    let (diff_p, scale_p, heat_diff_p) = summed_difference(&world, &want_p, &got_p, n_nodes);
+    let heat_p = want_p.heat[0].unwrap().side_a;
+    assert!(
+        (heat_p - heat).abs() > 0.2 * heat.abs(),
+        "h depends on the pressure: {heat_p} W against {heat} W without"
+    );
+    assert!(
+        diff_p <= 1e-12 * scale_p,
+        "terms with pressures differ by {diff_p:e}"
+    );
+    assert!(
+        heat_diff_p <= 1e-12 * heat_p.abs(),
+        "heat with pressures differs by {heat_diff_p:e}"
+    );
+    // One pressure short on the last rank that owns points: refused on every rank.
+    let owner = if own.is_empty() { 0 } else { rank + 1 };
+    let mut last_owner = 0;
+    world.all_reduce_into(
+        &owner,
+        &mut last_owner,
+        mpi::collective::SystemOperation::max(),
+    );
+    let short = match rank + 1 == last_owner {
+        true => &own[..own.len() - 1],
+        false => &own[..],
+    };
+    let r = e.set_point_pressures(0, Some(short));
+    assert!(
+        r.is_err(),
+        "rank {rank}: one pressure short on rank {} accepted",
+        last_owner - 1
+    );
+
     // Switched off: nothing on any rank, as serially.
     serial.set_active(0, false).expect("serial off");
     e.set_active(0, false).expect("rank off");
@@ -1151,7 +1207,7 @@ fn rank_setters_child() {
     assert!(got_off.jacobian.iter().all(|t| t.2 == 0.0) && diff_off == 0.0 && heat_off == 0.0);
     if rank == 0 {
         println!(
-            "rank setters: at t = 2 max |Δ| of the summed terms {diff:.2e} (of {scale:.3e}), max |Δheat| {heat_diff:.2e} W of {heat:.4e} (at t = 0: {heat_then:.4e}), {} points quarantined as serially; switched off: 0 W",
+            "rank setters: at t = 2 max |Δ| of the summed terms {diff:.2e} (of {scale:.3e}), max |Δheat| {heat_diff:.2e} W of {heat:.4e} (at t = 0: {heat_then:.4e}), {} points quarantined as serially; with point pressures {diff_p:.2e} (of {scale_p:.3e}) and {heat_diff_p:.2e} W of {heat_p:.4e}; switched off: 0 W",
             kept.len()
         );
     }

@@ -263,6 +263,29 @@ pub unsafe extern "C" fn seam_rank_set_active(
     })
 }
 
+/// The contact pressure (Pa, >= 0) at each of this rank's own `n` contact points of
+/// interaction `index`, in the order `seam_rank_point_fields` lists them on this rank;
+/// `pressures` null and `n` 0 (on every rank) go back to the enforcement's pressure. A
+/// search drops them. Collective. The last evaluation is dropped.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn seam_rank_set_point_pressures(
+    embedding: *mut SeamRankEmbedding,
+    index: usize,
+    pressures: *const f64,
+    n: usize,
+) -> c_int {
+    guard(|| {
+        let e = unsafe { handle(embedding, "embedding") }?;
+        let given = match pressures.is_null() && n == 0 {
+            true => Ok(None),
+            false => unsafe { slice(pressures, n, "pressures") }.map(Some),
+        };
+        let given = on_every_rank(e.inner.comm(), given)?;
+        (e.evaluated, e.csr_current) = (None, false);
+        Ok(e.inner.set_point_pressures(index, given)?)
+    })
+}
+
 /// Quarantine the points where interaction `index`'s conductance fails (`on`
 /// non-zero): they contribute nothing and each rank lists its own by
 /// `seam_rank_quarantined`. Collective, with the same arguments on every rank.

@@ -1,6 +1,8 @@
 //! What a host on MPI sets on its interactions between evaluations — the time, which
-//! interactions are on, quarantine, unpaired interactions — as the serial embedding's
-//! setters ([`crate::embed::Embedding::set_time`] and the rest), and the points each rank quarantined.
+//! interactions are on, the contact pressure at its own points, quarantine, unpaired
+//! interactions — as the serial embedding's setters
+//! ([`crate::embed::Embedding::set_time`] and the rest), and the points each rank
+//! quarantined.
 //!
 //! The setters are collective: every rank calls them in the same order with the same
 //! arguments. Each rank evaluates only its own points, so a rank told another time, or
@@ -39,6 +41,63 @@ impl RankEmbedding {
     /// Whether interaction `i` is switched on (local).
     pub fn is_active(&self, i: usize) -> bool {
         self.inner.is_active(i)
+    }
+
+    /// The contact pressure (Pa, ≥ 0) a conductance model sees at each of this rank's own
+    /// contact points of interaction `i`, in the order [`Self::point_fields`] lists them
+    /// (collective; every rank gives its own points' values, or every rank `None` to go
+    /// back to the enforcement's `Contact Pressure`), as
+    /// [`crate::embed::Embedding::set_point_pressures`]. A search drops them.
+    pub fn set_point_pressures(
+        &mut self,
+        i: usize,
+        pressures: Option<&[f64]>,
+    ) -> Result<(), EmbedError> {
+        self.alike(
+            "set_point_pressures",
+            &[i as u64, u64::from(pressures.is_some())],
+        )?;
+        let set = match pressures {
+            None => self.inner.set_point_pressures(i, None),
+            Some(mine) => match self.whole_pressures(i, mine) {
+                Ok(Some(whole)) => self.inner.set_point_pressures(i, Some(whole)),
+                // No such interaction, or not searched: the serial setter says which.
+                Ok(None) => self.inner.set_point_pressures(i, Some(mine.to_vec())),
+                Err(e) => Err(e),
+            },
+        };
+        agree(&self.comm, set)
+    }
+
+    /// Interaction `i`'s pressure at each of its points from this rank's own points'
+    /// `mine` (the other points, which this rank does not evaluate, at 0); `None` when
+    /// there is no interaction `i` or it has not been searched.
+    fn whole_pressures(&self, i: usize, mine: &[f64]) -> Result<Option<Vec<f64>>, EmbedError> {
+        let searched = (self.inner.pairs.get(i)).and_then(|p| {
+            p.result
+                .as_ref()
+                .map(|r| (r.points.len(), p.kept.as_deref()))
+        });
+        let Some((points, kept)) = searched else {
+            return Ok(None);
+        };
+        let kept: Vec<usize> = kept.map_or_else(|| (0..points).collect(), <[usize]>::to_vec);
+        if mine.len() != kept.len() {
+            return Err(argument(
+                format!(
+                    "{} pressures for interaction {i} on rank {}, which owns {} of its contact points",
+                    mine.len(),
+                    self.rank,
+                    kept.len()
+                ),
+                "give one pressure per point this rank owns, in the order of point_fields on this rank",
+            ));
+        }
+        let mut whole = vec![0.0; points];
+        for (&k, &p) in kept.iter().zip(mine) {
+            whole[k] = p;
+        }
+        Ok(Some(whole))
     }
 
     /// Quarantine the failing points of interaction `i`, or stop doing so (collective),
