@@ -586,22 +586,29 @@ fn cut_interface_transient_newton_cuts_failed_steps_as_serial() {
     let (problem, _) = write_transient_cut_case(tmp.path(), h_of_t, "max_iterations = 3\n", 0.1);
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
-    let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();
-    eprintln!("steps cut, serial: {}", serial.summary["transient"]);
-    assert!(
-        rejected(&serial) > 0,
-        "some steps cut: {}",
-        serial.summary["transient"]
-    );
+    assert_rejected_as_serial(&serial, &runs, "steps cut");
     let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
     for par in &runs {
+        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
+    }
+}
+
+/// The serial run rejected some attempts (`what`), and every distributed run as many.
+fn assert_rejected_as_serial(serial: &Ran, runs: &[Ran], what: &str) {
+    let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();
+    eprintln!("{what}, serial: {}", serial.summary["transient"]);
+    assert!(
+        rejected(serial) > 0,
+        "{what}: {}",
+        serial.summary["transient"]
+    );
+    for par in runs {
         assert_eq!(
             rejected(par),
-            rejected(&serial),
+            rejected(serial),
             "{}",
             par.summary["transient"]
         );
-        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
     }
 }
 
@@ -616,21 +623,7 @@ fn cut_interface_adaptive_transient_equals_serial() {
     let (problem, _) = write_transient_cut_case(tmp.path(), GAP_H, solve, 0.1);
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
-    let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();
-    eprintln!("adaptive steps, serial: {}", serial.summary["transient"]);
-    assert!(
-        rejected(&serial) > 0,
-        "some attempts rejected: {}",
-        serial.summary["transient"]
-    );
-    for par in &runs {
-        assert_eq!(
-            rejected(par),
-            rejected(&serial),
-            "{}",
-            par.summary["transient"]
-        );
-    }
+    assert_rejected_as_serial(&serial, &runs, "adaptive steps rejected");
 }
 
 /// `seam -v search deck --mesh mesh --points FILE args…`, serially or under `mpirun -n`.

@@ -496,14 +496,7 @@ fn rank_terms_sum_to_the_serial_terms() {
     if std::env::var_os(CHILD).is_some() {
         return rank_terms_child();
     }
-    for n in 1..=4 {
-        let text = child_on(n, "rank_terms_sum_to_the_serial_terms");
-        // libtest prints the test's name first, on the same line.
-        let line = text
-            .lines()
-            .find_map(|l| l.find("rank terms:").map(|k| &l[k..]))
-            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
-        eprintln!("mpirun -n {n}: {line}");
+    for (n, text) in on_1_to_4_ranks("rank_terms_sum_to_the_serial_terms", "rank terms:") {
         if let Some(points) = text
             .lines()
             .find_map(|l| l.find("rank point fields:").map(|k| &l[k..]))
@@ -547,6 +540,64 @@ fn child_on(n: usize, name: &str) -> String {
     text
 }
 
+/// Test `name` under `mpirun -n 1..4` ([`child_on`]): per rank count its output, after
+/// printing the line that `prefix` starts (rank 0's summary; libtest prints the test's
+/// name first, on the same line).
+fn on_1_to_4_ranks(name: &str, prefix: &str) -> Vec<(usize, String)> {
+    (1..=4)
+        .map(|n| {
+            let text = child_on(n, name);
+            let line = text
+                .lines()
+                .find_map(|l| l.find(prefix).map(|k| &l[k..]))
+                .unwrap_or_else(|| panic!("no `{prefix}` line on {n} ranks:\n{text}"));
+            eprintln!("mpirun -n {n}: {line}");
+            (n, text)
+        })
+        .collect()
+}
+
+/// The host field `f` by dof: the value at the node whose dof is each d.
+fn by_dof(m: &Mesh, f: impl Fn([f64; 3]) -> f64) -> Vec<f64> {
+    let n = m.coords.len();
+    (0..n)
+        .map(|d| f(m.coords[(0..n).find(|&g| dof_of(g, n) == d).unwrap()]))
+        .collect()
+}
+
+/// The serial embedding of all of `m` and this rank's embedding of its slab of elements,
+/// each with `interactions()` added and searched, and the rank's local nodes (by global
+/// number).
+fn serial_and_rank(
+    world: &mpi::topology::SimpleCommunicator,
+    m: &Mesh,
+    interactions: impl Fn() -> Vec<seam::embed::Interaction>,
+) -> (
+    seam::embed::Embedding,
+    seam::embed::RankEmbedding,
+    Vec<usize>,
+) {
+    use mpi::traits::Communicator;
+    let (rank, size, n_elems) = (world.rank() as usize, world.size() as usize, m.num_elems());
+    let all: Vec<usize> = (0..n_elems).collect();
+    let mut serial = builder_of(m, &all).0.build().expect("serial build");
+    for i in interactions() {
+        serial.add_interaction(i).expect("serial interaction");
+    }
+    serial.search().expect("serial search");
+    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
+    let (b, nodes) = builder_of(m, &mine);
+    let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
+    let mut e = b
+        .build_on_ranks(world.duplicate(), &gids)
+        .expect("rank build");
+    for i in interactions() {
+        e.add_interaction(i).expect("rank interaction");
+    }
+    e.search().expect("rank search");
+    (serial, e, nodes)
+}
+
 fn rank_terms_child() {
     use mpi::traits::{Communicator, CommunicatorCollectives};
     let universe = mpi::initialize().expect("MPI");
@@ -554,13 +605,7 @@ fn rank_terms_child() {
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let m = bricks();
     let (n_nodes, n_elems) = (m.coords.len(), m.num_elems());
-    let u: Vec<f64> = (0..n_nodes)
-        .map(|d| {
-            // u by dof: the node whose dof is d.
-            let g = (0..n_nodes).find(|&g| dof_of(g, n_nodes) == d).unwrap();
-            field(m.coords[g])
-        })
-        .collect();
+    let u = by_dof(&m, field);
 
     // The serial embedding of the whole mesh.
     let all: Vec<usize> = (0..n_elems).collect();
@@ -920,45 +965,18 @@ fn rank_csr_sums_to_the_serial_csr() {
     if std::env::var_os(CHILD).is_some() {
         return rank_csr_child();
     }
-    for n in 1..=4 {
-        let text = child_on(n, "rank_csr_sums_to_the_serial_csr");
-        let line = text
-            .lines()
-            .find_map(|l| l.find("rank csr:").map(|k| &l[k..]))
-            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
-        eprintln!("mpirun -n {n}: {line}");
-    }
+    on_1_to_4_ranks("rank_csr_sums_to_the_serial_csr", "rank csr:");
 }
 
 fn rank_csr_child() {
     use mpi::traits::{Communicator, CommunicatorCollectives};
     let universe = mpi::initialize().expect("MPI");
     let world = universe.world();
-    let (rank, size) = (world.rank() as usize, world.size() as usize);
+    let rank = world.rank() as usize;
     let m = bricks();
-    let (n, n_elems) = (m.coords.len(), m.num_elems());
-    let by_dof = |f: &dyn Fn([f64; 3]) -> f64| -> Vec<f64> {
-        (0..n)
-            .map(|d| f(m.coords[(0..n).find(|&g| dof_of(g, n) == d).unwrap()]))
-            .collect()
-    };
+    let n = m.coords.len();
     let other = |x: [f64; 3]| field(x) + 30.0 * x[1] * x[2];
-    let all: Vec<usize> = (0..n_elems).collect();
-    let mut serial = builder_of(&m, &all).0.build().expect("serial build");
-    for i in interactions() {
-        serial.add_interaction(i).expect("serial interaction");
-    }
-    serial.search().expect("serial search");
-    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
-    let (b, nodes) = builder_of(&m, &mine);
-    let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
-    let mut e = b
-        .build_on_ranks(world.duplicate(), &gids)
-        .expect("rank build");
-    for i in interactions() {
-        e.add_interaction(i).expect("rank interaction");
-    }
-    e.search().expect("rank search");
+    let (mut serial, mut e, nodes) = serial_and_rank(&world, &m, interactions);
     let summed = |got: &seam::embed::RankEvaluation| {
         let mine = dense_csr(got, n);
         let mut all = vec![0.0; mine.len()];
@@ -984,7 +1002,7 @@ fn rank_csr_child() {
     let mut first = None;
     for f in [&field as &dyn Fn([f64; 3]) -> f64, &other] {
         let (u, u_local) = (
-            by_dof(f),
+            by_dof(&m, f),
             nodes.iter().map(|&g| f(m.coords[g])).collect::<Vec<_>>(),
         );
         let want = serial.evaluate(&u).expect("serial csr").clone();
@@ -1048,13 +1066,7 @@ fn rank_setters_equal_the_serial_ones() {
     if std::env::var_os(CHILD).is_some() {
         return rank_setters_child();
     }
-    for n in 1..=4 {
-        let text = child_on(n, "rank_setters_equal_the_serial_ones");
-        let line = text
-            .lines()
-            .find_map(|l| l.find("rank setters:").map(|k| &l[k..]))
-            .unwrap_or_else(|| panic!("no summary line on {n} ranks:\n{text}"));
-        eprintln!("mpirun -n {n}: {line}");
+    for (n, text) in on_1_to_4_ranks("rank_setters_equal_the_serial_ones", "rank setters:") {
         if n > 1 {
             assert_eq!(
                 text.matches("refused on every rank (set_time)").count(),
@@ -1073,10 +1085,8 @@ fn rank_setters_child() {
     let world = universe.world();
     let (rank, size) = (world.rank() as usize, world.size() as usize);
     let m = bricks();
-    let (n_nodes, n_elems) = (m.coords.len(), m.num_elems());
-    let u: Vec<f64> = (0..n_nodes)
-        .map(|d| field(m.coords[(0..n_nodes).find(|&g| dof_of(g, n_nodes) == d).unwrap()]))
-        .collect();
+    let n_nodes = m.coords.len();
+    let u = by_dof(&m, field);
     let model = || {
         let h = FnConductance::new("h of t", false, |s: &seam::embed::PointState| {
             if s.time >= 1.0 && s.x[1] < 0.3 {
@@ -1091,23 +1101,12 @@ fn rank_setters_child() {
             .conductance(Arc::new(h))
             .quarantine()
     };
-    let all: Vec<usize> = (0..n_elems).collect();
-    let mut serial = builder_of(&m, &all).0.build().expect("serial build");
-    serial.add_interaction(model()).expect("serial interaction");
-    serial.search().expect("serial search");
+    let (mut serial, mut e, nodes) = serial_and_rank(&world, &m, || vec![model()]);
     let at_zero = serial.contributions(&u).expect("serial terms at t = 0");
     serial.set_time(2.0).expect("serial time");
     let want = serial.contributions(&u).expect("serial terms at t = 2");
     let kept = serial.quarantined(0);
 
-    let mine: Vec<usize> = (n_elems * rank / size..n_elems * (rank + 1) / size).collect();
-    let (b, nodes) = builder_of(&m, &mine);
-    let gids: Vec<u64> = nodes.iter().map(|&g| g as u64).collect();
-    let mut e = b
-        .build_on_ranks(world.duplicate(), &gids)
-        .expect("rank build");
-    e.add_interaction(model()).expect("rank interaction");
-    e.search().expect("rank search");
     let u_local: Vec<f64> = nodes.iter().map(|&g| field(m.coords[g])).collect();
     e.set_time(2.0).expect("rank time");
     assert_eq!(e.time(), 2.0);

@@ -276,11 +276,9 @@ pub unsafe extern "C" fn seam_rank_set_point_pressures(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let given = match pressures.is_null() && n == 0 {
-            true => Ok(None),
-            false => unsafe { slice(pressures, n, "pressures") }.map(Some),
-        };
-        let given = on_every_rank(e.inner.comm(), given)?;
+        let given = on_every_rank(e.inner.comm(), unsafe {
+            state::pressures_arg(pressures, n)
+        })?;
         (e.evaluated, e.csr_current) = (None, false);
         Ok(e.inner.set_point_pressures(index, given)?)
     })

@@ -34,11 +34,7 @@ pub unsafe extern "C" fn seam_set_point_pressures(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        let given = if pressures.is_null() && n == 0 {
-            None
-        } else {
-            Some(unsafe { slice(pressures, n, "pressures") }?.to_vec())
-        };
+        let given = unsafe { pressures_arg(pressures, n) }?.map(<[f64]>::to_vec);
         e.inner.set_point_pressures(index, given)?;
         e.values_changed();
         Ok(())
@@ -78,6 +74,18 @@ pub unsafe extern "C" fn seam_quarantined(
         let arrays = (&b.quarantined_xyz, &b.quarantined_reasons);
         unsafe { quarantined_out(arrays, out_n, out_xyz, out_reasons) }
     })
+}
+
+/// A setter's pressures: null with `n` 0 for none (back to the enforcement's
+/// pressure), else `n` values.
+pub(super) unsafe fn pressures_arg<'a>(
+    pressures: *const f64,
+    n: usize,
+) -> Result<Option<&'a [f64]>, Failure> {
+    match pressures.is_null() && n == 0 {
+        true => Ok(None),
+        false => unsafe { slice(pressures, n, "pressures") }.map(Some),
+    }
 }
 
 /// Quarantined points as C arrays: their xyz (3 per point) and the reasons, one line
