@@ -9,7 +9,7 @@
 
 use rayon::prelude::*;
 
-use super::{EmbedError, Embedding, Heat};
+use super::{EmbedError, Embedding, Heat, argument};
 use crate::slices::{filled_pieces, pieces, same_bits};
 
 /// A square sparse matrix in compressed sparse row form, in the host's dof numbers:
@@ -150,6 +150,42 @@ impl Embedding {
         self.evaluation = Some(e);
         refreshed?;
         Ok(self.evaluation.as_ref().expect("just put back"))
+    }
+
+    /// The interface residual `R_Γ(u)` of every flux interaction at the host's field
+    /// `u`, added into `r` (by host dof, as long as `u`), and the heats as
+    /// [`Self::evaluate`] gives them — without the Jacobian, whose blocks are most of an
+    /// evaluation's work: for a host that keeps its matrix (linear interfaces, a fixed
+    /// step). Each point's residual is [`Self::evaluate`]'s, bit for bit.
+    pub fn residual_into(&self, u: &[f64], r: &mut [f64]) -> Result<Vec<Option<Heat>>, EmbedError> {
+        if r.len() != u.len() {
+            return Err(argument(
+                format!(
+                    "the residual has {} entries, the field {}",
+                    r.len(),
+                    u.len()
+                ),
+                "pass a residual vector as long as the field, indexed by host dof",
+            ));
+        }
+        let local = self.local_field(u)?;
+        let mut heat = Vec::with_capacity(self.pairs.len());
+        for p in &self.pairs {
+            if !p.active {
+                heat.push(p.is_flux().then(Heat::default));
+                continue;
+            }
+            let Some(s) = self.with_form(p, |points, form| points.residual(form, &local))? else {
+                heat.push(None);
+                continue;
+            };
+            for &(d, v) in &s.residual {
+                r[self.host_dof[d as usize]] += v;
+            }
+            let (side_a, side_b) = s.heat();
+            heat.push(Some(Heat { side_a, side_b }));
+        }
+        Ok(heat)
     }
 
     /// Whether evaluating twice with the same inputs gives the same values: every

@@ -101,6 +101,18 @@ pub trait Interfaces {
         asm: &mut Assembler<'_>,
         first: usize,
     ) -> Result<Vec<(f64, f64)>, InterfaceFailure>;
+    /// [`Self::assemble`] without the Jacobian, for a solver that keeps its matrix (every
+    /// flux term linear, [`Self::is_linear`]): the residual added to `r` and the heats,
+    /// the same values. `None` where the interfaces only assemble both.
+    fn residual(
+        &self,
+        u: &[f64],
+        t: f64,
+        r: &mut [f64],
+    ) -> Result<Option<Vec<(f64, f64)>>, InterfaceFailure> {
+        let _ = (u, t, r);
+        Ok(None)
+    }
     /// The heat of each flux term at `u` and `t`.
     fn heat(&self, u: &[f64], t: f64) -> Result<Vec<(f64, f64)>, InterfaceFailure>;
     /// Before step `step` (1 = the first) is solved at time `t`, from the state `u`:

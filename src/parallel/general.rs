@@ -4,7 +4,7 @@
 //! all ranks, the solution then gathered whole on every rank.
 //!
 //! Entry point: [`GeneralSolve::solve`], with the [`System`] the serial solver would
-//! have chosen its method by: CG + GAMG for a symmetric positive definite system at or
+//! have chosen its method by: CG + BoomerAMG for a symmetric positive definite system at or
 //! above the AMG threshold, GMRES preconditioned by GAMG on the temperature and the
 //! voltage blocks for the coupled thermal–electrical Jacobian there, MUMPS LU otherwise
 //! (small, unsymmetric or indefinite: multiplier ties).
@@ -116,7 +116,7 @@ impl GeneralSolve {
         let n = a.nrows();
         let rows = block(n, rank, size);
         let method = match system {
-            System::Spd => Method::CgGamg,
+            System::Spd => Method::CgAmg,
             System::Coupled { .. } => Method::GmresBlocks,
             System::Direct => Method::MumpsLu,
         };

@@ -2,7 +2,7 @@
 //! partitioned by METIS, the contact search distributed ([`search`]: each rank pairs the
 //! side-A points of its own faces), each rank assembling its own elements' conduction and
 //! its own side-A points' interface terms into a PETSc distributed matrix, the solve by
-//! PETSc (CG + GAMG, or MUMPS LU), the solution gathered at the end so that rank 0 writes
+//! PETSc (CG + BoomerAMG, or MUMPS LU), the solution gathered at the end so that rank 0 writes
 //! what a serial run writes. What is and is not distributed is listed in
 //! `docs/parallel.md`.
 //!
@@ -87,7 +87,9 @@ impl System {
     /// Why its method, for the run's summary.
     pub fn why(self) -> &'static str {
         match self {
-            System::Spd => "symmetric positive definite, at or above the AMG threshold → CG + GAMG",
+            System::Spd => {
+                "symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG"
+            }
             System::Coupled { .. } => {
                 "unsymmetric coupled thermal–electrical Newton steps at or above the AMG threshold → GMRES, GAMG on the temperature and voltage blocks"
             }

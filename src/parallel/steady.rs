@@ -29,6 +29,7 @@ use crate::heat::steady::{
 };
 use crate::heat::{FaceBc, HeatError, TEMPERATURE, dirichlet_dofs};
 use crate::mesh::{ElemId, Mesh};
+use crate::solve::amg::KEPT_SOLUTIONS;
 use crate::solve::spmv_ref;
 use faer::sparse::SparseColMatRef;
 
@@ -66,12 +67,12 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         (Method::MumpsLu, false) => {
             "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
         }
-        _ => "symmetric positive definite, at or above the AMG threshold → CG + GAMG",
+        _ => "symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG",
     };
     super::record(method, why);
     let linear = LinearSolves {
         method: (solved.iterations > 0).then_some(match method {
-            Method::CgGamg => LinearMethod::AmgCg,
+            Method::CgAmg => LinearMethod::AmgCg,
             _ => LinearMethod::Lu,
         }),
         cg_iterations: solved.cg_iterations.clone(),
@@ -143,7 +144,7 @@ pub(super) struct Solved {
     pub heat: Vec<(f64, f64)>,
     /// Krylov iterations of each CG solve.
     pub cg_iterations: Vec<usize>,
-    /// Matrices set (each a new GAMG hierarchy or MUMPS factorisation).
+    /// Matrices set (each a new AMG hierarchy or MUMPS factorisation).
     pub setups: usize,
     pub timing: SolveTiming,
 }
@@ -487,7 +488,7 @@ fn log_partition(world: &SimpleCommunicator, layout: &Layout, pairs_of_mine: &[(
 /// The Newton iteration over a [`Built`] set-up, with the PETSc matrix, vectors and
 /// solver it keeps: the matrix is set again only when its values change (a new `c₀`,
 /// new conduction values, or an interface whose Jacobian depends on u), so a linear
-/// run stepping with a fixed step keeps its GAMG hierarchy or MUMPS factorisation.
+/// run stepping with a fixed step keeps its BoomerAMG hierarchy or MUMPS factorisation.
 pub(super) struct Newton<'b, 'p> {
     built: &'b Built<'p>,
     iasm: Assembler<'b>,
@@ -530,18 +531,20 @@ impl<'b, 'p> Newton<'b, 'p> {
         let x_vec = r_vec.duplicate().map_err(petsc_err)?;
         let symmetric = built.iface.is_none_or(|i| i.is_linear());
         let method = if symmetric && built.p.iterative {
-            Method::CgGamg
+            Method::CgAmg
         } else {
             Method::MumpsLu
         };
         let tolerance = match (method, stepping) {
-            (Method::CgGamg, false) => STEADY_AMG_TOLERANCE,
+            (Method::CgAmg, false) => STEADY_AMG_TOLERANCE,
             _ => AMG_TOLERANCE,
         };
         let mut ksp = Ksp::new(comm, &a, method, tolerance).map_err(petsc_err)?;
-        if stepping && method == Method::CgGamg {
-            // From a zero increment, on the true residual (see `step_tolerance`).
+        if stepping && method == Method::CgAmg {
+            // From a zero increment, on the true residual (see `step_tolerance`), moved
+            // to the best combination of the earlier steps' increments.
             ksp.start_from_x(false).map_err(petsc_err)?;
+            ksp.remember_solutions(KEPT_SOLUTIONS).map_err(petsc_err)?;
         }
         let (col_ptr, row_idx) = (built.k_sym.col_ptr(), built.k_sym.row_idx());
         let diagonal = (0..built.k_sym.ncols())
@@ -640,6 +643,11 @@ impl<'b, 'p> Newton<'b, 'p> {
                     r[d] += c.m[d] * (c.c0 * u[d] + c.rest[d]);
                 }
             }
+            // A matrix that stays (linear interfaces, the same c₀) needs the interfaces'
+            // residual alone.
+            let c0 = capacity.map_or(0.0, |c| c.c0);
+            let key = (self.symmetric).then_some(c0.to_bits());
+            let kept = key.is_some() && key == self.matrix_for;
             self.iasm.reset_couplings();
             let values: Vec<f64> = built.touched.iter().map(|&d| r[d]).collect();
             self.r_vec.zero().map_err(petsc_err)?;
@@ -650,9 +658,17 @@ impl<'b, 'p> Newton<'b, 'p> {
                 // This rank's points' terms, into the rows of any rank.
                 r.iter_mut().for_each(|x| *x = 0.0);
                 let r_iface = &mut r;
-                let mine = i
-                    .assemble(u, t, r_iface, &mut self.iasm, built.first)
-                    .map_err(failed)
+                let residual = match kept {
+                    true => i.residual(u, t, r_iface).map_err(failed),
+                    false => Ok(None),
+                };
+                let mine = residual
+                    .and_then(|heat| match heat {
+                        Some(heat) => Ok(heat),
+                        None => i
+                            .assemble(u, t, r_iface, &mut self.iasm, built.first)
+                            .map_err(failed),
+                    })
                     .and_then(|mine| {
                         // A point reads the field where it has terms: there it must be
                         // kept.
@@ -709,9 +725,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             iterations += 1;
             // J = K (+ c₀ m) + J_Γ: every entry this rank made, the interface rows it
             // owns; set again only when its values change.
-            let c0 = capacity.map_or(0.0, |c| c.c0);
-            let key = (self.symmetric).then_some(c0.to_bits());
-            if key.is_none() || key != self.matrix_for {
+            if !kept {
                 let start = Instant::now();
                 self.set_matrix(capacity)?;
                 timing.assembly_s += start.elapsed().as_secs_f64();
@@ -722,7 +736,7 @@ impl<'b, 'p> Newton<'b, 'p> {
                 setups += 1;
             }
             let start = Instant::now();
-            if capacity.is_some() && self.method == Method::CgGamg {
+            if capacity.is_some() && self.method == Method::CgAmg {
                 self.step_tolerance(u)?;
             }
             // The increment: J Δu = −R (Δu = 0 on the Dirichlet rows, whose R is 0).
@@ -743,7 +757,7 @@ impl<'b, 'p> Newton<'b, 'p> {
                 .map_err(petsc_err)?;
             last_step = built.scatter.update(&built.world, layout, &mine, u);
             timing.solve_s += start.elapsed().as_secs_f64();
-            if self.method == Method::CgGamg {
+            if self.method == Method::CgAmg {
                 cg_iterations.push(its);
             }
         }

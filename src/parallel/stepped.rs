@@ -194,7 +194,7 @@ pub(super) fn solve(
             cg_iterations: cg,
             gmres: false,
             hierarchy_setups: match newton.method {
-                Method::CgGamg => solved.setups,
+                Method::CgAmg => solved.setups,
                 _ => 0,
             },
             hierarchy_refreshes: 0,
@@ -227,8 +227,8 @@ pub(super) fn solve(
         agreed(handed)?;
     }
     let why = match (newton.method, newton.symmetric) {
-        (Method::CgGamg, _) => {
-            "transient steps assembled per rank, symmetric positive definite, at or above the AMG threshold → CG + GAMG (hierarchy kept while the step size holds)"
+        (Method::CgAmg, _) => {
+            "transient steps assembled per rank, symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG (hierarchy kept while the step size holds, each step started from the earlier steps' solutions)"
         }
         (_, true) => {
             "transient steps assembled per rank, below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU (factorisation kept while the step size holds)"

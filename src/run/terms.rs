@@ -903,6 +903,18 @@ impl Interfaces for ContactTerms<'_> {
         Ok(self.flux_heat(&ev.heat))
     }
 
+    fn residual(
+        &self,
+        u: &[f64],
+        t: f64,
+        r: &mut [f64],
+    ) -> Result<Option<Vec<(f64, f64)>>, InterfaceFailure> {
+        let e = self.embedded()?;
+        self.at_time(e, t)?;
+        let heat = e.embedding.borrow().residual_into(u, r).map_err(failure)?;
+        Ok(Some(self.flux_heat(&heat)))
+    }
+
     fn heat(&self, u: &[f64], t: f64) -> Result<Vec<(f64, f64)>, InterfaceFailure> {
         let e = self.embedded()?;
         self.at_time(e, t)?;

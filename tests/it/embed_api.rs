@@ -313,6 +313,45 @@ fn embed_csr_jacobian_matches_triplets_and_differences_and_keeps_its_pattern() {
     assert_eq!(seam.evaluate(&u1).unwrap().pattern, pattern + 1);
 }
 
+/// The residual alone is the evaluation's, bit for bit, added onto what the vector
+/// held, with the same heats; an interaction switched off adds nothing.
+#[test]
+fn embed_residual_alone_is_the_evaluated_residual() {
+    let (mut seam, n) = two_blocks(
+        Interaction::new("base_top", "lid_bottom", Model::GapConductance { h: 0.0 })
+            .conductance(quadratic_h()),
+    );
+    let u = field(n, 0.0);
+    let (residual, heat) = {
+        let e = seam.evaluate(&u).unwrap();
+        (e.residual.clone(), e.heat.clone())
+    };
+    assert!(residual.iter().any(|&v| v != 0.0));
+    let mut r = vec![0.0; n];
+    assert_eq!(seam.residual_into(&u, &mut r).unwrap(), heat);
+    assert!(
+        r.iter()
+            .zip(&residual)
+            .all(|(a, b)| a.to_bits() == b.to_bits()),
+        "the residual alone differs from the evaluated one"
+    );
+    // Added onto the vector's values.
+    let mut shifted = vec![1.0; n];
+    seam.residual_into(&u, &mut shifted).unwrap();
+    assert!(shifted.iter().zip(&residual).all(|(a, b)| *a == 1.0 + b));
+    // Too short a vector is refused.
+    let error = seam.residual_into(&u, &mut vec![0.0; n - 1]).unwrap_err();
+    assert!(
+        error.to_string().contains("as long as the field"),
+        "{error}"
+    );
+    seam.set_active(0, false).unwrap();
+    let mut off = vec![0.0; n];
+    let heat = seam.residual_into(&u, &mut off).unwrap();
+    assert!(off.iter().all(|&v| v == 0.0));
+    assert_eq!(heat[0].unwrap().side_a, 0.0);
+}
+
 #[test]
 fn embed_closure_conductance_matches_the_constant_model() {
     let (constant, n) = two_blocks(Interaction::new(
