@@ -248,7 +248,17 @@ pub fn linear_solver() -> Option<(String, String)> {
     {
         let (_, size) = world()?;
         let (method, why) = LAST.with(std::cell::Cell::get)?;
-        Some((method.name().into(), format!("MPI, {size} rank(s): {why}")))
+        // PETSc applies the user's options over the choice: say so.
+        let over = std::env::var("PETSC_OPTIONS")
+            .ok()
+            .filter(|o| !o.trim().is_empty())
+            .map_or(String::new(), |o| {
+                format!("; PETSC_OPTIONS \"{}\" applied over it", o.trim())
+            });
+        Some((
+            method.name().into(),
+            format!("MPI, {size} rank(s): {why}{over}"),
+        ))
     }
     #[cfg(not(feature = "mpi"))]
     {

@@ -597,12 +597,13 @@ impl Ksp {
                 Method::CgAmg => {
                     check("KSPSetType", KSPSetType(k, c_name("cg").as_ptr()))?;
                     // A `-pc_type` of the user's is left to `KSPSetFromOptions` (so that
-                    // a PETSc built without hypre can still run with `-pc_type gamg`).
+                    // a PETSc built without hypre can still run with `-pc_type gamg`);
+                    // BoomerAMG's settings hold for a `-pc_type hypre` too.
                     if !has_option("-pc_type")? {
                         check("PCSetType", PCSetType(pc, c_name("hypre").as_ptr()))?;
-                        for (name, value) in BOOMERAMG {
-                            default_option(name, value)?;
-                        }
+                    }
+                    for (name, value) in BOOMERAMG {
+                        default_option(name, value)?;
                     }
                     check(
                         "KSPSetTolerances",
