@@ -959,6 +959,32 @@ fn busbar_joint_by_gmres_equals_serial() {
     compare(&problem, false);
 }
 
+/// Two plates whose conductance comes from the C example plugin (a table of h in
+/// contact pressure), the library loaded by every rank and evaluated at the points it
+/// owns.
+#[test]
+fn plugin_conductance_equals_serial() {
+    let (tmp, problem) = example("plugin_conductance");
+    let library = tmp.path().join("libseam_c_table.so");
+    let compiler = std::env::var("CC").unwrap_or_else(|_| "cc".into());
+    let status = std::process::Command::new(&compiler)
+        .args(["-std=c99", "-O2", "-shared", "-fPIC", "-I"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("plugins/include"))
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("plugins/examples/c_table/c_table.c"))
+        .arg("-o")
+        .arg(&library)
+        .status()
+        .unwrap_or_else(|e| panic!("cannot run the C compiler `{compiler}`: {e}"));
+    assert!(status.success(), "compiling the c_table plugin failed");
+    let serial = compare(&problem, false);
+    // h = 5500 W/m²K at 2 MPa (the deck's table): a heat of about 96 W, which a
+    // conductance missed or counted twice would move.
+    let heat = serial.summary["interactions"][0]["heat_side_a"]
+        .as_f64()
+        .unwrap();
+    assert!((90.0..100.0).contains(&heat), "heat {heat} W");
+}
+
 /// Hydrogen through a coated wall: temperature and species, T-dependent diffusivities.
 #[test]
 fn hydrogen_wall_species_equals_serial() {
