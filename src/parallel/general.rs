@@ -5,7 +5,7 @@
 //!
 //! Entry point: [`GeneralSolve::solve`], with the [`System`] the serial solver would
 //! have chosen its method by: CG + BoomerAMG for a symmetric positive definite system at or
-//! above the AMG threshold, GMRES preconditioned by GAMG on the temperature and the
+//! above the AMG threshold, GMRES preconditioned by BoomerAMG on the temperature and the
 //! voltage blocks for the coupled thermal–electrical Jacobian there, MUMPS LU otherwise
 //! (small, unsymmetric or indefinite: multiplier ties).
 //!

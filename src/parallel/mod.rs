@@ -91,7 +91,7 @@ impl System {
                 "symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG"
             }
             System::Coupled { .. } => {
-                "unsymmetric coupled thermal–electrical Newton steps at or above the AMG threshold → GMRES, GAMG on the temperature and voltage blocks"
+                "unsymmetric coupled thermal–electrical Newton steps at or above the AMG threshold → GMRES, BoomerAMG on the temperature and voltage blocks"
             }
             System::Direct => {
                 "below the AMG threshold, unsymmetric, or with multipliers (indefinite) → MUMPS LU"

@@ -500,8 +500,9 @@ pub enum Method {
     CgAmg,
     /// A direct LU factorisation by MUMPS (small, unsymmetric or indefinite systems).
     MumpsLu,
-    /// GMRES, right-preconditioned, by GAMG on two diagonal blocks side by side (PETSc's
-    /// additive field split): the coupled thermal–electrical Jacobian.
+    /// GMRES, right-preconditioned, by BoomerAMG (the settings of [`BOOMERAMG`]) on two
+    /// diagonal blocks side by side (PETSc's additive field split): the coupled
+    /// thermal–electrical Jacobian.
     GmresBlocks,
 }
 
@@ -510,12 +511,14 @@ impl Method {
         match self {
             Method::CgAmg => "PETSc CG + BoomerAMG",
             Method::MumpsLu => "PETSc MUMPS LU",
-            Method::GmresBlocks => "PETSc GMRES + field-split GAMG",
+            Method::GmresBlocks => "PETSc GMRES + field-split BoomerAMG",
         }
     }
 }
 
-/// BoomerAMG's settings for [`Method::CgAmg`], each unless `PETSC_OPTIONS` gives it:
+/// BoomerAMG's settings for [`Method::CgAmg`] and for each block of
+/// [`Method::GmresBlocks`] (there as `-fieldsplit_0_…`, `-fieldsplit_1_…`), each unless
+/// `PETSC_OPTIONS` gives it:
 /// hypre's recommendations for 3-D problems — HMIS coarsening, extended+i
 /// interpolation of at most 4 entries a row, strength threshold 0.5 — with aggressive
 /// coarsening on the finest level. On the electronics warm-up at refine 6 (thin fins and
@@ -639,17 +642,14 @@ impl Ksp {
                         let set = PCFieldSplitSetIS(pc, c_name(name).as_ptr(), is);
                         ISDestroy(&mut is);
                         check("PCFieldSplitSetIS", set)?;
-                        // Each block: one V-cycle of GAMG (the split's own Krylov
-                        // method is `preonly` by default).
-                        let key = c_name(&format!("-fieldsplit_{name}_pc_type"));
-                        check(
-                            "PetscOptionsSetValue",
-                            PetscOptionsSetValue(
-                                std::ptr::null_mut(),
-                                key.as_ptr(),
-                                c_name("gamg").as_ptr(),
-                            ),
-                        )?;
+                        // Each block: one V-cycle of BoomerAMG with its settings (the
+                        // split's own Krylov method is `preonly` by default), each
+                        // unless the user's options say otherwise.
+                        let prefix = format!("-fieldsplit_{name}_");
+                        default_option(&format!("{prefix}pc_type"), "hypre")?;
+                        for (option, value) in BOOMERAMG {
+                            default_option(&option.replacen('-', &prefix, 1), value)?;
+                        }
                     }
                 }
                 Method::MumpsLu => {
