@@ -857,6 +857,26 @@ fn node_surface_side_a_equals_serial() {
     compare(&problem, true);
 }
 
+/// Every distributed run solved by `method` (a word of the summary's solver name) in at
+/// most 1.5 times the serial run's Krylov iterations over the run: the distributed
+/// preconditioner as good as seam's own.
+fn assert_iterations_near_serial(serial: &Ran, runs: &[Ran], method: &str) {
+    let iterations = |r: &Ran| r.summary["linear_solver"]["iterations"].as_u64().unwrap();
+    let expected = iterations(serial);
+    for (n, par) in (1..).zip(runs) {
+        let name = par.summary["linear_solver"]["name"].as_str().unwrap();
+        assert!(
+            name.contains(method),
+            "{method} asked for on {n} ranks: {name}"
+        );
+        assert!(
+            iterations(par) * 2 <= expected * 3,
+            "{n} ranks: {} {method} iterations over the run, serial {expected} (at most 1.5 times)",
+            iterations(par)
+        );
+    }
+}
+
 /// `file` of example `name` in a scratch folder with each `(from, to)` of `edits` made
 /// (each must be there).
 fn edited_example(name: &str, file: &str, edits: &[(&str, &str)]) -> (tempfile::TempDir, PathBuf) {
@@ -923,17 +943,7 @@ fn electronics_warm_up_by_cg_takes_about_the_serial_iterations() {
     );
     let (serial, runs) = compare_runs(&problem, false);
     assert_steps_distributed(&serial, &runs);
-    let iterations = |r: &Ran| r.summary["linear_solver"]["iterations"].as_u64().unwrap();
-    let expected = iterations(&serial);
-    for (n, par) in (1..).zip(&runs) {
-        let name = par.summary["linear_solver"]["name"].as_str().unwrap();
-        assert!(name.contains("CG"), "CG asked for on {n} ranks: {name}");
-        assert!(
-            iterations(par) * 2 <= expected * 3,
-            "{n} ranks: {} CG iterations over the run, serial {expected} (at most 1.5 times)",
-            iterations(par)
-        );
-    }
+    assert_iterations_near_serial(&serial, &runs, "CG");
 }
 
 /// Thermal–electrical (temperature and voltage, Joule heat, an electrical contact):
@@ -958,20 +968,7 @@ fn busbar_joint_by_gmres_equals_serial() {
         )],
     );
     let (serial, runs) = compare_runs(&problem, false);
-    let iterations = |r: &Ran| r.summary["linear_solver"]["iterations"].as_u64().unwrap();
-    let expected = iterations(&serial);
-    for (n, par) in (1..).zip(&runs) {
-        let name = par.summary["linear_solver"]["name"].as_str().unwrap();
-        assert!(
-            name.contains("GMRES"),
-            "GMRES asked for on {n} ranks: {name}"
-        );
-        assert!(
-            iterations(par) * 2 <= expected * 3,
-            "{n} ranks: {} GMRES iterations, serial {expected} (at most 1.5 times)",
-            iterations(par)
-        );
-    }
+    assert_iterations_near_serial(&serial, &runs, "GMRES");
 }
 
 /// Two plates whose conductance comes from the C example plugin (a table of h in
