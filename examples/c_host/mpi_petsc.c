@@ -201,6 +201,23 @@ static int serial(const Mesh *m) {
     return 0;
 }
 
+/* The last seam_rank_evaluate's terms of this rank's points, added to the matrix `a`
+ * and the load `b` in the host's global dofs (PETSc moves the entries of other ranks'
+ * rows at assembly). */
+static PetscErrorCode add_triplets(seam_rank_embedding *s, Mat a, Vec b) {
+    size_t n;
+    const int64_t *rows, *cols, *dofs;
+    const double *vals;
+    PetscFunctionBeginUser;
+    CHECK(seam_rank_jacobian(s, &n, &rows, &cols, &vals));
+    for (size_t q = 0; q < n; q++)
+        PetscCall(MatSetValue(a, (PetscInt)rows[q], (PetscInt)cols[q], vals[q], ADD_VALUES));
+    CHECK(seam_rank_load(s, &n, &dofs, &vals));
+    for (size_t q = 0; q < n; q++)
+        PetscCall(VecSetValue(b, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    PetscFunctionReturn(0);
+}
+
 /* The interface terms through the CSR form (seam_rank_evaluate_csr at u, this rank's
  * rows added row by row) against the triplets of the last seam_rank_evaluate at the same
  * u (which it replaces): prints the largest difference of the matrices and of the loads
@@ -210,10 +227,9 @@ static PetscErrorCode csr_against_triplets(seam_rank_embedding *s, int rank, Pet
     Mat T, C;
     Vec lt, lc;
     PetscReal dm, dv;
-    size_t n, n_rows, nnz;
-    const int64_t *rows, *cols, *dofs;
+    size_t n_rows, nnz;
     const size_t *csr_rows, *offsets, *columns;
-    const double *vals, *csr_vals, *csr_load;
+    const double *csr_vals, *csr_load;
     uint64_t pattern;
     PetscFunctionBeginUser;
     PetscCall(MatCreateAIJ(PETSC_COMM_WORLD, local_rows, local_rows, PETSC_DETERMINE,
@@ -221,12 +237,7 @@ static PetscErrorCode csr_against_triplets(seam_rank_embedding *s, int rank, Pet
     PetscCall(MatSetOption(T, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
     PetscCall(MatDuplicate(T, MAT_DO_NOT_COPY_VALUES, &C));
     PetscCall(MatCreateVecs(T, &lt, &lc));
-    CHECK(seam_rank_jacobian(s, &n, &rows, &cols, &vals));
-    for (size_t q = 0; q < n; q++)
-        PetscCall(MatSetValue(T, (PetscInt)rows[q], (PetscInt)cols[q], vals[q], ADD_VALUES));
-    CHECK(seam_rank_load(s, &n, &dofs, &vals));
-    for (size_t q = 0; q < n; q++)
-        PetscCall(VecSetValue(lt, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    PetscCall(add_triplets(s, T, lt));
     CHECK(seam_rank_evaluate_csr(s, u, n_local));
     CHECK(seam_rank_jacobian_csr(s, &n_rows, &nnz, &csr_rows, &offsets, &columns, &csr_vals,
                                  &pattern));
@@ -405,15 +416,7 @@ int main(int argc, char **argv) {
         CHECK(seam_rank_quarantined(s, 0, &own, &xyz, &reasons, &total));
         if (rank == 0) printf("quarantined: %zu\n", total + own);
     }
-    size_t n;
-    const int64_t *rows, *cols, *dofs;
-    const double *vals;
-    CHECK(seam_rank_jacobian(s, &n, &rows, &cols, &vals));
-    for (size_t q = 0; q < n; q++)
-        PetscCall(MatSetValue(A, (PetscInt)rows[q], (PetscInt)cols[q], vals[q], ADD_VALUES));
-    CHECK(seam_rank_load(s, &n, &dofs, &vals));
-    for (size_t q = 0; q < n; q++)
-        PetscCall(VecSetValue(rhs, (PetscInt)dofs[q], vals[q], ADD_VALUES));
+    PetscCall(add_triplets(s, A, rhs));
     PetscCall(csr_against_triplets(s, rank, local_rows, zero, (size_t)n_local));
     for (size_t q = 0; q < n_entries; q++) { /* C and C^T of this rank's multipliers */
         PetscInt row = NODES + (PetscInt)place[mults[q]], col = (PetscInt)mult_cols[q];

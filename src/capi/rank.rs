@@ -22,6 +22,21 @@ pub struct SeamRankEmbedding {
     csr_current: bool,
 }
 
+impl SeamRankEmbedding {
+    /// What the terms depend on changed (time, switches, pressures, quarantine): the
+    /// last evaluation's values no longer hold.
+    fn values_changed(&mut self) {
+        (self.evaluated, self.csr_current) = (None, false);
+    }
+
+    /// The interactions or the geometry changed (a search, a move): the last
+    /// evaluation and tie rows no longer hold.
+    fn forget_results(&mut self) {
+        self.values_changed();
+        self.rows = None;
+    }
+}
+
 /// This rank's own points of the last `seam_rank_point_fields`: their values, their
 /// indices in the interaction's point order, and their side-B faces' ranks.
 #[derive(Default)]
@@ -149,7 +164,7 @@ pub unsafe extern "C" fn seam_rank_add_interaction(
         let i = e
             .inner
             .add_interaction(Interaction::new(a, b, model).offset(offset))?;
-        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
+        e.forget_results();
         unsafe { interactions::optional_out(out_index, i) }
     })
 }
@@ -167,7 +182,7 @@ pub unsafe extern "C" fn seam_rank_add_deck(
         let args = unsafe { interactions::deck_args(deck_text, name) };
         let (deck, name) = on_every_rank(e.inner.comm(), args)?;
         let added = e.inner.add_deck(name, deck)?;
-        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
+        e.forget_results();
         unsafe { interactions::optional_out(out_count, added.len()) }
     })
 }
@@ -184,7 +199,7 @@ pub unsafe extern "C" fn seam_rank_add_deck_file(
         let e = unsafe { handle(embedding, "embedding") }?;
         let path = on_every_rank(e.inner.comm(), unsafe { text(path, "path") })?;
         let added = e.inner.add_deck_file(std::path::Path::new(path))?;
-        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
+        e.forget_results();
         unsafe { interactions::optional_out(out_count, added.len()) }
     })
 }
@@ -194,7 +209,7 @@ pub unsafe extern "C" fn seam_rank_add_deck_file(
 pub unsafe extern "C" fn seam_rank_search(embedding: *mut SeamRankEmbedding) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
+        e.forget_results();
         Ok(e.inner.search()?)
     })
 }
@@ -214,7 +229,7 @@ pub unsafe extern "C" fn seam_rank_move_nodes(
         let points = on_every_rank(e.inner.comm(), unsafe {
             interactions::xyz(coords, n_nodes)
         })?;
-        (e.evaluated, e.rows, e.csr_current) = (None, None, false);
+        e.forget_results();
         Ok(e.inner.move_nodes(&points)?)
     })
 }
@@ -242,7 +257,7 @@ pub unsafe extern "C" fn seam_rank_coverage(
 pub unsafe extern "C" fn seam_rank_set_time(embedding: *mut SeamRankEmbedding, time: f64) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        (e.evaluated, e.csr_current) = (None, false);
+        e.values_changed();
         Ok(e.inner.set_time(time)?)
     })
 }
@@ -258,7 +273,7 @@ pub unsafe extern "C" fn seam_rank_set_active(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        (e.evaluated, e.csr_current) = (None, false);
+        e.values_changed();
         Ok(e.inner.set_active(index, on != 0)?)
     })
 }
@@ -279,7 +294,7 @@ pub unsafe extern "C" fn seam_rank_set_point_pressures(
         let given = on_every_rank(e.inner.comm(), unsafe {
             state::pressures_arg(pressures, n)
         })?;
-        (e.evaluated, e.csr_current) = (None, false);
+        e.values_changed();
         Ok(e.inner.set_point_pressures(index, given)?)
     })
 }
@@ -295,7 +310,7 @@ pub unsafe extern "C" fn seam_rank_set_quarantine(
 ) -> c_int {
     guard(|| {
         let e = unsafe { handle(embedding, "embedding") }?;
-        (e.evaluated, e.csr_current) = (None, false);
+        e.values_changed();
         Ok(e.inner.set_quarantine(index, on != 0)?)
     })
 }
@@ -368,7 +383,7 @@ pub unsafe extern "C" fn seam_rank_evaluate(
         let u = on_every_rank(e.inner.comm(), unsafe {
             slice(u_local, n_nodes, "u_local")
         })?;
-        (e.evaluated, e.csr_current) = (None, false);
+        e.values_changed();
         e.evaluated = Some(Evaluated::from(e.inner.contributions(u)?));
         Ok(())
     })
@@ -463,7 +478,7 @@ pub unsafe extern "C" fn seam_rank_evaluate_csr(
         let u = on_every_rank(e.inner.comm(), unsafe {
             slice(u_local, n_nodes, "u_local")
         })?;
-        (e.evaluated, e.csr_current) = (None, false);
+        e.values_changed();
         e.inner.evaluate(u)?;
         e.csr_current = true;
         Ok(())

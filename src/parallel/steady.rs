@@ -648,7 +648,6 @@ impl<'b, 'p> Newton<'b, 'p> {
             let c0 = capacity.map_or(0.0, |c| c.c0);
             let key = (self.symmetric).then_some(c0.to_bits());
             let kept = key.is_some() && key == self.matrix_for;
-            self.iasm.reset_couplings();
             let values: Vec<f64> = built.touched.iter().map(|&d| r[d]).collect();
             self.r_vec.zero().map_err(petsc_err)?;
             self.r_vec
@@ -662,12 +661,15 @@ impl<'b, 'p> Newton<'b, 'p> {
                     true => i.residual(u, t, r_iface).map_err(failed),
                     false => Ok(None),
                 };
+                let iasm = &mut self.iasm;
                 let mine = residual
                     .and_then(|heat| match heat {
                         Some(heat) => Ok(heat),
-                        None => i
-                            .assemble(u, t, r_iface, &mut self.iasm, built.first)
-                            .map_err(failed),
+                        None => {
+                            iasm.reset_couplings();
+                            i.assemble(u, t, r_iface, iasm, built.first)
+                                .map_err(failed)
+                        }
                     })
                     .and_then(|mine| {
                         // A point reads the field where it has terms: there it must be

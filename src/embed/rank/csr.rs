@@ -52,10 +52,9 @@ impl RankEmbedding {
         let u = self.whole_field(u_local)?;
         agree(&self.comm, self.inner.evaluate(&u).map(|_| ()))?;
         let inner = self.inner.evaluation().expect("evaluated above");
-        let mut e = self.evaluation.take().unwrap_or_default();
-        if e.pattern != inner.pattern {
-            e = self.pattern_of(inner);
-        }
+        let mut e = (self.evaluation.take())
+            .filter(|e| e.pattern == inner.pattern)
+            .unwrap_or_else(|| self.pattern_of(inner));
         let j = &inner.jacobian;
         e.values.iter_mut().for_each(|v| *v = 0.0);
         for (&at, &v) in e.entry_at.iter().zip(&j.values) {
