@@ -593,6 +593,70 @@ fn cut_interface_transient_newton_cuts_failed_steps_as_serial() {
     }
 }
 
+/// The cut bar's conductivities as laws of temperature: a Lua expression in block 1, a
+/// table in block 2 (5 → 7.5 and 40 → 25 W/m/K over 300–600 K).
+fn conductivity_of_t(text: &str) -> String {
+    text.replacen(
+        "conductivity = 5.0",
+        "conductivity = \"5*(1 + (T - 300)/600)\"",
+        1,
+    )
+    .replacen(
+        "conductivity = 40.0",
+        "conductivity = { table = [[300.0, 40.0], [600.0, 25.0]] }",
+        1,
+    )
+}
+
+/// Transient steps with k(T) in both blocks: Newton at each step, each rank assembling
+/// its own elements' residual and tangent at every iterate (the mesh distributed), the
+/// unsymmetric Jacobian by MUMPS; every step's temperatures and heats equal serial.
+#[test]
+fn cut_interface_transient_conductivity_of_t_equals_serial() {
+    let tmp = scratch("transient_k_of_t");
+    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, "", 0.1);
+    std::fs::write(&problem, conductivity_of_t(&text)).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
+    for par in &runs {
+        let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(reason.contains("conductivity"), "{reason}");
+        // Newton's iterations are the serial steps' (the same stopping test).
+        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
+    }
+    assert!(newton(&serial) > 2 * 3, "{}", serial.summary);
+}
+
+/// A steady solve with k(T) (the general solver's one nonlinear solve), assembled per
+/// rank on the distributed mesh: by MUMPS, and by GMRES with BoomerAMG (serial: seam's
+/// AMG-GMRES); temperatures and heats equal serial.
+#[test]
+fn cut_interface_steady_conductivity_of_t_equals_serial() {
+    for solve in ["", "linear_solver = \"amg\""] {
+        let tmp = scratch("steady_k_of_t");
+        let problem = write_cut_case(tmp.path(), GAP_H, solve);
+        let text = std::fs::read_to_string(&problem).unwrap();
+        std::fs::write(&problem, conductivity_of_t(&text)).unwrap();
+        let (serial, runs) = compare_runs(&problem, true);
+        for (n, par) in (1..).zip(&runs) {
+            let solver = &par.summary["linear_solver"];
+            let reason = solver["reason"].as_str().unwrap();
+            assert!(
+                reason.contains("a steady solve assembled per rank"),
+                "{reason}"
+            );
+            if !solve.is_empty() {
+                assert_eq!(solver["name"], "PETSc GMRES + BoomerAMG", "{solver}");
+            }
+            if n > 1 {
+                assert!(par.log.contains(PART_ONLY), "{n} ranks:\n{}", par.log);
+            }
+        }
+        assert!(serial.summary["newton_iterations"].as_u64().unwrap() > 2);
+    }
+}
+
 /// The serial run rejected some attempts (`what`), and every distributed run as many.
 fn assert_rejected_as_serial(serial: &Ran, runs: &[Ran], what: &str) {
     let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();

@@ -21,6 +21,7 @@ pub mod electric;
 pub mod interfaces;
 pub mod kernel;
 pub mod law;
+pub(crate) mod nonlinear;
 pub mod species;
 pub mod steady;
 pub mod transient;
@@ -510,37 +511,12 @@ pub fn nonlinear_residual_jacobian(
     source: Option<SourceFn<'_>>,
     t: &[f64],
 ) -> Result<(Vec<f64>, SparseColMat<usize, f64>), HeatError> {
-    let field = temperature(dofs)?;
-    let rules = block_rules(mesh, dofs, field)?;
     let mut asm = Assembler::new(pattern);
-    let errors = FirstError::new();
-    asm.elements(mesh, Some(dofs.field_blocks(field)), |e, je, re| {
-        let b = mesh.block_of(e);
-        let rule = rules[b].as_ref().expect("rule of a temperature block");
-        let mut x = [[0.0; 3]; MAX_NODES];
-        let nn = elem_coords(mesh, e, &mut x);
-        let mut te = [0.0; MAX_NODES];
-        for (k, n) in mesh.elem_nodes(e).iter().enumerate() {
-            te[k] = t[dofs.dof(field, *n).expect("temperature dof").index()];
-        }
-        let r =
-            kernel::conduction_residual_jacobian(rule, &x[..nn], &te[..nn], conductivity, re, je)
-                .and_then(|_| match source {
-                    Some(q) => {
-                        let mut f = [0.0; MAX_NODES];
-                        kernel::source(rule, &x[..nn], q, &mut f)?;
-                        re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
-                        Ok(())
-                    }
-                    None => Ok(()),
-                });
-        if let Err(bad) = r {
-            errors.record(e, bad_jacobian(mesh, e, bad));
-        }
-    });
-    errors.into_result()?;
-    asm.check_finite(mesh)?;
-    Ok((asm.rhs(), asm.matrix()?))
+    let k = |_: usize, temp: f64, x: [f64; 3]| Ok(conductivity(temp, x));
+    nonlinear::assemble_at(&mut asm, mesh, dofs, (k, |_| source), &[], t)?;
+    // The assembly's loads are −R.
+    let r = asm.rhs().iter().map(|v| -v).collect();
+    Ok((r, asm.matrix()?))
 }
 
 /// Impose Dirichlet data on a Newton system: `R_k = T_k − g_k` and row `k` of the

@@ -6,8 +6,9 @@
 //! Entry point: [`GeneralSolve::solve`], with the [`System`] the serial solver would
 //! have chosen its method by: CG + BoomerAMG for a symmetric positive definite system at or
 //! above the AMG threshold, GMRES preconditioned by BoomerAMG on the temperature and the
-//! voltage blocks for the coupled thermal–electrical Jacobian there, MUMPS LU otherwise
-//! (small, unsymmetric or indefinite: multiplier ties).
+//! voltage blocks for the coupled thermal–electrical Jacobian there, GMRES by BoomerAMG
+//! for another unsymmetric Jacobian there (a temperature-dependent law), MUMPS LU
+//! otherwise (small, or indefinite: multiplier ties).
 //!
 //! Rows: rank `r` of `s` owns the contiguous block `[r n / s, (r + 1) n / s)` of the
 //! serial dof order — not the element partition of [`super::layout`], which numbers one
@@ -118,6 +119,7 @@ impl GeneralSolve {
         let method = match system {
             System::Spd => Method::CgAmg,
             System::Coupled { .. } => Method::GmresBlocks,
+            System::Unsymmetric => Method::GmresAmg,
             System::Direct => Method::MumpsLu,
         };
         let sym = a.symbolic();

@@ -79,7 +79,10 @@ pub enum System {
     /// The coupled thermal–electrical Jacobian at or above the threshold; the voltages
     /// (and what follows them) from dof `at` on.
     Coupled { at: usize },
-    /// Below the threshold, unsymmetric, or indefinite (multiplier ties).
+    /// Unsymmetric with no voltage (a temperature-dependent conductivity or
+    /// conductance), at or above the threshold.
+    Unsymmetric,
+    /// Below the threshold, or indefinite (multiplier ties).
     Direct,
 }
 
@@ -93,8 +96,11 @@ impl System {
             System::Coupled { .. } => {
                 "unsymmetric coupled thermal–electrical Newton steps at or above the AMG threshold → GMRES, BoomerAMG on the temperature and voltage blocks"
             }
+            System::Unsymmetric => {
+                "unsymmetric Newton steps (a temperature-dependent law) at or above the AMG threshold → GMRES + BoomerAMG"
+            }
             System::Direct => {
-                "below the AMG threshold, unsymmetric, or with multipliers (indefinite) → MUMPS LU"
+                "below the AMG threshold, or with multipliers (indefinite) → MUMPS LU"
             }
         }
     }
@@ -127,13 +133,13 @@ pub fn general_solve() -> Option<GeneralSolve> {
 #[cfg(feature = "mpi")]
 thread_local! {
     /// The method of the last distributed solve and why, for the run's summary.
-    static LAST: std::cell::Cell<Option<(petsc::Method, &'static str)>> =
-        const { std::cell::Cell::new(None) };
+    static LAST: std::cell::RefCell<Option<(petsc::Method, std::borrow::Cow<'static, str>)>> =
+        const { std::cell::RefCell::new(None) };
 }
 
 #[cfg(feature = "mpi")]
-fn record(method: petsc::Method, why: &'static str) {
-    LAST.with(|l| l.set(Some((method, why))));
+fn record(method: petsc::Method, why: impl Into<std::borrow::Cow<'static, str>>) {
+    LAST.with(|l| *l.borrow_mut() = Some((method, why.into())));
 }
 
 /// This process's rank and the number of ranks, when a run is distributed.
@@ -168,10 +174,16 @@ pub fn steady(p: &SteadyProblem<'_>) -> Option<Result<SteadySolution, HeatError>
     }
 }
 
-/// A linear transient run's time stepping, for [`transient`].
+/// A transient run's time stepping, for [`transient`] (or one steady solve: `steady`).
 pub struct Stepping<'s> {
     /// ρc (J/m³/K) per block of the problem's mesh.
     pub rho_c: &'s [f64],
+    /// k(T) per block of the problem's mesh, when the conductivity depends on
+    /// temperature (the problem's constant conductivities are then not read).
+    pub conductivity: Option<&'s [crate::heat::law::Law]>,
+    /// One steady solve at `start` instead of steps (the general solver's nonlinear
+    /// steady solve: a conductivity of T), reported as its step 0.
+    pub steady: bool,
     pub scheme: crate::heat::transient::Scheme,
     pub start: f64,
     pub end: f64,
@@ -195,8 +207,8 @@ pub struct Stepping<'s> {
     >,
 }
 
-/// The steps of a linear transient run with its assembly distributed when the run is
-/// distributed, else `None` (the caller steps serially): `p` the problem at the start,
+/// The steps of a transient run (or the one steady solve of `s.steady`) with its
+/// assembly distributed when the run is distributed, else `None` (the caller steps serially): `p` the problem at the start,
 /// `on_step` each accepted step (on rank 0 the whole state, on any other rank its own
 /// dofs).
 pub fn transient(
@@ -247,7 +259,7 @@ pub fn linear_solver() -> Option<(String, String)> {
     #[cfg(feature = "mpi")]
     {
         let (_, size) = world()?;
-        let (method, why) = LAST.with(std::cell::Cell::get)?;
+        let (method, why) = LAST.with(|l| l.borrow().clone())?;
         // PETSc applies the user's options over the choice: say so.
         let over = std::env::var("PETSC_OPTIONS")
             .ok()

@@ -504,6 +504,10 @@ pub enum Method {
     /// diagonal blocks side by side (PETSc's additive field split): the coupled
     /// thermal–electrical Jacobian.
     GmresBlocks,
+    /// GMRES, right-preconditioned, by BoomerAMG (the settings of [`BOOMERAMG`]) on the
+    /// whole matrix: an unsymmetric Jacobian of one field (a temperature-dependent
+    /// conductivity or conductance) beyond the size for a factorisation.
+    GmresAmg,
 }
 
 impl Method {
@@ -512,6 +516,7 @@ impl Method {
             Method::CgAmg => "PETSc CG + BoomerAMG",
             Method::MumpsLu => "PETSc MUMPS LU",
             Method::GmresBlocks => "PETSc GMRES + field-split BoomerAMG",
+            Method::GmresAmg => "PETSc GMRES + BoomerAMG",
         }
     }
 }
@@ -597,8 +602,13 @@ impl Ksp {
             check("KSPSetOperators", KSPSetOperators(k, a.0, a.0))?;
             check("KSPGetPC", KSPGetPC(k, &mut pc))?;
             match method {
-                Method::CgAmg => {
-                    check("KSPSetType", KSPSetType(k, c_name("cg").as_ptr()))?;
+                Method::CgAmg | Method::GmresAmg => {
+                    if method == Method::CgAmg {
+                        check("KSPSetType", KSPSetType(k, c_name("cg").as_ptr()))?;
+                    } else {
+                        check("KSPSetType", KSPSetType(k, c_name("gmres").as_ptr()))?;
+                        check("KSPSetPCSide", KSPSetPCSide(k, PC_RIGHT))?;
+                    }
                     // A `-pc_type` of the user's is left to `KSPSetFromOptions` (so that
                     // a PETSc built without hypre can still run with `-pc_type gamg`);
                     // BoomerAMG's settings hold for a `-pc_type hypre` too.

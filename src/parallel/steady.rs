@@ -1,7 +1,9 @@
 //! The steady solve on MPI: the Newton iteration of [`crate::heat::steady`] (the same
 //! residual, Jacobian, Dirichlet rows on the increment and stopping tests) with the
 //! system distributed; its set-up ([`Built`]) and iteration ([`Newton`]) also step a
-//! linear transient run ([`super::stepped`]), with the lumped capacity of a time step.
+//! transient run ([`super::stepped`]), with the lumped capacity of a time step. With a
+//! conductivity of T each rank assembles its elements' residual and tangent at every
+//! iterate instead of keeping `K` ([`Built::conduction_at`]).
 //!
 //! Each rank assembles the conduction of its own elements (a mesh of only those,
 //! [`Layout::local_mesh`]) with the serial kernels and adds every entry it made — rows of
@@ -23,6 +25,8 @@ use mpi::traits::{AsRaw, Communicator, CommunicatorCollectives};
 
 use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::heat::interfaces::InterfaceFailure;
+use crate::heat::law::Law;
+use crate::heat::nonlinear::conduction_at;
 use crate::heat::steady::{
     AMG_TOLERANCE, LinearMethod, LinearSolves, STEADY_AMG_TOLERANCE, SolveTiming, SteadyProblem,
     SteadySolution,
@@ -50,7 +54,7 @@ fn petsc_err(e: PetscError) -> HeatError {
 /// every other rank its own part (its owned dofs and those it reads; the rest as they
 /// started); else every rank the whole solution.
 pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> {
-    let built = Built::new(p, 0.0)?;
+    let built = Built::new(p, 0.0, None)?;
     let mut newton = Newton::new(&built, false)?;
     let mut u = vec![0.0; built.n];
     built.start(&mut u, &built.bcs);
@@ -67,12 +71,16 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         (Method::MumpsLu, false) => {
             "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
         }
+        (Method::GmresAmg, _) => {
+            "a temperature-dependent conductance makes the Jacobian unsymmetric, at or above the AMG threshold → GMRES + BoomerAMG"
+        }
         _ => "symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG",
     };
     super::record(method, why);
     let linear = LinearSolves {
         method: (solved.iterations > 0).then_some(match method {
             Method::CgAmg => LinearMethod::AmgCg,
+            Method::GmresAmg => LinearMethod::Gmres,
             _ => LinearMethod::Lu,
         }),
         cg_iterations: solved.cg_iterations.clone(),
@@ -167,7 +175,13 @@ pub(super) struct Built<'p> {
     /// there.
     local: Mesh,
     to_local: Vec<Option<ElemId>>,
+    /// The pattern of this rank's elements.
+    k_pattern: Pattern,
     k_sym: faer::sparse::SymbolicSparseColMat<usize>,
+    /// k(T) per block of `p.mesh`, when the conductivity depends on temperature: the
+    /// conduction is then assembled at every Newton iterate ([`Built::conduction_at`]),
+    /// and `p.materials`' conductivities are not read.
+    pub conductivity: Option<&'p [Law]>,
     /// The conduction's values and load of the set-up's face conditions.
     k_first: std::cell::RefCell<Option<(Vec<f64>, Vec<f64>)>>,
     /// The dofs whose residual this rank adds to (its elements' and its own), and their
@@ -187,8 +201,13 @@ pub(super) struct Built<'p> {
 }
 
 impl<'p> Built<'p> {
-    /// The set-up of `p` (its interfaces' couplings taken at time `t`).
-    pub(super) fn new(p: &'p SteadyProblem<'p>, t: f64) -> Result<Built<'p>, HeatError> {
+    /// The set-up of `p` (its interfaces' couplings taken at time `t`), its
+    /// conductivity `conductivity` per block when that depends on temperature.
+    pub(super) fn new(
+        p: &'p SteadyProblem<'p>,
+        t: f64,
+        conductivity: Option<&'p [Law]>,
+    ) -> Result<Built<'p>, HeatError> {
         let mesh = p.mesh;
         let world = session::comm();
         let blocks = part::solid_blocks(mesh);
@@ -229,7 +248,19 @@ impl<'p> Built<'p> {
 
         // This rank's conduction: its elements, their face conditions.
         let (local, to_local) = layout.local_mesh(mesh);
-        let (k_sym, k_local, f_local) = conduction(p, &local, &to_local, &dofs, p.face_bcs)?;
+        let mut k_pattern = Pattern::new(&local, &dofs);
+        k_pattern.build_direct()?;
+        let k_sym = k_pattern.symbolic().expect("built").clone();
+        let k_first = match conductivity {
+            Some(_) => None,
+            None => Some(conduction(
+                p,
+                (&local, &to_local),
+                &dofs,
+                &k_pattern,
+                p.face_bcs,
+            )?),
+        };
         phases.mark("own elements", start);
         let mut touched: Vec<usize> = local
             .blocks
@@ -296,8 +327,10 @@ impl<'p> Built<'p> {
             layout,
             local,
             to_local,
+            k_pattern,
             k_sym,
-            k_first: std::cell::RefCell::new(Some((k_local, f_local))),
+            conductivity,
+            k_first: std::cell::RefCell::new(k_first),
             touched,
             touched_petsc,
             ipattern,
@@ -422,43 +455,50 @@ impl<'p> Built<'p> {
     /// This rank's conduction values and load under the face conditions `faces` (of the
     /// problem's mesh), on the set-up's pattern.
     pub(super) fn conduction(&self, faces: &[FaceBc]) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
-        let (sym, k, f) = conduction(self.p, &self.local, &self.to_local, &self.dofs, faces)?;
-        if sym.col_ptr() != self.k_sym.col_ptr() || sym.row_idx() != self.k_sym.row_idx() {
-            return Err(HeatError::Contact(
-                "distributed solve: the conduction's pattern changed with the face conditions"
-                    .into(),
-            ));
-        }
-        Ok((k, f))
+        let local = (&self.local, self.to_local.as_slice());
+        conduction(self.p, local, &self.dofs, &self.k_pattern, faces)
+    }
+
+    /// This rank's conduction at the field `u` at time `t` under the face conditions
+    /// `faces` (of the problem's mesh), with the temperature-dependent conductivity
+    /// `laws`: the tangent's values on the set-up's pattern, and `−R` of its elements.
+    pub(super) fn conduction_at(
+        &self,
+        laws: &[Law],
+        faces: &[FaceBc],
+        u: &[f64],
+        t: f64,
+    ) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
+        let faces = local_faces(faces, &self.to_local);
+        let blocks = self.p.mesh.blocks.len();
+        let sources = match self.p.block_source {
+            Some(s) => s.to_vec(),
+            None => vec![self.p.source; blocks],
+        };
+        let mut asm = Assembler::direct(&self.k_pattern)?;
+        let terms = (laws, sources.as_slice());
+        conduction_at(&mut asm, &self.local, &self.dofs, terms, &faces, (u, t))?;
+        let f = asm.rhs();
+        Ok((asm.take_values()?, f))
     }
 }
 
-/// The conduction of the `local` mesh's elements (this rank's own) with the face
-/// conditions `faces` (of the problem's mesh) that fall on them: pattern, values, load.
-#[allow(clippy::type_complexity)]
+/// The conduction of the `local` mesh's elements (this rank's own; per element of the
+/// problem's mesh its element there) on their `pattern`, with the face conditions
+/// `faces` (of the problem's mesh) that fall on them: values and load.
 fn conduction(
     p: &SteadyProblem<'_>,
-    local: &Mesh,
-    to_local: &[Option<ElemId>],
+    (local, to_local): (&Mesh, &[Option<ElemId>]),
     dofs: &DofMap,
+    pattern: &Pattern,
     faces: &[FaceBc],
-) -> Result<
-    (
-        faer::sparse::SymbolicSparseColMat<usize>,
-        Vec<f64>,
-        Vec<f64>,
-    ),
-    HeatError,
-> {
+) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
     let faces = local_faces(faces, to_local);
-    let mut pattern = Pattern::new(local, dofs);
-    pattern.build_direct()?;
-    let sym = pattern.symbolic().expect("built").clone();
-    let mut asm = Assembler::direct(&pattern)?;
+    let mut asm = Assembler::direct(pattern)?;
     p.conduction_with_faces(&mut asm, local, dofs, &faces)?;
     let f = asm.rhs();
     let k = asm.take_values()?;
-    Ok((sym, k, f))
+    Ok((k, f))
 }
 
 /// How the partition meets the interfaces, in rank 0's log: couplings whose two dofs
@@ -495,6 +535,9 @@ pub(super) struct Newton<'b, 'p> {
     i_sym: faer::sparse::SymbolicSparseColMat<usize>,
     k_local: Vec<f64>,
     f_local: Vec<f64>,
+    /// The face conditions in force (of the problem's mesh): read at every iterate when
+    /// the conductivity depends on temperature.
+    faces: Vec<FaceBc>,
     a: Mat,
     r_vec: Vector,
     du_vec: Vector,
@@ -502,7 +545,8 @@ pub(super) struct Newton<'b, 'p> {
     x_vec: Vector,
     ksp: Ksp,
     pub method: Method,
-    /// The interfaces' Jacobian does not depend on u (and the matrix is symmetric).
+    /// Neither the interfaces' Jacobian nor the conductivity depends on u (and the
+    /// matrix is symmetric).
     pub symmetric: bool,
     /// The `c₀` of the matrix set last (`None`: none set, or values to set again).
     matrix_for: Option<u64>,
@@ -518,9 +562,11 @@ impl<'b, 'p> Newton<'b, 'p> {
         let comm = built.world.as_raw();
         let iasm = Assembler::direct(&built.ipattern)?;
         let i_sym = built.ipattern.symbolic().expect("built").clone();
-        let (k_local, f_local) = match built.k_first.borrow_mut().take() {
-            Some(kf) => kf,
-            None => built.conduction(built.p.face_bcs)?,
+        // (With a k(T), assembled at each iterate instead.)
+        let (k_local, f_local) = match (built.k_first.borrow_mut().take(), built.conductivity) {
+            (Some(kf), _) => kf,
+            (None, None) => built.conduction(built.p.face_bcs)?,
+            (None, Some(_)) => (Vec::new(), Vec::new()),
         };
         let (diagonal, off) = &built.preallocated;
         let global = layout.starts[layout.size];
@@ -529,11 +575,13 @@ impl<'b, 'p> Newton<'b, 'p> {
         let r_vec = Vector::new(comm, local_rows, global).map_err(petsc_err)?;
         let du_vec = r_vec.duplicate().map_err(petsc_err)?;
         let x_vec = r_vec.duplicate().map_err(petsc_err)?;
-        let symmetric = built.iface.is_none_or(|i| i.is_linear());
-        let method = if symmetric && built.p.iterative {
-            Method::CgAmg
-        } else {
-            Method::MumpsLu
+        let symmetric = built.iface.is_none_or(|i| i.is_linear()) && built.conductivity.is_none();
+        // The serial solvers' choice: AMG-CG, or AMG-GMRES for an unsymmetric Jacobian,
+        // from the threshold on; a factorisation below it.
+        let method = match (symmetric, built.p.iterative) {
+            (true, true) => Method::CgAmg,
+            (false, true) => Method::GmresAmg,
+            (_, false) => Method::MumpsLu,
         };
         let tolerance = match (method, stepping) {
             (Method::CgAmg, false) => STEADY_AMG_TOLERANCE,
@@ -560,6 +608,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             i_sym,
             k_local,
             f_local,
+            faces: built.p.face_bcs.to_vec(),
             a,
             r_vec,
             du_vec,
@@ -572,12 +621,16 @@ impl<'b, 'p> Newton<'b, 'p> {
         })
     }
 
-    /// New conduction values and load (face conditions that changed with time).
-    pub(super) fn set_conduction(&mut self, (k, f): (Vec<f64>, Vec<f64>)) {
-        if k != self.k_local {
-            self.matrix_for = None;
+    /// New face conditions (they changed with time), with the conduction's values and
+    /// load under them when the conductivity is constant ([`Built::conduction`]).
+    pub(super) fn set_faces(&mut self, faces: Vec<FaceBc>, linear: Option<(Vec<f64>, Vec<f64>)>) {
+        if let Some((k, f)) = linear {
+            if k != self.k_local {
+                self.matrix_for = None;
+            }
+            (self.k_local, self.f_local) = (k, f);
         }
-        (self.k_local, self.f_local) = (k, f);
+        self.faces = faces;
     }
 
     /// ‖v‖ over every rank of the vector each rank adds `values` at its touched dofs to.
@@ -608,8 +661,12 @@ impl<'b, 'p> Newton<'b, 'p> {
         let local_rows = layout.rows().len();
         let mut timing = SolveTiming::default();
         let start = Instant::now();
-        // ‖F‖ over every rank (of a time step, ‖F − m rest‖), the scale of the test.
-        let mut load = self.f_local.clone();
+        // ‖F‖ over every rank (of a time step, ‖F − m rest‖), the scale of the steady
+        // test (a conductivity of T stops by the steps' test, on the update).
+        let mut load = match built.conductivity {
+            Some(_) => vec![0.0; n],
+            None => self.f_local.clone(),
+        };
         if let Some(c) = capacity {
             for &d in &built.touched {
                 load[d] -= c.m[d] * c.rest[d];
@@ -628,15 +685,27 @@ impl<'b, 'p> Newton<'b, 'p> {
         for it in 0..=p.max_iterations {
             let start = Instant::now();
             // R = K u − F (+ m (c₀ u + rest)) + Σ R_Γ: this rank's elements, and its
-            // own rows of the interfaces.
+            // own rows of the interfaces. With a k(T), the elements' R(u) and tangent
+            // assembled at u.
             let mut r = vec![0.0; n];
-            spmv_ref(
-                SparseColMatRef::new(k_sym.as_ref(), &self.k_local),
-                u,
-                &mut r,
-            );
-            for (ri, fi) in r.iter_mut().zip(&self.f_local) {
-                *ri -= fi;
+            match built.conductivity {
+                Some(laws) => {
+                    let at_u = built.conduction_at(laws, &self.faces, u, t);
+                    (self.k_local, self.f_local) = agreed(at_u)?;
+                    for (ri, fi) in r.iter_mut().zip(&self.f_local) {
+                        *ri = -fi;
+                    }
+                }
+                None => {
+                    spmv_ref(
+                        SparseColMatRef::new(k_sym.as_ref(), &self.k_local),
+                        u,
+                        &mut r,
+                    );
+                    for (ri, fi) in r.iter_mut().zip(&self.f_local) {
+                        *ri -= fi;
+                    }
+                }
             }
             if let Some(c) = capacity {
                 for &d in &built.touched {
@@ -709,13 +778,16 @@ impl<'b, 'p> Newton<'b, 'p> {
             // tolerance of max |u| — so the steps take the serial iterations and fail
             // (and are cut) where the serial ones do.
             let u_max = built.scatter.u_max(&built.world, layout, u);
-            let done = match capacity {
-                Some(_) => {
+            // (A steady solve with a conductivity of T stops so too: the serial general
+            // solver's test.)
+            let by_update = capacity.is_some() || built.conductivity.is_some();
+            let done = match by_update {
+                true => {
                     record.history.push(rn);
                     let u_max = u_max.max(f64::MIN_POSITIVE);
                     it > 0 && (self.symmetric || last_step <= p.tolerance * u_max)
                 }
-                None => record.converged_at(it, rn, last_step, &[u_max], self.symmetric),
+                false => record.converged_at(it, rn, last_step, &[u_max], self.symmetric),
             };
             if done {
                 converged = true;

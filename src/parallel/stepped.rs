@@ -1,9 +1,11 @@
-//! A linear transient run on MPI with its assembly distributed: the steady path's
+//! A transient run of one field on MPI with its assembly distributed: the steady path's
 //! set-up and Newton iteration ([`super::steady`]: each rank its own elements, the
 //! interface points it owns, PETSc's rows of its nodes) with the lumped capacity of
 //! the serial general solver, stepped by backward Euler or BDF2 with the serial time
 //! loop's steps — fixed, or chosen by its local error estimate (the largest over every
-//! rank's own dofs), attempts above the tolerance taken again with a smaller step.
+//! rank's own dofs), attempts above the tolerance taken again with a smaller step. A
+//! steady run whose conductivity depends on T is its one Newton solve at the start time
+//! (the serial general solver's steady solve, reported as step 0).
 //!
 //! Every rank keeps its local dofs' last two states (the history of BDF2 and the
 //! predictor), up to date at the dofs it reads. After each accepted step the field is
@@ -11,9 +13,10 @@
 //! again and hands the whole state to the run (outputs, checkpoints); the other ranks
 //! hand their own.
 //!
-//! The run takes this path where the steady solver's conditions hold
-//! ([`super::Stepping`]): constant materials, sources of x alone, interface terms
-//! linear or Newton-nonlinear through a temperature-dependent conductance. A step whose
+//! The run takes this path where the steady solver's conditions hold but for k
+//! ([`super::Stepping`]): constant ρc, k constant or a law of T (then assembled at every
+//! iterate), sources of x alone, interface terms linear or Newton-nonlinear through a
+//! temperature-dependent conductance. A step whose
 //! Newton iteration does not converge (or meets a residual that is not finite, or a
 //! Krylov solve that diverges) is cut in half and taken again, as the serial loop cuts
 //! it, down to the run's `dt_min`; every rank sees the same failure, so they cut
@@ -26,7 +29,7 @@ use crate::heat::{HeatError, dirichlet_dofs};
 
 use super::Stepping;
 use super::petsc::Method;
-use super::steady::{Built, Capacity, Newton, agreed};
+use super::steady::{Built, Capacity, Newton, Solved, agreed};
 
 /// The run's steps over the MPI world from `s.start` to `s.end`; `on_step` gets each
 /// accepted step: on rank 0 the whole state, on every other rank its own dofs. Rank 0's
@@ -36,8 +39,8 @@ pub(super) fn solve(
     s: &Stepping<'_>,
     on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
 ) -> Result<Outcome, HeatError> {
-    let built = Built::new(p, s.start)?;
-    let mut newton = Newton::new(&built, true)?;
+    let built = Built::new(p, s.start, s.conductivity)?;
+    let mut newton = Newton::new(&built, !s.steady)?;
     let (n, field, root) = (built.n, built.field, built.is_root());
     let m = built.capacity(s.rho_c)?;
     // The initial field at the rank's nodes; a contact partner's nodes from their owners.
@@ -60,6 +63,9 @@ pub(super) fn solve(
     // What the run sees: the whole state on rank 0, its own dofs elsewhere.
     let mut state = mine.clone();
     built.gather(&mut state.u);
+    if s.steady {
+        return steady(p, (&built, &mut newton), mine, on_step);
+    }
     let mut faces = p.face_bcs.to_vec();
     let mut steps = 0;
     let eps = 1e-12 * s.end.abs().max(s.dt);
@@ -85,15 +91,18 @@ pub(super) fn solve(
             // The step's loads; a rank that cannot make them stops every rank.
             let loads = (s.loads)(t_new).and_then(|(dirichlet, now)| {
                 let bcs = dirichlet_dofs(p.mesh, &built.dofs, field, &dirichlet)?;
-                let conduction = match now != faces {
-                    true => Some(built.conduction(&now)?),
-                    false => None,
+                // New face conditions: the conduction again, unless it is assembled at
+                // every iterate (a conductivity of T).
+                let conduction = match (now != faces, built.conductivity) {
+                    (true, None) => Some(Some(built.conduction(&now)?)),
+                    (true, Some(_)) => Some(None),
+                    (false, _) => None,
                 };
                 Ok((bcs, now, conduction))
             });
             let (bcs, now, conduction) = agreed(loads)?;
-            if let Some(kf) = conduction {
-                newton.set_conduction(kf);
+            if let Some(linear) = conduction {
+                newton.set_faces(now.clone(), linear);
                 faces = now;
             }
             let (u, previous) = (&mine.u, mine.past.first().map(|(_, v)| v.as_slice()));
@@ -178,66 +187,17 @@ pub(super) fn solve(
         state.time = t_new;
         state.step += 1;
         state.dt = mine.dt;
-        let cg = solved.cg_iterations.iter().sum();
         let report = StepReport {
             step: state.step,
             time: t_new,
             dt,
-            newton_iterations: solved.iterations,
-            residual_history: solved.history,
             rejected,
             error_estimate: estimate,
-            heat: solved.heat,
-            assembly_s: solved.timing.assembly_s,
-            factor_s: solved.timing.factor_s,
-            solve_s: solved.timing.solve_s,
-            cg_iterations: cg,
-            gmres: false,
-            hierarchy_setups: match newton.method {
-                Method::CgAmg => solved.setups,
-                _ => 0,
-            },
-            hierarchy_refreshes: 0,
-            electric: Vec::new(),
-            diagnosis: None,
+            ..report(solved, newton.method)
         };
-        // Rank 0's outputs see every interface point; a failure there stops every rank.
-        let mut clock = [std::time::Instant::now(); 3];
-        let handed = match root {
-            true => built
-                .all_points()
-                .and_then(|()| {
-                    clock[1] = std::time::Instant::now();
-                    on_step(&report, &state, &built.dofs)
-                })
-                .and_then(|()| {
-                    clock[2] = std::time::Instant::now();
-                    built.own_points_again(&mine.u, t_new)
-                }),
-            false => on_step(&report, &state, &built.dofs),
-        };
-        log::debug!(
-            "step {}: handed to the run's outputs in {:.3} s (every point {:.3} s, outputs {:.3} s, own points again {:.3} s)",
-            state.step,
-            clock[0].elapsed().as_secs_f64(),
-            (clock[1] - clock[0]).as_secs_f64(),
-            (clock[2] - clock[1]).as_secs_f64(),
-            clock[2].elapsed().as_secs_f64(),
-        );
-        agreed(handed)?;
+        hand_over(&built, &report, (&state, &mine.u), on_step)?;
     }
-    let why = match (newton.method, newton.symmetric) {
-        (Method::CgAmg, _) => {
-            "transient steps assembled per rank, symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG (hierarchy kept while the step size holds, each step started from the earlier steps' solutions)"
-        }
-        (_, true) => {
-            "transient steps assembled per rank, below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU (factorisation kept while the step size holds)"
-        }
-        (_, false) => {
-            "transient steps assembled per rank, a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU at each Newton iteration"
-        }
-    };
-    super::record(newton.method, why);
+    record(&newton, &built, "transient steps assembled per rank");
     drop(newton);
     let dofs = built.dofs.clone();
     Ok(Outcome {
@@ -248,4 +208,126 @@ pub(super) fn solve(
         rejected: rejected_total,
         crosspoints: Vec::new(),
     })
+}
+
+/// The one steady solve of a run whose conductivity depends on temperature, from the
+/// state `mine` at its start: the serial general solver's steady solve, reported as its
+/// step 0 (a Newton iteration that runs out goes on marked not converged, as there).
+fn steady(
+    p: &SteadyProblem<'_>,
+    (built, newton): (&Built<'_>, &mut Newton<'_, '_>),
+    mut mine: State,
+    on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
+) -> Result<Outcome, HeatError> {
+    let t = mine.time;
+    built.start(&mut mine.u, &built.bcs);
+    let solved = newton.solve(&mut mine.u, t, None)?;
+    if let Some(why) = &solved.failure {
+        return Err(HeatError::Step(why.clone()));
+    }
+    let diagnosis = (!solved.converged).then(|| unconverged(p.max_iterations, t, &solved.history));
+    let report = StepReport {
+        step: 0,
+        time: t,
+        dt: 0.0,
+        diagnosis,
+        ..report(solved, newton.method)
+    };
+    let mut state = mine.clone();
+    built.gather(&mut state.u);
+    hand_over(built, &report, (&state, &mine.u), on_step)?;
+    record(newton, built, "a steady solve assembled per rank");
+    Ok(Outcome {
+        dofs: built.dofs.clone(),
+        fields: vec![built.field],
+        state,
+        steps: 1,
+        rejected: 0,
+        crosspoints: Vec::new(),
+    })
+}
+
+/// A step's report from its Newton solve (its step, time and size, rejections and
+/// error estimate left to the caller).
+fn report(solved: Solved, method: Method) -> StepReport {
+    StepReport {
+        step: 0,
+        time: 0.0,
+        dt: 0.0,
+        newton_iterations: solved.iterations,
+        residual_history: solved.history,
+        rejected: 0,
+        error_estimate: None,
+        heat: solved.heat,
+        assembly_s: solved.timing.assembly_s,
+        factor_s: solved.timing.factor_s,
+        solve_s: solved.timing.solve_s,
+        cg_iterations: solved.cg_iterations.iter().sum(),
+        gmres: method == Method::GmresAmg,
+        hierarchy_setups: match method {
+            Method::CgAmg | Method::GmresAmg => solved.setups,
+            _ => 0,
+        },
+        hierarchy_refreshes: 0,
+        electric: Vec::new(),
+        diagnosis: None,
+    }
+}
+
+/// Hand an accepted step to the run: on rank 0 `state` is the whole state, and its
+/// outputs see every interface point (this rank's own `mine` again afterwards); on the
+/// other ranks their own. A failure there stops every rank.
+fn hand_over(
+    built: &Built<'_>,
+    report: &StepReport,
+    (state, mine): (&State, &[f64]),
+    on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
+) -> Result<(), HeatError> {
+    let mut clock = [std::time::Instant::now(); 3];
+    let handed = match built.is_root() {
+        true => built
+            .all_points()
+            .and_then(|()| {
+                clock[1] = std::time::Instant::now();
+                on_step(report, state, &built.dofs)
+            })
+            .and_then(|()| {
+                clock[2] = std::time::Instant::now();
+                built.own_points_again(mine, state.time)
+            }),
+        false => on_step(report, state, &built.dofs),
+    };
+    log::debug!(
+        "step {}: handed to the run's outputs in {:.3} s (every point {:.3} s, outputs {:.3} s, own points again {:.3} s)",
+        state.step,
+        clock[0].elapsed().as_secs_f64(),
+        (clock[1] - clock[0]).as_secs_f64(),
+        (clock[2] - clock[1]).as_secs_f64(),
+        clock[2].elapsed().as_secs_f64(),
+    );
+    agreed(handed)
+}
+
+/// The run's summary: the method of `newton`'s solves (over `built`) and why (`what`:
+/// the steps or the steady solve).
+fn record(newton: &Newton<'_, '_>, built: &Built<'_>, what: &str) {
+    let (method, symmetric) = (newton.method, newton.symmetric);
+    let conductivity = built.conductivity.is_some();
+    let unsymmetric = match conductivity {
+        true => "a temperature-dependent conductivity makes the Jacobian unsymmetric",
+        false => "a temperature-dependent conductance makes the Jacobian unsymmetric",
+    };
+    let why = match (method, symmetric) {
+        (Method::CgAmg, _) => format!(
+            "{what}, symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG (hierarchy kept while the step size holds, each step started from the earlier steps' solutions)"
+        ),
+        (Method::GmresAmg, _) => format!(
+            "{what}, {unsymmetric}, at or above the AMG threshold → GMRES + BoomerAMG at each Newton iteration"
+        ),
+        (_, true) => format!(
+            "{what}, below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU (factorisation kept while the step size holds)"
+        ),
+        (_, false) => format!("{what}, {unsymmetric} → MUMPS LU at each Newton iteration"),
+    };
+    super::record(method, why);
 }

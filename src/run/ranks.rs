@@ -90,7 +90,9 @@ pub(super) fn quiet() -> RunError {
 
 /// Whether the run is one the distributed steady solve, or the distributed linear
 /// transient steps, take from start to end, so that the ranks other than 0 can hold
-/// their part of the mesh only: steady or transient, one temperature field with constant conductivities and sources of x alone (per block), no radiation,
+/// their part of the mesh only: steady or transient, one temperature field with
+/// conductivities constant or laws of T, ρc constant in a transient run, and sources of
+/// x alone (per block), no radiation,
 /// no moving or dying surfaces, no restart or nodal fields, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
 /// no toggle, no contact pressure field, no voltage or species enforcement, no
@@ -112,13 +114,13 @@ pub(super) fn distributable(
         return refuse("a [[nodal_field]]");
     }
     if !physics.source_of_x_only()
-        || physics.materials.constant().is_none()
+        || !physics.materials.assembled_per_rank(file.transient)
         || physics.field_names.len() != 1
         || physics.materials.electric()
         || physics.species.any()
     {
         return refuse(
-            "not one temperature field with constant materials and sources of x alone (the general solver)",
+            "not one temperature field with sources of x alone and, in a transient run, constant ρc (the general solver)",
         );
     }
     if p.bc.iter().any(|b| b.kind == BcKind::Radiation) {

@@ -1,19 +1,21 @@
 //! The solve of a run: one linear steady solve ([`solve_steady`]) when the problem allows
 //! it (one field, constant materials, a source of x, no toggles, no radiation), else the
 //! time loop of the general solver ([`transient::solve`]), of which a nonlinear steady
-//! solve is the one step. Each accepted step is recorded, written when due and
+//! solve is the one step — under MPI, the distributed steps of one field
+//! ([`crate::parallel::transient`]) where their conditions hold. Each accepted step is recorded, written when due and
 //! checkpointed; the linear solver that ran is summarised with the reason for it.
 
 use crate::assembly::DofMap;
 use crate::enforce::conductance::{ConductanceModel, PointState};
 use crate::enforce::interface::{HInput, HValue};
 use crate::heat::electric::{ContactPower, VOLTAGE};
+use crate::heat::law::Law;
 use crate::heat::species::SPECIES;
 use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
 use crate::heat::transient::{
     self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
 };
-use crate::heat::{HeatError, SourceFn, TEMPERATURE};
+use crate::heat::{HeatError, Material, SourceFn, TEMPERATURE};
 use crate::mesh::NodeId;
 
 use super::output::Output;
@@ -81,26 +83,29 @@ impl<'a> TimeLoop<'a> {
     ) -> Result<Solved, RunError> {
         if self.is_linear_steady() {
             self.linear_steady()
-        } else if self.is_linear_transient_on_ranks() {
-            self.linear_steps_on_ranks(initial, output)
+        } else if self.is_stepped_on_ranks() {
+            self.steps_on_ranks(initial, output)
         } else {
             self.steps(initial, output)
         }
     }
 
-    /// Whether a run under MPI steps with its assembly distributed: a transient run of
-    /// the kind the linear steady solve takes — one field, constant materials, a source
-    /// of x alone, no toggles, radiation or multiplier ties (its interfaces linear, or
-    /// Newton through a temperature-dependent conductance) — with no restart, nothing
-    /// moving or dying and no nodal field. (Every run whose mesh
-    /// `ranks::distributable` splits and is transient is one.)
-    fn is_linear_transient_on_ranks(&self) -> bool {
+    /// Whether a run under MPI steps with its assembly distributed: a transient run, or
+    /// a steady one whose conductivity depends on T (one Newton solve, the general
+    /// solver's steady solve), of the kind the linear steady solve takes but for k — one
+    /// field, k constant or a law of T, ρc constant, a source of x alone, no toggles,
+    /// radiation or multiplier ties (its interfaces linear, or Newton through a
+    /// temperature-dependent conductance) — with no restart, nothing moving or dying and
+    /// no nodal field. (Every run whose mesh `ranks::distributable` splits and is not a
+    /// linear steady one is one.)
+    fn is_stepped_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
+        let transient = self.file.transient;
         crate::parallel::world().is_some()
-            && self.file.transient
+            && (transient || physics.materials.conductivity_laws().is_some())
             && !self.terms.multiplier_ties()
             && physics.source_of_x_only()
-            && physics.materials.constant().is_some()
+            && physics.materials.assembled_per_rank(transient)
             && physics.field_names.len() == 1
             && !physics.materials.electric()
             && !physics.species.any()
@@ -197,8 +202,21 @@ impl<'a> TimeLoop<'a> {
             Some((m, origin)) => (m, Some(origin.as_slice())),
             None => (physics.mesh, None),
         };
-        let constant = physics.materials.constant().expect("checked constant");
-        let rho_c: Vec<f64> = constant.iter().map(|m| m.rho_c).collect();
+        // ρc constant where it is read (a transient run); a conductivity of T is read
+        // from `conductivity` instead (NaN here, never read).
+        let constant = |law: &Law, otherwise: f64| match law {
+            Law::Constant(v) => *v,
+            _ => otherwise,
+        };
+        let laws = &physics.materials.laws;
+        let rho_c: Vec<f64> = laws.iter().map(|l| constant(&l.capacity, 0.0)).collect();
+        let materials: Vec<Material> = (laws.iter())
+            .map(|l| Material {
+                conductivity: constant(&l.conductivity, f64::NAN),
+                rho_c: constant(&l.capacity, 0.0),
+            })
+            .collect();
+        let conductivity = (physics.materials.conductivity_laws()).map(|k| per_block(&k, origin));
         // The temperature unknowns (multipliers aside) decide the automatic choice.
         let solid: Vec<usize> = (0..mesh.blocks.len())
             .filter(|&b| mesh.blocks[b].topology.is_solid())
@@ -221,7 +239,8 @@ impl<'a> TimeLoop<'a> {
             .map_err(RunError::Solve)?;
         Ok(LinearProblem {
             mesh,
-            materials: per_block(&constant, origin),
+            materials: per_block(&materials, origin),
+            conductivity,
             rho_c: per_block(&rho_c, origin),
             block_source: per_block(sources, origin),
             loads,
@@ -231,11 +250,11 @@ impl<'a> TimeLoop<'a> {
         })
     }
 
-    /// A transient run under MPI of the kind the linear steady solve takes: its steps
-    /// with the assembly distributed
+    /// A transient run under MPI of the kind [`Self::is_stepped_on_ranks`] says (or its
+    /// steady solve with a conductivity of T): its steps with the assembly distributed
     /// ([`crate::parallel::transient`]), each accepted one recorded as the general
     /// solver's are — written by rank 0, which gets the whole state.
-    fn linear_steps_on_ranks(
+    fn steps_on_ranks(
         &self,
         initial: Option<Vec<f64>>,
         output: &mut Output<'a>,
@@ -258,6 +277,8 @@ impl<'a> TimeLoop<'a> {
         };
         let stepping = crate::parallel::Stepping {
             rho_c: &linear.rho_c,
+            conductivity: linear.conductivity.as_deref(),
+            steady: !self.file.transient,
             scheme: time.scheme,
             start: time.start,
             end: time.end,
@@ -555,6 +576,8 @@ impl<'a> TimeLoop<'a> {
 struct LinearProblem<'m> {
     mesh: &'m crate::mesh::Mesh,
     materials: Vec<crate::heat::Material>,
+    /// k(T) per block when some block's conductivity is not a constant.
+    conductivity: Option<Vec<Law>>,
     /// ρc per block.
     rho_c: Vec<f64>,
     block_source: Vec<Option<SourceFn<'m>>>,

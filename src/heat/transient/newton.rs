@@ -367,6 +367,7 @@ impl Context<'_, '_> {
                         Some(v) if gmres => System::Coupled {
                             at: setup.dofs.field_range(v).start,
                         },
+                        None if gmres => System::Unsymmetric,
                         _ => System::Direct,
                     };
                     let predictor = from_predictor && system == System::Spd;
