@@ -355,13 +355,18 @@ pub(super) fn empty_mesh(mesh: &Mesh) -> Mesh {
     }
 }
 
-/// Add the CSC matrix (`sym`, `values`; serial dofs) to `a`, rows where `keep` holds.
+/// Add the CSC matrix (`sym`, `values`; serial dofs) to `a`. Its zeros are left out
+/// unless `zeros`: where a later matrix of the same pattern may hold a value there (a
+/// tangent that depends on u: on a mesh of cubes the conduction's entries between the
+/// ends of an element edge are exactly 0 at a constant k, not at a k of T), since PETSc
+/// drops the preallocated places its first assembly did not fill and refuses a new
+/// entry afterwards.
 pub(super) fn add_columns(
     a: &mut Mat,
     sym: &faer::sparse::SymbolicSparseColMat<usize>,
     values: &[f64],
     layout: &Layout,
-    keep: impl Fn(usize) -> bool,
+    zeros: bool,
 ) -> Result<(), HeatError> {
     let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
     let (mut rows, mut vals) = (Vec::new(), Vec::new());
@@ -370,7 +375,7 @@ pub(super) fn add_columns(
         vals.clear();
         for k in col_ptr[j]..col_ptr[j + 1] {
             let i = row_idx[k];
-            if values[k] != 0.0 && keep(i) {
+            if zeros || values[k] != 0.0 {
                 rows.push(layout.petsc[i]);
                 vals.push(values[k]);
             }

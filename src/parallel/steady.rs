@@ -150,7 +150,7 @@ pub(super) struct Solved {
     pub history: Vec<f64>,
     /// Per interaction, the heat leaving side A and side B, summed over the ranks.
     pub heat: Vec<(f64, f64)>,
-    /// Krylov iterations of each CG solve.
+    /// Krylov iterations of each CG or GMRES solve.
     pub cg_iterations: Vec<usize>,
     /// Matrices set (each a new AMG hierarchy or MUMPS factorisation).
     pub setups: usize,
@@ -831,7 +831,7 @@ impl<'b, 'p> Newton<'b, 'p> {
                 .map_err(petsc_err)?;
             last_step = built.scatter.update(&built.world, layout, &mine, u);
             timing.solve_s += start.elapsed().as_secs_f64();
-            if self.method == Method::CgAmg {
+            if self.method != Method::MumpsLu {
                 cg_iterations.push(its);
             }
         }
@@ -890,19 +890,21 @@ impl<'b, 'p> Newton<'b, 'p> {
         let built = self.built;
         let layout = &built.layout;
         self.a.zero().map_err(petsc_err)?;
+        // (A tangent of k(T): its zeros of one iterate are not those of the next.)
+        let tangent = built.conductivity.is_some();
         match capacity {
             Some(c) => {
                 let mut k = self.k_local.clone();
                 for &(d, slot) in &self.diagonal {
                     k[slot] += c.c0 * c.m[d];
                 }
-                add_columns(&mut self.a, &built.k_sym, &k, layout, |_| true)?;
+                add_columns(&mut self.a, &built.k_sym, &k, layout, tangent)?;
             }
-            None => add_columns(&mut self.a, &built.k_sym, &self.k_local, layout, |_| true)?,
+            None => add_columns(&mut self.a, &built.k_sym, &self.k_local, layout, tangent)?,
         }
         let mut i_values = Vec::new();
         self.iasm.values_into(&mut i_values)?;
-        add_columns(&mut self.a, &self.i_sym, &i_values, layout, |_| true)?;
+        add_columns(&mut self.a, &self.i_sym, &i_values, layout, false)?;
         self.a.assemble().map_err(petsc_err)?;
         self.a.zero_rows_columns(&built.bc_rows).map_err(petsc_err)
     }
