@@ -666,6 +666,48 @@ fn cut_interface_steady_conductivity_of_t_equals_serial() {
     }
 }
 
+/// A source that grows in time (`Q = 2e3 y (1 + 30 t)`): each step takes it at its own
+/// time, as serially (the steps assembled per rank once froze it at the start time and
+/// moved 1 546 W instead of 3 395 W at t = 0.3).
+#[test]
+fn cut_interface_transient_source_in_time_equals_serial() {
+    let tmp = scratch("transient_source_in_time");
+    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, "", 0.1);
+    let text = text.replace("value = \"2e3*y\"", "value = \"2e3*y*(1 + 30*t)\"");
+    std::fs::write(&problem, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+}
+
+/// Every law of T at once, assembled per rank at every Newton iterate: k(T) in both
+/// blocks, ρc(T) (a table), a source of T and t (Lua) and a radiation condition on one
+/// face; BDF2 steps; temperatures, heats and Newton iterations equal serial.
+#[test]
+fn cut_interface_transient_laws_of_t_and_radiation_equal_serial() {
+    let tmp = scratch("transient_laws_of_t");
+    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, "scheme = \"bdf2\"\n", 0.1);
+    let text = conductivity_of_t(&text)
+        .replacen(
+            "specific_heat = 10.0",
+            "specific_heat = { table = [[300.0, 10.0], [600.0, 16.0]] }",
+            1,
+        )
+        .replace(
+            "value = \"2e3*y\"",
+            "value = \"2e3*y*(1 + 2*t) - 3*(T - 300)\"",
+        )
+        + "[[bc]]\nkind = \"radiation\"\nsurfaces = [\"surface_5\"]\nvalue = 0.8\nambient = 900.0\n";
+    std::fs::write(&problem, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
+    for par in &runs {
+        let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(reason.contains("a conduction of T"), "{reason}");
+        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
+    }
+}
+
 /// The serial run rejected some attempts (`what`), and every distributed run as many.
 fn assert_rejected_as_serial(serial: &Ran, runs: &[Ran], what: &str) {
     let rejected = |r: &Ran| r.summary["transient"]["rejected_steps"].as_u64().unwrap();

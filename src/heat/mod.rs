@@ -513,7 +513,15 @@ pub fn nonlinear_residual_jacobian(
 ) -> Result<(Vec<f64>, SparseColMat<usize, f64>), HeatError> {
     let mut asm = Assembler::new(pattern);
     let k = |_: usize, temp: f64, x: [f64; 3]| Ok(conductivity(temp, x));
-    nonlinear::assemble_at(&mut asm, mesh, dofs, (k, |_| source), &[], t)?;
+    let q = |_: usize, rule: &Basis, x: &[[f64; 3]], _: &[f64], re: &mut [f64], _: &mut [f64]| {
+        if let Some(q) = source {
+            let mut f = [0.0; MAX_NODES];
+            kernel::source(rule, x, q, &mut f).map_err(nonlinear::ElementFailure::Jacobian)?;
+            re.iter_mut().zip(&f).for_each(|(r, f)| *r -= f);
+        }
+        Ok(())
+    };
+    nonlinear::assemble_at(&mut asm, mesh, dofs, (k, q), &[], t)?;
     // The assembly's loads are −R.
     let r = asm.rhs().iter().map(|v| -v).collect();
     Ok((r, asm.matrix()?))

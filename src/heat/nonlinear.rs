@@ -1,31 +1,32 @@
-//! Conduction whose conductivity depends on temperature, assembled at an iterate for
-//! Newton: each element's exact tangent into its matrix slot and its residual, negated,
-//! into its load, so the assembled right-hand side is `−R(u)`. The terms are the
-//! general solver's (`transient::assemble`): `∫ k(T) ∇N_a·∇T` and its Jacobian with the
-//! `dk/dT` term, the face conditions' outflow `g(T)` and `dg/dT`, and a source of x.
+//! Conduction whose terms depend on temperature, assembled at an iterate for Newton:
+//! each element's exact tangent into its matrix slot and its residual, negated, into
+//! its load, so the assembled right-hand side is `−R(u)`. The terms are the general
+//! solver's (`transient::assemble`): `∫ k(T) ∇N_a·∇T` and its Jacobian with the `dk/dT`
+//! term, the face conditions' outflow `g(T)` (flux, convection, radiation) and `dg/dT`,
+//! and the source `−∫ Q(T, x, t) N_a` with its `dQ/dT`.
 
 use std::cell::Cell;
 
 use crate::assembly::{Assembler, DofMap};
-use crate::fem::{MAX_NODES, Measure};
+use crate::fem::{Basis, MAX_NODES, Measure};
 use crate::mesh::Mesh;
 
 use super::law::Law;
 use super::{
-    ByElement, FaceBc, FirstError, HeatError, SourceFn, bad_jacobian, block_rules, elem_coords,
-    kernel, temperature,
+    ByElement, FaceBc, FirstError, HeatError, bad_jacobian, block_rules, elem_coords, kernel,
+    temperature,
 };
 
 /// Fill `asm`'s element slots with the conduction of `mesh` at the field `u` (over
 /// `dofs`) at time `time`: the tangent `∂R/∂u` in the matrix slots, `−R` in the loads.
-/// `conductivity[b]` is block `b`'s k(T, x, t); `sources[b]` its source (`None`: none);
-/// `faces` the face conditions (flux, convection, radiation) on the mesh's sides.
+/// `conductivity[b]` is block `b`'s k(T, x, t), `source[b]` its Q(T, x, t) (a constant 0:
+/// none); `faces` the face conditions on the mesh's sides.
 #[cfg_attr(not(feature = "mpi"), allow(dead_code))]
 pub(crate) fn conduction_at(
     asm: &mut Assembler<'_>,
     mesh: &Mesh,
     dofs: &DofMap,
-    (conductivity, sources): (&[Law], &[Option<SourceFn<'_>>]),
+    (conductivity, source): (&[Law], &[Law]),
     faces: &[FaceBc],
     (u, time): (&[f64], f64),
 ) -> Result<(), HeatError> {
@@ -36,25 +37,65 @@ pub(crate) fn conduction_at(
             blocks,
         });
     }
-    if sources.len() != blocks {
+    if source.len() != blocks {
         return Err(HeatError::SourceCount {
-            count: sources.len(),
+            count: source.len(),
             blocks,
         });
     }
     let k = |b: usize, temp: f64, x: [f64; 3]| conductivity[b].eval(temp, x, time);
-    assemble_at(asm, mesh, dofs, (k, |b| sources[b]), faces, u)
+    // Q(T, x, t) and dQ/dT into the residual and the tangent; a failure or a value that
+    // is not finite is the block's error there (the serial general solver's message).
+    let q = |b: usize, rule: &Basis, x: &[[f64; 3]], te: &[f64], re: &mut [f64], ke: &mut [f64]| {
+        if source[b] == Law::Constant(0.0) {
+            return Ok(());
+        }
+        let failed = Cell::new(None);
+        let q = |temp: f64, xq: [f64; 3]| {
+            let what = match source[b].eval(temp, xq, time) {
+                Ok((q, dq)) if q.is_finite() && dq.is_finite() => return (q, dq),
+                Ok((q, dq)) => format!("Q = {q}, dQ/dT = {dq}"),
+                Err(m) => m.lines().next().unwrap_or_default().to_string(),
+            };
+            let [x0, x1, x2] = xq;
+            failed.set(Some(format!(
+                "{what} at ({x0:.6}, {x1:.6}, {x2:.6}), T = {temp}, t = {time}"
+            )));
+            (0.0, 0.0)
+        };
+        kernel::source_residual_jacobian(rule, x, te, q, re, ke)
+            .map_err(ElementFailure::Jacobian)?;
+        failed
+            .take()
+            .map_or(Ok(()), |m| Err(ElementFailure::Source(m)))
+    };
+    assemble_at(asm, mesh, dofs, (k, q), faces, u)
+}
+
+/// Why an element's source could not be added.
+pub(super) enum ElementFailure {
+    Jacobian(crate::fem::BadJacobian),
+    /// A source that failed or was not finite, with where.
+    Source(String),
 }
 
 /// [`conduction_at`] with block `b`'s conductivity `k(b, T, x)` (`Err`: a message for
-/// the block) and source `source_of(b)`.
-pub(super) fn assemble_at<'s>(
+/// the block) and its source added by `source(b, rule, x, T_e, R_e, J_e)`.
+pub(super) fn assemble_at(
     asm: &mut Assembler<'_>,
     mesh: &Mesh,
     dofs: &DofMap,
-    (k_of, source_of): (
+    (k_of, source): (
         impl Fn(usize, f64, [f64; 3]) -> Result<(f64, f64), String> + Sync,
-        impl Fn(usize) -> Option<SourceFn<'s>> + Sync,
+        impl Fn(
+            usize,
+            &Basis,
+            &[[f64; 3]],
+            &[f64],
+            &mut [f64],
+            &mut [f64],
+        ) -> Result<(), ElementFailure>
+        + Sync,
     ),
     faces: &[FaceBc],
     u: &[f64],
@@ -88,12 +129,13 @@ pub(super) fn assemble_at<'s>(
             }
         };
         let mut re = [0.0; MAX_NODES];
-        if let Err(bad) = kernel::conduction_residual_jacobian(rule, x, te, k, &mut re, ke) {
+        let re = &mut re[..nn];
+        if let Err(bad) = kernel::conduction_residual_jacobian(rule, x, te, k, re, ke) {
             errors.record(e, bad_jacobian(mesh, e, bad));
             return;
         }
+        let block = mesh.blocks[b].id;
         if let Some(message) = failed.take() {
-            let block = mesh.blocks[b].id;
             errors.record(e, HeatError::Material { block, message });
             return;
         }
@@ -101,18 +143,19 @@ pub(super) fn assemble_at<'s>(
             let bc = faces[f];
             let outflow = |temp: f64, _: [f64; 3]| bc.outflow(temp);
             let side = bc.side().side;
-            kernel::face_load_with(measure, topo, x, side, te, outflow, &mut re, ke);
+            kernel::face_load_with(measure, topo, x, side, te, outflow, re, ke);
         }
-        // −R = ∫ Q N − (the rest), the source summed on its own first.
-        let mut q_n = [0.0; MAX_NODES];
-        if let Some(q) = source_of(b)
-            && let Err(bad) = kernel::source(rule, x, q, &mut q_n)
-        {
-            errors.record(e, bad_jacobian(mesh, e, bad));
-            return;
+        match source(b, rule, x, te, re, ke) {
+            Ok(()) => {}
+            Err(ElementFailure::Jacobian(bad)) => {
+                return errors.record(e, bad_jacobian(mesh, e, bad));
+            }
+            Err(ElementFailure::Source(message)) => {
+                return errors.record(e, HeatError::Source { block, message });
+            }
         }
-        for ((f, q), r) in fe.iter_mut().zip(&q_n).zip(&re) {
-            *f = q - r;
+        for (f, r) in fe.iter_mut().zip(re.iter()) {
+            *f = -r;
         }
     });
     errors.into_result()?;
@@ -126,11 +169,20 @@ mod tests {
     use crate::assembly::Pattern;
     use crate::mesh::generate::{BoxSpec, single_box};
 
-    /// The residual of the assembly at `u`, and its tangent applied to `v`.
+    /// The source `expr` as a law.
+    fn lua(expr: &str) -> Law {
+        Law::Lua {
+            expr: expr.into(),
+            chunk: "source".into(),
+        }
+    }
+
+    /// The residual of the assembly at `u` with the conductivity `law` and the source
+    /// `q`, and its tangent applied to `v`.
     fn residual_and_tangent(
         mesh: &Mesh,
         dofs: &DofMap,
-        law: &Law,
+        (law, q): (&Law, &Law),
         faces: &[FaceBc],
         u: &[f64],
         v: &[f64],
@@ -138,10 +190,8 @@ mod tests {
         let mut pattern = Pattern::new(mesh, dofs);
         pattern.build_direct().unwrap();
         let mut asm = Assembler::direct(&pattern).unwrap();
-        let q = |x: [f64; 3]| 3.0 + x[0];
-        let q: SourceFn<'_> = &q;
         let laws = vec![law.clone(); mesh.blocks.len()];
-        let sources = vec![Some(q); mesh.blocks.len()];
+        let sources = vec![q.clone(); mesh.blocks.len()];
         conduction_at(&mut asm, mesh, dofs, (&laws, &sources), faces, (u, 0.0)).unwrap();
         let r: Vec<f64> = asm.rhs().iter().map(|f| -f).collect();
         let j = asm.matrix().unwrap();
@@ -151,7 +201,8 @@ mod tests {
     }
 
     /// The tangent is the residual's derivative: central differences of R along a
-    /// direction agree with J v to 1e-7 relative, for a k(T) and a convection face, on
+    /// direction agree with J v to 1e-7 relative, for a k(T), a Q(T), a convection and a
+    /// radiating face, on
     /// distorted cells of a non-uniform field; with a constant k the residual is
     /// `K u − F` of the linear assembly.
     #[test]
@@ -171,16 +222,30 @@ mod tests {
             elem: crate::mesh::ElemId(0),
             side: 1,
         };
-        let faces = [FaceBc::Convection {
-            side,
-            h: 7.0,
-            t_inf: 290.0,
-        }];
-        let (_, jv) = residual_and_tangent(&mesh, &dofs, &law, &faces, &u, &v);
+        let radiating = crate::mesh::Side {
+            elem: crate::mesh::ElemId(3),
+            side: 2,
+        };
+        let faces = [
+            FaceBc::Convection {
+                side,
+                h: 7.0,
+                t_inf: 290.0,
+            },
+            FaceBc::Radiation {
+                side: radiating,
+                emissivity: 0.7,
+                t_inf: 500.0,
+            },
+        ];
+        // Q = 3 + x + T/100: its dQ/dT in the tangent too.
+        let q = lua("3 + x + T/100");
+        let terms = (&law, &q);
+        let (_, jv) = residual_and_tangent(&mesh, &dofs, terms, &faces, &u, &v);
         let eps = 1e-4;
         let shifted = |s: f64| -> Vec<f64> { u.iter().zip(&v).map(|(a, b)| a + s * b).collect() };
-        let (rp, _) = residual_and_tangent(&mesh, &dofs, &law, &faces, &shifted(eps), &v);
-        let (rm, _) = residual_and_tangent(&mesh, &dofs, &law, &faces, &shifted(-eps), &v);
+        let (rp, _) = residual_and_tangent(&mesh, &dofs, terms, &faces, &shifted(eps), &v);
+        let (rm, _) = residual_and_tangent(&mesh, &dofs, terms, &faces, &shifted(-eps), &v);
         let scale = jv.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         for i in 0..n {
             let fd = (rp[i] - rm[i]) / (2.0 * eps);
@@ -191,15 +256,16 @@ mod tests {
             );
         }
 
-        // A constant k: R = K u − F of the linear conduction assembly.
-        let (r, _) = residual_and_tangent(&mesh, &dofs, &Law::Constant(2.5), &faces, &u, &v);
+        // A constant k, no radiation: R = K u − F of the linear conduction assembly.
+        let (terms, faces) = ((&Law::Constant(2.5), &lua("3 + x")), &faces[..1]);
+        let (r, _) = residual_and_tangent(&mesh, &dofs, terms, faces, &u, &v);
         let q = |x: [f64; 3]| 3.0 + x[0];
         let material = super::super::Material {
             conductivity: 2.5,
             rho_c: 1.0,
         };
         let system =
-            super::super::steady_conduction(&mesh, &dofs, &[material], Some(&q), &[], &faces)
+            super::super::steady_conduction(&mesh, &dofs, &[material], Some(&q), &[], faces)
                 .unwrap();
         let mut ku = vec![0.0; n];
         crate::solve::spmv(&system.matrix, &u, &mut ku);

@@ -27,6 +27,8 @@ use crate::heat::HeatError;
 use crate::heat::steady::{SteadyProblem, SteadySolution};
 
 #[cfg(feature = "mpi")]
+mod conduction;
+#[cfg(feature = "mpi")]
 mod general;
 #[cfg(feature = "mpi")]
 mod layout;
@@ -174,13 +176,26 @@ pub fn steady(p: &SteadyProblem<'_>) -> Option<Result<SteadySolution, HeatError>
     }
 }
 
+/// The laws of a run per block of its (rank's) mesh, for the distributed steps.
+#[derive(Clone, Copy, Debug)]
+pub struct Laws<'s> {
+    /// k(T, x, t), W/m/K.
+    pub conductivity: &'s [crate::heat::law::Law],
+    /// ρc(T, x, t), J/m³/K (read where one is not a constant; else [`Stepping::rho_c`]).
+    pub capacity: &'s [crate::heat::law::Law],
+    /// Q(T, x, t), W/m³ (a constant 0: none).
+    pub source: &'s [crate::heat::law::Law],
+}
+
 /// A transient run's time stepping, for [`transient`] (or one steady solve: `steady`).
 pub struct Stepping<'s> {
     /// ρc (J/m³/K) per block of the problem's mesh.
     pub rho_c: &'s [f64],
-    /// k(T) per block of the problem's mesh, when the conductivity depends on
-    /// temperature (the problem's constant conductivities are then not read).
-    pub conductivity: Option<&'s [crate::heat::law::Law]>,
+    /// The laws of the run's materials and sources per block of the problem's mesh: its
+    /// conduction is assembled at every Newton iterate when one depends on temperature
+    /// (or it has radiation), its sources taken at each step's time when they depend on
+    /// time.
+    pub laws: Laws<'s>,
     /// One steady solve at `start` instead of steps (the general solver's nonlinear
     /// steady solve: a conductivity of T), reported as its step 0.
     pub steady: bool,

@@ -31,19 +31,21 @@ use crate::heat::steady::{
     AMG_TOLERANCE, LinearMethod, LinearSolves, STEADY_AMG_TOLERANCE, SolveTiming, SteadyProblem,
     SteadySolution,
 };
+use crate::heat::transient::LumpedWeight;
 use crate::heat::{FaceBc, HeatError, TEMPERATURE, dirichlet_dofs};
 use crate::mesh::{ElemId, Mesh};
 use crate::solve::amg::KEPT_SOLUTIONS;
 use crate::solve::spmv_ref;
 use faer::sparse::SparseColMatRef;
 
+use super::conduction::{Capacity, Conduction, conduction};
 use super::part;
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::rows::{
     Layout, Scatter, add_columns, couplings_to_owners, empty_mesh, local_faces, preallocation,
     summed_heat,
 };
-use super::session;
+use super::{Laws, session};
 
 fn petsc_err(e: PetscError) -> HeatError {
     HeatError::Contact(format!("distributed solve: {e}"))
@@ -54,7 +56,7 @@ fn petsc_err(e: PetscError) -> HeatError {
 /// every other rank its own part (its owned dofs and those it reads; the rest as they
 /// started); else every rank the whole solution.
 pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> {
-    let built = Built::new(p, 0.0, None)?;
+    let built = Built::new(p, 0.0, None, false)?;
     let mut newton = Newton::new(&built, false)?;
     let mut u = vec![0.0; built.n];
     built.start(&mut u, &built.bcs);
@@ -125,18 +127,6 @@ pub(super) fn agreed<T>(r: Result<T, HeatError>) -> Result<T, HeatError> {
     Err(HeatError::Step(why.join("; ")))
 }
 
-/// The capacity terms of a time step (lumped, as the serial general solver's):
-/// `m (c₀ u + rest)` in the residual, `c₀ m` on the Jacobian's diagonal.
-pub(super) struct Capacity<'a> {
-    /// Per local dof, the lumped capacity `∫ ρc N_a` of this rank's own elements (0 at
-    /// the dofs none of them holds).
-    pub m: &'a [f64],
-    /// `α₀/Δt`.
-    pub c0: f64,
-    /// Per local dof, `(α₁ uⁿ + α₂ uⁿ⁻¹)/Δt`.
-    pub rest: &'a [f64],
-}
-
 /// What one Newton solve ([`Newton::solve`]) ends with, the same on every rank.
 pub(super) struct Solved {
     pub converged: bool,
@@ -171,6 +161,8 @@ pub(super) struct Built<'p> {
     pub bcs: Vec<(usize, f64)>,
     iface: Option<&'p dyn crate::heat::interfaces::Interfaces>,
     layout: Layout,
+    /// The time of the set-up.
+    start: f64,
     /// The mesh of this rank's own elements, and per element of `p.mesh` its element
     /// there.
     local: Mesh,
@@ -178,10 +170,18 @@ pub(super) struct Built<'p> {
     /// The pattern of this rank's elements.
     k_pattern: Pattern,
     k_sym: faer::sparse::SymbolicSparseColMat<usize>,
-    /// k(T) per block of `p.mesh`, when the conductivity depends on temperature: the
-    /// conduction is then assembled at every Newton iterate ([`Built::conduction_at`]),
-    /// and `p.materials`' conductivities are not read.
-    pub conductivity: Option<&'p [Law]>,
+    /// The run's laws per block of `p.mesh` (a stepped run's; `None`: the steady
+    /// solve's constant materials and sources of x).
+    laws: Option<Laws<'p>>,
+    /// The conduction depends on u: a k, a ρc (stepping) or a source of T, or a
+    /// radiation condition. It is then assembled at every Newton iterate
+    /// ([`Built::conduction_at`]) and `p.materials`' conductivities are not read.
+    pub nonlinear: bool,
+    /// A source depends on time: the linear conduction's load is made again at each
+    /// step's time ([`Built::conduction`]).
+    sources_in_time: bool,
+    /// ρc depends on T (stepping): the capacity is evaluated at every iterate.
+    pub capacity_of_t: bool,
     /// The conduction's values and load of the set-up's face conditions.
     k_first: std::cell::RefCell<Option<(Vec<f64>, Vec<f64>)>>,
     /// The dofs whose residual this rank adds to (its elements' and its own), and their
@@ -201,12 +201,13 @@ pub(super) struct Built<'p> {
 }
 
 impl<'p> Built<'p> {
-    /// The set-up of `p` (its interfaces' couplings taken at time `t`), its
-    /// conductivity `conductivity` per block when that depends on temperature.
+    /// The set-up of `p` (its interfaces' couplings taken at time `t`), with a stepped
+    /// run's `laws` (`transient`: time steps, whose capacity they hold too).
     pub(super) fn new(
         p: &'p SteadyProblem<'p>,
         t: f64,
-        conductivity: Option<&'p [Law]>,
+        laws: Option<Laws<'p>>,
+        transient: bool,
     ) -> Result<Built<'p>, HeatError> {
         let mesh = p.mesh;
         let world = session::comm();
@@ -251,15 +252,28 @@ impl<'p> Built<'p> {
         let mut k_pattern = Pattern::new(&local, &dofs);
         k_pattern.build_direct()?;
         let k_sym = k_pattern.symbolic().expect("built").clone();
-        let k_first = match conductivity {
-            Some(_) => None,
-            None => Some(conduction(
-                p,
-                (&local, &to_local),
-                &dofs,
-                &k_pattern,
-                p.face_bcs,
-            )?),
+        let varies = |l: &[Law]| l.iter().any(|l| !matches!(l, Law::Constant(_)));
+        let capacity_of_t = transient && laws.is_some_and(|l| varies(l.capacity));
+        let radiation = (p.face_bcs.iter()).any(|f| matches!(f, FaceBc::Radiation { .. }));
+        let nonlinear = capacity_of_t
+            || radiation
+            || laws.is_some_and(|l| {
+                varies(l.conductivity) || l.source.iter().any(Law::uses_temperature)
+            });
+        let sources_in_time = laws.is_some_and(|l| l.source.iter().any(Law::depends_on_time));
+        let k_first = match nonlinear {
+            true => None,
+            false => {
+                let sources = laws.map(|l| l.source).filter(|_| sources_in_time);
+                let local = (&local, to_local.as_slice());
+                let terms = Conduction {
+                    pattern: &k_pattern,
+                    faces: p.face_bcs,
+                    sources,
+                    t,
+                };
+                Some(conduction(p, local, &dofs, terms)?)
+            }
         };
         phases.mark("own elements", start);
         let mut touched: Vec<usize> = local
@@ -327,9 +341,13 @@ impl<'p> Built<'p> {
             layout,
             local,
             to_local,
+            start: t,
             k_pattern,
             k_sym,
-            conductivity,
+            laws,
+            nonlinear,
+            sources_in_time,
+            capacity_of_t,
             k_first: std::cell::RefCell::new(k_first),
             touched,
             touched_petsc,
@@ -441,64 +459,65 @@ impl<'p> Built<'p> {
     }
 
     /// The lumped capacity `∫ ρc N_a` of this rank's own elements at each local dof,
-    /// `rho_c` per block of the problem's mesh.
-    pub(super) fn capacity(&self, rho_c: &[f64]) -> Result<Vec<f64>, HeatError> {
+    /// `rho_c` per block of the problem's mesh, and its weights `∫ N_a` per (dof, block)
+    /// (for a ρc of T).
+    pub(super) fn capacity(
+        &self,
+        rho_c: &[f64],
+    ) -> Result<(Vec<f64>, Vec<LumpedWeight>), HeatError> {
         let weights =
             crate::heat::transient::lumped_weights(&self.local, &self.dofs, None, &|_| true)?;
         let mut m = vec![0.0; self.n];
-        for (d, b, w, _) in weights {
+        for &(d, b, w, _) in &weights {
             m[d as usize] += w * rho_c[b as usize];
         }
-        Ok(m)
+        Ok((m, weights))
     }
 
     /// This rank's conduction values and load under the face conditions `faces` (of the
     /// problem's mesh), on the set-up's pattern.
-    pub(super) fn conduction(&self, faces: &[FaceBc]) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
+    /// (`t`: the time of sources that change with it.)
+    pub(super) fn conduction(
+        &self,
+        faces: &[FaceBc],
+        t: f64,
+    ) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
         let local = (&self.local, self.to_local.as_slice());
-        conduction(self.p, local, &self.dofs, &self.k_pattern, faces)
+        let sources = self.laws.map(|l| l.source).filter(|_| self.sources_in_time);
+        let terms = Conduction {
+            pattern: &self.k_pattern,
+            faces,
+            sources,
+            t,
+        };
+        conduction(self.p, local, &self.dofs, terms)
+    }
+
+    /// Whether the linear conduction's load changes with time (a source of t): made
+    /// again at each step ([`Built::conduction`]).
+    pub(super) fn sources_in_time(&self) -> bool {
+        self.sources_in_time
     }
 
     /// This rank's conduction at the field `u` at time `t` under the face conditions
-    /// `faces` (of the problem's mesh), with the temperature-dependent conductivity
-    /// `laws`: the tangent's values on the set-up's pattern, and `−R` of its elements.
+    /// `faces` (of the problem's mesh), with the run's laws (a conduction that depends
+    /// on u): the tangent's values on the set-up's pattern, and `−R` of its elements.
     pub(super) fn conduction_at(
         &self,
-        laws: &[Law],
         faces: &[FaceBc],
         u: &[f64],
         t: f64,
     ) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
         let faces = local_faces(faces, &self.to_local);
-        let blocks = self.p.mesh.blocks.len();
-        let sources = match self.p.block_source {
-            Some(s) => s.to_vec(),
-            None => vec![self.p.source; blocks],
-        };
+        let laws = self.laws.ok_or_else(|| {
+            HeatError::Step("distributed solve: a conduction of T without its laws".into())
+        })?;
         let mut asm = Assembler::direct(&self.k_pattern)?;
-        let terms = (laws, sources.as_slice());
+        let terms = (laws.conductivity, laws.source);
         conduction_at(&mut asm, &self.local, &self.dofs, terms, &faces, (u, t))?;
         let f = asm.rhs();
         Ok((asm.take_values()?, f))
     }
-}
-
-/// The conduction of the `local` mesh's elements (this rank's own; per element of the
-/// problem's mesh its element there) on their `pattern`, with the face conditions
-/// `faces` (of the problem's mesh) that fall on them: values and load.
-fn conduction(
-    p: &SteadyProblem<'_>,
-    (local, to_local): (&Mesh, &[Option<ElemId>]),
-    dofs: &DofMap,
-    pattern: &Pattern,
-    faces: &[FaceBc],
-) -> Result<(Vec<f64>, Vec<f64>), HeatError> {
-    let faces = local_faces(faces, to_local);
-    let mut asm = Assembler::direct(pattern)?;
-    p.conduction_with_faces(&mut asm, local, dofs, &faces)?;
-    let f = asm.rhs();
-    let k = asm.take_values()?;
-    Ok((k, f))
 }
 
 /// How the partition meets the interfaces, in rank 0's log: couplings whose two dofs
@@ -562,11 +581,11 @@ impl<'b, 'p> Newton<'b, 'p> {
         let comm = built.world.as_raw();
         let iasm = Assembler::direct(&built.ipattern)?;
         let i_sym = built.ipattern.symbolic().expect("built").clone();
-        // (With a k(T), assembled at each iterate instead.)
-        let (k_local, f_local) = match (built.k_first.borrow_mut().take(), built.conductivity) {
+        // (A conduction of T is assembled at each iterate instead.)
+        let (k_local, f_local) = match (built.k_first.borrow_mut().take(), built.nonlinear) {
             (Some(kf), _) => kf,
-            (None, None) => built.conduction(built.p.face_bcs)?,
-            (None, Some(_)) => (Vec::new(), Vec::new()),
+            (None, false) => built.conduction(built.p.face_bcs, built.start)?,
+            (None, true) => (Vec::new(), Vec::new()),
         };
         let (diagonal, off) = &built.preallocated;
         let global = layout.starts[layout.size];
@@ -575,7 +594,7 @@ impl<'b, 'p> Newton<'b, 'p> {
         let r_vec = Vector::new(comm, local_rows, global).map_err(petsc_err)?;
         let du_vec = r_vec.duplicate().map_err(petsc_err)?;
         let x_vec = r_vec.duplicate().map_err(petsc_err)?;
-        let symmetric = built.iface.is_none_or(|i| i.is_linear()) && built.conductivity.is_none();
+        let symmetric = built.iface.is_none_or(|i| i.is_linear()) && !built.nonlinear;
         // The serial solvers' choice: AMG-CG, or AMG-GMRES for an unsymmetric Jacobian,
         // from the threshold on; a factorisation below it.
         let method = match (symmetric, built.p.iterative) {
@@ -662,12 +681,12 @@ impl<'b, 'p> Newton<'b, 'p> {
         let mut timing = SolveTiming::default();
         let start = Instant::now();
         // ‖F‖ over every rank (of a time step, ‖F − m rest‖), the scale of the steady
-        // test (a conductivity of T stops by the steps' test, on the update).
-        let mut load = match built.conductivity {
-            Some(_) => vec![0.0; n],
-            None => self.f_local.clone(),
+        // test (a conduction of T stops by the steps' test, on the update).
+        let mut load = match built.nonlinear {
+            true => vec![0.0; n],
+            false => self.f_local.clone(),
         };
-        if let Some(c) = capacity {
+        if let Some(c) = capacity.filter(|c| c.of_t.is_none()) {
             for &d in &built.touched {
                 load[d] -= c.m[d] * c.rest[d];
             }
@@ -688,15 +707,15 @@ impl<'b, 'p> Newton<'b, 'p> {
             // own rows of the interfaces. With a k(T), the elements' R(u) and tangent
             // assembled at u.
             let mut r = vec![0.0; n];
-            match built.conductivity {
-                Some(laws) => {
-                    let at_u = built.conduction_at(laws, &self.faces, u, t);
+            match built.nonlinear {
+                true => {
+                    let at_u = built.conduction_at(&self.faces, u, t);
                     (self.k_local, self.f_local) = agreed(at_u)?;
                     for (ri, fi) in r.iter_mut().zip(&self.f_local) {
                         *ri = -fi;
                     }
                 }
-                None => {
+                false => {
                     spmv_ref(
                         SparseColMatRef::new(k_sym.as_ref(), &self.k_local),
                         u,
@@ -707,9 +726,13 @@ impl<'b, 'p> Newton<'b, 'p> {
                     }
                 }
             }
-            if let Some(c) = capacity {
+            let stored = match capacity {
+                Some(c) => Some(agreed(c.terms(u, &built.touched))?),
+                None => None,
+            };
+            if let Some((stored, _)) = &stored {
                 for &d in &built.touched {
-                    r[d] += c.m[d] * (c.c0 * u[d] + c.rest[d]);
+                    r[d] += stored[d];
                 }
             }
             // A matrix that stays (linear interfaces, the same c₀) needs the interfaces'
@@ -780,7 +803,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             let u_max = built.scatter.u_max(&built.world, layout, u);
             // (A steady solve with a conductivity of T stops so too: the serial general
             // solver's test.)
-            let by_update = capacity.is_some() || built.conductivity.is_some();
+            let by_update = capacity.is_some() || built.nonlinear;
             let done = match by_update {
                 true => {
                     record.history.push(rn);
@@ -801,7 +824,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             // owns; set again only when its values change.
             if !kept {
                 let start = Instant::now();
-                self.set_matrix(capacity)?;
+                self.set_matrix(stored.as_ref().map(|(_, diagonal)| diagonal.as_slice()))?;
                 timing.assembly_s += start.elapsed().as_secs_f64();
                 let start = Instant::now();
                 self.ksp.set_up().map_err(petsc_err)?;
@@ -885,18 +908,19 @@ impl<'b, 'p> Newton<'b, 'p> {
             .map_err(petsc_err)
     }
 
-    /// The matrix `K + c₀ m + J_Γ` (Dirichlet rows and columns the identity's).
-    fn set_matrix(&mut self, capacity: Option<&Capacity<'_>>) -> Result<(), HeatError> {
+    /// The matrix `K + C + J_Γ`, `C` the capacity's diagonal per local dof (of a time
+    /// step; Dirichlet rows and columns the identity's).
+    fn set_matrix(&mut self, capacity: Option<&[f64]>) -> Result<(), HeatError> {
         let built = self.built;
         let layout = &built.layout;
         self.a.zero().map_err(petsc_err)?;
-        // (A tangent of k(T): its zeros of one iterate are not those of the next.)
-        let tangent = built.conductivity.is_some();
+        // (A tangent of T: its zeros of one iterate are not those of the next.)
+        let tangent = built.nonlinear;
         match capacity {
             Some(c) => {
                 let mut k = self.k_local.clone();
                 for &(d, slot) in &self.diagonal {
-                    k[slot] += c.c0 * c.m[d];
+                    k[slot] += c[d];
                 }
                 add_columns(&mut self.a, &built.k_sym, &k, layout, tangent)?;
             }

@@ -28,8 +28,9 @@ use crate::heat::transient::{Outcome, State, StepReport, factor, predictor, unco
 use crate::heat::{HeatError, dirichlet_dofs};
 
 use super::Stepping;
+use super::conduction::Capacity;
 use super::petsc::Method;
-use super::steady::{Built, Capacity, Newton, Solved, agreed};
+use super::steady::{Built, Newton, Solved, agreed};
 
 /// The run's steps over the MPI world from `s.start` to `s.end`; `on_step` gets each
 /// accepted step: on rank 0 the whole state, on every other rank its own dofs. Rank 0's
@@ -39,10 +40,10 @@ pub(super) fn solve(
     s: &Stepping<'_>,
     on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
 ) -> Result<Outcome, HeatError> {
-    let built = Built::new(p, s.start, s.conductivity)?;
+    let built = Built::new(p, s.start, Some(s.laws), !s.steady)?;
     let mut newton = Newton::new(&built, !s.steady)?;
     let (n, field, root) = (built.n, built.field, built.is_root());
-    let m = built.capacity(s.rho_c)?;
+    let (m, lumped) = built.capacity(s.rho_c)?;
     // The initial field at the rank's nodes; a contact partner's nodes from their owners.
     let mut u = vec![0.0; n];
     for (node, &v) in s.initial.iter().enumerate() {
@@ -91,12 +92,14 @@ pub(super) fn solve(
             // The step's loads; a rank that cannot make them stops every rank.
             let loads = (s.loads)(t_new).and_then(|(dirichlet, now)| {
                 let bcs = dirichlet_dofs(p.mesh, &built.dofs, field, &dirichlet)?;
-                // New face conditions: the conduction again, unless it is assembled at
-                // every iterate (a conductivity of T).
-                let conduction = match (now != faces, built.conductivity) {
-                    (true, None) => Some(Some(built.conduction(&now)?)),
-                    (true, Some(_)) => Some(None),
-                    (false, _) => None,
+                // New face conditions or sources of time: the conduction again, unless
+                // it is assembled at every iterate (a conduction of T).
+                let conduction = if built.nonlinear {
+                    (now != faces).then_some(None)
+                } else if now != faces || built.sources_in_time() {
+                    Some(Some(built.conduction(&now, t_new)?))
+                } else {
+                    None
                 };
                 Ok((bcs, now, conduction))
             });
@@ -107,15 +110,13 @@ pub(super) fn solve(
             }
             let (u, previous) = (&mine.u, mine.past.first().map(|(_, v)| v.as_slice()));
             let rest: Vec<f64> = (0..n)
-                .map(|d| match m[d] != 0.0 {
-                    true => (alpha[1] * u[d] + previous.map_or(0.0, |v| alpha[2] * v[d])) / dt,
-                    false => 0.0,
-                })
+                .map(|d| (alpha[1] * u[d] + previous.map_or(0.0, |v| alpha[2] * v[d])) / dt)
                 .collect();
             let capacity = Capacity {
                 m: &m,
                 c0: alpha[0] / dt,
                 rest: &rest,
+                of_t: (built.capacity_of_t).then_some((&lumped, s.laws.capacity, t_new)),
             };
             // From the serial step's predictor (its extrapolation is local to each dof).
             let predicted = predictor(&mine, dt, s.scheme.order() as usize);
@@ -312,9 +313,10 @@ fn hand_over(
 /// the steps or the steady solve).
 fn record(newton: &Newton<'_, '_>, built: &Built<'_>, what: &str) {
     let (method, symmetric) = (newton.method, newton.symmetric);
-    let conductivity = built.conductivity.is_some();
-    let unsymmetric = match conductivity {
-        true => "a temperature-dependent conductivity makes the Jacobian unsymmetric",
+    let unsymmetric = match built.nonlinear {
+        true => {
+            "a conduction of T (conductivity, capacity, source or radiation) makes the Jacobian unsymmetric"
+        }
         false => "a temperature-dependent conductance makes the Jacobian unsymmetric",
     };
     let why = match (method, symmetric) {

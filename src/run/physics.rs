@@ -236,19 +236,6 @@ impl Materials {
 }
 
 impl Materials {
-    /// Whether the conduction can be assembled per rank under MPI (the distributed
-    /// steady and stepped solves): ρc constant in every block of a transient run; k a
-    /// constant, or any law (then assembled at each Newton iterate).
-    pub(super) fn assembled_per_rank(&self, transient: bool) -> bool {
-        !transient || (self.laws.iter()).all(|l| matches!(l.capacity, Law::Constant(_)))
-    }
-
-    /// k per block as a law, when some block's is not a constant (`None`: constants).
-    pub(super) fn conductivity_laws(&self) -> Option<Vec<Law>> {
-        let varies = (self.laws.iter()).any(|l| !matches!(l.conductivity, Law::Constant(_)));
-        varies.then(|| self.laws.iter().map(|l| l.conductivity.clone()).collect())
-    }
-
     /// Constant k and ρc per block, for the linear steady solver.
     pub(super) fn constant(&self) -> Option<Vec<Material>> {
         self.laws

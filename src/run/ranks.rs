@@ -16,7 +16,7 @@ use crate::mesh::Mesh;
 use crate::parallel::{self, MeshPlan, MeshShare};
 
 use super::physics::Physics;
-use super::problem::{BcKind, ProblemFile};
+use super::problem::ProblemFile;
 use super::{RunError, RunOptions};
 
 /// The mesh this rank runs on, and the seconds reading it took: rank 0 (and a serial
@@ -90,9 +90,8 @@ pub(super) fn quiet() -> RunError {
 
 /// Whether the run is one the distributed steady solve, or the distributed linear
 /// transient steps, take from start to end, so that the ranks other than 0 can hold
-/// their part of the mesh only: steady or transient, one temperature field with
-/// conductivities constant or laws of T, ρc constant in a transient run, and sources of
-/// x alone (per block), no radiation,
+/// their part of the mesh only: steady or transient, one temperature field (its laws
+/// and sources of T, x and t, radiation or not),
 /// no moving or dying surfaces, no restart or nodal fields, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
 /// no toggle, no contact pressure field, no voltage or species enforcement, no
@@ -113,18 +112,8 @@ pub(super) fn distributable(
     if !p.nodal_field.is_empty() {
         return refuse("a [[nodal_field]]");
     }
-    if !physics.source_of_x_only()
-        || !physics.materials.assembled_per_rank(file.transient)
-        || physics.field_names.len() != 1
-        || physics.materials.electric()
-        || physics.species.any()
-    {
-        return refuse(
-            "not one temperature field with sources of x alone and, in a transient run, constant ρc (the general solver)",
-        );
-    }
-    if p.bc.iter().any(|b| b.kind == BcKind::Radiation) {
-        return refuse("a radiation condition (the general solver)");
+    if physics.field_names.len() != 1 || physics.materials.electric() || physics.species.any() {
+        return refuse("not one temperature field (the general solver)");
     }
     crate::parallel::can_distribute(physics.mesh)?;
     let Some(contact) = &p.contact else {

@@ -13,7 +13,7 @@ use crate::heat::law::Law;
 use crate::heat::species::SPECIES;
 use crate::heat::steady::{SteadyProblem, SteadySolution, solve_steady};
 use crate::heat::transient::{
-    self, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
+    self, BlockLaws, FieldSpec, Loads, Start, State, StepReport, TimeMode, TransientProblem,
 };
 use crate::heat::{HeatError, Material, SourceFn, TEMPERATURE};
 use crate::mesh::NodeId;
@@ -91,26 +91,20 @@ impl<'a> TimeLoop<'a> {
     }
 
     /// Whether a run under MPI steps with its assembly distributed: a transient run, or
-    /// a steady one whose conductivity depends on T (one Newton solve, the general
-    /// solver's steady solve), of the kind the linear steady solve takes but for k — one
-    /// field, k constant or a law of T, ρc constant, a source of x alone, no toggles,
-    /// radiation or multiplier ties (its interfaces linear, or Newton through a
-    /// temperature-dependent conductance) — with no restart, nothing moving or dying and
-    /// no nodal field. (Every run whose mesh `ranks::distributable` splits and is not a
-    /// linear steady one is one.)
+    /// a steady one the linear steady solve does not take (one Newton solve, the general
+    /// solver's steady solve), of one temperature field — its laws and sources of T, x
+    /// and t, radiation or not — with no toggles or multiplier ties (its interfaces
+    /// linear, or Newton through a temperature-dependent conductance), no restart,
+    /// nothing moving or dying and no nodal field. (Every run whose mesh
+    /// `ranks::distributable` splits and is not a linear steady one is one.)
     fn is_stepped_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
-        let transient = self.file.transient;
         crate::parallel::world().is_some()
-            && (transient || physics.materials.conductivity_laws().is_some())
             && !self.terms.multiplier_ties()
-            && physics.source_of_x_only()
-            && physics.materials.assembled_per_rank(transient)
             && physics.field_names.len() == 1
             && !physics.materials.electric()
             && !physics.species.any()
             && !self.terms.couplings.any_toggle()
-            && problem.bc.iter().all(|b| b.kind != BcKind::Radiation)
             && problem.restart.is_none()
             && self.options.restart.is_none()
             && problem.displacement.is_none()
@@ -202,8 +196,8 @@ impl<'a> TimeLoop<'a> {
             Some((m, origin)) => (m, Some(origin.as_slice())),
             None => (physics.mesh, None),
         };
-        // ρc constant where it is read (a transient run); a conductivity of T is read
-        // from `conductivity` instead (NaN here, never read).
+        // The constants of the linear solve; a law of T or time is read from `laws`
+        // instead (NaN or 0 here, never read).
         let constant = |law: &Law, otherwise: f64| match law {
             Law::Constant(v) => *v,
             _ => otherwise,
@@ -216,7 +210,17 @@ impl<'a> TimeLoop<'a> {
                 rho_c: constant(&l.capacity, 0.0),
             })
             .collect();
-        let conductivity = (physics.materials.conductivity_laws()).map(|k| per_block(&k, origin));
+        let of_blocks = |law: fn(&BlockLaws) -> &Law| -> Vec<Law> {
+            per_block(
+                &laws.iter().map(|l| law(l).clone()).collect::<Vec<_>>(),
+                origin,
+            )
+        };
+        let laws = (
+            of_blocks(|l| &l.conductivity),
+            of_blocks(|l| &l.capacity),
+            per_block(&physics.block_source, origin),
+        );
         // The temperature unknowns (multipliers aside) decide the automatic choice.
         let solid: Vec<usize> = (0..mesh.blocks.len())
             .filter(|&b| mesh.blocks[b].topology.is_solid())
@@ -240,7 +244,7 @@ impl<'a> TimeLoop<'a> {
         Ok(LinearProblem {
             mesh,
             materials: per_block(&materials, origin),
-            conductivity,
+            laws,
             rho_c: per_block(&rho_c, origin),
             block_source: per_block(sources, origin),
             loads,
@@ -277,7 +281,11 @@ impl<'a> TimeLoop<'a> {
         };
         let stepping = crate::parallel::Stepping {
             rho_c: &linear.rho_c,
-            conductivity: linear.conductivity.as_deref(),
+            laws: crate::parallel::Laws {
+                conductivity: &linear.laws.0,
+                capacity: &linear.laws.1,
+                source: &linear.laws.2,
+            },
             steady: !self.file.transient,
             scheme: time.scheme,
             start: time.start,
@@ -576,8 +584,8 @@ impl<'a> TimeLoop<'a> {
 struct LinearProblem<'m> {
     mesh: &'m crate::mesh::Mesh,
     materials: Vec<crate::heat::Material>,
-    /// k(T) per block when some block's conductivity is not a constant.
-    conductivity: Option<Vec<Law>>,
+    /// k, ρc and Q per block, as laws.
+    laws: (Vec<Law>, Vec<Law>, Vec<Law>),
     /// ρc per block.
     rho_c: Vec<f64>,
     block_source: Vec<Option<SourceFn<'m>>>,

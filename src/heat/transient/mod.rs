@@ -63,7 +63,7 @@ pub(crate) use newton::unconverged;
 use newton::{Context, History, Solvers};
 use setup::Setup;
 #[cfg(feature = "mpi")]
-pub(crate) use setup::lumped_weights;
+pub(crate) use setup::{LumpedWeight, lumped_weights};
 
 /// Time integration scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
