@@ -375,6 +375,38 @@ fn shrink_fit_block_source_equals_serial() {
     );
 }
 
+/// The shrink fit (2-D axisymmetric quadrilaterals) with a steel conductivity of T and
+/// the sleeve radiating besides its convection: the steady Newton solve assembled per
+/// rank on its mesh per rank, the element and face terms weighted by 2πr; equal to
+/// serial.
+#[test]
+fn shrink_fit_conductivity_of_t_and_radiation_equal_serial() {
+    let radiation = "[[bc]]\nkind = \"radiation\"\nsurfaces = [\"sleeve_outside\"]\n\
+                     value = 0.6\nambient = 300.0\n\n[contact]";
+    let (_tmp, problem) = edited_example(
+        "shrink_fit",
+        "problem.toml",
+        &[
+            (
+                "conductivity = 45.0",
+                "conductivity = { table = [[300.0, 50.0], [700.0, 30.0]] }",
+            ),
+            ("[contact]", radiation),
+        ],
+    );
+    let (_, runs) = compare_runs(&problem, true);
+    for (n, par) in (1..).zip(&runs) {
+        let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(
+            reason.contains("a steady solve assembled per rank"),
+            "{reason}"
+        );
+        if n > 1 {
+            assert!(par.log.contains(PART_ONLY), "{n} ranks:\n{}", par.log);
+        }
+    }
+}
+
 /// Two long non-matching boxes side by side, joined at x = 1: the partition of a long
 /// bar cuts across it, so the interface's side-A and side-B faces are spread over ranks.
 /// `enforcement`: the lines of its enforcement block; `solve`: more of `[solve]`.
