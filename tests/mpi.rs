@@ -1186,6 +1186,34 @@ fn opening_gap_moving_surfaces_equals_serial() {
     );
 }
 
+/// The same with the steel's conductivity a table of T and `linear_solver = "amg"`: the
+/// general solver's unsymmetric Newton steps of one field, by GMRES with BoomerAMG on
+/// the whole Jacobian (serial: seam's AMG-GMRES), the serial Newton iterations.
+#[test]
+fn opening_gap_conductivity_of_t_by_gmres_equals_serial() {
+    let (_tmp, problem) = edited_example(
+        "opening_gap",
+        "problem.toml",
+        &[
+            (
+                "end_time = 600.0\n",
+                "end_time = 200.0\nlinear_solver = \"amg\"\n",
+            ),
+            (
+                "conductivity = 45.0 ",
+                "conductivity = { table = [[300.0, 45.0], [500.0, 35.0]] } ",
+            ),
+        ],
+    );
+    let (serial, runs) = compare_runs(&problem, false);
+    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
+    for par in &runs {
+        let solver = &par.summary["linear_solver"];
+        assert_eq!(solver["name"], "PETSc GMRES + BoomerAMG", "{solver}");
+        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
+    }
+}
+
 /// Element death: block 1 (two layers) under a lid across a gas gap; its upper layer
 /// dies at t = 5 and the faces it exposes, block 1 being skinned for contact, carry the
 /// heat across the wider gap.
