@@ -619,9 +619,17 @@ fn cut_interface_transient_newton_cuts_failed_steps_as_serial() {
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
     assert_rejected_as_serial(&serial, &runs, "steps cut");
+    assert_newton_as_serial(&serial, &runs, "");
+}
+
+/// Every distributed run took the serial run's Newton iterations (the same stopping
+/// test), and its solver's reason says `reason`.
+fn assert_newton_as_serial(serial: &Ran, runs: &[Ran], reason: &str) {
     let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
-    for par in &runs {
-        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
+    for par in runs {
+        let why = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(why.contains(reason), "{why}");
+        assert_eq!(newton(par), newton(serial), "{}", par.summary);
     }
 }
 
@@ -650,14 +658,9 @@ fn cut_interface_transient_conductivity_of_t_equals_serial() {
     std::fs::write(&problem, conductivity_of_t(&text)).unwrap();
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
-    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
-    for par in &runs {
-        let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
-        assert!(reason.contains("conductivity"), "{reason}");
-        // Newton's iterations are the serial steps' (the same stopping test).
-        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
-    }
-    assert!(newton(&serial) > 2 * 3, "{}", serial.summary);
+    assert_newton_as_serial(&serial, &runs, "conductivity");
+    let newton = serial.summary["newton_iterations"].as_u64().unwrap();
+    assert!(newton > 2 * 3, "{}", serial.summary);
 }
 
 /// A steady solve with k(T) (the general solver's one nonlinear solve), assembled per
@@ -732,12 +735,7 @@ fn cut_interface_transient_laws_of_t_and_radiation_equal_serial() {
     std::fs::write(&problem, text).unwrap();
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
-    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
-    for par in &runs {
-        let reason = par.summary["linear_solver"]["reason"].as_str().unwrap();
-        assert!(reason.contains("a conduction of T"), "{reason}");
-        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
-    }
+    assert_newton_as_serial(&serial, &runs, "a conduction of T");
 }
 
 /// The serial run rejected some attempts (`what`), and every distributed run as many.
@@ -1206,11 +1204,10 @@ fn opening_gap_conductivity_of_t_by_gmres_equals_serial() {
         ],
     );
     let (serial, runs) = compare_runs(&problem, false);
-    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
+    assert_newton_as_serial(&serial, &runs, "GMRES + BoomerAMG");
     for par in &runs {
         let solver = &par.summary["linear_solver"];
         assert_eq!(solver["name"], "PETSc GMRES + BoomerAMG", "{solver}");
-        assert_eq!(newton(par), newton(&serial), "{}", par.summary);
     }
 }
 

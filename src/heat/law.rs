@@ -105,6 +105,48 @@ impl Law {
         }
     }
 
+    /// A source's Q(T, x, t) and dQ/dT where both are finite; else what went wrong there,
+    /// on one line with the place, T and t (what the solvers report).
+    pub(crate) fn source_at(
+        &self,
+        temp: f64,
+        x: [f64; 3],
+        time: f64,
+    ) -> Result<(f64, f64), String> {
+        let what = match self.eval(temp, x, time) {
+            Ok((q, dq)) if q.is_finite() && dq.is_finite() => return Ok((q, dq)),
+            Ok((q, dq)) => format!("Q = {q}, dQ/dT = {dq}"),
+            Err(m) => m.lines().next().unwrap_or_default().to_string(),
+        };
+        let [x0, x1, x2] = x;
+        Err(format!(
+            "{what} at ({x0:.6}, {x1:.6}, {x2:.6}), T = {temp}, t = {time}"
+        ))
+    }
+
+    /// The source at time `time` as a function of x alone (T not read), for the linear
+    /// solves: 0 where it fails or is not finite, the first such place kept in `failed`
+    /// (reported after the assembly).
+    pub(crate) fn source_of_x<'a>(
+        &'a self,
+        time: f64,
+        failed: &'a std::sync::Mutex<Option<String>>,
+    ) -> impl Fn([f64; 3]) -> f64 + Sync + 'a {
+        move |x| match self.eval(0.0, x, time) {
+            Ok((v, _)) if v.is_finite() => v,
+            r => {
+                let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
+                let what = match r {
+                    Err(e) => e.lines().next().unwrap_or_default().to_string(),
+                    Ok((v, _)) => format!("Q = {v}"),
+                };
+                let [x0, x1, x2] = x;
+                slot.get_or_insert_with(|| format!("{what} at ({x0:.6}, {x1:.6}, {x2:.6})"));
+                0.0
+            }
+        }
+    }
+
     /// Check the law once, on the calling thread: a Lua expression compiles and gives
     /// a finite number at `t`.
     pub fn check(&self, t: f64) -> Result<(), String> {

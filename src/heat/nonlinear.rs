@@ -52,16 +52,10 @@ pub(crate) fn conduction_at(
         }
         let failed = Cell::new(None);
         let q = |temp: f64, xq: [f64; 3]| {
-            let what = match source[b].eval(temp, xq, time) {
-                Ok((q, dq)) if q.is_finite() && dq.is_finite() => return (q, dq),
-                Ok((q, dq)) => format!("Q = {q}, dQ/dT = {dq}"),
-                Err(m) => m.lines().next().unwrap_or_default().to_string(),
-            };
-            let [x0, x1, x2] = xq;
-            failed.set(Some(format!(
-                "{what} at ({x0:.6}, {x1:.6}, {x2:.6}), T = {temp}, t = {time}"
-            )));
-            (0.0, 0.0)
+            source[b].source_at(temp, xq, time).unwrap_or_else(|m| {
+                failed.set(Some(m));
+                (0.0, 0.0)
+            })
         };
         kernel::source_residual_jacobian(rule, x, te, q, re, ke)
             .map_err(ElementFailure::Jacobian)?;

@@ -81,20 +81,10 @@ pub(super) fn conduction<'a>(
             // Each source at time t (of x alone: the linear conduction's); the first
             // failure met is reported.
             let mutex = std::sync::Mutex::new(None::<String>);
-            let t = terms.t;
             let failed = &mutex;
-            let at_t = |law: &'a Law| {
-                move |x: [f64; 3]| match law.eval(0.0, x, t) {
-                    Ok((v, _)) if v.is_finite() => v,
-                    r => {
-                        let what = r.map_or_else(|e| e, |(v, _)| format!("Q = {v}"));
-                        let mut slot = failed.lock().unwrap_or_else(|e| e.into_inner());
-                        slot.get_or_insert(format!("{what} at {x:?}, t = {t}"));
-                        0.0
-                    }
-                }
-            };
-            let closures: Vec<_> = laws.iter().map(at_t).collect();
+            let closures: Vec<_> = (laws.iter())
+                .map(|law: &'a Law| law.source_of_x(terms.t, failed))
+                .collect();
             let sources: Vec<Option<crate::heat::SourceFn<'_>>> = (closures.iter())
                 .zip(laws)
                 .map(|(f, law)| (*law != Law::Constant(0.0)).then_some(f as _))

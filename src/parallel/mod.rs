@@ -181,7 +181,7 @@ pub fn steady(p: &SteadyProblem<'_>) -> Option<Result<SteadySolution, HeatError>
 pub struct Laws<'s> {
     /// k(T, x, t), W/m/K.
     pub conductivity: &'s [crate::heat::law::Law],
-    /// ρc(T, x, t), J/m³/K (read where one is not a constant; else [`Stepping::rho_c`]).
+    /// ρc(T, x, t), J/m³/K.
     pub capacity: &'s [crate::heat::law::Law],
     /// Q(T, x, t), W/m³ (a constant 0: none).
     pub source: &'s [crate::heat::law::Law],
@@ -189,8 +189,6 @@ pub struct Laws<'s> {
 
 /// A transient run's time stepping, for [`transient`] (or one steady solve: `steady`).
 pub struct Stepping<'s> {
-    /// ρc (J/m³/K) per block of the problem's mesh.
-    pub rho_c: &'s [f64],
     /// The laws of the run's materials and sources per block of the problem's mesh: its
     /// conduction is assembled at every Newton iterate when one depends on temperature
     /// (or it has radiation), its sources taken at each step's time when they depend on

@@ -255,11 +255,14 @@ impl<'p> Built<'p> {
         let varies = |l: &[Law]| l.iter().any(|l| !matches!(l, Law::Constant(_)));
         let capacity_of_t = transient && laws.is_some_and(|l| varies(l.capacity));
         let radiation = (p.face_bcs.iter()).any(|f| matches!(f, FaceBc::Radiation { .. }));
-        let nonlinear = capacity_of_t
-            || radiation
-            || laws.is_some_and(|l| {
-                varies(l.conductivity) || l.source.iter().any(Law::uses_temperature)
-            });
+        // (Radiation without laws — the linear steady solve's — is refused by its
+        // conduction, as serially.)
+        let nonlinear = laws.is_some_and(|l| {
+            capacity_of_t
+                || radiation
+                || varies(l.conductivity)
+                || l.source.iter().any(Law::uses_temperature)
+        });
         let sources_in_time = laws.is_some_and(|l| l.source.iter().any(Law::depends_on_time));
         let k_first = match nonlinear {
             true => None,
@@ -458,18 +461,20 @@ impl<'p> Built<'p> {
         Some(worst * c)
     }
 
-    /// The lumped capacity `∫ ρc N_a` of this rank's own elements at each local dof,
-    /// `rho_c` per block of the problem's mesh, and its weights `∫ N_a` per (dof, block)
-    /// (for a ρc of T).
+    /// The lumped capacity `∫ ρc N_a` of this rank's own elements at each local dof, of
+    /// the blocks (of the problem's mesh) whose ρc in `capacity` is a constant, and the
+    /// weights `∫ N_a` per (dof, block) (a ρc of T takes them at each iterate).
     pub(super) fn capacity(
         &self,
-        rho_c: &[f64],
+        capacity: &[Law],
     ) -> Result<(Vec<f64>, Vec<LumpedWeight>), HeatError> {
         let weights =
             crate::heat::transient::lumped_weights(&self.local, &self.dofs, None, &|_| true)?;
         let mut m = vec![0.0; self.n];
         for &(d, b, w, _) in &weights {
-            m[d as usize] += w * rho_c[b as usize];
+            if let Law::Constant(rho_c) = capacity[b as usize] {
+                m[d as usize] += w * rho_c;
+            }
         }
         Ok((m, weights))
     }
@@ -726,8 +731,11 @@ impl<'b, 'p> Newton<'b, 'p> {
                     }
                 }
             }
+            // (Only a ρc of T can fail, and only then do the ranks agree on it: no
+            // collective on a linear step.)
             let stored = match capacity {
-                Some(c) => Some(agreed(c.terms(u, &built.touched))?),
+                Some(c) if c.of_t.is_some() => Some(agreed(c.terms(u, &built.touched))?),
+                Some(c) => Some(c.terms(u, &built.touched)?),
                 None => None,
             };
             if let Some((stored, _)) = &stored {

@@ -43,7 +43,7 @@ pub(super) fn solve(
     let built = Built::new(p, s.start, Some(s.laws), !s.steady)?;
     let mut newton = Newton::new(&built, !s.steady)?;
     let (n, field, root) = (built.n, built.field, built.is_root());
-    let (m, lumped) = built.capacity(s.rho_c)?;
+    let (m, lumped) = built.capacity(s.laws.capacity)?;
     // The initial field at the rank's nodes; a contact partner's nodes from their owners.
     let mut u = vec![0.0; n];
     for (node, &v) in s.initial.iter().enumerate() {

@@ -161,7 +161,7 @@ impl<'a> Physics<'a> {
         (self.block_source.iter())
             .map(|q| {
                 (*q != Law::Constant(0.0))
-                    .then(|| Box::new(source_of_x(q, self.time.start, failed)) as Box<_>)
+                    .then(|| Box::new(q.source_of_x(self.time.start, failed)) as Box<_>)
             })
             .collect()
     }
@@ -827,29 +827,6 @@ fn block_sources(
 
 /// A source as a function of x at one time (W/m³), for the linear steady solver.
 pub(super) type SourceOfX<'s> = Box<dyn Fn([f64; 3]) -> f64 + Sync + 's>;
-
-/// A source law that does not depend on T as a function of x at `time`, for the linear
-/// steady solver; the first failure (a Lua error, a non-finite value) is kept in
-/// `failed` and the point contributes nothing.
-fn source_of_x<'a>(
-    law: &'a Law,
-    time: f64,
-    failed: &'a std::sync::Mutex<Option<String>>,
-) -> impl Fn([f64; 3]) -> f64 + Sync + 'a {
-    move |x| match law.eval(0.0, x, time) {
-        Ok((v, _)) if v.is_finite() => v,
-        r => {
-            let mut slot = failed.lock().unwrap_or_else(|p| p.into_inner());
-            let what = match r {
-                Err(e) => e.lines().next().unwrap_or_default().to_string(),
-                Ok((v, _)) => format!("Q = {v}"),
-            };
-            let [x0, x1, x2] = x;
-            slot.get_or_insert_with(|| format!("{what} at ({x0:.6}, {x1:.6}, {x2:.6})"));
-            0.0
-        }
-    }
-}
 
 /// Initial nodal temperatures: `[initial] temperature`, else (a steady nonlinear
 /// solve's first guess) the mean of the Dirichlet values, else 0.

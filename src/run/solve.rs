@@ -203,7 +203,6 @@ impl<'a> TimeLoop<'a> {
             _ => otherwise,
         };
         let laws = &physics.materials.laws;
-        let rho_c: Vec<f64> = laws.iter().map(|l| constant(&l.capacity, 0.0)).collect();
         let materials: Vec<Material> = (laws.iter())
             .map(|l| Material {
                 conductivity: constant(&l.conductivity, f64::NAN),
@@ -245,7 +244,6 @@ impl<'a> TimeLoop<'a> {
             mesh,
             materials: per_block(&materials, origin),
             laws,
-            rho_c: per_block(&rho_c, origin),
             block_source: per_block(sources, origin),
             loads,
             interfaces,
@@ -280,7 +278,6 @@ impl<'a> TimeLoop<'a> {
                 .map_err(HeatError::Step)
         };
         let stepping = crate::parallel::Stepping {
-            rho_c: &linear.rho_c,
             laws: crate::parallel::Laws {
                 conductivity: &linear.laws.0,
                 capacity: &linear.laws.1,
@@ -586,8 +583,6 @@ struct LinearProblem<'m> {
     materials: Vec<crate::heat::Material>,
     /// k, ρc and Q per block, as laws.
     laws: (Vec<Law>, Vec<Law>, Vec<Law>),
-    /// ρc per block.
-    rho_c: Vec<f64>,
     block_source: Vec<Option<SourceFn<'m>>>,
     loads: Loads,
     interfaces: &'m dyn crate::heat::interfaces::Interfaces,

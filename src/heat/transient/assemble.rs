@@ -128,17 +128,11 @@ impl Context<'_, '_> {
             // Q(T, x, t) and dQ/dT; a failure or a non-finite value stops the run there.
             let q_failed = Cell::new(None);
             let q = |temp: f64, xq: [f64; 3]| {
-                let v = block_source.map_or(Ok((0.0, 0.0)), |s| s[b].eval(temp, xq, t));
-                let what = match v {
-                    Ok((q, dq)) if q.is_finite() && dq.is_finite() => return (q, dq),
-                    Ok((q, dq)) => format!("Q = {q}, dQ/dT = {dq}"),
-                    Err(m) => m.lines().next().unwrap_or_default().to_string(),
-                };
-                let [x0, x1, x2] = xq;
-                q_failed.set(Some(format!(
-                    "{what} at ({x0:.6}, {x1:.6}, {x2:.6}), T = {temp}, t = {t}"
-                )));
-                (0.0, 0.0)
+                let v = block_source.map_or(Ok((0.0, 0.0)), |s| s[b].source_at(temp, xq, t));
+                v.unwrap_or_else(|m| {
+                    q_failed.set(Some(m));
+                    (0.0, 0.0)
+                })
             };
             let conduction = if keep {
                 Ok(())
