@@ -601,6 +601,23 @@ fn metis_fill_is_at_most_amd_fill() {
 /// compared with the constraint eliminated by hand (u = T ū, Tᵀ K T ū = Tᵀ f, dense).
 #[test]
 fn saddle_ldlt_matches_eliminated_solution() {
+    saddle_ldlt_against_elimination(1.0, 1.0);
+}
+
+/// The same tie badly scaled, as a mortar tie is: conductivities 1e3 times larger and
+/// constraint rows 1e-4 times smaller (C scales with the face areas), so that the
+/// multipliers' Schur pivots sit near 1e-11 of K's diagonal, far below the
+/// regularisation δ = 1e-8 of it. Unscaled, the refinement stalled short of its
+/// tolerance and the answer was off; the factorisation of the scaled matrix
+/// solves it as the well-scaled one, without the LU fallback.
+#[test]
+fn saddle_ldlt_solves_a_badly_scaled_tie() {
+    saddle_ldlt_against_elimination(1e3, 1e-4);
+}
+
+/// [`saddle_ldlt_matches_eliminated_solution`] with conductivities times `k_scale` and
+/// the constraint rows times `c_scale`.
+fn saddle_ldlt_against_elimination(k_scale: f64, c_scale: f64) {
     let cells = [3, 3, 3];
     let mut mesh = seam::mesh::generate::boxes(
         &[
@@ -666,7 +683,7 @@ fn saddle_ldlt_matches_eliminated_solution() {
     pattern.build().unwrap();
     let mut asm = Assembler::new(&pattern);
     let rule = Basis::standard(Topology::Hex8).unwrap();
-    let kcond = [1.0, 4.0];
+    let kcond = [k_scale, 4.0 * k_scale];
     asm.elements(&mesh, None, |e, ke, fe| {
         let x: Vec<[f64; 3]> = mesh
             .elem_nodes(e)
@@ -679,9 +696,10 @@ fn saddle_ldlt_matches_eliminated_solution() {
     });
     for (k, (_, m)) in ties.iter().enumerate() {
         // Row λ_k: u_s − 0.6 u_m0 − 0.4 u_m1 = 0 (and the symmetric column).
-        asm.add_coupling(3 * k, 1.0, 1.0);
-        asm.add_coupling(3 * k + 1, -m[0].1, -m[0].1);
-        asm.add_coupling(3 * k + 2, -m[1].1, -m[1].1);
+        let c = c_scale;
+        asm.add_coupling(3 * k, c, c);
+        asm.add_coupling(3 * k + 1, -c * m[0].1, -c * m[0].1);
+        asm.add_coupling(3 * k + 2, -c * m[1].1, -c * m[1].1);
     }
     let mut a = asm.matrix().unwrap();
     let mut b = asm.rhs();
@@ -700,6 +718,10 @@ fn saddle_ldlt_matches_eliminated_solution() {
     let mut x = b.clone();
     let report = ldlt.solve(&mut x).unwrap();
     assert!(report.residual <= 1e-13, "{report:?}");
+    assert!(
+        !ldlt.fell_back(),
+        "the scaled factorisation solves without LU"
+    );
 
     // Reference: eliminate the slaves. T maps the free (non-slave) primal dofs to all.
     let is_slave: std::collections::HashMap<usize, [(usize, f64); 2]> =
