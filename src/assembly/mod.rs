@@ -299,7 +299,11 @@ impl Pattern {
     pub fn new(mesh: &Mesh, dofs: &DofMap) -> Self {
         let mut block_slots = Vec::with_capacity(mesh.blocks.len());
         let mut elem_values = 0;
-        let mut elem_dofs = Vec::new();
+        // Sized at once, not grown by doubling (copied, its pages faulted in again).
+        let total = (0..mesh.blocks.len())
+            .map(|b| mesh.blocks[b].len() * dofs.elem_dof_count(mesh, b))
+            .sum();
+        let mut elem_dofs = Vec::with_capacity(total);
         let mut buf = Vec::new();
         for (b, block) in mesh.blocks.iter().enumerate() {
             let ne = dofs.elem_dof_count(mesh, b);
