@@ -714,6 +714,30 @@ fn cut_interface_transient_source_in_time_equals_serial() {
     assert_steps_distributed(&serial, &runs);
 }
 
+/// A gap conductance that switches on during the run (`h = 2e4 max(t − 0.15, 0)`,
+/// Lua): zero over the first step, whose matrix the interface adds only zeros to, and
+/// 1 000 W/m²/K at the second. The steps assembled per rank take each step's h, as
+/// serially, and the interface entries the first matrix left out are filled later.
+#[test]
+fn cut_interface_conductance_switched_on_in_time_equals_serial() {
+    let tmp = scratch("conductance_in_time");
+    let enforcement = "enforcement for energy = gap_conductance\n \
+        gap conductance coefficient = lua \"2e4*math.max(t - 0.15, 0)\"";
+    let (problem, _) = write_transient_cut_case(tmp.path(), enforcement, "", 0.1);
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    let heat = |r: &Ran| {
+        r.summary["interactions"][0]["heat_side_a"]
+            .as_f64()
+            .unwrap()
+    };
+    assert!(
+        heat(&serial).abs() > 1.0,
+        "h is on at the end: {}",
+        serial.summary
+    );
+}
+
 /// Every law of T at once, assembled per rank at every Newton iterate: k(T) in both
 /// blocks, ρc(T) (a table), a source of T and t (Lua) and a radiation condition on one
 /// face; BDF2 steps; temperatures, heats and Newton iterations equal serial.
