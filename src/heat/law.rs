@@ -93,13 +93,13 @@ impl Law {
             Law::Table(p) => Ok(table(p, t)),
             Law::TimeTable(p) => Ok((table(p, time).0, 0.0)),
             Law::Lua { expr, chunk } => {
-                let h = 1e-6 * t.abs().max(1.0);
-                let v = lua_value(expr, chunk, [t, x[0], x[1], x[2], time])?;
+                let at = |t: f64| [t, x[0], x[1], x[2], time];
                 if !names_temperature(expr) {
+                    let [v] = lua_values(expr, chunk, [at(t)])?;
                     return Ok((v, 0.0));
                 }
-                let up = lua_value(expr, chunk, [t + h, x[0], x[1], x[2], time])?;
-                let down = lua_value(expr, chunk, [t - h, x[0], x[1], x[2], time])?;
+                let h = 1e-6 * t.abs().max(1.0);
+                let [v, up, down] = lua_values(expr, chunk, [at(t), at(t + h), at(t - h)])?;
                 Ok((v, (up - down) / (2.0 * h)))
             }
         }
@@ -185,7 +185,14 @@ fn table(p: &[(f64, f64)], t: f64) -> (f64, f64) {
     (a.1 + slope * (t - a.0), slope)
 }
 
-fn lua_value(expr: &str, chunk: &str, args: [f64; 5]) -> Result<f64, String> {
+/// `expr` at each of `args` in turn (`T, x, y, z, t`), compiled once per thread: the
+/// thread's sandbox borrowed and the compiled function looked up once for all of them
+/// (a k(T)'s value and its two differences are one lookup, not three).
+fn lua_values<const N: usize>(
+    expr: &str,
+    chunk: &str,
+    args: [[f64; 5]; N],
+) -> Result<[f64; N], String> {
     SANDBOX.with(|cell| {
         let mut slot = cell.borrow_mut();
         if slot.is_none() {
@@ -193,17 +200,18 @@ fn lua_value(expr: &str, chunk: &str, args: [f64; 5]) -> Result<f64, String> {
             *slot = Some((sandbox, HashMap::new()));
         }
         let (sandbox, compiled) = slot.as_mut().expect("just made");
-        let f = match compiled.get(expr) {
-            Some(f) => f.clone(),
-            None => {
-                let f = sandbox
-                    .expression(chunk, expr, &["T", "x", "y", "z", "t"])
-                    .map_err(|e| e.to_string())?;
-                compiled.insert(expr.to_string(), f.clone());
-                f
-            }
-        };
-        sandbox.call(&f, &args).map_err(|e| e.to_string())
+        if !compiled.contains_key(expr) {
+            let f = sandbox
+                .expression(chunk, expr, &["T", "x", "y", "z", "t"])
+                .map_err(|e| e.to_string())?;
+            compiled.insert(expr.to_string(), f);
+        }
+        let f = &compiled[expr];
+        let mut out = [0.0; N];
+        for (o, a) in out.iter_mut().zip(&args) {
+            *o = sandbox.call(f, a).map_err(|e| e.to_string())?;
+        }
+        Ok(out)
     })
 }
 

@@ -243,8 +243,12 @@ impl Sandbox {
     /// (none, two or more are [`ScriptError::NotOneValue`], naming what came back).
     pub fn call(&self, f: &ScriptFn, args: &[f64]) -> Result<f64, ScriptError> {
         self.reset_budget();
-        let args = mlua::Variadic::from_iter(args.iter().copied());
-        let values: mlua::MultiValue = f.f.call(args).map_err(|e| self.classify(&f.name, e))?;
+        // Five numbers (a law's `T, x, y, z, t`) pushed as a tuple: no list made per call.
+        let values: mlua::MultiValue = match *args {
+            [a, b, c, d, e] => f.f.call((a, b, c, d, e)),
+            _ => f.f.call(mlua::Variadic::from_iter(args.iter().copied())),
+        }
+        .map_err(|e| self.classify(&f.name, e))?;
         if values.len() != 1 {
             let shown: Vec<String> = values.iter().take(4).map(describe).collect();
             let more = if values.len() > 4 { ", …" } else { "" };
