@@ -14,7 +14,7 @@ use faer::sparse::linalg::cholesky::{
     SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::linalg::solvers::{Lu as FaerLu, SymbolicLu};
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Side};
 
 use super::{LinearSolver, SolveError, SolveReport, check_finite, check_rhs, norm, spmv};
@@ -491,13 +491,15 @@ impl LinearSolver for SaddleLdlt {
         let sym = &an.symbolic;
         self.values.resize(sym.len_val(), 0.0);
         self.scale = saddle_scaling(a, &self.signs);
-        let mut scaled = a.clone();
+        // The scaled values over the matrix's own structure (no copy of it).
         let s = a.symbolic();
+        let mut scaled_values = a.val().to_vec();
         for j in 0..a.ncols() {
             for p in s.col_range(j) {
-                scaled.val_mut()[p] *= self.scale[s.row_idx()[p]] * self.scale[j];
+                scaled_values[p] *= self.scale[s.row_idx()[p]] * self.scale[j];
             }
         }
+        let scaled = SparseColMatRef::new(s, &scaled_values);
         let mut dmax: f64 = 0.0;
         for j in 0..a.ncols() {
             for p in s.col_range(j) {
@@ -522,7 +524,7 @@ impl LinearSolver for SaddleLdlt {
         self.fallback = None;
         match sym.factorize_numeric_ldlt(
             &mut self.values,
-            scaled.as_ref(),
+            scaled,
             Side::Lower,
             reg,
             par,
