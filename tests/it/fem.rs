@@ -601,23 +601,33 @@ fn metis_fill_is_at_most_amd_fill() {
 /// compared with the constraint eliminated by hand (u = T ū, Tᵀ K T ū = Tᵀ f, dense).
 #[test]
 fn saddle_ldlt_matches_eliminated_solution() {
-    saddle_ldlt_against_elimination(1.0, 1.0);
+    saddle_ldlt_against_elimination(1.0, 1.0, true);
 }
 
 /// The same tie badly scaled, as a mortar tie is: conductivities 1e3 times larger and
 /// constraint rows 1e-4 times smaller (C scales with the face areas), so that the
 /// multipliers' Schur pivots sit near 1e-11 of K's diagonal, far below the
-/// regularisation δ = 1e-8 of it. Unscaled, the refinement stalled short of its
-/// tolerance and the answer was off; the factorisation of the scaled matrix
-/// solves it as the well-scaled one, without the LU fallback.
+/// regularisation δ = 1e-8 of it. Unscaled (the scaling disabled by hand), the
+/// refinement stopped above 1e-10 and the solve fell back to LU; the factorisation of
+/// the scaled matrix solves it as the well-scaled one, without the fallback.
 #[test]
 fn saddle_ldlt_solves_a_badly_scaled_tie() {
-    saddle_ldlt_against_elimination(1e3, 1e-4);
+    saddle_ldlt_against_elimination(1e3, 1e-4, true);
+}
+
+/// A factorisation that cannot be refined: a regularisation δ of 1e6 (its default is
+/// 1e-8) replaces every pivot of the scaled matrix (each near ±1) by ±1e6, so the
+/// refinement gains almost nothing in its 5 steps, and the solve falls back to LU: the
+/// answer is the eliminated one all the same.
+#[test]
+fn saddle_ldlt_falls_back_to_lu_when_refinement_fails() {
+    saddle_ldlt_against_elimination(1.0, 1.0, false);
 }
 
 /// [`saddle_ldlt_matches_eliminated_solution`] with conductivities times `k_scale` and
-/// the constraint rows times `c_scale`.
-fn saddle_ldlt_against_elimination(k_scale: f64, c_scale: f64) {
+/// the constraint rows times `c_scale`; `refinable` false spoils the factorisation (δ
+/// of 1e6: it must then fall back to LU).
+fn saddle_ldlt_against_elimination(k_scale: f64, c_scale: f64, refinable: bool) {
     let cells = [3, 3, 3];
     let mut mesh = seam::mesh::generate::boxes(
         &[
@@ -714,13 +724,17 @@ fn saddle_ldlt_against_elimination(k_scale: f64, c_scale: f64) {
         .collect();
     apply_dirichlet(&mut a, &mut b, &bc).unwrap();
     let mut ldlt = SaddleLdlt::with_primal(n_primal, dofs.len(), Ordering::Metis);
+    if !refinable {
+        ldlt.delta = 1e6;
+    }
     ldlt.factor(&a).unwrap();
     let mut x = b.clone();
     let report = ldlt.solve(&mut x).unwrap();
     assert!(report.residual <= 1e-13, "{report:?}");
-    assert!(
-        !ldlt.fell_back(),
-        "the scaled factorisation solves without LU"
+    assert_eq!(
+        ldlt.fell_back(),
+        !refinable,
+        "the scaled factorisation solves without LU, a spoilt one with it"
     );
 
     // Reference: eliminate the slaves. T maps the free (non-slave) primal dofs to all.
