@@ -488,6 +488,70 @@ fn cut_interface_constant_conductance_equals_serial() {
     compare(&problem, true);
 }
 
+/// `Contact Pressure Variable` from a `[[nodal_field]]`: a CMY contact resistance whose
+/// pressure rises along the bar (2 → 62 kPa in y), read from an Exodus II file on
+/// the bar's mesh, and given by the same Lua expression. Rank 0 reads the file and sends
+/// each rank the values at its nodes; the ranks hold their parts of the mesh, and the
+/// temperatures and heat equal serial. The field matters: the heat differs from that at
+/// a uniform 10 kPa by more than 1 % (at these pressures the contact resistance is
+/// comparable with the blocks').
+#[test]
+fn cut_interface_contact_pressure_field_equals_serial() {
+    let tmp = scratch("pressure_field");
+    let dir = tmp.path();
+    let cmy = "enforcement for energy = contact_resistance\n gap conductance coefficient = \
+               cmy k_a = 5 k_b = 40 slope = 0.1 roughness = 1e-6 hardness = 3e9";
+    let heat = |r: &Ran| {
+        r.summary["interactions"][0]["heat_side_a"]
+            .as_f64()
+            .unwrap()
+    };
+    let uniform = run(
+        &write_cut_case(dir, &format!("{cmy}\n contact pressure = 1e4"), ""),
+        None,
+    );
+    std::fs::remove_dir_all(dir.join("out_serial")).unwrap();
+    let problem = write_cut_case(dir, &format!("{cmy}\n contact pressure variable = p"), "");
+    let mesh = seam::mesh::read(&dir.join("bar.exo")).unwrap();
+    let p: Vec<f64> = mesh.coords.iter().map(|x| 2e3 + 2e4 * x[1]).collect();
+    let mut w = ExodusWriter::create(&dir.join("pressure.exo"), &mesh, &["pressure"], &[]).unwrap();
+    w.write_step(0.0, &[&p], &[]).unwrap();
+    w.finish().unwrap();
+    let text = std::fs::read_to_string(&problem).unwrap();
+    for field in [
+        "file = \"pressure.exo\"\nvariable = \"pressure\"\n",
+        "value = \"2e3 + 2e4*y\"\n",
+    ] {
+        std::fs::write(
+            &problem,
+            format!("{text}[[nodal_field]]\nname = \"p\"\n{field}"),
+        )
+        .unwrap();
+        let (serial, runs) = compare_runs(&problem, true);
+        for (n, par) in (1..).zip(&runs) {
+            assert!(
+                n == 1 || par.log.contains(PART_ONLY),
+                "{n} ranks: the mesh should be distributed:\n{}",
+                par.log
+            );
+        }
+        eprintln!(
+            "pressure field {field:?}: heat {} W, at 10 kPa {} W",
+            heat(&serial),
+            heat(&uniform)
+        );
+        assert!(
+            (heat(&serial) - heat(&uniform)).abs() > 0.01 * heat(&uniform).abs(),
+            "the field should change the heat: {} vs {}",
+            heat(&serial),
+            heat(&uniform)
+        );
+        for label in ["serial", "n1", "n2", "n3", "n4"] {
+            std::fs::remove_dir_all(dir.join(format!("out_{label}"))).unwrap();
+        }
+    }
+}
+
 /// The same, solved by AMG-preconditioned CG (serial: seam's AMG-CG; MPI: CG + BoomerAMG).
 #[test]
 fn cut_interface_by_amg_cg_equals_serial() {
@@ -735,6 +799,85 @@ fn cut_interface_conductance_switched_on_in_time_equals_serial() {
         heat(&serial).abs() > 1.0,
         "h is on at the end: {}",
         serial.summary
+    );
+}
+
+/// `Use Toggle Block`: the gap conductance on over [0.15, 0.25] only, by backward Euler
+/// steps of 0.1 to t = 0.4 — off at the first step, on at the second, off after. The
+/// first three steps have the same c₀, and the steps assembled per rank (the mesh
+/// distributed) set their matrix again when a term switches: a matrix kept from the
+/// step before would solve the linear steps 2 and 3 with the other step's interface
+/// Jacobian. Every step's temperatures equal serial, and the heat crosses at step 2
+/// only.
+#[test]
+fn cut_interface_toggled_in_time_equals_serial() {
+    let tmp = scratch("toggled_in_time");
+    let enforcement = format!("{GAP_H}\n use toggle block = middle");
+    let solve = "scheme = \"backward_euler\"\n";
+    let (problem, text) = write_transient_cut_case(tmp.path(), &enforcement, solve, 0.1);
+    let text = text.replace("end_time = 0.3", "end_time = 0.4")
+        + "[[toggle]]\nname = \"middle\"\non = [[0.15, 0.25]]\n";
+    std::fs::write(&problem, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    // The serial history: (step, heat leaving side A) of each step.
+    let csv = std::fs::read_to_string(tmp.path().join("out_serial/interface_heat.csv")).unwrap();
+    let heats: Vec<(usize, f64)> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[0].parse().unwrap(), f[5].parse().unwrap())
+        })
+        .collect();
+    eprintln!("toggled heat per step, serial: {heats:?}");
+    for &(step, heat) in &heats {
+        match step {
+            2 => assert!(heat.abs() > 1.0, "on at step 2: {heats:?}"),
+            _ => assert_eq!(heat, 0.0, "off at step {step}: {heats:?}"),
+        }
+    }
+    assert!(heats.iter().any(|&(s, _)| s == 4), "{heats:?}");
+}
+
+/// A restart: the cut bar by BDF2 (whose state holds two past steps), checkpointed by
+/// a serial run at step 3 of 6, continued from that checkpoint serially and on 1–4
+/// ranks. The distributed runs step per rank with the mesh distributed: rank 0 reads
+/// the checkpoint and sends each rank its part, and every continued step equals the
+/// serial continuation. A checkpoint of another problem stops every rank with the
+/// serial run's error.
+#[test]
+fn cut_interface_restart_equals_serial() {
+    let tmp = scratch("restart");
+    let solve = "scheme = \"bdf2\"\n";
+    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, solve, 0.05);
+    let full = text.replace("dir = \"out\"\n", "dir = \"out\"\ncheckpoint_every = 3\n");
+    assert_ne!(full, text, "the output table is where the test expects it");
+    std::fs::write(&problem, full).unwrap();
+    run(&problem, None);
+    let checkpoint = tmp.path().join("checkpoint.seam");
+    std::fs::copy(
+        tmp.path().join("out_serial/checkpoint_00003.seam"),
+        &checkpoint,
+    )
+    .unwrap();
+    std::fs::remove_dir_all(tmp.path().join("out_serial")).unwrap();
+    std::fs::write(
+        &problem,
+        text.clone() + "[restart]\nfile = \"checkpoint.seam\"\n",
+    )
+    .unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_eq!(serial.summary["transient"]["steps"].as_u64(), Some(3));
+    assert_steps_distributed(&serial, &runs);
+    // Another problem's checkpoint: every rank stops, rank 0 saying why.
+    std::fs::write(&checkpoint, b"SEAMCKP1 too short").unwrap();
+    let out = launch(&problem, Some(2));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(!out.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("E0713") && stdout.contains("checkpoint.seam"),
+        "{stdout}"
     );
 }
 

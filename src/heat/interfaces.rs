@@ -87,6 +87,12 @@ pub trait Interfaces {
     fn ties(&self) -> Result<Vec<TieRows>, String>;
     /// Whether tie `k` is switched on at time `t`.
     fn tie_on(&self, k: usize, t: f64) -> bool;
+    /// Whether flux term `k` is switched on at time `t` (a toggle): a solver that keeps
+    /// its matrix from step to step sets it again when a term switches.
+    fn flux_on(&self, k: usize, t: f64) -> bool {
+        let _ = (k, t);
+        true
+    }
     /// The dof pairs `(i, j)`, `i ≤ j`, the flux terms fill (each makes `(i, j)` and
     /// `(j, i)`), at a first state `u` and time `t`; fixed for the solve.
     fn couplings(&self, u: &[f64], t: f64) -> Result<Vec<(usize, usize)>, InterfaceFailure>;

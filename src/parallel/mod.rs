@@ -210,6 +210,10 @@ pub struct Stepping<'s> {
     /// The temperature at each node of the rank's mesh at `start` (the nodes after it,
     /// a contact partner's, take their owners' values).
     pub initial: &'s [f64],
+    /// A transient run from a checkpoint instead of `start` and `initial`: on rank 0 the
+    /// checkpoint's state (the serial dof order, the whole problem's); on the other
+    /// ranks any state (rank 0's is sent them).
+    pub restart: Option<&'s crate::heat::transient::State>,
     /// The Dirichlet values and face conditions at a time.
     #[allow(clippy::type_complexity)]
     pub loads: &'s dyn Fn(
@@ -403,6 +407,20 @@ pub(crate) fn mesh_is_distributed() -> bool {
     }
     #[cfg(not(feature = "mpi"))]
     false
+}
+
+/// A nodal field read by rank 0 alone (`whole`, its values at the whole mesh's nodes,
+/// `None` where it could not, and on the other ranks) at the nodes of this rank's mesh:
+/// collective where the mesh is distributed, each rank getting its nodes' values from
+/// rank 0, `None` on every rank when rank 0 has none. Otherwise `whole` itself.
+pub(crate) fn nodal_from_root(whole: Option<Vec<f64>>) -> Option<Vec<f64>> {
+    #[cfg(feature = "mpi")]
+    {
+        if part::distributed() {
+            return part::nodal_from_root(whole);
+        }
+    }
+    whole
 }
 
 /// Rank 0's `local` on every rank of a distributed run (collective), `local` serially:

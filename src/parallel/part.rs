@@ -696,6 +696,35 @@ pub(crate) fn broadcast_u8(value: u8) -> u8 {
     v
 }
 
+/// Rank 0's nodal field over the whole mesh (`whole`: `None` where it has none, and on
+/// the other ranks) at the nodes of this rank's local mesh, on a run whose mesh is
+/// distributed: each rank asks rank 0 for the values at its nodes' global indices
+/// (`MPI_Alltoallv`, 4 B a node, and 8 B a node back). `None` on every rank when rank 0
+/// has none.
+pub(crate) fn nodal_from_root(whole: Option<Vec<f64>>) -> Option<Vec<f64>> {
+    if broadcast_u8(whole.is_some() as u8) == 0 {
+        return None;
+    }
+    let world = session::comm();
+    let root = world.rank() == 0;
+    let mut asks = vec![Vec::new(); world.size() as usize];
+    if !root {
+        asks[0] = with(|p| p.node_global[..p.mesh_nodes].to_vec()).unwrap_or_default();
+    }
+    let asked = session::exchange(&world, &asks);
+    let values: Vec<Vec<f64>> = match &whole {
+        Some(w) => (asked.iter())
+            .map(|nodes| nodes.iter().map(|&g| w[g as usize]).collect())
+            .collect(),
+        None => vec![Vec::new(); asked.len()],
+    };
+    let mut got = session::exchange(&world, &values);
+    match root {
+        true => whole,
+        false => Some(std::mem::take(&mut got[0])),
+    }
+}
+
 fn encode_arrays(a: &LocalArrays, whole: &Part, w: &mut wire::Writer) {
     w.u32s(&a.elem_global);
     w.u32s(&a.elem_owner);

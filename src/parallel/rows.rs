@@ -237,6 +237,36 @@ impl Scatter {
         }
     }
 
+    /// Rank 0's `whole` (its `n` dofs; read there alone) at this rank's `n` local dofs:
+    /// its own rows from rank 0 (`MPI_Scatterv`), the dofs it asks for from their owners.
+    pub(super) fn sent_by_root(
+        &self,
+        world: &SimpleCommunicator,
+        layout: &Layout,
+        whole: &[f64],
+        n: usize,
+    ) -> Vec<f64> {
+        let mut by_row = vec![
+            0.0;
+            if layout.rank == 0 {
+                layout.starts[layout.size]
+            } else {
+                0
+            }
+        ];
+        for (d, &v) in whole.iter().enumerate() {
+            by_row[layout.petsc[d] as usize] = v;
+        }
+        let mine = session::scatter_root(world, &by_row, &layout.starts);
+        let first = layout.rows().start;
+        let mut u = vec![0.0; n];
+        for &d in &layout.owned {
+            u[d] = mine[layout.petsc[d] as usize - first];
+        }
+        self.start(world, layout, &mut u);
+        u
+    }
+
     /// Add the increment (`mine`: this rank's rows) to `u` at the dofs owned or asked;
     /// returns its largest magnitude over every rank.
     pub(super) fn update(

@@ -116,6 +116,27 @@ where
     all
 }
 
+/// The inverse of [`gather_root`]: rank `r` gets `whole[starts[r]..starts[r + 1]]` of
+/// rank 0's `whole` (read on rank 0 alone; `MPI_Scatterv`). `starts`: the `P + 1`
+/// block starts, the same on every rank.
+pub(super) fn scatter_root<T>(world: &SimpleCommunicator, whole: &[T], starts: &[usize]) -> Vec<T>
+where
+    T: mpi::datatype::Equivalence + Copy + Default,
+{
+    let root = world.process_at_rank(0);
+    let rank = world.rank() as usize;
+    let mut mine = vec![T::default(); starts[rank + 1] - starts[rank]];
+    if rank != 0 {
+        root.scatter_varcount_into(&mut mine[..]);
+        return mine;
+    }
+    let counts: Vec<i32> = starts.windows(2).map(|w| (w[1] - w[0]) as i32).collect();
+    let displs = displacements(&counts);
+    let sent = Partition::new(whole, &counts[..], &displs[..]);
+    root.scatter_varcount_into_root(&sent, &mut mine[..]);
+    mine
+}
+
 /// Send `out[r]` to rank `r`; returns what each rank sent here (`MPI_Alltoall` of the
 /// counts, then `MPI_Alltoallv`).
 pub(super) fn exchange<T>(world: &SimpleCommunicator, out: &[Vec<T>]) -> Vec<Vec<T>>

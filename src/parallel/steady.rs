@@ -392,6 +392,12 @@ impl<'p> Built<'p> {
         }
     }
 
+    /// The inverse of [`Self::gather`]: rank 0's `whole` (its dofs, the serial order) at
+    /// this rank's dofs, its own from rank 0, those it reads from their owners.
+    pub(super) fn scatter(&self, whole: &[f64]) -> Vec<f64> {
+        (self.scatter).sent_by_root(&self.world, &self.layout, whole, self.n)
+    }
+
     /// Whether this is rank 0, which writes the outputs.
     pub(super) fn is_root(&self) -> bool {
         self.layout.rank == 0
@@ -572,8 +578,9 @@ pub(super) struct Newton<'b, 'p> {
     /// Neither the interfaces' Jacobian nor the conductivity depends on u (and the
     /// matrix is symmetric).
     pub symmetric: bool,
-    /// The `c₀` of the matrix set last (`None`: none set, or values to set again).
-    matrix_for: Option<u64>,
+    /// The `c₀` of the matrix set last and which flux terms were on in it (`None`: none
+    /// set, or values to set again).
+    matrix_for: Option<(u64, Vec<bool>)>,
     /// Per conduction diagonal entry `(dof, slot)`, where a capacity enters.
     diagonal: Vec<(usize, usize)>,
 }
@@ -743,10 +750,13 @@ impl<'b, 'p> Newton<'b, 'p> {
                     r[d] += stored[d];
                 }
             }
-            // A matrix that stays (linear interfaces, the same c₀) needs the interfaces'
-            // residual alone.
+            // A matrix that stays (linear interfaces, the same c₀, the same terms
+            // switched on) needs the interfaces' residual alone.
             let c0 = capacity.map_or(0.0, |c| c.c0);
-            let key = (self.symmetric).then_some(c0.to_bits());
+            let on: Vec<bool> = built.iface.map_or_else(Vec::new, |i| {
+                (0..i.flux_count()).map(|k| i.flux_on(k, t)).collect()
+            });
+            let key = (self.symmetric).then_some((c0.to_bits(), on));
             let kept = key.is_some() && key == self.matrix_for;
             let values: Vec<f64> = built.touched.iter().map(|&d| r[d]).collect();
             self.r_vec.zero().map_err(petsc_err)?;
@@ -936,7 +946,9 @@ impl<'b, 'p> Newton<'b, 'p> {
         }
         let mut i_values = Vec::new();
         self.iasm.values_into(&mut i_values)?;
-        add_columns(&mut self.a, &self.i_sym, &i_values, layout, false)?;
+        // Its zeros too: a term switched off (a toggle, h = 0) leaves zeros where a later
+        // matrix has values, and PETSc drops the places its first assembly leaves empty.
+        add_columns(&mut self.a, &self.i_sym, &i_values, layout, true)?;
         self.a.assemble().map_err(petsc_err)?;
         self.a.zero_rows_columns(&built.bc_rows).map_err(petsc_err)
     }

@@ -40,30 +40,44 @@ pub(super) fn solve(
     s: &Stepping<'_>,
     on_step: &mut dyn FnMut(&StepReport, &State, &DofMap) -> Result<(), HeatError>,
 ) -> Result<Outcome, HeatError> {
-    let built = Built::new(p, s.start, Some(s.laws), !s.steady)?;
+    // From a checkpoint: its step, time and step size, from rank 0.
+    let header = s.restart.map(Header::of);
+    let start = header.as_ref().map_or(s.start, |h| h.time);
+    let built = Built::new(p, start, Some(s.laws), !s.steady)?;
     let mut newton = Newton::new(&built, !s.steady)?;
     let (n, field, root) = (built.n, built.field, built.is_root());
     let (m, lumped) = built.capacity(s.laws.capacity)?;
-    // The initial field at the rank's nodes; a contact partner's nodes from their owners.
-    let mut u = vec![0.0; n];
-    for (node, &v) in s.initial.iter().enumerate() {
-        if let Some(d) = built.dofs.dof(field, crate::mesh::NodeId(node as u32)) {
-            u[d.index()] = v;
-        }
-    }
-    built.start(&mut u, &[]);
     // This rank's state: its local dofs, up to date at those it reads, and its last two
     // accepted states before (BDF2 and the predictor read them).
-    let mut mine = State {
-        step: 0,
-        time: s.start,
-        dt: s.dt,
-        u,
-        past: Vec::new(),
+    let mut mine = match (s.restart, &header) {
+        (Some(checkpoint), Some(h)) => h.state(&built, checkpoint)?,
+        _ => {
+            // The initial field at the rank's nodes; a contact partner's nodes from
+            // their owners.
+            let mut u = vec![0.0; n];
+            for (node, &v) in s.initial.iter().enumerate() {
+                if let Some(d) = built.dofs.dof(field, crate::mesh::NodeId(node as u32)) {
+                    u[d.index()] = v;
+                }
+            }
+            built.start(&mut u, &[]);
+            State {
+                step: 0,
+                time: s.start,
+                dt: s.dt,
+                u,
+                past: Vec::new(),
+            }
+        }
     };
-    // What the run sees: the whole state on rank 0, its own dofs elsewhere.
+    // What the run sees: the whole state on rank 0, its own dofs elsewhere (a
+    // checkpoint's is rank 0's already: no rank gathers).
     let mut state = mine.clone();
-    built.gather(&mut state.u);
+    match s.restart {
+        Some(checkpoint) if root => state = checkpoint.clone(),
+        Some(_) => {}
+        None => built.gather(&mut state.u),
+    }
     if s.steady {
         return steady(p, (&built, &mut newton), mine, on_step);
     }
@@ -209,6 +223,75 @@ pub(super) fn solve(
         rejected: rejected_total,
         crosspoints: Vec::new(),
     })
+}
+
+/// A checkpoint's step, time, next step size and past times, as rank 0 read them.
+struct Header {
+    step: usize,
+    time: f64,
+    dt: f64,
+    past: Vec<f64>,
+}
+
+impl Header {
+    /// Rank 0's `checkpoint` (any state on the other ranks), on every rank
+    /// (`MPI_Bcast`, 48 B).
+    fn of(checkpoint: &State) -> Header {
+        use mpi::traits::{Communicator, Root};
+        let world = super::session::comm();
+        let mut h = [0.0; 6];
+        if world.rank() == 0 {
+            h[..4].copy_from_slice(&[
+                checkpoint.step as f64,
+                checkpoint.time,
+                checkpoint.dt,
+                checkpoint.past.len().min(2) as f64,
+            ]);
+            for (k, (t, _)) in checkpoint.past.iter().take(2).enumerate() {
+                h[4 + k] = *t;
+            }
+        }
+        world.process_at_rank(0).broadcast_into(&mut h[..]);
+        Header {
+            step: h[0] as usize,
+            time: h[1],
+            dt: h[2],
+            past: h[4..4 + h[3] as usize].to_vec(),
+        }
+    }
+
+    /// This rank's part of rank 0's `checkpoint`: its values and its past states' at
+    /// the rank's local dofs. A checkpoint whose states do not hold one value per dof of
+    /// the problem (another problem's) stops every rank, as serially.
+    fn state(&self, built: &Built<'_>, checkpoint: &State) -> Result<State, HeatError> {
+        let whole = built.dofs.len();
+        let fits = !built.is_root()
+            || std::iter::once(&checkpoint.u)
+                .chain(checkpoint.past.iter().map(|(_, v)| v))
+                .all(|v| v.len() == whole);
+        agreed(match fits {
+            true => Ok(()),
+            false => Err(HeatError::Step(format!(
+                "the state has {} values but the problem has {whole} dofs (a checkpoint of another problem?)",
+                checkpoint.u.len()
+            ))),
+        })?;
+        let past = (self.past.iter().enumerate())
+            .map(|(k, &t)| {
+                (
+                    t,
+                    built.scatter(checkpoint.past.get(k).map_or(&[][..], |p| &p.1)),
+                )
+            })
+            .collect();
+        Ok(State {
+            step: self.step,
+            time: self.time,
+            dt: self.dt,
+            u: built.scatter(&checkpoint.u),
+            past,
+        })
+    }
 }
 
 /// The one steady solve of a run whose conductivity depends on temperature, from the

@@ -19,7 +19,7 @@ use crate::search::scene::Pairing;
 
 use super::nodal_field::read_nodal_field;
 use super::physics::{FaceSite, Materials, Physics, evaluate};
-use super::problem::{ContactSpec, Problem, ProblemFile, Value};
+use super::problem::{ContactSpec, NodalFieldSpec, Problem, ProblemFile, Value};
 use super::{RunError, RunOptions, input_error};
 use crate::scene::ContactView;
 
@@ -417,6 +417,27 @@ fn interaction_fields(
         .collect()
 }
 
+/// [`read_nodal_field`], read by rank 0 alone where the ranks hold their parts of the
+/// mesh, each other rank getting the values at its nodes from rank 0 (collective); read
+/// serially otherwise. A rank other than 0 whose rank 0 could not read it gets an error
+/// without a message: rank 0 reports it, and the others follow its verdict.
+fn read_on_root(
+    field: &NodalFieldSpec,
+    file: &Path,
+    mesh: &Mesh,
+) -> Result<Vec<f64>, (String, String)> {
+    if !crate::parallel::mesh_is_distributed() {
+        return read_nodal_field(field, file, mesh);
+    }
+    let read = crate::parallel::is_root().then(|| read_nodal_field(field, file, mesh));
+    let whole = read.as_ref().and_then(|r| r.as_ref().ok()).cloned();
+    match (read, crate::parallel::nodal_from_root(whole)) {
+        (Some(Err(e)), _) => Err(e),
+        (_, Some(v)) => Ok(v),
+        (_, None) => Err((String::new(), String::new())),
+    }
+}
+
 /// Per interaction with `Contact Pressure Variable`: the pressure at each of its
 /// points, interpolated on side A from the named `[[nodal_field]]` (evaluated at the
 /// nodes at the start time).
@@ -450,7 +471,7 @@ fn point_pressures(
                 return None;
             };
             // From a file: every node read at once; else evaluated at the nodes used.
-            let read = field.file.as_ref().map(|f| read_nodal_field(field, &dir.join(f), mesh));
+            let read = field.file.as_ref().map(|f| read_on_root(field, &dir.join(f), mesh));
             let from_file = match read {
                 Some(Err((m, help))) => {
                     let k = p.nodal_field.iter().position(|f| std::ptr::eq(f, field));

@@ -92,9 +92,9 @@ pub(super) fn quiet() -> RunError {
 /// transient steps, take from start to end, so that the ranks other than 0 can hold
 /// their part of the mesh only: steady or transient, one temperature field (its laws
 /// and sources of T, x and t, radiation or not),
-/// no moving or dying surfaces, no restart or nodal fields, every block solid, and a
+/// no moving or dying surfaces, no restart of a steady run, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
-/// no toggle, no contact pressure field, no voltage or species enforcement, no
+/// no voltage or species enforcement, no
 /// `Align_Surface` periodicity, no `Auto Subset`). The reason why not, otherwise.
 pub(super) fn distributable(
     file: &ProblemFile,
@@ -103,14 +103,11 @@ pub(super) fn distributable(
 ) -> Result<(), String> {
     let p = &file.problem;
     let refuse = |why: &str| Err(why.to_string());
-    if p.restart.is_some() || options.restart.is_some() {
-        return refuse("a restart");
+    if !file.transient && (p.restart.is_some() || options.restart.is_some()) {
+        return refuse("a restart of a steady run");
     }
     if p.displacement.is_some() || !p.death.is_empty() {
         return refuse("surfaces that move or die");
-    }
-    if !p.nodal_field.is_empty() {
-        return refuse("a [[nodal_field]]");
     }
     if physics.field_names.len() != 1 || physics.materials.electric() || physics.species.any() {
         return refuse("not one temperature field (the general solver)");

@@ -93,9 +93,9 @@ impl<'a> TimeLoop<'a> {
     /// Whether a run under MPI steps with its assembly distributed: a transient run, or
     /// a steady one the linear steady solve does not take (one Newton solve, the general
     /// solver's steady solve), of one temperature field — its laws and sources of T, x
-    /// and t, radiation or not — with no toggles or multiplier ties (its interfaces
-    /// linear, or Newton through a temperature-dependent conductance), no restart,
-    /// nothing moving or dying and no nodal field. (Every run whose mesh
+    /// and t, radiation or not — with no multiplier ties (its interfaces linear, or
+    /// Newton through a temperature-dependent conductance; toggled or not), no restart
+    /// of a steady run, nothing moving or dying. (Every run whose mesh
     /// `ranks::distributable` splits and is not a linear steady one is one.)
     fn is_stepped_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
@@ -104,12 +104,9 @@ impl<'a> TimeLoop<'a> {
             && physics.field_names.len() == 1
             && !physics.materials.electric()
             && !physics.species.any()
-            && !self.terms.couplings.any_toggle()
-            && problem.restart.is_none()
-            && self.options.restart.is_none()
+            && (self.file.transient || self.checkpoint().is_none())
             && problem.displacement.is_none()
             && problem.death.is_empty()
-            && problem.nodal_field.is_empty()
     }
 
     /// Whether one linear steady solve answers the problem: steady, one field, constant
@@ -268,9 +265,25 @@ impl<'a> TimeLoop<'a> {
         let extended = crate::parallel::extended_mesh(physics.mesh);
         let linear = self.linear_problem(&extended, &sources)?;
         let steady = linear.problem(problem);
-        let initial = match initial {
-            Some(v) => v,
-            None => physics.initial_values()?,
+        // From a checkpoint, read by rank 0 (which sends every rank its part); the other
+        // ranks stop with it when it cannot read it.
+        let checkpoint = match self.checkpoint() {
+            Some(file) => {
+                let read = crate::parallel::is_root().then(|| steps::read_checkpoint(&file));
+                let failed = read.as_ref().is_some_and(Result::is_err);
+                if crate::parallel::root_verdict(failed) {
+                    return Err(read
+                        .and_then(Result::err)
+                        .unwrap_or_else(super::ranks::quiet));
+                }
+                Some(read.unwrap_or_else(|| Ok(State::default()))?)
+            }
+            None => None,
+        };
+        let initial = match (initial, &checkpoint) {
+            (Some(v), _) => v,
+            (None, Some(_)) => Vec::new(),
+            (None, None) => physics.initial_values()?,
         };
         let loads = |t: f64| {
             (physics.loads_at(t))
@@ -291,6 +304,7 @@ impl<'a> TimeLoop<'a> {
             adaptive: time.adaptive,
             dt_min: time.dt_min,
             initial: &initial,
+            restart: checkpoint.as_ref(),
             loads: &loads,
         };
         let mut recorder = Recorder {
@@ -421,11 +435,10 @@ impl<'a> TimeLoop<'a> {
                 initial: &species_at,
             }),
         };
-        let restart = match (&problem.restart, self.options.restart.as_ref()) {
-            (_, Some(file)) => Some(steps::read_checkpoint(file)?),
-            (Some(r), None) => Some(steps::read_checkpoint(&self.file.dir.join(&r.file))?),
-            (None, None) => None,
-        };
+        let restart = self
+            .checkpoint()
+            .map(|f| steps::read_checkpoint(&f))
+            .transpose()?;
         let initial = match restart {
             Some(_) => Vec::new(),
             None => match initial {
@@ -469,6 +482,16 @@ impl<'a> TimeLoop<'a> {
             .map_err(|e| RunError::Solve(e.to_string()))?;
         let n = outcome.dofs.len();
         self.stepped(recorder, outcome, n)
+    }
+
+    /// The checkpoint the run restarts from (`--restart` over the problem's
+    /// `[restart]`), if any.
+    fn checkpoint(&self) -> Option<std::path::PathBuf> {
+        match (&self.file.problem.restart, self.options.restart.as_ref()) {
+            (_, Some(file)) => Some(file.clone()),
+            (Some(r), None) => Some(self.file.dir.join(&r.file)),
+            (None, None) => None,
+        }
     }
 
     /// A stepped run's end: the last step written if it was not, the linear solver

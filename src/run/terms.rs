@@ -813,6 +813,10 @@ impl Interfaces for ContactTerms<'_> {
         self.couplings.on(self.term_choice[self.flux_count + k], t)
     }
 
+    fn flux_on(&self, k: usize, t: f64) -> bool {
+        self.couplings.on(self.term_choice[k], t)
+    }
+
     fn couplings(&self, u: &[f64], t: f64) -> Result<Vec<(usize, usize)>, InterfaceFailure> {
         let e = self.embedded()?;
         self.at_time(e, t)?;

@@ -738,8 +738,8 @@ pub fn conductance_model(
 /// whole mesh (docs/parallel.md), or `None` when each rank can hold its part: surfaces
 /// or maps made from whole surfaces (`Auto Subset`, an `Align_Surface` periodicity), a
 /// voltage or species enforcement, an Energy enforcement that is a mortar tie with
-/// multipliers, switched by a toggle or fed a contact pressure field (the general solver
-/// or whole-mesh data), or one that does not resolve with the problem's `fields`.
+/// multipliers (the general solver), or one that does not resolve with the problem's
+/// `fields`.
 pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static str> {
     use crate::deck::spec::{PeriodicTransform, SurfaceDef};
     for def in &loaded.deck.contact_definitions {
@@ -764,12 +764,6 @@ pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static
             };
             if c.mortar {
                 return Some("a mortar tie with multipliers (the general solver)");
-            }
-            if c.toggle.is_some() {
-                return Some("a toggled enforcement (the general solver)");
-            }
-            if c.pressure_variable.is_some() {
-                return Some("a `Contact Pressure Variable`");
             }
         }
     }

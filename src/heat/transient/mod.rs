@@ -202,7 +202,7 @@ pub enum TimeMode {
 }
 
 /// The state of a run between steps: enough to continue it exactly.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct State {
     pub step: usize,
     pub time: f64,
