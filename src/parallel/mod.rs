@@ -302,8 +302,10 @@ pub(crate) enum MeshPlan<'m> {
     Stop,
     /// Every rank reads the whole mesh.
     Whole,
-    /// Partition this mesh and send every other rank its part.
-    Parts(&'m crate::mesh::Mesh),
+    /// Partition this mesh and send every other rank its part; with, per block, the work
+    /// of assembling one of its elements when the blocks' differ (the parts then balance
+    /// that work as well as their elements).
+    Parts(&'m crate::mesh::Mesh, Option<Vec<u32>>),
 }
 
 /// What a rank other than 0 gets from [`receive_mesh`].
@@ -339,7 +341,8 @@ pub(crate) fn share_mesh(plan: MeshPlan<'_>) -> Result<(), String> {
                 part::broadcast_u8(1);
                 Ok(())
             }
-            MeshPlan::Parts(mesh) => match part::partition_for_ranks(mesh) {
+            MeshPlan::Parts(mesh, costs) => match part::partition_for_ranks(mesh, costs.as_deref())
+            {
                 Err(e) => {
                     part::broadcast_u8(0);
                     Err(e)
@@ -348,6 +351,17 @@ pub(crate) fn share_mesh(plan: MeshPlan<'_>) -> Result<(), String> {
                     part::broadcast_u8(2);
                     if let Some(path) = std::env::var_os("SEAM_PARTITION_FILE") {
                         write_partition(&path, &parts);
+                    }
+                    if let Some(costs) = &costs {
+                        let mut work = vec![0u64; world().map_or(1, |(_, size)| size)];
+                        for b in part::solid_blocks(mesh) {
+                            for e in mesh.blocks[b].elems() {
+                                work[parts[e.index()] as usize] += u64::from(costs[b]);
+                            }
+                        }
+                        log::info!(
+                            "the parts balance their elements and their assembly work (per block {costs:?} a kernel's each): work per rank {work:?}"
+                        );
                     }
                     let sent = part::distribute(mesh, parts);
                     log::info!(

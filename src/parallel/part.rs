@@ -351,11 +351,12 @@ pub(crate) fn can_distribute(mesh: &Mesh) -> Result<(), String> {
 /// On rank 0: partition `mesh` (METIS, its solid blocks), send every other rank its local
 /// mesh and part ([`receive`] takes them), and keep the whole mesh as rank 0's part. The
 /// partition is made before anything is sent, so that its failure stops rank 0 before
-/// the others wait for a mesh (the caller tells them).
-pub(crate) fn partition_for_ranks(mesh: &Mesh) -> Result<Vec<u32>, String> {
+/// the others wait for a mesh (the caller tells them). `costs`: per block, the work of
+/// assembling one of its elements ([`super::layout::partition`]).
+pub(crate) fn partition_for_ranks(mesh: &Mesh, costs: Option<&[u32]>) -> Result<Vec<u32>, String> {
     let world = session::comm();
     let blocks = solid_blocks(mesh);
-    partition(mesh, &blocks, world.size() as usize)
+    partition(mesh, &blocks, world.size() as usize, costs)
 }
 
 /// On rank 0, after [`partition_for_ranks`]: send every other rank its local mesh and
