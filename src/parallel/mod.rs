@@ -352,9 +352,13 @@ pub(crate) fn share_mesh(plan: MeshPlan<'_>) -> Result<(), String> {
                     if let Some(path) = std::env::var_os("SEAM_PARTITION_FILE") {
                         write_partition(&path, &parts);
                     }
-                    if let Some(costs) = &costs {
+                    let solid = part::solid_blocks(mesh);
+                    let weighted = costs
+                        .as_ref()
+                        .filter(|c| solid.iter().any(|&b| c[b] != c[solid[0]]));
+                    if let Some(costs) = weighted {
                         let mut work = vec![0u64; world().map_or(1, |(_, size)| size)];
-                        for b in part::solid_blocks(mesh) {
+                        for &b in &solid {
                             for e in mesh.blocks[b].elems() {
                                 work[parts[e.index()] as usize] += u64::from(costs[b]);
                             }
