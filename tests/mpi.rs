@@ -1592,3 +1592,29 @@ fn partition_balances_the_assembly_of_laws_in_lua() {
     assert!(split(&part[..lua_block]) <= 0.15, "Lua elements: {part:?}");
     compare(&problem, true);
 }
+
+/// What stops `seam search` is reported once, by rank 0: a deck with an unknown line,
+/// under `mpirun -n 2 … --json`, prints one JSON object (each rank printed its own
+/// before), with the error.
+#[test]
+fn search_reports_a_bad_deck_once() {
+    let tmp = scratch("bad_search");
+    let deck = tmp.path().join("bad.i");
+    std::fs::write(
+        &deck,
+        "begin contact definition x\n  bogus line here\nend\n",
+    )
+    .unwrap();
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/two_blocks/two_blocks.exo");
+    let mut cmd = seam(Some(2));
+    cmd.args(["search", "--json"])
+        .arg(&deck)
+        .arg("--mesh")
+        .arg(&mesh);
+    let out = cmd.output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(!out.status.success(), "{stdout}");
+    let objects = stdout.lines().filter(|l| l.starts_with('{')).count();
+    assert_eq!(objects, 1, "one report:\n{stdout}");
+    assert!(stdout.contains("E0103"), "{stdout}");
+}

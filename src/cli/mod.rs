@@ -40,10 +40,23 @@ pub fn load(
     axisymmetric: bool,
     json: bool,
 ) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
+    load_reporting(deck_path, mesh_path, axisymmetric, Some(json))
+}
+
+/// [`load`], its errors reported as `report` says: `Some(json)` on stderr or as JSON,
+/// `None` not at all (a rank of an MPI run other than 0, whose rank 0 reports them).
+pub fn load_reporting(
+    deck_path: &Path,
+    mesh_path: Option<&Path>,
+    axisymmetric: bool,
+    report: Option<bool>,
+) -> Result<(LoadedDeck, Option<Mesh>), ExitCode> {
     let loaded = deck::load(deck_path);
     let fail = |mut d: Diagnostics, extra: Option<Diagnostic>| {
         d.0.extend(extra);
-        report_errors(json, &d, &loaded.sources);
+        if let Some(json) = report {
+            report_errors(json, &d, &loaded.sources);
+        }
         Err(ExitCode::from(EXIT_BAD_INPUT))
     };
     if loaded.diagnostics.has_errors() {

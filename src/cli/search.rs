@@ -8,7 +8,7 @@ use serde::Serialize;
 use seam::scene::{ContactScene, SceneOptions};
 
 use super::surfaces::{Warning, print_json};
-use super::{EXIT_BAD_INPUT, eprint_diagnostics, format_number, load};
+use super::{EXIT_BAD_INPUT, eprint_diagnostics, format_number, load_reporting};
 
 #[derive(Serialize)]
 struct SearchReport {
@@ -38,7 +38,9 @@ pub fn search(
     if !root {
         log::set_max_level(log::LevelFilter::Error);
     }
-    let (loaded, mesh) = match load(deck_path, Some(mesh_path), axisymmetric, json) {
+    // (Rank 0 alone reports what stops the command: every rank meets it.)
+    let report = root.then_some(json);
+    let (loaded, mesh) = match load_reporting(deck_path, Some(mesh_path), axisymmetric, report) {
         Ok(x) => x,
         Err(code) => return code,
     };
