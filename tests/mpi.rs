@@ -881,6 +881,45 @@ fn cut_interface_restart_equals_serial() {
     );
 }
 
+/// A steady run with k(T) from a checkpoint: its one Newton solve starts from the
+/// checkpoint's state (a transient run's near its steady state, at t = 6 after 12
+/// steps, written serially), on 1–4 ranks with the mesh per rank as serially: the same
+/// temperatures and heat, and the same Newton iterations, fewer than from the uniform
+/// initial field.
+#[test]
+fn cut_interface_steady_restart_equals_serial() {
+    let tmp = scratch("steady_restart");
+    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, "", 0.5);
+    let text = conductivity_of_t(&text).replace("end_time = 0.3", "end_time = 6.0");
+    let full = text.replace("dir = \"out\"\n", "dir = \"out\"\ncheckpoint_every = 12\n");
+    std::fs::write(&problem, full).unwrap();
+    run(&problem, None);
+    std::fs::copy(
+        tmp.path().join("out_serial/checkpoint_00012.seam"),
+        tmp.path().join("checkpoint.seam"),
+    )
+    .unwrap();
+    std::fs::remove_dir_all(tmp.path().join("out_serial")).unwrap();
+    let steady = text.replace("kind = \"transient\"", "kind = \"steady\"");
+    assert_ne!(steady, text);
+    std::fs::write(&problem, &steady).unwrap();
+    let fresh = run(&problem, None);
+    std::fs::remove_dir_all(tmp.path().join("out_serial")).unwrap();
+    std::fs::write(&problem, steady + "[restart]\nfile = \"checkpoint.seam\"\n").unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_newton_as_serial(&serial, &runs, "a steady solve assembled per rank");
+    for (n, par) in (2..).zip(&runs[1..]) {
+        assert!(par.log.contains(PART_ONLY), "{n} ranks:\n{}", par.log);
+    }
+    let newton = |r: &Ran| r.summary["newton_iterations"].as_u64().unwrap();
+    eprintln!(
+        "steady k(T): {} Newton iterations from 300 K, {} from the checkpoint",
+        newton(&fresh),
+        newton(&serial)
+    );
+    assert!(newton(&serial) < newton(&fresh), "{}", serial.summary);
+}
+
 /// Every law of T at once, assembled per rank at every Newton iterate: k(T) in both
 /// blocks, ρc(T) (a table), a source of T and t (Lua) and a radiation condition on one
 /// face; BDF2 steps; temperatures, heats and Newton iterations equal serial.

@@ -79,6 +79,9 @@ pub(super) fn solve(
         None => built.gather(&mut state.u),
     }
     if s.steady {
+        // (From a checkpoint too, the steady solve is at the run's start, from the
+        // checkpoint's state, as serially.)
+        mine.time = s.start;
         return steady(p, (&built, &mut newton), mine, on_step);
     }
     let mut faces = p.face_bcs.to_vec();

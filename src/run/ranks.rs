@@ -46,7 +46,6 @@ pub(super) fn mesh_for_rank(
 pub(super) fn share_mesh(
     file: &ProblemFile,
     physics: &Physics<'_>,
-    options: &RunOptions,
     ready: bool,
 ) -> Result<(), RunError> {
     if !parallel::is_root() || parallel::world().is_none() {
@@ -55,7 +54,7 @@ pub(super) fn share_mesh(
     let plan = if !ready {
         MeshPlan::Stop
     } else {
-        match distributable(file, physics, options) {
+        match distributable(file, physics) {
             Ok(()) => MeshPlan::Parts(physics.mesh, Some(assembly_costs(file, physics))),
             Err(why) => {
                 log::info!("every rank reads the whole mesh: {why}");
@@ -120,20 +119,13 @@ pub(super) fn quiet() -> RunError {
 /// transient steps, take from start to end, so that the ranks other than 0 can hold
 /// their part of the mesh only: steady or transient, one temperature field (its laws
 /// and sources of T, x and t, radiation or not),
-/// no moving or dying surfaces, no restart of a steady run, every block solid, and a
+/// no moving or dying surfaces, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
 /// no voltage or species enforcement, no
 /// `Align_Surface` periodicity, no `Auto Subset`). The reason why not, otherwise.
-pub(super) fn distributable(
-    file: &ProblemFile,
-    physics: &Physics<'_>,
-    options: &RunOptions,
-) -> Result<(), String> {
+pub(super) fn distributable(file: &ProblemFile, physics: &Physics<'_>) -> Result<(), String> {
     let p = &file.problem;
     let refuse = |why: &str| Err(why.to_string());
-    if !file.transient && (p.restart.is_some() || options.restart.is_some()) {
-        return refuse("a restart of a steady run");
-    }
     if p.displacement.is_some() || !p.death.is_empty() {
         return refuse("surfaces that move or die");
     }

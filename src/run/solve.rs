@@ -94,8 +94,8 @@ impl<'a> TimeLoop<'a> {
     /// a steady one the linear steady solve does not take (one Newton solve, the general
     /// solver's steady solve), of one temperature field — its laws and sources of T, x
     /// and t, radiation or not — with no multiplier ties (its interfaces linear, or
-    /// Newton through a temperature-dependent conductance; toggled or not), no restart
-    /// of a steady run, nothing moving or dying. (Every run whose mesh
+    /// Newton through a temperature-dependent conductance; toggled or not), from a
+    /// checkpoint or not, nothing moving or dying. (Every run whose mesh
     /// `ranks::distributable` splits and is not a linear steady one is one.)
     fn is_stepped_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
@@ -104,7 +104,6 @@ impl<'a> TimeLoop<'a> {
             && physics.field_names.len() == 1
             && !physics.materials.electric()
             && !physics.species.any()
-            && (self.file.transient || self.checkpoint().is_none())
             && problem.displacement.is_none()
             && problem.death.is_empty()
     }
