@@ -494,7 +494,8 @@ fn cut_interface_constant_conductance_equals_serial() {
 /// each rank the values at its nodes; the ranks hold their parts of the mesh, and the
 /// temperatures and heat equal serial. The field matters: the heat differs from that at
 /// a uniform 10 kPa by more than 1 % (at these pressures the contact resistance is
-/// comparable with the blocks').
+/// comparable with the blocks'). A file rank 0 cannot read stops every rank, with one
+/// report.
 #[test]
 fn cut_interface_contact_pressure_field_equals_serial() {
     let tmp = scratch("pressure_field");
@@ -550,6 +551,23 @@ fn cut_interface_contact_pressure_field_equals_serial() {
             std::fs::remove_dir_all(dir.join(format!("out_{label}"))).unwrap();
         }
     }
+    // A file rank 0 cannot read: every rank stops (none waits for the values), and the
+    // error is reported once.
+    let missing = "file = \"missing.exo\"\nvariable = \"pressure\"\n";
+    std::fs::write(
+        &problem,
+        format!("{text}[[nodal_field]]\nname = \"p\"\n{missing}"),
+    )
+    .unwrap();
+    let out = launch(&problem, Some(2));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(2), "{stdout}");
+    let reports: Vec<&str> = stdout.lines().filter(|l| l.starts_with('{')).collect();
+    assert_eq!(reports.len(), 1, "{stdout}");
+    assert!(
+        reports[0].contains("E0712") && reports[0].contains("missing.exo"),
+        "{stdout}"
+    );
 }
 
 /// The same, solved by AMG-preconditioned CG (serial: seam's AMG-CG; MPI: CG + BoomerAMG).
