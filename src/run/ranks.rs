@@ -66,9 +66,11 @@ pub(super) fn share_mesh(
 }
 
 /// What a law in Lua adds to the work of assembling an element, in units of the
-/// element's kernel: each quadrature point calls it for its value and two differences
-/// (0.34 µs on the machine of docs/benchmarks.md, 2.7 µs over a Hex8's 8 points, against
-/// about 1 µs for the kernel of a tangent).
+/// element's kernel: an estimate. Each quadrature point calls it for its value and two
+/// differences (the three took 0.34 µs when measured alone for 46c6fd9, so 2.7 µs over a
+/// Hex8's 8 points); the weight was not fitted to kernel timings, but with it the
+/// partition took the k(T) scaling case's assembly from 1.39× to 1.84× on 2 ranks
+/// (docs/parallel.md).
 const LUA_COST: u32 = 3;
 
 /// Per block of the mesh, the work of assembling one of its elements, in kernels: one,
