@@ -774,6 +774,10 @@ fn cut_interface_steady_conductivity_of_t_equals_serial() {
             );
             if !solve.is_empty() {
                 assert_eq!(solver["name"], "PETSc GMRES + BoomerAMG", "{solver}");
+                // One BoomerAMG hierarchy, kept for every later Newton iterate's tangent.
+                let newton = par.summary["newton_iterations"].as_u64().unwrap();
+                assert_eq!(solver["hierarchy_setups"], 1, "{n} ranks: {solver}");
+                assert_eq!(solver["hierarchy_refreshes"], newton - 1, "{solver}");
             }
             if n > 1 {
                 assert!(par.log.contains(PART_ONLY), "{n} ranks:\n{}", par.log);

@@ -37,6 +37,8 @@ pub(crate) mod part;
 #[cfg(feature = "mpi")]
 pub mod petsc;
 #[cfg(feature = "mpi")]
+mod reuse;
+#[cfg(feature = "mpi")]
 mod rows;
 #[cfg(feature = "mpi")]
 pub mod search;

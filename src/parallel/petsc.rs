@@ -174,6 +174,7 @@ unsafe extern "C" {
     fn KSPGuessSetType(guess: Object, t: *const c_char) -> PetscErrorCode;
     fn KSPGuessFischerSetModel(guess: Object, model: PetscInt, size: PetscInt) -> PetscErrorCode;
     fn KSPSetUp(ksp: Object) -> PetscErrorCode;
+    fn KSPSetReusePreconditioner(ksp: Object, flag: c_int) -> PetscErrorCode;
     fn KSPSolve(ksp: Object, b: Object, x: Object) -> PetscErrorCode;
     fn KSPGetIterationNumber(ksp: Object, its: *mut PetscInt) -> PetscErrorCode;
     fn KSPGetConvergedReason(ksp: Object, reason: *mut c_int) -> PetscErrorCode;
@@ -526,17 +527,22 @@ impl Method {
 /// `PETSC_OPTIONS` gives it:
 /// hypre's recommendations for 3-D problems — HMIS coarsening, extended+i
 /// interpolation of at most 4 entries a row, strength threshold 0.5 — with aggressive
-/// coarsening on the finest level. On the electronics warm-up at refine 6 (thin fins and
-/// die, cells of aspect 5; docs/parallel.md) its first 10 steps took 137 CG iterations
-/// and 3.1 s, where GAMG with its defaults took 553 and 9.2 s and BoomerAMG with its
-/// own defaults 91 iterations at five times the cost of each.
-pub const BOOMERAMG: [(&str, &str); 6] = [
+/// coarsening on the finest level — and each smoothing sweep through the rows in their
+/// order rather than C points then F points (`no_CF`: one pass over the matrix a sweep
+/// instead of two). On the electronics warm-up at refine 6 (thin fins and die, cells of
+/// aspect 5; docs/parallel.md) its first 10 steps took 137 CG iterations and 3.1 s,
+/// where GAMG with its defaults took 553 and 9.2 s and BoomerAMG with its own defaults
+/// 91 iterations at five times the cost of each; the rows in order took 104 CG
+/// iterations where C then F took 112, and a V-cycle a quarter less time (2026-12-07,
+/// docs/parallel.md).
+pub const BOOMERAMG: [(&str, &str); 7] = [
     ("-pc_hypre_type", "boomeramg"),
     ("-pc_hypre_boomeramg_coarsen_type", "HMIS"),
     ("-pc_hypre_boomeramg_interp_type", "ext+i"),
     ("-pc_hypre_boomeramg_P_max", "4"),
     ("-pc_hypre_boomeramg_strong_threshold", "0.5"),
     ("-pc_hypre_boomeramg_agg_nl", "1"),
+    ("-pc_hypre_boomeramg_no_CF", "true"),
 ];
 
 /// Whether PETSc's options (`PETSC_OPTIONS`, the command line) name `name`.
@@ -719,6 +725,15 @@ impl Ksp {
         // SAFETY: a valid KSP.
         check("KSPSetTolerances", unsafe {
             KSPSetTolerances(self.0, rtol, atol, PETSC_DEFAULT, 10_000)
+        })
+    }
+
+    /// Keep the preconditioner made last when the matrix's values change (`true`),
+    /// or make it again at the next set-up or solve (`false`, PETSc's default).
+    pub fn keep_preconditioner(&mut self, keep: bool) -> Result<(), PetscError> {
+        // SAFETY: a valid KSP; PetscBool is an int.
+        check("KSPSetReusePreconditioner", unsafe {
+            KSPSetReusePreconditioner(self.0, keep as c_int)
         })
     }
 

@@ -165,3 +165,26 @@ where
         })
         .collect()
 }
+
+/// `r` where it holds on every rank; else this rank's error, and on the ranks where it
+/// held the failed ranks' errors (collective: a rank failing alone would leave the
+/// others waiting in the next collective).
+pub(super) fn agreed<T>(r: Result<T, crate::heat::HeatError>) -> Result<T, crate::heat::HeatError> {
+    if !super::any_rank(r.is_err()) {
+        return r;
+    }
+    let world = comm();
+    let mine = r.err().map(|e| e.to_string()).unwrap_or_default();
+    let lengths = gather_all(&world, &[mine.len() as u64]);
+    let bytes = gather_all(&world, mine.as_bytes());
+    let mut at = 0;
+    let mut why = Vec::new();
+    for (rank, &len) in lengths.iter().enumerate() {
+        let piece = &bytes[at..at + len as usize];
+        at += len as usize;
+        if len > 0 {
+            why.push(format!("rank {rank}: {}", String::from_utf8_lossy(piece)));
+        }
+    }
+    Err(crate::heat::HeatError::Step(why.join("; ")))
+}

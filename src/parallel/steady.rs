@@ -15,7 +15,7 @@
 //! owners only the values it reads (its elements' dofs, and its points' on both sides:
 //! [`Scatter`]), and the whole solution is gathered once, at the end, for the output.
 //! Mortar ties with multipliers are refused. A failure on one rank (an interface model,
-//! a load) is agreed on by every rank before the next collective ([`agreed`]).
+//! a load) is agreed on by every rank before the next collective ([`agreed`](super::session::agreed)).
 
 use std::time::Instant;
 
@@ -41,10 +41,12 @@ use faer::sparse::SparseColMatRef;
 use super::conduction::{Capacity, Conduction, conduction};
 use super::part;
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
+use super::reuse::Hierarchy;
 use super::rows::{
     Layout, Scatter, add_columns, couplings_to_owners, empty_mesh, local_faces, preallocation,
     summed_heat,
 };
+use super::session::agreed;
 use super::{Laws, session};
 
 fn petsc_err(e: PetscError) -> HeatError {
@@ -104,29 +106,6 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     })
 }
 
-/// `r` where it holds on every rank; else this rank's error, and on the ranks where it
-/// held the failed ranks' errors (collective: a rank failing alone would leave the
-/// others waiting in the next collective).
-pub(super) fn agreed<T>(r: Result<T, HeatError>) -> Result<T, HeatError> {
-    if !super::any_rank(r.is_err()) {
-        return r;
-    }
-    let world = session::comm();
-    let mine = r.err().map(|e| e.to_string()).unwrap_or_default();
-    let lengths = session::gather_all(&world, &[mine.len() as u64]);
-    let bytes = session::gather_all(&world, mine.as_bytes());
-    let mut at = 0;
-    let mut why = Vec::new();
-    for (rank, &len) in lengths.iter().enumerate() {
-        let piece = &bytes[at..at + len as usize];
-        at += len as usize;
-        if len > 0 {
-            why.push(format!("rank {rank}: {}", String::from_utf8_lossy(piece)));
-        }
-    }
-    Err(HeatError::Step(why.join("; ")))
-}
-
 /// What one Newton solve ([`Newton::solve`]) ends with, the same on every rank.
 pub(super) struct Solved {
     pub converged: bool,
@@ -142,8 +121,10 @@ pub(super) struct Solved {
     pub heat: Vec<(f64, f64)>,
     /// Krylov iterations of each CG or GMRES solve.
     pub cg_iterations: Vec<usize>,
-    /// Matrices set (each a new AMG hierarchy or MUMPS factorisation).
+    /// Matrices set up for (each a new AMG hierarchy or MUMPS factorisation).
     pub setups: usize,
+    /// Matrices solved on the AMG hierarchy of an earlier one.
+    pub kept: usize,
     pub timing: SolveTiming,
 }
 
@@ -583,6 +564,8 @@ pub(super) struct Newton<'b, 'p> {
     matrix_for: Option<(u64, Vec<bool>)>,
     /// Per conduction diagonal entry `(dof, slot)`, where a capacity enters.
     diagonal: Vec<(usize, usize)>,
+    /// The AMG hierarchy kept across matrices ([`Hierarchy`]).
+    hierarchy: Hierarchy,
 }
 
 impl<'b, 'p> Newton<'b, 'p> {
@@ -649,6 +632,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             symmetric,
             matrix_for: None,
             diagonal,
+            hierarchy: Hierarchy::default(),
         })
     }
 
@@ -708,7 +692,7 @@ impl<'b, 'p> Newton<'b, 'p> {
         timing.assembly_s += start.elapsed().as_secs_f64();
         let mut record = crate::heat::steady::Record::with_norm(f_norm, p.tolerance);
         let mut heat = Vec::new();
-        let (mut converged, mut iterations, mut setups) = (false, 0, 0);
+        let (mut converged, mut iterations, mut setups, mut kept_pc) = (false, 0, 0, 0);
         let mut failure = None;
         let mut cg_iterations = Vec::new();
         let mut last_step = f64::INFINITY;
@@ -840,15 +824,24 @@ impl<'b, 'p> Newton<'b, 'p> {
             iterations += 1;
             // J = K (+ c₀ m) + J_Γ: every entry this rank made, the interface rows it
             // owns; set again only when its values change.
+            // A Krylov method keeps its hierarchy for a new matrix of the same c₀ while
+            // its solves do not degrade.
+            let mut reused = false;
             if !kept {
                 let start = Instant::now();
                 self.set_matrix(stored.as_ref().map(|(_, diagonal)| diagonal.as_slice()))?;
                 timing.assembly_s += start.elapsed().as_secs_f64();
                 let start = Instant::now();
-                self.ksp.set_up().map_err(petsc_err)?;
+                reused = self.method != Method::MumpsLu && self.hierarchy.serves(c0);
+                match reused {
+                    true => {
+                        self.ksp.keep_preconditioner(true).map_err(petsc_err)?;
+                        kept_pc += 1;
+                    }
+                    false => setups += self.set_up(c0)?,
+                }
                 timing.factor_s += start.elapsed().as_secs_f64();
                 self.matrix_for = key;
-                setups += 1;
             }
             let start = Instant::now();
             if capacity.is_some() && self.method == Method::CgAmg {
@@ -858,7 +851,13 @@ impl<'b, 'p> Newton<'b, 'p> {
             self.r_vec
                 .with_local(local_rows, |v| v.iter_mut().for_each(|x| *x = -*x))
                 .map_err(petsc_err)?;
-            let its = match self.ksp.solve(&self.r_vec, &mut self.du_vec) {
+            let mut solved = self.ksp.solve(&self.r_vec, &mut self.du_vec);
+            if reused && solved.as_ref().is_err_and(PetscError::is_divergence) {
+                // The kept hierarchy failed: one for this matrix, and the solve again.
+                setups += self.set_up(c0)?;
+                solved = self.ksp.solve(&self.r_vec, &mut self.du_vec);
+            }
+            let its = match solved {
                 Ok(its) => its,
                 Err(e) if e.is_divergence() => {
                     failure = Some(format!("the linear solve failed at t = {t}: {e}"));
@@ -874,6 +873,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             timing.solve_s += start.elapsed().as_secs_f64();
             if self.method != Method::MumpsLu {
                 cg_iterations.push(its);
+                self.hierarchy.solved(its);
             }
         }
         Ok(Solved {
@@ -884,8 +884,17 @@ impl<'b, 'p> Newton<'b, 'p> {
             heat,
             cg_iterations,
             setups,
+            kept: kept_pc,
             timing,
         })
+    }
+
+    /// The preconditioner (or factorisation) made for the matrix set, of `c0`: one set-up.
+    fn set_up(&mut self, c0: f64) -> Result<usize, HeatError> {
+        self.ksp.keep_preconditioner(false).map_err(petsc_err)?;
+        self.ksp.set_up().map_err(petsc_err)?;
+        self.hierarchy.set_up(c0);
+        Ok(1)
     }
 
     /// A time step's CG stops as the serial one, which solves the step's own system

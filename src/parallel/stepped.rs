@@ -30,7 +30,8 @@ use crate::heat::{HeatError, dirichlet_dofs};
 use super::Stepping;
 use super::conduction::Capacity;
 use super::petsc::Method;
-use super::steady::{Built, Newton, Solved, agreed};
+use super::session::agreed;
+use super::steady::{Built, Newton, Solved};
 
 /// The run's steps over the MPI world from `s.start` to `s.end`; `on_step` gets each
 /// accepted step: on rank 0 the whole state, on every other rank its own dofs. Rank 0's
@@ -355,7 +356,11 @@ fn report(solved: Solved, method: Method) -> StepReport {
             Method::CgAmg | Method::GmresAmg => solved.setups,
             _ => 0,
         },
-        hierarchy_refreshes: 0,
+        // (PETSc's hierarchy kept whole, where the serial one refreshes its finest level.)
+        hierarchy_refreshes: match method {
+            Method::CgAmg | Method::GmresAmg => solved.kept,
+            _ => 0,
+        },
         electric: Vec::new(),
         diagnosis: None,
     }

@@ -113,7 +113,8 @@ pub struct LinearSolverSummary {
     /// CG iterations of each solve.
     pub iterations_per_solve: Vec<usize>,
     /// Iterative runs: AMG hierarchies set up, and kept hierarchies whose finest level
-    /// took a new matrix's values instead (time steps, Newton iterations).
+    /// took a new matrix's values instead (time steps, Newton iterations); under MPI,
+    /// matrices solved on a BoomerAMG hierarchy PETSc kept whole from an earlier one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hierarchy_setups: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
