@@ -330,6 +330,29 @@ impl Mat {
         })
     }
 
+    /// Add `values[k]` at `(row, cols[k])` (global indices, any rank's row; columns
+    /// ascending are found fastest).
+    pub fn add_row(
+        &mut self,
+        row: PetscInt,
+        cols: &[PetscInt],
+        values: &[f64],
+    ) -> Result<(), PetscError> {
+        debug_assert_eq!(cols.len(), values.len());
+        // SAFETY: `cols` and `values` have the length passed; one row.
+        check("MatSetValues", unsafe {
+            MatSetValues(
+                self.0,
+                1,
+                &row,
+                cols.len() as PetscInt,
+                cols.as_ptr(),
+                values.as_ptr(),
+                ADD_VALUES,
+            )
+        })
+    }
+
     /// Set row `row`'s entries at columns `cols` (global indices; the row owned here).
     pub fn set_row(
         &mut self,

@@ -385,34 +385,84 @@ pub(super) fn empty_mesh(mesh: &Mesh) -> Mesh {
     }
 }
 
-/// Add the CSC matrix (`sym`, `values`; serial dofs) to `a`. Its zeros are left out
-/// unless `zeros`: where a later matrix of the same pattern may hold a value there (a
-/// tangent that depends on u: on a mesh of cubes the conduction's entries between the
-/// ends of an element edge are exactly 0 at a constant k, not at a k of T), since PETSc
-/// drops the preallocated places its first assembly did not fill and refuses a new
-/// entry afterwards.
-pub(super) fn add_columns(
-    a: &mut Mat,
-    sym: &faer::sparse::SymbolicSparseColMat<usize>,
-    values: &[f64],
-    layout: &Layout,
-    zeros: bool,
-) -> Result<(), HeatError> {
-    let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
-    let (mut rows, mut vals) = (Vec::new(), Vec::new());
-    for j in 0..sym.ncols() {
-        rows.clear();
-        vals.clear();
-        for k in col_ptr[j]..col_ptr[j + 1] {
-            let i = row_idx[k];
-            if zeros || values[k] != 0.0 {
-                rows.push(layout.petsc[i]);
-                vals.push(values[k]);
+/// A matrix's entries in column storage over local dofs, listed by PETSc row with the
+/// columns ascending, for [`add_rows`]: PETSc finds each column of a row from the place
+/// of the one before, where entries set a column at a time search every row they touch
+/// anew. Made once per pattern.
+pub(super) struct ByRows {
+    /// The PETSc rows that hold entries, and where each row's entries start.
+    rows: Vec<PetscInt>,
+    start: Vec<usize>,
+    /// Per entry, its PETSc column and its slot in the column storage's values.
+    cols: Vec<PetscInt>,
+    slots: Vec<u32>,
+}
+
+impl ByRows {
+    pub(super) fn new(sym: &faer::sparse::SymbolicSparseColMat<usize>, layout: &Layout) -> ByRows {
+        let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
+        let mut count = vec![0usize; sym.nrows() + 1];
+        for &i in row_idx {
+            count[i + 1] += 1;
+        }
+        for i in 0..sym.nrows() {
+            count[i + 1] += count[i];
+        }
+        let mut at = count.clone();
+        let mut entries = vec![(0 as PetscInt, 0u32); row_idx.len()];
+        for j in 0..sym.ncols() {
+            let slots = col_ptr[j]..col_ptr[j + 1];
+            for (k, &i) in slots.clone().zip(&row_idx[slots]) {
+                entries[at[i]] = (layout.petsc[j], k as u32);
+                at[i] += 1;
             }
         }
-        if !rows.is_empty() {
-            a.add_column(&rows, layout.petsc[j], &vals)
-                .map_err(petsc_err)?;
+        let mut out = ByRows {
+            rows: Vec::new(),
+            start: vec![0],
+            cols: Vec::with_capacity(entries.len()),
+            slots: Vec::with_capacity(entries.len()),
+        };
+        for i in 0..sym.nrows() {
+            let row = &mut entries[count[i]..count[i + 1]];
+            if row.is_empty() {
+                continue;
+            }
+            row.sort_unstable();
+            out.rows.push(layout.petsc[i]);
+            out.cols.extend(row.iter().map(|e| e.0));
+            out.slots.extend(row.iter().map(|e| e.1));
+            out.start.push(out.cols.len());
+        }
+        out
+    }
+}
+
+/// Add a matrix's `values` (in the column storage `by` was made from) to `a`, a row at
+/// a time. Its zeros are left out unless `zeros`: where a later matrix of the same
+/// pattern may hold a value there (a tangent that depends on u: on a mesh of cubes the
+/// conduction's entries between the ends of an element edge are exactly 0 at a constant
+/// k, not at a k of T), since PETSc drops the preallocated places its first assembly
+/// did not fill and refuses a new entry afterwards.
+pub(super) fn add_rows(
+    a: &mut Mat,
+    by: &ByRows,
+    values: &[f64],
+    zeros: bool,
+) -> Result<(), HeatError> {
+    let (mut cols, mut vals) = (Vec::new(), Vec::new());
+    for (r, &row) in by.rows.iter().enumerate() {
+        cols.clear();
+        vals.clear();
+        for e in by.start[r]..by.start[r + 1] {
+            let v = values[by.slots[e] as usize];
+            if zeros || v != 0.0 {
+                cols.push(by.cols[e]);
+                vals.push(v);
+            }
+        }
+        if !cols.is_empty() {
+            a.add_row(row, &cols, &vals).map_err(petsc_err)?;
         }
     }
     Ok(())

@@ -43,7 +43,7 @@ use super::part;
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::reuse::Hierarchy;
 use super::rows::{
-    Layout, Scatter, add_columns, couplings_to_owners, empty_mesh, local_faces, preallocation,
+    ByRows, Layout, Scatter, add_rows, couplings_to_owners, empty_mesh, local_faces, preallocation,
     summed_heat,
 };
 use super::session::agreed;
@@ -543,7 +543,9 @@ fn log_partition(world: &SimpleCommunicator, layout: &Layout, pairs_of_mine: &[(
 pub(super) struct Newton<'b, 'p> {
     built: &'b Built<'p>,
     iasm: Assembler<'b>,
-    i_sym: faer::sparse::SymbolicSparseColMat<usize>,
+    /// The conduction's and the interfaces' entries by PETSc row.
+    k_rows: ByRows,
+    i_rows: ByRows,
     k_local: Vec<f64>,
     f_local: Vec<f64>,
     /// The face conditions in force (of the problem's mesh): read at every iterate when
@@ -575,7 +577,8 @@ impl<'b, 'p> Newton<'b, 'p> {
         let layout = &built.layout;
         let comm = built.world.as_raw();
         let iasm = Assembler::direct(&built.ipattern)?;
-        let i_sym = built.ipattern.symbolic().expect("built").clone();
+        let i_rows = ByRows::new(built.ipattern.symbolic().expect("built"), layout);
+        let k_rows = ByRows::new(&built.k_sym, layout);
         // (A conduction of T is assembled at each iterate instead.)
         let (k_local, f_local) = match (built.k_first.borrow_mut().take(), built.nonlinear) {
             (Some(kf), _) => kf,
@@ -619,7 +622,8 @@ impl<'b, 'p> Newton<'b, 'p> {
         Ok(Newton {
             built,
             iasm,
-            i_sym,
+            k_rows,
+            i_rows,
             k_local,
             f_local,
             faces: built.p.face_bcs.to_vec(),
@@ -939,7 +943,6 @@ impl<'b, 'p> Newton<'b, 'p> {
     /// step; Dirichlet rows and columns the identity's).
     fn set_matrix(&mut self, capacity: Option<&[f64]>) -> Result<(), HeatError> {
         let built = self.built;
-        let layout = &built.layout;
         self.a.zero().map_err(petsc_err)?;
         // (A tangent of T: its zeros of one iterate are not those of the next.)
         let tangent = built.nonlinear;
@@ -949,15 +952,15 @@ impl<'b, 'p> Newton<'b, 'p> {
                 for &(d, slot) in &self.diagonal {
                     k[slot] += c[d];
                 }
-                add_columns(&mut self.a, &built.k_sym, &k, layout, tangent)?;
+                add_rows(&mut self.a, &self.k_rows, &k, tangent)?;
             }
-            None => add_columns(&mut self.a, &built.k_sym, &self.k_local, layout, tangent)?,
+            None => add_rows(&mut self.a, &self.k_rows, &self.k_local, tangent)?,
         }
         let mut i_values = Vec::new();
         self.iasm.values_into(&mut i_values)?;
         // Its zeros too: a term switched off (a toggle, h = 0) leaves zeros where a later
         // matrix has values, and PETSc drops the places its first assembly leaves empty.
-        add_columns(&mut self.a, &self.i_sym, &i_values, layout, true)?;
+        add_rows(&mut self.a, &self.i_rows, &i_values, true)?;
         self.a.assemble().map_err(petsc_err)?;
         self.a.zero_rows_columns(&built.bc_rows).map_err(petsc_err)
     }
