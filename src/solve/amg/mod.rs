@@ -88,7 +88,7 @@ use super::{LinearSolver, SolveError, SolveReport, check_rhs, dot, norm};
 mod blocks;
 mod coarsen;
 mod csr;
-mod reuse;
+pub(crate) mod reuse;
 mod smooth;
 mod successive;
 
