@@ -153,6 +153,7 @@ impl GeneralSolve {
         if kept.values != a.val() {
             kept.set_values(a, &rows).map_err(failed)?;
             let diagonal = diagonal(a);
+            // (No c₀ here: the diagonal's drift stands for it.)
             reused = method != Method::MumpsLu
                 && kept.hierarchy.serves(0.0)
                 && !drifted(&kept.set_up_for, &diagonal);
