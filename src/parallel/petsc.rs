@@ -338,19 +338,7 @@ impl Mat {
         cols: &[PetscInt],
         values: &[f64],
     ) -> Result<(), PetscError> {
-        debug_assert_eq!(cols.len(), values.len());
-        // SAFETY: `cols` and `values` have the length passed; one row.
-        check("MatSetValues", unsafe {
-            MatSetValues(
-                self.0,
-                1,
-                &row,
-                cols.len() as PetscInt,
-                cols.as_ptr(),
-                values.as_ptr(),
-                ADD_VALUES,
-            )
-        })
+        self.row_values(row, cols, values, ADD_VALUES)
     }
 
     /// Set row `row`'s entries at columns `cols` (global indices; the row owned here).
@@ -360,7 +348,18 @@ impl Mat {
         cols: &[PetscInt],
         values: &[f64],
     ) -> Result<(), PetscError> {
-        debug_assert_eq!(cols.len(), values.len());
+        self.row_values(row, cols, values, INSERT_VALUES)
+    }
+
+    /// One row's values, added or set by `mode`.
+    fn row_values(
+        &mut self,
+        row: PetscInt,
+        cols: &[PetscInt],
+        values: &[f64],
+        mode: c_int,
+    ) -> Result<(), PetscError> {
+        assert_eq!(cols.len(), values.len(), "one value per column");
         // SAFETY: `cols` and `values` have the length passed; one row.
         check("MatSetValues", unsafe {
             MatSetValues(
@@ -370,7 +369,7 @@ impl Mat {
                 cols.len() as PetscInt,
                 cols.as_ptr(),
                 values.as_ptr(),
-                INSERT_VALUES,
+                mode,
             )
         })
     }
