@@ -23,9 +23,10 @@
 //! the values are set again only when they changed, so an unchanged matrix (a linear
 //! problem stepping with a fixed step) reuses its factorisation or AMG hierarchy, as the
 //! serial solver's `factored` cache does. A Krylov method keeps its BoomerAMG hierarchy
-//! for a changed matrix too, by the serial AMG's rules (`src/solve/amg/reuse.rs`): while
-//! no diagonal entry moved by more than [`DRIFT`] from the matrix it was set up for and
-//! the solves have not degraded ([`Hierarchy`]).
+//! for a changed matrix too, by the serial AMG's rules and tests
+//! (`src/solve/amg/reuse.rs`): while no diagonal entry moved by more than
+//! [`DRIFT`](crate::solve::amg::reuse::DRIFT) from the matrix it was set up for and the
+//! solves have not degraded ([`Hierarchy`]).
 
 use std::ops::Range;
 use std::time::Instant;
@@ -36,7 +37,7 @@ use mpi::traits::{AsRaw, Communicator, CommunicatorCollectives};
 
 use crate::heat::HeatError;
 use crate::solve::SolveError;
-use crate::solve::amg::reuse::DRIFT;
+use crate::solve::amg::reuse::{diagonal_of, drifted};
 
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Split, Vector};
 use super::reuse::Hierarchy;
@@ -55,8 +56,9 @@ struct Kept {
     slots: Vec<usize>,
     /// The values set last (the whole CSC value array).
     values: Vec<f64>,
-    /// The diagonal of the matrix the preconditioner was made for, and its state.
-    set_up_for: Vec<f64>,
+    /// The inverse diagonal of the matrix the preconditioner was made for (`None`: an
+    /// entry missing), and its state.
+    set_up_for: Option<Vec<f64>>,
     hierarchy: Hierarchy,
     a: Mat,
     ksp: Ksp,
@@ -144,7 +146,7 @@ impl GeneralSolve {
                 _ => None,
             };
             let mut made = Kept::new(&self.world, a, &rows, method, split).map_err(failed)?;
-            made.set_up(diagonal(a)).map_err(failed)?;
+            made.set_up(a).map_err(failed)?;
             self.kept = Some(made);
         }
         let kept = self.kept.as_mut().expect("made above");
@@ -152,14 +154,15 @@ impl GeneralSolve {
         let mut reused = false;
         if kept.values != a.val() {
             kept.set_values(a, &rows).map_err(failed)?;
-            let diagonal = diagonal(a);
             // (No c₀ here: the diagonal's drift stands for it.)
             reused = method != Method::MumpsLu
                 && kept.hierarchy.serves(0.0)
-                && !drifted(&kept.set_up_for, &diagonal);
+                && (kept.set_up_for.as_deref())
+                    .zip(diagonal_of(a.as_ref()))
+                    .is_some_and(|(inv, d)| !drifted(inv, &d));
             match reused {
                 true => kept.ksp.keep_preconditioner(true).map_err(failed)?,
-                false => kept.set_up(diagonal).map_err(failed)?,
+                false => kept.set_up(a).map_err(failed)?,
             }
         }
         let local = rows.len();
@@ -178,11 +181,15 @@ impl GeneralSolve {
         .map_err(failed)?;
         let setup_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let x0 = kept.x.with_local(local, |v| v.to_vec()).map_err(failed)?;
+        // (The start, for a solve again on a new hierarchy.)
+        let x0 = match reused {
+            true => Some(kept.x.with_local(local, |v| v.to_vec()).map_err(failed)?),
+            false => None,
+        };
         let mut solved = kept.ksp.solve(&kept.b, &mut kept.x);
-        if reused && solved.as_ref().is_err_and(PetscError::is_divergence) {
+        if let Some(x0) = x0.filter(|_| solved.as_ref().is_err_and(PetscError::is_divergence)) {
             // The kept hierarchy failed: one for this matrix, and the solve again.
-            kept.set_up(diagonal(a)).map_err(failed)?;
+            kept.set_up(a).map_err(failed)?;
             kept.x
                 .with_local(local, |v| v.copy_from_slice(&x0))
                 .map_err(failed)?;
@@ -204,32 +211,12 @@ impl GeneralSolve {
     }
 }
 
-/// The diagonal of a square matrix in column storage (0 where it has no entry).
-fn diagonal(a: &SparseColMat<usize, f64>) -> Vec<f64> {
-    let (sym, val) = (a.symbolic(), a.val());
-    let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
-    (0..a.ncols())
-        .map(|j| {
-            let column = col_ptr[j]..col_ptr[j + 1];
-            (column.clone().zip(&row_idx[column]))
-                .find(|&(_, &i)| i == j)
-                .map_or(0.0, |(k, _)| val[k])
-        })
-        .collect()
-}
-
-/// Whether a diagonal entry moved by more than [`DRIFT`] (relative) from `before`'s.
-fn drifted(before: &[f64], now: &[f64]) -> bool {
-    before.len() != now.len()
-        || (before.iter().zip(now)).any(|(&b, &d)| (d - b).abs() > DRIFT * b.abs())
-}
-
 impl Kept {
-    /// The preconditioner (or factorisation) made for the matrix set, of `diagonal`.
-    fn set_up(&mut self, diagonal: Vec<f64>) -> Result<(), PetscError> {
+    /// The preconditioner (or factorisation) made for the matrix set, `a`.
+    fn set_up(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), PetscError> {
         self.ksp.keep_preconditioner(false)?;
         self.ksp.set_up()?;
-        self.set_up_for = diagonal;
+        self.set_up_for = diagonal_of(a.as_ref()).map(|d| d.iter().map(|d| 1.0 / d).collect());
         self.hierarchy.set_up(0.0);
         Ok(())
     }
@@ -292,7 +279,7 @@ impl Kept {
             cols,
             slots,
             values: Vec::new(),
-            set_up_for: Vec::new(),
+            set_up_for: None,
             hierarchy: Hierarchy::default(),
             a: a_petsc,
             ksp,

@@ -59,8 +59,9 @@ impl Reuse {
     }
 }
 
-/// The diagonal the hierarchy was set up for, from its finest level's inverse.
-fn drifted(inv_diag: &[f64], diag: &[f64]) -> bool {
+/// Whether `diag` moved by more than [`DRIFT`] (relative, at any row) from the diagonal
+/// whose inverse is `inv_diag` (the one a hierarchy was set up for).
+pub(crate) fn drifted(inv_diag: &[f64], diag: &[f64]) -> bool {
     inv_diag
         .iter()
         .zip(diag)
@@ -277,6 +278,20 @@ impl RowIndex for u32 {
 }
 
 /// A square matrix in column storage, borrowed as its parts.
+/// The diagonal of a square matrix in column storage, rows ascending in each column
+/// (`None`: an entry missing): the distributed general solver's drift test.
+#[cfg(feature = "mpi")]
+pub(crate) fn diagonal_of(a: faer::sparse::SparseColMatRef<'_, usize, f64>) -> Option<Vec<f64>> {
+    let s = a.symbolic();
+    Csc {
+        n: a.ncols(),
+        col_ptr: s.col_ptr(),
+        rows: s.row_idx(),
+        val: a.val(),
+    }
+    .diagonal()
+}
+
 #[derive(Clone, Copy)]
 struct Csc<'a, I> {
     n: usize,
