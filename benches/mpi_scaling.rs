@@ -16,7 +16,9 @@
 //! the conductivities laws of temperature (5 (1 + (T − 300)/600) W/m/K, a Lua
 //! expression, in the first box; a table from 40 to 25 W/m/K over 300–600 K in the
 //! second): one Newton solve, its tangent assembled per rank at every iterate, by GMRES
-//! preconditioned by AMG (serial: seam's, MPI: BoomerAMG).
+//! preconditioned by AMG (serial: seam's, MPI: BoomerAMG). `SEAM_BENCH_TIE=standard` (or
+//! `dual`) joins the boxes by a mortar tie with Lagrange multipliers instead: a saddle
+//! point, factored (serial: LDLᵀ, or the dual tie condensed; MPI: MUMPS LU).
 
 use std::path::Path;
 use std::process::Command;
@@ -24,7 +26,7 @@ use std::process::Command;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::output::exodus::ExodusWriter;
 
-fn write_case(dir: &Path, cells: usize, k_of_t: bool) {
+fn write_case(dir: &Path, cells: usize, k_of_t: bool, tie: Option<&str>) {
     let m2 = (cells as f64 * 0.8).round() as usize;
     let m = generate::boxes(
         &[
@@ -39,15 +41,25 @@ fn write_case(dir: &Path, cells: usize, k_of_t: bool) {
         .unwrap()
         .finish()
         .unwrap();
+    let enforcement = match tie {
+        Some(m) => format!(
+            "enforcement for energy = tied multipliers = {m}\n side b variable temperature to temperature"
+        ),
+        None => {
+            "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000"
+                .to_string()
+        }
+    };
     std::fs::write(
         dir.join("contact.i"),
-        "begin contact definition cut\n\
-         contact surface a contains surface_3\n\
-         contact surface b contains surface_4\n\
-         begin interaction\n side a a\n side b b\n end\n\
-         begin enforcement\n enforcement for energy = gap_conductance\n \
-         gap conductance coefficient = constant h = 2000\n end\n\
-         end\n",
+        format!(
+            "begin contact definition cut\n\
+             contact surface a contains surface_3\n\
+             contact surface b contains surface_4\n\
+             begin interaction\n side a a\n side b b\n end\n\
+             begin enforcement\n {enforcement}\n end\n\
+             end\n"
+        ),
     )
     .unwrap();
     let (k1, k2) = match k_of_t {
@@ -127,16 +139,18 @@ fn main() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(40);
     let k_of_t = std::env::var("SEAM_BENCH_K_OF_T").is_ok_and(|v| v == "1");
+    let tie = std::env::var("SEAM_BENCH_TIE").ok();
+    let tie = tie.as_deref();
     let tmp = tempfile::tempdir().unwrap();
-    write_case(tmp.path(), cells, k_of_t);
+    write_case(tmp.path(), cells, k_of_t, tie);
     if let Some(keep) = std::env::var_os("SEAM_BENCH_KEEP") {
         // The case written where asked too, to run by hand.
         std::fs::create_dir_all(&keep).unwrap();
-        write_case(Path::new(&keep), cells, k_of_t);
+        write_case(Path::new(&keep), cells, k_of_t, tie);
     }
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!(
-        "cells {cells}, k(T) {k_of_t}, load average before: {}",
+        "cells {cells}, k(T) {k_of_t}, tie {tie:?}, load average before: {}",
         load.trim()
     );
     println!(

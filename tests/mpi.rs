@@ -607,6 +607,56 @@ fn cut_interface_crosspoints_on_rank_boundaries_equal_serial() {
     compare(&problem, true);
 }
 
+/// The cut bar tied by mortar with Lagrange multipliers (`multipliers`: standard or
+/// dual), its side-A edge along y = 0 held by the Dirichlet value (crosspoints), the
+/// interface cut by the partition: the distributed steady solve on the distributed
+/// mesh (from 2 ranks on each rank other than 0 holds its part), each rank adding the
+/// tie rows of the side-A points it owns (a multiplier's row gets the parts of the
+/// ranks around its node), MUMPS solving the saddle point — a dual tie too, not
+/// condensed. Fields and tie heats equal serial on 1–4 ranks; the summary's reason
+/// names the saddle point.
+fn cut_interface_multiplier_tie(multipliers: &str) {
+    let tmp = scratch(&format!("cut-tie-{multipliers}"));
+    let enforcement = format!(
+        "enforcement for energy = tied multipliers = {multipliers}\n side b variable temperature to temperature"
+    );
+    let problem = write_cut_case(tmp.path(), &enforcement, "");
+    let (serial, runs) = compare_runs(&problem, true);
+    let heat = serial.summary["interactions"][0]["heat_side_a"]
+        .as_f64()
+        .unwrap();
+    assert!(heat.abs() > 1.0, "the tie carries heat: {}", serial.summary);
+    for par in &runs {
+        let why = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(
+            why.contains("mortar ties with Lagrange multipliers") && why.contains("MUMPS"),
+            "the distributed steady solve of the saddle point: {why}"
+        );
+        assert!(
+            par.log.contains("distributed set-up on rank 0"),
+            "the distributed steady solve, not the general solver:\n{}",
+            par.log
+        );
+    }
+    for (n, par) in (1..).zip(&runs).skip(1) {
+        assert!(
+            par.log.contains(PART_ONLY),
+            "{n} ranks: the mesh should be distributed:\n{}",
+            par.log
+        );
+    }
+}
+
+#[test]
+fn cut_interface_standard_multiplier_tie_equals_serial() {
+    cut_interface_multiplier_tie("standard");
+}
+
+#[test]
+fn cut_interface_dual_multiplier_tie_equals_serial() {
+    cut_interface_multiplier_tie("dual");
+}
+
 /// The cut bar's gap conductance, constant.
 const GAP_H: &str =
     "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000";

@@ -197,6 +197,26 @@ impl Embedding {
     /// `condensed_too` (a host that solves for the multipliers does not need it, and a
     /// partly covered side A cannot be condensed).
     pub(crate) fn tie_rows(&self, condensed_too: bool) -> Result<Vec<TieConstraints>, EmbedError> {
+        self.tie_rows_of(condensed_too, None)
+    }
+
+    /// This process's share of every mortar tie's rows: those of the points it
+    /// evaluates ([`Embedding::own_points`]), each tie's multipliers on the side-A nodes
+    /// `carries(tie, node)` accepts (the ties' order; the whole tie's, decided where the
+    /// whole interface is held). Summed over the processes that share the points, they
+    /// are the whole tie's rows; dual bases are made face by face, so theirs too.
+    pub(crate) fn own_tie_rows(
+        &self,
+        carries: &dyn Fn(usize, NodeId) -> bool,
+    ) -> Result<Vec<TieConstraints>, EmbedError> {
+        self.tie_rows_of(false, Some(carries))
+    }
+
+    fn tie_rows_of(
+        &self,
+        condensed_too: bool,
+        carries: Option<&dyn Fn(usize, NodeId) -> bool>,
+    ) -> Result<Vec<TieConstraints>, EmbedError> {
         // Per side-A field: its fixed nodes, then the nodes of its earlier ties.
         let mut constrained: std::collections::HashMap<FieldId, HashSet<NodeId>> =
             Default::default();
@@ -210,12 +230,29 @@ impl Embedding {
             else {
                 continue;
             };
-            let fixed = || {
-                let own = self.fixed_of.iter().find(|(f, _)| *f == p.fields.a);
-                own.map_or(&self.fixed, |(_, n)| n)
-                    .iter()
-                    .copied()
-                    .collect()
+            // A share: the points kept, every side-A node but those carrying this
+            // tie's multipliers held as constrained.
+            let (points, mut share_constrained): (Vec<_>, HashSet<NodeId>);
+            let (points, constrained) = match carries {
+                None => (
+                    &result.points[..],
+                    constrained
+                        .entry(p.fields.a)
+                        .or_insert_with(|| self.fixed_of_field(p.fields.a)),
+                ),
+                Some(carries) => {
+                    let t = out.len();
+                    points = match &p.kept {
+                        Some(kept) => kept.iter().map(|&k| result.points[k]).collect(),
+                        None => result.points.to_vec(),
+                    };
+                    share_constrained = (p.a.faces.iter())
+                        .flat_map(|f| f.nodes[..f.len as usize].iter().copied())
+                        .chain(p.a.nodes.iter().map(|n| n.0))
+                        .filter(|&n| !carries(t, n))
+                        .collect();
+                    (&points[..], &mut share_constrained)
+                }
             };
             let tie = mortar_tie(
                 &self.mesh,
@@ -223,9 +260,9 @@ impl Embedding {
                 p.fields,
                 &p.a,
                 &p.b,
-                &result.points,
+                points,
                 p.coefficient(&self.conductivity),
-                constrained.entry(p.fields.a).or_insert_with(fixed),
+                constrained,
                 *multipliers,
             )
             .map_err(|source| EmbedError::Enforcement {
@@ -271,6 +308,31 @@ impl Embedding {
             out.push(t);
         }
         Ok(out)
+    }
+}
+
+impl From<&TieConstraints> for crate::heat::interfaces::TieRows {
+    fn from(t: &TieConstraints) -> Self {
+        Self {
+            own: t.multiplier_dofs.clone(),
+            entries: t.entries.clone(),
+            rhs: t.rhs.clone(),
+            crosspoints: t.crosspoints.iter().map(|&n| NodeId(n as u32)).collect(),
+            side_a_dofs: t.side_a_dofs.clone(),
+            side_b_dofs: t.side_b_dofs.clone(),
+            dual: t.multipliers == Multipliers::Dual,
+        }
+    }
+}
+
+impl Embedding {
+    /// The nodes of `field` the host fixed (its own list, or the common one).
+    fn fixed_of_field(&self, field: FieldId) -> HashSet<NodeId> {
+        let own = self.fixed_of.iter().find(|(f, _)| *f == field);
+        own.map_or(&self.fixed, |(_, n)| n)
+            .iter()
+            .copied()
+            .collect()
     }
 }
 

@@ -141,6 +141,13 @@ pub trait Interfaces {
             "these interfaces cannot be evaluated point by point per rank".into(),
         ))
     }
+    /// This rank's share of the ties' rows ([`Self::own_points`] set): those of the
+    /// points it evaluates, each tie's multipliers on the side-A nodes `carries(tie,
+    /// node)` accepts (the whole tie's). Summed over the ranks they are [`Self::ties`].
+    fn own_ties(&self, carries: &dyn Fn(usize, NodeId) -> bool) -> Result<Vec<TieRows>, String> {
+        let _ = carries;
+        Err("these interfaces cannot make their ties' rows per rank".into())
+    }
     /// The problem's electrical contacts as the last [`Self::advance`] left their
     /// surfaces (moved, searched anew or made again by element death), in the problem's
     /// order; `None` while they are as the problem gave them.

@@ -246,12 +246,7 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     };
     // Mortar ties: multipliers on side-A nodes not constrained already.
     let ties = iface.ties().map_err(HeatError::Contact)?;
-    if ties.iter().any(|t| t.dual) {
-        if ties.iter().any(|t| !t.dual) || !iface.is_linear() {
-            return Err(HeatError::Contact(
-                "dual mortar ties are condensed in a linear solve: do not mix them with standard ties or temperature-dependent conductances".into(),
-            ));
-        }
+    if dual_ties(&ties, iface.is_linear())? {
         return solve_dual(p, iface, dofs, field, bcs, ties);
     }
     let mut lambda_first = Vec::with_capacity(ties.len());
@@ -444,6 +439,72 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing,
         linear,
     })
+}
+
+/// Whether the ties are dual ones (condensed in a linear solve); refused mixed with
+/// standard ties or with a temperature-dependent conductance (not `linear`).
+pub(crate) fn dual_ties(ties: &[TieRows], linear: bool) -> Result<bool, HeatError> {
+    if !ties.iter().any(|t| t.dual) {
+        return Ok(false);
+    }
+    if ties.iter().any(|t| !t.dual) || !linear {
+        return Err(HeatError::Contact(
+            "dual mortar ties are condensed in a linear solve: do not mix them with standard ties or temperature-dependent conductances".into(),
+        ));
+    }
+    Ok(true)
+}
+
+/// A dual tie's condensation: per dof, the condensed row `(constant, [(dof,
+/// coefficient)])` of the side-A dofs that carry a multiplier, and the rows' diagonals.
+/// Refused where two condensed rows couple (a side-A face only partly covered by side
+/// B), as the distributed solve (which keeps the multipliers) refuses it too.
+pub(crate) fn dual_condensation(
+    ties: &[TieRows],
+    n: usize,
+) -> Result<(Vec<Condensed>, Vec<f64>), HeatError> {
+    let mut map: Vec<Condensed> = vec![None; n];
+    let mut diag = vec![0.0; n];
+    for tie in ties {
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); tie.own.len()];
+        for &(kk, d, c) in &tie.entries {
+            rows[kk].push((d, c));
+        }
+        for (kk, &own) in tie.own.iter().enumerate() {
+            if own == usize::MAX {
+                return Err(HeatError::NoTemperatureField);
+            }
+            let d = rows[kk]
+                .iter()
+                .filter(|(j, _)| *j == own)
+                .map(|(_, c)| c)
+                .sum::<f64>();
+            if d == 0.0 {
+                continue; // a node no point reached: left free
+            }
+            diag[own] = d;
+            let others = rows[kk]
+                .iter()
+                .filter(|(j, _)| *j != own)
+                .map(|&(j, c)| (j, -c / d))
+                .collect();
+            map[own] = Some((tie.rhs[kk] / d, others));
+        }
+    }
+    // Side-A rows of a dual basis reference no other condensed dof (biorthogonality);
+    // a non-negligible one means a face without full overlap.
+    for (i, m) in map.iter().enumerate() {
+        if let Some((_, row)) = m {
+            for &(j, a) in row {
+                if map[j].is_some() && a.abs() > 1e-9 {
+                    return Err(HeatError::Contact(format!(
+                        "dual mortar: the side-A rows of dofs {i} and {j} are coupled ({a:.3e}); a side-A face is only partly covered by side B — use standard multipliers (`Multipliers = Standard`) there"
+                    )));
+                }
+            }
+        }
+    }
+    Ok((map, diag))
 }
 
 /// The steady pattern over `dofs`: the elements, the interface `couplings` and one
@@ -673,6 +734,9 @@ fn solve_amg(
     })
 }
 
+/// A condensed dof's row: its constant and its terms `(dof, coefficient)`.
+type Condensed = Option<(f64, Vec<(usize, f64)>)>;
+
 /// The dual-mortar path: every tie's side-A interface values are condensed out
 /// (`u_A,k = (ΔT ∫ψ_k − Σ_j C_kj u_j) / D_k`, D the diagonal side-A block of C), the
 /// system `Tᵀ K T ũ = Tᵀ (F − K g)` stays symmetric positive definite and is solved by
@@ -711,49 +775,7 @@ fn solve_dual(
         *fi -= ri;
     }
     drop(asm);
-    // The condensation map: condensed dof → (constant, [(dof, coefficient)]).
-    type Condensed = Option<(f64, Vec<(usize, f64)>)>;
-    let mut map: Vec<Condensed> = vec![None; n];
-    let mut diag = vec![0.0; n];
-    for tie in &ties {
-        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); tie.own.len()];
-        for &(kk, d, c) in &tie.entries {
-            rows[kk].push((d, c));
-        }
-        for (kk, &own) in tie.own.iter().enumerate() {
-            if own == usize::MAX {
-                return Err(HeatError::NoTemperatureField);
-            }
-            let d = rows[kk]
-                .iter()
-                .filter(|(j, _)| *j == own)
-                .map(|(_, c)| c)
-                .sum::<f64>();
-            if d == 0.0 {
-                continue; // a node no point reached: left free
-            }
-            diag[own] = d;
-            let others = rows[kk]
-                .iter()
-                .filter(|(j, _)| *j != own)
-                .map(|&(j, c)| (j, -c / d))
-                .collect();
-            map[own] = Some((tie.rhs[kk] / d, others));
-        }
-    }
-    // Side-A rows of a dual basis reference no other condensed dof (biorthogonality);
-    // a non-negligible one means a face without full overlap.
-    for (i, m) in map.iter().enumerate() {
-        if let Some((_, row)) = m {
-            for &(j, a) in row {
-                if map[j].is_some() && a.abs() > 1e-9 {
-                    return Err(HeatError::Contact(format!(
-                        "dual mortar: the side-A rows of dofs {i} and {j} are coupled ({a:.3e}); a side-A face is only partly covered by side B — use standard multipliers (`Multipliers = Standard`) there"
-                    )));
-                }
-            }
-        }
-    }
+    let (map, diag) = dual_condensation(&ties, n)?;
     let expand = |i: usize| -> Vec<(usize, f64)> {
         match &map[i] {
             Some((_, row)) => row

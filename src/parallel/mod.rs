@@ -51,6 +51,8 @@ mod steady;
 #[cfg(feature = "mpi")]
 mod stepped;
 #[cfg(feature = "mpi")]
+mod ties;
+#[cfg(feature = "mpi")]
 mod wire;
 
 #[cfg(feature = "mpi")]

@@ -94,6 +94,20 @@ impl Layout {
         })
     }
 
+    /// `count` more local dofs, the last `count` of `dofs` (a tie's multipliers, which no
+    /// element owns): PETSc rows after every node's, owned by the last rank, in their
+    /// local (the serial) order. Every rank must hold the same multipliers.
+    pub(super) fn append_last(&mut self, count: usize) {
+        let global = self.starts[self.size];
+        let first = self.petsc.len();
+        self.petsc
+            .extend((0..count).map(|k| (global + k) as PetscInt));
+        self.starts[self.size] += count;
+        if self.rank + 1 == self.size {
+            self.owned.extend(first..first + count);
+        }
+    }
+
     /// Whether this rank owns an interface point on a side-A face of element `elem`, or
     /// at side-A node `node`.
     pub(super) fn owns_point(&self, elem: Option<ElemId>, node: Option<NodeId>) -> bool {
@@ -519,4 +533,32 @@ pub(super) fn preallocation(
         }
     }
     (diagonal, off)
+}
+
+/// How the partition meets the interfaces, in rank 0's log: couplings whose two dofs
+/// sit on different ranks are those a per-rank solve would get wrong.
+pub(super) fn log_partition(
+    world: &SimpleCommunicator,
+    layout: &Layout,
+    pairs_of_mine: &[(usize, usize)],
+) {
+    let across = pairs_of_mine
+        .iter()
+        .filter(|&&(i, j)| layout.owner(i) != layout.owner(j))
+        .count() as u64;
+    let mine = [across, pairs_of_mine.len() as u64];
+    let mut sum = [0u64; 2];
+    world.all_reduce_into(&mine[..], &mut sum[..], SystemOperation::sum());
+    let held = part::with(part::Part::counts).unwrap_or_default();
+    let mut elems = vec![0u64; layout.size];
+    world.all_gather_into(&(held.owned as u64), &mut elems[..]);
+    if layout.rank == 0 {
+        let dofs_per: Vec<usize> = layout.starts.windows(2).map(|w| w[1] - w[0]).collect();
+        log::info!(
+            "distributed over {} rank(s): elements per rank {elems:?}, dofs per rank {dofs_per:?}; {} of {} interface couplings join dofs of different ranks",
+            elems.len(),
+            sum[0],
+            sum[1]
+        );
+    }
 }

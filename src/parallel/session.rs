@@ -188,3 +188,17 @@ pub(super) fn agreed<T>(r: Result<T, crate::heat::HeatError>) -> Result<T, crate
     }
     Err(crate::heat::HeatError::Step(why.join("; ")))
 }
+
+/// The set-up's phases, as seconds from its start, for the log.
+#[derive(Default)]
+pub(super) struct Phases(pub(super) String);
+
+impl Phases {
+    pub(super) fn mark(&mut self, what: &str, since: std::time::Instant) {
+        if !self.0.is_empty() {
+            self.0.push_str(", ");
+        }
+        self.0
+            .push_str(&format!("{what} {:.3}", since.elapsed().as_secs_f64()));
+    }
+}

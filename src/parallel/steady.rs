@@ -14,7 +14,7 @@
 //! over the ranks. The increment is solved by PETSc; each rank then gets from their
 //! owners only the values it reads (its elements' dofs, and its points' on both sides:
 //! [`Scatter`]), and the whole solution is gathered once, at the end, for the output.
-//! Mortar ties with multipliers are refused. A failure on one rank (an interface model,
+//! Mortar ties with multipliers add their rows as [`super::ties`] says. A failure on one rank (an interface model,
 //! a load) is agreed on by every rank before the next collective ([`agreed`](super::session::agreed)).
 
 use std::time::Instant;
@@ -43,10 +43,11 @@ use super::part;
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Vector};
 use super::reuse::Hierarchy;
 use super::rows::{
-    ByRows, Layout, Scatter, add_rows, couplings_to_owners, empty_mesh, local_faces, preallocation,
-    summed_heat,
+    ByRows, Layout, Scatter, add_rows, couplings_to_owners, empty_mesh, local_faces, log_partition,
+    preallocation, summed_heat,
 };
-use super::session::agreed;
+use super::session::{Phases, agreed};
+use super::ties::Ties;
 use super::{Laws, session};
 
 fn petsc_err(e: PetscError) -> HeatError {
@@ -66,9 +67,13 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     if let Some(why) = solved.failure {
         return Err(HeatError::Step(why));
     }
+    let tie_heat = (built.ties.as_ref()).map_or_else(Vec::new, |t| t.heat(&built.world, &u));
     built.gather(&mut u);
     let (method, symmetric) = (newton.method, newton.symmetric);
     let why = match (method, symmetric) {
+        _ if built.ties.is_some() => {
+            "mortar ties with Lagrange multipliers make the system indefinite → MUMPS LU"
+        }
         (Method::MumpsLu, true) => {
             "below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
         }
@@ -99,8 +104,8 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         converged: solved.converged,
         residual_history: solved.history,
         heat: solved.heat,
-        tie_heat: Vec::new(),
-        crosspoints: Vec::new(),
+        tie_heat,
+        crosspoints: (built.ties.as_ref()).map_or_else(Vec::new, Ties::crosspoints),
         timing: solved.timing,
         linear,
     })
@@ -178,6 +183,8 @@ pub(super) struct Built<'p> {
     bc_rows: Vec<PetscInt>,
     bc_local: Vec<usize>,
     scatter: Scatter,
+    /// Mortar ties with multipliers ([`Ties`]).
+    ties: Option<Ties>,
     _all_again: Option<AllPoints<'p>>,
 }
 
@@ -193,11 +200,10 @@ impl<'p> Built<'p> {
         let mesh = p.mesh;
         let world = session::comm();
         let blocks = part::solid_blocks(mesh);
-        let dofs = DofMap::new(mesh, &[(TEMPERATURE, &blocks)])?;
+        let mut dofs = DofMap::new(mesh, &[(TEMPERATURE, &blocks)])?;
         let field = dofs
             .field(TEMPERATURE)
             .ok_or(HeatError::NoTemperatureField)?;
-        let n = dofs.len();
         let bcs = dirichlet_dofs(mesh, &dofs, field, p.dirichlet)?;
         let iface = match p.interfaces {
             Some(i) if p.contact.is_empty() && p.ties.is_empty() => Some(i),
@@ -208,19 +214,31 @@ impl<'p> Built<'p> {
                 ));
             }
         };
-        if let Some(i) = iface
-            && !i.ties().map_err(HeatError::Contact)?.is_empty()
-        {
-            return Err(refused(
-                "mortar ties with Lagrange multipliers (`Tied` with `Side B Variable`, standard or dual)",
-            ));
-        }
         let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
         let start = Instant::now();
         part::ensure(mesh).map_err(HeatError::Contact)?;
-        let layout = part::with(|part| Layout::new(part, mesh, &dofs, field))
+        let mut layout = part::with(|part| Layout::new(part, mesh, &dofs, field))
             .ok_or_else(|| HeatError::Contact("distributed solve: no partition".into()))?
             .map_err(HeatError::Contact)?;
+        // The interface terms of the points this rank owns (by their side-A face's
+        // element or side-A node), all points again when the solve ends however it ends.
+        let _all_again = match iface {
+            Some(i) => {
+                i.own_points(Some(&|e, n| layout.owns_point(e, n)))
+                    .map_err(failed)?;
+                Some(AllPoints(i))
+            }
+            None => None,
+        };
+        // Mortar ties' multipliers after the nodes' dofs (steady solves alone).
+        let mut ties = match iface {
+            Some(i) => Ties::new(&world, i, (&mut dofs, field), &mut layout)?,
+            None => None,
+        };
+        if ties.is_some() && laws.is_some() {
+            return Err(refused("time steps with mortar ties with multipliers"));
+        }
+        let n = dofs.len();
         let mut phases = Phases::default();
         phases.mark("partition", start);
         let mut u = vec![0.0; n];
@@ -271,16 +289,6 @@ impl<'p> Built<'p> {
         touched.dedup();
         let touched_petsc: Vec<PetscInt> = touched.iter().map(|&d| layout.petsc[d]).collect();
 
-        // The interface terms of the points this rank owns (by their side-A face's
-        // element or side-A node), all points again when the solve ends however it ends.
-        let _all_again = match iface {
-            Some(i) => {
-                i.own_points(Some(&|e, n| layout.owns_point(e, n)))
-                    .map_err(failed)?;
-                Some(AllPoints(i))
-            }
-            None => None,
-        };
         // Their pattern: this rank's couplings alone (no elements).
         let empty = empty_mesh(mesh);
         let mut ipattern = Pattern::new(&empty, &dofs);
@@ -289,11 +297,23 @@ impl<'p> Built<'p> {
             None => Vec::new(),
         };
         let first = ipattern.add_couplings(&pairs_of_mine)?.start;
+        // With the ties' couplings of this rank's multipliers.
+        let mut all_pairs = pairs_of_mine.clone();
+        if let Some(t) = &mut ties {
+            let pairs = t.couplings();
+            t.at_slot(ipattern.add_couplings(&pairs)?.start);
+            all_pairs.extend(pairs);
+        }
         ipattern.build_direct()?;
         // The couplings of every rank's points that reach this rank's rows, for their
         // preallocation.
-        let reaching = couplings_to_owners(&world, &layout, &pairs_of_mine);
-        log_partition(&world, &layout, &pairs_of_mine);
+        let reaching = couplings_to_owners(&world, &layout, &all_pairs);
+        let joined = ties.as_ref().map_or_else(Vec::new, Ties::joined);
+        log_partition(
+            &world,
+            &layout,
+            &[pairs_of_mine.as_slice(), &joined].concat(),
+        );
         phases.mark("interface pattern", start);
         let preallocated = preallocation(mesh, &dofs, field, &layout, &reaching);
         drop(reaching);
@@ -306,7 +326,7 @@ impl<'p> Built<'p> {
         let first_row = layout.rows().start;
         let bc_local: Vec<usize> = bc_rows.iter().map(|&i| i as usize - first_row).collect();
         // The dofs this rank reads: its elements' and its points' (side A and side B).
-        let scatter = Scatter::new(&world, &layout, &touched, &pairs_of_mine);
+        let scatter = Scatter::new(&world, &layout, &touched, &all_pairs);
         phases.mark("what each rank reads", start);
         if layout.rank == 0 {
             log::info!(
@@ -342,6 +362,7 @@ impl<'p> Built<'p> {
             bc_rows,
             bc_local,
             scatter,
+            ties,
             _all_again,
         })
     }
@@ -512,30 +533,6 @@ impl<'p> Built<'p> {
     }
 }
 
-/// How the partition meets the interfaces, in rank 0's log: couplings whose two dofs
-/// sit on different ranks are those a per-rank solve would get wrong.
-fn log_partition(world: &SimpleCommunicator, layout: &Layout, pairs_of_mine: &[(usize, usize)]) {
-    let across = pairs_of_mine
-        .iter()
-        .filter(|&&(i, j)| layout.owner(i) != layout.owner(j))
-        .count() as u64;
-    let mine = [across, pairs_of_mine.len() as u64];
-    let mut sum = [0u64; 2];
-    world.all_reduce_into(&mine[..], &mut sum[..], SystemOperation::sum());
-    let held = part::with(part::Part::counts).unwrap_or_default();
-    let mut elems = vec![0u64; layout.size];
-    world.all_gather_into(&(held.owned as u64), &mut elems[..]);
-    if layout.rank == 0 {
-        let dofs_per: Vec<usize> = layout.starts.windows(2).map(|w| w[1] - w[0]).collect();
-        log::info!(
-            "distributed over {} rank(s): elements per rank {elems:?}, dofs per rank {dofs_per:?}; {} of {} interface couplings join dofs of different ranks",
-            elems.len(),
-            sum[0],
-            sum[1]
-        );
-    }
-}
-
 /// The Newton iteration over a [`Built`] set-up, with the PETSc matrix, vectors and
 /// solver it keeps: the matrix is set again only when its values change (a new `c₀`,
 /// new conduction values, or an interface whose Jacobian depends on u), so a linear
@@ -596,6 +593,7 @@ impl<'b, 'p> Newton<'b, 'p> {
         // The serial solvers' choice: AMG-CG, or AMG-GMRES for an unsymmetric Jacobian,
         // from the threshold on; a factorisation below it.
         let method = match (symmetric, built.p.iterative) {
+            _ if built.ties.is_some() => Method::MumpsLu,
             (true, true) => Method::CgAmg,
             (false, true) => Method::GmresAmg,
             (_, false) => Method::MumpsLu,
@@ -767,6 +765,14 @@ impl<'b, 'p> Newton<'b, 'p> {
                             iasm.reset_couplings();
                             i.assemble(u, t, r_iface, iasm, built.first)
                                 .map_err(failed)
+                        }
+                    })
+                    .inspect(|_| {
+                        if let Some(ties) = &built.ties {
+                            ties.residual(u, r_iface);
+                            if !kept {
+                                ties.jacobian(iasm);
+                            }
                         }
                     })
                     .and_then(|mine| {
@@ -974,20 +980,6 @@ impl Drop for AllPoints<'_> {
     fn drop(&mut self) {
         // The run's interfaces accepted the restriction, so they accept its end.
         let _ = self.0.own_points(None);
-    }
-}
-
-/// The set-up's phases, as seconds from its start, for the log.
-#[derive(Default)]
-struct Phases(String);
-
-impl Phases {
-    fn mark(&mut self, what: &str, since: Instant) {
-        if !self.0.is_empty() {
-            self.0.push_str(", ");
-        }
-        self.0
-            .push_str(&format!("{what} {:.3}", since.elapsed().as_secs_f64()));
     }
 }
 

@@ -122,8 +122,8 @@ pub(super) fn quiet() -> RunError {
 /// their part of the mesh only: steady or transient, one temperature field (its laws
 /// and sources of T, x and t, radiation or not),
 /// no moving or dying surfaces, every block solid, and a
-/// contact deck whose enforcements need nothing whole (no mortar tie with multipliers,
-/// no voltage or species enforcement, no
+/// contact deck whose enforcements need nothing whole (no mortar tie with multipliers
+/// but in a linear steady run, no voltage or species enforcement, no
 /// `Align_Surface` periodicity, no `Auto Subset`). The reason why not, otherwise.
 pub(super) fn distributable(file: &ProblemFile, physics: &Physics<'_>) -> Result<(), String> {
     let p = &file.problem;
@@ -143,7 +143,10 @@ pub(super) fn distributable(file: &ProblemFile, physics: &Physics<'_>) -> Result
         return refuse("the contact deck has errors");
     }
     let fields: Vec<&str> = physics.field_names.iter().map(String::as_str).collect();
-    match crate::scene::needs_whole_mesh(&loaded, &fields) {
+    // Multiplier ties: on the linear steady solve alone (not the general solver).
+    let toggled = !p.toggle.is_empty();
+    let multipliers = super::solve::linear_steady(file, physics, toggled);
+    match crate::scene::needs_whole_mesh(&loaded, &fields, multipliers) {
         Some(why) => refuse(why),
         None => Ok(()),
     }

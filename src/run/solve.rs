@@ -108,23 +108,9 @@ impl<'a> TimeLoop<'a> {
             && problem.death.is_empty()
     }
 
-    /// Whether one linear steady solve answers the problem: steady, one field, constant
-    /// materials, a source of x alone, no toggles, no radiation. Under MPI, not with
-    /// multiplier ties: the distributed steady solve does not hold multipliers, the
-    /// general solver (its solves by PETSc) does.
+    /// Whether one linear steady solve answers the problem ([`linear_steady`]).
     fn is_linear_steady(&self) -> bool {
-        let physics = self.physics;
-        let multipliers_under_mpi =
-            crate::parallel::world().is_some() && self.terms.multiplier_ties();
-        !self.file.transient
-            && !multipliers_under_mpi
-            && physics.source_of_x_only()
-            && physics.materials.constant().is_some()
-            && physics.field_names.len() == 1
-            && !physics.materials.electric()
-            && !physics.species.any()
-            && !self.terms.couplings.any_toggle()
-            && (self.file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
+        linear_steady(self.file, self.physics, self.terms.couplings.any_toggle())
     }
 
     /// One linear steady solve, by a factorisation or AMG-CG as `linear_solver` and the
@@ -761,4 +747,18 @@ pub(super) fn per_block<T: Clone>(values: &[T], origin: Option<&[usize]>) -> Vec
         Some(origin) => origin.iter().map(|&b| values[b].clone()).collect(),
         None => values.to_vec(),
     }
+}
+
+/// Whether one linear steady solve answers a problem: steady, one field, constant
+/// materials, a source of x alone, no interaction `toggled`, no radiation (mortar ties
+/// with multipliers too, on ranks as serially).
+pub(super) fn linear_steady(file: &ProblemFile, physics: &Physics<'_>, toggled: bool) -> bool {
+    !file.transient
+        && physics.source_of_x_only()
+        && physics.materials.constant().is_some()
+        && physics.field_names.len() == 1
+        && !physics.materials.electric()
+        && !physics.species.any()
+        && !toggled
+        && (file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
 }

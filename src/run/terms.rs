@@ -795,17 +795,16 @@ impl Interfaces for ContactTerms<'_> {
 
     fn ties(&self) -> Result<Vec<TieRows>, String> {
         let e = self.embedded().map_err(|e| e.to_string())?;
-        Ok(Self::ties_of(e)?
+        Ok(Self::ties_of(e)?.iter().map(TieRows::from).collect())
+    }
+
+    fn own_ties(&self, carries: &dyn Fn(usize, NodeId) -> bool) -> Result<Vec<TieRows>, String> {
+        let e = self.embedded().map_err(|e| e.to_string())?;
+        let rows = e.embedding.borrow().own_tie_rows(carries);
+        Ok(rows
+            .map_err(|e| e.to_string())?
             .iter()
-            .map(|t| TieRows {
-                own: t.multiplier_dofs.clone(),
-                entries: t.entries.clone(),
-                rhs: t.rhs.clone(),
-                crosspoints: t.crosspoints.iter().map(|&n| NodeId(n as u32)).collect(),
-                side_a_dofs: t.side_a_dofs.clone(),
-                side_b_dofs: t.side_b_dofs.clone(),
-                dual: t.multipliers == crate::embed::Multipliers::Dual,
-            })
+            .map(TieRows::from)
             .collect())
     }
 

@@ -738,9 +738,14 @@ pub fn conductance_model(
 /// whole mesh (docs/parallel.md), or `None` when each rank can hold its part: surfaces
 /// or maps made from whole surfaces (`Auto Subset`, an `Align_Surface` periodicity), a
 /// voltage or species enforcement, an Energy enforcement that is a mortar tie with
-/// multipliers (the general solver), or one that does not resolve with the problem's
-/// `fields`.
-pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static str> {
+/// multipliers unless `multipliers` says the run's solve holds them (the linear steady
+/// solve does; the general solver does not), or one that does not resolve with the
+/// problem's `fields`.
+pub fn needs_whole_mesh(
+    loaded: &LoadedDeck,
+    fields: &[&str],
+    multipliers: bool,
+) -> Option<&'static str> {
     use crate::deck::spec::{PeriodicTransform, SurfaceDef};
     for def in &loaded.deck.contact_definitions {
         let auto = def
@@ -762,7 +767,7 @@ pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static
             let Ok(c) = resolve_for(enf, Some(fields)) else {
                 return Some("an enforcement with errors");
             };
-            if c.mortar {
+            if c.mortar && !multipliers {
                 return Some("a mortar tie with multipliers (the general solver)");
             }
         }

@@ -1,0 +1,217 @@
+//! Mortar ties with Lagrange multipliers in the distributed steady solve.
+//!
+//! A tie's rows `C u = g` are sums over side-A faces (a dual basis too is made face by
+//! face), so each rank makes those of the points it owns, on its part of the mesh with
+//! its contact partners ([`Interfaces::own_ties`]), and adds them — rows and columns,
+//! in PETSc's numbers, into rows of any rank — as it adds its points' flux terms. Which
+//! side-A nodes carry a multiplier (none where fixed or tied by an earlier tie) rank 0
+//! decides on the whole interface, as the serial solve does, and sends every rank,
+//! with each multiplier's number: its place in the serial tie. The multipliers are PETSc
+//! rows after every node's, on the last rank, in the serial order, so the gathered
+//! solution is the serial one's. The saddle point is solved by MUMPS; a dual tie too,
+//! as a saddle point rather than condensed (the same temperatures to round-off: the
+//! condensation is an exact elimination), after the serial solve's checks on its
+//! condensation.
+
+use std::collections::HashMap;
+
+use mpi::topology::SimpleCommunicator;
+
+use crate::assembly::{Assembler, DofMap, FieldId};
+use crate::heat::HeatError;
+use crate::heat::interfaces::{Interfaces, TieRows};
+use crate::heat::steady::{dual_condensation, dual_ties};
+use crate::mesh::NodeId;
+
+use super::petsc::PetscInt;
+use super::rows::{Layout, summed_heat};
+use super::session::{self, agreed};
+
+/// The ties of a distributed steady solve, and this rank's share of their terms.
+pub(super) struct Ties {
+    /// This rank's share of each tie's rows, and per multiplier of the share its
+    /// multiplier's local dof.
+    shares: Vec<(TieRows, Vec<usize>)>,
+    /// The entries of this rank's share: `(multiplier dof, primal dof, C)`.
+    entries: Vec<(usize, usize, f64)>,
+    /// Per entry, its multiplier's side-A dof.
+    side_a: Vec<usize>,
+    /// `g` of this rank's share: `(multiplier dof, g)`.
+    rhs: Vec<(usize, f64)>,
+    /// Multipliers whose row is empty (no point reached their node), on rank 0: an
+    /// identity row holds them at 0.
+    empty: Vec<usize>,
+    /// Per tie, the side-A nodes without a multiplier (rank 0's, of the whole tie).
+    crosspoints: Vec<Vec<NodeId>>,
+    /// Where the entries' couplings start in the interface pattern.
+    slot: usize,
+}
+
+/// Per tie, rank 0's word on its multipliers: the PETSc index of each multiplier's
+/// side-A dof (the serial order), the multipliers with an empty row.
+struct Decided {
+    nodes: Vec<PetscInt>,
+    empty: Vec<usize>,
+}
+
+impl Ties {
+    /// The mortar ties of `iface` (`None` without any; collective), their multipliers
+    /// appended to `dofs` and to `layout`; `iface` evaluates this rank's points only.
+    pub(super) fn new(
+        world: &SimpleCommunicator,
+        iface: &dyn Interfaces,
+        (dofs, field): (&mut DofMap, FieldId),
+        layout: &mut Layout,
+    ) -> Result<Option<Ties>, HeatError> {
+        // Rank 0 holds the whole interface: the whole ties, as serially.
+        let whole = match layout.rank {
+            0 => whole_ties(iface, dofs.len()),
+            _ => Ok(Vec::new()),
+        };
+        let whole = agreed(whole)?;
+        let decided = decide(world, &whole, layout);
+        if decided.is_empty() {
+            return Ok(None);
+        }
+        let places: Vec<HashMap<PetscInt, usize>> = (decided.iter())
+            .map(|d| d.nodes.iter().enumerate().map(|(m, &i)| (i, m)).collect())
+            .collect();
+        let carries = |t: usize, node: NodeId| {
+            (dofs.dof(field, node))
+                .is_some_and(|d| places[t].contains_key(&layout.petsc[d.index()]))
+        };
+        let own = agreed(iface.own_ties(&carries).map_err(HeatError::Contact))?;
+        if own.len() != decided.len() || own.iter().any(|t| t.own.contains(&usize::MAX)) {
+            return Err(HeatError::Contact(format!(
+                "distributed solve: rank {} made {} ties' rows, rank 0 {}",
+                layout.rank,
+                own.len(),
+                decided.len()
+            )));
+        }
+        let mut ties = Ties {
+            shares: Vec::with_capacity(own.len()),
+            entries: Vec::new(),
+            side_a: Vec::new(),
+            rhs: Vec::new(),
+            empty: Vec::new(),
+            crosspoints: whole.iter().map(|t| t.crosspoints.clone()).collect(),
+            slot: 0,
+        };
+        ties.crosspoints.resize(own.len(), Vec::new());
+        for ((share, decided), places) in own.into_iter().zip(&decided).zip(&places) {
+            let range = dofs.add_extra(decided.nodes.len());
+            layout.append_last(range.len());
+            let at: Vec<usize> = (share.own.iter())
+                .map(|&d| range.start + places[&layout.petsc[d]])
+                .collect();
+            for &(k, d, c) in &share.entries {
+                ties.entries.push((at[k], d, c));
+                ties.side_a.push(share.own[k]);
+            }
+            (ties.rhs).extend(at.iter().zip(&share.rhs).map(|(&l, &g)| (l, g)));
+            (ties.empty).extend(decided.empty.iter().map(|&m| range.start + m));
+            ties.shares.push((share, at));
+        }
+        Ok(Some(ties))
+    }
+
+    /// The couplings `(primal dof, multiplier dof)` of this rank's entries, in their
+    /// order.
+    pub(super) fn couplings(&self) -> Vec<(usize, usize)> {
+        self.entries.iter().map(|&(l, d, _)| (d, l)).collect()
+    }
+
+    /// The couplings `(side-A dof, primal dof)` of this rank's entries: those across
+    /// ranks join dofs of different ranks as a cut interface's points do.
+    pub(super) fn joined(&self) -> Vec<(usize, usize)> {
+        (self.side_a.iter().zip(&self.entries))
+            .map(|(&a, &(_, d, _))| (a, d))
+            .collect()
+    }
+
+    /// The interface pattern's slot of the first of [`Self::couplings`].
+    pub(super) fn at_slot(&mut self, slot: usize) {
+        self.slot = slot;
+    }
+
+    /// This rank's part of the residual at `u`: `Cᵀλ` on the primal rows, `C u − g` on
+    /// the multiplier rows (λ on an empty one).
+    pub(super) fn residual(&self, u: &[f64], r: &mut [f64]) {
+        for &(l, d, c) in &self.entries {
+            r[d] += c * u[l];
+            r[l] += c * u[d];
+        }
+        for &(l, g) in &self.rhs {
+            r[l] -= g;
+        }
+        for &l in &self.empty {
+            r[l] += u[l];
+        }
+    }
+
+    /// This rank's part of the Jacobian, into the interface assembler.
+    pub(super) fn jacobian(&self, asm: &mut Assembler<'_>) {
+        for (e, &(_, _, c)) in self.entries.iter().enumerate() {
+            asm.add_coupling(self.slot + e, c, c);
+        }
+        for &l in &self.empty {
+            asm.add_diagonal(l, 1.0);
+        }
+    }
+
+    /// Per tie, the heat leaving side A and side B at `u` (this rank's, its multipliers
+    /// up to date), summed over the ranks (collective).
+    pub(super) fn heat(&self, world: &SimpleCommunicator, u: &[f64]) -> Vec<(f64, f64)> {
+        let mine: Vec<(f64, f64)> = (self.shares.iter())
+            .map(|(share, at)| share.heat(&at.iter().map(|&l| u[l]).collect::<Vec<_>>()))
+            .collect();
+        summed_heat(world, &mine)
+    }
+
+    /// Per tie, its side-A nodes left without a multiplier (crosspoints; on rank 0).
+    pub(super) fn crosspoints(&self) -> Vec<Vec<NodeId>> {
+        self.crosspoints.clone()
+    }
+}
+
+/// The whole ties (rank 0), after the serial solve's refusals: dual ties mixed with
+/// others or with a conductance of T, dual rows that couple (a side-A face partly
+/// covered by side B). `n`: the dofs of the mesh.
+fn whole_ties(iface: &dyn Interfaces, n: usize) -> Result<Vec<TieRows>, HeatError> {
+    let ties = iface.ties().map_err(HeatError::Contact)?;
+    if dual_ties(&ties, iface.is_linear())? {
+        dual_condensation(&ties, n)?;
+    }
+    Ok(ties)
+}
+
+/// Rank 0's word on the multipliers of its `whole` ties, on every rank (collective).
+fn decide(world: &SimpleCommunicator, whole: &[TieRows], layout: &Layout) -> Vec<Decided> {
+    // [ties, then per tie: multipliers, their PETSc indices, empty ones, them].
+    let mut word: Vec<i64> = vec![whole.len() as i64];
+    for t in whole {
+        let mut reached = vec![false; t.own.len()];
+        t.entries.iter().for_each(|e| reached[e.0] = true);
+        word.push(t.own.len() as i64);
+        word.extend(t.own.iter().map(|&d| i64::from(layout.petsc[d])));
+        let empty: Vec<i64> = (0..t.own.len())
+            .filter(|&k| !reached[k])
+            .map(|k| k as i64)
+            .collect();
+        word.push(empty.len() as i64);
+        word.extend(empty);
+    }
+    // (Every rank gets rank 0's list alone.)
+    let word = session::gather_all(world, if layout.rank == 0 { &word[..] } else { &[] });
+    let mut it = word.into_iter();
+    let mut next = move || it.next().unwrap_or(0);
+    let ties = next() as usize;
+    let mut decided = Vec::with_capacity(ties);
+    for _ in 0..ties {
+        let nodes = (0..next()).map(|_| next() as PetscInt).collect();
+        let empty = (0..next()).map(|_| next() as usize).collect();
+        decided.push(Decided { nodes, empty });
+    }
+    decided
+}
