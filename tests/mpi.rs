@@ -615,6 +615,9 @@ fn cut_interface_crosspoints_on_rank_boundaries_equal_serial() {
 /// ranks around its node), MUMPS solving the saddle point — a dual tie too, not
 /// condensed. Fields and tie heats equal serial on 1–4 ranks; the summary's reason
 /// names the saddle point.
+/// The cut bar's mortar tie with standard multipliers.
+const STANDARD_TIE: &str = "enforcement for energy = tied multipliers = standard\n side b variable temperature to temperature";
+
 fn cut_interface_multiplier_tie(multipliers: &str) {
     let tmp = scratch(&format!("cut-tie-{multipliers}"));
     let enforcement = format!(
@@ -1047,6 +1050,39 @@ fn cut_interface_adaptive_transient_equals_serial() {
     let (serial, runs) = compare_runs(&problem, true);
     assert_steps_distributed(&serial, &runs);
     assert_rejected_as_serial(&serial, &runs, "adaptive steps rejected");
+}
+
+/// The cut bar stepped by adaptive BDF2 across a mortar tie with standard multipliers:
+/// each step's saddle point assembled per rank (the mesh distributed) and factored by
+/// MUMPS, the local error estimate over the temperatures alone (not the multipliers),
+/// as serially — the serial steps, rejected attempts, temperatures and tie heats.
+#[test]
+fn cut_interface_adaptive_transient_multiplier_tie_equals_serial() {
+    let tmp = scratch("transient_tie");
+    let solve = "scheme = \"bdf2\"\nadaptive = true\ntime_tolerance = 0.5\n";
+    let (problem, _) = write_transient_cut_case(tmp.path(), STANDARD_TIE, solve, 0.1);
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_steps_distributed(&serial, &runs);
+    assert_rejected_as_serial(&serial, &runs, "adaptive steps across a tie rejected");
+    assert_newton_as_serial(&serial, &runs, "mortar ties with Lagrange multipliers");
+}
+
+/// A steady run across a mortar tie whose conductivities are laws of temperature: one
+/// Newton solve of the saddle point, assembled per rank at every iterate, its stopping
+/// test on the temperatures' size (the serial general solver's), as serially.
+#[test]
+fn cut_interface_multiplier_tie_with_conductivity_of_t_equals_serial() {
+    let tmp = scratch("tie_k_of_t");
+    let problem = write_cut_case(tmp.path(), STANDARD_TIE, "");
+    let text = std::fs::read_to_string(&problem).unwrap();
+    std::fs::write(&problem, conductivity_of_t(&text)).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_newton_as_serial(&serial, &runs, "mortar ties with Lagrange multipliers");
+    assert!(
+        serial.summary["newton_iterations"].as_u64().unwrap() > 2,
+        "{}",
+        serial.summary
+    );
 }
 
 /// `seam -v search deck --mesh mesh --points FILE args…`, serially or under `mpirun -n`.

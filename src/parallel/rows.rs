@@ -308,9 +308,11 @@ impl Scatter {
         largest
     }
 
-    /// The largest |u| over the owned dofs of every rank.
+    /// The largest |u| over the owned dofs of every rank (of those `u` holds: the first
+    /// ones).
     pub(super) fn u_max(&self, world: &SimpleCommunicator, layout: &Layout, u: &[f64]) -> f64 {
-        let mine = layout.owned.iter().fold(0.0f64, |m, &d| m.max(u[d].abs()));
+        let own = layout.owned.iter().filter_map(|&d| u.get(d));
+        let mine = own.fold(0.0f64, |m, v| m.max(v.abs()));
         let mut largest = 0.0;
         world.all_reduce_into(&mine, &mut largest, SystemOperation::max());
         largest

@@ -46,7 +46,7 @@ use super::rows::{
     ByRows, Layout, Scatter, add_rows, couplings_to_owners, empty_mesh, local_faces, log_partition,
     preallocation, summed_heat,
 };
-use super::session::{Phases, agreed};
+use super::session::{AllPoints, Phases, agreed};
 use super::ties::Ties;
 use super::{Laws, session};
 
@@ -67,11 +67,10 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     if let Some(why) = solved.failure {
         return Err(HeatError::Step(why));
     }
-    let tie_heat = (built.ties.as_ref()).map_or_else(Vec::new, |t| t.heat(&built.world, &u));
     built.gather(&mut u);
     let (method, symmetric) = (newton.method, newton.symmetric);
     let why = match (method, symmetric) {
-        _ if built.ties.is_some() => {
+        _ if built.has_ties() => {
             "mortar ties with Lagrange multipliers make the system indefinite → MUMPS LU"
         }
         (Method::MumpsLu, true) => {
@@ -96,6 +95,7 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         ..LinearSolves::default()
     };
     let temperature = built.dofs.nodal_values(built.field, &u);
+    let crosspoints = built.crosspoints();
     Ok(SteadySolution {
         dofs: built.dofs,
         u,
@@ -104,8 +104,8 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         converged: solved.converged,
         residual_history: solved.history,
         heat: solved.heat,
-        tie_heat,
-        crosspoints: (built.ties.as_ref()).map_or_else(Vec::new, Ties::crosspoints),
+        tie_heat: solved.tie_heat,
+        crosspoints,
         timing: solved.timing,
         linear,
     })
@@ -124,6 +124,8 @@ pub(super) struct Solved {
     pub history: Vec<f64>,
     /// Per interaction, the heat leaving side A and side B, summed over the ranks.
     pub heat: Vec<(f64, f64)>,
+    /// Per mortar tie with multipliers, the same.
+    pub tie_heat: Vec<(f64, f64)>,
     /// Krylov iterations of each CG or GMRES solve.
     pub cg_iterations: Vec<usize>,
     /// Matrices set up for (each a new AMG hierarchy or MUMPS factorisation).
@@ -235,9 +237,6 @@ impl<'p> Built<'p> {
             Some(i) => Ties::new(&world, i, (&mut dofs, field), &mut layout)?,
             None => None,
         };
-        if ties.is_some() && laws.is_some() {
-            return Err(refused("time steps with mortar ties with multipliers"));
-        }
         let n = dofs.len();
         let mut phases = Phases::default();
         phases.mark("partition", start);
@@ -400,6 +399,21 @@ impl<'p> Built<'p> {
         (self.scatter).sent_by_root(&self.world, &self.layout, whole, self.n)
     }
 
+    /// The local dofs before the multipliers (the temperatures).
+    pub(super) fn primal(&self) -> usize {
+        self.dofs.extra_ranges().first().map_or(self.n, |r| r.start)
+    }
+
+    /// Whether the solve holds mortar ties with multipliers (a saddle point).
+    pub(super) fn has_ties(&self) -> bool {
+        self.ties.is_some()
+    }
+
+    /// Per mortar tie, its side-A nodes without a multiplier (on rank 0).
+    pub(super) fn crosspoints(&self) -> Vec<Vec<crate::mesh::NodeId>> {
+        self.ties.as_ref().map_or_else(Vec::new, Ties::crosspoints)
+    }
+
     /// Whether this is rank 0, which writes the outputs.
     pub(super) fn is_root(&self) -> bool {
         self.layout.rank == 0
@@ -461,8 +475,9 @@ impl<'p> Built<'p> {
                 2.0 / 11.0
             }
         };
-        let mine =
-            (self.layout.owned.iter()).fold(0.0f64, |m, &d| m.max((u_new[d] - predicted[d]).abs()));
+        // (The temperatures alone, not the multipliers, as serially.)
+        let own = self.layout.owned.iter().filter(|&&d| d < self.primal());
+        let mine = own.fold(0.0f64, |m, &d| m.max((u_new[d] - predicted[d]).abs()));
         let mut worst = 0.0;
         self.world
             .all_reduce_into(&mine, &mut worst, SystemOperation::max());
@@ -812,10 +827,11 @@ impl<'b, 'p> Newton<'b, 'p> {
             // after one solve of a linear step, else once the last update is within the
             // tolerance of max |u| — so the steps take the serial iterations and fail
             // (and are cut) where the serial ones do.
-            let u_max = built.scatter.u_max(&built.world, layout, u);
             // (A steady solve with a conductivity of T stops so too: the serial general
-            // solver's test.)
+            // solver's test, on the size of the field without the multipliers.)
             let by_update = capacity.is_some() || built.nonlinear;
+            let below = if by_update { built.primal() } else { n };
+            let u_max = built.scatter.u_max(&built.world, layout, &u[..below]);
             let done = match by_update {
                 true => {
                     record.history.push(rn);
@@ -886,12 +902,14 @@ impl<'b, 'p> Newton<'b, 'p> {
                 self.hierarchy.solved(its);
             }
         }
+        let ties = built.ties.as_ref();
         Ok(Solved {
             converged,
             failure,
             iterations,
             history: record.history,
             heat,
+            tie_heat: ties.map_or_else(Vec::new, |t| t.heat(&built.world, u)),
             cg_iterations,
             setups,
             kept: kept_pc,
@@ -969,17 +987,6 @@ impl<'b, 'p> Newton<'b, 'p> {
         add_rows(&mut self.a, &self.i_rows, &i_values, true)?;
         self.a.assemble().map_err(petsc_err)?;
         self.a.zero_rows_columns(&built.bc_rows).map_err(petsc_err)
-    }
-}
-
-/// Evaluates every point again when dropped (the run's output after the solve sees the
-/// whole interface).
-struct AllPoints<'a>(&'a dyn crate::heat::interfaces::Interfaces);
-
-impl Drop for AllPoints<'_> {
-    fn drop(&mut self) {
-        // The run's interfaces accepted the restriction, so they accept its end.
-        let _ = self.0.own_points(None);
     }
 }
 

@@ -225,7 +225,7 @@ pub(super) fn solve(
         state,
         steps,
         rejected: rejected_total,
-        crosspoints: Vec::new(),
+        crosspoints: built.crosspoints(),
     })
 }
 
@@ -331,7 +331,7 @@ fn steady(
         state,
         steps: 1,
         rejected: 0,
-        crosspoints: Vec::new(),
+        crosspoints: built.crosspoints(),
     })
 }
 
@@ -346,7 +346,7 @@ fn report(solved: Solved, method: Method) -> StepReport {
         residual_history: solved.history,
         rejected: 0,
         error_estimate: None,
-        heat: solved.heat,
+        heat: [solved.heat, solved.tie_heat].concat(),
         assembly_s: solved.timing.assembly_s,
         factor_s: solved.timing.factor_s,
         solve_s: solved.timing.solve_s,
@@ -411,6 +411,9 @@ fn record(newton: &Newton<'_, '_>, built: &Built<'_>, what: &str) {
         false => "a temperature-dependent conductance makes the Jacobian unsymmetric",
     };
     let why = match (method, symmetric) {
+        _ if built.has_ties() => format!(
+            "{what}, mortar ties with Lagrange multipliers make the system indefinite → MUMPS LU"
+        ),
         (Method::CgAmg, _) => format!(
             "{what}, symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG (hierarchy kept while the step size holds, each step started from the earlier steps' solutions)"
         ),

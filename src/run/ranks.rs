@@ -46,6 +46,7 @@ pub(super) fn mesh_for_rank(
 pub(super) fn share_mesh(
     file: &ProblemFile,
     physics: &Physics<'_>,
+    options: &RunOptions,
     ready: bool,
 ) -> Result<(), RunError> {
     if !parallel::is_root() || parallel::world().is_none() {
@@ -54,7 +55,8 @@ pub(super) fn share_mesh(
     let plan = if !ready {
         MeshPlan::Stop
     } else {
-        match distributable(file, physics) {
+        let restarting = file.problem.restart.is_some() || options.restart.is_some();
+        match distributable(file, physics, restarting) {
             Ok(()) => MeshPlan::Parts(physics.mesh, Some(assembly_costs(file, physics))),
             Err(why) => {
                 log::info!("every rank reads the whole mesh: {why}");
@@ -123,9 +125,13 @@ pub(super) fn quiet() -> RunError {
 /// and sources of T, x and t, radiation or not),
 /// no moving or dying surfaces, every block solid, and a
 /// contact deck whose enforcements need nothing whole (no mortar tie with multipliers
-/// but in a linear steady run, no voltage or species enforcement, no
+/// in a run with toggles or from a checkpoint, no voltage or species enforcement, no
 /// `Align_Surface` periodicity, no `Auto Subset`). The reason why not, otherwise.
-pub(super) fn distributable(file: &ProblemFile, physics: &Physics<'_>) -> Result<(), String> {
+pub(super) fn distributable(
+    file: &ProblemFile,
+    physics: &Physics<'_>,
+    restarting: bool,
+) -> Result<(), String> {
     let p = &file.problem;
     let refuse = |why: &str| Err(why.to_string());
     if p.displacement.is_some() || !p.death.is_empty() {
@@ -143,9 +149,8 @@ pub(super) fn distributable(file: &ProblemFile, physics: &Physics<'_>) -> Result
         return refuse("the contact deck has errors");
     }
     let fields: Vec<&str> = physics.field_names.iter().map(String::as_str).collect();
-    // Multiplier ties: on the linear steady solve alone (not the general solver).
-    let toggled = !p.toggle.is_empty();
-    let multipliers = super::solve::linear_steady(file, physics, toggled);
+    // Multiplier ties: not toggled nor from a checkpoint (those take the general solver).
+    let multipliers = p.toggle.is_empty() && !restarting;
     match crate::scene::needs_whole_mesh(&loaded, &fields, multipliers) {
         Some(why) => refuse(why),
         None => Ok(()),

@@ -93,14 +93,16 @@ impl<'a> TimeLoop<'a> {
     /// Whether a run under MPI steps with its assembly distributed: a transient run, or
     /// a steady one the linear steady solve does not take (one Newton solve, the general
     /// solver's steady solve), of one temperature field — its laws and sources of T, x
-    /// and t, radiation or not — with no multiplier ties (its interfaces linear, or
-    /// Newton through a temperature-dependent conductance; toggled or not), from a
-    /// checkpoint or not, nothing moving or dying. (Every run whose mesh
+    /// and t, radiation or not — its interfaces linear, or Newton through a
+    /// temperature-dependent conductance; toggled or not, from a checkpoint or not, but
+    /// with mortar ties with multipliers neither toggled nor from a checkpoint —
+    /// nothing moving or dying. (Every run whose mesh
     /// `ranks::distributable` splits and is not a linear steady one is one.)
     fn is_stepped_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
+        let (toggled, restarting) = (self.terms.couplings.any_toggle(), self.checkpoint());
         crate::parallel::world().is_some()
-            && !self.terms.multiplier_ties()
+            && !(self.terms.multiplier_ties() && (toggled || restarting.is_some()))
             && physics.field_names.len() == 1
             && !physics.materials.electric()
             && !physics.species.any()
@@ -752,7 +754,7 @@ pub(super) fn per_block<T: Clone>(values: &[T], origin: Option<&[usize]>) -> Vec
 /// Whether one linear steady solve answers a problem: steady, one field, constant
 /// materials, a source of x alone, no interaction `toggled`, no radiation (mortar ties
 /// with multipliers too, on ranks as serially).
-pub(super) fn linear_steady(file: &ProblemFile, physics: &Physics<'_>, toggled: bool) -> bool {
+fn linear_steady(file: &ProblemFile, physics: &Physics<'_>, toggled: bool) -> bool {
     !file.transient
         && physics.source_of_x_only()
         && physics.materials.constant().is_some()
