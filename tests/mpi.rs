@@ -660,6 +660,35 @@ fn cut_interface_dual_multiplier_tie_equals_serial() {
     cut_interface_multiplier_tie("dual");
 }
 
+/// The cut bar's tie with an `Align_Surface` periodicity of side A onto side B besides
+/// (an image on the tie's own place): every rank reads the whole mesh for it, and the
+/// periodic pair's second tie finds every side-A node taken by the first (all
+/// crosspoints, no multiplier). The steady solver adds each rank's share of the ties'
+/// rows on the whole mesh as on its part: fields and heats equal serial on 1–4 ranks.
+#[test]
+fn cut_interface_multiplier_tie_on_the_whole_mesh_equals_serial() {
+    let tmp = scratch("tie_whole_mesh");
+    let problem = write_cut_case(tmp.path(), STANDARD_TIE, "");
+    let deck = tmp.path().join("contact.i");
+    let text = std::fs::read_to_string(&deck).unwrap().replacen(
+        "begin interaction",
+        "periodicity for a = align_surface destination = b invert_normals = 1\nbegin interaction",
+        1,
+    );
+    std::fs::write(&deck, text).unwrap();
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_eq!(serial.summary["interactions"].as_array().unwrap().len(), 2);
+    for par in &runs[1..] {
+        assert!(
+            par.log
+                .contains("every rank reads the whole mesh: an `Align_Surface`")
+                && par.log.contains("distributed set-up on rank 0"),
+            "the steady solver on the whole mesh:\n{}",
+            par.log
+        );
+    }
+}
+
 /// The cut bar's gap conductance, constant.
 const GAP_H: &str =
     "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000";
