@@ -915,8 +915,23 @@ fn cut_interface_conductance_switched_on_in_time_equals_serial() {
 /// only.
 #[test]
 fn cut_interface_toggled_in_time_equals_serial() {
-    let tmp = scratch("toggled_in_time");
-    let enforcement = format!("{GAP_H}\n use toggle block = middle");
+    toggled_in_time("toggled_in_time", GAP_H);
+}
+
+/// The same with a mortar tie with standard multipliers, on over [0.15, 0.25] only:
+/// switched off, its multipliers are held at 0 (rank 0 adds their identity rows) and
+/// the matrix is set again, as serially.
+#[test]
+fn cut_interface_toggled_multiplier_tie_equals_serial() {
+    toggled_in_time("toggled_tie", STANDARD_TIE);
+}
+
+/// The cut bar by backward Euler to t = 0.4, its interface `enforcement` switched on
+/// over [0.15, 0.25] only: every step equals serial, and the heat crosses at step 2
+/// only.
+fn toggled_in_time(name: &str, enforcement: &str) {
+    let tmp = scratch(name);
+    let enforcement = format!("{enforcement}\n use toggle block = middle");
     let solve = "scheme = \"backward_euler\"\n";
     let (problem, text) = write_transient_cut_case(tmp.path(), &enforcement, solve, 0.1);
     let text = text.replace("end_time = 0.3", "end_time = 0.4")
@@ -952,9 +967,36 @@ fn cut_interface_toggled_in_time_equals_serial() {
 /// serial run's error.
 #[test]
 fn cut_interface_restart_equals_serial() {
-    let tmp = scratch("restart");
+    let (tmp, problem) = restart_case("restart", GAP_H);
+    let checkpoint = tmp.path().join("checkpoint.seam");
+    // Another problem's checkpoint: every rank stops, rank 0 saying why.
+    std::fs::write(&checkpoint, b"SEAMCKP1 too short").unwrap();
+    let out = launch(&problem, Some(2));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(!out.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("E0713") && stdout.contains("checkpoint.seam"),
+        "{stdout}"
+    );
+}
+
+/// The same restart across a mortar tie with standard multipliers: the checkpoint's
+/// state holds the multipliers (after the temperatures, as the serial general solver
+/// keeps them), and rank 0 sends them, with the temperatures, to the ranks that read
+/// them.
+#[test]
+fn cut_interface_restart_across_a_multiplier_tie_equals_serial() {
+    restart_case("restart_tie", STANDARD_TIE);
+}
+
+/// The cut bar by BDF2 across `enforcement`, checkpointed serially at step 3 of 6,
+/// continued from that checkpoint serially and on 1–4 ranks, the steps distributed:
+/// every continued step equals the serial continuation. The scratch folder (with
+/// `checkpoint.seam`) and the problem.
+fn restart_case(name: &str, enforcement: &str) -> (tempfile::TempDir, PathBuf) {
+    let tmp = scratch(name);
     let solve = "scheme = \"bdf2\"\n";
-    let (problem, text) = write_transient_cut_case(tmp.path(), GAP_H, solve, 0.05);
+    let (problem, text) = write_transient_cut_case(tmp.path(), enforcement, solve, 0.05);
     let full = text.replace("dir = \"out\"\n", "dir = \"out\"\ncheckpoint_every = 3\n");
     assert_ne!(full, text, "the output table is where the test expects it");
     std::fs::write(&problem, full).unwrap();
@@ -974,15 +1016,7 @@ fn cut_interface_restart_equals_serial() {
     let (serial, runs) = compare_runs(&problem, true);
     assert_eq!(serial.summary["transient"]["steps"].as_u64(), Some(3));
     assert_steps_distributed(&serial, &runs);
-    // Another problem's checkpoint: every rank stops, rank 0 saying why.
-    std::fs::write(&checkpoint, b"SEAMCKP1 too short").unwrap();
-    let out = launch(&problem, Some(2));
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(!out.status.success(), "{stdout}");
-    assert!(
-        stdout.contains("E0713") && stdout.contains("checkpoint.seam"),
-        "{stdout}"
-    );
+    (tmp, problem)
 }
 
 /// A steady run with k(T) from a checkpoint: its one Newton solve starts from the

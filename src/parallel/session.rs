@@ -213,3 +213,10 @@ impl Drop for AllPoints<'_> {
         let _ = self.0.own_points(None);
     }
 }
+
+/// The error refusing what the distributed solve does not do yet.
+pub(super) fn refused(what: &str) -> crate::heat::HeatError {
+    crate::heat::HeatError::Contact(format!(
+        "[E0902] {what}: not yet distributed under MPI (help: run without mpirun; docs/parallel.md lists what is distributed)"
+    ))
+}

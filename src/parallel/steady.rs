@@ -46,7 +46,7 @@ use super::rows::{
     ByRows, Layout, Scatter, add_rows, couplings_to_owners, empty_mesh, local_faces, log_partition,
     preallocation, summed_heat,
 };
-use super::session::{AllPoints, Phases, agreed};
+use super::session::{AllPoints, Phases, agreed, refused};
 use super::ties::Ties;
 use super::{Laws, session};
 
@@ -754,9 +754,13 @@ impl<'b, 'p> Newton<'b, 'p> {
             // A matrix that stays (linear interfaces, the same c₀, the same terms
             // switched on) needs the interfaces' residual alone.
             let c0 = capacity.map_or(0.0, |c| c.c0);
+            // (The ties' after the flux terms'.)
             let on: Vec<bool> = built.iface.map_or_else(Vec::new, |i| {
-                (0..i.flux_count()).map(|k| i.flux_on(k, t)).collect()
+                let ties = built.ties.as_ref().map_or(0, Ties::len);
+                let flux = (0..i.flux_count()).map(|k| i.flux_on(k, t));
+                flux.chain((0..ties).map(|k| i.tie_on(k, t))).collect()
             });
+            let on_now = on.clone();
             let key = (self.symmetric).then_some((c0.to_bits(), on));
             let kept = key.is_some() && key == self.matrix_for;
             let values: Vec<f64> = built.touched.iter().map(|&d| r[d]).collect();
@@ -783,10 +787,11 @@ impl<'b, 'p> Newton<'b, 'p> {
                         }
                     })
                     .inspect(|_| {
-                        if let Some(ties) = &built.ties {
-                            ties.residual(u, r_iface);
+                        if let (Some(ties), Some(i)) = (&built.ties, built.iface) {
+                            let on = &on_now[i.flux_count()..];
+                            ties.residual(u, r_iface, on);
                             if !kept {
-                                ties.jacobian(iasm);
+                                ties.jacobian(iasm, on);
                             }
                         }
                     })
@@ -988,11 +993,4 @@ impl<'b, 'p> Newton<'b, 'p> {
         self.a.assemble().map_err(petsc_err)?;
         self.a.zero_rows_columns(&built.bc_rows).map_err(petsc_err)
     }
-}
-
-/// The error refusing what the distributed solve does not do yet.
-fn refused(what: &str) -> HeatError {
-    HeatError::Contact(format!(
-        "[E0902] {what}: not yet distributed under MPI (help: run without mpirun; docs/parallel.md lists what is distributed)"
-    ))
 }

@@ -11,7 +11,8 @@
 //! solution is the serial one's. The saddle point is solved by MUMPS; a dual tie too,
 //! as a saddle point rather than condensed (the same temperatures to round-off: the
 //! condensation is an exact elimination), after the serial solve's checks on its
-//! condensation.
+//! condensation. A multiplier held at 0 (an empty row, or a tie switched off) gets its
+//! identity row from the last rank, which owns the multipliers and reads their values.
 
 use std::collections::HashMap;
 
@@ -29,17 +30,24 @@ use super::session::{self, agreed};
 
 /// The ties of a distributed steady solve, and this rank's share of their terms.
 pub(super) struct Ties {
-    /// This rank's share of each tie's rows, and per multiplier of the share its
+    /// Per tie: this rank's share of its rows, and per multiplier of the share its
     /// multiplier's local dof.
     shares: Vec<(TieRows, Vec<usize>)>,
+    /// Per tie: where its entries, its `g`s and its empty rows start in `entries`,
+    /// `rhs` and `empty` (one more at the end), and its multipliers' local dofs.
+    spans: Vec<(usize, usize, usize)>,
+    multipliers: Vec<std::ops::Range<usize>>,
+    /// This is the multipliers' owner (the last rank, which holds their values): it
+    /// holds a switched-off tie's multipliers at 0 (identity rows).
+    holder: bool,
     /// The entries of this rank's share: `(multiplier dof, primal dof, C)`.
     entries: Vec<(usize, usize, f64)>,
     /// Per entry, its multiplier's side-A dof.
     side_a: Vec<usize>,
     /// `g` of this rank's share: `(multiplier dof, g)`.
     rhs: Vec<(usize, f64)>,
-    /// Multipliers whose row is empty (no point reached their node), on rank 0: an
-    /// identity row holds them at 0.
+    /// Multipliers whose row is empty (no point reached their node), on their owner
+    /// (the last rank): an identity row holds them at 0.
     empty: Vec<usize>,
     /// Per tie, the side-A nodes without a multiplier (rank 0's, of the whole tie).
     crosspoints: Vec<Vec<NodeId>>,
@@ -91,6 +99,9 @@ impl Ties {
         }
         let mut ties = Ties {
             shares: Vec::with_capacity(own.len()),
+            spans: Vec::with_capacity(own.len() + 1),
+            multipliers: Vec::with_capacity(own.len()),
+            holder: layout.rank + 1 == layout.size,
             entries: Vec::new(),
             side_a: Vec::new(),
             rhs: Vec::new(),
@@ -100,7 +111,9 @@ impl Ties {
         };
         ties.crosspoints.resize(own.len(), Vec::new());
         for ((share, decided), places) in own.into_iter().zip(&decided).zip(&places) {
+            (ties.spans).push((ties.entries.len(), ties.rhs.len(), ties.empty.len()));
             let range = dofs.add_extra(decided.nodes.len());
+            ties.multipliers.push(range.clone());
             layout.append_last(range.len());
             let at: Vec<usize> = (share.own.iter())
                 .map(|&d| range.start + places[&layout.petsc[d]])
@@ -110,9 +123,11 @@ impl Ties {
                 ties.side_a.push(share.own[k]);
             }
             (ties.rhs).extend(at.iter().zip(&share.rhs).map(|(&l, &g)| (l, g)));
-            (ties.empty).extend(decided.empty.iter().map(|&m| range.start + m));
+            let empty = decided.empty.iter().filter(|_| ties.holder);
+            (ties.empty).extend(empty.map(|&m| range.start + m));
             ties.shares.push((share, at));
         }
+        (ties.spans).push((ties.entries.len(), ties.rhs.len(), ties.empty.len()));
         Ok(Some(ties))
     }
 
@@ -135,29 +150,50 @@ impl Ties {
         self.slot = slot;
     }
 
-    /// This rank's part of the residual at `u`: `Cᵀλ` on the primal rows, `C u − g` on
-    /// the multiplier rows (λ on an empty one).
-    pub(super) fn residual(&self, u: &[f64], r: &mut [f64]) {
-        for &(l, d, c) in &self.entries {
-            r[d] += c * u[l];
-            r[l] += c * u[d];
-        }
-        for &(l, g) in &self.rhs {
-            r[l] -= g;
-        }
-        for &l in &self.empty {
-            r[l] += u[l];
+    /// This rank's part of the residual at `u`, the ties switched on where `on` says:
+    /// `Cᵀλ` on the primal rows, `C u − g` on the multiplier rows (λ on an empty one,
+    /// and on every one of a tie switched off, as serially).
+    pub(super) fn residual(&self, u: &[f64], r: &mut [f64], on: &[bool]) {
+        for (t, w) in self.spans.windows(2).enumerate() {
+            if !on[t] {
+                let held = self.multipliers[t].clone().filter(|_| self.holder);
+                held.for_each(|l| r[l] += u[l]);
+                continue;
+            }
+            for &(l, d, c) in &self.entries[w[0].0..w[1].0] {
+                r[d] += c * u[l];
+                r[l] += c * u[d];
+            }
+            for &(l, g) in &self.rhs[w[0].1..w[1].1] {
+                r[l] -= g;
+            }
+            for &l in &self.empty[w[0].2..w[1].2] {
+                r[l] += u[l];
+            }
         }
     }
 
-    /// This rank's part of the Jacobian, into the interface assembler.
-    pub(super) fn jacobian(&self, asm: &mut Assembler<'_>) {
-        for (e, &(_, _, c)) in self.entries.iter().enumerate() {
-            asm.add_coupling(self.slot + e, c, c);
+    /// This rank's part of the Jacobian, into the interface assembler (its coupling
+    /// slots reset), the ties switched on where `on` says.
+    pub(super) fn jacobian(&self, asm: &mut Assembler<'_>, on: &[bool]) {
+        for (t, w) in self.spans.windows(2).enumerate() {
+            if !on[t] {
+                let held = self.multipliers[t].clone().filter(|_| self.holder);
+                held.for_each(|l| asm.add_diagonal(l, 1.0));
+                continue;
+            }
+            for e in w[0].0..w[1].0 {
+                asm.add_coupling(self.slot + e, self.entries[e].2, self.entries[e].2);
+            }
+            for &l in &self.empty[w[0].2..w[1].2] {
+                asm.add_diagonal(l, 1.0);
+            }
         }
-        for &l in &self.empty {
-            asm.add_diagonal(l, 1.0);
-        }
+    }
+
+    /// How many ties.
+    pub(super) fn len(&self) -> usize {
+        self.shares.len()
     }
 
     /// Per tie, the heat leaving side A and side B at `u` (this rank's, its multipliers

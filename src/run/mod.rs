@@ -228,7 +228,7 @@ fn run_until(path: &Path, options: &RunOptions, stop: Stop) -> Result<Outcome, R
     } else {
         physics.try_start()
     };
-    ranks::share_mesh(&file, &physics, options, ready.is_ok())?;
+    ranks::share_mesh(&file, &physics, ready.is_ok())?;
     if ranks::follows_root() {
         // Rank 0 checked the physics on the whole mesh.
         diags = Diagnostics::default();

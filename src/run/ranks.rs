@@ -46,7 +46,6 @@ pub(super) fn mesh_for_rank(
 pub(super) fn share_mesh(
     file: &ProblemFile,
     physics: &Physics<'_>,
-    options: &RunOptions,
     ready: bool,
 ) -> Result<(), RunError> {
     if !parallel::is_root() || parallel::world().is_none() {
@@ -55,8 +54,7 @@ pub(super) fn share_mesh(
     let plan = if !ready {
         MeshPlan::Stop
     } else {
-        let restarting = file.problem.restart.is_some() || options.restart.is_some();
-        match distributable(file, physics, restarting) {
+        match distributable(file, physics) {
             Ok(()) => MeshPlan::Parts(physics.mesh, Some(assembly_costs(file, physics))),
             Err(why) => {
                 log::info!("every rank reads the whole mesh: {why}");
@@ -124,14 +122,9 @@ pub(super) fn quiet() -> RunError {
 /// their part of the mesh only: steady or transient, one temperature field (its laws
 /// and sources of T, x and t, radiation or not),
 /// no moving or dying surfaces, every block solid, and a
-/// contact deck whose enforcements need nothing whole (no mortar tie with multipliers
-/// in a run with toggles or from a checkpoint, no voltage or species enforcement, no
+/// contact deck whose enforcements need nothing whole (no voltage or species enforcement, no
 /// `Align_Surface` periodicity, no `Auto Subset`). The reason why not, otherwise.
-pub(super) fn distributable(
-    file: &ProblemFile,
-    physics: &Physics<'_>,
-    restarting: bool,
-) -> Result<(), String> {
+pub(super) fn distributable(file: &ProblemFile, physics: &Physics<'_>) -> Result<(), String> {
     let p = &file.problem;
     let refuse = |why: &str| Err(why.to_string());
     if p.displacement.is_some() || !p.death.is_empty() {
@@ -149,9 +142,7 @@ pub(super) fn distributable(
         return refuse("the contact deck has errors");
     }
     let fields: Vec<&str> = physics.field_names.iter().map(String::as_str).collect();
-    // Multiplier ties: not toggled nor from a checkpoint (those take the general solver).
-    let multipliers = p.toggle.is_empty() && !restarting;
-    match crate::scene::needs_whole_mesh(&loaded, &fields, multipliers) {
+    match crate::scene::needs_whole_mesh(&loaded, &fields) {
         Some(why) => refuse(why),
         None => Ok(()),
     }

@@ -94,15 +94,12 @@ impl<'a> TimeLoop<'a> {
     /// a steady one the linear steady solve does not take (one Newton solve, the general
     /// solver's steady solve), of one temperature field — its laws and sources of T, x
     /// and t, radiation or not — its interfaces linear, or Newton through a
-    /// temperature-dependent conductance; toggled or not, from a checkpoint or not, but
-    /// with mortar ties with multipliers neither toggled nor from a checkpoint —
-    /// nothing moving or dying. (Every run whose mesh
+    /// temperature-dependent conductance, mortar ties with multipliers or not; toggled
+    /// or not, from a checkpoint or not — nothing moving or dying. (Every run whose mesh
     /// `ranks::distributable` splits and is not a linear steady one is one.)
     fn is_stepped_on_ranks(&self) -> bool {
         let (physics, problem) = (self.physics, &self.file.problem);
-        let (toggled, restarting) = (self.terms.couplings.any_toggle(), self.checkpoint());
         crate::parallel::world().is_some()
-            && !(self.terms.multiplier_ties() && (toggled || restarting.is_some()))
             && physics.field_names.len() == 1
             && !physics.materials.electric()
             && !physics.species.any()

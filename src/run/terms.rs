@@ -173,11 +173,6 @@ impl<'a> ContactTerms<'a> {
         }
     }
 
-    /// Whether some interaction is a mortar tie with multipliers (standard or dual).
-    pub(super) fn multiplier_ties(&self) -> bool {
-        self.term_choice.len() > self.flux_count
-    }
-
     /// Per mesh element its death time, when elements die.
     pub(super) fn death_times(&self) -> Option<&'a [f64]> {
         self.death.map(|d| d.times.as_slice())

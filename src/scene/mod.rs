@@ -737,15 +737,10 @@ pub fn conductance_model(
 /// Why the contact of `loaded` needs every rank of a distributed `seam run` to hold the
 /// whole mesh (docs/parallel.md), or `None` when each rank can hold its part: surfaces
 /// or maps made from whole surfaces (`Auto Subset`, an `Align_Surface` periodicity), a
-/// voltage or species enforcement, an Energy enforcement that is a mortar tie with
-/// multipliers unless `multipliers` says the run's solve holds them (the linear steady
-/// solve does; the general solver does not), or one that does not resolve with the
-/// problem's `fields`.
-pub fn needs_whole_mesh(
-    loaded: &LoadedDeck,
-    fields: &[&str],
-    multipliers: bool,
-) -> Option<&'static str> {
+/// voltage or species enforcement, or an Energy enforcement that does not resolve with
+/// the problem's `fields`. (A mortar tie with multipliers does not: each rank makes its
+/// share of the rows.)
+pub fn needs_whole_mesh(loaded: &LoadedDeck, fields: &[&str]) -> Option<&'static str> {
     use crate::deck::spec::{PeriodicTransform, SurfaceDef};
     for def in &loaded.deck.contact_definitions {
         let auto = def
@@ -764,11 +759,8 @@ pub fn needs_whole_mesh(
             if enf.models.iter().any(|m| m.equation != ENERGY) {
                 return Some("a voltage or species enforcement");
             }
-            let Ok(c) = resolve_for(enf, Some(fields)) else {
+            if resolve_for(enf, Some(fields)).is_err() {
                 return Some("an enforcement with errors");
-            };
-            if c.mortar && !multipliers {
-                return Some("a mortar tie with multipliers (the general solver)");
             }
         }
     }
