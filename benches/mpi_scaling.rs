@@ -26,6 +26,9 @@ use std::process::Command;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::output::exodus::ExodusWriter;
 
+#[path = "common/cut_deck.rs"]
+mod cut_deck;
+
 fn write_case(dir: &Path, cells: usize, k_of_t: bool, tie: Option<&str>) {
     let m2 = (cells as f64 * 0.8).round() as usize;
     let m = generate::boxes(
@@ -50,18 +53,7 @@ fn write_case(dir: &Path, cells: usize, k_of_t: bool, tie: Option<&str>) {
                 .to_string()
         }
     };
-    std::fs::write(
-        dir.join("contact.i"),
-        format!(
-            "begin contact definition cut\n\
-             contact surface a contains surface_3\n\
-             contact surface b contains surface_4\n\
-             begin interaction\n side a a\n side b b\n end\n\
-             begin enforcement\n {enforcement}\n end\n\
-             end\n"
-        ),
-    )
-    .unwrap();
+    std::fs::write(dir.join("contact.i"), cut_deck::cut_deck(&enforcement)).unwrap();
     let (k1, k2) = match k_of_t {
         true => (
             "\"5*(1 + (T - 300)/600)\"",

@@ -25,6 +25,9 @@ use seam::mesh::Mesh;
 use seam::mesh::generate::{self, BoxSpec};
 use seam::output::exodus::ExodusWriter;
 
+#[path = "../benches/common/cut_deck.rs"]
+mod cut_deck;
+
 /// Largest difference allowed, relative to the largest |value| of the serial run: the
 /// serial and the distributed runs solve with different methods (faer's Cholesky, LU or
 /// AMG-CG against MUMPS LU or PETSc's CG + BoomerAMG to 1e-13), which on these systems of up
@@ -412,18 +415,7 @@ fn shrink_fit_conductivity_of_t_and_radiation_equal_serial() {
 /// `enforcement`: the lines of its enforcement block; `solve`: more of `[solve]`.
 /// Side set 5 (side A's box bottom, z = 0) is left for a test to use.
 fn write_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
-    std::fs::write(
-        dir.join("contact.i"),
-        format!(
-            "begin contact definition cut\n\
-             contact surface a contains surface_3\n\
-             contact surface b contains surface_4\n\
-             begin interaction\n side a a\n side b b\n end\n\
-             begin enforcement\n {enforcement}\n end\n\
-             end\n"
-        ),
-    )
-    .unwrap();
+    std::fs::write(dir.join("contact.i"), cut_deck::cut_deck(enforcement)).unwrap();
     write_bar(
         dir,
         &[
