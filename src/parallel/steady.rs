@@ -14,8 +14,9 @@
 //! over the ranks. The increment is solved by PETSc; each rank then gets from their
 //! owners only the values it reads (its elements' dofs, and its points' on both sides:
 //! [`Scatter`]), and the whole solution is gathered once, at the end, for the output.
-//! Mortar ties with multipliers add their rows as [`super::ties`] says. A failure on one rank (an interface model,
-//! a load) is agreed on by every rank before the next collective ([`agreed`](super::session::agreed)).
+//! Mortar ties with multipliers add their rows as [`super::ties`] says. A failure on
+//! one rank (an interface model, a load) is agreed on by every rank before the next
+//! collective ([`agreed`](super::session::agreed)).
 
 use std::time::Instant;
 
@@ -232,7 +233,7 @@ impl<'p> Built<'p> {
             }
             None => None,
         };
-        // Mortar ties' multipliers after the nodes' dofs (steady solves alone).
+        // Mortar ties' multipliers, after the nodes' dofs.
         let mut ties = match iface {
             Some(i) => Ties::new(&world, i, (&mut dofs, field), &mut layout)?,
             None => None,
