@@ -41,6 +41,7 @@ use crate::solve::amg::reuse::{diagonal_of, drifted};
 
 use super::petsc::{Ksp, Mat, Method, PetscError, PetscInt, Split, Vector};
 use super::reuse::Hierarchy;
+use super::rows::ByRows;
 use super::{Solution, System, session};
 
 /// The PETSc objects of one pattern and method.
@@ -49,11 +50,8 @@ struct Kept {
     /// The pattern they were made for (column pointers, row indices of the CSC matrix).
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
-    /// This rank's rows by row: per local row its range in `cols` and `slots`, the
-    /// global column of each entry and where its value sits in the CSC value array.
-    row_ptr: Vec<usize>,
-    cols: Vec<PetscInt>,
-    slots: Vec<usize>,
+    /// This rank's rows, by row (PETSc's numbers are the serial ones).
+    by_rows: ByRows,
     /// The values set last (the whole CSC value array).
     values: Vec<f64>,
     /// The inverse diagonal of the matrix the preconditioner was made for (`None`: an
@@ -153,7 +151,7 @@ impl GeneralSolve {
         // A changed matrix: a new preconditioner, or a Krylov method's kept hierarchy.
         let mut reused = false;
         if kept.values != a.val() {
-            kept.set_values(a, &rows).map_err(failed)?;
+            kept.set_values(a).map_err(failed)?;
             // (No c₀ here: the diagonal's drift stands for it.)
             reused = method != Method::MumpsLu
                 && kept.hierarchy.serves(0.0)
@@ -233,36 +231,17 @@ impl Kept {
         let comm = world.as_raw();
         let n = a.nrows();
         let sym = a.symbolic();
-        let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
-        // This rank's rows, transposed out of the CSC columns (ascending within a row).
+        // This rank's rows, transposed out of the CSC columns.
         let local = rows.len();
-        let mut row_ptr = vec![0usize; local + 1];
-        for &i in row_idx.iter().filter(|i| rows.contains(i)) {
-            row_ptr[i - rows.start + 1] += 1;
-        }
-        for i in 0..local {
-            row_ptr[i + 1] += row_ptr[i];
-        }
-        let mut next = row_ptr[..local].to_vec();
-        let mut cols = vec![0 as PetscInt; row_ptr[local]];
-        let mut slots = vec![0usize; row_ptr[local]];
-        for j in 0..n {
-            let column = col_ptr[j]..col_ptr[j + 1];
-            for (k, &i) in column.clone().zip(&row_idx[column]) {
-                if rows.contains(&i) {
-                    let at = &mut next[i - rows.start];
-                    (cols[*at], slots[*at]) = (j as PetscInt, k);
-                    *at += 1;
-                }
-            }
-        }
+        let identity = |i: usize| i as PetscInt;
+        let by_rows = ByRows::of(sym, &identity, &|i| rows.contains(&i));
         let (mut diagonal, mut off) = (vec![0 as PetscInt; local], vec![0 as PetscInt; local]);
-        for r in 0..local {
-            for &j in &cols[row_ptr[r]..row_ptr[r + 1]] {
-                if rows.contains(&(j as usize)) {
-                    diagonal[r] += 1;
-                } else {
-                    off[r] += 1;
+        for (row, cols, _) in by_rows.rows() {
+            let r = row as usize - rows.start;
+            for &j in cols {
+                match rows.contains(&(j as usize)) {
+                    true => diagonal[r] += 1,
+                    false => off[r] += 1,
                 }
             }
         }
@@ -273,11 +252,9 @@ impl Kept {
         let ksp = Ksp::with_split(comm, &a_petsc, method, tolerance, split.as_ref())?;
         let mut kept = Kept {
             method,
-            col_ptr: col_ptr.to_vec(),
-            row_idx: row_idx.to_vec(),
-            row_ptr,
-            cols,
-            slots,
+            col_ptr: sym.col_ptr().to_vec(),
+            row_idx: sym.row_idx().to_vec(),
+            by_rows,
             values: Vec::new(),
             set_up_for: None,
             hierarchy: Hierarchy::default(),
@@ -286,24 +263,18 @@ impl Kept {
             b,
             x,
         };
-        kept.set_values(a, rows)?;
+        kept.set_values(a)?;
         Ok(kept)
     }
 
     /// `a`'s values into this rank's rows (collective).
-    fn set_values(
-        &mut self,
-        a: &SparseColMat<usize, f64>,
-        rows: &Range<usize>,
-    ) -> Result<(), PetscError> {
+    fn set_values(&mut self, a: &SparseColMat<usize, f64>) -> Result<(), PetscError> {
         let val = a.val();
         let mut buf = Vec::new();
-        for r in 0..rows.len() {
-            let range = self.row_ptr[r]..self.row_ptr[r + 1];
+        for (row, cols, slots) in self.by_rows.rows() {
             buf.clear();
-            buf.extend(self.slots[range.clone()].iter().map(|&k| val[k]));
-            let row = (rows.start + r) as PetscInt;
-            self.a.set_row(row, &self.cols[range], &buf)?;
+            buf.extend(slots.iter().map(|&k| val[k as usize]));
+            self.a.set_row(row, cols, &buf)?;
         }
         self.a.assemble()?;
         self.values.clear();

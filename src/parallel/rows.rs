@@ -401,10 +401,10 @@ pub(super) fn empty_mesh(mesh: &Mesh) -> Mesh {
     }
 }
 
-/// A matrix's entries in column storage over local dofs, listed by PETSc row with the
-/// columns ascending, for [`add_rows`]: PETSc finds each column of a row from the place
-/// of the one before, where entries set a column at a time search every row they touch
-/// anew. Made once per pattern.
+/// A matrix's entries in column storage, listed by PETSc row with the columns ascending,
+/// for [`add_rows`] (and the general solver's rows): PETSc finds each column of a row
+/// from the place of the one before, where entries set a column at a time search every
+/// row they touch anew. Made once per pattern.
 pub(super) struct ByRows {
     /// The PETSc rows that hold entries, and where each row's entries start.
     rows: Vec<PetscInt>,
@@ -415,21 +415,32 @@ pub(super) struct ByRows {
 }
 
 impl ByRows {
+    /// The entries of a matrix over local dofs, by their PETSc rows and columns.
     pub(super) fn new(sym: &faer::sparse::SymbolicSparseColMat<usize>, layout: &Layout) -> ByRows {
+        Self::of(sym.as_ref(), &|i| layout.petsc[i], &|_| true)
+    }
+
+    /// The entries of the rows `keep` accepts, each row and column `i` PETSc's
+    /// `petsc(i)`.
+    pub(super) fn of(
+        sym: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+        petsc: &dyn Fn(usize) -> PetscInt,
+        keep: &dyn Fn(usize) -> bool,
+    ) -> ByRows {
         let (col_ptr, row_idx) = (sym.col_ptr(), sym.row_idx());
         let mut count = vec![0usize; sym.nrows() + 1];
-        for &i in row_idx {
+        for &i in row_idx.iter().filter(|&&i| keep(i)) {
             count[i + 1] += 1;
         }
         for i in 0..sym.nrows() {
             count[i + 1] += count[i];
         }
         let mut at = count.clone();
-        let mut entries = vec![(0 as PetscInt, 0u32); row_idx.len()];
+        let mut entries = vec![(0 as PetscInt, 0u32); count[sym.nrows()]];
         for j in 0..sym.ncols() {
             let slots = col_ptr[j]..col_ptr[j + 1];
-            for (k, &i) in slots.clone().zip(&row_idx[slots]) {
-                entries[at[i]] = (layout.petsc[j], k as u32);
+            for (k, &i) in slots.clone().zip(&row_idx[slots]).filter(|e| keep(*e.1)) {
+                entries[at[i]] = (petsc(j), k as u32);
                 at[i] += 1;
             }
         }
@@ -445,12 +456,21 @@ impl ByRows {
                 continue;
             }
             row.sort_unstable();
-            out.rows.push(layout.petsc[i]);
+            out.rows.push(petsc(i));
             out.cols.extend(row.iter().map(|e| e.0));
             out.slots.extend(row.iter().map(|e| e.1));
             out.start.push(out.cols.len());
         }
         out
+    }
+}
+
+impl ByRows {
+    /// Each row: its PETSc index, its PETSc columns (ascending) and their slots in the
+    /// column storage's values.
+    pub(super) fn rows(&self) -> impl Iterator<Item = (PetscInt, &[PetscInt], &[u32])> {
+        (self.rows.iter().zip(self.start.windows(2)))
+            .map(|(&row, w)| (row, &self.cols[w[0]..w[1]], &self.slots[w[0]..w[1]]))
     }
 }
 
@@ -467,13 +487,13 @@ pub(super) fn add_rows(
     zeros: bool,
 ) -> Result<(), HeatError> {
     let (mut cols, mut vals) = (Vec::new(), Vec::new());
-    for (r, &row) in by.rows.iter().enumerate() {
+    for (row, row_cols, slots) in by.rows() {
         cols.clear();
         vals.clear();
-        for e in by.start[r]..by.start[r + 1] {
-            let v = values[by.slots[e] as usize];
+        for (&c, &k) in row_cols.iter().zip(slots) {
+            let v = values[k as usize];
             if zeros || v != 0.0 {
-                cols.push(by.cols[e]);
+                cols.push(c);
                 vals.push(v);
             }
         }

@@ -277,7 +277,6 @@ impl RowIndex for u32 {
     }
 }
 
-/// A square matrix in column storage, borrowed as its parts.
 /// The diagonal of a square matrix in column storage, rows ascending in each column
 /// (`None`: an entry missing): the distributed general solver's drift test.
 #[cfg(feature = "mpi")]
@@ -292,6 +291,7 @@ pub(crate) fn diagonal_of(a: faer::sparse::SparseColMatRef<'_, usize, f64>) -> O
     .diagonal()
 }
 
+/// A square matrix in column storage, borrowed as its parts.
 #[derive(Clone, Copy)]
 struct Csc<'a, I> {
     n: usize,
