@@ -107,9 +107,19 @@ impl<'a> TimeLoop<'a> {
             && problem.death.is_empty()
     }
 
-    /// Whether one linear steady solve answers the problem ([`linear_steady`]).
+    /// Whether one linear steady solve answers the problem: steady, one field, constant
+    /// materials, a source of x alone, no toggles, no radiation (mortar ties with
+    /// multipliers too, on ranks as serially).
     fn is_linear_steady(&self) -> bool {
-        linear_steady(self.file, self.physics, self.terms.couplings.any_toggle())
+        let physics = self.physics;
+        !self.file.transient
+            && physics.source_of_x_only()
+            && physics.materials.constant().is_some()
+            && physics.field_names.len() == 1
+            && !physics.materials.electric()
+            && !physics.species.any()
+            && !self.terms.couplings.any_toggle()
+            && (self.file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
     }
 
     /// One linear steady solve, by a factorisation or AMG-CG as `linear_solver` and the
@@ -746,18 +756,4 @@ pub(super) fn per_block<T: Clone>(values: &[T], origin: Option<&[usize]>) -> Vec
         Some(origin) => origin.iter().map(|&b| values[b].clone()).collect(),
         None => values.to_vec(),
     }
-}
-
-/// Whether one linear steady solve answers a problem: steady, one field, constant
-/// materials, a source of x alone, no interaction `toggled`, no radiation (mortar ties
-/// with multipliers too, on ranks as serially).
-fn linear_steady(file: &ProblemFile, physics: &Physics<'_>, toggled: bool) -> bool {
-    !file.transient
-        && physics.source_of_x_only()
-        && physics.materials.constant().is_some()
-        && physics.field_names.len() == 1
-        && !physics.materials.electric()
-        && !physics.species.any()
-        && !toggled
-        && (file.problem.bc.iter()).all(|b| b.kind != BcKind::Radiation)
 }
