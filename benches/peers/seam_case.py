@@ -7,11 +7,14 @@ is from the exact answer.
           [0,1]^2 x [0.5,1] (n2 cells per unit length), meshed independently and tied
           at z = 0.5 (`Enforcement for Energy = Tied_Temperature`). T = 1 at z = 0,
           T = 0 at z = 1, sides insulated: exact T = 1 - z.
+  dual  : the tied boxes, tied by a mortar tie with dual Lagrange multipliers
+          (`Enforcement for Energy = Tied Multipliers = Dual`, `Side B Variable
+          Temperature To Temperature`), condensed out: exact T = 1 - z.
   gap   : the same boxes joined by a gap conductance h at z = 0.5 (`Gap_Conductance`,
           constant h); k = 1 in both. T = 1 at z = 0, 0 at z = 1: the flux is
           q = 1 / (1 + 1/h), exact T = 1 - q z below and q (1 - z) above.
 
-usage: seam_case.py tied|gap --n1 120 --n2 80 [--h 10] [--seam target/release/seam]
+usage: seam_case.py tied|dual|gap --n1 120 --n2 80 [--h 10] [--seam target/release/seam]
        [--dir DIR] [--repeat 3]
 
 seam runs `--repeat` times (after the mesh file is written out to disk) and the line
@@ -83,7 +86,7 @@ def mesh(n1, n2):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("case", choices=["tied", "gap"])
+    ap.add_argument("case", choices=["tied", "dual", "gap"])
     ap.add_argument("--n1", type=int, default=12)
     ap.add_argument("--n2", type=int, default=8)
     ap.add_argument("--h", type=float, default=10.0)
@@ -97,8 +100,11 @@ def main():
     m = mesh(a.n1, a.n2)
     write_exodus(os.path.join(wd, "boxes.exo"), "NETCDF4", m)
     gen_s = time.time() - t0
-    enforcement = ("tied_temperature" if a.case == "tied"
-                   else f"gap_conductance\n    gap conductance coefficient = constant h = {a.h!r}")
+    enforcement = {
+        "tied": "tied_temperature",
+        "dual": "tied multipliers = dual\n    side b variable temperature to temperature",
+        "gap": f"gap_conductance\n    gap conductance coefficient = constant h = {a.h!r}",
+    }[a.case]
     with open(os.path.join(wd, "contact.i"), "w") as f:
         f.write("begin contact definition boxes\n"
                 "  contact surface below contains lower_top\n"
@@ -132,7 +138,7 @@ def main():
     k = names.index("temperature") + 1
     t = np.asarray(d.variables[f"vals_nod_var{k}"][-1, :], float)
     z = m["coords"][:, 2]
-    if a.case == "tied":
+    if a.case in ("tied", "dual"):
         exact = 1.0 - z
     else:
         q = 1.0 / (1.0 + 1.0 / a.h)

@@ -192,7 +192,14 @@ pub fn mortar_tie(
                 .collect()
         }
     };
-    let mut entries: BTreeMap<(u32, u32), f64> = BTreeMap::new();
+    // Per multiplier, its row `(dof, C_kd)` in order of first touch: a row holds a few
+    // dozen dofs, so a scan finds an entry sooner than a map of every entry would (11 M
+    // updates at 358 400 points), and each sum runs in point order as before.
+    let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); index.len()];
+    let add = |row: &mut Vec<(u32, f64)>, d: u32, v: f64| match row.iter_mut().find(|e| e.0 == d) {
+        Some(e) => e.1 += v,
+        None => row.push((d, v)),
+    };
     let mut psi_integral = vec![0.0; index.len()];
     let mut side_a = Vec::new();
     let mut side_b = Vec::new();
@@ -249,11 +256,12 @@ pub fn mortar_tie(
             }
             psi_integral[k as usize] += p.weight * psi;
             point_psi.push((at as u32, k, psi));
+            let row = &mut rows[k as usize];
             for j in 0..ea.len {
-                *entries.entry((k, ea.dofs[j])).or_default() += p.weight * psi * ea.n[j];
+                add(row, ea.dofs[j], p.weight * psi * ea.n[j]);
             }
             for j in 0..eb.len {
-                *entries.entry((k, eb.dofs[j])).or_default() -= p.weight * psi * eb.n[j];
+                add(row, eb.dofs[j], -(p.weight * psi * eb.n[j]));
             }
         }
         side_a.extend_from_slice(&ea.dofs[..ea.len]);
@@ -274,10 +282,13 @@ pub fn mortar_tie(
     Ok(MortarTie {
         nodes,
         crosspoints,
-        entries: entries
-            .into_iter()
-            .filter(|(_, v)| *v != 0.0)
-            .map(|((k, d), v)| (k, d, v))
+        entries: (rows.into_iter().enumerate())
+            .flat_map(|(k, mut row)| {
+                row.sort_unstable_by_key(|e| e.0);
+                row.into_iter()
+                    .filter(|e| e.1 != 0.0)
+                    .map(move |(d, v)| (k as u32, d, v))
+            })
             .collect(),
         psi_integral,
         side_a_dofs: side_a,

@@ -17,6 +17,7 @@
 // Index loops mirror the subscripts of the formulas they implement.
 #![allow(clippy::needless_range_loop)]
 
+pub(crate) mod dual;
 pub mod electric;
 pub mod interfaces;
 pub mod kernel;

@@ -15,7 +15,7 @@ use crate::assembly::{Assembler, DofMap, Pattern};
 use crate::mesh::{Mesh, NodeId};
 use crate::solve::{
     AmgCg, AmgOptions, BlockGmres, Cholesky, FineRadius, LinearSolver, Lu, Ordering, SaddleLdlt,
-    apply_dirichlet, apply_dirichlet_mut, apply_dirichlet_parts, spmv, spmv_parts, spmv_ref,
+    apply_dirichlet_mut, apply_dirichlet_parts, spmv_parts, spmv_ref,
 };
 use faer::sparse::{SparseColMat, SparseColMatMut, SparseColMatRef};
 use std::collections::HashSet;
@@ -245,9 +245,14 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         }
     };
     // Mortar ties: multipliers on side-A nodes not constrained already.
+    // Their rows count as assembly.
+    let t = Instant::now();
     let ties = iface.ties().map_err(HeatError::Contact)?;
-    if dual_ties(&ties, iface.is_linear())? {
-        return solve_dual(p, iface, dofs, field, bcs, ties);
+    let ties_s = t.elapsed().as_secs_f64();
+    if super::dual::dual_ties(&ties, iface.is_linear())? {
+        let mut solved = super::dual::solve_dual(p, iface, dofs, field, bcs, ties)?;
+        solved.timing.assembly_s += ties_s;
+        return Ok(solved);
     }
     let mut lambda_first = Vec::with_capacity(ties.len());
     for tie in &ties {
@@ -258,7 +263,10 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     for &(d, g) in &bcs {
         u[d] = g;
     }
-    let mut timing = SolveTiming::default();
+    let mut timing = SolveTiming {
+        assembly_s: ties_s,
+        ..SolveTiming::default()
+    };
     let mut linear = LinearSolves::default();
     let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
 
@@ -439,72 +447,6 @@ pub fn solve_steady(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
         timing,
         linear,
     })
-}
-
-/// Whether the ties are dual ones (condensed in a linear solve); refused mixed with
-/// standard ties or with a temperature-dependent conductance (not `linear`).
-pub(crate) fn dual_ties(ties: &[TieRows], linear: bool) -> Result<bool, HeatError> {
-    if !ties.iter().any(|t| t.dual) {
-        return Ok(false);
-    }
-    if ties.iter().any(|t| !t.dual) || !linear {
-        return Err(HeatError::Contact(
-            "dual mortar ties are condensed in a linear solve: do not mix them with standard ties or temperature-dependent conductances".into(),
-        ));
-    }
-    Ok(true)
-}
-
-/// A dual tie's condensation: per dof, the condensed row `(constant, [(dof,
-/// coefficient)])` of the side-A dofs that carry a multiplier, and the rows' diagonals.
-/// Refused where two condensed rows couple (a side-A face only partly covered by side
-/// B), as the distributed solve (which keeps the multipliers) refuses it too.
-pub(crate) fn dual_condensation(
-    ties: &[TieRows],
-    n: usize,
-) -> Result<(Vec<Condensed>, Vec<f64>), HeatError> {
-    let mut map: Vec<Condensed> = vec![None; n];
-    let mut diag = vec![0.0; n];
-    for tie in ties {
-        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); tie.own.len()];
-        for &(kk, d, c) in &tie.entries {
-            rows[kk].push((d, c));
-        }
-        for (kk, &own) in tie.own.iter().enumerate() {
-            if own == usize::MAX {
-                return Err(HeatError::NoTemperatureField);
-            }
-            let d = rows[kk]
-                .iter()
-                .filter(|(j, _)| *j == own)
-                .map(|(_, c)| c)
-                .sum::<f64>();
-            if d == 0.0 {
-                continue; // a node no point reached: left free
-            }
-            diag[own] = d;
-            let others = rows[kk]
-                .iter()
-                .filter(|(j, _)| *j != own)
-                .map(|&(j, c)| (j, -c / d))
-                .collect();
-            map[own] = Some((tie.rhs[kk] / d, others));
-        }
-    }
-    // Side-A rows of a dual basis reference no other condensed dof (biorthogonality);
-    // a non-negligible one means a face without full overlap.
-    for (i, m) in map.iter().enumerate() {
-        if let Some((_, row)) = m {
-            for &(j, a) in row {
-                if map[j].is_some() && a.abs() > 1e-9 {
-                    return Err(HeatError::Contact(format!(
-                        "dual mortar: the side-A rows of dofs {i} and {j} are coupled ({a:.3e}); a side-A face is only partly covered by side B — use standard multipliers (`Multipliers = Standard`) there"
-                    )));
-                }
-            }
-        }
-    }
-    Ok((map, diag))
 }
 
 /// The steady pattern over `dofs`: the elements, the interface `couplings` and one
@@ -731,162 +673,5 @@ fn solve_amg(
         steps,
         converged: false,
         history: record.history,
-    })
-}
-
-/// A condensed dof's row: its constant and its terms `(dof, coefficient)`.
-type Condensed = Option<(f64, Vec<(usize, f64)>)>;
-
-/// The dual-mortar path: every tie's side-A interface values are condensed out
-/// (`u_A,k = (ΔT ∫ψ_k − Σ_j C_kj u_j) / D_k`, D the diagonal side-A block of C), the
-/// system `Tᵀ K T ũ = Tᵀ (F − K g)` stays symmetric positive definite and is solved by
-/// Cholesky; the multipliers are recovered from the condensed rows.
-fn solve_dual(
-    p: &SteadyProblem<'_>,
-    iface: &dyn Interfaces,
-    dofs: DofMap,
-    field: crate::assembly::FieldId,
-    bcs: Vec<(usize, f64)>,
-    ties: Vec<TieRows>,
-) -> Result<SteadySolution, HeatError> {
-    use faer::sparse::Triplet;
-    let mesh = p.mesh;
-    let n = dofs.len();
-    let mut timing = SolveTiming::default();
-    let t = Instant::now();
-    let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
-    // K and F with the flux-type contact terms (linear: evaluated at u = 0, where the
-    // residual is −F_Γ).
-    let zero = vec![0.0; n];
-    let mut pattern = Pattern::new(mesh, &dofs);
-    let first = pattern
-        .add_couplings(&iface.couplings(&zero, 0.0).map_err(failed)?)?
-        .start;
-    pattern.build()?;
-    let mut asm = Assembler::new(&pattern);
-    p.conduction(&mut asm, mesh, &dofs)?;
-    let mut r_contact = vec![0.0; n];
-    iface
-        .assemble(&zero, 0.0, &mut r_contact, &mut asm, first)
-        .map_err(failed)?;
-    let k = asm.matrix()?;
-    let mut f = asm.rhs();
-    for (fi, ri) in f.iter_mut().zip(&r_contact) {
-        *fi -= ri;
-    }
-    drop(asm);
-    let (map, diag) = dual_condensation(&ties, n)?;
-    let expand = |i: usize| -> Vec<(usize, f64)> {
-        match &map[i] {
-            Some((_, row)) => row
-                .iter()
-                .filter(|(j, _)| map[*j].is_none())
-                .copied()
-                .collect(),
-            None => vec![(i, 1.0)],
-        }
-    };
-    // g: the constant part of u; reduced rhs Tᵀ (F − K g).
-    let mut g = vec![0.0; n];
-    for (i, m) in map.iter().enumerate() {
-        if let Some((c, _)) = m {
-            g[i] = *c;
-        }
-    }
-    let mut kg = vec![0.0; n];
-    spmv(&k, &g, &mut kg);
-    let mut triplets = Vec::with_capacity(k.compute_nnz() * 2);
-    let sym = k.symbolic();
-    let vals = k.val();
-    for j in 0..n {
-        let ej = expand(j);
-        for pos in sym.col_range(j) {
-            let i = sym.row_idx()[pos];
-            let v = vals[pos];
-            for &(a, wa) in &expand(i) {
-                for &(b, wb) in &ej {
-                    triplets.push(Triplet::new(a, b, wa * v * wb));
-                }
-            }
-        }
-    }
-    let mut rhs = vec![0.0; n];
-    for i in 0..n {
-        let r = f[i] - kg[i];
-        for (a, w) in expand(i) {
-            rhs[a] += w * r;
-        }
-    }
-    // Condensed dofs keep an identity row so the reduced matrix stays non-singular.
-    for (i, m) in map.iter().enumerate() {
-        if m.is_some() {
-            triplets.push(Triplet::new(i, i, 1.0));
-            rhs[i] = 0.0;
-        }
-    }
-    let mut reduced = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &triplets)
-        .map_err(|e| HeatError::Contact(format!("reduced system: {e:?}")))?;
-    apply_dirichlet(&mut reduced, &mut rhs, &bcs)?;
-    timing.assembly_s += t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let mut chol = Cholesky::new(Ordering::Metis);
-    chol.sequential = p.reproducible;
-    chol.factor(&reduced)?;
-    timing.factor_s += t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    chol.solve(&mut rhs)?;
-    timing.solve_s += t.elapsed().as_secs_f64();
-    let mut u = rhs;
-    for (i, m) in map.iter().enumerate() {
-        if let Some((c, row)) = m {
-            u[i] = c + row.iter().map(|&(j, a)| a * u[j]).sum::<f64>();
-        }
-    }
-    // Multipliers from the condensed rows: D_k λ_k = −(K u − F)_k.
-    let mut ku = vec![0.0; n];
-    spmv(&k, &u, &mut ku);
-    let lambdas: Vec<Vec<f64>> = ties
-        .iter()
-        .map(|tie| {
-            tie.own
-                .iter()
-                .map(|&d| {
-                    if diag[d] == 0.0 {
-                        0.0
-                    } else {
-                        -(ku[d] - f[d]) / diag[d]
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    let tie_heat = ties
-        .iter()
-        .zip(&lambdas)
-        .map(|(tie, lambda)| tie.heat(lambda))
-        .collect();
-    let heat = iface.heat(&u, 0.0).map_err(failed)?;
-    let temperature = dofs.nodal_values(field, &u);
-    // The multipliers after the primal dofs, as the saddle-point path stores them.
-    let mut dofs = dofs;
-    for lambda in &lambdas {
-        dofs.add_extra(lambda.len());
-        u.extend_from_slice(lambda);
-    }
-    Ok(SteadySolution {
-        crosspoints: ties.iter().map(|t| t.crosspoints.clone()).collect(),
-        dofs,
-        u,
-        temperature,
-        newton_iterations: 1,
-        converged: true,
-        residual_history: Vec::new(),
-        heat,
-        tie_heat,
-        timing,
-        linear: LinearSolves {
-            method: Some(LinearMethod::Cholesky),
-            ..LinearSolves::default()
-        },
     })
 }

@@ -20,8 +20,8 @@ use mpi::topology::SimpleCommunicator;
 
 use crate::assembly::{Assembler, DofMap, FieldId};
 use crate::heat::HeatError;
+use crate::heat::dual::{dual_condensation, dual_ties};
 use crate::heat::interfaces::{Interfaces, TieRows};
-use crate::heat::steady::{dual_condensation, dual_ties};
 use crate::mesh::NodeId;
 
 use super::petsc::PetscInt;

@@ -687,6 +687,9 @@ fn linear_solver_summary(
     use crate::heat::steady::LinearMethod;
     let auto = matches!(requested, None | Some("auto"));
     let why = match linear.method {
+        Some(LinearMethod::AmgCg) if ties => format!(
+            "{n:.1e} unknowns, dual mortar ties condensed to a symmetric positive definite system → AMG-CG"
+        ),
         Some(LinearMethod::AmgCg) => {
             format!("{n:.1e} unknowns, symmetric positive definite → AMG-CG")
         }
@@ -697,9 +700,9 @@ fn linear_solver_summary(
         Some(LinearMethod::Lu) => {
             "a temperature-dependent conductance makes the Jacobian unsymmetric → LU".into()
         }
-        Some(LinearMethod::Cholesky) if ties => {
-            "dual mortar ties condensed to a symmetric positive definite system → Cholesky".into()
-        }
+        Some(LinearMethod::Cholesky) if ties => format!(
+            "{n} unknowns (< {threshold}), dual mortar ties condensed to a symmetric positive definite system → Cholesky"
+        ),
         Some(LinearMethod::Cholesky) => format!("{n} unknowns (< {threshold}) → Cholesky"),
         None => "no linear solve was needed".into(),
     };

@@ -159,11 +159,10 @@ fn amg_can_be_requested_on_a_small_problem() {
     assert!(ls.iterations > 0);
 }
 
-#[test]
-fn multipliers_keep_the_direct_saddle_point_solver() {
-    // The standard Lagrange-multiplier tie of the verification case, its paths made
-    // absolute, above a threshold of one unknown: still LDLᵀ.
-    let case = root().join("tests/cases/two_slab_mortar_lagrange");
+/// The verification case `tests/cases/<case>` run from a scratch folder, its paths made
+/// absolute, no output, with `solve` (key, value) set in its `[solve]` table.
+fn run_case_with(case: &str, tag: &str, solve: &[(&str, toml::Value)]) -> RunResult {
+    let case = root().join("tests/cases").join(case);
     let mut table: toml::Table =
         toml::from_str(&std::fs::read_to_string(case.join("problem.toml")).unwrap()).unwrap();
     let abs =
@@ -172,15 +171,23 @@ fn multipliers_keep_the_direct_saddle_point_solver() {
     mesh["file"] = abs(&mesh["file"]);
     let contact = table["contact"].as_table_mut().unwrap();
     contact["file"] = abs(&contact["file"]);
-    table["solve"]
-        .as_table_mut()
-        .unwrap()
-        .insert("auto_threshold".into(), toml::Value::Integer(1));
+    let table_solve = table["solve"].as_table_mut().unwrap();
+    for (key, value) in solve {
+        table_solve.insert((*key).into(), value.clone());
+    }
     table.remove("output");
-    let dir = crate::scratch("auto-lagrange");
+    let dir = crate::scratch(tag);
     let path = dir.path().join("problem.toml");
     std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
-    let r = run(&path);
+    run(&path)
+}
+
+#[test]
+fn multipliers_keep_the_direct_saddle_point_solver() {
+    // The standard Lagrange-multiplier tie of the verification case above a threshold
+    // of one unknown: still LDLᵀ.
+    let one = ("auto_threshold", toml::Value::Integer(1));
+    let r = run_case_with("two_slab_mortar_lagrange", "auto-lagrange", &[one]);
     let ls = &r.summary.linear_solver;
     assert_eq!(ls.name, "LDLᵀ");
     assert!(
@@ -188,6 +195,52 @@ fn multipliers_keep_the_direct_saddle_point_solver() {
         "{}",
         ls.reason
     );
+}
+
+/// A dual mortar tie is condensed to a symmetric positive definite system, which the
+/// automatic choice solves like any other: by AMG-CG from the threshold (a
+/// factorisation of it at 1.16 M unknowns took minutes), by Cholesky below it. Both
+/// give the case's exact T = z/1.5 and its heat, and the same multipliers.
+#[test]
+fn dual_ties_are_condensed_and_solved_by_amg_above_the_threshold() {
+    let case = "two_slab_mortar_dual";
+    let one = ("auto_threshold", toml::Value::Integer(1));
+    let amg = run_case_with(case, "auto-dual-amg", &[one]);
+    let direct = run_case_with(case, "auto-dual-direct", &[]);
+    let (ls, ld) = (&amg.summary.linear_solver, &direct.summary.linear_solver);
+    assert_eq!((ls.name.as_str(), ld.name.as_str()), ("AMG-CG", "Cholesky"));
+    for reason in [&ls.reason, &ld.reason] {
+        assert!(
+            reason.starts_with("auto: ")
+                && reason.contains("dual mortar ties condensed to a symmetric positive definite"),
+            "{reason}"
+        );
+    }
+    assert!(ls.iterations > 0);
+    for r in [&amg, &direct] {
+        let z = |k: usize| r.mesh.coords[k][2];
+        for (k, t) in r.solution.temperature.iter().enumerate() {
+            assert!(
+                (t - z(k) / 1.5).abs() < 1e-12,
+                "node {k}: {t} against {}",
+                z(k) / 1.5
+            );
+        }
+        let heat = r.summary.interactions[0].heat_side_a;
+        assert!((heat + 1.0 / 1.5).abs() < 1e-12, "{heat}");
+    }
+    // The multipliers, after the temperatures in both.
+    let (ua, ud) = (&amg.solution.u, &direct.solution.u);
+    assert_eq!(ua.len(), ud.len());
+    let n = amg.solution.temperature.len();
+    assert!(ua.len() > n, "no multipliers");
+    for (k, (x, y)) in ua.iter().zip(ud).enumerate().skip(n) {
+        assert!(
+            (x - y).abs() < 1e-10 * max_abs(&ud[n..]),
+            "multiplier {}: {x} against {y}",
+            k - n
+        );
+    }
 }
 
 #[test]
