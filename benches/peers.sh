@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # seam beside CalculiX on the same problems, in one sitting: the tied boxes (CalculiX
 # *TIE against seam's Tied_Temperature) and the boxes joined by a gap conductance h = 10
-# (CalculiX surface-to-surface contact against seam's Gap_Conductance), lower box
+# (CalculiX surface-to-surface contact against seam's Gap_Conductance), and seam's mortar
+# tie with dual multipliers beside the same CalculiX *TIE; lower box
 # n1 and upper box n2 cells per unit length, T = 1 at z = 0 and 0 at z = 1. Both run on
 # one thread with their defaults (CalculiX's iterative solver from 1e5 nodes, where its
 # direct one runs out of memory). Prints, per case, each code's wall time (seam's: the
@@ -43,6 +44,8 @@ for nn in "${sizes[@]}"; do
     target/bench-venv/bin/python benches/peers/seam_case.py tied --n1 "$n1" --n2 "$n2" >> "$out"
     (cd target/peers && CCX_RESULTS="$out" "$PWD/../peers-venv/bin/python" "$peers/case_tie.py" \
         --field z --n1 "$n1" --n2 "$n2" "${solver[@]}" > /dev/null)
+    echo "== dual ${n1}x${n2}" >&2
+    target/bench-venv/bin/python benches/peers/seam_case.py dual --n1 "$n1" --n2 "$n2" >> "$out"
     echo "== gap ${n1}x${n2}" >&2
     target/bench-venv/bin/python benches/peers/seam_case.py gap --n1 "$n1" --n2 "$n2" --h 10 >> "$out"
     (cd target/peers && CCX_RESULTS="$out" "$PWD/../peers-venv/bin/python" "$peers/case_gap.py" \
@@ -61,7 +64,8 @@ for r in rows:
 print(f"{'case':<16}{'nodes':>10}{'seam s':>9}{'ccx s':>9}{'ccx/seam':>9}"
       f"{'seam MiB':>10}{'ccx MiB':>9}{'seam err':>11}{'ccx err':>11}")
 for key, s in seam.items():
-    c = peer.get(key)
+    # The mortar tie with dual multipliers beside the same CalculiX *TIE.
+    c = peer.get(("tied" if key[0] == "dual" else key[0],) + key[1:])
     if c is None:
         continue
     print(f"{key[0] + ' ' + str(key[1]) + 'x' + str(key[2]):<16}{s['nodes']:>10}"
