@@ -610,12 +610,21 @@ fn cut_interface_crosspoints_on_rank_boundaries_equal_serial() {
 /// The cut bar's mortar tie with standard multipliers.
 const STANDARD_TIE: &str = "enforcement for energy = tied multipliers = standard\n side b variable temperature to temperature";
 
-fn cut_interface_multiplier_tie(multipliers: &str) {
-    let tmp = scratch(&format!("cut-tie-{multipliers}"));
+fn cut_interface_multiplier_tie(multipliers: &str, solve: &str, reason: &[&str], held_b: bool) {
+    let tmp = scratch(&format!("cut-tie-{multipliers}-{}-{held_b}", solve.len()));
     let enforcement = format!(
         "enforcement for energy = tied multipliers = {multipliers}\n side b variable temperature to temperature"
     );
-    let problem = write_cut_case(tmp.path(), &enforcement, "");
+    let problem = write_cut_case(tmp.path(), &enforcement, solve);
+    if held_b {
+        // Side B's face held at 450 K: the tie's start is off its constraints.
+        let text = std::fs::read_to_string(&problem).unwrap().replacen(
+            "[[source]]",
+            "[[bc]]\nkind = \"temperature\"\nsurfaces = [\"surface_4\"]\nvalue = 450.0\n[[source]]",
+            1,
+        );
+        std::fs::write(&problem, text).unwrap();
+    }
     let (serial, runs) = compare_runs(&problem, true);
     let heat = serial.summary["interactions"][0]["heat_side_a"]
         .as_f64()
@@ -624,8 +633,8 @@ fn cut_interface_multiplier_tie(multipliers: &str) {
     for par in &runs {
         let why = par.summary["linear_solver"]["reason"].as_str().unwrap();
         assert!(
-            why.contains("mortar ties with Lagrange multipliers") && why.contains("MUMPS"),
-            "the distributed steady solve of the saddle point: {why}"
+            reason.iter().all(|r| why.contains(r)),
+            "the distributed steady solve with {multipliers} multipliers: {why}"
         );
         assert!(
             par.log.contains("distributed set-up on rank 0"),
@@ -644,12 +653,21 @@ fn cut_interface_multiplier_tie(multipliers: &str) {
 
 #[test]
 fn cut_interface_standard_multiplier_tie_equals_serial() {
-    cut_interface_multiplier_tie("standard");
+    let saddle = ["mortar ties with Lagrange multipliers", "MUMPS"];
+    cut_interface_multiplier_tie("standard", "", &saddle, false);
 }
 
+/// A dual tie is condensed on the ranks as serially, its side-A rows summed over the
+/// ranks of its points before each owner makes its rows of the condensation: solved
+/// by CG + BoomerAMG from the threshold (here 1 unknown), MUMPS below it; and with
+/// side B held, so that the solve must start on the tie's constraints.
 #[test]
 fn cut_interface_dual_multiplier_tie_equals_serial() {
-    cut_interface_multiplier_tie("dual");
+    let condensed = ["dual mortar ties condensed", "CG + BoomerAMG"];
+    cut_interface_multiplier_tie("dual", "auto_threshold = 1", &condensed, false);
+    cut_interface_multiplier_tie("dual", "auto_threshold = 1", &condensed, true);
+    let condensed = ["dual mortar ties condensed", "MUMPS"];
+    cut_interface_multiplier_tie("dual", "", &condensed, false);
 }
 
 /// The cut bar's tie with an `Align_Surface` periodicity of side A onto side B besides

@@ -148,6 +148,35 @@ fn record(method: petsc::Method, why: impl Into<std::borrow::Cow<'static, str>>)
     LAST.with(|l| *l.borrow_mut() = Some((method, why.into())));
 }
 
+/// Why the distributed steady solve took `method` for a Jacobian that is `symmetric`
+/// or not, with mortar ties with multipliers (`Some(condensed)`: dual ones condensed)
+/// or without.
+#[cfg(feature = "mpi")]
+fn steady_reason(method: petsc::Method, symmetric: bool, ties: Option<bool>) -> &'static str {
+    use petsc::Method;
+    match (method, symmetric, ties) {
+        (Method::CgAmg, _, Some(_)) => {
+            "dual mortar ties condensed to a symmetric positive definite system, at or above the AMG threshold → CG + BoomerAMG"
+        }
+        (_, true, Some(true)) => {
+            "dual mortar ties condensed to a symmetric positive definite system, below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
+        }
+        (_, _, Some(_)) => {
+            "mortar ties with Lagrange multipliers make the system indefinite → MUMPS LU"
+        }
+        (Method::MumpsLu, true, None) => {
+            "below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
+        }
+        (Method::MumpsLu, false, None) => {
+            "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
+        }
+        (Method::GmresAmg, _, None) => {
+            "a temperature-dependent conductance makes the Jacobian unsymmetric, at or above the AMG threshold → GMRES + BoomerAMG"
+        }
+        _ => "symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG",
+    }
+}
+
 /// This process's rank and the number of ranks, when a run is distributed.
 pub fn world() -> Option<(usize, usize)> {
     #[cfg(feature = "mpi")]

@@ -26,6 +26,11 @@ type Object = *mut c_void;
 const INSERT_VALUES: c_int = 1;
 const ADD_VALUES: c_int = 2;
 const MAT_FINAL_ASSEMBLY: c_int = 0;
+/// `MatReuse`: `MAT_INITIAL_MATRIX`, `MAT_REUSE_MATRIX`.
+const MAT_INITIAL_MATRIX: c_int = 0;
+const MAT_REUSE_MATRIX: c_int = 1;
+/// `MatOption` `MAT_NEW_NONZERO_ALLOCATION_ERR`.
+const MAT_NEW_NONZERO_ALLOCATION_ERR: c_int = 19;
 const NORM_2: c_int = 1;
 /// `KSPNormType` `KSP_NORM_UNPRECONDITIONED`: stop on the true residual ‖b − Ax‖.
 const KSP_NORM_UNPRECONDITIONED: c_int = 2;
@@ -113,6 +118,23 @@ unsafe extern "C" {
         b: Object,
     ) -> PetscErrorCode;
     fn MatMult(mat: Object, x: Object, y: Object) -> PetscErrorCode;
+    fn MatMultTranspose(mat: Object, x: Object, y: Object) -> PetscErrorCode;
+    fn MatPtAP(a: Object, p: Object, reuse: c_int, fill: f64, c: *mut Object) -> PetscErrorCode;
+    fn MatGetRow(
+        mat: Object,
+        row: PetscInt,
+        ncols: *mut PetscInt,
+        cols: *mut *const PetscInt,
+        vals: *mut *const f64,
+    ) -> PetscErrorCode;
+    fn MatRestoreRow(
+        mat: Object,
+        row: PetscInt,
+        ncols: *mut PetscInt,
+        cols: *mut *const PetscInt,
+        vals: *mut *const f64,
+    ) -> PetscErrorCode;
+    fn MatSetOption(mat: Object, option: c_int, flag: c_int) -> PetscErrorCode;
     fn MatDestroy(mat: *mut Object) -> PetscErrorCode;
 
     fn VecCreateMPI(comm: MPI_Comm, n: PetscInt, nn: PetscInt, v: *mut Object) -> PetscErrorCode;
@@ -306,6 +328,74 @@ impl Mat {
     pub fn mult(&self, x: &Vector, y: &mut Vector) -> Result<(), PetscError> {
         // SAFETY: valid handles with the matrix's layout.
         check("MatMult", unsafe { MatMult(self.0, x.0, y.0) })
+    }
+
+    /// `y = Aᵀ x` (collective; the matrix assembled).
+    pub fn mult_transpose(&self, x: &Vector, y: &mut Vector) -> Result<(), PetscError> {
+        // SAFETY: valid handles with the matrix's layout.
+        check("MatMultTranspose", unsafe {
+            MatMultTranspose(self.0, x.0, y.0)
+        })
+    }
+
+    /// `Pᵀ A P` (collective; both assembled, `p` square of `a`'s layout), made anew
+    /// into `out` when it is `None`, else its values made again in place (the same
+    /// patterns).
+    pub fn ptap_into(&self, p: &Mat, out: &mut Option<Mat>) -> Result<(), PetscError> {
+        // SAFETY: valid handles; PETSc writes the product's handle, or reuses it.
+        unsafe {
+            match out {
+                Some(c) => check(
+                    "MatPtAP",
+                    MatPtAP(self.0, p.0, MAT_REUSE_MATRIX, PETSC_DEFAULT, &mut c.0),
+                ),
+                None => {
+                    let mut c: Object = std::ptr::null_mut();
+                    check(
+                        "MatPtAP",
+                        MatPtAP(self.0, p.0, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &mut c),
+                    )?;
+                    *out = Some(Mat(c));
+                    Ok(())
+                }
+            }
+        }
+    }
+
+    /// Row `row`'s stored columns and values (global indices; the row owned here, the
+    /// matrix assembled).
+    pub fn row(&self, row: PetscInt) -> Result<(Vec<PetscInt>, Vec<f64>), PetscError> {
+        let (mut n, mut cols, mut vals) = (0, std::ptr::null(), std::ptr::null());
+        // SAFETY: PETSc lends `n` columns and values until the row is restored; they
+        // are copied first.
+        unsafe {
+            check(
+                "MatGetRow",
+                MatGetRow(self.0, row, &mut n, &mut cols, &mut vals),
+            )?;
+            let n_usize = n as usize;
+            let copied = match n_usize {
+                0 => (Vec::new(), Vec::new()),
+                _ => (
+                    std::slice::from_raw_parts(cols, n_usize).to_vec(),
+                    std::slice::from_raw_parts(vals, n_usize).to_vec(),
+                ),
+            };
+            check(
+                "MatRestoreRow",
+                MatRestoreRow(self.0, row, &mut n, &mut cols, &mut vals),
+            )?;
+            Ok(copied)
+        }
+    }
+
+    /// Let entries beyond the preallocation in (each one found room for at some cost):
+    /// for a matrix whose row lengths only the assembly knows.
+    pub fn allow_new_entries(&mut self) -> Result<(), PetscError> {
+        // SAFETY: a valid matrix; `PETSC_FALSE` is 0.
+        check("MatSetOption", unsafe {
+            MatSetOption(self.0, MAT_NEW_NONZERO_ALLOCATION_ERR, 0)
+        })
     }
 
     /// Add `values[k]` at `(rows[k], col)` (global indices, any rank's rows).
@@ -760,6 +850,14 @@ impl Ksp {
     }
 
     /// The preconditioner or factorisation made (collective).
+    /// Solve with `a` from now on (its preconditioner made again at the next set-up).
+    pub fn set_operators(&mut self, a: &Mat) -> Result<(), PetscError> {
+        // SAFETY: valid handles; PETSc takes its own reference to the matrix.
+        check("KSPSetOperators", unsafe {
+            KSPSetOperators(self.0, a.0, a.0)
+        })
+    }
+
     pub fn set_up(&mut self) -> Result<(), PetscError> {
         // SAFETY: a valid KSP with operators.
         check("KSPSetUp", unsafe { KSPSetUp(self.0) })

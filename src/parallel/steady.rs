@@ -25,6 +25,7 @@ use mpi::topology::SimpleCommunicator;
 use mpi::traits::{AsRaw, Communicator, CommunicatorCollectives};
 
 use crate::assembly::{Assembler, DofMap, Pattern};
+use crate::heat::dual::DUAL_AMG_TOLERANCE;
 use crate::heat::interfaces::InterfaceFailure;
 use crate::heat::law::Law;
 use crate::heat::nonlinear::conduction_at;
@@ -51,6 +52,8 @@ use super::session::{AllPoints, Phases, agreed, refused};
 use super::ties::Ties;
 use super::{Laws, session};
 
+mod condense;
+
 fn petsc_err(e: PetscError) -> HeatError {
     HeatError::Contact(format!("distributed solve: {e}"))
 }
@@ -70,22 +73,8 @@ pub(super) fn solve(p: &SteadyProblem<'_>) -> Result<SteadySolution, HeatError> 
     }
     built.gather(&mut u);
     let (method, symmetric) = (newton.method, newton.symmetric);
-    let why = match (method, symmetric) {
-        _ if built.has_ties() => {
-            "mortar ties with Lagrange multipliers make the system indefinite → MUMPS LU"
-        }
-        (Method::MumpsLu, true) => {
-            "below the AMG threshold (or linear_solver = \"direct\") → MUMPS LU"
-        }
-        (Method::MumpsLu, false) => {
-            "a temperature-dependent conductance makes the Jacobian unsymmetric → MUMPS LU"
-        }
-        (Method::GmresAmg, _) => {
-            "a temperature-dependent conductance makes the Jacobian unsymmetric, at or above the AMG threshold → GMRES + BoomerAMG"
-        }
-        _ => "symmetric positive definite, at or above the AMG threshold → CG + BoomerAMG",
-    };
-    super::record(method, why);
+    let ties = built.has_ties().then_some(newton.condensed.is_some());
+    super::record(method, super::steady_reason(method, symmetric, ties));
     let linear = LinearSolves {
         method: (solved.iterations > 0).then_some(match method {
             Method::CgAmg => LinearMethod::AmgCg,
@@ -581,6 +570,8 @@ pub(super) struct Newton<'b, 'p> {
     diagonal: Vec<(usize, usize)>,
     /// The AMG hierarchy kept across matrices ([`Hierarchy`]).
     hierarchy: Hierarchy,
+    /// Dual ties condensed out of a linear steady solve ([`condense`]).
+    condensed: Option<condense::Condensed>,
 }
 
 impl<'b, 'p> Newton<'b, 'p> {
@@ -608,13 +599,15 @@ impl<'b, 'p> Newton<'b, 'p> {
         let symmetric = built.iface.is_none_or(|i| i.is_linear()) && !built.nonlinear;
         // The serial solvers' choice: AMG-CG, or AMG-GMRES for an unsymmetric Jacobian,
         // from the threshold on; a factorisation below it.
+        let condensed = condense::Condensed::new(built, stepping)?;
         let method = match (symmetric, built.p.iterative) {
-            _ if built.ties.is_some() => Method::MumpsLu,
+            _ if built.ties.is_some() && condensed.is_none() => Method::MumpsLu,
             (true, true) => Method::CgAmg,
             (false, true) => Method::GmresAmg,
             (_, false) => Method::MumpsLu,
         };
         let tolerance = match (method, stepping) {
+            (Method::CgAmg, false) if condensed.is_some() => DUAL_AMG_TOLERANCE,
             (Method::CgAmg, false) => STEADY_AMG_TOLERANCE,
             _ => AMG_TOLERANCE,
         };
@@ -651,6 +644,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             matrix_for: None,
             diagonal,
             hierarchy: Hierarchy::default(),
+            condensed,
         })
     }
 
@@ -715,6 +709,7 @@ impl<'b, 'p> Newton<'b, 'p> {
         let mut cg_iterations = Vec::new();
         let mut last_step = f64::INFINITY;
         let k_sym = &built.k_sym;
+        (self.condensed.as_mut()).map_or(Ok(()), |c| c.start(built, u))?;
         for it in 0..=p.max_iterations {
             let start = Instant::now();
             // R = K u − F (+ m (c₀ u + rest)) + Σ R_Γ: this rank's elements, and its
@@ -821,6 +816,7 @@ impl<'b, 'p> Newton<'b, 'p> {
             self.r_vec
                 .with_local(local_rows, |v| bc_local.iter().for_each(|&i| v[i] = 0.0))
                 .map_err(petsc_err)?;
+            (self.condensed.as_mut()).map_or(Ok(()), |c| c.reduce(&mut self.r_vec, local_rows))?;
             let rn = self.r_vec.norm().map_err(petsc_err)?;
             timing.assembly_s += start.elapsed().as_secs_f64();
             if !rn.is_finite() {
@@ -897,6 +893,7 @@ impl<'b, 'p> Newton<'b, 'p> {
                 }
                 Err(e) => return Err(petsc_err(e)),
             };
+            (self.condensed.as_mut()).map_or(Ok(()), |c| c.expand(&mut self.du_vec, local_rows))?;
             let mine = self
                 .du_vec
                 .with_local(local_rows, |v| v.to_vec())
@@ -908,6 +905,8 @@ impl<'b, 'p> Newton<'b, 'p> {
                 self.hierarchy.solved(its);
             }
         }
+        (self.condensed.as_mut().filter(|_| converged))
+            .map_or(Ok(()), |c| c.multipliers(built, u))?;
         let ties = built.ties.as_ref();
         Ok(Solved {
             converged,
@@ -992,6 +991,9 @@ impl<'b, 'p> Newton<'b, 'p> {
         // matrix has values, and PETSc drops the places its first assembly leaves empty.
         add_rows(&mut self.a, &self.i_rows, &i_values, true)?;
         self.a.assemble().map_err(petsc_err)?;
-        self.a.zero_rows_columns(&built.bc_rows).map_err(petsc_err)
+        self.a
+            .zero_rows_columns(&built.bc_rows)
+            .map_err(petsc_err)?;
+        (self.condensed.as_mut()).map_or(Ok(()), |c| c.set_matrix(&self.a, &mut self.ksp))
     }
 }

@@ -8,11 +8,12 @@
 //! decides on the whole interface, as the serial solve does, and sends every rank,
 //! with each multiplier's number: its place in the serial tie. The multipliers are PETSc
 //! rows after every node's, on the last rank, in the serial order, so the gathered
-//! solution is the serial one's. The saddle point is solved by MUMPS; a dual tie too,
-//! as a saddle point rather than condensed (the same temperatures to round-off: the
-//! condensation is an exact elimination), after the serial solve's checks on its
-//! condensation. A multiplier held at 0 (an empty row, or a tie switched off) gets its
-//! identity row from the last rank, which owns the multipliers and reads their values.
+//! solution is the serial one's. The saddle point is solved by MUMPS. Dual ties pass
+//! the serial solve's checks on their condensation first; in a linear steady solve they
+//! are condensed as serially (`steady::condense`), elsewhere (time steps, laws of T)
+//! solved as a saddle point. A multiplier held at 0 (an empty row, or a tie switched
+//! off) gets its identity row from the last rank, which owns the multipliers and reads
+//! their values.
 
 use std::collections::HashMap;
 
@@ -53,6 +54,12 @@ pub(super) struct Ties {
     crosspoints: Vec<Vec<NodeId>>,
     /// Where the entries' couplings start in the interface pattern.
     slot: usize,
+    /// Every tie is dual (condensed in a linear steady solve: `steady::condense`).
+    dual: bool,
+    /// Per `g` of `rhs`, its multiplier's side-A dof.
+    rhs_side_a: Vec<usize>,
+    /// Every multiplier some point reaches: its side-A node's PETSc row and its dof.
+    carried: Vec<(PetscInt, usize)>,
 }
 
 /// Per tie, rank 0's word on its multipliers: the PETSc index of each multiplier's
@@ -108,6 +115,9 @@ impl Ties {
             empty: Vec::new(),
             crosspoints: whole.iter().map(|t| t.crosspoints.clone()).collect(),
             slot: 0,
+            dual: own.iter().all(|t| t.dual),
+            rhs_side_a: Vec::new(),
+            carried: Vec::new(),
         };
         ties.crosspoints.resize(own.len(), Vec::new());
         for ((share, decided), places) in own.into_iter().zip(&decided).zip(&places) {
@@ -123,6 +133,11 @@ impl Ties {
                 ties.side_a.push(share.own[k]);
             }
             (ties.rhs).extend(at.iter().zip(&share.rhs).map(|(&l, &g)| (l, g)));
+            ties.rhs_side_a.extend_from_slice(&share.own);
+            let mut reached = vec![true; decided.nodes.len()];
+            decided.empty.iter().for_each(|&m| reached[m] = false);
+            let carried = (decided.nodes.iter().enumerate()).filter(|&(m, _)| reached[m]);
+            (ties.carried).extend(carried.map(|(m, &row)| (row, range.start + m)));
             let empty = decided.empty.iter().filter(|_| ties.holder);
             (ties.empty).extend(empty.map(|&m| range.start + m));
             ties.shares.push((share, at));
@@ -189,6 +204,32 @@ impl Ties {
                 asm.add_diagonal(l, 1.0);
             }
         }
+    }
+
+    /// Whether every tie is dual.
+    pub(super) fn dual(&self) -> bool {
+        self.dual
+    }
+
+    /// This rank's entries of `C` by side-A dof: `(side-A dof, primal dof, C)`, a
+    /// multiplier's in a run.
+    pub(super) fn by_side_a(&self) -> impl Iterator<Item = (usize, usize, f64)> + '_ {
+        (self.side_a.iter().zip(&self.entries)).map(|(&a, &(_, d, c))| (a, d, c))
+    }
+
+    /// This rank's `g`s by side-A dof.
+    pub(super) fn g_by_side_a(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        (self.rhs_side_a.iter().zip(&self.rhs)).map(|(&a, &(_, g))| (a, g))
+    }
+
+    /// Every multiplier some point reaches: its side-A node's PETSc row and its dof.
+    pub(super) fn carried(&self) -> &[(PetscInt, usize)] {
+        &self.carried
+    }
+
+    /// Every multiplier's dof.
+    pub(super) fn multiplier_dofs(&self) -> impl Iterator<Item = usize> + '_ {
+        self.multipliers.iter().flat_map(|r| r.clone())
     }
 
     /// How many ties.
