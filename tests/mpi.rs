@@ -1389,6 +1389,29 @@ fn node_surface_side_a_equals_serial() {
     compare(&problem, true);
 }
 
+/// A dual tie from a node surface (`Contact Type = node`, collocated at side A's
+/// nodes): condensed on the ranks as serially, its nodes' rows summed where they are
+/// owned.
+#[test]
+fn node_surface_dual_tie_equals_serial() {
+    let tmp = scratch("cut-node-dual");
+    let problem = write_cut_case(
+        tmp.path(),
+        "enforcement for energy = tied multipliers = dual\n side b variable temperature to temperature",
+        "auto_threshold = 1",
+    );
+    let deck = tmp.path().join("contact.i");
+    let faces = "contact surface a contains surface_3\n";
+    let text = std::fs::read_to_string(&deck).unwrap();
+    let nodes = "begin contact surface a\n surface = surface_3\n contact type = node\n end\n";
+    std::fs::write(&deck, text.replace(faces, nodes)).unwrap();
+    let (_, runs) = compare_runs(&problem, true);
+    for par in &runs {
+        let why = par.summary["linear_solver"]["reason"].as_str().unwrap();
+        assert!(why.contains("dual mortar ties condensed"), "{why}");
+    }
+}
+
 /// Every distributed run solved by `method` (a word of the summary's solver name) in at
 /// most 1.5 times the serial run's Krylov iterations over the run: the distributed
 /// preconditioner as good as seam's own.
