@@ -1361,22 +1361,29 @@ fn crosspoint_of_two_interfaces_on_rank_boundaries_equals_serial() {
     compare(&problem, true);
 }
 
-/// Side A as a node surface (`Contact Type = node`): its points are nodes, owned by the
-/// lowest rank among their elements; the search and the run equal serial.
-#[test]
-fn node_surface_side_a_equals_serial() {
-    let tmp = scratch("cut-node");
-    let problem = write_cut_case(
-        tmp.path(),
-        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
-        "",
-    );
-    let deck = tmp.path().join("contact.i");
+/// [`write_cut_case`] with side A a node surface (`Contact Type = node`).
+fn write_node_cut_case(dir: &Path, enforcement: &str, solve: &str) -> PathBuf {
+    let problem = write_cut_case(dir, enforcement, solve);
+    let deck = dir.join("contact.i");
     let faces = "contact surface a contains surface_3\n";
     let text = std::fs::read_to_string(&deck).unwrap();
     assert!(text.contains(faces), "{text}");
     let nodes = "begin contact surface a\n surface = surface_3\n contact type = node\n end\n";
     std::fs::write(&deck, text.replace(faces, nodes)).unwrap();
+    problem
+}
+
+/// Side A as a node surface (`Contact Type = node`): its points are nodes, owned by the
+/// lowest rank among their elements; the search and the run equal serial.
+#[test]
+fn node_surface_side_a_equals_serial() {
+    let tmp = scratch("cut-node");
+    let problem = write_node_cut_case(
+        tmp.path(),
+        "enforcement for energy = gap_conductance\n gap conductance coefficient = constant h = 2000",
+        "",
+    );
+    let deck = tmp.path().join("contact.i");
     compare_search(&deck, &tmp.path().join("bar.exo"), &[]);
     let points = std::fs::read_to_string(tmp.path().join("points_serial.csv")).unwrap();
     assert!(
@@ -1395,16 +1402,11 @@ fn node_surface_side_a_equals_serial() {
 #[test]
 fn node_surface_dual_tie_equals_serial() {
     let tmp = scratch("cut-node-dual");
-    let problem = write_cut_case(
+    let problem = write_node_cut_case(
         tmp.path(),
         "enforcement for energy = tied multipliers = dual\n side b variable temperature to temperature",
         "auto_threshold = 1",
     );
-    let deck = tmp.path().join("contact.i");
-    let faces = "contact surface a contains surface_3\n";
-    let text = std::fs::read_to_string(&deck).unwrap();
-    let nodes = "begin contact surface a\n surface = surface_3\n contact type = node\n end\n";
-    std::fs::write(&deck, text.replace(faces, nodes)).unwrap();
     let (_, runs) = compare_runs(&problem, true);
     for par in &runs {
         let why = par.summary["linear_solver"]["reason"].as_str().unwrap();
