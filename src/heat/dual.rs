@@ -14,6 +14,7 @@ use std::time::Instant;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
 use crate::assembly::{Assembler, DofMap, FieldId, Pattern};
+use crate::solve::amg::reuse::{Csc, RowIndex};
 use crate::solve::{
     AmgCg, AmgOptions, Cholesky, FineRadius, LinearSolver, Ordering, apply_dirichlet_parts,
 };
@@ -101,35 +102,27 @@ pub(crate) fn dual_condensation(
     Ok((map, diag))
 }
 
-/// A square CSC matrix as its parts: column pointers, 32-bit rows ascending in each
-/// column, values.
-#[derive(Clone, Copy)]
-struct Csc<'a> {
-    col_ptr: &'a [usize],
-    rows: &'a [u32],
-    vals: &'a [f64],
-}
-
-impl Csc<'_> {
-    /// Column `j`'s entries `(row, value)`.
-    fn column(&self, j: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
-        let range = self.col_ptr[j]..self.col_ptr[j + 1];
-        (self.rows[range.clone()].iter().map(|&i| i as usize)).zip(self.vals[range].iter().copied())
-    }
-}
-
 /// The operator `P` of `u = P ũ + c`, read both ways: a dof's free dofs with their
 /// weights (its row of P), and the condensed dofs whose rows name a free dof (its
 /// column of P beyond its own 1).
-struct Condensation<'m> {
-    map: &'m [Condensed],
+pub(crate) struct Condensation {
+    map: Vec<Condensed>,
+    /// Per dof, the diagonal `D_a` of its condensed row (0 on the free dofs).
+    diag: Vec<f64>,
     /// Free dof `j`'s condensed dofs `(a, P_aj)` are `named[start[j]..start[j + 1]]`.
     start: Vec<usize>,
     named: Vec<(usize, f64)>,
 }
 
-impl<'m> Condensation<'m> {
-    fn new(map: &'m [Condensed]) -> Self {
+impl Condensation {
+    /// The condensation of the dual `ties` over the first `n` dofs (the primal ones;
+    /// refused as [`dual_condensation`] refuses).
+    pub(crate) fn of(ties: &[TieRows], n: usize) -> Result<Self, HeatError> {
+        let (map, diag) = dual_condensation(ties, n)?;
+        Ok(Self::new(map, diag))
+    }
+
+    fn new(map: Vec<Condensed>, diag: Vec<f64>) -> Self {
         let free = |j: &&(usize, f64)| map[j.0].is_none();
         let mut start = vec![0usize; map.len() + 1];
         for (_, row) in map.iter().flatten() {
@@ -150,7 +143,12 @@ impl<'m> Condensation<'m> {
                 }
             }
         }
-        Condensation { map, start, named }
+        Condensation {
+            map,
+            diag,
+            start,
+            named,
+        }
     }
 
     /// `f(j, P_ij)` for every free dof `j` of row `i` of P: `i` itself with 1 when it
@@ -174,7 +172,9 @@ impl<'m> Condensation<'m> {
     /// parts. A column away from the ties is K's as it is; the others are summed in a
     /// dense accumulator: `K e_j + Σ_a P_aj K e_a`, each entry's row spread over its
     /// row of P.
-    fn matrix(&self, k: Csc<'_>) -> (Vec<usize>, Vec<u32>, Vec<f64>) {
+    /// K's rows and columns past the first `n` (a saddle point's multipliers) are left
+    /// out.
+    pub(crate) fn matrix<I: RowIndex>(&self, k: Csc<'_, I>) -> (Vec<usize>, Vec<u32>, Vec<f64>) {
         let n = self.map.len();
         let mut col_ptr = Vec::with_capacity(n + 1);
         col_ptr.push(0);
@@ -193,16 +193,16 @@ impl<'m> Condensation<'m> {
             let plain = named.is_empty()
                 && k.rows[range.clone()]
                     .iter()
-                    .all(|&i| self.map[i as usize].is_none());
+                    .all(|&i| i.ix() < n && self.map[i.ix()].is_none());
             if plain {
-                rows.extend_from_slice(&k.rows[range.clone()]);
-                vals.extend_from_slice(&k.vals[range]);
+                rows.extend(k.rows[range.clone()].iter().map(|&i| i.ix() as u32));
+                vals.extend_from_slice(&k.val[range]);
             } else {
-                for (i, v) in k.column(j) {
+                for (i, v) in k.column(j).filter(|&(i, _)| i < n) {
                     self.row(i, |r, w| sum.add(r, w * v));
                 }
                 for &(a, p) in named {
-                    for (i, v) in k.column(a) {
+                    for (i, v) in k.column(a).filter(|&(i, _)| i < n) {
                         self.row(i, |r, w| sum.add(r, w * (p * v)));
                     }
                 }
@@ -213,13 +213,138 @@ impl<'m> Condensation<'m> {
         (col_ptr, rows, vals)
     }
 
-    /// `Pᵀ x` (zero on the condensed dofs).
-    fn transpose_times(&self, x: &[f64]) -> Vec<f64> {
-        let mut y = vec![0.0; x.len()];
-        for (i, &xi) in x.iter().enumerate() {
+    /// `Pᵀ x` over the first `n` dofs (zero on the condensed ones).
+    pub(crate) fn transpose_times(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; self.map.len()];
+        for (i, &xi) in x.iter().enumerate().take(self.map.len()) {
             self.row(i, |j, w| y[j] += w * xi);
         }
         y
+    }
+
+    /// `P x` into the first `n` entries of `y` (whose others are left alone): `x` on the
+    /// free dofs, a condensed dof's terms in them on the others.
+    pub(crate) fn times(&self, x: &[f64], y: &mut [f64]) {
+        for (i, m) in self.map.iter().enumerate() {
+            y[i] = match m {
+                None => x[i],
+                Some((_, row)) => (row.iter())
+                    .filter(|&&(j, _)| self.map[j].is_none())
+                    .map(|&(j, w)| w * x[j])
+                    .sum(),
+            };
+        }
+    }
+
+    /// `u` put on the ties' constraints: each condensed dof set to its row's value,
+    /// `c_a + Σ_j P_aj u_j`.
+    pub(crate) fn constrain(&self, u: &mut [f64]) {
+        for (i, m) in self.map.iter().enumerate() {
+            if let Some((c, row)) = m {
+                u[i] = c + row.iter().map(|&(j, a)| a * u[j]).sum::<f64>();
+            }
+        }
+    }
+
+    /// The multiplier of condensed dof `a` from the residual `r_a` of the primal rows
+    /// at a solution: `λ_a = −r_a / D_a` (0 for a free dof).
+    pub(crate) fn multiplier(&self, a: usize, r_a: f64) -> f64 {
+        match self.diag[a] {
+            0.0 => 0.0,
+            d => -r_a / d,
+        }
+    }
+}
+
+/// A transient run's steps with dual ties condensed: the Newton step `J Δu = −R` of a
+/// symmetric step system solved as `Pᵀ J P Δũ = −Pᵀ R`, `Δu = P Δũ` (the multipliers'
+/// rows and columns of `J` left out), by AMG-CG with its hierarchy kept across steps
+/// as the steps' own; the start put on the ties' constraints first, and the
+/// multipliers recovered from the condensed rows of the residual after the step.
+pub(crate) struct CondensedSteps {
+    condensation: Condensation,
+    amg: AmgCg,
+    values: Vec<f64>,
+}
+
+impl CondensedSteps {
+    /// For the dual `ties` over the first `n` (primal) dofs.
+    pub(crate) fn new(ties: &[TieRows], n: usize) -> Result<Self, HeatError> {
+        Ok(CondensedSteps {
+            condensation: Condensation::of(ties, n)?,
+            // Relative to the step's residual: the steady solve's tolerance.
+            amg: AmgCg::new(AmgOptions {
+                tolerance: super::steady::STEADY_AMG_TOLERANCE,
+                ..AmgOptions::default()
+            }),
+            values: Vec::new(),
+        })
+    }
+
+    /// `u` put on the ties' constraints.
+    pub(crate) fn constrain(&self, u: &mut [f64]) {
+        self.condensation.constrain(u);
+    }
+
+    /// The step of `jac Δu = rhs` (`rhs` on entry, the step on return; the rows `held`
+    /// kept at their values, zero for an increment), condensed: the seconds of the
+    /// condensed matrix and its hierarchy, of the solve, and the CG iterations.
+    pub(crate) fn solve(
+        &mut self,
+        jac: &SparseColMat<usize, f64>,
+        rhs: &mut [f64],
+        held: &[(usize, f64)],
+    ) -> Result<(f64, f64, usize), HeatError> {
+        let t = Instant::now();
+        let s = jac.symbolic();
+        let k = Csc {
+            n: jac.ncols(),
+            col_ptr: s.col_ptr(),
+            rows: s.row_idx(),
+            val: jac.val(),
+        };
+        let (col_ptr, rows, values) = self.condensation.matrix(k);
+        self.values = values;
+        let mut b = self.condensation.transpose_times(rhs);
+        apply_dirichlet_parts(&col_ptr, &rows, &mut self.values, &mut b, held)?;
+        (self.amg).factor_or_refresh_parts(&col_ptr, &rows, &mut self.values)?;
+        let set_up = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let its = self.amg.solve(&mut b)?.iterations;
+        self.amg.note_iterations(its);
+        let n = b.len();
+        self.condensation.times(&b, &mut rhs[..n]);
+        rhs[n..].fill(0.0);
+        Ok((set_up, t.elapsed().as_secs_f64(), its))
+    }
+
+    /// After the step: each multiplier moved by `−r_a / D_a` of its condensed row in
+    /// the residual `r` at `u` (multipliers in `u` after the primal dofs, tie `t`'s from
+    /// `first[t]`), and `r` by `Cᵀ` of that move, so that it is the residual at the new
+    /// multipliers.
+    pub(crate) fn multipliers(
+        &self,
+        ties: &[TieRows],
+        first: &[usize],
+        u: &mut [f64],
+        r: &mut [f64],
+    ) {
+        for (tie, &first) in ties.iter().zip(first) {
+            let step: Vec<f64> = (tie.own.iter())
+                .map(|&a| self.condensation.multiplier(a, r[a]))
+                .collect();
+            for (k, d) in step.iter().enumerate() {
+                u[first + k] += d;
+            }
+            for &(k, j, c) in &tie.entries {
+                r[j] += c * step[k];
+            }
+        }
+    }
+
+    /// The hierarchy's set-ups and refreshes so far.
+    pub(crate) fn reuse_counts(&self) -> (usize, usize) {
+        self.amg.reuse_counts()
     }
 }
 
@@ -278,8 +403,7 @@ pub(super) fn solve_dual(
     let mut linear = LinearSolves::default();
     let t = Instant::now();
     let failed = |e: InterfaceFailure| HeatError::Contact(e.to_string());
-    let (map, diag) = dual_condensation(&ties, n)?;
-    let condensation = Condensation::new(&map);
+    let condensation = Condensation::of(&ties, n)?;
     // K and F with the flux-type contact terms (linear: evaluated at u = 0, where the
     // residual is −F_Γ).
     let zero = vec![0.0; n];
@@ -302,13 +426,14 @@ pub(super) fn solve_dual(
         }
         let vals = asm.take_values()?;
         let k = Csc {
+            n,
             col_ptr,
             rows,
-            vals: &vals,
+            val: &vals,
         };
         // F − K c, c nonzero on the condensed dofs alone; then Pᵀ of it.
         let mut r = f.clone();
-        for (a, m) in map.iter().enumerate() {
+        for (a, m) in condensation.map.iter().enumerate() {
             if let Some((c, _)) = m {
                 for (i, v) in k.column(a) {
                     r[i] -= v * c;
@@ -321,7 +446,7 @@ pub(super) fn solve_dual(
         let mut condensed_rows = Vec::new();
         for j in 0..n {
             for (i, v) in k.column(j) {
-                if map[i].is_some() {
+                if condensation.map[i].is_some() {
                     condensed_rows.push((i, j, v));
                 }
             }
@@ -362,11 +487,7 @@ pub(super) fn solve_dual(
         linear.method = Some(LinearMethod::Cholesky);
     }
     let mut u = rhs;
-    for (i, m) in map.iter().enumerate() {
-        if let Some((c, row)) = m {
-            u[i] = c + row.iter().map(|&(j, a)| a * u[j]).sum::<f64>();
-        }
-    }
+    condensation.constrain(&mut u);
     // Multipliers from the condensed rows: D_a λ_a = −(K u − F)_a.
     let mut ku = vec![0.0; n];
     for &(i, j, v) in &condensed_rows {
@@ -375,10 +496,7 @@ pub(super) fn solve_dual(
     let lambdas: Vec<Vec<f64>> = (ties.iter())
         .map(|tie| {
             (tie.own.iter())
-                .map(|&d| match diag[d] {
-                    0.0 => 0.0,
-                    dd => -(ku[d] - f[d]) / dd,
-                })
+                .map(|&d| condensation.multiplier(d, ku[d] - f[d]))
                 .collect()
         })
         .collect();
@@ -450,11 +568,12 @@ mod tests {
         let mut map: Vec<Condensed> = vec![None; n];
         map[1] = Some((0.5, vec![(4, 0.25), (5, 0.75)]));
         map[3] = Some((-1.0, vec![(0, 2.0)]));
-        let condensation = Condensation::new(&map);
+        let condensation = Condensation::new(map.clone(), vec![0.0; n]);
         let k = Csc {
+            n,
             col_ptr: &col_ptr,
             rows: &rows,
-            vals: &vals,
+            val: &vals,
         };
         let (cp, ri, va) = condensation.matrix(k);
         let mut p = vec![vec![0.0; n]; n];

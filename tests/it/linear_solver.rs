@@ -162,6 +162,16 @@ fn amg_can_be_requested_on_a_small_problem() {
 /// The verification case `tests/cases/<case>` run from a scratch folder, its paths made
 /// absolute, no output, with `solve` (key, value) set in its `[solve]` table.
 fn run_case_with(case: &str, tag: &str, solve: &[(&str, toml::Value)]) -> RunResult {
+    run_case_edited(case, tag, |table| {
+        let table_solve = table["solve"].as_table_mut().unwrap();
+        for (key, value) in solve {
+            table_solve.insert((*key).into(), value.clone());
+        }
+    })
+}
+
+/// [`run_case_with`] with the problem table changed by `edit` instead.
+fn run_case_edited(case: &str, tag: &str, edit: impl FnOnce(&mut toml::Table)) -> RunResult {
     let case = root().join("tests/cases").join(case);
     let mut table: toml::Table =
         toml::from_str(&std::fs::read_to_string(case.join("problem.toml")).unwrap()).unwrap();
@@ -171,10 +181,7 @@ fn run_case_with(case: &str, tag: &str, solve: &[(&str, toml::Value)]) -> RunRes
     mesh["file"] = abs(&mesh["file"]);
     let contact = table["contact"].as_table_mut().unwrap();
     contact["file"] = abs(&contact["file"]);
-    let table_solve = table["solve"].as_table_mut().unwrap();
-    for (key, value) in solve {
-        table_solve.insert((*key).into(), value.clone());
-    }
+    edit(&mut table);
     table.remove("output");
     let dir = crate::scratch(tag);
     let path = dir.path().join("problem.toml");
@@ -237,6 +244,57 @@ fn dual_ties_are_condensed_and_solved_by_amg_above_the_threshold() {
     for (k, (x, y)) in ua.iter().zip(ud).enumerate().skip(n) {
         assert!(
             (x - y).abs() < 1e-10 * max_abs(&ud[n..]),
+            "multiplier {}: {x} against {y}",
+            k - n
+        );
+    }
+}
+
+/// The dual tie's slabs as a transient run (BDF2, from a field off the tie's
+/// constraints): its steps condensed and solved by AMG-CG above the threshold, saddle
+/// points factored below it — the same temperatures and tie heat at every step's end.
+#[test]
+fn transient_dual_ties_are_condensed_above_the_threshold_and_agree_with_ldlt() {
+    let transient = |threshold: i64| {
+        move |table: &mut toml::Table| {
+            let solve: toml::Table = toml::from_str(&format!(
+                "kind = \"transient\"\nscheme = \"bdf2\"\ndt = 0.05\nend_time = 0.5\n\
+                 tolerance = 1e-10\nauto_threshold = {threshold}"
+            ))
+            .unwrap();
+            table.insert("solve".into(), solve.into());
+            let initial: toml::Table = toml::from_str("temperature = \"0.3*x*x + 0.5*z\"").unwrap();
+            table.insert("initial".into(), initial.into());
+            for m in table["material"].as_array_mut().unwrap() {
+                let m = m.as_table_mut().unwrap();
+                m.insert("density".into(), toml::Value::Float(1.0));
+                m.insert("specific_heat".into(), toml::Value::Float(1.0));
+            }
+        }
+    };
+    let case = "two_slab_mortar_dual";
+    let amg = run_case_edited(case, "transient-dual-amg", transient(1));
+    let direct = run_case_edited(case, "transient-dual-direct", transient(1_000_000));
+    assert_eq!(amg.summary.linear_solver.name, "AMG-CG");
+    assert_eq!(direct.summary.linear_solver.name, "direct");
+    assert_eq!(amg.history.len(), direct.history.len());
+    assert!(amg.history.len() >= 10);
+    for (a, d) in amg.history.iter().zip(&direct.history) {
+        let q = d.heat[0].0.abs().max(1e-3);
+        assert!(
+            (a.heat[0].0 - d.heat[0].0).abs() <= AGREE * q,
+            "t = {}: tie heat {} against {}",
+            a.time,
+            a.heat[0].0,
+            d.heat[0].0
+        );
+    }
+    agree_with_cholesky(&amg, &direct);
+    let (ua, ud) = (&amg.solution.u, &direct.solution.u);
+    let n = amg.solution.temperature.len();
+    for (k, (x, y)) in ua.iter().zip(ud).enumerate().skip(n) {
+        assert!(
+            (x - y).abs() < AGREE * max_abs(&ud[n..]),
             "multiplier {}: {x} against {y}",
             k - n
         );

@@ -14,6 +14,7 @@ use faer::sparse::SparseColMat;
 
 use super::setup::Setup;
 use super::{Failure, Loads, StepReport, TransientProblem};
+use crate::heat::dual::CondensedSteps;
 
 /// The time history a step needs.
 pub(super) struct History<'s> {
@@ -46,6 +47,9 @@ pub(super) struct Solvers {
     pub(super) values: Vec<f64>,
     /// Under MPI, the solves by PETSc over every rank in place of the solvers above.
     pub(super) distributed: Option<GeneralSolve>,
+    /// Dual ties condensed out of symmetric step systems from the threshold on; made at
+    /// its first use.
+    pub(super) dual: Option<CondensedSteps>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,6 +80,7 @@ impl Solvers {
             matrix: None,
             values: Vec::new(),
             distributed: crate::parallel::general_solve(),
+            dual: None,
         }
     }
 }
@@ -132,7 +137,8 @@ pub(crate) fn unconverged(iterations: usize, t: f64, history: &[f64]) -> String 
 fn solvers_counts(s: &Solvers) -> (usize, usize) {
     let (a, b) = s.amg.reuse_counts();
     let (c, d) = s.gmres.as_ref().map_or((0, 0), BlockGmres::reuse_counts);
-    (a + c, b + d)
+    let (e, f) = s.dual.as_ref().map_or((0, 0), CondensedSteps::reuse_counts);
+    (a + c + e, b + d + f)
 }
 
 /// The right-hand side `J u + Δb` of a linear step's own system `J x = b`, from its
@@ -248,6 +254,22 @@ impl Context<'_, '_> {
         let large = setup.ties.is_empty() && p.amg_threshold.is_some_and(|k| setup.n >= k);
         let symmetric = linear;
         let amg = large && symmetric;
+        // Dual ties, every one switched on, in a symmetric step system from the
+        // threshold on: condensed, the step starting on their constraints.
+        let dual = symmetric
+            && solvers.distributed.is_none()
+            && !setup.ties.is_empty()
+            && setup.ties.iter().all(|t| t.dual)
+            && p.amg_threshold.is_some_and(|k| setup.n_primal >= k)
+            && (p.interfaces).is_some_and(|i| (0..setup.ties.len()).all(|k| i.tie_on(k, t)));
+        if dual {
+            let steps = match solvers.dual.take() {
+                Some(steps) => steps,
+                None => CondensedSteps::new(&setup.ties, setup.n_primal)?,
+            };
+            steps.constrain(u);
+            solvers.dual = Some(steps);
+        }
         // A linear time step by AMG-CG on one process solves the step's own system
         // `J x = b` from the predictor (below). Its right-hand side is the residual at
         // `u₀`, `u` with every unknown but the held ones set to 0: `R(x) = R(u₀) +
@@ -285,6 +307,9 @@ impl Context<'_, '_> {
             };
             for &(d, _) in &bcs {
                 r[d] = 0.0;
+            }
+            if let Some(steps) = solvers.dual.as_ref().filter(|_| dual && it > 0) {
+                steps.multipliers(&setup.ties, &setup.lambda_first, u, &mut r);
             }
             // (From u₀: replaced by the predictor's residual once the solve has it.)
             let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -373,6 +398,15 @@ impl Context<'_, '_> {
                     let predictor = from_predictor && system == System::Spd;
                     let jac = jac.as_ref().expect("a matrix of its own under MPI");
                     return solve_distributed(d, jac, &mut rhs, predictor.then_some(&*u), system);
+                }
+                if let Some(steps) = solvers.dual.as_mut().filter(|_| dual) {
+                    let jac = jac.as_ref().expect("a step matrix of its own");
+                    let before = steps.reuse_counts();
+                    let solved = steps.solve(jac, &mut rhs, held)?;
+                    let after = steps.reuse_counts();
+                    report.hierarchy_setups += after.0 - before.0;
+                    report.hierarchy_refreshes += after.1 - before.1;
+                    return Ok(solved);
                 }
                 let t0 = std::time::Instant::now();
                 let same = jac.as_ref().and_then(|jac| {

@@ -261,7 +261,7 @@ impl AmgCg {
 }
 
 /// A row index of column storage: faer's 64-bit or a pattern's 32-bit.
-pub(super) trait RowIndex: Copy {
+pub(crate) trait RowIndex: Copy {
     fn ix(self) -> usize;
 }
 
@@ -293,16 +293,22 @@ pub(crate) fn diagonal_of(a: faer::sparse::SparseColMatRef<'_, usize, f64>) -> O
 
 /// A square matrix in column storage, borrowed as its parts.
 #[derive(Clone, Copy)]
-struct Csc<'a, I> {
-    n: usize,
-    col_ptr: &'a [usize],
-    rows: &'a [I],
-    val: &'a [f64],
+pub(crate) struct Csc<'a, I> {
+    pub(crate) n: usize,
+    pub(crate) col_ptr: &'a [usize],
+    pub(crate) rows: &'a [I],
+    pub(crate) val: &'a [f64],
 }
 
 impl<I: RowIndex> Csc<'_, I> {
     fn col(&self, j: usize) -> std::ops::Range<usize> {
         self.col_ptr[j]..self.col_ptr[j + 1]
+    }
+
+    /// Column `j`'s entries `(row, value)`.
+    pub(crate) fn column(&self, j: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let range = self.col(j);
+        (self.rows[range.clone()].iter().map(|&i| i.ix())).zip(self.val[range].iter().copied())
     }
 
     /// The diagonal (`None`: an entry missing).
