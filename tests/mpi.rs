@@ -1140,6 +1140,21 @@ fn cut_interface_adaptive_transient_multiplier_tie_equals_serial() {
     assert_newton_as_serial(&serial, &runs, "mortar ties with Lagrange multipliers");
 }
 
+/// The cut bar stepped by BDF2 across a dual tie above the threshold: serially each
+/// step is condensed and solved by AMG-CG, on the ranks a saddle point by MUMPS — the
+/// same temperatures and tie heats.
+#[test]
+fn cut_interface_transient_dual_tie_equals_serial() {
+    let tmp = scratch("transient_dual_tie");
+    let dual = STANDARD_TIE.replace("multipliers = standard", "multipliers = dual");
+    assert_ne!(dual, STANDARD_TIE);
+    let solve = "scheme = \"bdf2\"\nauto_threshold = 1\n";
+    let (problem, _) = write_transient_cut_case(tmp.path(), &dual, solve, 0.1);
+    let (serial, runs) = compare_runs(&problem, true);
+    assert_eq!(serial.summary["linear_solver"]["name"], "AMG-CG");
+    assert_steps_distributed(&serial, &runs);
+}
+
 /// A steady run across a mortar tie whose conductivities are laws of temperature: one
 /// Newton solve of the saddle point, assembled per rank at every iterate, its stopping
 /// test on the temperatures' size (the serial general solver's), as serially.
