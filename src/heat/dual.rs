@@ -172,6 +172,7 @@ impl Condensation {
     /// parts. A column away from the ties is K's as it is; the others are summed in a
     /// dense accumulator: `K e_j + Σ_a P_aj K e_a`, each entry's row spread over its
     /// row of P.
+    ///
     /// K's rows and columns past the first `n` (a saddle point's multipliers) are left
     /// out.
     pub(crate) fn matrix<I: RowIndex>(&self, k: Csc<'_, I>) -> (Vec<usize>, Vec<u32>, Vec<f64>) {
@@ -225,14 +226,10 @@ impl Condensation {
     /// `P x` into the first `n` entries of `y` (whose others are left alone): `x` on the
     /// free dofs, a condensed dof's terms in them on the others.
     pub(crate) fn times(&self, x: &[f64], y: &mut [f64]) {
-        for (i, m) in self.map.iter().enumerate() {
-            y[i] = match m {
-                None => x[i],
-                Some((_, row)) => (row.iter())
-                    .filter(|&&(j, _)| self.map[j].is_none())
-                    .map(|&(j, w)| w * x[j])
-                    .sum(),
-            };
+        for (i, y) in y.iter_mut().enumerate().take(self.map.len()) {
+            let mut sum = 0.0;
+            self.row(i, |j, w| sum += w * x[j]);
+            *y = sum;
         }
     }
 

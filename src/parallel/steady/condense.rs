@@ -105,10 +105,8 @@ impl Condensed {
         let g_local = g.with_local(local, |v| v.to_vec()).map_err(petsc_err)?;
         // The rows of P: a condensed row's terms in other condensed dofs are left out,
         // as serially (below 1e-9 by rank 0's check of the whole ties).
-        let mut condensed = vec![false; global];
-        ties.carried()
-            .iter()
-            .for_each(|&(row, _)| condensed[row as usize] = true);
+        let mut condensed: Vec<PetscInt> = ties.carried().iter().map(|&(row, _)| row).collect();
+        condensed.sort_unstable();
         let mut p_rows: Vec<(PetscInt, Vec<PetscInt>, Vec<f64>)> = Vec::with_capacity(local);
         let mut own = Vec::new();
         let mut c_at = Vec::new();
@@ -124,7 +122,7 @@ impl Condensed {
             let mut p_cols = vec![row];
             let mut p_vals = vec![0.0];
             for (&j, &v) in cols.iter().zip(&vals) {
-                if j != row && !condensed[j as usize] {
+                if j != row && condensed.binary_search(&j).is_err() {
                     p_cols.push(j);
                     p_vals.push(-v / d);
                 }
