@@ -16,9 +16,10 @@
 //! the conductivities laws of temperature (5 (1 + (T − 300)/600) W/m/K, a Lua
 //! expression, in the first box; a table from 40 to 25 W/m/K over 300–600 K in the
 //! second): one Newton solve, its tangent assembled per rank at every iterate, by GMRES
-//! preconditioned by AMG (serial: seam's, MPI: BoomerAMG). `SEAM_BENCH_TIE=standard` (or
-//! `dual`) joins the boxes by a mortar tie with Lagrange multipliers instead: a saddle
-//! point, factored (serial: LDLᵀ, or the dual tie condensed; MPI: MUMPS LU).
+//! preconditioned by AMG (serial: seam's, MPI: BoomerAMG). `SEAM_BENCH_TIE=standard`
+//! joins the boxes by a mortar tie with Lagrange multipliers instead: a saddle point,
+//! factored (serial: LDLᵀ, MPI: MUMPS LU); `SEAM_BENCH_TIE=dual`, by a tie with dual
+//! multipliers, condensed (serial: AMG-CG, MPI: CG + BoomerAMG from the threshold).
 
 use std::path::Path;
 use std::process::Command;
