@@ -261,7 +261,6 @@ impl Condensation {
 pub(crate) struct CondensedSteps {
     condensation: Condensation,
     amg: AmgCg,
-    values: Vec<f64>,
 }
 
 impl CondensedSteps {
@@ -274,7 +273,6 @@ impl CondensedSteps {
                 tolerance: super::steady::STEADY_AMG_TOLERANCE,
                 ..AmgOptions::default()
             }),
-            values: Vec::new(),
         })
     }
 
@@ -300,11 +298,12 @@ impl CondensedSteps {
             rows: s.row_idx(),
             val: jac.val(),
         };
-        let (col_ptr, rows, values) = self.condensation.matrix(k);
-        self.values = values;
+        // (The values are the hierarchy's after a set-up, and let go after a refresh:
+        // nothing of them is kept between steps.)
+        let (col_ptr, rows, mut values) = self.condensation.matrix(k);
         let mut b = self.condensation.transpose_times(rhs);
-        apply_dirichlet_parts(&col_ptr, &rows, &mut self.values, &mut b, held)?;
-        (self.amg).factor_or_refresh_parts(&col_ptr, &rows, &mut self.values)?;
+        apply_dirichlet_parts(&col_ptr, &rows, &mut values, &mut b, held)?;
+        (self.amg).factor_or_refresh_parts(&col_ptr, &rows, &mut values)?;
         let set_up = t.elapsed().as_secs_f64();
         let t = Instant::now();
         let its = self.amg.solve(&mut b)?.iterations;
